@@ -1,0 +1,186 @@
+#include "derivations.hpp"
+
+#include <fmt/format.h>
+
+namespace wlx::gen {
+
+namespace {
+
+int coordinate_count(const Model& m) { return static_cast<int>(m.coordinates.size()); }
+
+// A column-major Eigen matrix element: "(*{})(r, c)".
+std::string at(int r, int c) { return fmt::format("(*{{}})({}, {})", r, c); }
+std::string at(int r) { return fmt::format("(*{{}})({})", r); }
+std::string at_array(int k, int r, int c) { return fmt::format("(*{{}})[{}]({}, {})", k, r, c); }
+
+const char* kZeroMatrix = "{}->setZero();";
+const char* kZeroArray = "for (auto& m : *{}) m.setZero();";
+
+struct ClosureRow {
+  ex value;
+  std::vector<ex> gradient;
+  ex convective;  // (d/dt dPhi_i/ds) s'
+};
+
+ClosureRow closure_row(const Model& m, const ClosureCondition& c) {
+  const int n = coordinate_count(m);
+  ClosureRow row{0, std::vector<ex>(static_cast<std::size_t>(n), 0), 0};
+  using K = ClosureCondition::Kind;
+  switch (c.kind) {
+    case K::PointEqualsCoordinate: {
+      const Frame& f = m.frame(c.frame);
+      const int k = static_cast<int>(c.axis);
+      row.value = f.r[k] - m.coordinates[static_cast<std::size_t>(c.target)].q;
+      const auto J = linear_jacobian(f, n);
+      for (int j = 0; j < n; ++j) row.gradient[static_cast<std::size_t>(j)] = J[static_cast<std::size_t>(j)][k];
+      row.gradient[static_cast<std::size_t>(c.target)] -= 1;
+      row.convective = f.a_bias[k];
+      break;
+    }
+    case K::AttachedDirectionLevel: {
+      const Frame& f = m.frame(c.frame);
+      const Vec3 u = f.R.col(static_cast<int>(c.axis));
+      const Vec3 up = unit(Axis::Z);
+      row.value = u[2];
+      row.gradient = attached_direction_gradient(f, u, up, n);
+      row.convective = attached_direction_convective(f, u, up);
+      break;
+    }
+    case K::CoordinateSum:
+      for (int k : c.coordinates) {
+        row.value += m.coordinates[static_cast<std::size_t>(k)].q;
+        row.gradient[static_cast<std::size_t>(k)] = 1;
+      }
+      break;
+  }
+  return row;
+}
+
+struct WheelRow {
+  std::vector<ex> C;     // v_W . n_W = C s'
+  std::vector<ex> spin;  // spin rate = spin s'
+  ex convective;         // (d/dt C) s'
+};
+
+WheelRow wheel_row(const Model& m, const NonholonomicWheel& wheel) {
+  const int n = coordinate_count(m);
+  const Frame& f = m.frame(wheel.contact);
+  const Vec3 lateral = f.R.col(static_cast<int>(wheel.lateral));
+  const Vec3 forward = f.R.col(static_cast<int>(wheel.forward));
+  const ex radius = m.parameter(wheel.radius).symbol;
+  const auto J = linear_jacobian(f, n);
+  WheelRow row;
+  for (int j = 0; j < n; ++j) {
+    row.C.push_back(dot(lateral, J[static_cast<std::size_t>(j)]));
+    row.spin.push_back(dot(forward, J[static_cast<std::size_t>(j)]) / radius);
+  }
+  // d/dt(n . v) with zero accelerations: n turns with the contact frame.
+  row.convective = dot(cross(f.omega, lateral), f.v) + dot(lateral, f.a_bias);
+  return row;
+}
+
+}  // namespace
+
+FunctionSpec derive_kinematics(const Model& m) {
+  FunctionSpec fn{"kinematics", "kinematics.hpp",
+                  "Forward kinematics (thesis 3.4): position and orientation in K0 of every frame of "
+                  "interest (index with wlx::gen::frame::...).",
+                  false, {}};
+  OutputSpec pos{"positions", "FramePositions", "frame origins in K0, one column per frame", "", {}};
+  OutputSpec rot{"rotations", "FrameRotations", "frame orientations in K0 (columns: frame axes)", "", {}};
+  for (int k = 0; k < static_cast<int>(m.frames.size()); ++k) {
+    const Frame& f = m.frames[static_cast<std::size_t>(k)].frame;
+    for (int i = 0; i < 3; ++i) pos.elements.emplace_back(at(i, k), f.r[i]);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) rot.elements.emplace_back(at_array(k, i, j), f.R(i, j));
+  }
+  fn.outputs = {pos, rot};
+  return fn;
+}
+
+FunctionSpec derive_closure(const Model& m) {
+  FunctionSpec fn{"closure", "closure.hpp",
+                  "Loop closure (thesis 3.3, MODEL.md 4): Phi(s) and its Jacobian dPhi/ds.", false, {}};
+  OutputSpec phi{"Phi", "ClosureVector", "closure residuals, zero on the constraint manifold", "", {}};
+  OutputSpec jac{"dPhi_ds", "ClosureJacobian", "dPhi/ds, 14 x 32", kZeroMatrix, {}};
+  for (int i = 0; i < static_cast<int>(m.closure.size()); ++i) {
+    const ClosureRow row = closure_row(m, m.closure[static_cast<std::size_t>(i)]);
+    phi.elements.emplace_back(at(i), row.value);
+    for (int j = 0; j < coordinate_count(m); ++j)
+      jac.elements.emplace_back(at(i, j), row.gradient[static_cast<std::size_t>(j)]);
+  }
+  fn.outputs = {phi, jac};
+  return fn;
+}
+
+FunctionSpec derive_nonholonomic(const Model& m) {
+  FunctionSpec fn{"nonholonomic", "nonholonomic.hpp",
+                  "Non-holonomic wheels (thesis 4, MODEL.md 5): rows C(s) with v_W . n_W = C(s) s', and "
+                  "the rolling rows with spin rate = (v_W . e_x,W) / w = spin(s) s'.",
+                  false, {}};
+  OutputSpec C{"C", "WheelRows", "cornering constraint rows, one per wheel (l, r)", kZeroMatrix, {}};
+  OutputSpec spin{"spin", "WheelRows", "wheel spin-rate rows, one per wheel (l, r)", kZeroMatrix, {}};
+  for (int i = 0; i < static_cast<int>(m.wheels.size()); ++i) {
+    const WheelRow row = wheel_row(m, m.wheels[static_cast<std::size_t>(i)]);
+    for (int j = 0; j < coordinate_count(m); ++j) {
+      C.elements.emplace_back(at(i, j), row.C[static_cast<std::size_t>(j)]);
+      spin.elements.emplace_back(at(i, j), row.spin[static_cast<std::size_t>(j)]);
+    }
+  }
+  fn.outputs = {C, spin};
+  return fn;
+}
+
+FunctionSpec derive_convective(const Model& m) {
+  FunctionSpec fn{"convective", "convective.hpp",
+                  "Convective terms (thesis eqs. 6.5-6.7): (d/dt dPhi/ds) s' and (d/dt C) s', i.e. the "
+                  "second time derivatives of Phi and of v_W . n_W with all accelerations zero.",
+                  true, {}};
+  OutputSpec phi{"dPhi_ds_dot_sdot", "ClosureVector", "(d/dt dPhi/ds) s'", "", {}};
+  OutputSpec C{"C_dot_sdot", "WheelVector", "(d/dt C) s', one per wheel (l, r)", "", {}};
+  for (int i = 0; i < static_cast<int>(m.closure.size()); ++i)
+    phi.elements.emplace_back(at(i), closure_row(m, m.closure[static_cast<std::size_t>(i)]).convective);
+  for (int i = 0; i < static_cast<int>(m.wheels.size()); ++i)
+    C.elements.emplace_back(at(i), wheel_row(m, m.wheels[static_cast<std::size_t>(i)]).convective);
+  fn.outputs = {phi, C};
+  return fn;
+}
+
+FunctionSpec derive_bodies(const Model& m) {
+  FunctionSpec fn{"bodies", "bodies.hpp",
+                  "Body kinematics for the dynamics (thesis 6.2-6.3): per body (index with "
+                  "wlx::gen::body::...) the CoM position and orientation in K0, the Jacobians of the CoM "
+                  "velocity and of the angular velocity (both in K0), and their convective terms Jdot s'.",
+                  true, {}};
+  OutputSpec com{"com", "BodyVectors", "CoM positions in K0, one column per body", "", {}};
+  OutputSpec rot{"rotations", "BodyRotations", "body orientations in K0", "", {}};
+  OutputSpec Jv{"Jv", "BodyJacobians", "CoM velocity Jacobians, v = Jv s'", kZeroArray, {}};
+  OutputSpec Jw{"Jw", "BodyJacobians", "angular velocity Jacobians, omega = Jw s'", kZeroArray, {}};
+  OutputSpec Jv_dot{"Jv_dot_sdot", "BodyVectors", "CoM convective accelerations (d/dt Jv) s'", "", {}};
+  OutputSpec Jw_dot{"Jw_dot_sdot", "BodyVectors", "convective angular accelerations (d/dt Jw) s'", "", {}};
+  const int n = coordinate_count(m);
+  for (int k = 0; k < static_cast<int>(m.bodies.size()); ++k) {
+    const Frame& f = m.bodies[static_cast<std::size_t>(k)].com_frame;
+    const auto Lv = linear_jacobian(f, n);
+    const auto Lw = angular_jacobian(f, n);
+    for (int i = 0; i < 3; ++i) {
+      com.elements.emplace_back(at(i, k), f.r[i]);
+      for (int j = 0; j < 3; ++j) rot.elements.emplace_back(at_array(k, i, j), f.R(i, j));
+      for (int j = 0; j < n; ++j) {
+        Jv.elements.emplace_back(at_array(k, i, j), Lv[static_cast<std::size_t>(j)][i]);
+        Jw.elements.emplace_back(at_array(k, i, j), Lw[static_cast<std::size_t>(j)][i]);
+      }
+      Jv_dot.elements.emplace_back(at(i, k), f.a_bias[i]);
+      Jw_dot.elements.emplace_back(at(i, k), f.alpha_bias[i]);
+    }
+  }
+  fn.outputs = {com, rot, Jv, Jw, Jv_dot, Jw_dot};
+  return fn;
+}
+
+std::vector<FunctionSpec> derive_all(const Model& m) {
+  return {derive_kinematics(m), derive_closure(m), derive_nonholonomic(m), derive_convective(m),
+          derive_bodies(m)};
+}
+
+}  // namespace wlx::gen

@@ -1,0 +1,39 @@
+// The derivations, in the order of the thesis chapters: kinematics (3.4), closure (3.3),
+// non-holonomic rows (4, 5), convective terms (6.5-6.7) and body kinematics for the
+// dynamics (6.2-6.3). Each returns the symbolic outputs of one emitted function.
+#pragma once
+
+#include "model.hpp"
+
+#include <string>
+#include <vector>
+
+namespace wlx::gen {
+
+// One output argument of an emitted function: a pointer parameter, filled only when non-null.
+struct OutputSpec {
+  std::string name;
+  std::string type;      // C++ type the pointer points to
+  std::string doc;
+  std::string prologue;  // statement run before the elements are written (zeroing), or empty
+  std::vector<std::pair<std::string, ex>> elements;  // lvalue (with `{}` for the name) -> value
+};
+
+struct FunctionSpec {
+  std::string name;
+  std::string header;  // file name in generated/wlx/gen/
+  std::string doc;
+  bool needs_rates = false;  // takes sdot
+  std::vector<OutputSpec> outputs;
+};
+
+FunctionSpec derive_kinematics(const Model& m);
+FunctionSpec derive_closure(const Model& m);
+FunctionSpec derive_nonholonomic(const Model& m);
+FunctionSpec derive_convective(const Model& m);
+FunctionSpec derive_bodies(const Model& m);
+
+// All of the above, in that order.
+std::vector<FunctionSpec> derive_all(const Model& m);
+
+}  // namespace wlx::gen

@@ -1,0 +1,41 @@
+// Emission of header-only C++ (Eigen fixed-size types only) from derived functions.
+#pragma once
+
+#include "derivations.hpp"
+#include "expr_graph.hpp"
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace wlx::gen {
+
+struct EmitOptions {
+  std::string generator_version;
+  std::string name_space = "wlx::gen";
+  // Parameters replaced by numeric constants (name -> value); empty: all read from Params.
+  std::map<std::string, double> baked;
+};
+
+struct FunctionStats {
+  std::string name;
+  int intermediates = 0;
+  OpCount before_cse;  // the outputs as trees, without any sharing
+  OpCount after_cse;   // what the emitted code evaluates (all outputs requested)
+  double seconds = 0;  // derivation + CSE + printing
+};
+
+struct EmittedFile {
+  std::string path;  // relative to the output root, e.g. "wlx/gen/closure.hpp"
+  std::string text;
+};
+
+// Headers describing the model itself: parameters and coordinate/frame/body names and types.
+std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& opt);
+// One header per derived function; `stats` receives the numbers written into its banner.
+EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOptions& opt, FunctionStats& stats);
+// The umbrella header including everything, with the operation-count table.
+EmittedFile emit_umbrella(const Model& m, const std::vector<FunctionSpec>& fns,
+                          const std::vector<FunctionStats>& stats, const EmitOptions& opt);
+
+}  // namespace wlx::gen

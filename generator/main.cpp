@@ -1,0 +1,112 @@
+// wlx-gen: derives the model's equations with GiNaC and emits header-only C++ into a folder.
+#include "derivations.hpp"
+#include "emit.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#ifndef WLX_VERSION
+#define WLX_VERSION "unknown"
+#endif
+
+namespace fs = std::filesystem;
+using namespace wlx::gen;
+
+namespace {
+
+// Writes only when the content changed, so unchanged headers keep their time stamps.
+bool write_if_changed(const fs::path& path, const std::string& text) {
+  if (std::ifstream in(path, std::ios::binary); in) {
+    std::ostringstream old;
+    old << in.rdbuf();
+    if (old.str() == text) return false;
+  }
+  fs::create_directories(path.parent_path());
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"wlx-gen: derive the excavator's kinematics symbolically and emit C++ headers"};
+  std::string out_dir;
+  std::vector<std::string> bake_args;
+  bool bake_defaults = false, stats_only = false, quiet = false;
+  EmitOptions opt;
+  opt.generator_version = WLX_VERSION;
+  app.add_option("--out", out_dir, "output root; headers go to OUT/wlx/gen/")->required();
+  app.add_option("--bake", bake_args, "bake a parameter in as a constant: NAME=VALUE (repeatable)");
+  app.add_flag("--bake-defaults", bake_defaults, "bake every geometry parameter in at its MODEL.md default");
+  app.add_option("--namespace", opt.name_space, "C++ namespace of the emitted code")->capture_default_str();
+  app.add_flag("--quiet", quiet, "print nothing on success");
+  app.add_flag("--stats", stats_only, "print the operation-count table (always printed unless --quiet)");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Model model = make_excavator_model();
+    if (bake_defaults)
+      for (const char* name : {"cxd", "cyd", "thighD", "legD", "wl", "w"})
+        opt.baked[name] = model.parameter(name).default_value;
+    for (const auto& arg : bake_args) {
+      const auto eq = arg.find('=');
+      if (eq == std::string::npos) throw std::runtime_error("--bake " + arg + ": expected NAME=VALUE");
+      const std::string name = arg.substr(0, eq);
+      model.parameter(name);  // throws with the name when unknown
+      std::size_t used = 0;
+      double value = 0;
+      try {
+        value = std::stod(arg.substr(eq + 1), &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != arg.size() - eq - 1 || !std::isfinite(value))
+        throw std::runtime_error("--bake " + arg + ": value of '" + name + "' is not a finite number");
+      opt.baked[name] = value;
+    }
+
+    std::vector<EmittedFile> files = emit_model_headers(model, opt);
+    const auto t1 = std::chrono::steady_clock::now();
+    std::vector<FunctionSpec> fns;
+    std::vector<FunctionStats> stats;
+    for (auto derive : {derive_kinematics, derive_closure, derive_nonholonomic, derive_convective, derive_bodies}) {
+      const auto d0 = std::chrono::steady_clock::now();
+      fns.push_back(derive(model));
+      const double derive_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
+      FunctionStats s;
+      files.push_back(emit_function(model, fns.back(), opt, s));
+      s.seconds += derive_s;
+      stats.push_back(s);
+    }
+    files.push_back(emit_umbrella(model, fns, stats, opt));
+    int changed = 0;
+    for (const auto& f : files) changed += write_if_changed(fs::path(out_dir) / f.path, f.text);
+    const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!quiet || stats_only) {
+      fmt::print("{:<14} {:>8} {:>12} {:>11} {:>9}\n", "function", "temps", "ops before", "ops after", "seconds");
+      long b = 0, a = 0;
+      for (const auto& s : stats) {
+        fmt::print("{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", s.name, s.intermediates, s.before_cse.total(),
+                   s.after_cse.total(), s.seconds);
+        b += s.before_cse.total();
+        a += s.after_cse.total();
+      }
+      fmt::print("{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", "total", "", b, a, total);
+      fmt::print("model built in {:.3f} s; {} files written to {} ({} changed)\n",
+                 std::chrono::duration<double>(t1 - t0).count(), files.size(), out_dir, changed);
+    }
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "wlx-gen: error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,106 @@
+// The modelling vocabulary of wlx-gen (thesis chapter 2): 3-vectors and rotation matrices over
+// GiNaC expressions, coordinates, and frames that move with the mechanism.
+//
+// A Frame carries, besides its pose in K0, its angular velocity, the velocity of its origin and
+// the acceleration "bias" terms (the accelerations obtained with all coordinate accelerations set
+// to zero), plus the list of joints that move it. Jacobians then follow geometrically
+// (a_k x (p - o_k) for a revolute joint, a_k for a prismatic one) and convective terms
+// Jdot*s' are the propagated bias accelerations: both reuse the forward-kinematics
+// subexpressions instead of differentiating them again.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace wlx::gen {
+
+using GiNaC::ex;
+
+struct Vec3 {
+  std::array<ex, 3> e{0, 0, 0};
+  Vec3() = default;
+  Vec3(ex x, ex y, ex z) : e{std::move(x), std::move(y), std::move(z)} {}
+  ex& operator[](int i) { return e[static_cast<std::size_t>(i)]; }
+  const ex& operator[](int i) const { return e[static_cast<std::size_t>(i)]; }
+};
+
+Vec3 operator+(const Vec3& a, const Vec3& b);
+Vec3 operator-(const Vec3& a, const Vec3& b);
+Vec3 operator*(const ex& s, const Vec3& a);
+ex dot(const Vec3& a, const Vec3& b);
+Vec3 cross(const Vec3& a, const Vec3& b);
+
+struct Mat3 {
+  std::array<ex, 9> e{0, 0, 0, 0, 0, 0, 0, 0, 0};  // row-major
+  ex& operator()(int r, int c) { return e[static_cast<std::size_t>(3 * r + c)]; }
+  const ex& operator()(int r, int c) const { return e[static_cast<std::size_t>(3 * r + c)]; }
+  Vec3 col(int c) const { return {(*this)(0, c), (*this)(1, c), (*this)(2, c)}; }
+  static Mat3 identity();
+};
+
+Mat3 operator*(const Mat3& a, const Mat3& b);
+Vec3 operator*(const Mat3& a, const Vec3& v);
+
+enum class Axis { X = 0, Y = 1, Z = 2 };
+Vec3 unit(Axis axis);
+// Elementary rotation, right-handed: Ry(a)*(1,0,0) = (cos a, 0, -sin a).
+Mat3 rot(Axis axis, const ex& angle);
+
+// One generalized coordinate of the model: a position symbol and its rate symbol.
+struct Coordinate {
+  std::string name;
+  int index = -1;  // position in the coordinate vector s
+  GiNaC::realsymbol q;
+  GiNaC::realsymbol qdot;
+  std::string unit;  // "m" or "rad"
+  std::string meaning;
+};
+
+// A named model parameter (geometry or mass), with its default from MODEL.md.
+struct Parameter {
+  std::string name;
+  double default_value = 0;
+  std::string unit;
+  std::string meaning;
+  GiNaC::realsymbol symbol;
+};
+
+struct JointRecord {
+  int coordinate = -1;
+  bool revolute = true;
+  Vec3 axis;    // unit joint axis in K0
+  Vec3 origin;  // a point on the axis, in K0
+};
+
+class Frame {
+ public:
+  Mat3 R = Mat3::identity();  // orientation in K0
+  Vec3 r;                     // origin in K0
+  Vec3 omega;                 // angular velocity in K0 (in terms of coordinate rates)
+  Vec3 v;                     // origin velocity in K0
+  Vec3 alpha_bias;            // angular acceleration with all coordinate accelerations zero
+  Vec3 a_bias;                // origin acceleration with all coordinate accelerations zero
+  std::vector<JointRecord> joints;  // every joint between K0 and this frame
+
+  static Frame ground() { return {}; }
+  // A rigid offset, given in this frame's coordinates.
+  Frame translated(const Vec3& local_offset) const;
+  // A revolute joint about this frame's `axis`, angle = coordinate.
+  Frame rotated(Axis axis, const Coordinate& c) const;
+  // A prismatic joint along this frame's `axis`, displacement = coordinate.
+  Frame slid(Axis axis, const Coordinate& c) const;
+};
+
+// Jacobian columns of the frame origin's velocity, one per coordinate (n in all).
+std::vector<Vec3> linear_jacobian(const Frame& f, int n);
+// Jacobian columns of the frame's angular velocity.
+std::vector<Vec3> angular_jacobian(const Frame& f, int n);
+// d(e . u)/ds for a unit vector u attached to frame f (fixed in it) and a constant vector e.
+std::vector<ex> attached_direction_gradient(const Frame& f, const Vec3& u, const Vec3& e, int n);
+// (d/dt d(e.u)/ds) s' for the same u and e.
+ex attached_direction_convective(const Frame& f, const Vec3& u, const Vec3& e);
+
+}  // namespace wlx::gen

@@ -1,0 +1,268 @@
+#include "wlx/ik.hpp"
+
+#include "wlx/error.hpp"
+
+#include "wlx/kinematics.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace wlx {
+
+namespace c = gen::coord;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+// Targets this close outside the reach (relative to the reach) are rounding, not user error:
+// they are clamped onto the boundary (straight leg, lever at +-90 deg).
+constexpr double kReachSlack = 1e-12;
+
+double wrap(double a) {
+  a = std::remainder(a, 2 * kPi);
+  return a == -kPi ? kPi : a;
+}
+
+Eigen::Matrix3d cabin_rotation(const Coordinates& s) {
+  const double cy = std::cos(s(c::yaw)), sy = std::sin(s(c::yaw)), cp = std::cos(s(c::pitch)),
+               sp = std::sin(s(c::pitch)), cr = std::cos(s(c::roll)), sr = std::sin(s(c::roll));
+  Eigen::Matrix3d R;
+  R << cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,  //
+      sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,   //
+      -sp, cp * sr, cp * cr;
+  return R;
+}
+
+struct LimbIndices {
+  int side;                // +1 left, -1 right
+  std::array<int, 4> dep;  // dependent joints (3 for legs)
+  int rows;                // first closure row
+  int count;               // 3 or 4
+};
+
+LimbIndices indices(Limb limb) {
+  switch (limb) {
+    case Limb::leg_l: return {1, {c::psi_l2, c::psi_l3, c::psi_l4, -1}, 0, 3};
+    case Limb::leg_r: return {-1, {c::psi_r2, c::psi_r3, c::psi_r4, -1}, 3, 3};
+    case Limb::wheel_l: return {1, {c::theta_l2, c::theta_l3, c::theta_l4, c::theta_l6}, 6, 4};
+    case Limb::wheel_r: return {-1, {c::theta_r2, c::theta_r3, c::theta_r4, c::theta_r6}, 10, 4};
+  }
+  return {};
+}
+
+void require_finite(const Coordinates& s, std::initializer_list<int> coords) {
+  for (int k : coords)
+    if (!std::isfinite(s(k)))
+      throw Error(std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]),
+                  fmt::format("must be a finite number, got {}", s(k)));
+}
+
+void require_cabin_finite(const Coordinates& s) { require_finite(s, {c::x_C, c::y_C, c::z_C, c::yaw, c::pitch, c::roll}); }
+
+// Clamps x into [-1, 1] when it is outside by rounding only.
+bool clamp_unit(double& x) {
+  if (std::abs(x) <= 1) return true;
+  if (std::abs(x) <= 1 + kReachSlack) {
+    x = std::copysign(1.0, x);
+    return true;
+  }
+  return false;
+}
+
+void solve_leg(const Model& model, Limb limb, int branch, Coordinates& s) {
+  const Params& p = model.params();
+  const bool left = limb == Limb::leg_l;
+  const int x_F = left ? c::x_Fl : c::x_Fr, y_F = left ? c::y_Fl : c::y_Fr, z_F = left ? c::z_Fl : c::z_Fr;
+  const int psi1 = left ? c::psi_l1 : c::psi_r1;
+  require_cabin_finite(s);
+  require_finite(s, {x_F, y_F, z_F, psi1});
+  const double side = left ? 1.0 : -1.0;
+  const Eigen::Matrix3d R_C = cabin_rotation(s);
+  const Eigen::Vector3d r_C(s(c::x_C), s(c::y_C), s(c::z_C));
+  const Eigen::Vector3d hip(p.cxd / 2, side * p.cyd / 2, 0);
+  // Foot relative to the hip, in the frame after the hip roll joint Rx(psi_1).
+  const Eigen::Vector3d in_cabin = R_C.transpose() * (Eigen::Vector3d(s(x_F), s(y_F), s(z_F)) - r_C) - hip;
+  const double c1 = std::cos(s(psi1)), s1 = std::sin(s(psi1));
+  const Eigen::Vector3d d(in_cabin.x(), c1 * in_cabin.y() + s1 * in_cabin.z(), -s1 * in_cabin.y() + c1 * in_cabin.z());
+  const double T = p.thighD, L = p.legD, dist = d.norm();
+  const double near = std::abs(T - L), far = T + L;
+  double c4 = (dist * dist - T * T - L * L) / (2 * T * L);
+  if (!clamp_unit(c4))
+    throw Error(std::string(limb_name(limb)),
+                fmt::format("foot is {:.4f} m from the hip, reach is [{:.4f}, {:.4f}] m (|thighD - legD| to thighD + legD)",
+                            dist, near, far));
+  const double psi4 = (branch & 1 ? -1.0 : 1.0) * std::acos(c4);
+  const double a = T + L * std::cos(psi4), b = -L * std::sin(psi4);
+  // d_y = a sin(psi_3); (d_x, d_z) is (a cos(psi_3), b) turned by -psi_2 about y.
+  double s3 = std::abs(a) > 1e-300 ? d.y() / a : 0.0;
+  clamp_unit(s3);  // |d_y| <= |a| holds exactly; this only removes rounding
+  double psi3 = std::asin(s3);
+  if (branch & 2) psi3 = wrap(kPi - psi3);
+  const double k = a * std::cos(psi3);
+  const double psi2 = wrap(std::atan2(b, k) - std::atan2(d.z(), d.x()));
+  const auto idx = indices(limb);
+  s(idx.dep[0]) = psi2;
+  s(idx.dep[1]) = psi3;
+  s(idx.dep[2]) = psi4;
+}
+
+void solve_wheel(const Model& model, Limb limb, int branch, Coordinates& s) {
+  const Params& p = model.params();
+  const bool left = limb == Limb::wheel_l;
+  const int z_W = left ? c::z_Wl : c::z_Wr, th5 = left ? c::theta_l5 : c::theta_r5;
+  require_cabin_finite(s);
+  require_finite(s, {z_W, th5});
+  const double side = left ? 1.0 : -1.0;
+  const Eigen::Matrix3d R_C = cabin_rotation(s);
+  const Eigen::Vector3d g = R_C.row(2).transpose();  // world up, seen from the cabin
+  const double rho = std::hypot(g.x(), g.z());
+  const double phi = std::atan2(g.x(), g.z());
+  // Parallel guidance: theta_4 = -theta_5, so R_10 = Ry(theta_3 + theta_6) =: Ry(sigma).
+  // Level x axis: g . Ry(sigma) e_x = 0  ->  sigma = phi (hub above the contact) or phi + pi.
+  const double sigma = (branch & 4) ? wrap(phi + kPi) : phi;
+  const double m = g.x() * std::sin(sigma) + g.z() * std::cos(sigma);  // +-rho
+  // Level y axis: sin(theta_2) m + g_y cos(theta_2) = 0.
+  double theta2 = std::atan2(-g.y() * (m < 0 ? -1.0 : 1.0), std::abs(m));
+  if (branch & 2) theta2 = wrap(theta2 + kPi);
+  // Contact height: z_C + g.h - w m + wl (-s5 g_y... ) : rho sin(theta_6 - phi) * wl c5 = z_W - centre.
+  const double s5 = std::sin(s(th5)), c5 = std::cos(s(th5));
+  const Eigen::Vector3d h(-p.cxd / 2, side * p.cyd / 2, 0);
+  const double centre = s(c::z_C) + g.dot(h) - p.w * m - p.wl * s5 * g.y();
+  const double half_width = p.wl * std::abs(c5) * rho;
+  double sine = half_width > 0 ? (s(z_W) - centre) / (p.wl * c5 * rho) : 0.0;
+  if (!(half_width > 0) || !clamp_unit(sine)) {
+    const std::string level(gen::kCoordinateNames[static_cast<std::size_t>(z_W)]);
+    throw Error(std::string(limb_name(limb)),
+                fmt::format("ground level {} = {:.4f} m is out of the lever's reach: for this cabin pose and {} = "
+                            "{:.2f} deg the contact point reaches {} in [{:.4f}, {:.4f}] m",
+                            level, s(z_W), gen::kCoordinateNames[static_cast<std::size_t>(th5)],
+                            s(th5) * 180 / kPi, level, centre - half_width, centre + half_width));
+  }
+  double theta6 = phi + std::asin(sine);
+  if (branch & 1) theta6 = phi + kPi - std::asin(sine);
+  theta6 = wrap(theta6);
+  const auto idx = indices(limb);
+  s(idx.dep[0]) = theta2;
+  s(idx.dep[1]) = wrap(sigma - theta6);
+  s(idx.dep[2]) = -s(th5);
+  s(idx.dep[3]) = theta6;
+}
+
+}  // namespace
+
+std::string_view limb_name(Limb limb) noexcept {
+  switch (limb) {
+    case Limb::leg_l: return "left leg";
+    case Limb::leg_r: return "right leg";
+    case Limb::wheel_l: return "left wheel";
+    case Limb::wheel_r: return "right wheel";
+  }
+  return "limb";
+}
+
+void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinates& s) {
+  if (branch < 0 || branch >= branch_count(limb))
+    throw Error("branch", fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, branch));
+  if (limb == Limb::leg_l || limb == Limb::leg_r) solve_leg(model, limb, branch, s);
+  else solve_wheel(model, limb, branch, s);
+}
+
+void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches) {
+  for (Limb limb : kLimbs) solve_limb_closed_form(model, limb, branches.limb[static_cast<std::size_t>(limb)], s);
+}
+
+int classify_branch(const Model& model, Limb limb, const Coordinates& s) {
+  static_cast<void>(model);
+  const auto idx = indices(limb);
+  if (limb == Limb::leg_l || limb == Limb::leg_r)
+    return (s(idx.dep[2]) < 0 ? 1 : 0) | (std::cos(s(idx.dep[1])) < 0 ? 2 : 0);
+  const Eigen::Vector3d g = cabin_rotation(s).row(2).transpose();
+  const double phi = std::atan2(g.x(), g.z());
+  const double theta2 = s(idx.dep[0]), theta3 = s(idx.dep[1]), theta6 = s(idx.dep[3]);
+  const double sigma = theta3 + theta6;
+  const double m = g.x() * std::sin(sigma) + g.z() * std::cos(sigma);
+  return (std::cos(theta6 - phi) < 0 ? 1 : 0) | (std::cos(theta2) < 0 ? 2 : 0) | (m < 0 ? 4 : 0);
+}
+
+NewtonReport solve_ik_newton(const Model& model, Coordinates& s, Data& data, const NewtonOptions& options) {
+  for (int k = 0; k < kCoordinateCount; ++k) require_finite(s, {k});
+  NewtonReport report;
+  std::array<bool, 4> done{false, false, false, false};
+  const auto limb_residual = [&](const gen::ClosureVector& Phi, const LimbIndices& idx) {
+    return Phi.segment(idx.rows, idx.count).cwiseAbs().maxCoeff();
+  };
+  for (int iteration = 0;; ++iteration) {
+    closure(model, s, data, true);
+    if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
+    bool all_done = true;
+    std::array<Eigen::Vector4d, 4> step;
+    std::array<double, 4> before{};
+    for (Limb limb : kLimbs) {
+      const auto l = static_cast<std::size_t>(limb);
+      const auto idx = indices(limb);
+      before[l] = limb_residual(data.Phi, idx);
+      done[l] = before[l] <= options.tolerance;
+      if (done[l]) continue;
+      all_done = false;
+      if (report.iterations[l] >= options.max_iterations)
+        throw Error(std::string(limb_name(limb)),
+                    fmt::format("Newton did not converge in {} iterations (residual {:.3e}, tolerance {:.1e}); the "
+                                "target may be unreachable or the start too far: warm-start from a nearby solution or "
+                                "use the closed form",
+                                options.max_iterations, before[l], options.tolerance));
+      // The limb's block of dPhi/ds: its rows against its own dependent joints.
+      Eigen::Matrix4d J = Eigen::Matrix4d::Identity();
+      Eigen::Vector4d r = Eigen::Vector4d::Zero();
+      for (int i = 0; i < idx.count; ++i) {
+        r(i) = data.Phi(idx.rows + i);
+        for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(idx.rows + i, idx.dep[static_cast<std::size_t>(j)]);
+      }
+      const Eigen::FullPivLU<Eigen::Matrix4d> lu(J);
+      if (lu.rcond() > 1e-12) {
+        step[l] = -lu.solve(r);
+      } else {  // at a singular pose (straight leg, lever at 90 deg): Levenberg-Marquardt step
+        const double mu = 1e-8 * std::max(1.0, J.squaredNorm());
+        step[l] = -(J.transpose() * J + mu * Eigen::Matrix4d::Identity()).ldlt().solve(J.transpose() * r);
+      }
+      ++report.iterations[l];
+    }
+    if (all_done) break;
+    // Damping: halve a limb's step until its residual decreases.
+    std::array<double, 4> lambda{1, 1, 1, 1};
+    std::array<bool, 4> accepted = done;
+    const Coordinates start = s;
+    for (int halving = 0; halving < 40; ++halving) {
+      for (Limb limb : kLimbs) {
+        const auto l = static_cast<std::size_t>(limb);
+        if (accepted[l]) continue;
+        const auto idx = indices(limb);
+        for (int j = 0; j < idx.count; ++j)
+          s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]) + lambda[l] * step[l](j);
+      }
+      if (!options.damped) break;
+      closure(model, s, data, false);
+      bool all_accepted = true;
+      for (Limb limb : kLimbs) {
+        const auto l = static_cast<std::size_t>(limb);
+        if (accepted[l]) continue;
+        const double after = limb_residual(data.Phi, indices(limb));
+        if (after < before[l] || !std::isfinite(before[l])) accepted[l] = true;
+        else lambda[l] *= 0.5;
+        all_accepted = all_accepted && accepted[l];
+      }
+      if (all_accepted) break;
+    }
+  }
+  for (auto& v : s.tail(kDependentCount)) v = wrap(v);
+  closure(model, s, data, false);
+  report.residual = data.Phi.cwiseAbs().maxCoeff();
+  report.converged = true;
+  return report;
+}
+
+}  // namespace wlx

@@ -1,0 +1,13 @@
+#include "wlx/kinematics.hpp"
+
+namespace wlx {
+
+void forward_kinematics(const Model& model, const Coordinates& s, Data& data) noexcept {
+  gen::kinematics(s, model.params(), &data.frame_positions, &data.frame_rotations);
+}
+
+void closure(const Model& model, const Coordinates& s, Data& data, bool with_jacobian) noexcept {
+  gen::closure(s, model.params(), &data.Phi, with_jacobian ? &data.dPhi_ds : nullptr);
+}
+
+}  // namespace wlx

@@ -1,0 +1,62 @@
+// The immutable model (validated parameters and what follows from them) and the preallocated
+// workspace the evaluations write into, in the spirit of Pinocchio's Model / Data split: after
+// a Data is constructed, evaluating the model allocates nothing.
+#pragma once
+
+#include <wlx/gen/all.hpp>
+
+#include <string_view>
+
+namespace wlx {
+
+using gen::Coordinates;
+using gen::Params;
+
+inline constexpr int kCoordinateCount = gen::kCoordinateCount;
+inline constexpr int kInputCount = gen::kInputCount;
+inline constexpr int kDependentCount = gen::kDependentCount;
+
+class Model {
+ public:
+  // Validates every parameter (finite; lengths and masses positive; inertias physical) and
+  // throws wlx::Error naming the first bad one.
+  explicit Model(const Params& params = Params{});
+
+  const Params& params() const noexcept { return params_; }
+  double total_mass() const noexcept { return total_mass_; }
+
+ private:
+  Params params_;
+  double total_mass_ = 0;
+};
+
+// Workspace for one evaluation thread. Fixed-size members only: no heap allocation.
+struct Data {
+  gen::FramePositions frame_positions;
+  gen::FrameRotations frame_rotations;
+  gen::ClosureVector Phi;
+  gen::ClosureJacobian dPhi_ds;
+  gen::WheelRows C;
+  gen::WheelRows spin;
+  gen::ClosureVector dPhi_ds_dot_sdot;
+  gen::WheelVector C_dot_sdot;
+  gen::BodyVectors body_com;
+  gen::BodyRotations body_rotations;
+  gen::BodyJacobians body_Jv;
+  gen::BodyJacobians body_Jw;
+  gen::BodyVectors body_Jv_dot_sdot;
+  gen::BodyVectors body_Jw_dot_sdot;
+};
+
+// Index of a coordinate by its MODEL.md name, or -1.
+int coordinate_index(std::string_view name) noexcept;
+// Index of a frame of interest by name (C, hip_l, F_l, W_r, ...), or -1.
+int frame_index(std::string_view name) noexcept;
+// A pointer to the parameter of that name, or nullptr.
+double* find_param(Params& params, std::string_view name) noexcept;
+
+// The common initial state of the thesis scenarios (MODEL.md section 8): inputs set, dependent
+// joints zero (solve them with the IK).
+Coordinates nominal_inputs();
+
+}  // namespace wlx
