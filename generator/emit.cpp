@@ -261,9 +261,6 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
 
 EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOptions& opt, FunctionStats& stats) {
   const auto start = std::chrono::steady_clock::now();
-  // Symbols: baked parameters become numbers before anything else.
-  GiNaC::exmap bake;
-  for (const auto& [name, value] : opt.baked) bake[m.parameter(name).symbol] = GiNaC::numeric(value);
   ExprGraph g;
   struct Element { std::string lvalue; int id; };
   std::vector<std::vector<Element>> outs;
@@ -271,7 +268,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   for (const auto& o : fn.outputs) {
     std::vector<Element> els;
     for (const auto& [lv, e] : o.elements) {
-      const int id = g.add(bake.empty() ? e : e.subs(bake));
+      const int id = g.add(e);
       if (g.is_zero(id) && !o.prologue.empty()) continue;  // structural zero, written by the prologue
       els.push_back({fmt::format(fmt::runtime(lv), o.name), id});
       roots.push_back(id);
@@ -331,8 +328,15 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
     if (symbols.count(c.name)) aliases += fmt::format("  const double {} = s({});\n", c.name, c.index);
   for (const auto& c : m.coordinates)
     if (symbols.count(c.name + "_dot")) aliases += fmt::format("  const double {}_dot = sdot({});\n", c.name, c.index);
-  for (const auto& par : m.parameters)
-    if (symbols.count(par.name)) aliases += fmt::format("  const double {0} = p.{0};\n", par.name);
+  // Baked parameters become compile-time constants: the expression structure stays the symbolic
+  // one (GiNaC would distribute numeric factors over sums), and the compiler folds the numbers.
+  for (const auto& par : m.parameters) {
+    if (!symbols.count(par.name)) continue;
+    if (auto it = opt.baked.find(par.name); it != opt.baked.end())
+      aliases += fmt::format("  constexpr double {} = {};\n", par.name, literal(it->second));
+    else
+      aliases += fmt::format("  const double {0} = p.{0};\n", par.name);
+  }
 
   std::string t = banner(m, opt, fmt::format("{}: {}", fn.name, fn.doc));
   t += "#pragma once\n\n#include <cmath>\n\n#include \"params.hpp\"\n#include \"types.hpp\"\n\n" + namespace_open(opt) + "\n";

@@ -1,0 +1,31 @@
+// `wlx-gen --bake-defaults` output (built into the build tree in namespace wlx::baked) computes
+// the same as the committed symbolic headers at the default parameters.
+#include "../support/random.hpp"
+
+#include <doctest/doctest.h>
+#include <wlx/gen/all.hpp>
+#include WLX_BAKED_ALL
+
+TEST_CASE("baked parameters: same results as the symbolic headers at MODEL.md's defaults") {
+  std::mt19937_64 rng(40);
+  const wlx::gen::Params p;
+  wlx::baked::Params ignored;
+  ignored.cxd = ignored.cyd = ignored.thighD = ignored.legD = ignored.wl = ignored.w = 123.0;  // must not matter
+  double worst = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const wlx::gen::Coordinates s = wlx::test::random_coordinates(rng), sdot = wlx::test::random_rates(rng);
+    wlx::gen::ClosureJacobian J1, J2;
+    wlx::gen::ClosureVector c1, c2;
+    wlx::gen::BodyJacobians Jv1, Jv2;
+    wlx::gen::closure(s, p, nullptr, &J1);
+    wlx::baked::closure(s, ignored, nullptr, &J2);
+    wlx::gen::convective(s, sdot, p, &c1, nullptr);
+    wlx::baked::convective(s, sdot, ignored, &c2, nullptr);
+    wlx::gen::bodies(s, sdot, p, nullptr, nullptr, &Jv1, nullptr, nullptr, nullptr);
+    wlx::baked::bodies(s, sdot, ignored, nullptr, nullptr, &Jv2, nullptr, nullptr, nullptr);
+    worst = std::max({worst, (J1 - J2).cwiseAbs().maxCoeff(), (c1 - c2).cwiseAbs().maxCoeff()});
+    for (int b = 0; b < wlx::gen::kBodyCount; ++b) worst = std::max(worst, (Jv1[b] - Jv2[b]).cwiseAbs().maxCoeff());
+  }
+  // Constant folding may round 0.5*cxd differently from a run-time product: a few ulps.
+  CHECK(worst <= 1e-12);
+}
