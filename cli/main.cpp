@@ -1,4 +1,6 @@
 // wlx: the command-line tool over the runtime.
+#include "commands.hpp"
+
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -10,12 +12,14 @@
 #include <cmath>
 #include <iostream>
 
-namespace {
+namespace wlx::cli {
 
-using namespace wlx;
+namespace {
 
 // Rounding residue such as -1e-17 would print as "-0.0000" in a table.
 double tidy(double v) { return std::abs(v) < 5e-13 ? 0.0 : v; }
+
+}  // namespace
 
 // `wlx fk`: the nominal pose of MODEL.md section 8, dependent joints by closed-form IK, and the
 // forward kinematics of every frame of interest.
@@ -51,7 +55,7 @@ int run_fk(bool as_json) {
   return 0;
 }
 
-}  // namespace
+}  // namespace wlx::cli
 
 int main(int argc, char** argv) {
   CLI::App app{"wlx: kinematics and dynamics of the walking excavator, from generated closed-form code"};
@@ -59,9 +63,25 @@ int main(int argc, char** argv) {
   bool fk_json = false;
   auto* fk = app.add_subcommand("fk", "forward kinematics of the nominal pose (MODEL.md section 8)");
   fk->add_flag("--json", fk_json, "print JSON instead of a table");
+
+  bool batch = false;
+  auto* ik = app.add_subcommand("ik", "inverse kinematics: one JSON object of inputs on stdin, one JSON object out");
+  ik->add_flag("--batch", batch, "NDJSON: one object per line in, one per line out (Newton warm-starts along the lines)");
+
+  auto* verify = app.add_subcommand("verify", "the thesis' verifications");
+  verify->require_subcommand(1);
+  std::string ik_out = "out/verify-ik";
+  std::vector<std::string> sweep_ids;
+  auto* verify_ik = verify->add_subcommand("ik", "the 12 IK sweeps of MODEL.md section 8, closed form and Newton");
+  verify_ik->add_option("--out", ik_out, "folder for one CSV per sweep")->capture_default_str();
+  verify_ik->add_option("--sweep", sweep_ids, "only these sweeps (IK-L1, ..., IK-WR2)");
+
   CLI11_PARSE(app, argc, argv);
+  using namespace wlx::cli;
   try {
     if (fk->parsed()) return run_fk(fk_json);
+    if (ik->parsed()) return run_ik(batch);
+    if (verify_ik->parsed()) return run_verify_ik(ik_out, sweep_ids);
   } catch (const wlx::Error& e) {
     fmt::print(stderr, "wlx: error: {}\n", e.what());
     return 2;

@@ -1,0 +1,133 @@
+#include "input.hpp"
+
+#include <fmt/format.h>
+#include <wlx/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace wlx::cli {
+
+namespace {
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) == std::tolower(static_cast<unsigned char>(b[j - 1]));
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::vector<std::string> input_names() {
+  std::vector<std::string> v;
+  for (int k = 0; k < kInputCount; ++k) v.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+  return v;
+}
+
+std::vector<std::string> dependent_names() {
+  std::vector<std::string> v;
+  for (int k = kInputCount; k < kCoordinateCount; ++k) v.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+  return v;
+}
+
+std::string type_name(const nlohmann::json& v) { return v.type_name(); }
+
+}  // namespace
+
+std::string nearest(const std::string& key, const std::vector<std::string>& valid) {
+  std::string best;
+  std::size_t best_d = std::max<std::size_t>(2, key.size() / 3) + 1;
+  for (const auto& v : valid) {
+    const std::size_t d = edit_distance(key, v);
+    if (d < best_d) {
+      best_d = d;
+      best = v;
+    }
+  }
+  return best;
+}
+
+void reject_unknown_keys(const nlohmann::json& object, const std::vector<std::string>& valid, const std::string& where) {
+  for (const auto& [key, value] : object.items()) {
+    if (std::find(valid.begin(), valid.end(), key) != valid.end()) continue;
+    const std::string hint = nearest(key, valid);
+    throw Error(where + key, hint.empty() ? "unknown key" : fmt::format("unknown key; did you mean '{}'?", hint));
+  }
+}
+
+double finite_number(const nlohmann::json& value, const std::string& key) {
+  if (!value.is_number())
+    throw Error(key, fmt::format("must be a number, got {} {}", type_name(value), value.dump()));
+  const double v = value.get<double>();
+  if (!std::isfinite(v)) throw Error(key, fmt::format("must be a finite number, got {}", v));
+  return v;
+}
+
+Params parse_params(const nlohmann::json& object, Params params) {
+  if (!object.is_object()) throw Error("params", fmt::format("must be an object, got {}", type_name(object)));
+  std::vector<std::string> names;
+  for (const auto& info : gen::kParamInfo) names.emplace_back(info.name);
+  reject_unknown_keys(object, names, "params.");
+  for (const auto& [key, value] : object.items()) *find_param(params, key) = finite_number(value, "params." + key);
+  try {
+    Model check(params);
+  } catch (const Error& e) {
+    throw Error("params." + e.field(), std::string(e.what()).substr(e.field().size() + 2));
+  }
+  return params;
+}
+
+IkRequest parse_ik_request(const nlohmann::json& j) {
+  if (!j.is_object()) throw Error("", fmt::format("expected a JSON object, got {}", type_name(j)));
+  auto valid = input_names();
+  for (const char* k : {"params", "method", "branch", "start"}) valid.emplace_back(k);
+  reject_unknown_keys(j, valid, "");
+  IkRequest r;
+  r.s = nominal_inputs();
+  for (int k = 0; k < kInputCount; ++k) {
+    const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+    if (j.contains(name)) r.s(k) = finite_number(j.at(name), name);
+  }
+  if (j.contains("params")) r.params = parse_params(j.at("params"));
+  if (j.contains("method")) {
+    const auto& m = j.at("method");
+    if (m == "closed-form") r.method = IkMethod::closed_form;
+    else if (m == "newton") r.method = IkMethod::newton;
+    else throw Error("method", fmt::format("must be \"closed-form\" or \"newton\", got {}", m.dump()));
+  }
+  if (j.contains("branch")) {
+    const auto& b = j.at("branch");
+    const auto set = [&](Limb limb, const nlohmann::json& v, const std::string& key) {
+      if (!v.is_number_integer()) throw Error(key, fmt::format("must be an integer, got {}", v.dump()));
+      const int n = v.get<int>();
+      if (n < 0 || n >= branch_count(limb))
+        throw Error(key, fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, n));
+      r.branches.limb[static_cast<std::size_t>(limb)] = n;
+    };
+    const std::vector<std::string> limbs = {"leg_l", "leg_r", "wheel_l", "wheel_r"};
+    if (b.is_object()) {
+      reject_unknown_keys(b, limbs, "branch.");
+      for (std::size_t k = 0; k < limbs.size(); ++k)
+        if (b.contains(limbs[k])) set(kLimbs[k], b.at(limbs[k]), "branch." + limbs[k]);
+    } else {
+      for (Limb limb : kLimbs) set(limb, b, "branch");
+    }
+  }
+  if (j.contains("start")) {
+    const auto& st = j.at("start");
+    if (!st.is_object()) throw Error("start", fmt::format("must be an object of dependent joints, got {}", type_name(st)));
+    reject_unknown_keys(st, dependent_names(), "start.");
+    for (const auto& [key, value] : st.items()) r.start.emplace_back(coordinate_index(key), finite_number(value, "start." + key));
+  }
+  return r;
+}
+
+}  // namespace wlx::cli

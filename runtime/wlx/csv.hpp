@@ -1,0 +1,48 @@
+// A CSV writer for results: full double precision, and never a NaN or Inf in a file.
+#pragma once
+
+#include "wlx/error.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace wlx {
+
+class CsvWriter {
+ public:
+  CsvWriter(const std::string& path, const std::vector<std::string>& header) : path_(path), columns_(header.size()) {
+    file_ = std::fopen(path.c_str(), "w");
+    if (file_ == nullptr) throw Error(path, "cannot open for writing");
+    std::string line;
+    for (const auto& h : header) line += (line.empty() ? "" : ",") + h;
+    fmt::print(file_, "{}\n", line);
+    header_ = header;
+  }
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+  ~CsvWriter() {
+    if (file_ != nullptr) std::fclose(file_);
+  }
+
+  // One row; a non-finite value is an error naming its column, and nothing of the row is written.
+  void row(const std::vector<double>& values) {
+    if (values.size() != columns_) throw Error(path_, fmt::format("row has {} values for {} columns", values.size(), columns_));
+    for (std::size_t k = 0; k < values.size(); ++k)
+      if (!std::isfinite(values[k])) throw Error(header_[k], fmt::format("non-finite value {} not written to {}", values[k], path_));
+    std::string line;
+    for (std::size_t k = 0; k < values.size(); ++k) line += (k == 0 ? "" : ",") + fmt::format("{:.17g}", values[k]);
+    fmt::print(file_, "{}\n", line);
+  }
+
+ private:
+  std::string path_;
+  std::size_t columns_;
+  std::vector<std::string> header_;
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace wlx

@@ -1,0 +1,64 @@
+// The thesis' verification of the inverse kinematics (thesis 3.4, MODEL.md section 8): sweep
+// one input, solve the dependent joints, put them back into the forward kinematics and measure
+// the distance to the target; here with both the closed form and Newton's method.
+#pragma once
+
+#include "wlx/ik.hpp"
+
+#include <string>
+#include <vector>
+
+namespace wlx {
+
+struct IkSweep {
+  std::string id;      // "IK-L1", ...
+  std::string input;   // MODEL.md name of the swept input
+  double from = 0, to = 0, step = 0;  // SI units (radians for angles)
+  bool degrees = false;               // the thesis quotes this sweep in degrees
+  Limb limb = Limb::leg_l;
+  // Number of points, both ends included.
+  int points() const;
+  double value(int k) const;
+};
+
+// The 12 sweeps of MODEL.md section 8.
+const std::vector<IkSweep>& thesis_ik_sweeps();
+const IkSweep* find_ik_sweep(const std::string& id);
+
+// The initial state of the IK sweeps: MODEL.md section 8 with z_Wr = 0.
+Coordinates ik_sweep_inputs();
+
+// The analytic check of one limb: put the solution into the generated forward kinematics and
+// measure the target error. Legs: |r_F - target| (m). Wheels: |z of r_W - z_W| (m), and the
+// level conditions |(R e_x).e_z|, |(R e_y).e_z| (dimensionless) reported separately.
+struct LimbCheck {
+  double position_error = 0;  // m
+  double level_error = 0;     // wheels only
+};
+LimbCheck analytic_check(const Model& model, Limb limb, const Coordinates& s, Data& data);
+
+struct IkSweepPoint {
+  double value = 0;                 // the swept input
+  Coordinates closed_form;          // all 32 coordinates
+  Coordinates newton;               // Newton, warm-started from the previous point (continuation)
+  Eigen::Vector4d contacts;         // x_Wl, y_Wl, x_Wr, y_Wr (closed form)
+  LimbCheck check_closed_form, check_newton;
+  double newton_difference = 0;     // max |closed form - Newton| over the limb's joints (rad)
+  int newton_iterations = 0;
+  int newton_branch = 0;            // branch of the continued Newton result
+  int cold_newton_branch = -1;      // branch Newton reaches from the sweep's start pose (-1: no convergence)
+};
+
+struct IkSweepResult {
+  IkSweep sweep;
+  std::vector<IkSweepPoint> points;
+  double max_check_closed_form = 0, max_check_newton = 0, max_level_error = 0, max_newton_difference = 0;
+  double mean_newton_iterations = 0;
+  int max_newton_iterations = 0;
+  int newton_branch_changes = 0;       // along the continued path
+  int cold_start_off_default = 0;      // points where a cold start lands off the default branch
+};
+
+IkSweepResult run_ik_sweep(const Model& model, const IkSweep& sweep, Data& data);
+
+}  // namespace wlx
