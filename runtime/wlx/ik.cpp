@@ -189,10 +189,14 @@ int classify_branch(const Model& model, Limb limb, const Coordinates& s) {
   return (std::cos(theta6 - phi) < 0 ? 1 : 0) | (std::cos(theta2) < 0 ? 2 : 0) | (m < 0 ? 4 : 0);
 }
 
-NewtonReport solve_ik_newton(const Model& model, Coordinates& s, Data& data, const NewtonOptions& options) {
+namespace {
+
+NewtonReport newton(const Model& model, std::array<bool, 4> active, Coordinates& s, Data& data,
+                    const NewtonOptions& options) {
   for (int k = 0; k < kCoordinateCount; ++k) require_finite(s, {k});
   NewtonReport report;
-  std::array<bool, 4> done{false, false, false, false};
+  std::array<bool, 4> done{!active[0], !active[1], !active[2], !active[3]};
+  std::array<bool, 4> stalled{false, false, false, false};  // the last damped step could not descend
   const auto limb_residual = [&](const gen::ClosureVector& Phi, const LimbIndices& idx) {
     return Phi.segment(idx.rows, idx.count).cwiseAbs().maxCoeff();
   };
@@ -204,9 +208,10 @@ NewtonReport solve_ik_newton(const Model& model, Coordinates& s, Data& data, con
     std::array<double, 4> before{};
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
+      if (!active[l]) continue;
       const auto idx = indices(limb);
       before[l] = limb_residual(data.Phi, idx);
-      done[l] = before[l] <= options.tolerance;
+      done[l] = before[l] <= options.tolerance || (stalled[l] && before[l] <= options.floor_tolerance);
       if (done[l]) continue;
       all_done = false;
       if (report.iterations[l] >= options.max_iterations)
@@ -257,12 +262,33 @@ NewtonReport solve_ik_newton(const Model& model, Coordinates& s, Data& data, con
       }
       if (all_accepted) break;
     }
+    for (Limb limb : kLimbs) {
+      const auto l = static_cast<std::size_t>(limb);
+      stalled[l] = !done[l] && !accepted[l];
+    }
   }
-  for (auto& v : s.tail(kDependentCount)) v = wrap(v);
+  for (Limb limb : kLimbs) {
+    if (!active[static_cast<std::size_t>(limb)]) continue;
+    const auto idx = indices(limb);
+    for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = wrap(s(idx.dep[static_cast<std::size_t>(j)]));
+  }
   closure(model, s, data, false);
-  report.residual = data.Phi.cwiseAbs().maxCoeff();
+  for (Limb limb : kLimbs)
+    if (active[static_cast<std::size_t>(limb)]) report.residual = std::max(report.residual, limb_residual(data.Phi, indices(limb)));
   report.converged = true;
   return report;
+}
+
+}  // namespace
+
+NewtonReport solve_ik_newton(const Model& model, Coordinates& s, Data& data, const NewtonOptions& options) {
+  return newton(model, {true, true, true, true}, s, data, options);
+}
+
+NewtonReport solve_limb_newton(const Model& model, Limb limb, Coordinates& s, Data& data, const NewtonOptions& options) {
+  std::array<bool, 4> active{false, false, false, false};
+  active[static_cast<std::size_t>(limb)] = true;
+  return newton(model, active, s, data, options);
 }
 
 }  // namespace wlx

@@ -47,14 +47,17 @@ void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& br
 int classify_branch(const Model& model, Limb limb, const Coordinates& s);
 
 struct NewtonOptions {
-  double tolerance = 1e-14;  // on max |Phi| of the limb, in m or rad
+  double tolerance = 1e-13;  // on max |Phi| of the limb, in m or rad
+  // A limb whose residual no damped step can lower any more has reached its rounding floor; it
+  // counts as converged if that floor is below this (ill-conditioned poses amplify rounding).
+  double floor_tolerance = 1e-10;
   int max_iterations = 50;
   bool damped = true;  // backtracking on |Phi| when a full step does not decrease it
 };
 
 struct NewtonReport {
   std::array<int, 4> iterations{0, 0, 0, 0};  // per limb
-  double residual = 0;                        // max |Phi| over all 14 equations at the end
+  double residual = 0;                        // max |Phi| over the solved limbs' equations at the end
   bool converged = false;
 };
 
@@ -62,5 +65,8 @@ struct NewtonReport {
 // from the dependent joints already in s (warm start). Throws wlx::Error if a limb does not
 // converge within max_iterations (naming the limb, its residual and the iterations).
 NewtonReport solve_ik_newton(const Model& model, Coordinates& s, Data& data, const NewtonOptions& options = {});
+// The same for one limb only; the other limbs' joints are left as they are.
+NewtonReport solve_limb_newton(const Model& model, Limb limb, Coordinates& s, Data& data,
+                               const NewtonOptions& options = {});
 
 }  // namespace wlx

@@ -1,0 +1,129 @@
+// The wlx command line, run as a user would: exit codes, stdout, stderr, files.
+#include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
+#include <wlx/gen/kinematics.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+Run run_wlx(const std::string& args, const std::string& input = "") {
+  const fs::path dir = fs::temp_directory_path() / "wlx_cli_test";
+  fs::create_directories(dir);
+  std::ofstream(dir / "in") << input;
+  const std::string cmd = std::string(WLX_BINARY) + " " + args + " < " + (dir / "in").string() + " > " +
+                          (dir / "out").string() + " 2> " + (dir / "err").string();
+  const int status = std::system(cmd.c_str());
+  return {WEXITSTATUS(status), slurp(dir / "out"), slurp(dir / "err")};
+}
+
+}  // namespace
+
+TEST_CASE("cli: wlx ik solves the nominal state; the numbers put back into the FK hit the targets") {
+  const Run r = run_wlx("ik", "{}");
+  REQUIRE(r.code == 0);
+  CHECK(r.err.empty());
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"psi_l2", "psi_l3", "psi_l4", "psi_r2", "psi_r3", "psi_r4", "theta_l2", "theta_l3",
+                          "theta_l4", "theta_l6", "theta_r2", "theta_r3", "theta_r4", "theta_r6", "x_Wl", "y_Wl",
+                          "x_Wr", "y_Wr", "closure_residual"})
+    CHECK(j.contains(key));
+  // Independent check of the printed joints: nominal feet (3.5, +-1.5, 0) and wheel levels.
+  wlx::gen::Coordinates s = wlx::gen::Coordinates::Zero();
+  s(wlx::gen::coord::z_C) = 2.0;
+  for (int k = wlx::gen::kInputCount; k < wlx::gen::kCoordinateCount; ++k)
+    s(k) = j.at(std::string(wlx::gen::kCoordinateNames[k])).get<double>();
+  wlx::gen::FramePositions pos;
+  wlx::gen::kinematics(s, wlx::gen::Params{}, &pos, nullptr);
+  CHECK((pos.col(wlx::gen::frame::F_l) - Eigen::Vector3d(3.5, 1.5, 0)).norm() <= 1e-12);
+  CHECK((pos.col(wlx::gen::frame::F_r) - Eigen::Vector3d(3.5, -1.5, 0)).norm() <= 1e-12);
+  CHECK(std::abs(pos(2, wlx::gen::frame::W_r) - 0.05) <= 1e-12);
+  CHECK(j.at("x_Wr").get<double>() == doctest::Approx(pos(0, wlx::gen::frame::W_r)).epsilon(1e-15));
+}
+
+TEST_CASE("cli: Newton agrees with the closed form and reports its iterations") {
+  const Run cf = run_wlx("ik", R"({"z_C": 1.7, "roll": 0.05, "theta_l5": 0.2})");
+  const Run nt = run_wlx("ik", R"({"z_C": 1.7, "roll": 0.05, "theta_l5": 0.2, "method": "newton"})");
+  REQUIRE(cf.code == 0);
+  REQUIRE(nt.code == 0);
+  const auto a = nlohmann::json::parse(cf.out), b = nlohmann::json::parse(nt.out);
+  for (const char* key : {"psi_l2", "psi_r4", "theta_l6", "theta_r3", "x_Wl"})
+    CHECK(std::abs(a.at(key).get<double>() - b.at(key).get<double>()) <= 1e-12);
+  CHECK(b.at("iterations_total").get<int>() > 0);
+  CHECK(!a.contains("iterations"));
+}
+
+TEST_CASE("cli: bad input gets a message naming the field and exit code 2") {
+  Run r = run_wlx("ik", R"({"x_Fll": 7})");
+  CHECK(r.code == 2);
+  CHECK(r.err == "wlx: error: x_Fll: unknown key; did you mean 'x_Fl'?\n");
+  CHECK(r.out.empty());
+  r = run_wlx("ik", R"({"x_Fl": 7})");
+  CHECK(r.code == 2);
+  CHECK(r.err ==
+        "wlx: error: left leg: foot is 5.8523 m from the hip, reach is [0.5000, 3.5000] m (|thighD - legD| to thighD + "
+        "legD)\n");
+  r = run_wlx("ik", R"({"params": {"thighd": 2}})");
+  CHECK(r.err == "wlx: error: params.thighd: unknown key; did you mean 'thighD'?\n");
+  r = run_wlx("ik", R"({"params": {"w": 0}})");
+  CHECK(r.err == "wlx: error: params.w: a length must be positive, got 0 m\n");
+  r = run_wlx("ik", R"({"method": "mobile"})");
+  CHECK(r.err == "wlx: error: method: must be \"closed-form\" or \"newton\", got \"mobile\"\n");
+  r = run_wlx("ik", R"({"branch": {"leg_l": 4}})");
+  CHECK(r.err == "wlx: error: branch.leg_l: left leg has branches 0 to 3, got 4\n");
+  r = run_wlx("ik", R"({"yaw": 1e999})");
+  CHECK(r.code == 2);
+  CHECK(r.err.rfind("wlx: error: stdin: not valid JSON", 0) == 0);
+  r = run_wlx("ik", "[1, 2]");
+  CHECK(r.err == "wlx: error: expected a JSON object, got array\n");
+}
+
+TEST_CASE("cli: wlx ik --batch answers line by line and keeps going after a bad line") {
+  const Run r = run_wlx("ik --batch", "{\"z_Fl\": 0.1, \"method\": \"newton\"}\n{\"z_Fl\": 9}\n{\"z_Fl\": 0.2, \"method\": \"newton\"}\n");
+  CHECK(r.code == 2);
+  std::istringstream lines(r.out);
+  std::string line;
+  std::vector<nlohmann::json> out;
+  while (std::getline(lines, line)) out.push_back(nlohmann::json::parse(line));
+  REQUIRE(out.size() == 3);
+  CHECK(out[0].contains("psi_l2"));
+  CHECK(out[1].at("line") == 2);
+  CHECK(out[1].at("error").get<std::string>().rfind("left leg: foot is", 0) == 0);
+  CHECK(out[2].at("closure_residual").get<double>() <= 1e-13);
+  // Warm start from line 1: a small step needs few iterations.
+  CHECK(out[2].at("iterations").at("leg_l").get<int>() <= 4);
+  CHECK(r.err.find("wlx ik: line 2: left leg") != std::string::npos);
+}
+
+TEST_CASE("cli: wlx verify ik writes one CSV per sweep and passes") {
+  const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "verify";
+  fs::remove_all(dir);
+  const Run r = run_wlx("verify ik --sweep IK-L1 --sweep IK-WR2 --out " + dir.string());
+  CHECK(r.code == 0);
+  CHECK(r.out.find("all sweeps pass") != std::string::npos);
+  const std::string csv = slurp(dir / "IK-L1.csv");
+  CHECK(csv.rfind("x_Fl,psi_l2,psi_l3,psi_l4,", 0) == 0);
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 251);
+  CHECK(csv.find("nan") == std::string::npos);
+  CHECK(fs::exists(dir / "IK-WR2.csv"));
+  const Run bad = run_wlx("verify ik --sweep IK-L9 --out " + dir.string());
+  CHECK(bad.code == 2);
+  CHECK(bad.err == "wlx: error: --sweep: no sweep 'IK-L9'; did you mean 'IK-L1'?\n");
+}
