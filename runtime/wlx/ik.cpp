@@ -24,6 +24,7 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kReachSlack = 1e-12;
 
 double wrap(double a) {
+  if (a > -kPi && a <= kPi) return a;  // the usual case, without the slow remainder
   a = std::remainder(a, 2 * kPi);
   return a == -kPi ? kPi : a;
 }
@@ -36,6 +37,18 @@ Eigen::Matrix3d cabin_rotation(const Coordinates& s) {
       sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,   //
       -sp, cp * sr, cp * cr;
   return R;
+}
+
+// What every limb's closed form needs from the cabin pose, computed once per solve.
+struct CabinPose {
+  Eigen::Matrix3d R;  // R_C
+  Eigen::Vector3d r;  // r_C
+  Eigen::Vector3d g;  // world up seen from the cabin, R_C^T e_z
+};
+
+CabinPose cabin_pose(const Coordinates& s) {
+  const Eigen::Matrix3d R = cabin_rotation(s);
+  return {R, Eigen::Vector3d(s(c::x_C), s(c::y_C), s(c::z_C)), R.row(2).transpose()};
 }
 
 struct LimbIndices {
@@ -74,19 +87,16 @@ bool clamp_unit(double& x) {
   return false;
 }
 
-void solve_leg(const Model& model, Limb limb, int branch, Coordinates& s) {
+void solve_leg(const Model& model, const CabinPose& cabin, Limb limb, int branch, Coordinates& s) {
   const Params& p = model.params();
   const bool left = limb == Limb::leg_l;
   const int x_F = left ? c::x_Fl : c::x_Fr, y_F = left ? c::y_Fl : c::y_Fr, z_F = left ? c::z_Fl : c::z_Fr;
   const int psi1 = left ? c::psi_l1 : c::psi_r1;
-  require_cabin_finite(s);
   require_finite(s, {x_F, y_F, z_F, psi1});
   const double side = left ? 1.0 : -1.0;
-  const Eigen::Matrix3d R_C = cabin_rotation(s);
-  const Eigen::Vector3d r_C(s(c::x_C), s(c::y_C), s(c::z_C));
   const Eigen::Vector3d hip(p.cxd / 2, side * p.cyd / 2, 0);
   // Foot relative to the hip, in the frame after the hip roll joint Rx(psi_1).
-  const Eigen::Vector3d in_cabin = R_C.transpose() * (Eigen::Vector3d(s(x_F), s(y_F), s(z_F)) - r_C) - hip;
+  const Eigen::Vector3d in_cabin = cabin.R.transpose() * (Eigen::Vector3d(s(x_F), s(y_F), s(z_F)) - cabin.r) - hip;
   const double c1 = std::cos(s(psi1)), s1 = std::sin(s(psi1));
   const Eigen::Vector3d d(in_cabin.x(), c1 * in_cabin.y() + s1 * in_cabin.z(), -s1 * in_cabin.y() + c1 * in_cabin.z());
   const double T = p.thighD, L = p.legD, dist = d.norm();
@@ -96,8 +106,9 @@ void solve_leg(const Model& model, Limb limb, int branch, Coordinates& s) {
     throw Error(std::string(limb_name(limb)),
                 fmt::format("foot is {:.4f} m from the hip, reach is [{:.4f}, {:.4f}] m (|thighD - legD| to thighD + legD)",
                             dist, near, far));
-  const double psi4 = (branch & 1 ? -1.0 : 1.0) * std::acos(c4);
-  const double a = T + L * std::cos(psi4), b = -L * std::sin(psi4);
+  const double sign4 = branch & 1 ? -1.0 : 1.0;
+  const double psi4 = sign4 * std::acos(c4);
+  const double a = T + L * c4, b = -L * sign4 * std::sqrt(1 - c4 * c4);
   // d_y = a sin(psi_3); (d_x, d_z) is (a cos(psi_3), b) turned by -psi_2 about y.
   double s3 = std::abs(a) > 1e-300 ? d.y() / a : 0.0;
   clamp_unit(s3);  // |d_y| <= |a| holds exactly; this only removes rounding
@@ -111,21 +122,19 @@ void solve_leg(const Model& model, Limb limb, int branch, Coordinates& s) {
   s(idx.dep[2]) = psi4;
 }
 
-void solve_wheel(const Model& model, Limb limb, int branch, Coordinates& s) {
+void solve_wheel(const Model& model, const CabinPose& cabin, Limb limb, int branch, Coordinates& s) {
   const Params& p = model.params();
   const bool left = limb == Limb::wheel_l;
   const int z_W = left ? c::z_Wl : c::z_Wr, th5 = left ? c::theta_l5 : c::theta_r5;
-  require_cabin_finite(s);
   require_finite(s, {z_W, th5});
   const double side = left ? 1.0 : -1.0;
-  const Eigen::Matrix3d R_C = cabin_rotation(s);
-  const Eigen::Vector3d g = R_C.row(2).transpose();  // world up, seen from the cabin
+  const Eigen::Vector3d& g = cabin.g;
   const double rho = std::hypot(g.x(), g.z());
   const double phi = std::atan2(g.x(), g.z());
   // Parallel guidance: theta_4 = -theta_5, so R_10 = Ry(theta_3 + theta_6) =: Ry(sigma).
   // Level x axis: g . Ry(sigma) e_x = 0  ->  sigma = phi (hub above the contact) or phi + pi.
   const double sigma = (branch & 4) ? wrap(phi + kPi) : phi;
-  const double m = g.x() * std::sin(sigma) + g.z() * std::cos(sigma);  // +-rho
+  const double m = (branch & 4) ? -rho : rho;  // g_x sin(sigma) + g_z cos(sigma)
   // Level y axis: sin(theta_2) m + g_y cos(theta_2) = 0.
   double theta2 = std::atan2(-g.y() * (m < 0 ? -1.0 : 1.0), std::abs(m));
   if (branch & 2) theta2 = wrap(theta2 + kPi);
@@ -165,15 +174,26 @@ std::string_view limb_name(Limb limb) noexcept {
   return "limb";
 }
 
-void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinates& s) {
+namespace {
+
+void solve_limb(const Model& model, const CabinPose& cabin, Limb limb, int branch, Coordinates& s) {
   if (branch < 0 || branch >= branch_count(limb))
     throw Error("branch", fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, branch));
-  if (limb == Limb::leg_l || limb == Limb::leg_r) solve_leg(model, limb, branch, s);
-  else solve_wheel(model, limb, branch, s);
+  if (limb == Limb::leg_l || limb == Limb::leg_r) solve_leg(model, cabin, limb, branch, s);
+  else solve_wheel(model, cabin, limb, branch, s);
+}
+
+}  // namespace
+
+void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinates& s) {
+  require_cabin_finite(s);
+  solve_limb(model, cabin_pose(s), limb, branch, s);
 }
 
 void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches) {
-  for (Limb limb : kLimbs) solve_limb_closed_form(model, limb, branches.limb[static_cast<std::size_t>(limb)], s);
+  require_cabin_finite(s);
+  const CabinPose cabin = cabin_pose(s);
+  for (Limb limb : kLimbs) solve_limb(model, cabin, limb, branches.limb[static_cast<std::size_t>(limb)], s);
 }
 
 int classify_branch(const Model& model, Limb limb, const Coordinates& s) {
