@@ -1,6 +1,7 @@
 // The CLI's subcommands, one function each.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -9,5 +10,15 @@ namespace wlx::cli {
 int run_fk(bool as_json);
 int run_ik(bool batch);
 int run_verify_ik(const std::string& out_dir, const std::vector<std::string>& sweep_ids);
+
+struct SimulateOptions {
+  std::string scenario;
+  std::string out_dir = "out/simulate";
+  std::string integrator;    // empty: the scenario's
+  std::optional<double> dt;  // empty: the scenario's
+  bool list = false;
+};
+int run_simulate(const SimulateOptions& options);
+int run_verify_nonholonomic(const std::string& out_dir);
 
 }  // namespace wlx::cli

@@ -76,12 +76,29 @@ int main(int argc, char** argv) {
   verify_ik->add_option("--out", ik_out, "folder for one CSV per sweep")->capture_default_str();
   verify_ik->add_option("--sweep", sweep_ids, "only these sweeps (IK-L1, ..., IK-WR2)");
 
+  std::string nh_out = "out/verify-nonholonomic";
+  auto* verify_nh = verify->add_subcommand("nonholonomic", "NH-1 to NH-4: the wheels' sideways-velocity residual");
+  verify_nh->add_option("--out", nh_out, "folder for one trajectory CSV per run")->capture_default_str();
+
+  wlx::cli::SimulateOptions sim;
+  auto* simulate = app.add_subcommand("simulate", "integrate a scenario (a file, or an id of MODEL.md section 8)");
+  simulate->add_option("SCENARIO", sim.scenario, "scenario file or id (NH-1, ST-A1+, ...)");
+  simulate->add_option("--out", sim.out_dir, "output folder for trajectory.csv")->capture_default_str();
+  simulate->add_option("--integrator", sim.integrator, "rk4 or euler (default: the scenario's)");
+  simulate->add_option("--dt", sim.dt, "step in seconds (default: the scenario's)");
+  simulate->add_flag("--list", sim.list, "list the built-in scenarios");
+
   CLI11_PARSE(app, argc, argv);
   using namespace wlx::cli;
   try {
     if (fk->parsed()) return run_fk(fk_json);
     if (ik->parsed()) return run_ik(batch);
     if (verify_ik->parsed()) return run_verify_ik(ik_out, sweep_ids);
+    if (verify_nh->parsed()) return run_verify_nonholonomic(nh_out);
+    if (simulate->parsed()) {
+      if (!sim.list && sim.scenario.empty()) throw wlx::Error("SCENARIO", "missing: give a scenario file or id (--list shows the ids)");
+      return run_simulate(sim);
+    }
   } catch (const wlx::Error& e) {
     fmt::print(stderr, "wlx: error: {}\n", e.what());
     return 2;

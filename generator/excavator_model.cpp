@@ -44,6 +44,9 @@ Model make_excavator_model() {
   const ex wl = b.param("wl", 2.5, "m", "wheel lever length");
   b.param("w", 0.5, "m", "wheel radius: hub to contact point");
   const ex w = b.m.parameters.back().symbol;
+  // The cabin is a cxd x cyd x cabin_height block centred on K_C (thesis 6.2.1); only the
+  // ground-clearance check uses its height.
+  b.param("cabin_height", 0.5, "m", "height of the cabin block centred on the cabin frame");
   // Mass properties (thesis Table 6-1): mass and principal inertia about the CoM.
   const struct { const char* body; double mass; double Ixx, Iyy, Izz; const char* what; } masses[] = {
       {"M1", 5400.0, 4090.5, 4090.5, 8100.0, "cabin"},

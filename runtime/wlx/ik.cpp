@@ -51,21 +51,16 @@ CabinPose cabin_pose(const Coordinates& s) {
   return {R, Eigen::Vector3d(s(c::x_C), s(c::y_C), s(c::z_C)), R.row(2).transpose()};
 }
 
+// Short names for the limb blocks inside this file.
 struct LimbIndices {
-  int side;                // +1 left, -1 right
-  std::array<int, 4> dep;  // dependent joints (3 for legs)
-  int rows;                // first closure row
-  int count;               // 3 or 4
+  std::array<int, 4> dep;
+  int rows;
+  int count;
 };
 
 LimbIndices indices(Limb limb) {
-  switch (limb) {
-    case Limb::leg_l: return {1, {c::psi_l2, c::psi_l3, c::psi_l4, -1}, 0, 3};
-    case Limb::leg_r: return {-1, {c::psi_r2, c::psi_r3, c::psi_r4, -1}, 3, 3};
-    case Limb::wheel_l: return {1, {c::theta_l2, c::theta_l3, c::theta_l4, c::theta_l6}, 6, 4};
-    case Limb::wheel_r: return {-1, {c::theta_r2, c::theta_r3, c::theta_r4, c::theta_r6}, 10, 4};
-  }
-  return {};
+  const LimbBlock b = limb_block(limb);
+  return {b.joints, b.first_row, b.size};
 }
 
 void require_finite(const Coordinates& s, std::initializer_list<int> coords) {
@@ -163,6 +158,16 @@ void solve_wheel(const Model& model, const CabinPose& cabin, Limb limb, int bran
 }
 
 }  // namespace
+
+LimbBlock limb_block(Limb limb) noexcept {
+  switch (limb) {
+    case Limb::leg_l: return {0, 3, {c::psi_l2, c::psi_l3, c::psi_l4, -1}};
+    case Limb::leg_r: return {3, 3, {c::psi_r2, c::psi_r3, c::psi_r4, -1}};
+    case Limb::wheel_l: return {6, 4, {c::theta_l2, c::theta_l3, c::theta_l4, c::theta_l6}};
+    case Limb::wheel_r: return {10, 4, {c::theta_r2, c::theta_r3, c::theta_r4, c::theta_r6}};
+  }
+  return {};
+}
 
 std::string_view limb_name(Limb limb) noexcept {
   switch (limb) {

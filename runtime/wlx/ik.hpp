@@ -32,6 +32,14 @@ inline int branch_count(Limb limb) noexcept {
   return limb == Limb::leg_l || limb == Limb::leg_r ? kLegBranchCount : kWheelBranchCount;
 }
 
+// A limb's rows in Phi and its dependent joints (its block of dPhi/ds is square).
+struct LimbBlock {
+  int first_row = 0;
+  int size = 0;                 // 3 for a leg, 4 for a wheel
+  std::array<int, 4> joints{};  // coordinate indices; the 4th is unused for legs
+};
+LimbBlock limb_block(Limb limb) noexcept;
+
 struct Branches {
   std::array<int, 4> limb{0, 0, 0, 0};  // indexed by Limb
 };

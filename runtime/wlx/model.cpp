@@ -11,7 +11,7 @@ namespace wlx {
 namespace {
 
 bool is_length(std::string_view name) {
-  for (std::string_view n : {"cxd", "cyd", "thighD", "legD", "wl", "w"})
+  for (std::string_view n : {"cxd", "cyd", "thighD", "legD", "wl", "w", "cabin_height"})
     if (n == name) return true;
   return false;
 }

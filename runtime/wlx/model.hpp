@@ -5,6 +5,8 @@
 
 #include <wlx/gen/all.hpp>
 
+#include <Eigen/LU>
+
 #include <string_view>
 
 namespace wlx {
@@ -46,6 +48,15 @@ struct Data {
   gen::BodyJacobians body_Jw;
   gen::BodyVectors body_Jv_dot_sdot;
   gen::BodyVectors body_Jw_dot_sdot;
+
+  // Non-holonomic solve (nonholonomic.hpp): the closure's per-limb factorizations (legs padded to
+  // 4 x 4 with a unit diagonal), the dependent-joint sensitivity X = Phi_dep^-1 Phi_q, the wheel
+  // rows reduced to the inputs, and J_beta.
+  std::array<Eigen::PartialPivLU<Eigen::Matrix4d>, 4> limb_lu;
+  Eigen::Matrix<double, gen::kDependentCount, gen::kInputCount> closure_sensitivity;
+  Eigen::Matrix<double, gen::kWheelCount, gen::kInputCount> C_reduced;
+  Eigen::Matrix2d J_beta;
+  double cond_J_beta = 0;
 };
 
 // Index of a coordinate by its MODEL.md name, or -1.

@@ -127,3 +127,43 @@ TEST_CASE("cli: wlx verify ik writes one CSV per sweep and passes") {
   CHECK(bad.code == 2);
   CHECK(bad.err == "wlx: error: --sweep: no sweep 'IK-L9'; did you mean 'IK-L1'?\n");
 }
+
+TEST_CASE("cli: wlx simulate writes trajectory.csv with the public columns") {
+  const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "sim";
+  fs::remove_all(dir);
+  const Run r = run_wlx("simulate NH-2 --out " + dir.string());
+  CHECK(r.code == 0);
+  const std::string csv = slurp(dir / "trajectory.csv");
+  std::string expected = "t,x_C,y_C,z_C,yaw,pitch,roll,x_Fl,y_Fl,z_Fl,x_Fr,y_Fr,z_Fr,z_Wl,z_Wr,psi_l1,psi_r1,theta_l5,"
+                         "theta_r5,psi_l2,psi_l3,psi_l4,psi_r2,psi_r3,psi_r4,theta_l2,theta_l3,theta_l4,theta_l6,theta_r2,"
+                         "theta_r3,theta_r4,theta_r6,x_Wl,y_Wl,x_Wr,y_Wr,nh_residual_l,nh_residual_r,spin_rate_l,spin_rate_r,";
+  CHECK(csv.rfind(expected, 0) == 0);
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 452);  // 0.451 s at 1 ms, t = 0 included
+  CHECK(csv.find("nan") == std::string::npos);
+  CHECK(r.out.find("452 samples") != std::string::npos);
+}
+
+TEST_CASE("cli: wlx simulate overrides, errors, and a run that fails midway") {
+  const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "sim2";
+  fs::remove_all(dir);
+  Run r = run_wlx("simulate ST-A2+ --integrator euler --dt 0.0005 --out " + dir.string());
+  CHECK(r.code == 0);
+  CHECK(r.out.find("903 samples (0.451 s, dt 0.0005 s, euler)") != std::string::npos);
+  r = run_wlx("simulate ST-A9 --out " + dir.string());
+  CHECK(r.code == 2);
+  CHECK(r.err == "wlx: error: SCENARIO: 'ST-A9' is neither a file nor a scenario id; did you mean 'ST-A1+'?\n");
+  r = run_wlx("simulate NH-1 --dt -1 --out " + dir.string());
+  CHECK(r.err == "wlx: error: dt: must be a positive number of seconds, got -1\n");
+  // Lifting the cabin at 3 m/s: the legs lose the feet after a few tenths of a second.
+  const fs::path file = dir / "lift.json";
+  std::ofstream(file) << R"({"id": "lift", "rates": {"z_C": 3}, "dependent": ["y_C", "yaw"], "duration": 1})";
+  r = run_wlx("simulate " + file.string() + " --out " + dir.string());
+  CHECK(r.code == 2);
+  CHECK(r.err.find("wlx: error: stopped at t = ") == 0);
+  CHECK(r.err.find("leg: foot is") != std::string::npos);
+  const std::string csv = slurp(dir / "trajectory.csv");
+  const auto rows = std::count(csv.begin(), csv.end(), '\n');
+  CHECK(rows > 10);
+  CHECK(rows < 1001);
+  CHECK(csv.find("nan") == std::string::npos);
+}

@@ -19,6 +19,7 @@ struct Params {
   double legD = 1.5;  // m: knee-to-foot length of a leg
   double wl = 2.5;  // m: wheel lever length
   double w = 0.5;  // m: wheel radius: hub to contact point
+  double cabin_height = 0.5;  // m: height of the cabin block centred on the cabin frame
   double m_M1 = 5400.0;  // kg: mass of the cabin
   double Ixx_M1 = 4090.5;  // kg*m^2: inertia of the cabin about its CoM, body x
   double Iyy_M1 = 4090.5;  // kg*m^2: inertia of the cabin about its CoM, body y
@@ -57,13 +58,14 @@ struct ParamInfo {
   std::string_view meaning;
 };
 
-inline constexpr std::array<ParamInfo, 35> kParamInfo{{
+inline constexpr std::array<ParamInfo, 36> kParamInfo{{
     {"cxd", &Params::cxd, "m", "cabin length between front hips and rear hips"},
     {"cyd", &Params::cyd, "m", "cabin width between left and right hips"},
     {"thighD", &Params::thighD, "m", "hip-to-knee length of a leg"},
     {"legD", &Params::legD, "m", "knee-to-foot length of a leg"},
     {"wl", &Params::wl, "m", "wheel lever length"},
     {"w", &Params::w, "m", "wheel radius: hub to contact point"},
+    {"cabin_height", &Params::cabin_height, "m", "height of the cabin block centred on the cabin frame"},
     {"m_M1", &Params::m_M1, "kg", "mass of the cabin"},
     {"Ixx_M1", &Params::Ixx_M1, "kg*m^2", "inertia of the cabin about its CoM, body x"},
     {"Iyy_M1", &Params::Iyy_M1, "kg*m^2", "inertia of the cabin about its CoM, body y"},

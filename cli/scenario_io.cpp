@@ -1,0 +1,125 @@
+#include "scenario_io.hpp"
+
+#include "input.hpp"
+
+#include <fmt/format.h>
+#include <wlx/error.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+namespace wlx::cli {
+
+// Defined in the build tree's embedded_scenarios.cpp (CMakeLists.txt writes it from scenarios/).
+extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios;
+
+namespace {
+
+bool is_angle(int coordinate) { return gen::kCoordinateUnits[static_cast<std::size_t>(coordinate)] == std::string_view("rad"); }
+
+std::vector<std::string> input_names() {
+  std::vector<std::string> v;
+  for (int k = 0; k < kInputCount; ++k) v.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+  return v;
+}
+
+}  // namespace
+
+std::vector<std::string> scenario_ids() {
+  std::vector<std::string> ids;
+  for (const auto& [id, text] : kEmbeddedScenarios) ids.push_back(id);
+  return ids;
+}
+
+std::string embedded_scenario(const std::string& id) {
+  for (const auto& [i, text] : kEmbeddedScenarios)
+    if (i == id) return text;
+  return {};
+}
+
+nlohmann::json read_scenario_json(const std::string& arg) {
+  std::string text;
+  if (std::filesystem::is_regular_file(arg)) {
+    std::ifstream in(arg);
+    std::ostringstream s;
+    s << in.rdbuf();
+    text = s.str();
+  } else {
+    text = embedded_scenario(arg);
+    if (text.empty()) {
+      const std::string hint = nearest(arg, scenario_ids());
+      throw Error("SCENARIO", fmt::format("'{}' is neither a file nor a scenario id{}", arg,
+                                          hint.empty() ? " (wlx simulate --list shows them)" : "; did you mean '" + hint + "'?"));
+    }
+  }
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(arg, fmt::format("not valid JSON ({})", e.what()));
+  }
+}
+
+double si_value(const nlohmann::json& v, const std::string& key, bool angle) {
+  if (v.is_object()) {
+    if (!angle) throw Error(key, "only angles may be given in degrees; give this value in SI units");
+    if (v.size() != 1 || !(v.contains("deg") || v.contains("deg/s")))
+      throw Error(key, fmt::format("expected a number or {{\"deg\": x}} / {{\"deg/s\": x}}, got {}", v.dump()));
+    const auto& [unit, value] = *v.items().begin();
+    return finite_number(value, key + "." + unit) * std::numbers::pi / 180;
+  }
+  return finite_number(v, key);
+}
+
+Scenario parse_scenario(const nlohmann::json& j) {
+  if (!j.is_object()) throw Error("", fmt::format("a scenario is a JSON object, got {}", j.type_name()));
+  reject_unknown_keys(j, {"id", "description", "observation", "initial", "params", "rates", "dependent", "duration", "dt",
+                          "integrator", "branch", "max_condition", "weighting"},
+                      "");
+  Scenario sc;
+  const auto text = [&](const char* key) {
+    if (!j.contains(key)) return std::string();
+    if (!j.at(key).is_string()) throw Error(key, fmt::format("must be a string, got {}", j.at(key).dump()));
+    return j.at(key).get<std::string>();
+  };
+  sc.id = text("id");
+  sc.description = text("description");
+  if (j.contains("params")) sc.params = parse_params(j.at("params"));
+  for (const char* group : {"initial", "rates"}) {
+    if (!j.contains(group)) continue;
+    const auto& obj = j.at(group);
+    if (!obj.is_object()) throw Error(group, fmt::format("must be an object of input names, got {}", obj.type_name()));
+    reject_unknown_keys(obj, input_names(), std::string(group) + ".");
+    for (const auto& [key, value] : obj.items()) {
+      const int k = coordinate_index(key);
+      const double v = si_value(value, std::string(group) + "." + key, is_angle(k));
+      if (std::string(group) == "initial") sc.initial(k) = v;
+      else sc.rates(k) = v;
+    }
+  }
+  if (!j.contains("dependent")) throw Error("dependent", "missing: name the two dependent rates, e.g. [\"y_C\", \"yaw\"]");
+  const auto& dep = j.at("dependent");
+  if (!dep.is_array() || dep.size() != 2 || !dep[0].is_string() || !dep[1].is_string())
+    throw Error("dependent", fmt::format("must be an array of 2 names, got {}", dep.dump()));
+  sc.pair = dependent_pair(dep[0].get<std::string>(), dep[1].get<std::string>());
+  if (!j.contains("duration")) throw Error("duration", "missing: the run's length in seconds");
+  sc.duration = finite_number(j.at("duration"), "duration");
+  if (j.contains("dt")) sc.dt = finite_number(j.at("dt"), "dt");
+  if (j.contains("integrator")) {
+    const auto& in = j.at("integrator");
+    if (in == "rk4") sc.integrator = Integrator::rk4;
+    else if (in == "euler") sc.integrator = Integrator::euler;
+    else throw Error("integrator", fmt::format("must be \"rk4\" or \"euler\", got {}", in.dump()));
+  }
+  if (j.contains("branch")) sc.branches = parse_ik_request(nlohmann::json{{"branch", j.at("branch")}}).branches;
+  if (j.contains("max_condition")) {
+    sc.nonholonomic.max_condition = finite_number(j.at("max_condition"), "max_condition");
+    if (!(sc.nonholonomic.max_condition > 1))
+      throw Error("max_condition", fmt::format("must be above 1, got {}", sc.nonholonomic.max_condition));
+  }
+  sc.validate();
+  return sc;
+}
+
+}  // namespace wlx::cli

@@ -1,0 +1,56 @@
+// Non-holonomic wheels (thesis 4, 5; MODEL.md section 5): the two dependent rates that keep both
+// wheels from sliding sideways, at velocity and at acceleration level, from the generated C(s),
+// dPhi/ds and convective terms (no numeric differentiation).
+//
+// With the 14 dependent joints eliminated through the linearised closure
+// (beta_dep' = -Phi_dep^-1 Phi_q q'), the wheel rows reduce to C_hat q' = 0 (2 x 18). Splitting q'
+// into the chosen dependent pair and the commanded rest gives the thesis' eq. 4.9:
+// J_beta pair' + phi_hat = 0.
+#pragma once
+
+#include "wlx/model.hpp"
+
+#include <array>
+#include <string>
+#include <string_view>
+
+namespace wlx {
+
+// The 8 velocities the wheel constraints involve (MODEL.md section 5); any 2 may be dependent.
+inline constexpr std::array<int, 8> kWheelCoupledInputs = {gen::coord::x_C,   gen::coord::y_C,      gen::coord::z_C,
+                                                           gen::coord::yaw,   gen::coord::pitch,    gen::coord::roll,
+                                                           gen::coord::theta_l5, gen::coord::theta_r5};
+
+struct DependentPair {
+  std::array<int, 2> index{gen::coord::y_C, gen::coord::yaw};  // coordinate indices; default: pair A
+  std::string label() const;  // "(y_C', yaw')"
+};
+// Validates two names of the 8 (distinct); throws wlx::Error naming `field`.
+DependentPair dependent_pair(std::string_view first, std::string_view second, const std::string& field = "dependent");
+inline const DependentPair kPairA{{gen::coord::y_C, gen::coord::yaw}};
+inline const DependentPair kPairB{{gen::coord::theta_l5, gen::coord::theta_r5}};
+
+struct NonholonomicOptions {
+  // J_beta counts as singular above this condition number. The thesis scenarios reach 2.7e7
+  // (ST-A1- crossing its singular point on the 1 ms grid); 1e10 leaves a wide margin while
+  // stopping rates that would be rounding noise amplified by more than 1e10 * 1e-16 = 1e-6.
+  double max_condition = 1e10;
+};
+
+// Velocity level. `s`: all 32 coordinates, closure satisfied. `sdot`: the commanded input rates
+// (its pair entries are ignored). Fills the pair's rates and the 14 dependent joint rates in
+// sdot, and data.J_beta, data.cond_J_beta, data.C (and the closure Jacobian). Throws wlx::Error
+// if J_beta is singular.
+void solve_dependent_rates(const Model& model, const Coordinates& s, Coordinates& sdot, const DependentPair& pair,
+                           Data& data, const NonholonomicOptions& options = {});
+
+// Acceleration level (thesis eqs. 6.5-6.7). Needs the full sdot of the velocity level and the
+// commanded input accelerations in sddot; fills the pair's and the dependent joints' accelerations.
+// Must follow solve_dependent_rates at the same (s, sdot): it reuses its factorizations in data.
+void solve_dependent_accelerations(const Model& model, const Coordinates& s, const Coordinates& sdot,
+                                   Coordinates& sddot, const DependentPair& pair, Data& data);
+
+// v_W . n_W per wheel for the full sdot: the thesis' residual check of the rolling constraint.
+Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& data);
+
+}  // namespace wlx

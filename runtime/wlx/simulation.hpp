@@ -1,0 +1,62 @@
+// Time integration of a scenario (thesis 4.2, 5; MODEL.md sections 5 and 8): the commanded input
+// rates and the dependent pair are integrated; the 14 holonomic dependents are re-solved by the
+// closed-form IK at every evaluation, so the loop closure cannot drift.
+#pragma once
+
+#include "wlx/ik.hpp"
+#include "wlx/model.hpp"
+#include "wlx/nonholonomic.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace wlx {
+
+enum class Integrator { rk4, euler };
+
+struct Scenario {
+  std::string id;
+  std::string description;
+  Params params;
+  Coordinates initial = nominal_inputs();                 // inputs; dependents are solved
+  Eigen::Matrix<double, kInputCount, 1> rates = Eigen::Matrix<double, kInputCount, 1>::Zero();  // commanded
+  DependentPair pair = kPairA;
+  double duration = 0;  // s
+  double dt = 1e-3;     // s
+  Integrator integrator = Integrator::rk4;
+  Branches branches;
+  NonholonomicOptions nonholonomic;
+
+  // Number of output samples: duration / dt steps plus t = 0 (the thesis' "2001 integrations" for 2 s).
+  long samples() const;
+  // Throws wlx::Error naming the field for a bad duration, step, or a commanded dependent rate.
+  void validate() const;
+};
+
+struct Sample {
+  double t = 0;
+  Coordinates s;                 // all 32 coordinates
+  Coordinates sdot;              // their rates
+  Eigen::Vector4d contacts;      // x_Wl, y_Wl, x_Wr, y_Wr
+  Eigen::Vector2d nh_residual;   // v_W . n_W per wheel (should be 0)
+  Eigen::Vector2d spin_rate;     // wheel spin rates, rad/s
+  double cond_J_beta = 0;
+  double cabin_clearance = 0;    // lowest cabin corner above z = 0, m
+};
+
+struct Trajectory {
+  std::vector<Sample> samples;
+  bool complete = true;
+  std::string error;  // why the run stopped early (with its time), when !complete
+};
+
+// Called after each sample with (samples done, samples in all).
+using Progress = std::function<void(long, long)>;
+
+Trajectory simulate(const Scenario& scenario, const Progress& progress = {});
+
+// Lowest corner of the cabin block (cxd x cyd x cabin_height, centred on K_C) above the ground.
+double cabin_clearance(const Params& p, const Coordinates& s);
+
+}  // namespace wlx

@@ -1,0 +1,119 @@
+// The shipped scenario files: each runs, keeps both wheels from sliding, and shows the thesis'
+// observations (MODEL.md section 8).
+#include <doctest/doctest.h>
+#include <scenario_io.hpp>
+#include <wlx/error.hpp>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+
+using namespace wlx;
+namespace c = gen::coord;
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180;
+
+const Trajectory& run(const std::string& id) {
+  static std::map<std::string, Trajectory> cache;
+  auto it = cache.find(id);
+  if (it == cache.end()) it = cache.emplace(id, simulate(cli::parse_scenario(cli::read_scenario_json(id)))).first;
+  return it->second;
+}
+
+double end(const std::string& id, int coordinate) { return run(id).samples.back().s(coordinate); }
+
+}  // namespace
+
+TEST_CASE("scenarios: one file per NH and ST row of MODEL.md section 8, each sign separately") {
+  const auto ids = cli::scenario_ids();
+  for (const char* id : {"NH-1", "NH-2", "NH-3", "NH-4", "ST-A1+", "ST-A1-", "ST-A2+", "ST-A2-", "ST-A3+", "ST-A3-",
+                         "ST-B1+", "ST-B1-", "ST-B2+", "ST-B2-", "ST-B3+", "ST-B3-"})
+    CHECK(std::find(ids.begin(), ids.end(), id) != ids.end());
+}
+
+TEST_CASE("scenarios: every shipped NH/ST run completes with |v_W . n_W| <= 1e-12 at every step") {
+  for (const auto& id : cli::scenario_ids()) {
+    if (id.rfind("NH", 0) != 0 && id.rfind("ST", 0) != 0) continue;
+    CAPTURE(id);
+    const Trajectory& tr = run(id);
+    CHECK(tr.complete);
+    double worst = 0;
+    for (const auto& smp : tr.samples) worst = std::max(worst, smp.nh_residual.cwiseAbs().maxCoeff());
+    CHECK(worst <= 1e-12);
+    const auto sc = cli::parse_scenario(cli::read_scenario_json(id));
+    CHECK(static_cast<long>(tr.samples.size()) == sc.samples());
+  }
+}
+
+TEST_CASE("scenarios: ST-A1: increasing roll makes yaw and y_C decrease; decreasing roll the opposite") {
+  CHECK(end("ST-A1+", c::yaw) < 0);
+  CHECK(end("ST-A1+", c::y_C) < 0);
+  CHECK(end("ST-A1-", c::yaw) > 0);
+  CHECK(end("ST-A1-", c::y_C) > 0);
+  // Monotonic along the run.
+  const auto& tr = run("ST-A1+");
+  for (std::size_t k = 1; k < tr.samples.size(); ++k) CHECK(tr.samples[k].s(c::yaw) < tr.samples[k - 1].s(c::yaw));
+}
+
+TEST_CASE("scenarios: ST-A2: a positive left straddle steers left, y_C and yaw combining; ST-A3 mirrors it") {
+  CHECK(end("ST-A2+", c::yaw) > 0);
+  CHECK(end("ST-A2+", c::y_C) > 0);
+  CHECK(end("ST-A2-", c::yaw) < 0);
+  CHECK(end("ST-A2-", c::y_C) < 0);
+  // Mirror image: the right lever turns the other way by nearly the same amount (the 5 cm
+  // step under the right wheel breaks the symmetry slightly).
+  CHECK(end("ST-A3+", c::yaw) == doctest::Approx(-end("ST-A2+", c::yaw)).epsilon(0.01));
+  CHECK(end("ST-A3+", c::y_C) == doctest::Approx(-end("ST-A2+", c::y_C)).epsilon(0.02));
+  CHECK(end("ST-A3-", c::yaw) == doctest::Approx(-end("ST-A2-", c::yaw)).epsilon(0.01));
+}
+
+TEST_CASE("scenarios: ST-B: with the straddle angles dependent, roll, yaw and y_C move alone") {
+  for (const char* id : {"ST-B1+", "ST-B1-"}) {
+    CAPTURE(id);
+    CHECK(end(id, c::yaw) == 0.0);
+    CHECK(end(id, c::y_C) == 0.0);
+    CHECK(std::abs(end(id, c::roll)) == doctest::Approx(20 * kDeg));
+    CHECK(std::abs(end(id, c::theta_l5)) > 1 * kDeg);  // the straddle angles follow
+  }
+  for (const char* id : {"ST-B2+", "ST-B2-"}) {
+    CAPTURE(id);
+    CHECK(std::abs(end(id, c::yaw)) == doctest::Approx(20 * kDeg));
+    CHECK(end(id, c::y_C) == 0.0);
+    CHECK(std::abs(end(id, c::theta_l5)) > 1 * kDeg);
+    CHECK(std::abs(end(id, c::theta_r5)) > 1 * kDeg);
+  }
+  for (const char* id : {"ST-B3+", "ST-B3-"}) {
+    CAPTURE(id);
+    CHECK(std::abs(end(id, c::y_C)) == doctest::Approx(1.0));
+    CHECK(end(id, c::yaw) == 0.0);
+    CHECK(end(id, c::theta_l5) * end(id, c::y_C) > 0);  // both levers swing towards the motion
+    CHECK(end(id, c::theta_r5) * end(id, c::y_C) > 0);
+  }
+}
+
+TEST_CASE("scenarios: bad scenario files get messages naming the field") {
+  const auto message = [](const std::string& text) {
+    try {
+      cli::parse_scenario(nlohmann::json::parse(text));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "rates": {"rol": 1}})") ==
+        "rates.rol: unknown key; did you mean 'roll'?");
+  CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "rates": {"x_C": {"deg/s": 3}}})") ==
+        "rates.x_C: only angles may be given in degrees; give this value in SI units");
+  CHECK(message(R"({"dependent": ["y_C"], "duration": 1})") == "dependent: must be an array of 2 names, got [\"y_C\"]");
+  CHECK(message(R"({"dependent": ["y_C", "yaw"]})") == "duration: missing: the run's length in seconds");
+  CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "integrator": "rk45"})") ==
+        "integrator: must be \"rk4\" or \"euler\", got \"rk45\"");
+  CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "dt": 0.3})") ==
+        "dt: the duration 1 s is not a whole number of steps of 0.3 s");
+  CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "params": {"m_M1": -3}})") ==
+        "params.m_M1: a mass must be positive, got -3 kg");
+  CHECK_THROWS_WITH_AS(cli::read_scenario_json("NH-7"), "SCENARIO: 'NH-7' is neither a file nor a scenario id; did you mean 'NH-1'?",
+                       Error);
+}

@@ -1,0 +1,145 @@
+// Dependent rates of the non-holonomic wheels at velocity and acceleration level.
+#include <doctest/doctest.h>
+#include <wlx/error.hpp>
+#include <wlx/ik.hpp>
+#include <wlx/nonholonomic.hpp>
+#include <wlx/simulation.hpp>
+
+#include <cmath>
+#include <numbers>
+
+using namespace wlx;
+namespace c = gen::coord;
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180;
+
+Coordinates assembled(Coordinates s, const Model& model = Model()) {
+  solve_ik_closed_form(model, s);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("nonholonomic: the thesis' nominal figures: cond(J_beta) ~ 7e2 and yaw' ~ 34 deg/s for theta_l5' = 0.5 deg/s") {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled(nominal_inputs());
+  Coordinates sdot = Coordinates::Zero();
+  sdot(c::theta_l5) = 0.5 * kDeg;
+  solve_dependent_rates(model, s, sdot, kPairA, d);
+  MESSAGE("cond(J_beta) = " << d.cond_J_beta << ", yaw' = " << sdot(c::yaw) / kDeg << " deg/s");
+  CHECK(d.cond_J_beta == doctest::Approx(7e2).epsilon(0.1));
+  CHECK(sdot(c::yaw) / kDeg == doctest::Approx(34).epsilon(0.03));
+  CHECK(sdot(c::theta_l5) == 0.5 * kDeg);  // commanded rates come back untouched
+  // Both constraints hold, and so does the linearised closure.
+  CHECK(sideways_velocity(model, s, sdot, d).cwiseAbs().maxCoeff() <= 1e-15);
+  gen::closure(s, model.params(), nullptr, &d.dPhi_ds);
+  CHECK((d.dPhi_ds * sdot).cwiseAbs().maxCoeff() <= 1e-15);
+}
+
+TEST_CASE("nonholonomic: both wheels level under a level cabin: J_beta singular, a clear error") {
+  const Model model;
+  Data d;
+  Coordinates s = nominal_inputs();
+  s(c::z_Wr) = 0.0;
+  s = assembled(s);
+  Coordinates sdot = Coordinates::Zero();
+  sdot(c::roll) = 0.1;
+  try {
+    solve_dependent_rates(model, s, sdot, kPairA, d);
+    FAIL("no error for a singular J_beta");
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    CHECK(e.field() == "dependent");
+    CHECK(m.find("J_beta for the dependent pair (y_C', yaw') is singular: condition number") != std::string::npos);
+    CHECK(m.find("exceeds the threshold 1e+10") != std::string::npos);
+    CHECK(m.find("Raise one wheel (the thesis uses z_Wr = 0.05 m) or choose another dependent pair.") != std::string::npos);
+  }
+  // A documented, configurable threshold: below the nominal 7e2, even the nominal state is singular.
+  NonholonomicOptions strict;
+  strict.max_condition = 100;
+  const Coordinates nominal = assembled(nominal_inputs());
+  CHECK_THROWS_AS(solve_dependent_rates(model, nominal, sdot, kPairA, d, strict), Error);
+}
+
+TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are errors") {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled(nominal_inputs());
+  int regular = 0, singular = 0;
+  for (std::size_t i = 0; i < kWheelCoupledInputs.size(); ++i)
+    for (std::size_t j = i + 1; j < kWheelCoupledInputs.size(); ++j) {
+      const DependentPair pair{{kWheelCoupledInputs[i], kWheelCoupledInputs[j]}};
+      CAPTURE(pair.label());
+      Coordinates sdot = Coordinates::Zero();
+      for (int k : kWheelCoupledInputs) sdot(k) = 0.01 * (k + 1);  // some commanded motion
+      sdot(pair.index[0]) = sdot(pair.index[1]) = 0;
+      const Coordinates commanded = sdot;
+      try {
+        solve_dependent_rates(model, s, sdot, pair, d);
+      } catch (const Error&) {
+        ++singular;
+        CHECK(!(d.cond_J_beta <= 1e10));
+        continue;
+      }
+      ++regular;
+      CHECK(sideways_velocity(model, s, sdot, d).cwiseAbs().maxCoeff() <= 1e-13 * std::max(1.0, d.cond_J_beta / 1e3));
+      for (int k : kWheelCoupledInputs)
+        if (k != pair.index[0] && k != pair.index[1]) CHECK(sdot(k) == commanded(k));
+    }
+  MESSAGE(regular << " of 28 pairs regular at the nominal pose, " << singular << " singular");
+  CHECK(regular + singular == 28);
+  CHECK(regular >= 2);
+}
+
+TEST_CASE("nonholonomic: pair names are validated") {
+  CHECK(dependent_pair("theta_l5", "theta_r5").index == kPairB.index);
+  const auto message = [](const char* a, const char* b) {
+    try {
+      dependent_pair(a, b);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  CHECK(message("y_C", "y_C") == "dependent: the two dependent rates must differ, got 'y_C' twice");
+  CHECK(message("y_C", "psi_l2") ==
+        "dependent: 'psi_l2' cannot be a dependent rate: choose 2 of x_C, y_C, z_C, yaw, pitch, roll, theta_l5, theta_r5");
+}
+
+TEST_CASE("nonholonomic: rates and accelerations against finite differences along an integrated trajectory") {
+  // ST-A2+-like motion plus roll, RK4 with dt = 1e-4: central differences of the samples have
+  // error ~dt^2 |s'''| / 6 ~ 1e-8 relative; the integration itself is converged far below that.
+  Scenario sc;
+  sc.rates(c::theta_l5) = 0.5 * kDeg;
+  sc.rates(c::roll) = 3 * kDeg;
+  sc.duration = 0.02;
+  sc.dt = 1e-4;
+  const Trajectory tr = simulate(sc);
+  REQUIRE(tr.complete);
+  const Model model;
+  Data d;
+  double worst_v = 0, worst_a = 0, scale_v = 0, scale_a = 0;
+  for (std::size_t k = 1; k + 1 < tr.samples.size(); ++k) {
+    const auto& prev = tr.samples[k - 1];
+    const auto& now = tr.samples[k];
+    const auto& next = tr.samples[k + 1];
+    const Coordinates fd_v = (next.s - prev.s) / (2 * sc.dt);
+    const Coordinates fd_a = (next.sdot - prev.sdot) / (2 * sc.dt);
+    Coordinates sdot = now.sdot;
+    solve_dependent_rates(model, now.s, sdot, sc.pair, d);
+    Coordinates sddot = Coordinates::Zero();  // constant commanded rates
+    solve_dependent_accelerations(model, now.s, sdot, sddot, sc.pair, d);
+    worst_v = std::max(worst_v, (fd_v - now.sdot).cwiseAbs().maxCoeff());
+    worst_a = std::max(worst_a, (fd_a - sddot).cwiseAbs().maxCoeff());
+    scale_v = std::max(scale_v, now.sdot.cwiseAbs().maxCoeff());
+    scale_a = std::max(scale_a, sddot.cwiseAbs().maxCoeff());
+  }
+  MESSAGE("max |finite difference - analytic|: rates " << worst_v << " (scale " << scale_v << "), accelerations "
+                                                        << worst_a << " (scale " << scale_a << ")");
+  CHECK(worst_v <= 1e-7 * scale_v);
+  CHECK(worst_a <= 1e-6 * scale_a);
+  CHECK(scale_a > 1e-3);  // the acceleration check is not vacuous
+}

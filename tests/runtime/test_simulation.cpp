@@ -1,0 +1,117 @@
+// Integration: no drift, convergence, the thesis' singular crossing, stopping cleanly.
+#include <doctest/doctest.h>
+#include <wlx/error.hpp>
+#include <wlx/kinematics.hpp>
+#include <wlx/simulation.hpp>
+
+#include <cmath>
+#include <numbers>
+
+using namespace wlx;
+namespace c = gen::coord;
+
+namespace {
+constexpr double kDeg = std::numbers::pi / 180;
+}
+
+TEST_CASE("simulation: the closure does not drift; sample count includes t = 0") {
+  Scenario sc;
+  sc.rates(c::roll) = 5 * kDeg;
+  sc.duration = 2.0;
+  const Trajectory tr = simulate(sc);
+  REQUIRE(tr.complete);
+  CHECK(tr.samples.size() == 2001);  // the thesis' "2001 integrations" for 2 s
+  const Model model;
+  Data d;
+  double worst = 0;
+  for (const auto& smp : tr.samples) {
+    closure(model, smp.s, d, false);
+    worst = std::max(worst, d.Phi.cwiseAbs().maxCoeff());
+  }
+  CHECK(worst <= 1e-13);
+  CHECK(tr.samples.back().s(c::roll) == doctest::Approx(10 * kDeg).epsilon(1e-12));
+}
+
+TEST_CASE("simulation: RK4 at 1 ms is converged; Euler differs by ~4e-5 m in y_C (MODEL.md section 5)") {
+  Scenario sc;
+  sc.rates(c::theta_l5) = 0.5 * kDeg;  // ST-A2+
+  sc.duration = 0.451;
+  const Trajectory rk4 = simulate(sc);
+  sc.dt = 0.0005;
+  const Trajectory fine = simulate(sc);
+  sc.dt = 0.001;
+  sc.integrator = Integrator::euler;
+  const Trajectory euler = simulate(sc);
+  const double rk4_error = std::abs(rk4.samples.back().s(c::y_C) - fine.samples.back().s(c::y_C));
+  double euler_error = 0;
+  for (std::size_t k = 0; k < rk4.samples.size(); ++k)
+    euler_error = std::max(euler_error, std::abs(euler.samples[k].s(c::y_C) - rk4.samples[k].s(c::y_C)));
+  MESSAGE("ST-A2+ y_C: |RK4(1 ms) - RK4(0.5 ms)| = " << rk4_error << " m, max |Euler - RK4| = " << euler_error << " m");
+  CHECK(rk4_error <= 1e-12);
+  CHECK(euler_error == doctest::Approx(4e-5).epsilon(0.5));
+}
+
+TEST_CASE("simulation: ST-A1- passes the singular point at t ~ 0.1910 s smoothly") {
+  Scenario sc;
+  sc.rates(c::roll) = -5 * kDeg;
+  sc.duration = 0.4;
+  const Trajectory tr = simulate(sc);
+  REQUIRE(tr.complete);
+  std::size_t peak = 0;
+  for (std::size_t k = 0; k < tr.samples.size(); ++k)
+    if (tr.samples[k].cond_J_beta > tr.samples[peak].cond_J_beta) peak = k;
+  MESSAGE("largest cond(J_beta) " << tr.samples[peak].cond_J_beta << " at t = " << tr.samples[peak].t << " s");
+  CHECK(tr.samples[peak].t == doctest::Approx(0.191).epsilon(0.005));
+  CHECK(tr.samples[peak].cond_J_beta == doctest::Approx(2.7e7).epsilon(0.1));
+  // roll there is -asin(0.05 / 3): the roll cancels the 5 cm step between the wheels.
+  CHECK(tr.samples[peak].s(c::roll) == doctest::Approx(-std::asin(0.05 / 3)).epsilon(0.01));
+  // The dependent rates stay smooth: second differences at the crossing are as small as elsewhere.
+  const auto second = [&](std::size_t k, int i) {
+    return std::abs(tr.samples[k + 1].sdot(i) - 2 * tr.samples[k].sdot(i) + tr.samples[k - 1].sdot(i));
+  };
+  double typical = 0;
+  for (std::size_t k = 10; k < 100; ++k) typical = std::max(typical, second(k, c::yaw));
+  CHECK(second(peak, c::yaw) <= 10 * typical + 1e-6);
+  CHECK(second(peak, c::y_C) <= 1e-6);
+}
+
+TEST_CASE("simulation: a run that becomes unreachable stops, keeps its samples and says when") {
+  Scenario sc;
+  sc.rates(c::z_C) = 3.0;  // lift the cabin until the legs cannot reach the feet
+  sc.duration = 1.0;
+  const Trajectory tr = simulate(sc);
+  CHECK_FALSE(tr.complete);
+  REQUIRE(!tr.samples.empty());
+  CHECK(tr.samples.size() < 1001);
+  CHECK(tr.error.find("stopped at t = ") == 0);
+  CHECK(tr.error.find("leg: foot is") != std::string::npos);
+  for (const auto& smp : tr.samples) CHECK(smp.s.allFinite());
+}
+
+TEST_CASE("simulation: scenario validation names the field") {
+  Scenario sc;
+  sc.duration = 1;
+  sc.dt = 0;
+  CHECK_THROWS_WITH_AS(sc.validate(), "dt: must be a positive number of seconds, got 0", Error);
+  sc.dt = 1e-9;
+  sc.duration = 1000;
+  CHECK_THROWS_WITH_AS(sc.validate(), "dt: 1e-09 s over 1000 s is 1e+12 steps, more than the limit of 1e8", Error);
+  sc = Scenario{};
+  sc.duration = -2;
+  CHECK_THROWS_WITH_AS(sc.validate(), "duration: must be a positive number of seconds, got -2", Error);
+  sc = Scenario{};
+  sc.duration = 1;
+  sc.rates(c::yaw) = 0.1;
+  CHECK_THROWS_WITH_AS(sc.validate(),
+                       "rates.yaw: yaw is a dependent rate in this scenario (pair (y_C', yaw')): it is computed, not "
+                       "commanded",
+                       Error);
+}
+
+TEST_CASE("simulation: cabin clearance of the 3 x 3 x 0.5 m block") {
+  const Params p;
+  Coordinates s = nominal_inputs();
+  CHECK(cabin_clearance(p, s) == doctest::Approx(2.0 - 0.25));
+  s(c::roll) = 0.1;
+  CHECK(cabin_clearance(p, s) == doctest::Approx(2.0 - (std::sin(0.1) * 1.5 + std::cos(0.1) * 0.25)));
+}
