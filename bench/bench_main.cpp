@@ -3,6 +3,10 @@
 #include <benchmark/benchmark.h>
 #include <wlx/ik.hpp>
 #include <wlx/kinematics.hpp>
+#include <wlx/nonholonomic.hpp>
+#include <wlx/simulation.hpp>
+
+#include <numbers>
 
 #include <random>
 
@@ -133,8 +137,48 @@ void BM_ik_newton_warm_4_limbs(benchmark::State& st) {
   st.counters["iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
 }
 
+// Velocity level: closure Jacobian + C(s) + block factorizations + J_beta solve.
+void BM_dependent_rates(benchmark::State& st) {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled_nominal(model);
+  Coordinates sdot = Coordinates::Zero();
+  sdot(gen::coord::roll) = 0.1;
+  for (auto _ : st) {
+    solve_dependent_rates(model, s, sdot, kPairA, d);
+    benchmark::DoNotOptimize(sdot.data());
+  }
+}
+// Acceleration level, after the velocity level at the same state (it reuses the factorizations).
+void BM_dependent_accelerations(benchmark::State& st) {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled_nominal(model);
+  Coordinates sdot = Coordinates::Zero();
+  sdot(gen::coord::roll) = 0.1;
+  solve_dependent_rates(model, s, sdot, kPairA, d);
+  Coordinates sddot = Coordinates::Zero();
+  for (auto _ : st) {
+    solve_dependent_accelerations(model, s, sdot, sddot, kPairA, d);
+    benchmark::DoNotOptimize(sddot.data());
+  }
+}
+// The whole NH-1 run: 2 s at 1 ms, RK4, closed-form IK at every stage.
+void BM_run_NH1(benchmark::State& st) {
+  Scenario sc;
+  sc.rates(gen::coord::roll) = 5 * std::numbers::pi / 180;
+  sc.duration = 2.0;
+  for (auto _ : st) {
+    const Trajectory tr = simulate(sc);
+    benchmark::DoNotOptimize(tr.samples.data());
+  }
+}
+
 }  // namespace
 
+BENCHMARK(BM_dependent_rates);
+BENCHMARK(BM_dependent_accelerations);
+BENCHMARK(BM_run_NH1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_gen_kinematics_positions);
 BENCHMARK(BM_gen_kinematics_all);
 BENCHMARK(BM_gen_closure);

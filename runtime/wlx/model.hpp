@@ -50,10 +50,10 @@ struct Data {
   gen::BodyVectors body_Jw_dot_sdot;
 
   // Non-holonomic solve (nonholonomic.hpp): the closure's per-limb factorizations (legs padded to
-  // 4 x 4 with a unit diagonal), the dependent-joint sensitivity X = Phi_dep^-1 Phi_q, the wheel
-  // rows reduced to the inputs, and J_beta.
+  // 4 x 4 with a unit diagonal), the adjoint Lambda = Phi_dep^-T C_dep^T, the wheel rows reduced
+  // to the inputs C_hat = C_q - Lambda^T Phi_q, and J_beta.
   std::array<Eigen::PartialPivLU<Eigen::Matrix4d>, 4> limb_lu;
-  Eigen::Matrix<double, gen::kDependentCount, gen::kInputCount> closure_sensitivity;
+  Eigen::Matrix<double, gen::kDependentCount, gen::kWheelCount> wheel_adjoint;
   Eigen::Matrix<double, gen::kWheelCount, gen::kInputCount> C_reduced;
   Eigen::Matrix2d J_beta;
   double cond_J_beta = 0;

@@ -3,7 +3,6 @@
 #include "wlx/error.hpp"
 #include "wlx/ik.hpp"
 
-#include <Eigen/SVD>
 #include <fmt/format.h>
 
 #include <cmath>
@@ -23,42 +22,45 @@ bool is_wheel_coupled(int coordinate) {
   return false;
 }
 
-// Factorizes each limb's block of dPhi/ds and forms X = Phi_dep^-1 Phi_q and C_hat = C_q - C_dep X.
+// Factorizes each limb's block of dPhi/ds, solves the adjoint Phi_dep^T Lambda = C_dep^T and forms
+// C_hat = C_q - Lambda^T Phi_q: 2 right-hand sides instead of the 18 of Phi_dep^-1 Phi_q.
 void reduce(Data& d) {
   for (Limb limb : kLimbs) {
     const LimbBlock b = limb_block(limb);
     Eigen::Matrix4d block = Eigen::Matrix4d::Identity();
-    Eigen::Matrix<double, 4, kNq> rhs = Eigen::Matrix<double, 4, kNq>::Zero();
-    for (int i = 0; i < b.size; ++i) {
-      for (int j = 0; j < b.size; ++j) block(i, j) = d.dPhi_ds(b.first_row + i, b.joints[static_cast<std::size_t>(j)]);
-      rhs.row(i) = d.dPhi_ds.block<1, kNq>(b.first_row + i, 0);
+    Eigen::Matrix<double, 4, 2> rhs = Eigen::Matrix<double, 4, 2>::Zero();
+    for (int j = 0; j < b.size; ++j) {
+      const int joint = b.joints[static_cast<std::size_t>(j)];
+      for (int i = 0; i < b.size; ++i) block(i, j) = d.dPhi_ds(b.first_row + i, joint);
+      rhs.row(j) = d.C.col(joint).transpose();
     }
     auto& lu = d.limb_lu[static_cast<std::size_t>(limb)];
     lu.compute(block);
-    const Eigen::Matrix<double, 4, kNq> x = lu.solve(rhs);
-    for (int j = 0; j < b.size; ++j) d.closure_sensitivity.row(b.joints[static_cast<std::size_t>(j)] - kNq) = x.row(j);
+    const Eigen::Matrix<double, 4, 2> lambda = lu.transpose().solve(rhs);
+    for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.first_row + i) = lambda.row(i);
   }
-  d.C_reduced = d.C.leftCols<kNq>() - d.C.rightCols<kDependentCount>() * d.closure_sensitivity;
+  d.C_reduced = d.C.leftCols<kNq>() - d.wheel_adjoint.transpose() * d.dPhi_ds.leftCols<kNq>();
 }
 
-// Phi_dep^-1 v, block by block with the factorizations of reduce().
-gen::ClosureVector solve_closure(const Data& d, const gen::ClosureVector& v) {
-  gen::ClosureVector out;
+// The dependent joints' part of s'' or s' for a closure right-hand side: Phi_dep x = -v.
+void solve_closure(const Data& d, const gen::ClosureVector& v, Coordinates& out) {
   for (Limb limb : kLimbs) {
     const LimbBlock b = limb_block(limb);
     Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
-    for (int i = 0; i < b.size; ++i) rhs(i) = v(b.first_row + i);
+    for (int i = 0; i < b.size; ++i) rhs(i) = -v(b.first_row + i);
     const Eigen::Vector4d x = d.limb_lu[static_cast<std::size_t>(limb)].solve(rhs);
-    for (int j = 0; j < b.size; ++j) out(b.joints[static_cast<std::size_t>(j)] - kNq) = x(j);
+    for (int j = 0; j < b.size; ++j) out(b.joints[static_cast<std::size_t>(j)]) = x(j);
   }
-  return out;
 }
 
+// 2-norm condition number of a 2 x 2 matrix in closed form: with E = |J|_F^2 and D = |det J|,
+// sigma_max^2 = (E + sqrt(E^2 - 4 D^2)) / 2 and sigma_max sigma_min = D.
 double condition_number(const Eigen::Matrix2d& J) {
-  const Eigen::JacobiSVD<Eigen::Matrix2d> svd(J);
-  const double smax = svd.singularValues()(0), smin = svd.singularValues()(1);
-  if (!std::isfinite(smax)) return std::numeric_limits<double>::infinity();
-  return smin > 0 ? smax / smin : std::numeric_limits<double>::infinity();
+  const double E = J.squaredNorm(), D = std::abs(J.determinant());
+  if (!std::isfinite(E)) return std::numeric_limits<double>::infinity();
+  if (!(D > 0)) return std::numeric_limits<double>::infinity();
+  const double smax2 = 0.5 * (E + std::sqrt(std::max(0.0, (E - 2 * D) * (E + 2 * D))));
+  return smax2 / D;
 }
 
 }  // namespace
@@ -106,23 +108,26 @@ void solve_dependent_rates(const Model& model, const Coordinates& s, Coordinates
   q_rate(pair.index[0]) = pair_rate(0);
   q_rate(pair.index[1]) = pair_rate(1);
   sdot.head<kNq>() = q_rate;
-  sdot.tail<kDependentCount>() = -d.closure_sensitivity * q_rate;
+  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>() * q_rate;
+  solve_closure(d, closure_rhs, sdot);
 }
 
 void solve_dependent_accelerations(const Model& model, const Coordinates& s, const Coordinates& sdot,
                                    Coordinates& sddot, const DependentPair& pair, Data& d) {
   gen::convective(s, sdot, model.params(), &d.dPhi_ds_dot_sdot, &d.C_dot_sdot);
-  const gen::ClosureVector y = solve_closure(d, d.dPhi_ds_dot_sdot);
   Eigen::Matrix<double, kNq, 1> q_acc = sddot.head<kNq>();
   q_acc(pair.index[0]) = 0;
   q_acc(pair.index[1]) = 0;
-  // C s'' + (d/dt C) s' = 0 with s''_dep = -X q'' - y.
-  const Eigen::Vector2d rhs = d.C_reduced * q_acc + d.C_dot_sdot - d.C.rightCols<kDependentCount>() * y;
+  // Phi_dep s''_dep = -(Phi_q q'' + conv_Phi) and C s'' + conv_C = 0 give
+  // C_hat q'' = -(conv_C - Lambda^T conv_Phi).
+  const Eigen::Vector2d rhs =
+      d.C_reduced * q_acc + d.C_dot_sdot - d.wheel_adjoint.transpose() * d.dPhi_ds_dot_sdot;
   const Eigen::Vector2d pair_acc = -d.J_beta.partialPivLu().solve(rhs);
   q_acc(pair.index[0]) = pair_acc(0);
   q_acc(pair.index[1]) = pair_acc(1);
   sddot.head<kNq>() = q_acc;
-  sddot.tail<kDependentCount>() = -d.closure_sensitivity * q_acc - y;
+  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>() * q_acc + d.dPhi_ds_dot_sdot;
+  solve_closure(d, closure_rhs, sddot);
 }
 
 Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& d) {
