@@ -2,6 +2,7 @@
 // Compare numbers from one run only (ratios): these machines are noisy.
 #include <benchmark/benchmark.h>
 #include <wlx/ik.hpp>
+#include <wlx/dynamics.hpp>
 #include <wlx/kinematics.hpp>
 #include <wlx/nonholonomic.hpp>
 #include <wlx/simulation.hpp>
@@ -174,8 +175,38 @@ void BM_run_NH1(benchmark::State& st) {
   }
 }
 
+// One inverse-dynamics step: closed-form IK, dependent rates and accelerations, body kinematics,
+// Kane's sums, J_beta, and the weighted torque distribution.
+void BM_inverse_dynamics_step(benchmark::State& st) {
+  const Model model;
+  Data d;
+  DynamicsTerms terms;
+  Coordinates s = nominal_inputs();
+  s(gen::coord::x_C) = 0.3;
+  const Vector4 u(0, 3, 0, 0);
+  for (auto _ : st) {
+    solve_ik_closed_form(model, s);
+    inverse_dynamics(model, s, u, Vector4::Zero(), d, terms);
+    const Vector8 tau = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
+    benchmark::DoNotOptimize(tau.data());
+  }
+}
+// The whole ID-1 run (495 samples, RK4) with weighting 1.
+void BM_run_ID1(benchmark::State& st) {
+  Scenario sc;
+  sc.rates(gen::coord::x_C) = 3.0;
+  sc.duration = 0.494;
+  sc.weighting = Weighting::strong_weak();
+  for (auto _ : st) {
+    const Trajectory tr = simulate(sc);
+    benchmark::DoNotOptimize(tr.samples.data());
+  }
+}
+
 }  // namespace
 
+BENCHMARK(BM_inverse_dynamics_step);
+BENCHMARK(BM_run_ID1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_dependent_rates);
 BENCHMARK(BM_dependent_accelerations);
 BENCHMARK(BM_run_NH1)->Unit(benchmark::kMillisecond);

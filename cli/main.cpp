@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
   simulate->add_option("--out", sim.out_dir, "output folder for trajectory.csv")->capture_default_str();
   simulate->add_option("--integrator", sim.integrator, "rk4 or euler (default: the scenario's)");
   simulate->add_option("--dt", sim.dt, "step in seconds (default: the scenario's)");
+  simulate->add_option("--weighting", sim.weighting, "torque weighting 1 or 2 (inverse dynamics, MODEL.md section 7)");
   simulate->add_flag("--list", sim.list, "list the built-in scenarios");
 
   CLI11_PARSE(app, argc, argv);

@@ -72,6 +72,37 @@ double si_value(const nlohmann::json& v, const std::string& key, bool angle) {
   return finite_number(v, key);
 }
 
+Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
+  if (v.is_number_integer() && (v == 1 || v == 2)) return v == 1 ? Weighting::strong_weak() : Weighting::contribution();
+  if (v.is_object() && v.size() == 1 && v.contains("diag")) {
+    const auto& d = v.at("diag");
+    if (!d.is_array() || d.size() != 8) throw Error(key + ".diag", fmt::format("must be an array of 8 weights, got {}", d.dump()));
+    Vector8 w;
+    for (int i = 0; i < 8; ++i) w(i) = finite_number(d[static_cast<std::size_t>(i)], fmt::format("{}.diag[{}]", key, i));
+    try {
+      return Weighting::diagonal_of(w);
+    } catch (const Error& e) {
+      throw Error(key + ".diag", std::string(e.what()).substr(e.field().size() + 2));
+    }
+  }
+  if (v.is_object() && v.size() == 1 && v.contains("matrix")) {
+    const auto& m = v.at("matrix");
+    if (!m.is_array() || m.size() != 8) throw Error(key + ".matrix", "must be 8 rows of 8 numbers");
+    Eigen::Matrix<double, 8, 8> W;
+    for (int r = 0; r < 8; ++r) {
+      const auto& row = m[static_cast<std::size_t>(r)];
+      if (!row.is_array() || row.size() != 8) throw Error(fmt::format("{}.matrix[{}]", key, r), "must be a row of 8 numbers");
+      for (int c = 0; c < 8; ++c) W(r, c) = finite_number(row[static_cast<std::size_t>(c)], fmt::format("{}.matrix[{}][{}]", key, r, c));
+    }
+    try {
+      return Weighting::matrix_of(W);
+    } catch (const Error& e) {
+      throw Error(key + ".matrix", std::string(e.what()).substr(e.field().size() + 2));
+    }
+  }
+  throw Error(key, fmt::format("must be 1, 2, {{\"diag\": [8 weights]}} or {{\"matrix\": [[8 x 8]]}}, got {}", v.dump()));
+}
+
 Scenario parse_scenario(const nlohmann::json& j) {
   if (!j.is_object()) throw Error("", fmt::format("a scenario is a JSON object, got {}", j.type_name()));
   reject_unknown_keys(j, {"id", "description", "observation", "initial", "params", "rates", "dependent", "duration", "dt",
@@ -118,6 +149,7 @@ Scenario parse_scenario(const nlohmann::json& j) {
     if (!(sc.nonholonomic.max_condition > 1))
       throw Error("max_condition", fmt::format("must be above 1, got {}", sc.nonholonomic.max_condition));
   }
+  if (j.contains("weighting")) sc.weighting = parse_weighting(j.at("weighting"), "weighting");
   sc.validate();
   return sc;
 }

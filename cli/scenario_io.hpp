@@ -18,6 +18,9 @@ std::string embedded_scenario(const std::string& id);
 nlohmann::json read_scenario_json(const std::string& path_or_id);
 Scenario parse_scenario(const nlohmann::json& j);
 
+// 1, 2, {"diag": [...]} or {"matrix": [[...]]}.
+Weighting parse_weighting(const nlohmann::json& v, const std::string& key);
+
 // A number in SI units, or {"deg": x} / {"deg/s": x} for angle coordinates.
 double si_value(const nlohmann::json& v, const std::string& key, bool is_angle);
 

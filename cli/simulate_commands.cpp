@@ -11,7 +11,7 @@
 
 namespace wlx::cli {
 
-std::vector<std::string> trajectory_header() {
+std::vector<std::string> trajectory_header(bool dynamics) {
   std::vector<std::string> h{"t"};
   for (int k = 0; k < kCoordinateCount; ++k) h.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
   for (const char* c : {"x_Wl", "y_Wl", "x_Wr", "y_Wr", "nh_residual_l", "nh_residual_r", "spin_rate_l", "spin_rate_r"})
@@ -19,10 +19,14 @@ std::vector<std::string> trajectory_header() {
   for (int k = 0; k < kInputCount; ++k) h.push_back(std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]) + "_dot");
   h.emplace_back("cond_J_beta");
   h.emplace_back("cabin_clearance");
+  if (dynamics) {
+    for (int k : kActuatedJoints) h.push_back("tau_" + std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]));
+    for (int k : kCommandedSpeeds) h.push_back("Qstar_" + std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]));
+  }
   return h;
 }
 
-std::vector<double> trajectory_row(const Sample& smp) {
+std::vector<double> trajectory_row(const Sample& smp, bool dynamics) {
   std::vector<double> row{smp.t};
   for (int k = 0; k < kCoordinateCount; ++k) row.push_back(smp.s(k));
   for (int k = 0; k < 4; ++k) row.push_back(smp.contacts(k));
@@ -30,12 +34,16 @@ std::vector<double> trajectory_row(const Sample& smp) {
   for (int k = 0; k < kInputCount; ++k) row.push_back(smp.sdot(k));
   row.push_back(smp.cond_J_beta);
   row.push_back(smp.cabin_clearance);
+  if (dynamics) {
+    for (int k = 0; k < 8; ++k) row.push_back(smp.tau(k));
+    for (int k = 0; k < 4; ++k) row.push_back(smp.Qstar(k));
+  }
   return row;
 }
 
-void write_trajectory(const std::string& path, const Trajectory& tr) {
-  CsvWriter csv(path, trajectory_header());
-  for (const auto& smp : tr.samples) csv.row(trajectory_row(smp));
+void write_trajectory(const std::string& path, const Trajectory& tr, bool dynamics) {
+  CsvWriter csv(path, trajectory_header(dynamics));
+  for (const auto& smp : tr.samples) csv.row(trajectory_row(smp, dynamics));
 }
 
 int run_simulate(const SimulateOptions& o) {
@@ -51,11 +59,15 @@ int run_simulate(const SimulateOptions& o) {
   else if (o.integrator == "rk4") sc.integrator = Integrator::rk4;
   else if (!o.integrator.empty()) throw Error("--integrator", fmt::format("must be rk4 or euler, got '{}'", o.integrator));
   if (o.dt) sc.dt = *o.dt;
+  if (!o.weighting.empty()) {
+    if (o.weighting != "1" && o.weighting != "2") throw Error("--weighting", fmt::format("must be 1 or 2, got '{}'", o.weighting));
+    sc.weighting = o.weighting == "1" ? Weighting::strong_weak() : Weighting::contribution();
+  }
   sc.validate();
   std::filesystem::create_directories(o.out_dir);
   const Trajectory tr = simulate(sc);
   const std::string path = (std::filesystem::path(o.out_dir) / "trajectory.csv").string();
-  write_trajectory(path, tr);
+  write_trajectory(path, tr, sc.weighting.has_value());
   double worst = 0, worst_cond = 0, min_clearance = 1e300;
   for (const auto& smp : tr.samples) {
     worst = std::max(worst, smp.nh_residual.cwiseAbs().maxCoeff());
@@ -66,6 +78,11 @@ int run_simulate(const SimulateOptions& o) {
              tr.samples.size(), sc.duration, sc.dt, sc.integrator == Integrator::rk4 ? "rk4" : "euler", sc.pair.label());
   fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, min cabin clearance = {:.4f} m\n", worst, worst_cond,
              min_clearance);
+  if (sc.weighting && !tr.samples.empty()) {
+    double peak = 0;
+    for (const auto& smp : tr.samples) peak = std::max(peak, smp.tau.cwiseAbs().maxCoeff());
+    fmt::print("inverse dynamics with {}: largest |tau| = {:.4g} N m\n", sc.weighting->label(), peak);
+  }
   fmt::print("wrote {}\n", path);
   if (!tr.complete) {
     fmt::print(stderr, "wlx: error: {}; {} wrote the {} samples computed before\n", tr.error, path, tr.samples.size());
@@ -82,7 +99,7 @@ int run_verify_nonholonomic(const std::string& out_dir) {
   for (const char* id : {"NH-1", "NH-2", "NH-3", "NH-4"}) {
     const Scenario sc = parse_scenario(read_scenario_json(id));
     const Trajectory tr = simulate(sc);
-    write_trajectory((std::filesystem::path(out_dir) / (std::string(id) + ".csv")).string(), tr);
+    write_trajectory((std::filesystem::path(out_dir) / (std::string(id) + ".csv")).string(), tr, false);
     double l = 0, r = 0, cond = 0;
     for (const auto& smp : tr.samples) {
       l = std::max(l, std::abs(smp.nh_residual(0)));

@@ -36,6 +36,14 @@ void reduce(Data& d) {
     }
     auto& lu = d.limb_lu[static_cast<std::size_t>(limb)];
     lu.compute(block);
+    // A singular block means the limb's joint rates are not determined by its target's motion.
+    if (!(lu.rcond() > 1e-13))
+      throw Error(std::string(limb_name(limb)),
+                  fmt::format("the closure Jacobian of this limb is singular (reciprocal condition {:.2g}): {}; its joint "
+                              "rates are undefined here",
+                              lu.rcond(),
+                              b.size == 3 ? "the leg is stretched straight or folded, or its hip yaw is at 90 deg"
+                                          : "the lever stands at 90 deg to the level or is straddled to 90 deg"));
     const Eigen::Matrix<double, 4, 2> lambda = lu.transpose().solve(rhs);
     for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.first_row + i) = lambda.row(i);
   }
@@ -128,6 +136,23 @@ void solve_dependent_accelerations(const Model& model, const Coordinates& s, con
   sddot.head<kNq>() = q_acc;
   const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>() * q_acc + d.dPhi_ds_dot_sdot;
   solve_closure(d, closure_rhs, sddot);
+}
+
+Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& commanded, const DependentPair& pair,
+                                                      const Data& d) {
+  Eigen::Matrix<double, kCoordinateCount, 4> T = Eigen::Matrix<double, kCoordinateCount, 4>::Zero();
+  const auto lu = d.J_beta.partialPivLu();
+  for (int k = 0; k < 4; ++k) {
+    Coordinates col = Coordinates::Zero();
+    col(commanded[static_cast<std::size_t>(k)]) = 1;
+    const Eigen::Vector2d pair_rate = -lu.solve(d.C_reduced.col(commanded[static_cast<std::size_t>(k)]));
+    col(pair.index[0]) = pair_rate(0);
+    col(pair.index[1]) = pair_rate(1);
+    const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>() * col.head<kNq>();
+    solve_closure(d, closure_rhs, col);
+    T.col(k) = col;
+  }
+  return T;
 }
 
 Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& d) {

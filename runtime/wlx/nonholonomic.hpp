@@ -50,6 +50,12 @@ void solve_dependent_rates(const Model& model, const Coordinates& s, Coordinates
 void solve_dependent_accelerations(const Model& model, const Coordinates& s, const Coordinates& sdot,
                                    Coordinates& sddot, const DependentPair& pair, Data& data);
 
+// After solve_dependent_rates at s (same pair): the full rates s' caused by a unit rate of each
+// input in `commanded` (one column each), every other commanded rate zero. Linear in the rates,
+// so s' = T u for u the rates of `commanded`.
+Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& commanded, const DependentPair& pair,
+                                                      const Data& data);
+
 // v_W . n_W per wheel for the full sdot: the thesis' residual check of the rolling constraint.
 Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& data);
 

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace wlx {
@@ -48,6 +49,16 @@ void Scenario::validate() const {
       throw Error(fmt::format("rates.{}", gen::kCoordinateNames[static_cast<std::size_t>(k)]),
                   fmt::format("{} is a dependent rate in this scenario (pair {}): it is computed, not commanded",
                               gen::kCoordinateNames[static_cast<std::size_t>(k)], pair.label()));
+  if (weighting) {
+    if (pair.index != kPairA.index)
+      throw Error("dependent", fmt::format("an inverse-dynamics run needs the dependent pair (y_C', yaw') (MODEL.md "
+                                           "section 7), got {}",
+                                           pair.label()));
+    for (int k = 0; k < kInputCount; ++k)
+      if (rates(k) != 0 && std::find(kCommandedSpeeds.begin(), kCommandedSpeeds.end(), k) == kCommandedSpeeds.end())
+        throw Error(fmt::format("rates.{}", gen::kCoordinateNames[static_cast<std::size_t>(k)]),
+                    "an inverse-dynamics run commands only z_C, x_C, roll and pitch; every other input is constant");
+  }
   for (int k = 0; k < kInputCount; ++k) {
     const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
     if (!std::isfinite(initial(k))) throw Error("initial." + name, fmt::format("must be a finite number, got {}", initial(k)));
@@ -71,6 +82,9 @@ Trajectory simulate(const Scenario& sc, const Progress& progress) {
   const long n = sc.samples();
   out.samples.reserve(static_cast<std::size_t>(n));
   InputVector q = sc.initial.head<kInputCount>();
+  DynamicsTerms terms;
+  Vector4 u;
+  for (int k = 0; k < 4; ++k) u(k) = sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]);
   for (long k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) * sc.dt;
     try {
@@ -87,6 +101,11 @@ Trajectory simulate(const Scenario& sc, const Progress& progress) {
       smp.nh_residual = data.C * f.sdot;
       smp.spin_rate = data.spin * f.sdot;
       smp.cabin_clearance = cabin_clearance(model.params(), f.s);
+      if (sc.weighting) {
+        inverse_dynamics(model, f.s, u, Vector4::Zero(), data, terms, sc.nonholonomic);
+        smp.Qstar = terms.Qstar;
+        smp.tau = distribute_torques(terms.J_beta, terms.Qstar, *sc.weighting);
+      }
       out.samples.push_back(smp);
       if (progress) progress(k + 1, n);
       if (k + 1 == n) break;

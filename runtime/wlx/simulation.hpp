@@ -3,11 +3,13 @@
 // closed-form IK at every evaluation, so the loop closure cannot drift.
 #pragma once
 
+#include "wlx/dynamics.hpp"
 #include "wlx/ik.hpp"
 #include "wlx/model.hpp"
 #include "wlx/nonholonomic.hpp"
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,9 @@ struct Scenario {
   Integrator integrator = Integrator::rk4;
   Branches branches;
   NonholonomicOptions nonholonomic;
+  // Set: an inverse-dynamics run (MODEL.md section 7): pair A, only u = [z_C', x_C', roll',
+  // pitch'] commanded (constant, so u' = 0), torques distributed with this weighting.
+  std::optional<Weighting> weighting;
 
   // Number of output samples: duration / dt steps plus t = 0 (the thesis' "2001 integrations" for 2 s).
   long samples() const;
@@ -43,6 +48,9 @@ struct Sample {
   Eigen::Vector2d spin_rate;     // wheel spin rates, rad/s
   double cond_J_beta = 0;
   double cabin_clearance = 0;    // lowest cabin corner above z = 0, m
+  // Inverse-dynamics runs only:
+  Vector8 tau = Vector8::Zero();   // actuator torques, order of kActuatedJoints
+  Vector4 Qstar = Vector4::Zero(); // generalized forces on u
 };
 
 struct Trajectory {

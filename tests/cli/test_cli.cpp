@@ -167,3 +167,17 @@ TEST_CASE("cli: wlx simulate overrides, errors, and a run that fails midway") {
   CHECK(rows < 1001);
   CHECK(csv.find("nan") == std::string::npos);
 }
+
+TEST_CASE("cli: wlx simulate ID-1 --weighting 2 adds the torque and Q* columns") {
+  const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "id1";
+  fs::remove_all(dir);
+  const Run r = run_wlx("simulate ID-1 --weighting 2 --out " + dir.string());
+  CHECK(r.code == 0);
+  CHECK(r.out.find("inverse dynamics with weighting 2 (contribution)") != std::string::npos);
+  const std::string csv = slurp(dir / "trajectory.csv");
+  const std::string header = csv.substr(0, csv.find('\n'));
+  CHECK(header.find(",tau_psi_l2,tau_psi_l3,tau_psi_l4,tau_psi_r2,tau_psi_r3,tau_psi_r4,tau_theta_l6,tau_theta_r6,"
+                    "Qstar_z_C,Qstar_x_C,Qstar_roll,Qstar_pitch") != std::string::npos);
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 495);
+  CHECK(run_wlx("simulate ID-1 --weighting 3 --out " + dir.string()).err == "wlx: error: --weighting: must be 1 or 2, got '3'\n");
+}

@@ -143,3 +143,21 @@ TEST_CASE("nonholonomic: rates and accelerations against finite differences alon
   CHECK(worst_a <= 1e-6 * scale_a);
   CHECK(scale_a > 1e-3);  // the acceleration check is not vacuous
 }
+
+TEST_CASE("nonholonomic: a limb at a singular pose is named") {
+  const Model model;
+  Data d;
+  Coordinates s = nominal_inputs();
+  s(c::x_Fl) = 1.5 + 3.5;  // left foot exactly at full reach: straight leg
+  s(c::z_Fl) = 2.0;
+  s = assembled(s);
+  Coordinates sdot = Coordinates::Zero();
+  sdot(c::roll) = 0.1;
+  try {
+    solve_dependent_rates(model, s, sdot, kPairA, d);
+    FAIL("no error at a straight leg");
+  } catch (const Error& e) {
+    CHECK(e.field() == "left leg");
+    CHECK(std::string(e.what()).find("the leg is stretched straight or folded") != std::string::npos);
+  }
+}

@@ -1,0 +1,138 @@
+#include "wlx/dynamics.hpp"
+
+#include "wlx/error.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <Eigen/QR>
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace wlx {
+
+namespace {
+
+Eigen::Matrix3d world_inertia(const Params& p, int body, const Eigen::Matrix3d& R) {
+  const auto& info = gen::kBodyMass[static_cast<std::size_t>(body)];
+  const Eigen::Vector3d I(p.*info.inertia[0], p.*info.inertia[1], p.*info.inertia[2]);
+  return R * I.asDiagonal() * R.transpose();
+}
+
+double mass(const Params& p, int body) { return p.*gen::kBodyMass[static_cast<std::size_t>(body)].mass; }
+
+}  // namespace
+
+void inverse_dynamics(const Model& model, const Coordinates& s, const Vector4& u, const Vector4& u_dot, Data& d,
+                      DynamicsTerms& out, const NonholonomicOptions& options) {
+  const Params& p = model.params();
+  out.sdot.setZero();
+  for (int k = 0; k < 4; ++k) out.sdot(kCommandedSpeeds[static_cast<std::size_t>(k)]) = u(k);
+  solve_dependent_rates(model, s, out.sdot, kPairA, d, options);
+  out.T = rate_basis(kCommandedSpeeds, kPairA, d);
+  Coordinates bias = Coordinates::Zero();  // s'' with u' = 0
+  solve_dependent_accelerations(model, s, out.sdot, bias, kPairA, d);
+  out.sddot = out.T * u_dot + bias;
+  gen::bodies(s, out.sdot, p, &d.body_com, &d.body_rotations, &d.body_Jv, &d.body_Jw, &d.body_Jv_dot_sdot,
+              &d.body_Jw_dot_sdot);
+  out.M.setZero();
+  out.b.setZero();
+  out.Q_gravity.setZero();
+  const Eigen::Vector3d gravity(0, 0, -p.g);
+  for (int i = 0; i < gen::kBodyCount; ++i) {
+    const auto& Jv = d.body_Jv[static_cast<std::size_t>(i)];
+    const auto& Jw = d.body_Jw[static_cast<std::size_t>(i)];
+    const double m = mass(p, i);
+    const Eigen::Matrix3d inertia = world_inertia(p, i, d.body_rotations[static_cast<std::size_t>(i)]);
+    const Eigen::Matrix<double, 3, 4> A = Jv * out.T;  // partial velocities dv/du
+    const Eigen::Matrix<double, 3, 4> B = Jw * out.T;  // partial angular velocities domega/du
+    const Eigen::Vector3d omega = Jw * out.sdot;
+    const Eigen::Vector3d a_bias = Jv * bias + d.body_Jv_dot_sdot.col(i);
+    const Eigen::Vector3d alpha_bias = Jw * bias + d.body_Jw_dot_sdot.col(i);
+    out.M.noalias() += m * A.transpose() * A + B.transpose() * inertia * B;
+    out.b.noalias() += A.transpose() * (m * a_bias) + B.transpose() * (inertia * alpha_bias + omega.cross(inertia * omega));
+    out.Q_gravity.noalias() += A.transpose() * (m * gravity);
+  }
+  out.Qstar = out.M * u_dot + out.b - out.Q_gravity;
+  for (int r = 0; r < 8; ++r) out.J_beta.row(r) = out.T.row(kActuatedJoints[static_cast<std::size_t>(r)]);
+}
+
+double potential_energy(const Model& model, const Coordinates& s, Data& d) {
+  const Params& p = model.params();
+  gen::bodies(s, Coordinates::Zero(), p, &d.body_com, nullptr, nullptr, nullptr, nullptr, nullptr);
+  double V = 0;
+  for (int i = 0; i < gen::kBodyCount; ++i) V += mass(p, i) * p.g * d.body_com(2, i);
+  return V;
+}
+
+double kinetic_energy(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& d) {
+  const Params& p = model.params();
+  gen::bodies(s, sdot, p, nullptr, &d.body_rotations, &d.body_Jv, &d.body_Jw, nullptr, nullptr);
+  double T = 0;
+  for (int i = 0; i < gen::kBodyCount; ++i) {
+    const Eigen::Vector3d v = d.body_Jv[static_cast<std::size_t>(i)] * sdot;
+    const Eigen::Vector3d w = d.body_Jw[static_cast<std::size_t>(i)] * sdot;
+    T += 0.5 * mass(p, i) * v.squaredNorm() + 0.5 * w.dot(world_inertia(p, i, d.body_rotations[static_cast<std::size_t>(i)]) * w);
+  }
+  return T;
+}
+
+std::string Weighting::label() const {
+  switch (kind) {
+    case Kind::strong_weak: return "weighting 1 (strong/weak)";
+    case Kind::contribution: return "weighting 2 (contribution)";
+    case Kind::diagonal: return "diagonal weights";
+    case Kind::matrix: return "weight matrix";
+  }
+  return {};
+}
+
+Weighting Weighting::diagonal_of(const Vector8& w) {
+  for (int i = 0; i < 8; ++i)
+    if (!(std::isfinite(w(i)) && w(i) > 0))
+      throw Error(fmt::format("weighting[{}]", i), fmt::format("a weight must be positive and finite, got {}", w(i)));
+  Weighting out;
+  out.kind = Kind::diagonal;
+  out.diagonal = w;
+  return out;
+}
+
+Weighting Weighting::matrix_of(const Eigen::Matrix<double, 8, 8>& W) {
+  if (!W.allFinite()) throw Error("weighting", "the weight matrix has a non-finite entry");
+  if ((W - W.transpose()).cwiseAbs().maxCoeff() > 1e-12 * W.cwiseAbs().maxCoeff())
+    throw Error("weighting", "the weight matrix must be symmetric");
+  if (W.llt().info() != Eigen::Success) throw Error("weighting", "the weight matrix must be positive definite");
+  Weighting out;
+  out.kind = Kind::matrix;
+  out.matrix = W;
+  return out;
+}
+
+Vector8 distribute_torques(const ActuatorJacobian& J_beta, const Vector4& Qstar, const Weighting& weighting) {
+  // S with S S^T = W^-1: tau = S x and |x| = sqrt(tau^T W tau).
+  Eigen::Matrix<double, 8, 8> S = Eigen::Matrix<double, 8, 8>::Zero();
+  switch (weighting.kind) {
+    case Weighting::Kind::strong_weak: S.diagonal() = kStrongWeakDiagonal.cwiseInverse().cwiseSqrt(); break;
+    case Weighting::Kind::contribution:  // W_ii^-1 = |row i| directly: a zero row gets zero torque
+      for (int i = 0; i < 8; ++i) S(i, i) = std::sqrt(J_beta.row(i).norm());
+      break;
+    case Weighting::Kind::diagonal: S.diagonal() = weighting.diagonal.cwiseInverse().cwiseSqrt(); break;
+    case Weighting::Kind::matrix: {
+      const Eigen::Matrix<double, 8, 8> L = weighting.matrix.llt().matrixL();
+      S = L.transpose().triangularView<Eigen::Upper>().solve(Eigen::Matrix<double, 8, 8>::Identity());
+      break;
+    }
+  }
+  const Eigen::Matrix<double, 4, 8> A = J_beta.transpose() * S;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 4, 8>> cod;
+  cod.setThreshold(1e-13);  // relative to the largest pivot: only a real rank loss, not ID-3's 1e6 conditioning
+  cod.compute(A);
+  if (cod.rank() < 4)
+    throw Error("J_beta", fmt::format("the actuator Jacobian has rank {} < 4 with {}: the 8 actuators cannot produce "
+                                      "every generalized force on u = [z_C', x_C', roll', pitch'] in this pose",
+                                      cod.rank(), weighting.label()));
+  const Vector8 x = cod.solve(Qstar);
+  return S * x;
+}
+
+}  // namespace wlx

@@ -1,0 +1,259 @@
+// Inverse dynamics: checks independent of the Kane formula under test (energy, power, statics).
+#include "../support/random.hpp"
+
+#include <doctest/doctest.h>
+#include <wlx/dynamics.hpp>
+#include <wlx/error.hpp>
+#include <wlx/ik.hpp>
+#include <wlx/simulation.hpp>
+
+#include <cmath>
+#include <numbers>
+
+using namespace wlx;
+namespace c = gen::coord;
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180;
+
+// A random admissible state near the thesis' workspace: cabin moved and tilted, feet and
+// levers moved, dependents by the closed form; pair A regular.
+Coordinates random_state(std::mt19937_64& rng, const Model& model) {
+  std::uniform_real_distribution<double> small(-1, 1);
+  for (;;) {
+    Coordinates s = nominal_inputs();
+    s(c::x_C) = small(rng);
+    s(c::y_C) = small(rng);
+    s(c::z_C) = 1.7 + 0.3 * small(rng);
+    s(c::yaw) = small(rng);
+    s(c::pitch) = 0.1 * small(rng);
+    s(c::roll) = 0.1 * small(rng);
+    // Feet ahead of the hips, turned with the cabin's yaw.
+    const double cy = std::cos(s(c::yaw)), sy = std::sin(s(c::yaw));
+    for (double side : {1.0, -1.0}) {
+      const double ahead = 3.3 + 0.3 * small(rng), across = side * (1.5 + 0.3 * small(rng));
+      s(side > 0 ? c::x_Fl : c::x_Fr) = s(c::x_C) + cy * ahead - sy * across;
+      s(side > 0 ? c::y_Fl : c::y_Fr) = s(c::y_C) + sy * ahead + cy * across;
+    }
+    s(c::z_Wl) = 0.1 * small(rng);
+    s(c::z_Wr) = 0.1 + 0.1 * small(rng);
+    s(c::theta_l5) = 0.2 * small(rng);
+    s(c::theta_r5) = 0.2 * small(rng);
+    try {
+      solve_ik_closed_form(model, s);
+      return s;
+    } catch (const Error&) {
+    }
+  }
+}
+
+Vector4 random4(std::mt19937_64& rng, double scale) {
+  std::uniform_real_distribution<double> d(-scale, scale);
+  return Vector4(d(rng), d(rng), d(rng), d(rng));
+}
+
+}  // namespace
+
+TEST_CASE("dynamics: J_beta^T tau = Q* and the power balance tau . beta' = Q* . u, every weighting") {
+  std::mt19937_64 rng(60);
+  const Model model;
+  Data d;
+  DynamicsTerms t;
+  Eigen::Matrix<double, 8, 8> G = Eigen::Matrix<double, 8, 8>::Random();
+  const Weighting weightings[] = {Weighting::strong_weak(), Weighting::contribution(),
+                                  Weighting::diagonal_of((Vector8() << 1, 2, 3, 4, 5, 6, 7, 8).finished()),
+                                  Weighting::matrix_of(G * G.transpose() + Eigen::Matrix<double, 8, 8>::Identity())};
+  double worst_force = 0, worst_power = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Coordinates s = random_state(rng, model);
+    const Vector4 u = random4(rng, 1.0), u_dot = random4(rng, 2.0);
+    inverse_dynamics(model, s, u, u_dot, d, t);
+    const Vector8 beta_dot = t.J_beta * u;
+    // beta' really is the actuated joints' rate of the solved motion.
+    for (int r = 0; r < 8; ++r) CHECK(beta_dot(r) == doctest::Approx(t.sdot(kActuatedJoints[r])).epsilon(1e-12).scale(1));
+    for (const Weighting& w : weightings) {
+      const Vector8 tau = distribute_torques(t.J_beta, t.Qstar, w);
+      const double scale = t.Qstar.cwiseAbs().maxCoeff();
+      worst_force = std::max(worst_force, (t.J_beta.transpose() * tau - t.Qstar).cwiseAbs().maxCoeff() / scale);
+      worst_power = std::max(worst_power, std::abs(tau.dot(beta_dot) - t.Qstar.dot(u)) / (scale * u.norm()));
+    }
+  }
+  MESSAGE("relative errors: J_beta^T tau - Q* " << worst_force << ", power " << worst_power);
+  CHECK(worst_force <= 1e-12);
+  CHECK(worst_power <= 1e-12);
+}
+
+TEST_CASE("dynamics: the weighted least norm is the optimum (no other solution has a smaller tau^T W tau)") {
+  std::mt19937_64 rng(61);
+  const Model model;
+  Data d;
+  DynamicsTerms t;
+  const Coordinates s = random_state(rng, model);
+  inverse_dynamics(model, s, Vector4(0.1, 0.5, 0.05, 0.0), Vector4::Zero(), d, t);
+  const Vector8 tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+  const auto cost = [](const Vector8& x) { return x.dot(kStrongWeakDiagonal.asDiagonal() * x); };
+  // Add null-space directions of J_beta^T: the constraint still holds, the cost only grows.
+  const Eigen::FullPivLU<Eigen::Matrix<double, 4, 8>> lu(t.J_beta.transpose());
+  const Eigen::MatrixXd null = lu.kernel();
+  REQUIRE(null.cols() == 4);
+  for (int k = 0; k < 4; ++k)
+    for (double step : {-1e3, -1.0, 1.0, 1e3}) CHECK(cost(tau + step * null.col(k)) > cost(tau));
+}
+
+TEST_CASE("dynamics: M is the Hessian of the kinetic energy: T = u^T M u / 2") {
+  std::mt19937_64 rng(62);
+  const Model model;
+  Data d;
+  DynamicsTerms t;
+  double worst = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const Coordinates s = random_state(rng, model);
+    const Vector4 u = random4(rng, 1.0);
+    inverse_dynamics(model, s, u, Vector4::Zero(), d, t);
+    const double T = kinetic_energy(model, s, t.sdot, d);
+    worst = std::max(worst, std::abs(T - 0.5 * u.dot(t.M * u)) / T);
+    CHECK((t.M - t.M.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * t.M.cwiseAbs().maxCoeff());
+  }
+  CHECK(worst <= 1e-12);
+}
+
+TEST_CASE("dynamics: statics: at rest Q* . u is the rate of change of V along the admissible motion u") {
+  // Integrate a short constrained motion with rates +u and -u (RK4, h = 1e-4 s in 10 steps);
+  // (V(h) - V(-h)) / 2h matches dV/dt to O(h^2). Q* . u is a sum of terms of size |Q*||u| that
+  // largely cancel, so the error is measured against that scale.
+  std::mt19937_64 rng(63);
+  const Model model;
+  Data d;
+  DynamicsTerms t;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Coordinates s = random_state(rng, model);
+    const Vector4 u = random4(rng, 0.5);
+    inverse_dynamics(model, s, Vector4::Zero(), Vector4::Zero(), d, t);
+    const double predicted = t.Qstar.dot(u);
+    // Near a singular J_beta the dependent rates are large: shorten h so that the motion's third
+    // derivative (~|s'|^3) does not dominate the difference quotient.
+    const double fastest = std::max(1.0, (t.T * u).cwiseAbs().maxCoeff());
+    Scenario sc;
+    sc.initial = s;
+    sc.duration = 1e-4 / fastest;
+    sc.dt = sc.duration / 10;
+    double V[2];
+    for (int sign : {0, 1}) {
+      for (int k = 0; k < 4; ++k) sc.rates(kCommandedSpeeds[k]) = (sign ? -1 : 1) * u(k);
+      const Trajectory tr = simulate(sc);
+      REQUIRE(tr.complete);
+      V[sign] = potential_energy(model, tr.samples.back().s, d);
+    }
+    const double measured = (V[0] - V[1]) / (2 * sc.duration);
+    CAPTURE(d.cond_J_beta);
+    CAPTURE(predicted);
+    CHECK(std::abs(predicted - measured) <= 1e-7 * t.Qstar.norm() * u.norm());
+  }
+}
+
+TEST_CASE("dynamics: energy: Q* . u = d(T + V)/dt along integrated motions with constant u") {
+  std::mt19937_64 rng(64);
+  const Model model;
+  Data d;
+  DynamicsTerms t;
+  double worst = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    Scenario sc;
+    sc.initial = random_state(rng, model);
+    Vector4 u = random4(rng, 0.5);
+    // Scale u so the fastest coordinate moves at 1 unit/s: the central differences below then
+    // have truncation errors ~dt^2 = 1e-8 whatever the conditioning of J_beta.
+    inverse_dynamics(model, sc.initial, u, Vector4::Zero(), d, t);
+    u /= t.sdot.cwiseAbs().maxCoeff();
+    for (int k = 0; k < 4; ++k) sc.rates(kCommandedSpeeds[k]) = u(k);
+    sc.duration = 0.002;
+    sc.dt = 1e-5;
+    const Trajectory tr = simulate(sc);
+    REQUIRE(tr.complete);
+    const auto energy = [&](std::size_t k) {
+      const Sample& smp = tr.samples[k];
+      return kinetic_energy(model, smp.s, smp.sdot, d) + potential_energy(model, smp.s, d);
+    };
+    for (std::size_t k = 2; k + 2 < tr.samples.size(); k += 20) {
+      // Five-point stencil: truncation ~dt^4 |E^(5)| / 30, rounding ~1e-16 |E| / dt.
+      const double dEdt = (energy(k - 2) - 8 * energy(k - 1) + 8 * energy(k + 1) - energy(k + 2)) / (12 * sc.dt);
+      inverse_dynamics(model, tr.samples[k].s, u, Vector4::Zero(), d, t);
+      const double power = t.Qstar.dot(u);
+      worst = std::max(worst, std::abs(power - dEdt) / std::max(1.0, std::abs(power)));
+    }
+  }
+  MESSAGE("max relative |Q* . u - d(T + V)/dt| = " << worst);
+  CHECK(worst <= 1e-6);
+}
+
+TEST_CASE("dynamics: the thesis' magnitudes: static torques ~2.8e4 N m (2D estimate 4.53e4), ID-1 torques ~1e4") {
+  const Model model;
+  Data d;
+  DynamicsTerms t;
+  Coordinates s = nominal_inputs();
+  solve_ik_closed_form(model, s);
+  inverse_dynamics(model, s, Vector4::Zero(), Vector4::Zero(), d, t);
+  const Vector8 tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+  const double estimate = model.params().cxd / 2 * model.total_mass() * model.params().g / 2;  // thesis eq. 6.34
+  CHECK(estimate == doctest::Approx(4.53e4).epsilon(1e-3));
+  for (int k : {0, 3, 6, 7}) {  // psi_l2, psi_r2, theta_l6, theta_r6
+    CAPTURE(k);
+    CHECK(std::abs(tau(k)) == doctest::Approx(2.8e4).epsilon(0.05));
+    CHECK(std::abs(tau(k)) / estimate > 0.3);  // same order as the 2D estimate
+  }
+  // Weighting 1 loads the strong joints (weight 0.01) and spares the weak hip yaw (weight 100).
+  for (int k : {1, 4}) CHECK(std::abs(tau(k)) < 1e-3 * std::abs(tau(0)));
+  const Vector8 tau2 = distribute_torques(t.J_beta, t.Qstar, Weighting::contribution());
+  CHECK(std::abs(tau2(1)) > 100 * std::abs(tau(1)));
+}
+
+TEST_CASE("dynamics: ID-1..3 reach the thesis' end states with torques of order 1e4 N m") {
+  struct Run { int coordinate; double rate, duration, end; };
+  for (const Run& r : {Run{c::x_C, 3.0, 0.494, 1.482}, Run{c::roll, -10 * kDeg, 0.541, -5.41 * kDeg},
+                       Run{c::z_C, -3.0, 0.581, 0.257}}) {
+    for (const Weighting& w : {Weighting::strong_weak(), Weighting::contribution()}) {
+      Scenario sc;
+      sc.rates(r.coordinate) = r.rate;
+      sc.duration = r.duration;
+      sc.weighting = w;
+      const Trajectory tr = simulate(sc);
+      REQUIRE(tr.complete);
+      CHECK(tr.samples.back().s(r.coordinate) == doctest::Approx(r.end).epsilon(1e-9));
+      double peak = 0;
+      for (const auto& smp : tr.samples) peak = std::max(peak, smp.tau.cwiseAbs().maxCoeff());
+      CHECK(peak > 1e4);
+      CHECK(peak < 1e5);
+      CHECK(tr.samples.back().cabin_clearance > 0);
+    }
+  }
+}
+
+TEST_CASE("dynamics: ID-3 ends 7 mm above the ground: the cabin would touch it at t ~ 0.583 s") {
+  Scenario sc;
+  sc.rates(c::z_C) = -3.0;
+  sc.duration = 0.581;
+  sc.weighting = Weighting::strong_weak();
+  const Trajectory tr = simulate(sc);
+  const double clearance = tr.samples.back().cabin_clearance;
+  CHECK(clearance == doctest::Approx(0.007).epsilon(0.05));
+  CHECK(0.581 + clearance / 3.0 == doctest::Approx(0.583).epsilon(1e-3));
+}
+
+TEST_CASE("dynamics: a rank-deficient J_beta and bad weights are clear errors; zero rows get zero torque") {
+  ActuatorJacobian J = ActuatorJacobian::Zero();
+  J(0, 0) = J(1, 1) = J(2, 2) = 1;  // nothing acts on pitch
+  CHECK_THROWS_WITH_AS(distribute_torques(J, Vector4(1, 2, 3, 4), Weighting::strong_weak()),
+                       "J_beta: the actuator Jacobian has rank 3 < 4 with weighting 1 (strong/weak): the 8 actuators "
+                       "cannot produce every generalized force on u = [z_C', x_C', roll', pitch'] in this pose",
+                       Error);
+  J(3, 3) = 2;
+  const Vector8 tau = distribute_torques(J, Vector4(1, 2, 3, 4), Weighting::contribution());
+  for (int r = 4; r < 8; ++r) CHECK(tau(r) == 0.0);
+  CHECK((J.transpose() * tau - Vector4(1, 2, 3, 4)).norm() <= 1e-15);
+  CHECK_THROWS_WITH_AS(Weighting::diagonal_of(Vector8::Constant(-1)), "weighting[0]: a weight must be positive and finite, got -1",
+                       Error);
+  Eigen::Matrix<double, 8, 8> W = Eigen::Matrix<double, 8, 8>::Identity();
+  W(7, 7) = -1;
+  CHECK_THROWS_WITH_AS(Weighting::matrix_of(W), "weighting: the weight matrix must be positive definite", Error);
+}
