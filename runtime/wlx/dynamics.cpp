@@ -44,12 +44,17 @@ void inverse_dynamics(const Model& model, const Coordinates& s, const Vector4& u
     const auto& Jw = d.body_Jw[static_cast<std::size_t>(i)];
     const double m = mass(p, i);
     const Eigen::Matrix3d inertia = world_inertia(p, i, d.body_rotations[static_cast<std::size_t>(i)]);
-    const Eigen::Matrix<double, 3, 4> A = Jv * out.T;  // partial velocities dv/du
-    const Eigen::Matrix<double, 3, 4> B = Jw * out.T;  // partial angular velocities domega/du
+    // Partial velocities dv/du = Jv T and domega/du = Jw T over the body's non-zero columns only.
+    Eigen::Matrix<double, 3, 4> A = Eigen::Matrix<double, 3, 4>::Zero();
+    Eigen::Matrix<double, 3, 4> B = Eigen::Matrix<double, 3, 4>::Zero();
+    for (int j : model.body_columns(i)) {
+      A.noalias() += Jv.col(j) * out.T.row(j);
+      B.noalias() += Jw.col(j) * out.T.row(j);
+    }
     const Eigen::Vector3d omega = Jw * out.sdot;
     const Eigen::Vector3d a_bias = Jv * bias + d.body_Jv_dot_sdot.col(i);
     const Eigen::Vector3d alpha_bias = Jw * bias + d.body_Jw_dot_sdot.col(i);
-    out.M.noalias() += m * A.transpose() * A + B.transpose() * inertia * B;
+    out.M.noalias() += m * A.transpose().lazyProduct(A) + B.transpose().lazyProduct(inertia.lazyProduct(B));
     out.b.noalias() += A.transpose() * (m * a_bias) + B.transpose() * (inertia * alpha_bias + omega.cross(inertia * omega));
     out.Q_gravity.noalias() += A.transpose() * (m * gravity);
   }
@@ -123,15 +128,21 @@ Vector8 distribute_torques(const ActuatorJacobian& J_beta, const Vector4& Qstar,
       break;
     }
   }
-  const Eigen::Matrix<double, 4, 8> A = J_beta.transpose() * S;
-  Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 4, 8>> cod;
-  cod.setThreshold(1e-13);  // relative to the largest pivot: only a real rank loss, not ID-3's 1e6 conditioning
-  cod.compute(A);
-  if (cod.rank() < 4)
+  // Minimum-norm solution of A x = Q* with A = J_beta^T S (4 x 8): from A^T P = Q R (column-pivoted,
+  // rank-revealing QR), x = Q [R^-T P^T Q*; 0].
+  const Eigen::Matrix<double, 8, 4> At = S.transpose() * J_beta;
+  Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 8, 4>> qr;
+  qr.setThreshold(1e-13);  // relative to the largest pivot: only a real rank loss, not ID-3's 1e6 conditioning
+  qr.compute(At);
+  if (qr.rank() < 4)
     throw Error("J_beta", fmt::format("the actuator Jacobian has rank {} < 4 with {}: the 8 actuators cannot produce "
                                       "every generalized force on u = [z_C', x_C', roll', pitch'] in this pose",
-                                      cod.rank(), weighting.label()));
-  const Vector8 x = cod.solve(Qstar);
+                                      qr.rank(), weighting.label()));
+  const Eigen::Matrix4d R = qr.matrixR().topLeftCorner<4, 4>().triangularView<Eigen::Upper>();
+  const Vector4 y = R.transpose().triangularView<Eigen::Lower>().solve(qr.colsPermutation().transpose() * Qstar);
+  Vector8 x = Vector8::Zero();
+  x.head<4>() = y;
+  x.applyOnTheLeft(qr.householderQ());
   return S * x;
 }
 

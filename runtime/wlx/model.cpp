@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include <Eigen/Core>
+
 namespace wlx {
 
 namespace {
@@ -44,6 +46,19 @@ Model::Model(const Params& params) : params_(params) {
                                                 I[k], I[(k + 1) % 3], I[(k + 2) % 3]));
     total_mass_ += m;
   }
+  // Structural zeros: a column that is zero at a generic configuration is zero everywhere (the
+  // generated code writes only its non-zero entries). Generic: irrational-looking values.
+  Coordinates s, sdot;
+  for (int k = 0; k < gen::kCoordinateCount; ++k) {
+    s(k) = 0.1 + 0.7071067811865476 * std::sin(1.0 + 3.0 * k);
+    sdot(k) = 0.3 + 0.5 * std::cos(2.0 + 5.0 * k);
+  }
+  gen::BodyJacobians Jv, Jw;
+  gen::bodies(s, sdot, params_, nullptr, nullptr, &Jv, &Jw, nullptr, nullptr);
+  for (int b = 0; b < gen::kBodyCount; ++b)
+    for (int j = 0; j < gen::kCoordinateCount; ++j)
+      if (Jv[static_cast<std::size_t>(b)].col(j).any() || Jw[static_cast<std::size_t>(b)].col(j).any())
+        body_columns_[static_cast<std::size_t>(b)].push_back(j);
 }
 
 int coordinate_index(std::string_view name) noexcept {

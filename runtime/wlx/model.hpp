@@ -5,9 +5,10 @@
 
 #include <wlx/gen/all.hpp>
 
-#include <Eigen/LU>
+#include <Eigen/LU>  // Matrix4d::inverse
 
 #include <string_view>
+#include <vector>
 
 namespace wlx {
 
@@ -26,10 +27,14 @@ class Model {
 
   const Params& params() const noexcept { return params_; }
   double total_mass() const noexcept { return total_mass_; }
+  // The coordinates each body's velocity Jacobians depend on (the rest are structural zeros of
+  // the generated code), so the dynamics can skip them.
+  const std::vector<int>& body_columns(int body) const { return body_columns_[static_cast<std::size_t>(body)]; }
 
  private:
   Params params_;
   double total_mass_ = 0;
+  std::array<std::vector<int>, gen::kBodyCount> body_columns_;
 };
 
 // Workspace for one evaluation thread. Fixed-size members only: no heap allocation.
@@ -49,10 +54,11 @@ struct Data {
   gen::BodyVectors body_Jv_dot_sdot;
   gen::BodyVectors body_Jw_dot_sdot;
 
-  // Non-holonomic solve (nonholonomic.hpp): the closure's per-limb factorizations (legs padded to
-  // 4 x 4 with a unit diagonal), the adjoint Lambda = Phi_dep^-T C_dep^T, the wheel rows reduced
-  // to the inputs C_hat = C_q - Lambda^T Phi_q, and J_beta.
-  std::array<Eigen::PartialPivLU<Eigen::Matrix4d>, 4> limb_lu;
+  // Non-holonomic solve (nonholonomic.hpp): the inverses of the closure's per-limb blocks (legs
+  // padded to 4 x 4 with a unit diagonal; at this size products beat factorizations), the adjoint
+  // Lambda = Phi_dep^-T C_dep^T, the wheel rows reduced to the inputs C_hat = C_q - Lambda^T Phi_q,
+  // and J_beta.
+  std::array<Eigen::Matrix4d, 4> limb_inverse;
   Eigen::Matrix<double, gen::kDependentCount, gen::kWheelCount> wheel_adjoint;
   Eigen::Matrix<double, gen::kWheelCount, gen::kInputCount> C_reduced;
   Eigen::Matrix2d J_beta;

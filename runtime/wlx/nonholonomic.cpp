@@ -34,20 +34,21 @@ void reduce(Data& d) {
       for (int i = 0; i < b.size; ++i) block(i, j) = d.dPhi_ds(b.first_row + i, joint);
       rhs.row(j) = d.C.col(joint).transpose();
     }
-    auto& lu = d.limb_lu[static_cast<std::size_t>(limb)];
-    lu.compute(block);
+    auto& inverse = d.limb_inverse[static_cast<std::size_t>(limb)];
+    inverse = block.inverse();
     // A singular block means the limb's joint rates are not determined by its target's motion.
-    if (!(lu.rcond() > 1e-13))
+    const double rcond = 1.0 / (block.cwiseAbs().colwise().sum().maxCoeff() * inverse.cwiseAbs().colwise().sum().maxCoeff());
+    if (!(rcond > 1e-13))
       throw Error(std::string(limb_name(limb)),
                   fmt::format("the closure Jacobian of this limb is singular (reciprocal condition {:.2g}): {}; its joint "
                               "rates are undefined here",
-                              lu.rcond(),
+                              rcond,
                               b.size == 3 ? "the leg is stretched straight or folded, or its hip yaw is at 90 deg"
                                           : "the lever stands at 90 deg to the level or is straddled to 90 deg"));
-    const Eigen::Matrix<double, 4, 2> lambda = lu.transpose().solve(rhs);
+    const Eigen::Matrix<double, 4, 2> lambda = inverse.transpose().lazyProduct(rhs);
     for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.first_row + i) = lambda.row(i);
   }
-  d.C_reduced = d.C.leftCols<kNq>() - d.wheel_adjoint.transpose() * d.dPhi_ds.leftCols<kNq>();
+  d.C_reduced = d.C.leftCols<kNq>() - d.wheel_adjoint.transpose().lazyProduct(d.dPhi_ds.leftCols<kNq>());
 }
 
 // The dependent joints' part of s'' or s' for a closure right-hand side: Phi_dep x = -v.
@@ -56,7 +57,7 @@ void solve_closure(const Data& d, const gen::ClosureVector& v, Coordinates& out)
     const LimbBlock b = limb_block(limb);
     Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
     for (int i = 0; i < b.size; ++i) rhs(i) = -v(b.first_row + i);
-    const Eigen::Vector4d x = d.limb_lu[static_cast<std::size_t>(limb)].solve(rhs);
+    const Eigen::Vector4d x = d.limb_inverse[static_cast<std::size_t>(limb)] * rhs;
     for (int j = 0; j < b.size; ++j) out(b.joints[static_cast<std::size_t>(j)]) = x(j);
   }
 }
@@ -140,17 +141,24 @@ void solve_dependent_accelerations(const Model& model, const Coordinates& s, con
 
 Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& commanded, const DependentPair& pair,
                                                       const Data& d) {
+  // Input-rate columns: a unit commanded rate, and the pair's answer to it.
+  Eigen::Matrix<double, 2, 4> ch;
+  for (int k = 0; k < 4; ++k) ch.col(k) = d.C_reduced.col(commanded[static_cast<std::size_t>(k)]);
+  const Eigen::Matrix<double, 2, 4> pair_rates = -d.J_beta.partialPivLu().solve(ch);
   Eigen::Matrix<double, kCoordinateCount, 4> T = Eigen::Matrix<double, kCoordinateCount, 4>::Zero();
-  const auto lu = d.J_beta.partialPivLu();
   for (int k = 0; k < 4; ++k) {
-    Coordinates col = Coordinates::Zero();
-    col(commanded[static_cast<std::size_t>(k)]) = 1;
-    const Eigen::Vector2d pair_rate = -lu.solve(d.C_reduced.col(commanded[static_cast<std::size_t>(k)]));
-    col(pair.index[0]) = pair_rate(0);
-    col(pair.index[1]) = pair_rate(1);
-    const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>() * col.head<kNq>();
-    solve_closure(d, closure_rhs, col);
-    T.col(k) = col;
+    T(commanded[static_cast<std::size_t>(k)], k) = 1;
+    T(pair.index[0], k) = pair_rates(0, k);
+    T(pair.index[1], k) = pair_rates(1, k);
+  }
+  // Dependent joints: Phi_dep T_dep = -Phi_q T_q, all four columns per limb block at once.
+  const Eigen::Matrix<double, gen::kClosureCount, 4> rhs = d.dPhi_ds.leftCols<kNq>().lazyProduct(T.topRows<kNq>());
+  for (Limb limb : kLimbs) {
+    const LimbBlock b = limb_block(limb);
+    Eigen::Matrix4d block_rhs = Eigen::Matrix4d::Zero();
+    for (int i = 0; i < b.size; ++i) block_rhs.row(i) = -rhs.row(b.first_row + i);
+    const Eigen::Matrix4d x = d.limb_inverse[static_cast<std::size_t>(limb)].lazyProduct(block_rhs);
+    for (int j = 0; j < b.size; ++j) T.row(b.joints[static_cast<std::size_t>(j)]) = x.row(j);
   }
   return T;
 }
