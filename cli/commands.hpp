@@ -22,4 +22,10 @@ struct SimulateOptions {
 int run_simulate(const SimulateOptions& options);
 int run_verify_nonholonomic(const std::string& out_dir);
 
+struct ReportOptions {
+  std::string out_dir = "report";
+  bool quick = false;  // a reduced set of runs (for tests)
+};
+int run_report(const ReportOptions& options);
+
 }  // namespace wlx::cli

@@ -1,6 +1,7 @@
 // `wlx ik` and `wlx verify ik`.
 #include "commands.hpp"
 #include "input.hpp"
+#include "outputs.hpp"
 
 #include <fmt/format.h>
 #include <wlx/csv.hpp>
@@ -67,6 +68,26 @@ nlohmann::ordered_json solve(const IkRequest& r, Coordinates* warm) {
 
 }  // namespace
 
+void write_ik_sweep_csv(const std::string& path, const IkSweepResult& r) {
+  std::vector<std::string> header{r.sweep.input};
+  for (int k = kInputCount; k < kCoordinateCount; ++k) header.emplace_back(gen::kCoordinateNames[k]);
+  for (const char* h : {"x_Wl", "y_Wl", "x_Wr", "y_Wr", "check_error_closed_form", "check_error_newton",
+                        "level_error_closed_form", "level_error_newton", "newton_minus_closed_form", "newton_iterations",
+                        "newton_branch", "cold_start_branch"})
+    header.emplace_back(h);
+  CsvWriter csv(path, header);
+  for (const auto& p : r.points) {
+    std::vector<double> row{p.value};
+    for (int k = kInputCount; k < kCoordinateCount; ++k) row.push_back(p.closed_form(k));
+    for (int k = 0; k < 4; ++k) row.push_back(p.contacts(k));
+    row.insert(row.end(), {p.check_closed_form.position_error, p.check_newton.position_error,
+                           p.check_closed_form.level_error, p.check_newton.level_error, p.newton_difference,
+                           static_cast<double>(p.newton_iterations), static_cast<double>(p.newton_branch),
+                           static_cast<double>(p.cold_newton_branch)});
+    csv.row(row);
+  }
+}
+
 int run_ik(bool batch) {
   if (!batch) {
     nlohmann::json j;
@@ -128,23 +149,7 @@ int run_verify_ik(const std::string& out_dir, const std::vector<std::string>& sw
              "check CF (m)", "check N (m)", "level err", "|CF-N| (rad)", "N iter avg", "N max", "cold start");
   for (const auto& sweep : sweeps) {
     const IkSweepResult r = run_ik_sweep(model, sweep, data);
-    std::vector<std::string> header{sweep.input};
-    for (int k = kInputCount; k < kCoordinateCount; ++k) header.emplace_back(gen::kCoordinateNames[k]);
-    for (const char* h : {"x_Wl", "y_Wl", "x_Wr", "y_Wr", "check_error_closed_form", "check_error_newton",
-                          "level_error_closed_form", "level_error_newton", "newton_minus_closed_form",
-                          "newton_iterations", "newton_branch", "cold_start_branch"})
-      header.emplace_back(h);
-    CsvWriter csv((std::filesystem::path(out_dir) / (sweep.id + ".csv")).string(), header);
-    for (const auto& p : r.points) {
-      std::vector<double> row{p.value};
-      for (int k = kInputCount; k < kCoordinateCount; ++k) row.push_back(p.closed_form(k));
-      for (int k = 0; k < 4; ++k) row.push_back(p.contacts(k));
-      row.insert(row.end(), {p.check_closed_form.position_error, p.check_newton.position_error,
-                             p.check_closed_form.level_error, p.check_newton.level_error, p.newton_difference,
-                             static_cast<double>(p.newton_iterations), static_cast<double>(p.newton_branch),
-                             static_cast<double>(p.cold_newton_branch)});
-      csv.row(row);
-    }
+    write_ik_sweep_csv((std::filesystem::path(out_dir) / (sweep.id + ".csv")).string(), r);
     const bool pass = r.max_check_closed_form <= kLimit && r.max_check_newton <= kLimit && r.max_level_error <= kLimit &&
                       r.newton_branch_changes == 0;
     ok = ok && pass;

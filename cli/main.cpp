@@ -89,6 +89,11 @@ int main(int argc, char** argv) {
   simulate->add_option("--weighting", sim.weighting, "torque weighting 1 or 2 (inverse dynamics, MODEL.md section 7)");
   simulate->add_flag("--list", sim.list, "list the built-in scenarios");
 
+  wlx::cli::ReportOptions report_options;
+  auto* report = app.add_subcommand("report", "run everything of MODEL.md section 8 and write an HTML report with figures");
+  report->add_option("--out", report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
+  report->add_flag("--quick", report_options.quick, "a reduced set of runs, for a fast look");
+
   CLI11_PARSE(app, argc, argv);
   using namespace wlx::cli;
   try {
@@ -96,6 +101,7 @@ int main(int argc, char** argv) {
     if (ik->parsed()) return run_ik(batch);
     if (verify_ik->parsed()) return run_verify_ik(ik_out, sweep_ids);
     if (verify_nh->parsed()) return run_verify_nonholonomic(nh_out);
+    if (report->parsed()) return run_report(report_options);
     if (simulate->parsed()) {
       if (!sim.list && sim.scenario.empty()) throw wlx::Error("SCENARIO", "missing: give a scenario file or id (--list shows the ids)");
       return run_simulate(sim);

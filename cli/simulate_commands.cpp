@@ -1,5 +1,6 @@
 // `wlx simulate` and `wlx verify nonholonomic`.
 #include "commands.hpp"
+#include "outputs.hpp"
 #include "scenario_io.hpp"
 
 #include <fmt/format.h>

@@ -1,0 +1,20 @@
+// The CSV files the CLI writes (their column names are a public interface).
+#pragma once
+
+#include <wlx/ik_verification.hpp>
+#include <wlx/simulation.hpp>
+
+#include <string>
+#include <vector>
+
+namespace wlx::cli {
+
+// One row per sweep point: the swept input, the 14 dependents, contacts, check errors, Newton.
+void write_ik_sweep_csv(const std::string& path, const IkSweepResult& result);
+
+// t, the 32 coordinates, x_Wl..y_Wr, nh_residual_l/r, spin_rate_l/r, the 18 input rates
+// (<name>_dot), cond_J_beta, cabin_clearance, and for dynamics runs tau_<joint> and Qstar_<speed>.
+std::vector<std::string> trajectory_header(bool dynamics);
+void write_trajectory(const std::string& path, const Trajectory& trajectory, bool dynamics);
+
+}  // namespace wlx::cli
