@@ -94,6 +94,39 @@ void BM_gen_bodies(benchmark::State& st) {
   }
 }
 
+// FK + Phi + dPhi/ds + C(s): the fused generated function, and the three separate ones.
+void BM_gen_kinematic_update_fused(benchmark::State& st) {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled_nominal(model);
+  for (auto _ : st) {
+    gen::kinematic_update(s, model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds, &d.C);
+    benchmark::DoNotOptimize(d.C.data());
+  }
+}
+void BM_gen_kinematic_update_separate(benchmark::State& st) {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled_nominal(model);
+  for (auto _ : st) {
+    gen::kinematics(s, model.params(), &d.frame_positions, &d.frame_rotations);
+    gen::closure(s, model.params(), &d.Phi, &d.dPhi_ds);
+    gen::nonholonomic(s, model.params(), &d.C, nullptr);
+    benchmark::DoNotOptimize(d.C.data());
+  }
+}
+// The full kinematic update of a controller step: closed-form IK of the 4 limbs, then the fused pass.
+void BM_full_kinematic_update(benchmark::State& st) {
+  const Model model;
+  Data d;
+  Coordinates s = moved_target();
+  for (auto _ : st) {
+    solve_ik_closed_form(model, s);
+    kinematic_update(model, s, d);
+    benchmark::DoNotOptimize(d.C.data());
+  }
+}
+
 void BM_ik_closed_form_4_limbs(benchmark::State& st) {
   const Model model;
   Coordinates s = moved_target();
@@ -216,6 +249,9 @@ BENCHMARK(BM_gen_closure);
 BENCHMARK(BM_gen_nonholonomic);
 BENCHMARK(BM_gen_convective);
 BENCHMARK(BM_gen_bodies);
+BENCHMARK(BM_gen_kinematic_update_fused);
+BENCHMARK(BM_gen_kinematic_update_separate);
+BENCHMARK(BM_full_kinematic_update);
 BENCHMARK(BM_ik_closed_form_4_limbs);
 BENCHMARK(BM_ik_newton_cold_4_limbs);
 BENCHMARK(BM_ik_newton_warm_4_limbs);

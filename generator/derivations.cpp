@@ -178,9 +178,20 @@ FunctionSpec derive_bodies(const Model& m) {
   return fn;
 }
 
+FunctionSpec derive_kinematic_update(const Model& m) {
+  FunctionSpec fn{"kinematic_update", "kinematic_update.hpp",
+                  "The per-step kinematic update in one pass: frame positions and orientations, Phi, dPhi/ds and "
+                  "the non-holonomic rows C(s) (the outputs of kinematics, closure and nonholonomic, sharing "
+                  "their common subexpressions).",
+                  false, {}};
+  const FunctionSpec k = derive_kinematics(m), c = derive_closure(m), n = derive_nonholonomic(m);
+  fn.outputs = {k.outputs[0], k.outputs[1], c.outputs[0], c.outputs[1], n.outputs[0]};
+  return fn;
+}
+
 std::vector<FunctionSpec> derive_all(const Model& m) {
   return {derive_kinematics(m), derive_closure(m), derive_nonholonomic(m), derive_convective(m),
-          derive_bodies(m)};
+          derive_bodies(m), derive_kinematic_update(m)};
 }
 
 }  // namespace wlx::gen

@@ -32,6 +32,9 @@ FunctionSpec derive_closure(const Model& m);
 FunctionSpec derive_nonholonomic(const Model& m);
 FunctionSpec derive_convective(const Model& m);
 FunctionSpec derive_bodies(const Model& m);
+// Kinematics, closure and non-holonomic rows fused into one function, so that their common
+// subexpressions (the frames' rotations and positions) are computed once per update.
+FunctionSpec derive_kinematic_update(const Model& m);
 
 // All of the above, in that order.
 std::vector<FunctionSpec> derive_all(const Model& m);

@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<FunctionSpec> fns;
     std::vector<FunctionStats> stats;
-    for (auto derive : {derive_kinematics, derive_closure, derive_nonholonomic, derive_convective, derive_bodies}) {
+    for (auto derive : {derive_kinematics, derive_closure, derive_nonholonomic, derive_convective, derive_bodies,
+                        derive_kinematic_update}) {
       const auto d0 = std::chrono::steady_clock::now();
       fns.push_back(derive(model));
       const double derive_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();

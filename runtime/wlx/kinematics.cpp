@@ -6,6 +6,11 @@ void forward_kinematics(const Model& model, const Coordinates& s, Data& data) no
   gen::kinematics(s, model.params(), &data.frame_positions, &data.frame_rotations);
 }
 
+void kinematic_update(const Model& model, const Coordinates& s, Data& data) noexcept {
+  gen::kinematic_update(s, model.params(), &data.frame_positions, &data.frame_rotations, &data.Phi, &data.dPhi_ds,
+                        &data.C);
+}
+
 void closure(const Model& model, const Coordinates& s, Data& data, bool with_jacobian) noexcept {
   gen::closure(s, model.params(), &data.Phi, with_jacobian ? &data.dPhi_ds : nullptr);
 }

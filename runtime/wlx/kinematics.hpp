@@ -16,6 +16,9 @@ inline const Eigen::Matrix3d& frame_rotation(const Data& data, int frame) {
   return data.frame_rotations[static_cast<std::size_t>(frame)];
 }
 
+// The per-step kinematic update in one generated pass: frame poses, Phi, dPhi/ds and C(s).
+void kinematic_update(const Model& model, const Coordinates& s, Data& data) noexcept;
+
 // Fills data.Phi and, when with_jacobian, data.dPhi_ds.
 void closure(const Model& model, const Coordinates& s, Data& data, bool with_jacobian) noexcept;
 

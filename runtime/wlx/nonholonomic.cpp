@@ -96,8 +96,8 @@ DependentPair dependent_pair(std::string_view first, std::string_view second, co
 
 void solve_dependent_rates(const Model& model, const Coordinates& s, Coordinates& sdot, const DependentPair& pair,
                            Data& d, const NonholonomicOptions& options) {
-  gen::closure(s, model.params(), nullptr, &d.dPhi_ds);
-  gen::nonholonomic(s, model.params(), &d.C, nullptr);
+  // dPhi/ds and C(s) from the fused generated function: they share most subexpressions.
+  gen::kinematic_update(s, model.params(), nullptr, nullptr, nullptr, &d.dPhi_ds, &d.C);
   reduce(d);
   Eigen::Matrix<double, kNq, 1> q_rate = sdot.head<kNq>();
   q_rate(pair.index[0]) = 0;

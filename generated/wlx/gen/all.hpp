@@ -12,7 +12,8 @@
 //   nonholonomic             132         27474           625
 //   convective               395         62310          1867
 //   bodies                   345         58902          2163
-//   total                               181867          6177
+//   kinematic_update           236         48373          1304
+//   total                               230240          7481
 #pragma once
 
 #include "params.hpp"
@@ -22,3 +23,4 @@
 #include "nonholonomic.hpp"
 #include "convective.hpp"
 #include "bodies.hpp"
+#include "kinematic_update.hpp"
