@@ -1,6 +1,9 @@
 // Benchmarks (Google Benchmark): generated functions per call, and closed-form vs Newton IK.
 // Compare numbers from one run only (ratios): these machines are noisy.
+#include "numeric_baseline.hpp"
+
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 #include <wlx/ik.hpp>
 #include <wlx/dynamics.hpp>
 #include <wlx/kinematics.hpp>
@@ -9,7 +12,11 @@
 
 #include <numbers>
 
+#include <cstring>
+#include <map>
 #include <random>
+#include <string>
+#include <vector>
 
 namespace {
 
@@ -236,8 +243,77 @@ void BM_run_ID1(benchmark::State& st) {
   }
 }
 
+// ---- the numeric baseline: the same quantities without generated code ----
+void BM_base_frames(benchmark::State& st) {
+  const Model model;
+  baseline::Frames w;
+  const Coordinates s = assembled_nominal(model);
+  for (auto _ : st) {
+    baseline::frames(model.params(), s, w);
+    benchmark::DoNotOptimize(w.r.data());
+  }
+}
+void BM_base_closure_jacobian(benchmark::State& st) {
+  const Model model;
+  baseline::Frames w;
+  gen::ClosureJacobian J;
+  const Coordinates s = assembled_nominal(model);
+  for (auto _ : st) {
+    baseline::closure_jacobian(model.params(), s, J, w);
+    benchmark::DoNotOptimize(J.data());
+  }
+}
+void BM_base_nonholonomic(benchmark::State& st) {
+  const Model model;
+  baseline::Frames w;
+  gen::WheelRows C;
+  const Coordinates s = assembled_nominal(model);
+  for (auto _ : st) {
+    baseline::nonholonomic_rows(model.params(), s, C, w);
+    benchmark::DoNotOptimize(C.data());
+  }
+}
+void BM_base_convective(benchmark::State& st) {
+  const Model model;
+  baseline::Frames w;
+  gen::ClosureVector phi;
+  gen::WheelVector C;
+  const Coordinates s = assembled_nominal(model);
+  const Coordinates sdot = Coordinates::Constant(0.1);
+  for (auto _ : st) {
+    baseline::convective(model.params(), s, sdot, phi, C, w);
+    benchmark::DoNotOptimize(C.data());
+  }
+}
+void BM_base_body_jacobians(benchmark::State& st) {
+  const Model model;
+  baseline::Frames w;
+  gen::BodyJacobians Jv, Jw;
+  const Coordinates s = assembled_nominal(model);
+  for (auto _ : st) {
+    baseline::body_jacobians(model.params(), s, Jv, Jw, w);
+    benchmark::DoNotOptimize(Jv.data());
+  }
+}
+void BM_base_newton_cold(benchmark::State& st) {
+  const Model model;
+  baseline::Frames w;
+  Coordinates start = assembled_nominal(model);
+  start.head(kInputCount) = moved_target().head(kInputCount);
+  for (auto _ : st) {
+    Coordinates s = start;
+    benchmark::DoNotOptimize(baseline::newton_ik(model.params(), s, w));
+  }
+}
+
 }  // namespace
 
+BENCHMARK(BM_base_frames);
+BENCHMARK(BM_base_closure_jacobian);
+BENCHMARK(BM_base_nonholonomic);
+BENCHMARK(BM_base_convective);
+BENCHMARK(BM_base_body_jacobians);
+BENCHMARK(BM_base_newton_cold);
 BENCHMARK(BM_inverse_dynamics_step);
 BENCHMARK(BM_run_ID1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_dependent_rates);
@@ -255,4 +331,105 @@ BENCHMARK(BM_full_kinematic_update);
 BENCHMARK(BM_ik_closed_form_4_limbs);
 BENCHMARK(BM_ik_newton_cold_4_limbs);
 BENCHMARK(BM_ik_newton_warm_4_limbs);
-BENCHMARK_MAIN();
+namespace {
+
+// Collects the median of the repetitions of every benchmark, in nanoseconds.
+class MedianCollector : public benchmark::BenchmarkReporter {
+ public:
+  bool ReportContext(const Context&) override { return true; }
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const auto& r : runs)
+      if (r.run_type == Run::RT_Aggregate && r.aggregate_name == "median")
+        median_ns[r.run_name.function_name] = r.GetAdjustedRealTime() * to_ns(r.time_unit);
+  }
+  static double to_ns(benchmark::TimeUnit u) {
+    switch (u) {
+      case benchmark::kNanosecond: return 1;
+      case benchmark::kMicrosecond: return 1e3;
+      case benchmark::kMillisecond: return 1e6;
+      case benchmark::kSecond: return 1e9;
+    }
+    return 1;
+  }
+  std::map<std::string, double> median_ns;
+};
+
+struct Row {
+  const char* what;
+  const char* generated;  // benchmark name
+  const char* baseline;   // benchmark name, or nullptr
+  long ops;               // operations of the generated function, or 0
+};
+
+}  // namespace
+
+// Runs the suite (5 repetitions each) and prints one table: operation, median ns per call, the
+// numeric baseline and the ratio measured in the same run, and the generated op counts.
+// --json prints the same as JSON. Other arguments go to Google Benchmark (e.g. --benchmark_filter).
+int main(int argc, char** argv) {
+  bool json = false;
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--json") == 0) json = true;
+    else args.push_back(argv[i]);
+  }
+  std::string reps = "--benchmark_repetitions=5";
+  std::string min_time = "--benchmark_min_time=0.05";
+  args.push_back(reps.data());
+  args.push_back(min_time.data());
+  int n = static_cast<int>(args.size());
+  benchmark::Initialize(&n, args.data());
+  MedianCollector collector;
+  benchmark::RunSpecifiedBenchmarks(&collector);
+  namespace ops = wlx::gen::operations;
+  const Row rows[] = {
+      {"FK of 13 frames (positions + rotations)", "BM_gen_kinematics_all", "BM_base_frames", ops::kinematics},
+      {"FK positions only", "BM_gen_kinematics_positions", nullptr, 0},
+      {"Phi + dPhi/ds (14 x 32)", "BM_gen_closure", "BM_base_closure_jacobian", ops::closure},
+      {"non-holonomic rows C(s) + spin rows", "BM_gen_nonholonomic", "BM_base_nonholonomic", ops::nonholonomic},
+      {"convective terms (dPhi/ds)' s', C' s'", "BM_gen_convective", "BM_base_convective", ops::convective},
+      {"7 bodies: CoM, R, Jv, Jw, convective", "BM_gen_bodies", "BM_base_body_jacobians", ops::bodies},
+      {"fused FK + Phi + dPhi/ds + C(s)", "BM_gen_kinematic_update_fused", "BM_gen_kinematic_update_separate", ops::kinematic_update},
+      {"full kinematic update (4-limb IK + fused)", "BM_full_kinematic_update", nullptr, 0},
+      {"IK closed form, 4 limbs (vs Newton, cold)", "BM_ik_closed_form_4_limbs", "BM_ik_newton_cold_4_limbs", 0},
+      {"IK closed form, 4 limbs (vs Newton, warm)", "BM_ik_closed_form_4_limbs", "BM_ik_newton_warm_4_limbs", 0},
+      {"IK Newton (generated J), cold start", "BM_ik_newton_cold_4_limbs", "BM_base_newton_cold", 0},
+      {"IK Newton (generated J), warm start", "BM_ik_newton_warm_4_limbs", nullptr, 0},
+      {"dependent rates (velocity level)", "BM_dependent_rates", nullptr, 0},
+      {"dependent accelerations", "BM_dependent_accelerations", nullptr, 0},
+      {"inverse-dynamics step", "BM_inverse_dynamics_step", nullptr, 0},
+      {"NH-1 run (2001 samples, RK4)", "BM_run_NH1", nullptr, 0},
+      {"ID-1 run (495 samples, RK4, torques)", "BM_run_ID1", nullptr, 0},
+  };
+  const auto get = [&](const char* name) {
+    const auto it = collector.median_ns.find(name);
+    return it == collector.median_ns.end() ? -1.0 : it->second;
+  };
+  if (json) {
+    std::string out = "[\n";
+    bool first = true;
+    for (const Row& r : rows) {
+      const double g = get(r.generated), b = r.baseline ? get(r.baseline) : -1;
+      if (g < 0) continue;
+      out += fmt::format("{}  {{\"operation\": \"{}\", \"ns\": {:.1f}", first ? "" : ",\n", r.what, g);
+      if (b > 0) out += fmt::format(", \"baseline\": \"{}\", \"baseline_ns\": {:.1f}, \"speedup\": {:.2f}", r.baseline, b, b / g);
+      if (r.ops > 0) out += fmt::format(", \"ops\": {}, \"ns_per_op\": {:.3f}", r.ops, g / static_cast<double>(r.ops));
+      out += "}";
+      first = false;
+    }
+    fmt::print("{}\n]\n", out);
+    return 0;
+  }
+  fmt::print("\n{:<44} {:>11} {:>34} {:>9} {:>7} {:>7}\n", "operation", "ns/call", "baseline (ns/call)", "speedup", "ops",
+             "ns/op");
+  for (const Row& r : rows) {
+    const double g = get(r.generated);
+    if (g < 0) continue;
+    const double b = r.baseline ? get(r.baseline) : -1;
+    const std::string base = b > 0 ? fmt::format("{} {:.0f}", std::string(r.baseline).substr(3), b) : "";
+    fmt::print("{:<44} {:>11.1f} {:>34} {:>9} {:>7} {:>7}\n", r.what, g, base, b > 0 ? fmt::format("{:.1f}x", b / g) : "",
+               r.ops > 0 ? std::to_string(r.ops) : "", r.ops > 0 ? fmt::format("{:.3f}", g / static_cast<double>(r.ops)) : "");
+  }
+  fmt::print("\nmedians of 5 repetitions, one run; speedup = baseline / generated measured side by side\n");
+  return 0;
+}

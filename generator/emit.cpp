@@ -356,7 +356,11 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   t += signature + ") noexcept {\n";
   t += "  static_cast<void>(s);\n  static_cast<void>(p);\n";
   if (fn.needs_rates) t += "  static_cast<void>(sdot);\n";
-  t += aliases + body + "}\n\n" + namespace_close(opt);
+  t += aliases + body + "}\n\n";
+  t += fmt::format("namespace operations {{\n// Operations {}() evaluates with every output requested (adds, muls, divs, calls).\n"
+                   "inline constexpr long {} = {};\n}}  // namespace operations\n\n",
+                   fn.name, fn.name, total.total());
+  t += namespace_close(opt);
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return {"wlx/gen/" + fn.header, t};
 }

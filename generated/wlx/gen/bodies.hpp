@@ -773,4 +773,9 @@ inline void bodies(const Coordinates& s, const Coordinates& sdot, const Params& 
   }
 }
 
+namespace operations {
+// Operations bodies() evaluates with every output requested (adds, muls, divs, calls).
+inline constexpr long bodies = 2163;
+}  // namespace operations
+
 }  // namespace wlx::gen

@@ -369,4 +369,9 @@ inline void closure(const Coordinates& s, const Params& p, ClosureVector* Phi, C
   }
 }
 
+namespace operations {
+// Operations closure() evaluates with every output requested (adds, muls, divs, calls).
+inline constexpr long closure = 906;
+}  // namespace operations
+
 }  // namespace wlx::gen

@@ -493,4 +493,9 @@ inline void convective(const Coordinates& s, const Coordinates& sdot, const Para
   }
 }
 
+namespace operations {
+// Operations convective() evaluates with every output requested (adds, muls, divs, calls).
+inline constexpr long convective = 1867;
+}  // namespace operations
+
 }  // namespace wlx::gen

@@ -384,4 +384,9 @@ inline void kinematics(const Coordinates& s, const Params& p, FramePositions* po
   }
 }
 
+namespace operations {
+// Operations kinematics() evaluates with every output requested (adds, muls, divs, calls).
+inline constexpr long kinematics = 616;
+}  // namespace operations
+
 }  // namespace wlx::gen

@@ -221,4 +221,9 @@ inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, Wh
   }
 }
 
+namespace operations {
+// Operations nonholonomic() evaluates with every output requested (adds, muls, divs, calls).
+inline constexpr long nonholonomic = 625;
+}  // namespace operations
+
 }  // namespace wlx::gen
