@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 namespace wlx {
 
@@ -75,12 +76,21 @@ double cabin_clearance(const Params& p, const Coordinates& s) {
 
 Trajectory simulate(const Scenario& sc, const Progress& progress) {
   sc.validate();
+  std::vector<Sample> samples;
+  samples.reserve(static_cast<std::size_t>(sc.samples()));
+  Trajectory out = simulate_each(sc, [&](const Sample& smp) { samples.push_back(smp); }, progress);
+  out.samples = std::move(samples);
+  return out;
+}
+
+Trajectory simulate_each(const Scenario& sc, const std::function<void(const Sample&)>& on_sample, const Progress& progress) {
+  sc.validate();
   const Model model(sc.params);
-  Data data;
+  auto data_storage = std::make_unique<Data>();  // ~7 KB: kept off the stack
+  Data& data = *data_storage;
   RightHandSide f{sc, model, data, sc.initial, Coordinates::Zero(), InputVector::Zero()};
   Trajectory out;
   const long n = sc.samples();
-  out.samples.reserve(static_cast<std::size_t>(n));
   InputVector q = sc.initial.head<kInputCount>();
   DynamicsTerms terms;
   Vector4 u;
@@ -106,7 +116,7 @@ Trajectory simulate(const Scenario& sc, const Progress& progress) {
         smp.Qstar = terms.Qstar;
         smp.tau = distribute_torques(terms.J_beta, terms.Qstar, *sc.weighting);
       }
-      out.samples.push_back(smp);
+      on_sample(smp);
       if (progress) progress(k + 1, n);
       if (k + 1 == n) break;
       if (sc.integrator == Integrator::euler) {

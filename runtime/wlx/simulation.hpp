@@ -64,6 +64,11 @@ using Progress = std::function<void(long, long)>;
 
 Trajectory simulate(const Scenario& scenario, const Progress& progress = {});
 
+// The same without storing the samples: each one goes to `on_sample` as it is computed, so a
+// run of any length needs constant memory. Returns how the run ended (samples left empty).
+Trajectory simulate_each(const Scenario& scenario, const std::function<void(const Sample&)>& on_sample,
+                         const Progress& progress = {});
+
 // Lowest corner of the cabin block (cxd x cyd x cabin_height, centred on K_C) above the ground.
 double cabin_clearance(const Params& p, const Coordinates& s);
 
