@@ -66,8 +66,8 @@ double si_value(const nlohmann::json& v, const std::string& key, bool angle) {
     if (!angle) throw Error(key, "only angles may be given in degrees; give this value in SI units");
     if (v.size() != 1 || !(v.contains("deg") || v.contains("deg/s")))
       throw Error(key, fmt::format("expected a number or {{\"deg\": x}} / {{\"deg/s\": x}}, got {}", v.dump()));
-    const auto& [unit, value] = *v.items().begin();
-    return finite_number(value, key + "." + unit) * std::numbers::pi / 180;
+    // v.items() is a proxy: iterate it in place (a reference into a dereferenced temporary dangles).
+    for (const auto& item : v.items()) return finite_number(item.value(), key + "." + item.key()) * std::numbers::pi / 180;
   }
   return finite_number(v, key);
 }

@@ -102,14 +102,37 @@ void solve_leg(const Model& model, const CabinPose& cabin, Limb limb, int branch
                 fmt::format("foot is {:.4f} m from the hip, reach is [{:.4f}, {:.4f}] m (|thighD - legD| to thighD + legD)",
                             dist, near, far));
   const double sign4 = branch & 1 ? -1.0 : 1.0;
-  const double psi4 = sign4 * std::acos(c4);
-  const double a = T + L * c4, b = -L * sign4 * std::sqrt(1 - c4 * c4);
-  // d_y = a sin(psi_3); (d_x, d_z) is (a cos(psi_3), b) turned by -psi_2 about y.
-  double s3 = std::abs(a) > 1e-300 ? d.y() / a : 0.0;
-  clamp_unit(s3);  // |d_y| <= |a| holds exactly; this only removes rounding
-  double psi3 = std::asin(s3);
-  if (branch & 2) psi3 = wrap(kPi - psi3);
-  const double k = a * std::cos(psi3);
+  double psi4 = sign4 * std::acos(c4);
+  double a = T + L * c4, b = -L * sign4 * std::sqrt(1 - c4 * c4);
+  // d_y = a sin(psi_3); (d_x, d_z) is (k, b) = (a cos(psi_3), b) turned by -psi_2 about y. With
+  // psi_1 an input, the distance fixes the knee, and the knee limits how far beside the hip's
+  // pitch plane the foot can be: the in-plane distance must be at least |b| (equivalently
+  // |d_y| <= |a|). The annulus of distances alone is not the reach.
+  const double in_plane2 = d.x() * d.x() + d.z() * d.z();
+  if (b * b > in_plane2) {
+    if (b * b - in_plane2 > kReachSlack * far * far)
+      throw Error(std::string(limb_name(limb)),
+                  fmt::format("foot out of reach: at {:.4f} m from the hip the knee must bend to {} = {:.2f} deg, and "
+                              "the foot can then be at most {:.4f} m beside the hip's pitch plane (the plane after the "
+                              "hip roll {}), but it is {:.4f} m beside it",
+                              dist, gen::kCoordinateNames[static_cast<std::size_t>(indices(limb).dep[2])],
+                              std::abs(psi4) * 180 / kPi, std::abs(a), gen::kCoordinateNames[static_cast<std::size_t>(psi1)],
+                              std::abs(d.y())));
+    // On that boundary (e.g. a straight leg pointing sideways) rounding of |d| can break the
+    // condition by an ulp: take the knee from the in-plane distance instead.
+    const double sin4 = std::min(1.0, std::sqrt(in_plane2) / L);
+    psi4 = sign4 * (c4 >= 0 ? std::asin(sin4) : kPi - std::asin(sin4));
+    a = T + L * std::cos(psi4);
+    b = -L * std::sin(psi4);
+  }
+  // psi_3 from atan2 of both legs of its triangle (asin near 1 would lose half the digits).
+  const double a_sign = a < 0 ? -1.0 : 1.0;
+  double k = a_sign * std::sqrt(std::max(0.0, in_plane2 - b * b));  // a cos(psi_3), branch |psi_3| < 90 deg
+  double psi3 = std::atan2(a_sign * d.y(), a_sign * k);
+  if (branch & 2) {
+    psi3 = wrap(kPi - psi3);
+    k = -k;
+  }
   const double psi2 = wrap(std::atan2(b, k) - std::atan2(d.z(), d.x()));
   const auto idx = indices(limb);
   s(idx.dep[0]) = psi2;

@@ -181,3 +181,57 @@ TEST_CASE("cli: wlx simulate ID-1 --weighting 2 adds the torque and Q* columns")
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 495);
   CHECK(run_wlx("simulate ID-1 --weighting 3 --out " + dir.string()).err == "wlx: error: --weighting: must be 1 or 2, got '3'\n");
 }
+
+TEST_CASE("cli: every validation rule names the field, the value and the rule, with exit code 2") {
+  const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "rules";
+  fs::create_directories(dir);
+  struct Case {
+    std::string args, input, file, message;
+  };
+  const std::string ok = R"("dependent": ["y_C", "yaw"], "duration": 0.01)";
+  const Case cases[] = {
+      {"ik", R"({"x_C": "1"})", "", "x_C: must be a number, got string \"1\""},
+      {"ik", R"({"params": {"cxd": -3}})", "", "params.cxd: a length must be positive, got -3 m"},
+      {"ik", R"({"params": {"m_M2": 0}})", "", "params.m_M2: a mass must be positive, got 0 kg"},
+      {"ik", R"({"params": {"Izz_M1": 9000}})", "", "params.Izz_M1: 9000 kg*m^2 exceeds the sum of the other two"},
+      {"ik", R"({"params": {"Iyy_M7": -1}})", "", "params.Iyy_M7: a principal inertia must be positive, got -1"},
+      {"ik", R"({"params": "none"})", "", "params: must be an object, got string"},
+      {"ik", R"({"start": {"psi_l9": 0}})", "", "start.psi_l9: unknown key; did you mean 'psi_l2'?"},
+      {"ik", R"({"branch": 1.5})", "", "branch: must be an integer, got 1.5"},
+      {"ik", R"({"branch": {"leg_x": 1}})", "", "branch.leg_x: unknown key; did you mean 'leg_l'?"},
+      {"simulate FILE", "", "{" + ok + R"(, "durration": 1})", "durration: unknown key; did you mean 'duration'?"},
+      {"simulate FILE", "", R"({"dependent": ["y_C", "y_C"], "duration": 1})", "dependent: the two dependent rates must differ"},
+      {"simulate FILE", "", R"({"dependent": ["y_C", "psi_l2"], "duration": 1})",
+       "dependent: 'psi_l2' cannot be a dependent rate: choose 2 of x_C, y_C, z_C, yaw, pitch, roll, theta_l5, theta_r5"},
+      {"simulate FILE", "", R"({"dependent": ["y_C", "yaw"], "duration": 0})", "duration: must be a positive number of seconds, got 0"},
+      {"simulate FILE", "", R"({"dependent": ["y_C", "yaw"], "duration": 1e6, "dt": 1e-6})",
+       "dt: 1e-06 s over 1000000 s is 1e+12 steps, more than the limit of 1e8"},
+      {"simulate FILE", "", "{" + ok + R"(, "weighting": 3})", "weighting: must be 1, 2, {\"diag\": [8 weights]} or"},
+      {"simulate FILE", "", "{" + ok + R"(, "weighting": {"diag": [1, 1, 1, 1, 1, 1, 1, 0]}})",
+       "weighting.diag: a weight must be positive and finite, got 0"},
+      {"simulate FILE", "", "{" + ok + R"(, "weighting": 1, "rates": {"theta_l5": 0.1}})",
+       "rates.theta_l5: an inverse-dynamics run commands only z_C, x_C, roll and pitch"},
+      {"simulate FILE", "", "{" + ok + R"(, "max_condition": 0.5})", "max_condition: must be above 1, got 0.5"},
+      {"simulate FILE", "", "{" + ok + R"(, "initial": {"z_C": {"deg": 3}}})",
+       "initial.z_C: only angles may be given in degrees; give this value in SI units"},
+      {"simulate NH-1 --dt nan", "", "", "dt: must be a positive number of seconds, got nan"},
+      {"simulate NH-1 --dt 0.0003", "", "", "dt: the duration 2 s is not a whole number of steps of 0.0003 s"},
+      {"simulate NH-1 --integrator rk45", "", "", "--integrator: must be rk4 or euler, got 'rk45'"},
+      {"simulate", "", "", "SCENARIO: missing: give a scenario file or id (--list shows the ids)"},
+  };
+  for (const Case& c : cases) {
+    std::string args = c.args;
+    if (!c.file.empty()) {
+      std::ofstream(dir / "case.json") << c.file;
+      args.replace(args.find("FILE"), 4, (dir / "case.json").string());
+    }
+    if (args.rfind("simulate", 0) == 0 && args != "simulate") args += " --out " + (dir / "out").string();
+    CAPTURE(args);
+    CAPTURE(c.input);
+    const Run r = run_wlx(args, c.input);
+    CHECK(r.code == 2);
+    CHECK(r.err.find("wlx: error: " + c.message) == 0);
+    const bool nan_only_when_quoted = r.err.find("nan") == std::string::npos || c.message.find("nan") != std::string::npos;
+    CHECK(nan_only_when_quoted);
+  }
+}

@@ -115,3 +115,19 @@ TEST_CASE("simulation: cabin clearance of the 3 x 3 x 0.5 m block") {
   s(c::roll) = 0.1;
   CHECK(cabin_clearance(p, s) == doctest::Approx(2.0 - (std::sin(0.1) * 1.5 + std::cos(0.1) * 0.25)));
 }
+
+TEST_CASE("simulation: a run that meets a singular J_beta midway stops there with the reason") {
+  // Lowering the right wheel's ground to the left one's level makes the wheel axes collinear;
+  // with a threshold of 1e4 the run stops when cond(J_beta) passes it.
+  Scenario sc;
+  sc.rates(c::z_Wr) = -0.1;  // z_Wr: 0.05 m -> 0 at t = 0.5 s
+  sc.duration = 1.0;
+  sc.nonholonomic.max_condition = 1e4;
+  const Trajectory tr = simulate(sc);
+  CHECK_FALSE(tr.complete);
+  REQUIRE(tr.samples.size() > 100);
+  CHECK(tr.samples.back().t < 0.5);
+  CHECK(tr.samples.back().cond_J_beta <= 1e4);
+  CHECK(tr.error.find("J_beta for the dependent pair (y_C', yaw') is singular: condition number") != std::string::npos);
+  CHECK(tr.error.find("exceeds the threshold 1e+04") != std::string::npos);
+}
