@@ -119,9 +119,9 @@ void solve_leg(const Model& model, const CabinPose& cabin, Limb limb, int branch
                               std::abs(psi4) * 180 / kPi, std::abs(a), gen::kCoordinateNames[static_cast<std::size_t>(psi1)],
                               std::abs(d.y())));
     // On that boundary (e.g. a straight leg pointing sideways) rounding of |d| can break the
-    // condition by an ulp: take the knee from the in-plane distance instead.
-    const double sin4 = std::min(1.0, std::sqrt(in_plane2) / L);
-    psi4 = sign4 * (c4 >= 0 ? std::asin(sin4) : kPi - std::asin(sin4));
+    // condition by an ulp: take the knee from both legs of its triangle, L cos(psi_4) from the
+    // distance and L |sin(psi_4)| from the in-plane offset (atan2 stays accurate at every angle).
+    psi4 = sign4 * std::atan2(std::sqrt(in_plane2), L * c4);
     a = T + L * std::cos(psi4);
     b = -L * std::sin(psi4);
   }
