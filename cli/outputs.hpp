@@ -13,7 +13,8 @@ namespace wlx::cli {
 void write_ik_sweep_csv(const std::string& path, const IkSweepResult& result);
 
 // t, the 32 coordinates, x_Wl..y_Wr, nh_residual_l/r, spin_rate_l/r, the 18 input rates
-// (<name>_dot), cond_J_beta, cabin_clearance, and for dynamics runs tau_<joint> and Qstar_<speed>.
+// (<name>_dot), cond_J_beta, cabin_clearance, the contact velocities vx_Wl..vz_Wr, and for
+// dynamics runs tau_<joint> and Qstar_<speed>.
 std::vector<std::string> trajectory_header(bool dynamics);
 void write_trajectory(const std::string& path, const Trajectory& trajectory, bool dynamics);
 

@@ -20,6 +20,7 @@ std::vector<std::string> trajectory_header(bool dynamics) {
   for (int k = 0; k < kInputCount; ++k) h.push_back(std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]) + "_dot");
   h.emplace_back("cond_J_beta");
   h.emplace_back("cabin_clearance");
+  for (const char* c : {"vx_Wl", "vy_Wl", "vz_Wl", "vx_Wr", "vy_Wr", "vz_Wr"}) h.emplace_back(c);
   if (dynamics) {
     for (int k : kActuatedJoints) h.push_back("tau_" + std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]));
     for (int k : kCommandedSpeeds) h.push_back("Qstar_" + std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]));
@@ -35,6 +36,8 @@ std::vector<double> trajectory_row(const Sample& smp, bool dynamics) {
   for (int k = 0; k < kInputCount; ++k) row.push_back(smp.sdot(k));
   row.push_back(smp.cond_J_beta);
   row.push_back(smp.cabin_clearance);
+  for (int w = 0; w < 2; ++w)
+    for (int i = 0; i < 3; ++i) row.push_back(smp.contact_velocity(i, w));
   if (dynamics) {
     for (int k = 0; k < 8; ++k) row.push_back(smp.tau(k));
     for (int k = 0; k < 4; ++k) row.push_back(smp.Qstar(k));

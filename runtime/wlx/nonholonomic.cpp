@@ -163,6 +163,21 @@ Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& 
   return T;
 }
 
+Eigen::Matrix<double, 3, 2> contact_velocities(const Model& model, const Coordinates& s, const Coordinates& sdot,
+                                               Data& d) {
+  gen::kinematics(s, model.params(), nullptr, &d.frame_rotations);
+  gen::nonholonomic(s, model.params(), &d.C, &d.spin);
+  const Eigen::Vector2d forward = model.params().w * (d.spin * sdot), sideways = d.C * sdot;
+  Eigen::Matrix<double, 3, 2> v;
+  const int frames[2] = {gen::frame::W_l, gen::frame::W_r};
+  const int levels[2] = {gen::coord::z_Wl, gen::coord::z_Wr};
+  for (int w = 0; w < 2; ++w) {
+    const Eigen::Matrix3d& R = d.frame_rotations[static_cast<std::size_t>(frames[w])];
+    v.col(w) = R.col(0) * forward(w) + R.col(1) * sideways(w) + Eigen::Vector3d::UnitZ() * sdot(levels[w]);
+  }
+  return v;
+}
+
 Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& d) {
   gen::nonholonomic(s, model.params(), &d.C, nullptr);
   return d.C * sdot;

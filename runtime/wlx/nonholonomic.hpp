@@ -56,6 +56,13 @@ void solve_dependent_accelerations(const Model& model, const Coordinates& s, con
 Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& commanded, const DependentPair& pair,
                                                       const Data& data);
 
+// Velocity in K0 of each wheel's contact point (columns l, r) for the full sdot, from the
+// generated rows: along the contact frame's x axis w * spin rate, along its lateral axis n_W the
+// sideways velocity C s' (zero when the constraint holds), and vertically the ground level's
+// rate z_W' (the contact frame stays level). Uses data.frame_rotations, data.C and data.spin.
+Eigen::Matrix<double, 3, 2> contact_velocities(const Model& model, const Coordinates& s, const Coordinates& sdot,
+                                               Data& data);
+
 // v_W . n_W per wheel for the full sdot: the thesis' residual check of the rolling constraint.
 Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& data);
 

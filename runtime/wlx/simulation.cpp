@@ -107,7 +107,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       forward_kinematics(model, f.s, data);
       smp.contacts << data.frame_positions(0, gen::frame::W_l), data.frame_positions(1, gen::frame::W_l),
           data.frame_positions(0, gen::frame::W_r), data.frame_positions(1, gen::frame::W_r);
-      gen::nonholonomic(f.s, model.params(), &data.C, &data.spin);
+      smp.contact_velocity = contact_velocities(model, f.s, f.sdot, data);  // also fills data.C, data.spin
       smp.nh_residual = data.C * f.sdot;
       smp.spin_rate = data.spin * f.sdot;
       smp.cabin_clearance = cabin_clearance(model.params(), f.s);

@@ -44,6 +44,7 @@ struct Sample {
   Coordinates s;                 // all 32 coordinates
   Coordinates sdot;              // their rates
   Eigen::Vector4d contacts;      // x_Wl, y_Wl, x_Wr, y_Wr
+  Eigen::Matrix<double, 3, 2> contact_velocity;  // v_W in K0, columns l, r
   Eigen::Vector2d nh_residual;   // v_W . n_W per wheel (should be 0)
   Eigen::Vector2d spin_rate;     // wheel spin rates, rad/s
   double cond_J_beta = 0;

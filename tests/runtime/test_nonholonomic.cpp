@@ -5,6 +5,7 @@
 #include <wlx/nonholonomic.hpp>
 #include <wlx/simulation.hpp>
 
+
 #include <cmath>
 #include <numbers>
 
@@ -160,4 +161,27 @@ TEST_CASE("nonholonomic: a limb at a singular pose is named") {
     CHECK(e.field() == "left leg");
     CHECK(std::string(e.what()).find("the leg is stretched straight or folded") != std::string::npos);
   }
+}
+
+TEST_CASE("nonholonomic: contact velocities match finite differences of the contact positions") {
+  // ST-A2+-like run at dt = 1e-4: central differences of x_W, y_W good to ~1e-8 m/s.
+  Scenario sc;
+  sc.rates(c::theta_l5) = 0.5 * kDeg;
+  sc.rates(c::roll) = 2 * kDeg;
+  sc.duration = 0.01;
+  sc.dt = 1e-4;
+  const Trajectory tr = simulate(sc);
+  REQUIRE(tr.complete);
+  double worst = 0, scale = 0;
+  for (std::size_t k = 1; k + 1 < tr.samples.size(); ++k) {
+    const Eigen::Vector4d fd = (tr.samples[k + 1].contacts - tr.samples[k - 1].contacts) / (2 * sc.dt);
+    const auto& v = tr.samples[k].contact_velocity;
+    worst = std::max({worst, std::abs(fd(0) - v(0, 0)), std::abs(fd(1) - v(1, 0)), std::abs(fd(2) - v(0, 1)),
+                      std::abs(fd(3) - v(1, 1))});
+    scale = std::max(scale, v.cwiseAbs().maxCoeff());
+    CHECK(std::abs(v(2, 0)) <= 1e-15);  // the ground levels do not move (the frame is level to rounding)
+  }
+  MESSAGE("contact velocity vs finite differences: " << worst << " m/s (velocities up to " << scale << " m/s)");
+  CHECK(scale > 0.1);
+  CHECK(worst <= 1e-7 * scale);
 }
