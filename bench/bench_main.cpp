@@ -66,7 +66,7 @@ void BM_gen_closure(benchmark::State& st) {
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::closure(s, model.params(), &d.Phi, &d.dPhi_ds);
+    gen::closure(s, model.params(), &d.Phi, &d.dPhi_ds, false);
     benchmark::DoNotOptimize(d.dPhi_ds.data());
   }
 }
@@ -75,7 +75,7 @@ void BM_gen_nonholonomic(benchmark::State& st) {
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::nonholonomic(s, model.params(), &d.C, &d.spin);
+    gen::nonholonomic(s, model.params(), &d.C, &d.spin, false);
     benchmark::DoNotOptimize(d.C.data());
   }
 }
@@ -96,18 +96,44 @@ void BM_gen_bodies(benchmark::State& st) {
   const Coordinates sdot = Coordinates::Constant(0.1);
   for (auto _ : st) {
     gen::bodies(s, sdot, model.params(), &d.body_com, &d.body_rotations, &d.body_Jv, &d.body_Jw, &d.body_Jv_dot_sdot,
-                &d.body_Jw_dot_sdot);
+                &d.body_Jw_dot_sdot, false);
     benchmark::DoNotOptimize(d.body_Jv.data());
   }
 }
 
-// FK + Phi + dPhi/ds + C(s): the fused generated function, and the three separate ones.
+// FK + Phi + dPhi/ds + C(s): the fused generated function, and the three separate ones. The
+// workspace keeps its structural zeros (zero_fill = false, as the runtime calls it); the second
+// variant rewrites them every call; the third cycles through 64 random poses (angles within
+// +-pi), where data-dependent branches of a libm would show.
 void BM_gen_kinematic_update_fused(benchmark::State& st) {
   const Model model;
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::kinematic_update(s, model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds, &d.C);
+    gen::kinematic_update(s, model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds, &d.C, false);
+    benchmark::DoNotOptimize(d.C.data());
+  }
+}
+void BM_gen_kinematic_update_fused_zero_fill(benchmark::State& st) {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled_nominal(model);
+  for (auto _ : st) {
+    gen::kinematic_update(s, model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds, &d.C, true);
+    benchmark::DoNotOptimize(d.C.data());
+  }
+}
+void BM_gen_kinematic_update_fused_random_poses(benchmark::State& st) {
+  const Model model;
+  Data d;
+  std::array<Coordinates, 64> poses;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(-3.14, 3.14);
+  for (auto& s : poses) s = Coordinates::NullaryExpr([&] { return angle(rng); });
+  std::size_t k = 0;
+  for (auto _ : st) {
+    gen::kinematic_update(poses[k++ & 63], model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds,
+                          &d.C, false);
     benchmark::DoNotOptimize(d.C.data());
   }
 }
@@ -117,8 +143,8 @@ void BM_gen_kinematic_update_separate(benchmark::State& st) {
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
     gen::kinematics(s, model.params(), &d.frame_positions, &d.frame_rotations);
-    gen::closure(s, model.params(), &d.Phi, &d.dPhi_ds);
-    gen::nonholonomic(s, model.params(), &d.C, nullptr);
+    gen::closure(s, model.params(), &d.Phi, &d.dPhi_ds, false);
+    gen::nonholonomic(s, model.params(), &d.C, nullptr, false);
     benchmark::DoNotOptimize(d.C.data());
   }
 }
@@ -326,6 +352,8 @@ BENCHMARK(BM_gen_nonholonomic);
 BENCHMARK(BM_gen_convective);
 BENCHMARK(BM_gen_bodies);
 BENCHMARK(BM_gen_kinematic_update_fused);
+BENCHMARK(BM_gen_kinematic_update_fused_zero_fill);
+BENCHMARK(BM_gen_kinematic_update_fused_random_poses);
 BENCHMARK(BM_gen_kinematic_update_separate);
 BENCHMARK(BM_full_kinematic_update);
 BENCHMARK(BM_ik_closed_form_4_limbs);
@@ -390,6 +418,8 @@ int main(int argc, char** argv) {
       {"convective terms (dPhi/ds)' s', C' s'", "BM_gen_convective", "BM_base_convective", ops::convective},
       {"7 bodies: CoM, R, Jv, Jw, convective", "BM_gen_bodies", "BM_base_body_jacobians", ops::bodies},
       {"fused FK + Phi + dPhi/ds + C(s)", "BM_gen_kinematic_update_fused", "BM_gen_kinematic_update_separate", ops::kinematic_update},
+      {"  the same, rewriting structural zeros", "BM_gen_kinematic_update_fused_zero_fill", nullptr, ops::kinematic_update},
+      {"  the same, 64 random poses in turn", "BM_gen_kinematic_update_fused_random_poses", nullptr, ops::kinematic_update},
       {"full kinematic update (4-limb IK + fused)", "BM_full_kinematic_update", nullptr, 0},
       {"IK closed form, 4 limbs (vs Newton, cold)", "BM_ik_closed_form_4_limbs", "BM_ik_newton_cold_4_limbs", 0},
       {"IK closed form, 4 limbs (vs Newton, warm)", "BM_ik_closed_form_4_limbs", "BM_ik_newton_warm_4_limbs", 0},

@@ -10,8 +10,6 @@
 
 namespace wlx::gen {
 
-namespace {
-
 std::string banner(const Model& m, const EmitOptions& opt, const std::string& what) {
   std::string b = fmt::format(
       "// {}\n"
@@ -32,6 +30,8 @@ std::string banner(const Model& m, const EmitOptions& opt, const std::string& wh
 
 std::string namespace_open(const EmitOptions& opt) { return fmt::format("namespace {} {{\n", opt.name_space); }
 std::string namespace_close(const EmitOptions& opt) { return fmt::format("}}  // namespace {}\n", opt.name_space); }
+
+namespace {
 
 std::string literal(double v) {
   std::string s = fmt::format("{}", v);
@@ -57,7 +57,9 @@ class Printer {
  public:
   enum class Context { Root, Term, Factor };
 
-  Printer(const ExprGraph& g, const CsePlan& plan) : g_(g), plan_(plan) {}
+  // `precomputed`: nodes already held in named variables (sin/cos of the batched angles).
+  Printer(const ExprGraph& g, const CsePlan& plan, const std::map<int, std::string>& precomputed)
+      : g_(g), plan_(plan), precomputed_(precomputed) {}
 
   std::string temp_name(int id) const { return fmt::format("t{}", plan_.temp_index.at(id)); }
   bool is_temp(int id) const { return plan_.temp_index.count(id) != 0; }
@@ -67,6 +69,7 @@ class Printer {
 
  private:
   std::string use(int id, Context ctx, OpCount& ops, bool* negated) {
+    if (auto it = precomputed_.find(id); it != precomputed_.end()) return it->second;
     if (is_temp(id)) return temp_name(id);
     return node(id, ctx, ops, negated);
   }
@@ -89,6 +92,7 @@ class Printer {
         return ctx == Context::Factor && s.find_first_of("*/") != std::string::npos ? "(" + s + ")" : s;
       }
       case NodeKind::Call: {
+        if (auto it = precomputed_.find(id); it != precomputed_.end()) return it->second;
         std::string args;
         for (int a : n.args) args += (args.empty() ? "" : ", ") + use(a, Context::Root, ops, nullptr);
         ++ops.calls;
@@ -179,7 +183,53 @@ class Printer {
 
   const ExprGraph& g_;
   const CsePlan& plan_;
+  const std::map<int, std::string>& precomputed_;
 };
+
+// sin and cos of coordinates, batched into one trig.hpp pass: node id -> variable name, and
+// the prologue computing them (angles in coordinate order, so the output is deterministic).
+struct TrigBatch {
+  std::map<int, std::string> names;
+  std::string prologue;
+  long calls = 0;
+};
+
+TrigBatch batch_trig(const Model& m, const ExprGraph& g, const std::vector<int>& roots) {
+  std::map<std::string, std::map<std::string, int>> by_angle;  // angle -> {"sin"/"cos" -> node}
+  std::unordered_set<int> seen;
+  std::function<void(int)> visit = [&](int id) {
+    if (!seen.insert(id).second) return;
+    const Node& n = g.node(id);
+    if (n.kind == NodeKind::Call && (n.text == "sin" || n.text == "cos") && n.args.size() == 1 &&
+        g.node(n.args[0]).kind == NodeKind::Symbol)
+      by_angle[g.node(n.args[0]).text][n.text] = id;
+    for (int a : n.args) visit(a);
+  };
+  for (int r : roots) visit(r);
+  TrigBatch b;
+  std::vector<std::string> angles;
+  for (const auto& c : m.coordinates)
+    if (by_angle.count(c.name)) angles.push_back(c.name);
+  if (angles.size() != by_angle.size()) throw std::runtime_error("sin/cos of a symbol that is not a coordinate");
+  if (angles.empty()) return b;
+  const std::size_t count = angles.size();
+  std::string list, named;
+  for (std::size_t k = 0; k < count; ++k) {
+    list += (k ? ", " : "") + angles[k];
+    for (const auto& [f, id] : by_angle[angles[k]]) {
+      b.names[id] = fmt::format("{}_{}", f, angles[k]);
+      named += fmt::format("  const double {0}_{1} = {0}_angle[{2}];\n", f, angles[k], k);
+      ++b.calls;
+    }
+  }
+  b.prologue = fmt::format(
+      "  // sin and cos of all {0} angles in one vectorized pass (trig.hpp).\n"
+      "  const std::array<double, {0}> angle{{{1}}};\n"
+      "  std::array<double, {0}> sin_angle, cos_angle;\n"
+      "  sincos(angle, sin_angle, cos_angle);\n{2}",
+      count, list, named);
+  return b;
+}
 
 std::string op_summary(const OpCount& c) {
   return fmt::format("{} (adds {}, muls {}, divs {}, calls {})", c.total(), c.adds, c.muls, c.divs, c.calls);
@@ -276,6 +326,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
     outs.push_back(std::move(els));
   }
   const CsePlan plan = eliminate_common_subexpressions(g, roots);
+  const TrigBatch trig = batch_trig(m, g, roots);
 
   // Which outputs need which temporaries: those needed by one output only are computed inside
   // that output's block, so unrequested outputs cost nothing.
@@ -293,23 +344,28 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
     for (const auto& el : outs[o]) visit(el.id);
   }
 
-  Printer pr(g, plan);
+  Printer pr(g, plan, trig.names);
   OpCount shared_ops;
+  shared_ops.calls += trig.calls;
   std::vector<OpCount> output_ops(outs.size());
-  std::string body;
+  std::string body = trig.prologue;
+  const auto batched = [&](std::size_t k) { return trig.names.count(plan.temporaries[k]) != 0; };
   for (std::size_t k = 0; k < plan.temporaries.size(); ++k) {
-    if (users[k].size() < 2) continue;
+    if (users[k].size() < 2 || batched(k)) continue;
     body += fmt::format("  const double t{} = {};\n", k, pr.define(plan.temporaries[k], shared_ops));
   }
   for (std::size_t o = 0; o < outs.size(); ++o) {
     const auto& spec = fn.outputs[o];
     body += fmt::format("  if ({} != nullptr) {{\n", spec.name);
-    if (!spec.prologue.empty()) body += "    " + fmt::format(fmt::runtime(spec.prologue), spec.name) + "\n";
+    if (!spec.prologue.empty())
+      body += "    if (zero_fill) " + fmt::format(fmt::runtime(spec.prologue), spec.name) + "\n";
     for (std::size_t k = 0; k < plan.temporaries.size(); ++k)
-      if (users[k].size() == 1 && *users[k].begin() == static_cast<int>(o))
+      if (users[k].size() == 1 && *users[k].begin() == static_cast<int>(o) && !batched(k))
         body += fmt::format("    const double t{} = {};\n", k, pr.define(plan.temporaries[k], output_ops[o]));
     for (const auto& el : outs[o]) {
-      const std::string value = pr.is_temp(el.id) ? pr.temp_name(el.id) : pr.define(el.id, output_ops[o]);
+      const std::string value = trig.names.count(el.id) ? trig.names.at(el.id)
+                                : pr.is_temp(el.id) ? pr.temp_name(el.id)
+                                                    : pr.define(el.id, output_ops[o]);
       body += fmt::format("    {} = {};\n", el.lvalue, value);
     }
     body += "  }\n";
@@ -320,6 +376,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   for (int r : roots) before += g.tree_ops(r);
   stats.name = fn.name;
   stats.intermediates = static_cast<int>(plan.temporaries.size());
+  for (std::size_t k = 0; k < plan.temporaries.size(); ++k) stats.intermediates -= batched(k) ? 1 : 0;
   stats.before_cse = before;
   stats.after_cse = total;
 
@@ -339,20 +396,31 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   }
 
   std::string t = banner(m, opt, fmt::format("{}: {}", fn.name, fn.doc));
-  t += "#pragma once\n\n#include <cmath>\n\n#include \"params.hpp\"\n#include \"types.hpp\"\n\n" + namespace_open(opt) + "\n";
+  t += "#pragma once\n\n#include <array>\n#include <cmath>\n\n#include \"params.hpp\"\n";
+  t += trig.names.empty() ? "" : "#include \"trig.hpp\"\n";
+  t += "#include \"types.hpp\"\n\n" + namespace_open(opt) + "\n";
   t += fmt::format("// {}\n//\n", fn.doc);
   t += "// Outputs, each computed only when its pointer is non-null:\n";
   for (std::size_t o = 0; o < outs.size(); ++o)
     t += fmt::format("//   {:<18} {} (own operations: {}, nonzero entries: {})\n", fn.outputs[o].name, fn.outputs[o].doc,
                      output_ops[o].total(), outs[o].size());
-  t += fmt::format("// Intermediate terms: {}; shared by several outputs: {} operations.\n",
-                   plan.temporaries.size(), shared_ops.total());
+  t += fmt::format("// Intermediate terms: {}; shared by several outputs: {} operations (sin and cos of all angles\n"
+                   "// included: they are computed up front, whichever outputs are requested).\n",
+                   stats.intermediates, shared_ops.total());
   t += fmt::format("// Operations with every output requested: {}.\n", op_summary(total));
   t += fmt::format("// The same outputs as expression trees, before CSE: {}.\n", op_summary(before));
   std::string signature = fmt::format("inline void {}(const Coordinates& s, ", fn.name);
   if (fn.needs_rates) signature += "const Coordinates& sdot, ";
   signature += "const Params& p";
   for (const auto& o : fn.outputs) signature += fmt::format(", {}* {}", o.type, o.name);
+  const bool has_zeros = std::any_of(fn.outputs.begin(), fn.outputs.end(), [](const auto& o) { return !o.prologue.empty(); });
+  if (has_zeros) {
+    // Zeroing a 14 x 32 or 7 x 3 x 32 output costs more than computing its nonzeros (store
+    // bandwidth), so a workspace that keeps its zeros can skip it.
+    t += "// zero_fill: write the structural zeros of the matrix outputs too. Pass false when they are\n"
+         "// zero already (a workspace zeroed once at setup): this function never writes them.\n";
+    signature += ", bool zero_fill = true";
+  }
   t += signature + ") noexcept {\n";
   t += "  static_cast<void>(s);\n  static_cast<void>(p);\n";
   if (fn.needs_rates) t += "  static_cast<void>(sdot);\n";

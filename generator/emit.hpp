@@ -30,6 +30,13 @@ struct EmittedFile {
   std::string text;
 };
 
+// The banner every emitted header opens with (what it is, by what, from what, do not edit).
+std::string banner(const Model& m, const EmitOptions& opt, const std::string& what);
+std::string namespace_open(const EmitOptions& opt);
+std::string namespace_close(const EmitOptions& opt);
+
+// trig.hpp: sin and cos of a fixed-size array of angles in one branch-free SIMD pass.
+EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt);
 // Headers describing the model itself: parameters and coordinate/frame/body names and types.
 std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& opt);
 // One header per derived function; `stats` receives the numbers written into its banner.

@@ -75,6 +75,7 @@ int main(int argc, char** argv) {
     }
 
     std::vector<EmittedFile> files = emit_model_headers(model, opt);
+    files.push_back(emit_trig_header(model, opt));
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<FunctionSpec> fns;
     std::vector<FunctionStats> stats;

@@ -34,7 +34,7 @@ void inverse_dynamics(const Model& model, const Coordinates& s, const Vector4& u
   solve_dependent_accelerations(model, s, out.sdot, bias, kPairA, d);
   out.sddot = out.T * u_dot + bias;
   gen::bodies(s, out.sdot, p, &d.body_com, &d.body_rotations, &d.body_Jv, &d.body_Jw, &d.body_Jv_dot_sdot,
-              &d.body_Jw_dot_sdot);
+              &d.body_Jw_dot_sdot, false);
   out.M.setZero();
   out.b.setZero();
   out.Q_gravity.setZero();
@@ -64,7 +64,7 @@ void inverse_dynamics(const Model& model, const Coordinates& s, const Vector4& u
 
 double potential_energy(const Model& model, const Coordinates& s, Data& d) {
   const Params& p = model.params();
-  gen::bodies(s, Coordinates::Zero(), p, &d.body_com, nullptr, nullptr, nullptr, nullptr, nullptr);
+  gen::bodies(s, Coordinates::Zero(), p, &d.body_com, nullptr, nullptr, nullptr, nullptr, nullptr, false);
   double V = 0;
   for (int i = 0; i < gen::kBodyCount; ++i) V += mass(p, i) * p.g * d.body_com(2, i);
   return V;
@@ -72,7 +72,7 @@ double potential_energy(const Model& model, const Coordinates& s, Data& d) {
 
 double kinetic_energy(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& d) {
   const Params& p = model.params();
-  gen::bodies(s, sdot, p, nullptr, &d.body_rotations, &d.body_Jv, &d.body_Jw, nullptr, nullptr);
+  gen::bodies(s, sdot, p, nullptr, &d.body_rotations, &d.body_Jv, &d.body_Jw, nullptr, nullptr, false);
   double T = 0;
   for (int i = 0; i < gen::kBodyCount; ++i) {
     const Eigen::Vector3d v = d.body_Jv[static_cast<std::size_t>(i)] * sdot;

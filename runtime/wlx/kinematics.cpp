@@ -8,11 +8,11 @@ void forward_kinematics(const Model& model, const Coordinates& s, Data& data) no
 
 void kinematic_update(const Model& model, const Coordinates& s, Data& data) noexcept {
   gen::kinematic_update(s, model.params(), &data.frame_positions, &data.frame_rotations, &data.Phi, &data.dPhi_ds,
-                        &data.C);
+                        &data.C, false);
 }
 
 void closure(const Model& model, const Coordinates& s, Data& data, bool with_jacobian) noexcept {
-  gen::closure(s, model.params(), &data.Phi, with_jacobian ? &data.dPhi_ds : nullptr);
+  gen::closure(s, model.params(), &data.Phi, with_jacobian ? &data.dPhi_ds : nullptr, false);
 }
 
 }  // namespace wlx

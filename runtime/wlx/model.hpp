@@ -39,6 +39,17 @@ class Model {
 
 // Workspace for one evaluation thread. Fixed-size members only: no heap allocation.
 struct Data {
+  // The matrix outputs with structural zeros start zeroed, and the runtime calls the generated
+  // functions with zero_fill = false: rewriting those zeros every call cost more store bandwidth
+  // than computing the nonzeros (about 50 ns of the fused update). Nothing else writes them.
+  Data() noexcept {
+    dPhi_ds.setZero();
+    C.setZero();
+    spin.setZero();
+    for (auto& J : body_Jv) J.setZero();
+    for (auto& J : body_Jw) J.setZero();
+  }
+
   gen::FramePositions frame_positions;
   gen::FrameRotations frame_rotations;
   gen::ClosureVector Phi;

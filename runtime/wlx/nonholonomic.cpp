@@ -97,7 +97,7 @@ DependentPair dependent_pair(std::string_view first, std::string_view second, co
 void solve_dependent_rates(const Model& model, const Coordinates& s, Coordinates& sdot, const DependentPair& pair,
                            Data& d, const NonholonomicOptions& options) {
   // dPhi/ds and C(s) from the fused generated function: they share most subexpressions.
-  gen::kinematic_update(s, model.params(), nullptr, nullptr, nullptr, &d.dPhi_ds, &d.C);
+  gen::kinematic_update(s, model.params(), nullptr, nullptr, nullptr, &d.dPhi_ds, &d.C, false);
   reduce(d);
   Eigen::Matrix<double, kNq, 1> q_rate = sdot.head<kNq>();
   q_rate(pair.index[0]) = 0;
@@ -166,7 +166,7 @@ Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& 
 Eigen::Matrix<double, 3, 2> contact_velocities(const Model& model, const Coordinates& s, const Coordinates& sdot,
                                                Data& d) {
   gen::kinematics(s, model.params(), nullptr, &d.frame_rotations);
-  gen::nonholonomic(s, model.params(), &d.C, &d.spin);
+  gen::nonholonomic(s, model.params(), &d.C, &d.spin, false);
   const Eigen::Vector2d forward = model.params().w * (d.spin * sdot), sideways = d.C * sdot;
   Eigen::Matrix<double, 3, 2> v;
   const int frames[2] = {gen::frame::W_l, gen::frame::W_r};
@@ -179,7 +179,7 @@ Eigen::Matrix<double, 3, 2> contact_velocities(const Model& model, const Coordin
 }
 
 Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& d) {
-  gen::nonholonomic(s, model.params(), &d.C, nullptr);
+  gen::nonholonomic(s, model.params(), &d.C, nullptr, false);
   return d.C * sdot;
 }
 

@@ -7,12 +7,12 @@
 //
 // Operation counts (each +, -, *, /, negation and function call counts as one):
 //   function       intermediates    before CSE     after CSE
-//   kinematics               168          9681           616
-//   closure                  188         23500           906
-//   nonholonomic             132         27474           625
-//   convective               395         62310          1867
-//   bodies                   345         58902          2163
-//   kinematic_update           236         48373          1304
+//   kinematics               126          9681           616
+//   closure                  146         23500           906
+//   nonholonomic             106         27474           625
+//   convective               353         62310          1867
+//   bodies                   315         58902          2163
+//   kinematic_update           194         48373          1304
 //   total                               230240          7481
 #pragma once
 

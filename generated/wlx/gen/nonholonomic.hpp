@@ -6,9 +6,11 @@
 // Depends on Eigen only.
 #pragma once
 
+#include <array>
 #include <cmath>
 
 #include "params.hpp"
+#include "trig.hpp"
 #include "types.hpp"
 
 namespace wlx::gen {
@@ -16,12 +18,15 @@ namespace wlx::gen {
 // Non-holonomic wheels (thesis 4, MODEL.md 5): rows C(s) with v_W . n_W = C(s) s', and the rolling rows with spin rate = (v_W . e_x,W) / w = spin(s) s'.
 //
 // Outputs, each computed only when its pointer is non-null:
-//   C                  cornering constraint rows, one per wheel (l, r) (own operations: 114, nonzero entries: 20)
+//   C                  cornering constraint rows, one per wheel (l, r) (own operations: 110, nonzero entries: 20)
 //   spin               wheel spin-rate rows, one per wheel (l, r) (own operations: 126, nonzero entries: 20)
-// Intermediate terms: 132; shared by several outputs: 385 operations.
+// Intermediate terms: 106; shared by several outputs: 389 operations (sin and cos of all angles
+// included: they are computed up front, whichever outputs are requested).
 // Operations with every output requested: 625 (adds 183, muls 415, divs 1, calls 26).
 // The same outputs as expression trees, before CSE: 27474 (adds 3796, muls 10138, divs 20, calls 13520).
-inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, WheelRows* spin) noexcept {
+// zero_fill: write the structural zeros of the matrix outputs too. Pass false when they are
+// zero already (a workspace zeroed once at setup): this function never writes them.
+inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, WheelRows* spin, bool zero_fill = true) noexcept {
   static_cast<void>(s);
   static_cast<void>(p);
   const double yaw = s(3);
@@ -41,55 +46,71 @@ inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, Wh
   const double cyd = p.cyd;
   const double wl = p.wl;
   const double w = p.w;
-  const double t0 = std::cos(theta_l4);
-  const double t1 = std::sin(theta_l5);
-  const double t2 = std::sin(pitch);
-  const double t3 = std::cos(yaw);
-  const double t4 = std::cos(roll);
-  const double t5 = std::sin(roll);
-  const double t6 = std::sin(yaw);
-  const double t7 = t2*t3*t4 + t5*t6;
-  const double t8 = std::sin(theta_l6);
-  const double t9 = std::cos(theta_l6);
-  const double t10 = std::cos(pitch);
-  const double t11 = t7*t8 - t3*t9*t10;
-  const double t12 = t5*t2*t3 - t4*t6;
-  const double t13 = std::cos(theta_l5);
-  const double t14 = t1*t11 + t12*t13;
-  const double t15 = std::sin(theta_l4);
-  const double t16 = t1*t12 - t11*t13;
-  const double t17 = t0*t14 - t15*t16;
-  const double t19 = std::cos(theta_l3);
-  const double t20 = t8*t3*t10 + t7*t9;
-  const double t21 = std::sin(theta_l3);
-  const double t22 = t0*t16 + t14*t15;
-  const double t23 = t19*t20 + t21*t22;
-  const double t26 = t2*t4*t6 - t5*t3;
-  const double t27 = t9*t10*t6 - t8*t26;
-  const double t28 = t3*t4 + t5*t2*t6;
-  const double t29 = t13*t27 + t1*t28;
-  const double t30 = t28*t13 - t1*t27;
-  const double t31 = t29*t0 + t15*t30;
-  const double t32 = t26*t9 + t8*t10*t6;
-  const double t33 = t21*t31 + t32*t19;
-  const double t34 = t29*t15 - t0*t30;
-  const double t36 = t8*t4*t10 + t2*t9;
-  const double t37 = t13*t36 - t5*t1*t10;
-  const double t38 = t1*t36 + t5*t13*t10;
-  const double t39 = t0*t37 - t38*t15;
-  const double t40 = t9*t4*t10 - t8*t2;
-  const double t41 = t40*t19 - t39*t21;
-  const double t42 = t38*t0 + t15*t37;
+  // sin and cos of all 13 angles in one vectorized pass (trig.hpp).
+  const std::array<double, 13> angle{yaw, pitch, roll, theta_l5, theta_r5, theta_l2, theta_l3, theta_l4, theta_l6, theta_r2, theta_r3, theta_r4, theta_r6};
+  std::array<double, 13> sin_angle, cos_angle;
+  sincos(angle, sin_angle, cos_angle);
+  const double cos_yaw = cos_angle[0];
+  const double sin_yaw = sin_angle[0];
+  const double cos_pitch = cos_angle[1];
+  const double sin_pitch = sin_angle[1];
+  const double cos_roll = cos_angle[2];
+  const double sin_roll = sin_angle[2];
+  const double cos_theta_l5 = cos_angle[3];
+  const double sin_theta_l5 = sin_angle[3];
+  const double cos_theta_r5 = cos_angle[4];
+  const double sin_theta_r5 = sin_angle[4];
+  const double cos_theta_l2 = cos_angle[5];
+  const double sin_theta_l2 = sin_angle[5];
+  const double cos_theta_l3 = cos_angle[6];
+  const double sin_theta_l3 = sin_angle[6];
+  const double cos_theta_l4 = cos_angle[7];
+  const double sin_theta_l4 = sin_angle[7];
+  const double cos_theta_l6 = cos_angle[8];
+  const double sin_theta_l6 = sin_angle[8];
+  const double cos_theta_r2 = cos_angle[9];
+  const double sin_theta_r2 = sin_angle[9];
+  const double cos_theta_r3 = cos_angle[10];
+  const double sin_theta_r3 = sin_angle[10];
+  const double cos_theta_r4 = cos_angle[11];
+  const double sin_theta_r4 = sin_angle[11];
+  const double cos_theta_r6 = cos_angle[12];
+  const double sin_theta_r6 = sin_angle[12];
+  const double t7 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
+  const double t11 = t7*sin_theta_l6 - cos_yaw*cos_theta_l6*cos_pitch;
+  const double t12 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
+  const double t14 = sin_theta_l5*t11 + t12*cos_theta_l5;
+  const double t16 = sin_theta_l5*t12 - t11*cos_theta_l5;
+  const double t17 = cos_theta_l4*t14 - sin_theta_l4*t16;
+  const double t20 = sin_theta_l6*cos_yaw*cos_pitch + t7*cos_theta_l6;
+  const double t22 = cos_theta_l4*t16 + t14*sin_theta_l4;
+  const double t23 = cos_theta_l3*t20 + sin_theta_l3*t22;
+  const double t26 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
+  const double t27 = cos_theta_l6*cos_pitch*sin_yaw - sin_theta_l6*t26;
+  const double t28 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
+  const double t29 = cos_theta_l5*t27 + sin_theta_l5*t28;
+  const double t30 = t28*cos_theta_l5 - sin_theta_l5*t27;
+  const double t31 = t29*cos_theta_l4 + sin_theta_l4*t30;
+  const double t32 = t26*cos_theta_l6 + sin_theta_l6*cos_pitch*sin_yaw;
+  const double t33 = sin_theta_l3*t31 + t32*cos_theta_l3;
+  const double t34 = t29*sin_theta_l4 - cos_theta_l4*t30;
+  const double t36 = sin_theta_l6*cos_roll*cos_pitch + sin_pitch*cos_theta_l6;
+  const double t37 = cos_theta_l5*t36 - sin_roll*sin_theta_l5*cos_pitch;
+  const double t38 = sin_theta_l5*t36 + sin_roll*cos_theta_l5*cos_pitch;
+  const double t39 = cos_theta_l4*t37 - t38*sin_theta_l4;
+  const double t40 = cos_theta_l6*cos_roll*cos_pitch - sin_theta_l6*sin_pitch;
+  const double t41 = t40*cos_theta_l3 - t39*sin_theta_l3;
+  const double t42 = t38*cos_theta_l4 + sin_theta_l4*t37;
   const double t44 = t12*cyd;
-  const double t45 = t44 - 2.0*w*t23 - 2.0*wl*t16 - t3*cxd*t10;
-  const double t46 = cxd*t10*t6;
+  const double t45 = t44 - 2.0*w*t23 - 2.0*wl*t16 - cos_yaw*cxd*cos_pitch;
+  const double t46 = cxd*cos_pitch*sin_yaw;
   const double t47 = 2.0*t29*wl + t46 + 2.0*w*t33 - t28*cyd;
-  const double t48 = t5*cyd*t10;
-  const double t49 = 2.0*t37*wl + t48 + t2*cxd - 2.0*w*t41;
-  const double t50 = t3*t45 - t6*t47;
-  const double t51 = t45*t10*t6 + t3*t10*t47;
-  const double t52 = t10*t6*t49 - t2*t47;
-  const double t53 = t2*t45 + t3*t10*t49;
+  const double t48 = sin_roll*cyd*cos_pitch;
+  const double t49 = 2.0*t37*wl + t48 + sin_pitch*cxd - 2.0*w*t41;
+  const double t50 = cos_yaw*t45 - sin_yaw*t47;
+  const double t51 = t45*cos_pitch*sin_yaw + cos_yaw*cos_pitch*t47;
+  const double t52 = cos_pitch*sin_yaw*t49 - sin_pitch*t47;
+  const double t53 = sin_pitch*t45 + cos_yaw*cos_pitch*t49;
   const double t54 = t29*wl + w*t33;
   const double t55 = wl*t16 + w*t23;
   const double t56 = t32*t55 - t20*t54;
@@ -102,45 +123,37 @@ inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, Wh
   const double t63 = w*t32*t23 - w*t33*t20;
   const double t64 = w*t32*t41 - t40*w*t33;
   const double t65 = t40*w*t23 - w*t20*t41;
-  const double t66 = t28*t57 - t5*t10*t54;
-  const double t67 = t12*t57 - t5*t55*t10;
+  const double t66 = t28*t57 - sin_roll*cos_pitch*t54;
+  const double t67 = t12*t57 - sin_roll*t55*cos_pitch;
   const double t68 = t12*t54 - t28*t55;
-  const double t69 = std::sin(theta_r3);
-  const double t70 = std::cos(theta_r4);
-  const double t71 = std::sin(theta_r5);
-  const double t72 = std::cos(theta_r6);
-  const double t73 = std::sin(theta_r6);
-  const double t74 = t3*t72*t10 - t7*t73;
-  const double t75 = std::cos(theta_r5);
-  const double t76 = t12*t71 + t74*t75;
-  const double t77 = t12*t75 - t74*t71;
-  const double t78 = std::sin(theta_r4);
-  const double t79 = t70*t76 + t77*t78;
-  const double t80 = t7*t72 + t3*t73*t10;
-  const double t81 = std::cos(theta_r3);
-  const double t82 = t69*t79 + t80*t81;
-  const double t84 = t78*t76 - t70*t77;
-  const double t87 = t73*t10*t6 + t72*t26;
-  const double t88 = t73*t26 - t72*t10*t6;
-  const double t89 = t28*t71 - t75*t88;
-  const double t90 = t28*t75 + t71*t88;
-  const double t91 = t70*t89 + t78*t90;
-  const double t92 = t87*t81 + t91*t69;
-  const double t93 = t70*t90 - t78*t89;
-  const double t95 = t2*t72 + t73*t4*t10;
-  const double t96 = t71*t95 + t5*t75*t10;
-  const double t97 = t95*t75 - t5*t71*t10;
-  const double t98 = t96*t78 - t70*t97;
-  const double t99 = t72*t4*t10 - t2*t73;
-  const double t100 = t98*t69 + t99*t81;
-  const double t101 = t78*t97 + t96*t70;
-  const double t103 = 2.0*t82*w + t44 + 2.0*wl*t76 + t3*cxd*t10;
+  const double t74 = cos_yaw*cos_theta_r6*cos_pitch - t7*sin_theta_r6;
+  const double t76 = t12*sin_theta_r5 + t74*cos_theta_r5;
+  const double t77 = t12*cos_theta_r5 - t74*sin_theta_r5;
+  const double t79 = cos_theta_r4*t76 + t77*sin_theta_r4;
+  const double t80 = t7*cos_theta_r6 + cos_yaw*sin_theta_r6*cos_pitch;
+  const double t82 = sin_theta_r3*t79 + t80*cos_theta_r3;
+  const double t84 = sin_theta_r4*t76 - cos_theta_r4*t77;
+  const double t87 = sin_theta_r6*cos_pitch*sin_yaw + cos_theta_r6*t26;
+  const double t88 = sin_theta_r6*t26 - cos_theta_r6*cos_pitch*sin_yaw;
+  const double t89 = t28*sin_theta_r5 - cos_theta_r5*t88;
+  const double t90 = t28*cos_theta_r5 + sin_theta_r5*t88;
+  const double t91 = cos_theta_r4*t89 + sin_theta_r4*t90;
+  const double t92 = t87*cos_theta_r3 + t91*sin_theta_r3;
+  const double t93 = cos_theta_r4*t90 - sin_theta_r4*t89;
+  const double t95 = sin_pitch*cos_theta_r6 + sin_theta_r6*cos_roll*cos_pitch;
+  const double t96 = sin_theta_r5*t95 + sin_roll*cos_theta_r5*cos_pitch;
+  const double t97 = t95*cos_theta_r5 - sin_roll*sin_theta_r5*cos_pitch;
+  const double t98 = t96*sin_theta_r4 - cos_theta_r4*t97;
+  const double t99 = cos_theta_r6*cos_roll*cos_pitch - sin_pitch*sin_theta_r6;
+  const double t100 = t98*sin_theta_r3 + t99*cos_theta_r3;
+  const double t101 = sin_theta_r4*t97 + t96*cos_theta_r4;
+  const double t103 = 2.0*t82*w + t44 + 2.0*wl*t76 + cos_yaw*cxd*cos_pitch;
   const double t104 = 2.0*t89*wl + t28*cyd + t46 + 2.0*w*t92;
-  const double t105 = t48 + 2.0*t100*w - 2.0*wl*t97 - t2*cxd;
-  const double t106 = t3*t103 + t6*t104;
-  const double t107 = t10*t103*t6 - t3*t10*t104;
-  const double t108 = t105*t10*t6 + t2*t104;
-  const double t109 = t105*t3*t10 + t2*t103;
+  const double t105 = t48 + 2.0*t100*w - 2.0*wl*t97 - sin_pitch*cxd;
+  const double t106 = cos_yaw*t103 + sin_yaw*t104;
+  const double t107 = cos_pitch*t103*sin_yaw - cos_yaw*cos_pitch*t104;
+  const double t108 = t105*cos_pitch*sin_yaw + sin_pitch*t104;
+  const double t109 = t105*cos_yaw*cos_pitch + sin_pitch*t103;
   const double t110 = wl*t97 - t100*w;
   const double t111 = t89*wl + w*t92;
   const double t112 = t87*t110 + t111*t99;
@@ -153,26 +166,22 @@ inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, Wh
   const double t119 = t82*w*t99 - t100*w*t80;
   const double t120 = w*t99*t92 - t87*t100*w;
   const double t121 = w*t80*t92 - t82*t87*w;
-  const double t122 = t5*t113*t10 + t12*t110;
-  const double t123 = t5*t111*t10 + t28*t110;
+  const double t122 = sin_roll*t113*cos_pitch + t12*t110;
+  const double t123 = sin_roll*t111*cos_pitch + t28*t110;
   const double t124 = t28*t113 - t111*t12;
   if (C != nullptr) {
-    C->setZero();
-    const double t18 = std::cos(theta_l2);
-    const double t24 = std::sin(theta_l2);
-    const double t25 = t17*t18 + t23*t24;
-    const double t35 = t33*t24 - t34*t18;
-    const double t43 = t24*t41 + t42*t18;
-    const double t83 = std::sin(theta_r2);
-    const double t85 = std::cos(theta_r2);
-    const double t86 = t82*t83 - t84*t85;
-    const double t94 = t83*t92 + t93*t85;
-    const double t102 = t100*t83 + t101*t85;
+    if (zero_fill) C->setZero();
+    const double t25 = t17*cos_theta_l2 + t23*sin_theta_l2;
+    const double t35 = t33*sin_theta_l2 - t34*cos_theta_l2;
+    const double t43 = sin_theta_l2*t41 + t42*cos_theta_l2;
+    const double t86 = t82*sin_theta_r2 - t84*cos_theta_r2;
+    const double t94 = sin_theta_r2*t92 + t93*cos_theta_r2;
+    const double t102 = t100*sin_theta_r2 + t101*cos_theta_r2;
     (*C)(0, 0) = t25;
     (*C)(0, 1) = t35;
     (*C)(0, 2) = t43;
     (*C)(0, 3) = 0.5*t45*t35 + 0.5*t25*t47;
-    (*C)(0, 4) = 0.5*t35*t6*t49 + 0.5*t3*t25*t49 - 0.5*t43*t50;
+    (*C)(0, 4) = 0.5*t35*sin_yaw*t49 + 0.5*cos_yaw*t25*t49 - 0.5*t43*t50;
     (*C)(0, 5) = -(0.5*t43*t51 + 0.5*t53*t35 - 0.5*t25*t52);
     (*C)(0, 16) = t43*t56 + t25*t58 + t59*t35;
     (*C)(0, 25) = -(t43*t60 + t62*t35 - t61*t25);
@@ -182,7 +191,7 @@ inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, Wh
     (*C)(1, 1) = t94;
     (*C)(1, 2) = t102;
     (*C)(1, 3) = -(0.5*t94*t103 - 0.5*t86*t104);
-    (*C)(1, 4) = 0.5*t102*t106 - 0.5*t105*t3*t86 - 0.5*t105*t94*t6;
+    (*C)(1, 4) = 0.5*t102*t106 - 0.5*t105*cos_yaw*t86 - 0.5*t105*t94*sin_yaw;
     (*C)(1, 5) = 0.5*t102*t107 + 0.5*t109*t94 - 0.5*t86*t108;
     (*C)(1, 17) = t112*t86 + t102*t115 - t94*t114;
     (*C)(1, 29) = -(t86*t116 + t118*t94 - t102*t117);
@@ -190,19 +199,19 @@ inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, Wh
     (*C)(1, 31) = t86*t123 + t102*t124 - t94*t122;
   }
   if (spin != nullptr) {
-    spin->setZero();
-    const double t125 = t19*t22 - t21*t20;
+    if (zero_fill) spin->setZero();
+    const double t125 = cos_theta_l3*t22 - sin_theta_l3*t20;
     const double t126 = 1.0/w;
-    const double t127 = t21*t32 - t19*t31;
-    const double t128 = t39*t19 + t21*t40;
-    const double t129 = t69*t80 - t81*t79;
-    const double t130 = t87*t69 - t91*t81;
-    const double t131 = t69*t99 - t98*t81;
+    const double t127 = sin_theta_l3*t32 - cos_theta_l3*t31;
+    const double t128 = t39*cos_theta_l3 + sin_theta_l3*t40;
+    const double t129 = sin_theta_r3*t80 - cos_theta_r3*t79;
+    const double t130 = t87*sin_theta_r3 - t91*cos_theta_r3;
+    const double t131 = sin_theta_r3*t99 - t98*cos_theta_r3;
     (*spin)(0, 0) = t125*t126;
     (*spin)(0, 1) = -t127*t126;
     (*spin)(0, 2) = -t128*t126;
     (*spin)(0, 3) = -0.5*(t45*t127 - t125*t47)*t126;
-    (*spin)(0, 4) = 0.5*(t128*t50 + t3*t125*t49 - t127*t6*t49)*t126;
+    (*spin)(0, 4) = 0.5*(t128*t50 + cos_yaw*t125*t49 - t127*sin_yaw*t49)*t126;
     (*spin)(0, 5) = 0.5*(t125*t52 + t53*t127 + t128*t51)*t126;
     (*spin)(0, 16) = (t125*t58 - t128*t56 - t59*t127)*t126;
     (*spin)(0, 25) = (t61*t125 + t128*t60 + t62*t127)*t126;
@@ -212,7 +221,7 @@ inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, Wh
     (*spin)(1, 1) = -t130*t126;
     (*spin)(1, 2) = -t131*t126;
     (*spin)(1, 3) = 0.5*t126*(t130*t103 - t129*t104);
-    (*spin)(1, 4) = 0.5*(t105*t130*t6 + t105*t3*t129 - t106*t131)*t126;
+    (*spin)(1, 4) = 0.5*(t105*t130*sin_yaw + t105*cos_yaw*t129 - t106*t131)*t126;
     (*spin)(1, 5) = -0.5*(t107*t131 + t109*t130 - t129*t108)*t126;
     (*spin)(1, 17) = -(t112*t129 + t115*t131 - t130*t114)*t126;
     (*spin)(1, 29) = (t116*t129 + t118*t130 - t117*t131)*t126;
