@@ -4,6 +4,8 @@
 
 #include "wlx/kinematics.hpp"
 
+#include <wlx/gen/trig.hpp>
+
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <fmt/format.h>
@@ -29,9 +31,7 @@ double wrap(double a) {
   return a == -kPi ? kPi : a;
 }
 
-Eigen::Matrix3d cabin_rotation(const Coordinates& s) {
-  const double cy = std::cos(s(c::yaw)), sy = std::sin(s(c::yaw)), cp = std::cos(s(c::pitch)),
-               sp = std::sin(s(c::pitch)), cr = std::cos(s(c::roll)), sr = std::sin(s(c::roll));
+Eigen::Matrix3d cabin_rotation(double sy, double cy, double sp, double cp, double sr, double cr) {
   Eigen::Matrix3d R;
   R << cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,  //
       sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,   //
@@ -39,16 +39,41 @@ Eigen::Matrix3d cabin_rotation(const Coordinates& s) {
   return R;
 }
 
-// What every limb's closed form needs from the cabin pose, computed once per solve.
+Eigen::Matrix3d cabin_rotation(const Coordinates& s) {
+  return cabin_rotation(std::sin(s(c::yaw)), std::cos(s(c::yaw)), std::sin(s(c::pitch)), std::cos(s(c::pitch)),
+                        std::sin(s(c::roll)), std::cos(s(c::roll)));
+}
+
+// What the limbs' closed forms need from the cabin pose and the angle inputs, computed once per
+// solve: sin and cos of all seven input angles in one pass of the generated batched sincos, and
+// the lever quantities that depend on the cabin only (both wheels share them).
 struct CabinPose {
   Eigen::Matrix3d R;  // R_C
   Eigen::Vector3d r;  // r_C
   Eigen::Vector3d g;  // world up seen from the cabin, R_C^T e_z
+  double rho = 0;     // |g| in the levers' pitch plane (x-z)
+  double phi = 0;     // direction of g in that plane
+  double theta2 = 0;  // the camber levelling the lever's y axis, hub above the contact (no branch bits)
+  std::array<double, 2> sin_psi1{}, cos_psi1{}, sin_theta5{}, cos_theta5{};  // [left, right]
 };
 
 CabinPose cabin_pose(const Coordinates& s) {
-  const Eigen::Matrix3d R = cabin_rotation(s);
-  return {R, Eigen::Vector3d(s(c::x_C), s(c::y_C), s(c::z_C)), R.row(2).transpose()};
+  const std::array<double, 7> angle{s(c::yaw), s(c::pitch), s(c::roll), s(c::psi_l1), s(c::psi_r1), s(c::theta_l5),
+                                    s(c::theta_r5)};
+  std::array<double, 7> sin_a, cos_a;
+  gen::sincos(angle, sin_a, cos_a);
+  CabinPose pose;
+  pose.R = cabin_rotation(sin_a[0], cos_a[0], sin_a[1], cos_a[1], sin_a[2], cos_a[2]);
+  pose.r = Eigen::Vector3d(s(c::x_C), s(c::y_C), s(c::z_C));
+  pose.g = pose.R.row(2).transpose();
+  pose.rho = std::sqrt(pose.g.x() * pose.g.x() + pose.g.z() * pose.g.z());  // g is a unit vector: no overflow
+  pose.phi = std::atan2(pose.g.x(), pose.g.z());
+  pose.theta2 = std::atan2(-pose.g.y(), pose.rho);
+  pose.sin_psi1 = {sin_a[3], sin_a[4]};
+  pose.cos_psi1 = {cos_a[3], cos_a[4]};
+  pose.sin_theta5 = {sin_a[5], sin_a[6]};
+  pose.cos_theta5 = {cos_a[5], cos_a[6]};
+  return pose;
 }
 
 // Short names for the limb blocks inside this file.
@@ -92,7 +117,7 @@ void solve_leg(const Model& model, const CabinPose& cabin, Limb limb, int branch
   const Eigen::Vector3d hip(p.cxd / 2, side * p.cyd / 2, 0);
   // Foot relative to the hip, in the frame after the hip roll joint Rx(psi_1).
   const Eigen::Vector3d in_cabin = cabin.R.transpose() * (Eigen::Vector3d(s(x_F), s(y_F), s(z_F)) - cabin.r) - hip;
-  const double c1 = std::cos(s(psi1)), s1 = std::sin(s(psi1));
+  const double c1 = cabin.cos_psi1[left ? 0 : 1], s1 = cabin.sin_psi1[left ? 0 : 1];
   const Eigen::Vector3d d(in_cabin.x(), c1 * in_cabin.y() + s1 * in_cabin.z(), -s1 * in_cabin.y() + c1 * in_cabin.z());
   const double T = p.thighD, L = p.legD, dist = d.norm();
   const double near = std::abs(T - L), far = T + L;
@@ -133,7 +158,8 @@ void solve_leg(const Model& model, const CabinPose& cabin, Limb limb, int branch
     psi3 = wrap(kPi - psi3);
     k = -k;
   }
-  const double psi2 = wrap(std::atan2(b, k) - std::atan2(d.z(), d.x()));
+  // psi_2 = atan2(b, k) - atan2(d_z, d_x), as the angle of (k + i b) conj(d_x + i d_z): one atan2.
+  const double psi2 = std::atan2(b * d.x() - k * d.z(), k * d.x() + b * d.z());
   const auto idx = indices(limb);
   s(idx.dep[0]) = psi2;
   s(idx.dep[1]) = psi3;
@@ -147,17 +173,17 @@ void solve_wheel(const Model& model, const CabinPose& cabin, Limb limb, int bran
   require_finite(s, {z_W, th5});
   const double side = left ? 1.0 : -1.0;
   const Eigen::Vector3d& g = cabin.g;
-  const double rho = std::hypot(g.x(), g.z());
-  const double phi = std::atan2(g.x(), g.z());
+  const double rho = cabin.rho, phi = cabin.phi;
   // Parallel guidance: theta_4 = -theta_5, so R_10 = Ry(theta_3 + theta_6) =: Ry(sigma).
   // Level x axis: g . Ry(sigma) e_x = 0  ->  sigma = phi (hub above the contact) or phi + pi.
   const double sigma = (branch & 4) ? wrap(phi + kPi) : phi;
   const double m = (branch & 4) ? -rho : rho;  // g_x sin(sigma) + g_z cos(sigma)
-  // Level y axis: sin(theta_2) m + g_y cos(theta_2) = 0.
-  double theta2 = std::atan2(-g.y() * (m < 0 ? -1.0 : 1.0), std::abs(m));
+  // Level y axis: sin(theta_2) m + g_y cos(theta_2) = 0, i.e. atan2(-g_y sign(m), |m|); atan2 is
+  // odd in its first argument, so the upside-down branch negates the cabin's value.
+  double theta2 = m < 0 ? -cabin.theta2 : cabin.theta2;
   if (branch & 2) theta2 = wrap(theta2 + kPi);
   // Contact height: z_C + g.h - w m + wl (-s5 g_y... ) : rho sin(theta_6 - phi) * wl c5 = z_W - centre.
-  const double s5 = std::sin(s(th5)), c5 = std::cos(s(th5));
+  const double s5 = cabin.sin_theta5[left ? 0 : 1], c5 = cabin.cos_theta5[left ? 0 : 1];
   const Eigen::Vector3d h(-p.cxd / 2, side * p.cyd / 2, 0);
   const double centre = s(c::z_C) + g.dot(h) - p.w * m - p.wl * s5 * g.y();
   const double half_width = p.wl * std::abs(c5) * rho;
