@@ -16,6 +16,7 @@ struct SimulateOptions {
   std::string out_dir = "out/simulate";
   std::string integrator;    // empty: the scenario's
   std::optional<double> dt;  // empty: the scenario's
+  std::optional<double> tolerance;  // dopri5 only; empty: the scenario's
   std::string weighting;     // "1" or "2" overrides the scenario's (and makes it a dynamics run)
   bool list = false;
 };

@@ -84,8 +84,10 @@ int main(int argc, char** argv) {
   auto* simulate = app.add_subcommand("simulate", "integrate a scenario (a file, or an id of MODEL.md section 8)");
   simulate->add_option("SCENARIO", sim.scenario, "scenario file or id (NH-1, ST-A1+, ...)");
   simulate->add_option("--out", sim.out_dir, "output folder for trajectory.csv")->capture_default_str();
-  simulate->add_option("--integrator", sim.integrator, "rk4 or euler (default: the scenario's)");
-  simulate->add_option("--dt", sim.dt, "step in seconds (default: the scenario's)");
+  simulate->add_option("--integrator", sim.integrator,
+                       "rk4, euler or dopri5 (adaptive Dormand-Prince 5(4)); default: the scenario's");
+  simulate->add_option("--dt", sim.dt, "step in seconds, or with dopri5 the output interval (default: the scenario's)");
+  simulate->add_option("--tolerance", sim.tolerance, "dopri5's local error bound per step, relative to 1 + |q| (default 1e-10)");
   simulate->add_option("--weighting", sim.weighting, "torque weighting 1 or 2 (inverse dynamics, MODEL.md section 7)");
   simulate->add_flag("--list", sim.list, "list the built-in scenarios");
 

@@ -106,7 +106,7 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
 Scenario parse_scenario(const nlohmann::json& j) {
   if (!j.is_object()) throw Error("", fmt::format("a scenario is a JSON object, got {}", j.type_name()));
   reject_unknown_keys(j, {"id", "description", "observation", "initial", "params", "rates", "dependent", "duration", "dt",
-                          "integrator", "branch", "max_condition", "weighting"},
+                          "integrator", "tolerance", "branch", "max_condition", "weighting"},
                       "");
   Scenario sc;
   const auto text = [&](const char* key) {
@@ -141,8 +141,10 @@ Scenario parse_scenario(const nlohmann::json& j) {
     const auto& in = j.at("integrator");
     if (in == "rk4") sc.integrator = Integrator::rk4;
     else if (in == "euler") sc.integrator = Integrator::euler;
-    else throw Error("integrator", fmt::format("must be \"rk4\" or \"euler\", got {}", in.dump()));
+    else if (in == "dopri5") sc.integrator = Integrator::dopri5;
+    else throw Error("integrator", fmt::format("must be \"rk4\", \"euler\" or \"dopri5\", got {}", in.dump()));
   }
+  if (j.contains("tolerance")) sc.tolerance = finite_number(j.at("tolerance"), "tolerance");
   if (j.contains("branch")) sc.branches = parse_ik_request(nlohmann::json{{"branch", j.at("branch")}}).branches;
   if (j.contains("max_condition")) {
     sc.nonholonomic.max_condition = finite_number(j.at("max_condition"), "max_condition");

@@ -61,8 +61,15 @@ int run_simulate(const SimulateOptions& o) {
   Scenario sc = parse_scenario(read_scenario_json(o.scenario));
   if (o.integrator == "euler") sc.integrator = Integrator::euler;
   else if (o.integrator == "rk4") sc.integrator = Integrator::rk4;
-  else if (!o.integrator.empty()) throw Error("--integrator", fmt::format("must be rk4 or euler, got '{}'", o.integrator));
+  else if (o.integrator == "dopri5") sc.integrator = Integrator::dopri5;
+  else if (!o.integrator.empty())
+    throw Error("--integrator", fmt::format("must be rk4, euler or dopri5, got '{}'", o.integrator));
   if (o.dt) sc.dt = *o.dt;
+  if (o.tolerance) {
+    if (sc.integrator != Integrator::dopri5)
+      throw Error("--tolerance", "applies to the adaptive integrator only: add --integrator dopri5");
+    sc.tolerance = *o.tolerance;
+  }
   if (!o.weighting.empty()) {
     if (o.weighting != "1" && o.weighting != "2") throw Error("--weighting", fmt::format("must be 1 or 2, got '{}'", o.weighting));
     sc.weighting = o.weighting == "1" ? Weighting::strong_weak() : Weighting::contribution();
@@ -79,7 +86,12 @@ int run_simulate(const SimulateOptions& o) {
     min_clearance = std::min(min_clearance, smp.cabin_clearance);
   }
   fmt::print("{}: {} samples ({} s, dt {} s, {}), dependent pair {}\n", sc.id.empty() ? o.scenario : sc.id,
-             tr.samples.size(), sc.duration, sc.dt, sc.integrator == Integrator::rk4 ? "rk4" : "euler", sc.pair.label());
+             tr.samples.size(), sc.duration, sc.dt, integrator_name(sc.integrator), sc.pair.label());
+  fmt::print("integration: {} steps{}, {} evaluations of the right-hand side\n", tr.steps,
+             sc.integrator == Integrator::dopri5
+                 ? fmt::format(" ({} rejected; tolerance {:.1e})", tr.rejected_steps, sc.tolerance)
+                 : std::string(),
+             tr.evaluations);
   fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, min cabin clearance = {:.4f} m\n", worst, worst_cond,
              min_clearance);
   if (sc.weighting && !tr.samples.empty()) {

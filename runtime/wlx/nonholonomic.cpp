@@ -42,7 +42,7 @@ void reduce(Data& d) {
       throw Error(std::string(limb_name(limb)),
                   fmt::format("the closure Jacobian of this limb is singular (reciprocal condition {:.2g}): {}; its joint "
                               "rates are undefined here",
-                              rcond,
+                              std::isfinite(rcond) ? rcond : 0.0,  // an exactly singular block inverts to inf/NaN
                               b.size == 3 ? "the leg is stretched straight or folded, or its hip yaw is at 90 deg"
                                           : "the lever stands at 90 deg to the level or is straddled to 90 deg"));
     const Eigen::Matrix<double, 4, 2> lambda = inverse.transpose().lazyProduct(rhs);

@@ -23,6 +23,7 @@ struct RightHandSide {
   Coordinates s, sdot;
 
   const InputVector& operator()(const InputVector& q) {
+    ++evaluations;
     s.head<kInputCount>() = q;
     solve_ik_closed_form(model, s, sc.branches);
     sdot.head<kInputCount>() = sc.rates;
@@ -31,9 +32,88 @@ struct RightHandSide {
     return rate;
   }
   InputVector rate;
+  long evaluations = 0;
 };
 
+// The Dormand-Prince 5(4) pair (Hairer, Norsett, Wanner, Solving ODEs I, table 5.2): the stages,
+// the 5th-order weights (= the last stage row: first same as last) and the difference to the
+// embedded 4th-order weights, which estimates the local error.
+namespace dopri {
+constexpr double c2 = 1.0 / 5, c3 = 3.0 / 10, c4 = 4.0 / 5, c5 = 8.0 / 9;
+constexpr double a21 = 1.0 / 5;
+constexpr double a31 = 3.0 / 40, a32 = 9.0 / 40;
+constexpr double a41 = 44.0 / 45, a42 = -56.0 / 15, a43 = 32.0 / 9;
+constexpr double a51 = 19372.0 / 6561, a52 = -25360.0 / 2187, a53 = 64448.0 / 6561, a54 = -212.0 / 729;
+constexpr double a61 = 9017.0 / 3168, a62 = -355.0 / 33, a63 = 46732.0 / 5247, a64 = 49.0 / 176, a65 = -5103.0 / 18656;
+constexpr double b1 = 35.0 / 384, b3 = 500.0 / 1113, b4 = 125.0 / 192, b5 = -2187.0 / 6784, b6 = 11.0 / 84;
+constexpr double e1 = 71.0 / 57600, e3 = -71.0 / 16695, e4 = 71.0 / 1920, e5 = -17253.0 / 339200, e6 = 22.0 / 525,
+                 e7 = -1.0 / 40;
+}  // namespace dopri
+
+// Advances q from t to t + span with Dormand-Prince steps under error control. `h` carries the
+// step size from one call to the next; k1 = f(q) on entry.
+void dopri5_span(RightHandSide& f, InputVector& q, InputVector k1, double t, double span, double tolerance, double& h,
+                 Trajectory& stats) {
+  using namespace dopri;
+  const double end = t + span;
+  double now = t;
+  int rejected_in_a_row = 0;
+  while (now < end) {
+    const bool last = h >= (end - now) * (1 - 1e-12);  // finish the span rather than leave a sliver
+    const double step = last ? end - now : h;
+    InputVector next, k7;
+    double scaled = 0;
+    std::string failure;  // a stage that left the workspace (unreachable pose, singular J_beta)
+    try {
+      const InputVector k2 = f(q + step * a21 * k1);
+      const InputVector k3 = f(q + step * (a31 * k1 + a32 * k2));
+      const InputVector k4 = f(q + step * (a41 * k1 + a42 * k2 + a43 * k3));
+      const InputVector k5 = f(q + step * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4));
+      const InputVector k6 = f(q + step * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5));
+      next = q + step * (b1 * k1 + b3 * k3 + b4 * k4 + b5 * k5 + b6 * k6);
+      k7 = f(next);
+      const InputVector error = step * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
+      scaled = (error.array().abs() / (tolerance * (1 + q.array().abs().max(next.array().abs())))).maxCoeff();
+    } catch (const Error& e) {
+      // The stages reach ahead of the step (up to 3.7 step lengths with these coefficients), so
+      // a long step can probe poses the motion itself never reaches: reject and shrink. A real
+      // failure shrinks the step to nothing and is reported below.
+      failure = e.what();
+      scaled = 1e10;
+    }
+    // The usual controller: the error scales as step^5; a safety factor and bounded changes.
+    const double factor = std::clamp(0.9 * std::pow(std::max(scaled, 1e-10), -0.2), 0.2, 5.0);
+    if (scaled <= 1) {
+      q = next;
+      k1 = k7;  // first same as last
+      now = last ? end : now + step;
+      ++stats.steps;
+      rejected_in_a_row = 0;
+      if (!last || factor < 1) h = step * factor;  // a step clipped to the sample time says little
+    } else {
+      ++stats.rejected_steps;
+      h = step * std::min(factor, 0.5);
+      if (++rejected_in_a_row > 60 || h < 1e-14 * std::max(1.0, std::abs(end))) {
+        if (!failure.empty()) throw Error("", fmt::format("at t = {:.6f} s (adaptive step {:.3g} s): {}", now, step, failure));
+        throw Error("tolerance", fmt::format("the adaptive step fell to {:.3g} s at t = {:.6f} s without meeting the "
+                                             "tolerance {:.3g}: the motion is not smooth here (a singular J_beta or a "
+                                             "limb at its reach); use rk4 with a small dt or loosen the tolerance",
+                                             h, now, tolerance));
+      }
+    }
+  }
+}
+
 }  // namespace
+
+std::string_view integrator_name(Integrator integrator) noexcept {
+  switch (integrator) {
+    case Integrator::rk4: return "rk4";
+    case Integrator::euler: return "euler";
+    case Integrator::dopri5: return "dopri5";
+  }
+  return "?";
+}
 
 long Scenario::samples() const { return std::lround(duration / dt) + 1; }
 
@@ -41,6 +121,8 @@ void Scenario::validate() const {
   if (!(std::isfinite(duration) && duration > 0))
     throw Error("duration", fmt::format("must be a positive number of seconds, got {}", duration));
   if (!(std::isfinite(dt) && dt > 0)) throw Error("dt", fmt::format("must be a positive number of seconds, got {}", dt));
+  if (integrator == Integrator::dopri5 && !(std::isfinite(tolerance) && tolerance >= 1e-14 && tolerance <= 1e-2))
+    throw Error("tolerance", fmt::format("must be between 1e-14 (rounding) and 1e-2, got {}", tolerance));
   if (duration / dt > 1e8)
     throw Error("dt", fmt::format("{} s over {} s is {:.3g} steps, more than the limit of 1e8", dt, duration, duration / dt));
   if (std::abs(duration / dt - std::round(duration / dt)) > 1e-6 * (duration / dt))
@@ -95,6 +177,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
   DynamicsTerms terms;
   Vector4 u;
   for (int k = 0; k < 4; ++k) u(k) = sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]);
+  double h = sc.dt;  // dopri5's step, adapted as it goes
   for (long k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) * sc.dt;
     try {
@@ -121,11 +204,15 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       if (k + 1 == n) break;
       if (sc.integrator == Integrator::euler) {
         q += sc.dt * k1;
-      } else {
+        ++out.steps;
+      } else if (sc.integrator == Integrator::rk4) {
         const InputVector k2 = f(q + 0.5 * sc.dt * k1);
         const InputVector k3 = f(q + 0.5 * sc.dt * k2);
         const InputVector k4 = f(q + sc.dt * k3);
         q += sc.dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+        ++out.steps;
+      } else {
+        dopri5_span(f, q, k1, t, sc.dt, sc.tolerance, h, out);
       }
     } catch (const Error& e) {
       out.complete = false;
@@ -133,6 +220,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       break;
     }
   }
+  out.evaluations = f.evaluations;
   return out;
 }
 

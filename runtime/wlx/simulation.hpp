@@ -11,11 +11,16 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace wlx {
 
-enum class Integrator { rk4, euler };
+// rk4 and euler take fixed steps of dt (the thesis used euler with 0.001 s). dopri5 is the
+// Dormand-Prince 5(4) pair with error control: adaptive steps between the output samples, which
+// stay dt apart; each step's local error estimate is kept below tolerance * (1 + |q|).
+enum class Integrator { rk4, euler, dopri5 };
+std::string_view integrator_name(Integrator integrator) noexcept;
 
 struct Scenario {
   std::string id;
@@ -27,6 +32,7 @@ struct Scenario {
   double duration = 0;  // s
   double dt = 1e-3;     // s
   Integrator integrator = Integrator::rk4;
+  double tolerance = 1e-10;  // dopri5 only: local error per step, relative to 1 + |q| (m or rad)
   Branches branches;
   NonholonomicOptions nonholonomic;
   // Set: an inverse-dynamics run (MODEL.md section 7): pair A, only u = [z_C', x_C', roll',
@@ -58,6 +64,9 @@ struct Trajectory {
   std::vector<Sample> samples;
   bool complete = true;
   std::string error;  // why the run stopped early (with its time), when !complete
+  // Integration work: accepted steps, rejected steps (dopri5 only), right-hand-side evaluations
+  // (each one a closed-form IK of the 4 limbs plus a dependent-rate solve).
+  long steps = 0, rejected_steps = 0, evaluations = 0;
 };
 
 // Called after each sample with (samples done, samples in all).

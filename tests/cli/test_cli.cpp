@@ -216,7 +216,9 @@ TEST_CASE("cli: every validation rule names the field, the value and the rule, w
        "initial.z_C: only angles may be given in degrees; give this value in SI units"},
       {"simulate NH-1 --dt nan", "", "", "dt: must be a positive number of seconds, got nan"},
       {"simulate NH-1 --dt 0.0003", "", "", "dt: the duration 2 s is not a whole number of steps of 0.0003 s"},
-      {"simulate NH-1 --integrator rk45", "", "", "--integrator: must be rk4 or euler, got 'rk45'"},
+      {"simulate NH-1 --integrator rk45", "", "", "--integrator: must be rk4, euler or dopri5, got 'rk45'"},
+      {"simulate NH-1 --tolerance 1e-8", "", "", "--tolerance: applies to the adaptive integrator only: add --integrator dopri5"},
+      {"simulate NH-1 --integrator dopri5 --tolerance 0", "", "", "tolerance: must be between 1e-14 (rounding) and 1e-2, got 0"},
       {"simulate", "", "", "SCENARIO: missing: give a scenario file or id (--list shows the ids)"},
   };
   for (const Case& c : cases) {

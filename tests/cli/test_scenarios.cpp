@@ -109,7 +109,7 @@ TEST_CASE("scenarios: bad scenario files get messages naming the field") {
   CHECK(message(R"({"dependent": ["y_C"], "duration": 1})") == "dependent: must be an array of 2 names, got [\"y_C\"]");
   CHECK(message(R"({"dependent": ["y_C", "yaw"]})") == "duration: missing: the run's length in seconds");
   CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "integrator": "rk45"})") ==
-        "integrator: must be \"rk4\" or \"euler\", got \"rk45\"");
+        "integrator: must be \"rk4\", \"euler\" or \"dopri5\", got \"rk45\"");
   CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "dt": 0.3})") ==
         "dt: the duration 1 s is not a whole number of steps of 0.3 s");
   CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "params": {"m_M1": -3}})") ==
