@@ -105,21 +105,13 @@ void BM_gen_bodies(benchmark::State& st) {
 // workspace keeps its structural zeros (zero_fill = false, as the runtime calls it); the second
 // variant rewrites them every call; the third cycles through 64 random poses (angles within
 // +-pi), where data-dependent branches of a libm would show.
+template <bool zero_fill>
 void BM_gen_kinematic_update_fused(benchmark::State& st) {
   const Model model;
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::kinematic_update(s, model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds, &d.C, false);
-    benchmark::DoNotOptimize(d.C.data());
-  }
-}
-void BM_gen_kinematic_update_fused_zero_fill(benchmark::State& st) {
-  const Model model;
-  Data d;
-  const Coordinates s = assembled_nominal(model);
-  for (auto _ : st) {
-    gen::kinematic_update(s, model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds, &d.C, true);
+    gen::kinematic_update(s, model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds, &d.C, zero_fill);
     benchmark::DoNotOptimize(d.C.data());
   }
 }
@@ -351,8 +343,8 @@ BENCHMARK(BM_gen_closure);
 BENCHMARK(BM_gen_nonholonomic);
 BENCHMARK(BM_gen_convective);
 BENCHMARK(BM_gen_bodies);
-BENCHMARK(BM_gen_kinematic_update_fused);
-BENCHMARK(BM_gen_kinematic_update_fused_zero_fill);
+BENCHMARK(BM_gen_kinematic_update_fused<false>)->Name("BM_gen_kinematic_update_fused");
+BENCHMARK(BM_gen_kinematic_update_fused<true>)->Name("BM_gen_kinematic_update_fused_zero_fill");
 BENCHMARK(BM_gen_kinematic_update_fused_random_poses);
 BENCHMARK(BM_gen_kinematic_update_separate);
 BENCHMARK(BM_full_kinematic_update);
