@@ -51,6 +51,15 @@ struct RunResult {
   std::string csv;  // relative path
 };
 
+// One run integrated one way, against RK4 at 0.1 ms (MODEL.md section 5's reference behaviour).
+struct IntegratorRow {
+  std::string id, integrator, setting;
+  long samples = 0, evaluations = 0;
+  double inputs = 0;     // max |q - q_ref| over the samples, m or rad
+  double y_C = 0;        // max |y_C - ref|, m
+  double theta5 = 0;     // max |theta_l5/r5 - ref|, rad
+};
+
 std::string html_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
@@ -88,6 +97,7 @@ class Report {
 
   void run_ik();
   void run_simulations();
+  void compare_integrators();
   void add_checks();
   void figures_ik();
   void figures_nonholonomic();
@@ -108,6 +118,7 @@ class Report {
   int step_ = 0, total_steps_ = 0;
   std::vector<IkSweepResult> sweeps_;
   std::vector<RunResult> runs_;
+  std::vector<IntegratorRow> integrators_;
   std::vector<Check> checks_;
   std::vector<FigureSpec> figures_;
   std::map<std::string, std::vector<std::string>> sections_;  // section -> figure names
@@ -150,6 +161,46 @@ void Report::run_simulations() {
   }
 }
 
+void Report::compare_integrators() {
+  // MODEL.md section 5: RK4 at 1 ms is converged to ~1e-14; the thesis' explicit Euler differs by
+  // up to 4e-5 m in y_C (ST-A2) and 6e-4 deg in theta_5 (ST-B). dopri5 writes 10 samples per run
+  // and chooses its own steps in between.
+  constexpr double kReferenceStep = 1e-4;
+  for (const char* id : {"ST-A2+", "ST-A2-", "ST-B1+", "ST-B1-", "ST-B2+", "ST-B2-", "ST-B3+", "ST-B3-"}) {
+    Scenario sc = parse_scenario(read_scenario_json(id));
+    Scenario ref_sc = sc;
+    ref_sc.dt = kReferenceStep;
+    const Trajectory ref = simulate(ref_sc);
+    if (!ref.complete) throw Error(id, ref.error);
+    const auto compare = [&](const std::string& integrator, const std::string& setting, const Scenario& run) {
+      const Trajectory tr = simulate(run);
+      if (!tr.complete) throw Error(id, tr.error);
+      IntegratorRow row{id, integrator, setting, static_cast<long>(tr.samples.size()), tr.evaluations};
+      for (const auto& smp : tr.samples) {
+        const auto& r = ref.samples[static_cast<std::size_t>(std::lround(smp.t / kReferenceStep))];
+        const Coordinates d = (smp.s - r.s).cwiseAbs();
+        row.inputs = std::max(row.inputs, d.head<kInputCount>().maxCoeff());
+        row.y_C = std::max(row.y_C, d(gen::coord::y_C));
+        row.theta5 = std::max({row.theta5, d(gen::coord::theta_l5), d(gen::coord::theta_r5)});
+      }
+      integrators_.push_back(row);
+    };
+    Scenario euler = sc, rk4 = sc, dopri = sc;
+    euler.integrator = Integrator::euler;
+    compare("euler (thesis)", fmt::format("dt {} s", sc.dt), euler);
+    compare("rk4", fmt::format("dt {} s", sc.dt), rk4);
+    dopri.integrator = Integrator::dopri5;
+    dopri.dt = sc.duration / 10;
+    compare("dopri5", fmt::format("tolerance {:.0e}", dopri.tolerance), dopri);
+  }
+  CsvWriter csv(data("integrators.csv"), {"run", "integrator", "samples", "evaluations", "max_input_deviation",
+                                          "max_y_C_deviation", "max_theta_5_deviation"});
+  for (const auto& r : integrators_) {
+    const std::string integrator = r.integrator.substr(0, r.integrator.find(' '));
+    csv.row({r.id, integrator}, {static_cast<double>(r.samples), static_cast<double>(r.evaluations), r.inputs, r.y_C, r.theta5});
+  }
+}
+
 void Report::add_checks() {
   const auto sci = [](double v) { return fmt::format("{:.2e}", v); };
   const auto has = [&](const std::string& id) {
@@ -176,6 +227,20 @@ void Report::add_checks() {
       if (p.cold_newton_branch == 1) first = std::min(first, p.value);
     checks_.push_back({"IK-L3: Newton started at the nominal pose converges to psi_4 < 0 high up (MODEL.md 4)",
                        "from z_Fl = 2.63 m", fmt::format("from z_Fl = {:.2f} m", first), std::abs(first - 2.63) <= 0.05});
+  }
+  if (!integrators_.empty()) {
+    double rk4 = 0, euler_y = 0, euler_theta = 0;
+    for (const auto& r : integrators_) {
+      if (r.integrator == "rk4") rk4 = std::max(rk4, r.inputs);
+      if (r.integrator.rfind("euler", 0) == 0 && r.id.rfind("ST-A2", 0) == 0) euler_y = std::max(euler_y, r.y_C);
+      if (r.integrator.rfind("euler", 0) == 0 && r.id.rfind("ST-B", 0) == 0) euler_theta = std::max(euler_theta, r.theta5);
+    }
+    checks_.push_back({"RK4 at dt = 1 ms is converged (vs RK4 at 0.1 ms; ST-A2, ST-B) (MODEL.md 5)", "~1e-14",
+                       sci(rk4) + " m or rad", rk4 <= 1e-12});
+    checks_.push_back({"Explicit Euler at 1 ms, the thesis' integrator, differs in y_C (ST-A2) (MODEL.md 5)", "up to 4e-5 m",
+                       sci(euler_y) + " m", euler_y >= 1e-5 && euler_y <= 1e-4});
+    checks_.push_back({"... and in theta_5 (ST-B) (MODEL.md 5)", "6e-4 deg", fmt::format("{:.2e} deg", euler_theta / kDeg),
+                       euler_theta / kDeg >= 2e-4 && euler_theta / kDeg <= 1.5e-3});
   }
   double worst_nh = 0;
   for (const auto& r : runs_)
@@ -518,6 +583,19 @@ void Report::write_html() {
   h += "<h2 id=\"st\">Steering (thesis 5)</h2>\n";
   runs_table("ST-");
   for (const auto& n : sections_["st"]) figure(n);
+  if (!integrators_.empty()) {
+    h += "<h3 id=\"integrators\">Integrators compared (MODEL.md section 5)</h3>\n<p>Each run integrated three ways and "
+         "compared at its samples with RK4 at 0.1 ms. The thesis used explicit Euler at 1 ms; wlx defaults to RK4; "
+         "<code>dopri5</code> (adaptive Dormand-Prince 5(4)) writes 10 samples per run and chooses its steps in between. "
+         "An evaluation is one closed-form IK of the four limbs plus a dependent-rate solve. "
+         "<a href=\"data/integrators.csv\">integrators.csv</a></p>\n<table>\n<tr><th>run</th><th>integrator</th><th>setting</th>"
+         "<th>samples</th><th>evaluations</th><th>max |q - q_ref| (m or rad)</th><th>max |y_C - ref| (m)</th>"
+         "<th>max |theta_5 - ref| (deg)</th></tr>\n";
+    for (const auto& r : integrators_)
+      h += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td></tr>\n",
+                       r.id, r.integrator, r.setting, r.samples, r.evaluations, r.inputs, r.y_C, r.theta5 / kDeg);
+    h += "</table>\n";
+  }
   h += "<h2 id=\"id\">Inverse dynamics with redundant actuation (thesis 6)</h2>\n";
   runs_table("ID-");
   for (const auto& n : sections_["id"]) figure(n);
@@ -531,9 +609,13 @@ int Report::run() {
   const auto start = std::chrono::steady_clock::now();
   fs::create_directories(root_ / "data");
   fs::create_directories(root_ / "fig");
-  total_steps_ = (opt_.quick ? 2 : 12) + (opt_.quick ? 6 : static_cast<int>(scenario_ids().size()) + 3) + 2;
+  total_steps_ = (opt_.quick ? 2 : 12) + (opt_.quick ? 6 : static_cast<int>(scenario_ids().size()) + 3 + 1) + 2;
   run_ik();
   run_simulations();
+  if (!opt_.quick) {
+    progress("comparing integrators: Euler (thesis), RK4, dopri5 against RK4 at 0.1 ms on ST-A2 and ST-B");
+    compare_integrators();
+  }
   progress("checking the thesis' claims");
   add_checks();
   figures_ik();

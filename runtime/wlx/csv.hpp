@@ -29,12 +29,21 @@ class CsvWriter {
   }
 
   // One row; a non-finite value is an error naming its column, and nothing of the row is written.
-  void row(const std::vector<double>& values) {
-    if (values.size() != columns_) throw Error(path_, fmt::format("row has {} values for {} columns", values.size(), columns_));
+  void row(const std::vector<double>& values) { row({}, values); }
+  // The same after leading text columns (identifiers: no commas or quotes).
+  void row(const std::vector<std::string>& labels, const std::vector<double>& values) {
+    if (labels.size() + values.size() != columns_)
+      throw Error(path_, fmt::format("row has {} values for {} columns", labels.size() + values.size(), columns_));
+    for (std::size_t k = 0; k < labels.size(); ++k)
+      if (labels[k].find_first_of(",\"\n") != std::string::npos)
+        throw Error(header_[k], fmt::format("text '{}' would need quoting in {}", labels[k], path_));
     for (std::size_t k = 0; k < values.size(); ++k)
-      if (!std::isfinite(values[k])) throw Error(header_[k], fmt::format("non-finite value {} not written to {}", values[k], path_));
+      if (!std::isfinite(values[k]))
+        throw Error(header_[labels.size() + k], fmt::format("non-finite value {} not written to {}", values[k], path_));
     std::string line;
-    for (std::size_t k = 0; k < values.size(); ++k) line += (k == 0 ? "" : ",") + fmt::format("{:.17g}", values[k]);
+    for (const auto& l : labels) line += (line.empty() ? "" : ",") + l;
+    for (std::size_t k = 0; k < values.size(); ++k)
+      line += (labels.empty() && k == 0 ? "" : ",") + fmt::format("{:.17g}", values[k]);
     fmt::print(file_, "{}\n", line);
   }
 
