@@ -77,6 +77,8 @@ TEST_CASE("report: the full report runs, every image exists, every check passes,
     CHECK(text.find("inf") == std::string::npos);
   }
   const std::string log = slurp(dir.string() + ".log");
-  CHECK(log.find("/36] rendering") != std::string::npos);  // progress was shown
+  // Progress was shown, and its last step is numbered as the last of all.
+  CHECK(std::regex_search(log, std::regex(R"(\[(\d+)/\1\] rendering)")));
+  CHECK(html.find("Integrators compared") != std::string::npos);
   CHECK(log.find("open " + fs::absolute(dir / "index.html").string()) != std::string::npos);
 }
