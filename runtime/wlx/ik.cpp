@@ -159,7 +159,7 @@ void solve_leg(const Model& model, const CabinPose& cabin, Limb limb, int branch
     k = -k;
   }
   // psi_2 = atan2(b, k) - atan2(d_z, d_x), as the angle of (k + i b) conj(d_x + i d_z): one atan2.
-  const double psi2 = std::atan2(b * d.x() - k * d.z(), k * d.x() + b * d.z());
+  const double psi2 = wrap(std::atan2(b * d.x() - k * d.z(), k * d.x() + b * d.z()));  // -pi -> pi
   const auto idx = indices(limb);
   s(idx.dep[0]) = psi2;
   s(idx.dep[1]) = psi3;
