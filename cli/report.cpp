@@ -53,7 +53,9 @@ struct RunResult {
 
 // One run integrated one way, against RK4 at 0.1 ms (MODEL.md section 5's reference behaviour).
 struct IntegratorRow {
-  std::string id, integrator, setting;
+  std::string id;
+  Integrator integrator;
+  std::string setting;
   long samples = 0, evaluations = 0;
   double inputs = 0;     // max |q - q_ref| over the samples, m or rad
   double y_C = 0;        // max |y_C - ref|, m
@@ -172,10 +174,10 @@ void Report::compare_integrators() {
     ref_sc.dt = kReferenceStep;
     const Trajectory ref = simulate(ref_sc);
     if (!ref.complete) throw Error(id, ref.error);
-    const auto compare = [&](const std::string& integrator, const std::string& setting, const Scenario& run) {
+    const auto compare = [&](const std::string& setting, const Scenario& run) {
       const Trajectory tr = simulate(run);
       if (!tr.complete) throw Error(id, tr.error);
-      IntegratorRow row{id, integrator, setting, static_cast<long>(tr.samples.size()), tr.evaluations};
+      IntegratorRow row{id, run.integrator, setting, static_cast<long>(tr.samples.size()), tr.evaluations};
       for (const auto& smp : tr.samples) {
         const auto& r = ref.samples[static_cast<std::size_t>(std::lround(smp.t / kReferenceStep))];
         const Coordinates d = (smp.s - r.s).cwiseAbs();
@@ -187,18 +189,18 @@ void Report::compare_integrators() {
     };
     Scenario euler = sc, rk4 = sc, dopri = sc;
     euler.integrator = Integrator::euler;
-    compare("euler (thesis)", fmt::format("dt {} s", sc.dt), euler);
-    compare("rk4", fmt::format("dt {} s", sc.dt), rk4);
+    rk4.integrator = Integrator::rk4;
+    compare(fmt::format("dt {} s", sc.dt), euler);
+    compare(fmt::format("dt {} s", sc.dt), rk4);
     dopri.integrator = Integrator::dopri5;
     dopri.dt = sc.duration / 10;
-    compare("dopri5", fmt::format("tolerance {:.0e}", dopri.tolerance), dopri);
+    compare(fmt::format("tolerance {:.0e}", dopri.tolerance), dopri);
   }
   CsvWriter csv(data("integrators.csv"), {"run", "integrator", "samples", "evaluations", "max_input_deviation",
                                           "max_y_C_deviation", "max_theta_5_deviation"});
-  for (const auto& r : integrators_) {
-    const std::string integrator = r.integrator.substr(0, r.integrator.find(' '));
-    csv.row({r.id, integrator}, {static_cast<double>(r.samples), static_cast<double>(r.evaluations), r.inputs, r.y_C, r.theta5});
-  }
+  for (const auto& r : integrators_)
+    csv.row({r.id, std::string(integrator_name(r.integrator))},
+            {static_cast<double>(r.samples), static_cast<double>(r.evaluations), r.inputs, r.y_C, r.theta5});
 }
 
 void Report::add_checks() {
@@ -231,9 +233,9 @@ void Report::add_checks() {
   if (!integrators_.empty()) {
     double rk4 = 0, euler_y = 0, euler_theta = 0;
     for (const auto& r : integrators_) {
-      if (r.integrator == "rk4") rk4 = std::max(rk4, r.inputs);
-      if (r.integrator.rfind("euler", 0) == 0 && r.id.rfind("ST-A2", 0) == 0) euler_y = std::max(euler_y, r.y_C);
-      if (r.integrator.rfind("euler", 0) == 0 && r.id.rfind("ST-B", 0) == 0) euler_theta = std::max(euler_theta, r.theta5);
+      if (r.integrator == Integrator::rk4) rk4 = std::max(rk4, r.inputs);
+      if (r.integrator == Integrator::euler && r.id.rfind("ST-A2", 0) == 0) euler_y = std::max(euler_y, r.y_C);
+      if (r.integrator == Integrator::euler && r.id.rfind("ST-B", 0) == 0) euler_theta = std::max(euler_theta, r.theta5);
     }
     checks_.push_back({"RK4 at dt = 1 ms is converged (vs RK4 at 0.1 ms; ST-A2, ST-B) (MODEL.md 5)", "~1e-14",
                        sci(rk4) + " m or rad", rk4 <= 1e-12});
@@ -593,7 +595,8 @@ void Report::write_html() {
          "<th>max |theta_5 - ref| (deg)</th></tr>\n";
     for (const auto& r : integrators_)
       h += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td></tr>\n",
-                       r.id, r.integrator, r.setting, r.samples, r.evaluations, r.inputs, r.y_C, r.theta5 / kDeg);
+                       r.id, std::string(integrator_name(r.integrator)) + (r.integrator == Integrator::euler ? " (thesis)" : ""),
+                       r.setting, r.samples, r.evaluations, r.inputs, r.y_C, r.theta5 / kDeg);
     h += "</table>\n";
   }
   h += "<h2 id=\"id\">Inverse dynamics with redundant actuation (thesis 6)</h2>\n";

@@ -139,10 +139,9 @@ Scenario parse_scenario(const nlohmann::json& j) {
   if (j.contains("dt")) sc.dt = finite_number(j.at("dt"), "dt");
   if (j.contains("integrator")) {
     const auto& in = j.at("integrator");
-    if (in == "rk4") sc.integrator = Integrator::rk4;
-    else if (in == "euler") sc.integrator = Integrator::euler;
-    else if (in == "dopri5") sc.integrator = Integrator::dopri5;
-    else throw Error("integrator", fmt::format("must be \"rk4\", \"euler\" or \"dopri5\", got {}", in.dump()));
+    const auto integrator = in.is_string() ? integrator_from_name(in.get<std::string>()) : std::nullopt;
+    if (!integrator) throw Error("integrator", fmt::format("must be \"rk4\", \"euler\" or \"dopri5\", got {}", in.dump()));
+    sc.integrator = *integrator;
   }
   if (j.contains("tolerance")) sc.tolerance = finite_number(j.at("tolerance"), "tolerance");
   if (j.contains("branch")) sc.branches = parse_ik_request(nlohmann::json{{"branch", j.at("branch")}}).branches;

@@ -59,11 +59,11 @@ int run_simulate(const SimulateOptions& o) {
     return 0;
   }
   Scenario sc = parse_scenario(read_scenario_json(o.scenario));
-  if (o.integrator == "euler") sc.integrator = Integrator::euler;
-  else if (o.integrator == "rk4") sc.integrator = Integrator::rk4;
-  else if (o.integrator == "dopri5") sc.integrator = Integrator::dopri5;
-  else if (!o.integrator.empty())
-    throw Error("--integrator", fmt::format("must be rk4, euler or dopri5, got '{}'", o.integrator));
+  if (!o.integrator.empty()) {
+    const auto integrator = integrator_from_name(o.integrator);
+    if (!integrator) throw Error("--integrator", fmt::format("must be rk4, euler or dopri5, got '{}'", o.integrator));
+    sc.integrator = *integrator;
+  }
   if (o.dt) sc.dt = *o.dt;
   if (o.tolerance) {
     if (sc.integrator != Integrator::dopri5)

@@ -31,13 +31,13 @@ std::string banner(const Model& m, const EmitOptions& opt, const std::string& wh
 std::string namespace_open(const EmitOptions& opt) { return fmt::format("namespace {} {{\n", opt.name_space); }
 std::string namespace_close(const EmitOptions& opt) { return fmt::format("}}  // namespace {}\n", opt.name_space); }
 
-namespace {
-
 std::string literal(double v) {
   std::string s = fmt::format("{}", v);
   if (s.find_first_of(".en") == std::string::npos) s += ".0";
   return s;
 }
+
+namespace {
 
 bool integer_exponent(double e) { return e == static_cast<double>(static_cast<long>(e)); }
 
@@ -66,6 +66,8 @@ class Printer {
 
   // The definition of node `id` itself (temporaries among its arguments are used by name).
   std::string define(int id, OpCount& ops) { return node(id, Context::Root, ops, nullptr); }
+  // Node `id` as an output's value: its variable if it has one, else its definition.
+  std::string value(int id, OpCount& ops) { return use(id, Context::Root, ops, nullptr); }
 
  private:
   std::string use(int id, Context ctx, OpCount& ops, bool* negated) {
@@ -92,7 +94,6 @@ class Printer {
         return ctx == Context::Factor && s.find_first_of("*/") != std::string::npos ? "(" + s + ")" : s;
       }
       case NodeKind::Call: {
-        if (auto it = precomputed_.find(id); it != precomputed_.end()) return it->second;
         std::string args;
         for (int a : n.args) args += (args.empty() ? "" : ", ") + use(a, Context::Root, ops, nullptr);
         ++ops.calls;
@@ -363,10 +364,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
       if (users[k].size() == 1 && *users[k].begin() == static_cast<int>(o) && !batched(k))
         body += fmt::format("    const double t{} = {};\n", k, pr.define(plan.temporaries[k], output_ops[o]));
     for (const auto& el : outs[o]) {
-      const std::string value = trig.names.count(el.id) ? trig.names.at(el.id)
-                                : pr.is_temp(el.id) ? pr.temp_name(el.id)
-                                                    : pr.define(el.id, output_ops[o]);
-      body += fmt::format("    {} = {};\n", el.lvalue, value);
+      body += fmt::format("    {} = {};\n", el.lvalue, pr.value(el.id, output_ops[o]));
     }
     body += "  }\n";
   }

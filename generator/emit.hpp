@@ -34,6 +34,8 @@ struct EmittedFile {
 std::string banner(const Model& m, const EmitOptions& opt, const std::string& what);
 std::string namespace_open(const EmitOptions& opt);
 std::string namespace_close(const EmitOptions& opt);
+// A double as a C++ literal that round-trips exactly (always with a '.', 'e' or "nan"/"inf").
+std::string literal(double v);
 
 // trig.hpp: sin and cos of a fixed-size array of angles in one branch-free SIMD pass.
 EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt);

@@ -15,13 +15,6 @@ namespace wlx::gen {
 
 namespace {
 
-// Digits of double constants that round-trip exactly ({} prints the shortest such form).
-std::string exact(double v) {
-  std::string s = fmt::format("{}", v);
-  if (s.find_first_of(".en") == std::string::npos) s += ".0";
-  return s;
-}
-
 struct TrigConstants {
   double two_over_pi;
   // pi/2 = hi + mid + lo: hi and mid carry 33 and 31 significant bits, so n * hi and n * mid are
@@ -48,22 +41,19 @@ TrigConstants derive_constants() {
   k.half_pi_lo = tail.to_double();
   // Taylor terms suffice on |r| <= pi/4: the first omitted ones, (pi/4)^17/17! and (pi/4)^18/18!,
   // are below 5e-17, under half an ulp of the results.
-  for (int k2 = 3; k2 <= 15; k2 += 2) {
-    const numeric c = numeric((k2 / 2) % 2 ? -1 : 1) / GiNaC::factorial(numeric(k2));
-    k.sin_coefficients.push_back(c.to_double());
-  }
-  for (int k2 = 4; k2 <= 16; k2 += 2) {
-    const numeric c = numeric((k2 / 2) % 2 ? -1 : 1) / GiNaC::factorial(numeric(k2));
-    k.cos_coefficients.push_back(c.to_double());
-  }
+  const auto taylor = [](int power) {  // the coefficient of r^power in sin r or cos r
+    return (numeric((power / 2) % 2 ? -1 : 1) / GiNaC::factorial(numeric(power))).to_double();
+  };
+  for (int power = 3; power <= 15; power += 2) k.sin_coefficients.push_back(taylor(power));
+  for (int power = 4; power <= 16; power += 2) k.cos_coefficients.push_back(taylor(power));
   GiNaC::Digits = saved_digits;
   return k;
 }
 
 // Horner form c0 + r2*(c1 + r2*(...)) of the coefficients.
 std::string horner(const std::vector<double>& c, std::size_t i = 0) {
-  if (i + 1 == c.size()) return exact(c[i]);
-  return fmt::format("{} + r2 * ({})", exact(c[i]), horner(c, i + 1));
+  if (i + 1 == c.size()) return literal(c[i]);
+  return fmt::format("{} + r2 * ({})", literal(c[i]), horner(c, i + 1));
 }
 
 }  // namespace
@@ -98,7 +88,7 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
       "inline constexpr double kHalfPiMid = {};  // 31 bits\n"
       "inline constexpr double kHalfPiLo = {};\n"
       "inline constexpr double kFastPathLimit = 1e6;  // |n| < 2^21 keeps n * kHalfPiHi and n * kHalfPiMid exact\n\n",
-      exact(k.two_over_pi), exact(k.half_pi_hi), exact(k.half_pi_mid), exact(k.half_pi_lo));
+      literal(k.two_over_pi), literal(k.half_pi_hi), literal(k.half_pi_mid), literal(k.half_pi_lo));
   t += "#if (defined(__GNUC__) || defined(__clang__)) && !defined(__FAST_MATH__)\n"
        "#define WLX_GEN_SIMD_SINCOS 1\n"
        "#if defined(__AVX__)\n"

@@ -37,9 +37,9 @@ struct RightHandSide {
 
 // The Dormand-Prince 5(4) pair (Hairer, Norsett, Wanner, Solving ODEs I, table 5.2): the stages,
 // the 5th-order weights (= the last stage row: first same as last) and the difference to the
-// embedded 4th-order weights, which estimates the local error.
+// embedded 4th-order weights, which estimates the local error. The right-hand side does not
+// depend on t, so the nodes c_i are not needed.
 namespace dopri {
-constexpr double c2 = 1.0 / 5, c3 = 3.0 / 10, c4 = 4.0 / 5, c5 = 8.0 / 9;
 constexpr double a21 = 1.0 / 5;
 constexpr double a31 = 3.0 / 40, a32 = 9.0 / 40;
 constexpr double a41 = 44.0 / 45, a42 = -56.0 / 15, a43 = 32.0 / 9;
@@ -113,6 +113,12 @@ std::string_view integrator_name(Integrator integrator) noexcept {
     case Integrator::dopri5: return "dopri5";
   }
   return "?";
+}
+
+std::optional<Integrator> integrator_from_name(std::string_view name) noexcept {
+  for (Integrator i : {Integrator::rk4, Integrator::euler, Integrator::dopri5})
+    if (integrator_name(i) == name) return i;
+  return std::nullopt;
 }
 
 long Scenario::samples() const { return std::lround(duration / dt) + 1; }

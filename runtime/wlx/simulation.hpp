@@ -21,6 +21,8 @@ namespace wlx {
 // stay dt apart; each step's local error estimate is kept below tolerance * (1 + |q|).
 enum class Integrator { rk4, euler, dopri5 };
 std::string_view integrator_name(Integrator integrator) noexcept;
+// The integrator of that name ("rk4", "euler", "dopri5"), or nothing.
+std::optional<Integrator> integrator_from_name(std::string_view name) noexcept;
 
 struct Scenario {
   std::string id;
