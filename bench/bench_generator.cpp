@@ -3,20 +3,22 @@
 #include "../generator/derivations.hpp"
 #include "../generator/emit.hpp"
 #include "../generator/expr_graph.hpp"
+#include "../generator/model_file.hpp"
 
 #include <benchmark/benchmark.h>
 
 namespace {
 
-using namespace wlx::gen;
+using namespace wlx::codegen;
 
 const Model& model() {
-  static const Model m = make_excavator_model();
+  static const Model m = load_model_file(WLX_MODEL_FILE);
   return m;
 }
 
+// Reading and checking the model file, building the frames' symbolic kinematics.
 void BM_build_model(benchmark::State& st) {
-  for (auto _ : st) benchmark::DoNotOptimize(make_excavator_model());
+  for (auto _ : st) benchmark::DoNotOptimize(load_model_file(WLX_MODEL_FILE));
 }
 
 template <FunctionSpec (*Derive)(const Model&)>
@@ -42,7 +44,7 @@ void BM_generate_everything(benchmark::State& st) {
   EmitOptions opt;
   opt.generator_version = "bench";
   for (auto _ : st) {
-    const Model m = make_excavator_model();
+    const Model m = load_model_file(WLX_MODEL_FILE);
     auto files = emit_model_headers(m, opt);
     std::vector<FunctionStats> stats;
     const auto fns = derive_all(m);

@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-namespace wlx::gen {
+namespace wlx::codegen {
 
 namespace {
 
@@ -194,4 +194,4 @@ std::vector<FunctionSpec> derive_all(const Model& m) {
           derive_bodies(m), derive_kinematic_update(m)};
 }
 
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

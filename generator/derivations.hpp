@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace wlx::gen {
+namespace wlx::codegen {
 
 // One output argument of an emitted function: a pointer parameter, filled only when non-null.
 struct OutputSpec {
@@ -39,4 +39,4 @@ FunctionSpec derive_kinematic_update(const Model& m);
 // All of the above, in that order.
 std::vector<FunctionSpec> derive_all(const Model& m);
 
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

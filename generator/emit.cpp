@@ -8,7 +8,7 @@
 #include <set>
 #include <unordered_set>
 
-namespace wlx::gen {
+namespace wlx::codegen {
 
 std::string banner(const Model& m, const EmitOptions& opt, const std::string& what) {
   std::string b = fmt::format(
@@ -448,4 +448,4 @@ EmittedFile emit_umbrella(const Model& m, const std::vector<FunctionSpec>& fns, 
   return {"wlx/gen/all.hpp", t};
 }
 
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace wlx::gen {
+namespace wlx::codegen {
 
 struct EmitOptions {
   std::string generator_version;
@@ -47,4 +47,4 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
 EmittedFile emit_umbrella(const Model& m, const std::vector<FunctionSpec>& fns,
                           const std::vector<FunctionStats>& stats, const EmitOptions& opt);
 
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

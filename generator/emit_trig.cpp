@@ -11,7 +11,7 @@
 
 #include <cmath>
 
-namespace wlx::gen {
+namespace wlx::codegen {
 
 namespace {
 
@@ -153,4 +153,4 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
   return {"wlx/gen/trig.hpp", t};
 }
 
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <unordered_set>
 
-namespace wlx::gen {
+namespace wlx::codegen {
 
 namespace {
 
@@ -250,4 +250,4 @@ CsePlan eliminate_common_subexpressions(const ExprGraph& g, const std::vector<in
   return plan;
 }
 
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

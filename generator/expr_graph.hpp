@@ -15,7 +15,7 @@
 #include <unordered_map>
 #include <vector>
 
-namespace wlx::gen {
+namespace wlx::codegen {
 
 enum class NodeKind { Symbol, Number, Add, Mul, Pow, Call };
 
@@ -83,4 +83,4 @@ struct CsePlan {
 // power, which would otherwise be evaluated once per factor).
 CsePlan eliminate_common_subexpressions(const ExprGraph& g, const std::vector<int>& roots);
 
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

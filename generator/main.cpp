@@ -1,6 +1,7 @@
 // wlx-gen: derives the model's equations with GiNaC and emits header-only C++ into a folder.
 #include "derivations.hpp"
 #include "emit.hpp"
+#include "model_file.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -16,7 +17,7 @@
 #endif
 
 namespace fs = std::filesystem;
-using namespace wlx::gen;
+using namespace wlx::codegen;
 
 namespace {
 
@@ -37,15 +38,16 @@ bool write_if_changed(const fs::path& path, const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"wlx-gen: derive the excavator's kinematics symbolically and emit C++ headers"};
-  std::string out_dir;
+  CLI::App app{"wlx-gen: derive a model's kinematics and dynamics symbolically and emit C++ headers"};
+  std::string model_path, out_dir;
   std::vector<std::string> bake_args;
   bool bake_defaults = false, stats_only = false, quiet = false;
   EmitOptions opt;
   opt.generator_version = WLX_VERSION;
+  app.add_option("MODEL", model_path, "the model file (models/*.yaml; format: docs/model-format.md)")->required();
   app.add_option("--out", out_dir, "output root; headers go to OUT/wlx/gen/")->required();
   app.add_option("--bake", bake_args, "bake a parameter in as a constant: NAME=VALUE (repeatable)");
-  app.add_flag("--bake-defaults", bake_defaults, "bake every geometry parameter in at its MODEL.md default");
+  app.add_flag("--bake-defaults", bake_defaults, "bake every geometry parameter (kinds length, offset, angle) in at its default");
   app.add_option("--namespace", opt.name_space, "C++ namespace of the emitted code")->capture_default_str();
   app.add_flag("--quiet", quiet, "print nothing on success");
   app.add_flag("--stats", stats_only, "print the operation-count table (always printed unless --quiet)");
@@ -53,10 +55,13 @@ int main(int argc, char** argv) {
 
   try {
     const auto t0 = std::chrono::steady_clock::now();
-    const Model model = make_excavator_model();
+    const Model model = load_model_file(model_path);
     if (bake_defaults)
-      for (const char* name : {"cxd", "cyd", "thighD", "legD", "wl", "w"})
-        opt.baked[name] = model.parameter(name).default_value;
+      for (std::size_t k = 0; k < model.parameters.size(); ++k) {
+        const ParameterKind kind = model.parameter_kinds[k];
+        if (kind == ParameterKind::length || kind == ParameterKind::offset || kind == ParameterKind::angle)
+          opt.baked[model.parameters[k].name] = model.parameters[k].default_value;
+      }
     for (const auto& arg : bake_args) {
       const auto eq = arg.find('=');
       if (eq == std::string::npos) throw std::runtime_error("--bake " + arg + ": expected NAME=VALUE");
@@ -106,6 +111,9 @@ int main(int argc, char** argv) {
       fmt::print("model built in {:.3f} s; {} files written to {} ({} changed)\n",
                  std::chrono::duration<double>(t1 - t0).count(), files.size(), out_dir, changed);
     }
+  } catch (const ModelFileError& e) {
+    fmt::print(stderr, "wlx-gen: error: {}\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     fmt::print(stderr, "wlx-gen: error: {}\n", e.what());
     return 1;

@@ -1,18 +1,38 @@
-// What a model description is: parameters, coordinates, frames of interest, bodies, and the
-// holonomic (closure) and non-holonomic conditions, all in the vocabulary of vocabulary.hpp.
-// The derivations (derivations.hpp) turn a Model into the functions that get emitted.
+// What a model is, in memory: parameters, coordinates, frames, bodies, the holonomic (closure)
+// and non-holonomic conditions, and the structure the runtime needs (limbs, dependent pairs,
+// inverse-dynamics set-up, nominal state), all in the vocabulary of vocabulary.hpp.
+// model_file.hpp builds a Model from a model file; derivations.hpp turns it into functions.
 #pragma once
 
 #include "vocabulary.hpp"
 
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
-namespace wlx::gen {
+namespace wlx::codegen {
+
+// What a parameter is, which fixes its unit and the values the runtime accepts for it.
+enum class ParameterKind { length, offset, angle, mass, inertia, gravity, other };
+const char* kind_name(ParameterKind kind) noexcept;
+
+// One elementary transform of a frame's chain, as the model file gives it (kept for the
+// inverse-kinematics derivation, which matches patterns on the chain).
+struct ChainStep {
+  enum class Kind { Translate, Rotate, Slide, Turn };  // fixed offset, joint, prismatic joint, fixed angle
+  Kind kind = Kind::Translate;
+  Axis axis = Axis::X;
+  Vec3 offset;          // Translate
+  int coordinate = -1;  // Rotate, Slide
+  ex angle;             // Turn
+};
 
 struct NamedFrame {
   std::string name;
   std::string meaning;
+  std::string parent;  // "K0" for the ground
+  std::vector<ChainStep> chain;
   Frame frame;
 };
 
@@ -21,6 +41,7 @@ struct NamedFrame {
 struct Body {
   std::string name;
   std::string meaning;
+  std::string frame;  // the frame it moves with
   Frame com_frame;
   std::string mass;
   std::array<std::string, 3> inertia;  // principal moments about the CoM, in the body frame
@@ -48,25 +69,62 @@ struct NonholonomicWheel {
   Axis lateral = Axis::Y;
   Axis forward = Axis::X;
   std::string radius;  // parameter name of the rolling radius
+  int ground = -1;     // the input holding the ground level under the wheel
+};
+
+// Closure rows and the dependent joints they determine: a square diagonal block of dPhi/ds.
+struct Limb {
+  std::string name;
+  std::string title;  // for messages: "left leg"
+  std::vector<int> rows;
+  std::vector<int> joints;
+};
+
+struct DependentPair {
+  std::string name;
+  std::array<int, 2> coordinates{-1, -1};
+};
+
+struct Dynamics {
+  std::string gravity;  // parameter name; gravity acts along -z of K0
+  std::vector<int> commanded;
+  std::string pair;  // name of the dependent pair
+  std::vector<int> actuated;
+  std::vector<double> weights;  // default weighting, one per actuated joint
+};
+
+// A box attached to a frame (centred on its origin, along its axes) whose lowest corner must
+// stay above the ground.
+struct ClearanceBox {
+  std::string frame;
+  std::array<ex, 3> size;
 };
 
 struct Model {
   std::string name;
+  std::string description;
   std::string source;  // where the description lives, for the banner
   std::vector<Parameter> parameters;
+  std::vector<ParameterKind> parameter_kinds;  // one per parameter
   std::vector<Coordinate> coordinates;
   int input_count = 0;  // the first input_count coordinates are the independent inputs
   std::vector<NamedFrame> frames;
   std::vector<Body> bodies;
   std::vector<ClosureCondition> closure;
   std::vector<NonholonomicWheel> wheels;
+  std::vector<Limb> limbs;
+  std::vector<int> pair_candidates;
+  std::vector<DependentPair> pairs;
+  std::string default_pair;
+  std::optional<Dynamics> dynamics;
+  std::optional<ClearanceBox> clearance;
+  std::vector<double> nominal;  // one value per input
 
   const Parameter& parameter(const std::string& name) const;
   const Coordinate& coordinate(const std::string& name) const;
   const Frame& frame(const std::string& name) const;
+  int frame_index(const std::string& name) const;  // -1 if absent
+  const DependentPair& pair(const std::string& name) const;
 };
 
-// The walking excavator of MODEL.md, built in excavator_model.cpp.
-Model make_excavator_model();
-
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

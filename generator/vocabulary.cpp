@@ -1,6 +1,6 @@
 #include "vocabulary.hpp"
 
-namespace wlx::gen {
+namespace wlx::codegen {
 
 Vec3 operator+(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 Vec3 operator-(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
@@ -77,6 +77,12 @@ Frame Frame::slid(Axis axis, const Coordinate& c) const {
   return f;
 }
 
+Frame Frame::turned(Axis axis, const ex& angle) const {
+  Frame f = *this;
+  f.R = R * rot(axis, angle);
+  return f;
+}
+
 std::vector<Vec3> linear_jacobian(const Frame& f, int n) {
   std::vector<Vec3> cols(static_cast<std::size_t>(n));
   for (const auto& j : f.joints)
@@ -102,4 +108,4 @@ ex attached_direction_convective(const Frame& f, const Vec3& u, const Vec3& e) {
   return dot(e, cross(f.alpha_bias, u) + cross(f.omega, cross(f.omega, u)));
 }
 
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

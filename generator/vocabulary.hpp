@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace wlx::gen {
+namespace wlx::codegen {
 
 using GiNaC::ex;
 
@@ -92,6 +92,8 @@ class Frame {
   Frame rotated(Axis axis, const Coordinate& c) const;
   // A prismatic joint along this frame's `axis`, displacement = coordinate.
   Frame slid(Axis axis, const Coordinate& c) const;
+  // A fixed rotation about this frame's `axis` by an angle that depends on parameters only.
+  Frame turned(Axis axis, const ex& angle) const;
 };
 
 // Jacobian columns of the frame origin's velocity, one per coordinate (n in all).
@@ -103,4 +105,4 @@ std::vector<ex> attached_direction_gradient(const Frame& f, const Vec3& u, const
 // (d/dt d(e.u)/ds) s' for the same u and e.
 ex attached_direction_convective(const Frame& f, const Vec3& u, const Vec3& e);
 
-}  // namespace wlx::gen
+}  // namespace wlx::codegen

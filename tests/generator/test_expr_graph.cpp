@@ -3,7 +3,7 @@
 
 #include <doctest/doctest.h>
 
-using namespace wlx::gen;
+using namespace wlx::codegen;
 using GiNaC::ex;
 
 TEST_CASE("expr_graph: structurally equal expressions are one node, signs are canonical") {

@@ -1,0 +1,865 @@
+#include "model_file.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <ginac/ginac.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace wlx::codegen {
+
+namespace {
+
+// ---- messages ---------------------------------------------------------------------------------
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// " (did you mean 'x'?)" when one candidate is close, else "".
+std::string suggestion(const std::string& name, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t best_distance = std::max<std::size_t>(2, name.size() / 3) + 1;
+  for (const auto& c : candidates) {
+    const std::size_t d = edit_distance(name, c);
+    if (d < best_distance) best_distance = d, best = c;
+  }
+  return best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best);
+}
+
+// A value shown in a message: short, with control characters escaped.
+std::string excerpt(const std::string& s) {
+  std::string out;
+  for (char ch : s.substr(0, 60)) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (u < 0x20 || u == 0x7f) out += fmt::format("\\x{:02x}", u);
+    else out += ch;
+  }
+  return s.size() > 60 ? out + "..." : out;
+}
+
+bool is_identifier(const std::string& s) {
+  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+}
+
+// Names the emitted C++ cannot use for a parameter or coordinate: keywords, and the names the
+// generated functions give their own arguments and locals.
+std::string reserved_reason(const std::string& n) {
+  static const std::set<std::string> keywords = {
+      "alignas", "alignof", "and", "and_eq", "asm", "auto", "bitand", "bitor", "bool", "break", "case", "catch",
+      "char", "char8_t", "char16_t", "char32_t", "class", "compl", "concept", "const", "consteval", "constexpr",
+      "constinit", "const_cast", "continue", "co_await", "co_return", "co_yield", "decltype", "default", "delete",
+      "do", "double", "dynamic_cast", "else", "enum", "explicit", "export", "extern", "false", "float", "for",
+      "friend", "goto", "if", "inline", "int", "long", "mutable", "namespace", "new", "noexcept", "not", "not_eq",
+      "nullptr", "operator", "or", "or_eq", "private", "protected", "public", "register", "reinterpret_cast",
+      "requires", "return", "short", "signed", "sizeof", "static", "static_assert", "static_cast", "struct",
+      "switch", "template", "this", "thread_local", "throw", "true", "try", "typedef", "typeid", "typename",
+      "union", "unsigned", "using", "virtual", "void", "volatile", "wchar_t", "while", "xor", "xor_eq", "NULL",
+      "K0"};
+  static const std::set<std::string> locals = {
+      "s", "sdot", "p", "zero_fill", "angle", "sin_angle", "cos_angle", "std", "Eigen", "positions", "rotations",
+      "Phi", "dPhi_ds", "C", "spin", "dPhi_ds_dot_sdot", "C_dot_sdot", "com", "Jv", "Jw", "Jv_dot_sdot",
+      "Jw_dot_sdot", "Params", "Coordinates", "Pi", "pi", "sin", "cos", "tan", "asin", "acos", "atan", "sqrt",
+      "exp", "log", "abs"};
+  if (keywords.count(n)) return "it is a C++ keyword";
+  if (locals.count(n)) return "the generated functions use that name themselves";
+  if (n.size() > 1 && n[0] == 't' && std::all_of(n.begin() + 1, n.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+    return "t<number> names the generated code's intermediate terms";
+  if (n.rfind("sin_", 0) == 0 || n.rfind("cos_", 0) == 0) return "sin_<angle> and cos_<angle> name the generated code's sines and cosines";
+  if (n.size() > 4 && n.compare(n.size() - 4, 4, "_dot") == 0) return "<coordinate>_dot names the generated code's rates";
+  if (n[0] == '_' || n.find("__") != std::string::npos) return "C++ reserves names starting with _ or containing __";
+  return {};
+}
+
+// ---- places, items and fields -----------------------------------------------------------------
+
+using Env = std::map<std::string, std::string>;
+
+struct Source {
+  std::string name;
+
+  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path, const std::string& reason) const {
+    if (mark.is_null()) throw ModelFileError(fmt::format("{}: {}: {}", name, path, reason));
+    throw ModelFileError(fmt::format("{}:{}:{}: {}: {}", name, mark.line + 1, mark.column + 1, path, reason));
+  }
+};
+
+// A YAML node with its place and the repetition variables in force.
+class Item {
+ public:
+  Item(const Source& src, YAML::Node node, std::string path, Env env, YAML::Mark fallback = YAML::Mark::null_mark())
+      : src_(&src), node_(std::move(node)), path_(std::move(path)), env_(std::move(env)), fallback_(fallback) {}
+
+  const YAML::Node& node() const { return node_; }
+  const std::string& path() const { return path_; }
+  const Env& env() const { return env_; }
+  const Source& source() const { return *src_; }
+  YAML::Mark mark() const { return node_.IsDefined() && !node_.Mark().is_null() ? node_.Mark() : fallback_; }
+  [[noreturn]] void fail(const std::string& reason) const { src_->fail(mark(), path_, reason); }
+
+  bool defined() const { return node_.IsDefined() && !node_.IsNull(); }
+  bool is_map() const { return node_.IsMap(); }
+  bool is_sequence() const { return node_.IsSequence(); }
+  bool has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined(); }
+  std::size_t size() const { return node_.size(); }
+
+  Item child(const std::string& key) const { return Item(*src_, node_[key], path_ + "." + key, env_, mark()); }
+  Item element(std::size_t k) const { return Item(*src_, node_[k], fmt::format("{}[{}]", path_, k), env_, mark()); }
+  Item with(Env env, const std::string& suffix) const { return Item(*src_, node_, path_ + suffix, std::move(env), fallback_); }
+
+  // The scalar, with repetition variables <name> substituted.
+  std::string text() const {
+    if (!node_.IsDefined() || node_.IsNull()) fail("missing: give a value");
+    if (!node_.IsScalar()) fail("must be a single value, not a list or map");
+    const std::string& s = node_.Scalar();
+    std::string out;
+    for (std::size_t i = 0; i < s.size();) {
+      const std::size_t close = s[i] == '<' ? s.find('>', i) : std::string::npos;
+      if (close != std::string::npos && is_identifier(s.substr(i + 1, close - i - 1))) {
+        const std::string var = s.substr(i + 1, close - i - 1);
+        const auto it = env_.find(var);
+        if (it == env_.end()) {
+          std::vector<std::string> names;
+          for (const auto& kv : env_) names.push_back(kv.first);
+          fail(fmt::format("'<{}>' is not a repetition variable here{}{}", var, suggestion(var, names),
+                           env_.empty() ? " (the entry has no `for`)" : ""));
+        }
+        out += it->second;
+        i = close + 1;
+      } else {
+        out += s[i++];
+      }
+    }
+    return out;
+  }
+  std::string name() const {
+    const std::string s = text();
+    if (!is_identifier(s))
+      fail(fmt::format("'{}' is not a name: use letters, digits and _, not starting with a digit", excerpt(s)));
+    return s;
+  }
+  double number() const {
+    const std::string s = text();
+    double v = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || end != s.data() + s.size()) fail(fmt::format("'{}' is not a number", excerpt(s)));
+    if (!std::isfinite(v)) fail(fmt::format("must be a finite number, got {}", excerpt(s)));
+    return v;
+  }
+  std::vector<Item> list() const {
+    if (!node_.IsSequence()) fail("must be a list [a, b, ...]");
+    std::vector<Item> out;
+    for (std::size_t k = 0; k < node_.size(); ++k) out.push_back(element(k));
+    return out;
+  }
+
+ private:
+  const Source* src_;
+  YAML::Node node_;
+  std::string path_;
+  Env env_;
+  YAML::Mark fallback_;
+};
+
+// The fields of a map: reports unknown keys (with the nearest known one) and missing ones.
+class Fields {
+ public:
+  Fields(const Item& item, std::vector<std::string> allowed) : item_(item), allowed_(std::move(allowed)) {
+    if (!item.is_map()) item.fail("must be a map of fields (key: value)");
+    for (const auto& kv : item.node()) {
+      const std::string key = kv.first.Scalar();
+      if (key == "for") continue;  // the repetition, already expanded
+      if (std::find(allowed_.begin(), allowed_.end(), key) == allowed_.end())
+        item.source().fail(kv.first.Mark(), item.path(),
+                           fmt::format("unknown field '{}'{}; the fields here are: {}", excerpt(key),
+                                       suggestion(key, allowed_), fmt::join(allowed_, ", ")));
+    }
+  }
+  Item operator[](const std::string& key) const {
+    if (!item_.has(key)) item_.fail(fmt::format("missing field '{}'", key));
+    return item_.child(key);
+  }
+  std::optional<Item> optional(const std::string& key) const {
+    if (!item_.has(key)) return std::nullopt;
+    return item_.child(key);
+  }
+
+ private:
+  const Item& item_;
+  std::vector<std::string> allowed_;
+};
+
+Axis axis_of(const Item& it) {
+  const std::string a = it.text();
+  if (a == "x") return Axis::X;
+  if (a == "y") return Axis::Y;
+  if (a == "z") return Axis::Z;
+  it.fail(fmt::format("'{}' is not an axis: use x, y or z", excerpt(a)));
+}
+
+// ---- the parser -------------------------------------------------------------------------------
+
+class Parser {
+ public:
+  explicit Parser(std::string source) : src_{std::move(source)} {}
+
+  Model parse(const YAML::Node& root) {
+    const Item top(src_, root, "model file", {});
+    const Fields f(top, {"model", "description", "repeat", "parameters", "coordinates", "frames", "bodies", "closure",
+                         "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "nominal"});
+    m_.name = f["model"].name();
+    m_.source = src_.name;
+    if (auto d = f.optional("description")) m_.description = d->text();
+    if (auto r = f.optional("repeat")) repeats(*r);
+    parameters(f["parameters"]);
+    coordinates(f["coordinates"]);
+    frames(f["frames"]);
+    if (auto b = f.optional("bodies")) bodies(*b);
+    if (auto c = f.optional("closure")) closure(*c);
+    limbs(f.optional("limbs"), top);
+    if (auto w = f.optional("wheels")) wheels(*w);
+    nonholonomic(f.optional("nonholonomic"), top);
+    if (auto d = f.optional("dynamics")) dynamics(*d);
+    if (auto c = f.optional("clearance")) clearance(*c);
+    nominal(f.optional("nominal"));
+    return std::move(m_);
+  }
+
+ private:
+  // ---- repetition ----
+  void repeats(const Item& r) {
+    if (!r.is_map()) r.fail("must map each repetition variable to its rows");
+    for (const auto& kv : r.node()) {
+      const std::string table = kv.first.Scalar();
+      const Item rows(src_, kv.second, "repeat." + table, {});
+      if (!is_identifier(table)) rows.fail(fmt::format("'{}' is not a name", excerpt(table)));
+      if (!rows.is_sequence() || rows.size() == 0) rows.fail("must be a non-empty list of rows {variable: value, ...}");
+      std::vector<Env> envs;
+      for (const Item& row : rows.list()) {
+        if (!row.is_map()) row.fail("a row must map variable names to values");
+        Env env;
+        for (const auto& v : row.node()) {
+          const std::string var = v.first.Scalar();
+          if (!is_identifier(var)) row.fail(fmt::format("'{}' is not a variable name", excerpt(var)));
+          if (!v.second.IsScalar()) row.fail(fmt::format("variable '{}' must have a single value", var));
+          env[var] = v.second.Scalar();
+        }
+        if (!envs.empty()) {
+          std::set<std::string> a, b;
+          for (const auto& kv2 : envs.front()) a.insert(kv2.first);
+          for (const auto& kv2 : env) b.insert(kv2.first);
+          if (a != b) row.fail("every row of a repetition must define the same variables as the first");
+        }
+        envs.push_back(std::move(env));
+      }
+      repeat_[table] = std::move(envs);
+    }
+  }
+
+  // Calls fn for every entry of a list, writing out entries with `for:` once per row (nested
+  // repetitions multiply; `items:` repeats a block of entries).
+  void each(const Item& list, const std::function<void(const Item&)>& fn) {
+    if (!list.defined()) return;
+    for (const Item& e : list.list()) {
+      if (!(e.is_map() && e.has("for"))) {
+        fn(e);
+        continue;
+      }
+      const Item spec = e.child("for");
+      std::vector<std::string> tables;
+      if (spec.is_sequence())
+        for (const Item& t : spec.list()) tables.push_back(t.name());
+      else
+        tables.push_back(spec.name());
+      for (const auto& t : tables)
+        if (!repeat_.count(t)) {
+          std::vector<std::string> names;
+          for (const auto& kv : repeat_) names.push_back(kv.first);
+          spec.fail(fmt::format("no repetition '{}' under `repeat:`{}", t, suggestion(t, names)));
+        }
+      std::vector<std::size_t> index(tables.size(), 0);
+      while (true) {
+        Env env = e.env();
+        std::string suffix = "{";
+        for (std::size_t k = 0; k < tables.size(); ++k) {
+          const Env& row = repeat_[tables[k]][index[k]];
+          for (const auto& [var, value] : row) {
+            if (env.count(var)) spec.fail(fmt::format("repetition variable '{}' is defined twice here", var));
+            env[var] = value;
+          }
+          suffix += fmt::format("{}{}={}", k ? "," : "", tables[k], index[k]);
+        }
+        suffix += "}";
+        const Item instance = e.with(env, suffix);
+        if (e.has("items")) {
+          const Fields only(instance, {"items"});
+          each(only["items"], fn);
+        } else {
+          fn(instance);
+        }
+        std::size_t k = tables.size();
+        while (k > 0 && ++index[k - 1] == repeat_[tables[k - 1]].size()) index[--k] = 0;
+        if (k == 0) break;
+      }
+    }
+  }
+
+  // ---- names ----
+  void claim_symbol_name(const Item& it, const std::string& n) {
+    if (const std::string why = reserved_reason(n); !why.empty()) it.fail(fmt::format("'{}' cannot be used as a name: {}", n, why));
+    if (const auto found = symbol_kind_.find(n); found != symbol_kind_.end())
+      it.fail(fmt::format("'{}' is already the name of a {}", n, found->second));
+  }
+
+  int coordinate_index(const Item& it, bool inputs_only = false, bool dependents_only = false) const {
+    const std::string n = it.name();
+    for (const auto& c : m_.coordinates)
+      if (c.name == n) {
+        if (inputs_only && c.index >= m_.input_count) it.fail(fmt::format("'{}' is a dependent joint; an input is needed here", n));
+        if (dependents_only && c.index < m_.input_count) it.fail(fmt::format("'{}' is an input; a dependent joint is needed here", n));
+        return c.index;
+      }
+    std::vector<std::string> names;
+    for (const auto& c : m_.coordinates) names.push_back(c.name);
+    it.fail(fmt::format("no coordinate '{}'{}", n, suggestion(n, names)));
+  }
+
+  const Parameter& parameter(const Item& it, std::optional<ParameterKind> kind = std::nullopt) const {
+    const std::string n = it.name();
+    for (std::size_t k = 0; k < m_.parameters.size(); ++k)
+      if (m_.parameters[k].name == n) {
+        if (kind && m_.parameter_kinds[k] != *kind)
+          it.fail(fmt::format("'{}' is a parameter of kind {}; one of kind {} is needed here", n,
+                              kind_name(m_.parameter_kinds[k]), kind_name(*kind)));
+        return m_.parameters[k];
+      }
+    std::vector<std::string> names;
+    for (const auto& p : m_.parameters) names.push_back(p.name);
+    it.fail(fmt::format("no parameter '{}'{}", n, suggestion(n, names)));
+  }
+
+  int frame_index(const Item& it) const {
+    const std::string n = it.name();
+    const int k = m_.frame_index(n);
+    if (k >= 0) return k;
+    std::vector<std::string> names;
+    for (const auto& f : m_.frames) names.push_back(f.name);
+    it.fail(fmt::format("no frame '{}'{}", n, suggestion(n, names)));
+  }
+
+  // ---- expressions ----
+  // An expression of parameters (and, where allowed, coordinates), parsed by GiNaC's parser
+  // against a strict table. Identifiers are checked first so that a typo gets a suggestion.
+  ex expression(const Item& it, bool allow_coordinates) const {
+    const std::string s = it.text();
+    static const std::set<std::string> functions = {"sin", "cos", "tan", "asin", "acos", "atan", "sqrt", "exp", "log"};
+    for (std::size_t i = 0; i < s.size();) {
+      const auto c = static_cast<unsigned char>(s[i]);
+      if (std::isdigit(c) || (s[i] == '.' && i + 1 < s.size() && std::isdigit(static_cast<unsigned char>(s[i + 1])))) {
+        while (i < s.size() && (std::isdigit(static_cast<unsigned char>(s[i])) || s[i] == '.')) ++i;
+        if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+          ++i;
+          if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+          while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i;
+        }
+        continue;
+      }
+      if (std::isalpha(c) || s[i] == '_') {
+        std::size_t j = i;
+        while (j < s.size() && (std::isalnum(static_cast<unsigned char>(s[j])) || s[j] == '_')) ++j;
+        const std::string id = s.substr(i, j - i);
+        std::size_t k = j;
+        while (k < s.size() && s[k] == ' ') ++k;
+        const bool call = k < s.size() && s[k] == '(';
+        if (call) {
+          if (!functions.count(id))
+            it.fail(fmt::format("unknown function '{}' in '{}'; the functions are {}", id, excerpt(s), fmt::join(functions, ", ")));
+        } else if (id != "Pi" && !params_.count(id)) {
+          const bool coordinate = coordinates_.count(id) != 0;
+          if (coordinate && !allow_coordinates)
+            it.fail(fmt::format("'{}' is a coordinate; only parameters may appear in '{}'", id, excerpt(s)));
+          if (!coordinate) {
+            std::vector<std::string> names;
+            for (const auto& kv : params_) names.push_back(kv.first);
+            if (allow_coordinates)
+              for (const auto& kv : coordinates_) names.push_back(kv.first);
+            it.fail(fmt::format("unknown symbol '{}' in '{}'{}", id, excerpt(s), suggestion(id, names)));
+          }
+        }
+        i = j;
+        continue;
+      }
+      ++i;
+    }
+    GiNaC::symtab table = params_;
+    if (allow_coordinates) table.insert(coordinates_.begin(), coordinates_.end());
+    table["Pi"] = GiNaC::Pi;
+    try {
+      GiNaC::parser reader(table, true);
+      return reader(s);
+    } catch (const std::exception& e) {
+      it.fail(fmt::format("cannot read the expression '{}': {}", excerpt(s), e.what()));
+    }
+  }
+
+  Vec3 vector3(const Item& it) const {
+    if (!it.is_sequence() || it.size() != 3) it.fail("must be a list of 3 expressions [x, y, z]");
+    return {expression(it.element(0), false), expression(it.element(1), false), expression(it.element(2), false)};
+  }
+
+  // ---- sections ----
+  void parameters(const Item& list) {
+    each(list, [&](const Item& it) {
+      const Fields f(it, {"name", "value", "unit", "kind", "meaning"});
+      const std::string n = f["name"].name();
+      claim_symbol_name(f["name"], n);
+      const Item kind_item = f["kind"];
+      const std::string kind = kind_item.text();
+      static const std::map<std::string, std::pair<ParameterKind, const char*>> kinds = {
+          {"length", {ParameterKind::length, "m"}},   {"offset", {ParameterKind::offset, "m"}},
+          {"angle", {ParameterKind::angle, "rad"}},   {"mass", {ParameterKind::mass, "kg"}},
+          {"inertia", {ParameterKind::inertia, "kg*m^2"}}, {"gravity", {ParameterKind::gravity, "m/s^2"}},
+          {"other", {ParameterKind::other, nullptr}}};
+      const auto k = kinds.find(kind);
+      if (k == kinds.end()) {
+        std::vector<std::string> names;
+        for (const auto& kv : kinds) names.push_back(kv.first);
+        kind_item.fail(fmt::format("unknown kind '{}'{}; the kinds are {}", excerpt(kind), suggestion(kind, names), fmt::join(names, ", ")));
+      }
+      const std::string unit = f["unit"].text();
+      if (k->second.second != nullptr && unit != k->second.second)
+        f["unit"].fail(fmt::format("a parameter of kind {} has unit {}, not '{}'", kind, k->second.second, excerpt(unit)));
+      const double value = f["value"].number();
+      const ParameterKind pk = k->second.first;
+      if ((pk == ParameterKind::length || pk == ParameterKind::mass || pk == ParameterKind::inertia) && !(value > 0))
+        f["value"].fail(fmt::format("a {} must be positive, got {}", kind, value));
+      if (pk == ParameterKind::gravity && !(value >= 0)) f["value"].fail(fmt::format("gravity must be non-negative, got {}", value));
+      m_.parameters.push_back({n, value, unit, f.optional("meaning") ? f["meaning"].text() : "", GiNaC::realsymbol(n)});
+      m_.parameter_kinds.push_back(pk);
+      params_[n] = m_.parameters.back().symbol;
+      symbol_kind_[n] = "parameter";
+    });
+    if (m_.parameters.empty()) list.fail("a model needs at least one parameter");
+  }
+
+  void coordinate(const Item& it) {
+    const Fields f(it, {"name", "unit", "meaning"});
+    const std::string n = f["name"].name();
+    claim_symbol_name(f["name"], n);
+    const std::string unit = f["unit"].text();
+    if (unit != "m" && unit != "rad") f["unit"].fail(fmt::format("a coordinate is in m or rad, not '{}'", excerpt(unit)));
+    const int index = static_cast<int>(m_.coordinates.size());
+    m_.coordinates.push_back({n, index, GiNaC::realsymbol(n), GiNaC::realsymbol(n + "_dot"), unit,
+                              f.optional("meaning") ? f["meaning"].text() : ""});
+    coordinates_[n] = m_.coordinates.back().q;
+    symbol_kind_[n] = "coordinate";
+  }
+
+  void coordinates(const Item& c) {
+    const Fields f(c, {"inputs", "dependent"});
+    each(f["inputs"], [&](const Item& it) { coordinate(it); });
+    m_.input_count = static_cast<int>(m_.coordinates.size());
+    if (m_.input_count == 0) f["inputs"].fail("a model needs at least one input");
+    if (auto d = f.optional("dependent")) each(*d, [&](const Item& it) { coordinate(it); });
+  }
+
+  // Frames may name parents listed after them; they are built parents first, with cycles found.
+  void frames(const Item& list) {
+    std::vector<Item> entries;
+    each(list, [&](const Item& it) { entries.push_back(it); });
+    if (entries.empty()) list.fail("a model needs at least one frame");
+    std::map<std::string, std::size_t> by_name;
+    std::vector<std::string> names;
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      const Fields f(entries[k], {"name", "meaning", "parent", "chain"});
+      const std::string n = f["name"].name();
+      if (n == "K0") f["name"].fail("K0 is the ground frame and cannot be defined");
+      if (by_name.count(n)) f["name"].fail(fmt::format("frame '{}' is defined twice", n));
+      by_name[n] = k;
+      names.push_back(n);
+    }
+    m_.frames.resize(entries.size());
+    std::vector<int> state(entries.size(), 0);  // 0 not built, 1 being built, 2 built
+    std::function<const Frame&(std::size_t, std::vector<std::string>&)> build = [&](std::size_t k, std::vector<std::string>& trail) -> const Frame& {
+      NamedFrame& out = m_.frames[k];
+      if (state[k] == 2) return out.frame;
+      const Item& it = entries[k];
+      const Fields f(it, {"name", "meaning", "parent", "chain"});
+      if (state[k] == 1) {
+        trail.push_back(names[k]);
+        f["parent"].fail(fmt::format("the frames' parents form a cycle: {}", fmt::join(trail, " -> ")));
+      }
+      state[k] = 1;
+      trail.push_back(names[k]);
+      out.name = names[k];
+      out.meaning = f.optional("meaning") ? f["meaning"].text() : "";
+      out.parent = f["parent"].name();
+      Frame frame = Frame::ground();
+      if (out.parent != "K0") {
+        const auto p = by_name.find(out.parent);
+        if (p == by_name.end()) f["parent"].fail(fmt::format("no frame '{}' (K0 is the ground){}", out.parent, suggestion(out.parent, names)));
+        frame = build(p->second, trail);
+      }
+      for (const Item& step : f["chain"].list()) {
+        if (!step.is_map() || step.size() != 1)
+          step.fail("a chain step is one of tx, ty, tz, rx, ry, rz: <coordinate or expression>, or translate: [x, y, z]");
+        const std::string op = step.node().begin()->first.Scalar();
+        const Item arg = step.child(op);
+        ChainStep cs;
+        if (op == "translate") {
+          cs.kind = ChainStep::Kind::Translate;
+          cs.offset = vector3(arg);
+          frame = frame.translated(cs.offset);
+        } else if (op.size() == 2 && (op[0] == 't' || op[0] == 'r') && op[1] >= 'x' && op[1] <= 'z') {
+          cs.axis = static_cast<Axis>(op[1] - 'x');
+          const ex e = expression(arg, true);
+          const bool rotation = op[0] == 'r';
+          if (GiNaC::is_a<GiNaC::symbol>(e) && coordinates_.count(GiNaC::ex_to<GiNaC::symbol>(e).get_name())) {
+            const Coordinate& c = m_.coordinate(GiNaC::ex_to<GiNaC::symbol>(e).get_name());
+            if (rotation && c.unit != "rad") arg.fail(fmt::format("'{}' turns a revolute joint, so its unit must be rad, not {}", c.name, c.unit));
+            if (!rotation && c.unit != "m") arg.fail(fmt::format("'{}' drives a prismatic joint, so its unit must be m, not {}", c.name, c.unit));
+            for (const auto& [user, at] : joint_users_)
+              if (user == c.index) arg.fail(fmt::format("coordinate '{}' already drives a joint (at {})", c.name, at));
+            joint_users_.emplace_back(c.index, arg.path());
+            cs.kind = rotation ? ChainStep::Kind::Rotate : ChainStep::Kind::Slide;
+            cs.coordinate = c.index;
+            frame = rotation ? frame.rotated(cs.axis, c) : frame.slid(cs.axis, c);
+          } else {
+            for (const auto& kv : coordinates_)
+              if (e.has(kv.second))
+                arg.fail(fmt::format("a joint is driven by one coordinate alone; '{}' mixes coordinate '{}' with other terms",
+                                     excerpt(arg.text()), kv.first));
+            if (rotation) {
+              cs.kind = ChainStep::Kind::Turn;
+              cs.angle = e;
+              frame = frame.turned(cs.axis, e);
+            } else {
+              cs.kind = ChainStep::Kind::Translate;
+              cs.offset[static_cast<int>(cs.axis)] = e;
+              frame = frame.translated(cs.offset);
+            }
+          }
+        } else {
+          step.fail(fmt::format("unknown chain step '{}'{}; the steps are tx, ty, tz, rx, ry, rz, translate", excerpt(op),
+                                suggestion(op, {"tx", "ty", "tz", "rx", "ry", "rz", "translate"})));
+        }
+        out.chain.push_back(cs);
+      }
+      out.frame = std::move(frame);
+      state[k] = 2;
+      trail.pop_back();
+      return out.frame;
+    };
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      std::vector<std::string> trail;
+      build(k, trail);
+    }
+  }
+
+  void bodies(const Item& list) {
+    std::set<std::string> seen;
+    each(list, [&](const Item& it) {
+      const Fields f(it, {"name", "meaning", "frame", "com", "mass", "inertia"});
+      Body b;
+      b.name = f["name"].name();
+      if (!seen.insert(b.name).second) f["name"].fail(fmt::format("body '{}' is defined twice", b.name));
+      b.meaning = f.optional("meaning") ? f["meaning"].text() : "";
+      const int frame = frame_index(f["frame"]);
+      b.frame = m_.frames[static_cast<std::size_t>(frame)].name;
+      b.com_frame = m_.frames[static_cast<std::size_t>(frame)].frame.translated(vector3(f["com"]));
+      b.mass = parameter(f["mass"], ParameterKind::mass).name;
+      const Item inertia = f["inertia"];
+      if (!inertia.is_sequence() || inertia.size() != 3)
+        inertia.fail("must list the 3 principal moments about the CoM, in the frame's axes: [Ixx, Iyy, Izz]");
+      for (std::size_t k = 0; k < 3; ++k) b.inertia[k] = parameter(inertia.element(k), ParameterKind::inertia).name;
+      m_.bodies.push_back(std::move(b));
+    });
+  }
+
+  void closure(const Item& list) {
+    std::set<std::string> seen;
+    each(list, [&](const Item& it) {
+      const Item type_item = it.is_map() && it.has("type") ? it.child("type") : it;
+      const std::string type = it.is_map() && it.has("type") ? type_item.text() : "";
+      ClosureCondition c;
+      using K = ClosureCondition::Kind;
+      if (type == "point") {
+        const Fields f(it, {"name", "type", "frame", "component", "equals"});
+        c.name = f["name"].name();
+        c.kind = K::PointEqualsCoordinate;
+        c.frame = m_.frames[static_cast<std::size_t>(frame_index(f["frame"]))].name;
+        c.axis = axis_of(f["component"]);
+        c.target = coordinate_index(f["equals"], true);
+        if (m_.coordinates[static_cast<std::size_t>(c.target)].unit != "m")
+          f["equals"].fail(fmt::format("'{}' is an angle; a point's component equals a length coordinate (m)",
+                                       m_.coordinates[static_cast<std::size_t>(c.target)].name));
+      } else if (type == "level") {
+        const Fields f(it, {"name", "type", "frame", "axis"});
+        c.name = f["name"].name();
+        c.kind = K::AttachedDirectionLevel;
+        c.frame = m_.frames[static_cast<std::size_t>(frame_index(f["frame"]))].name;
+        c.axis = axis_of(f["axis"]);
+      } else if (type == "sum") {
+        const Fields f(it, {"name", "type", "coordinates"});
+        c.name = f["name"].name();
+        c.kind = K::CoordinateSum;
+        for (const Item& ci : f["coordinates"].list()) c.coordinates.push_back(coordinate_index(ci));
+        if (c.coordinates.empty()) f["coordinates"].fail("must name at least one coordinate");
+      } else {
+        (it.is_map() && it.has("type") ? type_item : it)
+            .fail(fmt::format("a closure condition needs `type: point`, `level` or `sum`{}",
+                              type.empty() ? "" : fmt::format(", not '{}'{}", excerpt(type), suggestion(type, {"point", "level", "sum"}))));
+      }
+      if (!seen.insert(c.name).second) it.child("name").fail(fmt::format("closure condition '{}' is defined twice", c.name));
+      m_.closure.push_back(std::move(c));
+    });
+    rows_item_ = list;
+  }
+
+  // The dependent coordinates a closure row involves (structurally, without differentiating).
+  std::set<int> row_dependents(const ClosureCondition& c) const {
+    std::set<int> out;
+    if (c.kind == ClosureCondition::Kind::CoordinateSum) {
+      out.insert(c.coordinates.begin(), c.coordinates.end());
+    } else {
+      for (const auto& j : m_.frame(c.frame).joints) out.insert(j.coordinate);
+      if (c.target >= 0) out.insert(c.target);
+    }
+    std::set<int> dependents;
+    for (int k : out)
+      if (k >= m_.input_count) dependents.insert(k);
+    return dependents;
+  }
+
+  void limbs(const std::optional<Item>& list, const Item& top) {
+    const int dependents = static_cast<int>(m_.coordinates.size()) - m_.input_count;
+    if (static_cast<int>(m_.closure.size()) != dependents)
+      (rows_item_ ? *rows_item_ : top)
+          .fail(fmt::format("{} closure conditions for {} dependent joints: the closure needs exactly one equation per "
+                            "dependent joint",
+                            m_.closure.size(), dependents));
+    if (!list) {
+      if (dependents > 0) top.fail("missing field 'limbs': group the closure rows and dependent joints into limbs");
+      return;
+    }
+    std::map<int, std::string> row_owner, joint_owner;
+    each(*list, [&](const Item& it) {
+      const Fields f(it, {"name", "title", "closure", "joints"});
+      Limb limb;
+      limb.name = f["name"].name();
+      for (const auto& l : m_.limbs)
+        if (l.name == limb.name) f["name"].fail(fmt::format("limb '{}' is defined twice", limb.name));
+      limb.title = f.optional("title") ? f["title"].text() : limb.name;
+      for (const Item& r : f["closure"].list()) {
+        const std::string n = r.name();
+        int row = -1;
+        std::vector<std::string> names;
+        for (std::size_t k = 0; k < m_.closure.size(); ++k) {
+          names.push_back(m_.closure[k].name);
+          if (m_.closure[k].name == n) row = static_cast<int>(k);
+        }
+        if (row < 0) r.fail(fmt::format("no closure condition '{}'{}", n, suggestion(n, names)));
+        if (row_owner.count(row)) r.fail(fmt::format("closure condition '{}' already belongs to limb '{}'", n, row_owner[row]));
+        row_owner[row] = limb.name;
+        limb.rows.push_back(row);
+      }
+      for (const Item& j : f["joints"].list()) {
+        const int k = coordinate_index(j, false, true);
+        if (joint_owner.count(k))
+          j.fail(fmt::format("joint '{}' already belongs to limb '{}'", m_.coordinates[static_cast<std::size_t>(k)].name, joint_owner[k]));
+        joint_owner[k] = limb.name;
+        limb.joints.push_back(k);
+      }
+      if (limb.rows.size() != limb.joints.size() || limb.rows.empty())
+        it.fail(fmt::format("limb '{}' has {} closure conditions and {} joints: a limb's block of dPhi/ds must be square and "
+                            "non-empty",
+                            limb.name, limb.rows.size(), limb.joints.size()));
+      for (int row : limb.rows)
+        for (int k : row_dependents(m_.closure[static_cast<std::size_t>(row)]))
+          if (std::find(limb.joints.begin(), limb.joints.end(), k) == limb.joints.end())
+            f["closure"].fail(fmt::format("closure condition '{}' depends on joint '{}', which is not one of limb '{}''s joints: "
+                                          "the limbs must decouple",
+                                          m_.closure[static_cast<std::size_t>(row)].name,
+                                          m_.coordinates[static_cast<std::size_t>(k)].name, limb.name));
+      m_.limbs.push_back(std::move(limb));
+    });
+    for (std::size_t k = 0; k < m_.closure.size(); ++k)
+      if (!row_owner.count(static_cast<int>(k)))
+        list->fail(fmt::format("closure condition '{}' belongs to no limb", m_.closure[k].name));
+    for (int k = m_.input_count; k < static_cast<int>(m_.coordinates.size()); ++k)
+      if (!joint_owner.count(k)) list->fail(fmt::format("dependent joint '{}' belongs to no limb", m_.coordinates[static_cast<std::size_t>(k)].name));
+  }
+
+  void wheels(const Item& list) {
+    each(list, [&](const Item& it) {
+      const Fields f(it, {"name", "contact", "forward", "lateral", "radius", "ground"});
+      NonholonomicWheel w;
+      w.name = f["name"].name();
+      for (const auto& other : m_.wheels)
+        if (other.name == w.name) f["name"].fail(fmt::format("wheel '{}' is defined twice", w.name));
+      w.contact = m_.frames[static_cast<std::size_t>(frame_index(f["contact"]))].name;
+      w.forward = axis_of(f["forward"]);
+      w.lateral = axis_of(f["lateral"]);
+      if (w.forward == w.lateral) f["lateral"].fail("the lateral axis must differ from the forward axis");
+      w.radius = parameter(f["radius"], ParameterKind::length).name;
+      w.ground = coordinate_index(f["ground"], true);
+      m_.wheels.push_back(std::move(w));
+    });
+  }
+
+  void nonholonomic(const std::optional<Item>& section, const Item& top) {
+    if (m_.wheels.empty()) {
+      if (section) section->fail("the model has no wheels, so it has no non-holonomic section");
+      return;
+    }
+    if (!section) top.fail("missing field 'nonholonomic': a model with wheels names the candidate dependent rates and pairs");
+    const Fields f(*section, {"pair_candidates", "pairs", "default_pair"});
+    for (const Item& c : f["pair_candidates"].list()) {
+      const int k = coordinate_index(c, true);
+      if (std::count(m_.pair_candidates.begin(), m_.pair_candidates.end(), k)) c.fail("listed twice");
+      m_.pair_candidates.push_back(k);
+    }
+    const Item pairs = f["pairs"];
+    if (!pairs.is_map() || pairs.size() == 0) pairs.fail("must map pair names to lists of dependent rates");
+    for (const auto& kv : pairs.node()) {
+      DependentPair p;
+      p.name = kv.first.Scalar();
+      const Item list = pairs.child(p.name);
+      if (!is_identifier(p.name)) list.fail(fmt::format("'{}' is not a name", excerpt(p.name)));
+      if (!list.is_sequence() || list.size() != m_.wheels.size())
+        list.fail(fmt::format("a dependent pair lists {} rates, one per wheel", m_.wheels.size()));
+      if (m_.wheels.size() != 2) list.fail("the runtime solves for two wheels; models with another number of wheels are not supported yet");
+      for (std::size_t k = 0; k < 2; ++k) {
+        p.coordinates[k] = coordinate_index(list.element(k), true);
+        if (!std::count(m_.pair_candidates.begin(), m_.pair_candidates.end(), p.coordinates[k]))
+          list.element(k).fail(fmt::format("'{}' is not one of pair_candidates", m_.coordinates[static_cast<std::size_t>(p.coordinates[k])].name));
+      }
+      if (p.coordinates[0] == p.coordinates[1]) list.fail("the two dependent rates must differ");
+      m_.pairs.push_back(p);
+    }
+    const Item def = f["default_pair"];
+    m_.default_pair = def.name();
+    bool found = false;
+    for (const auto& p : m_.pairs) found = found || p.name == m_.default_pair;
+    if (!found) def.fail(fmt::format("no pair '{}' under pairs", m_.default_pair));
+  }
+
+  void dynamics(const Item& section) {
+    if (m_.bodies.empty()) section.fail("inverse dynamics needs bodies");
+    if (m_.wheels.empty()) section.fail("the inverse dynamics of wlx is that of wheeled machines: it needs wheels and a dependent pair");
+    const Fields f(section, {"gravity", "commanded", "pair", "actuated", "weights"});
+    Dynamics d;
+    d.gravity = parameter(f["gravity"], ParameterKind::gravity).name;
+    d.pair = f["pair"].name();
+    const DependentPair* pair = nullptr;
+    for (const auto& p : m_.pairs)
+      if (p.name == d.pair) pair = &p;
+    if (pair == nullptr) f["pair"].fail(fmt::format("no pair '{}' under nonholonomic.pairs", d.pair));
+    for (const Item& c : f["commanded"].list()) {
+      const int k = coordinate_index(c, true);
+      if (std::count(d.commanded.begin(), d.commanded.end(), k)) c.fail("listed twice");
+      if (k == pair->coordinates[0] || k == pair->coordinates[1]) c.fail("a commanded rate cannot be one of the dependent pair");
+      d.commanded.push_back(k);
+    }
+    if (d.commanded.size() != 4) f["commanded"].fail("the runtime's inverse dynamics takes 4 commanded speeds (a fixed-size solve); other counts are not supported yet");
+    for (const Item& c : f["actuated"].list()) {
+      const int k = coordinate_index(c);
+      if (std::count(d.actuated.begin(), d.actuated.end(), k)) c.fail("listed twice");
+      d.actuated.push_back(k);
+    }
+    if (d.actuated.size() != 8) f["actuated"].fail("the runtime's torque split takes 8 actuated joints (a fixed-size solve); other counts are not supported yet");
+    if (auto w = f.optional("weights")) {
+      for (const Item& x : w->list()) {
+        const double v = x.number();
+        if (!(v > 0)) x.fail(fmt::format("a weight must be positive, got {}", v));
+        d.weights.push_back(v);
+      }
+      if (d.weights.size() != d.actuated.size()) w->fail(fmt::format("one weight per actuated joint: {} needed", d.actuated.size()));
+    } else {
+      d.weights.assign(d.actuated.size(), 1.0);
+    }
+    m_.dynamics = std::move(d);
+  }
+
+  void clearance(const Item& section) {
+    const Fields f(section, {"frame", "size"});
+    ClearanceBox box;
+    box.frame = m_.frames[static_cast<std::size_t>(frame_index(f["frame"]))].name;
+    const Vec3 size = vector3(f["size"]);
+    box.size = {size[0], size[1], size[2]};
+    m_.clearance = std::move(box);
+  }
+
+  void nominal(const std::optional<Item>& section) {
+    m_.nominal.assign(static_cast<std::size_t>(m_.input_count), 0.0);
+    if (!section) return;
+    if (!section->is_map()) section->fail("must map input names to values");
+    for (const auto& kv : section->node()) {
+      const Item key(src_, kv.first, section->path(), {});
+      const int k = coordinate_index(key, true);
+      m_.nominal[static_cast<std::size_t>(k)] = section->child(kv.first.Scalar()).number();
+    }
+  }
+
+  Source src_;
+  Model m_;
+  GiNaC::symtab params_, coordinates_;
+  std::map<std::string, std::string> symbol_kind_;
+  std::map<std::string, std::vector<Env>> repeat_;
+  std::vector<std::pair<int, std::string>> joint_users_;
+  std::optional<Item> rows_item_;
+};
+
+// FNV-1a, 64 bits: a stable fingerprint of the model file for the generated banners.
+std::uint64_t fingerprint(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+}  // namespace
+
+Model parse_model(const std::string& text, const std::string& source_name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw ModelFileError(fmt::format("{}:{}:{}: not valid YAML: {}", source_name, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
+  if (!root.IsMap()) throw ModelFileError(fmt::format("{}: the model file must be a YAML map (model:, parameters:, ...)", source_name));
+  Model m = Parser(source_name).parse(root);
+  m.source = fmt::format("{}, fingerprint {:016x}", source_name, fingerprint(text));
+  return m;
+}
+
+Model load_model_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ModelFileError(fmt::format("{}: cannot open the model file", path));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ModelFileError(fmt::format("{}: cannot read the model file", path));
+  const auto slash = path.find_last_of('/');
+  return parse_model(text.str(), slash == std::string::npos ? path : path.substr(slash + 1));
+}
+
+}  // namespace wlx::codegen

@@ -1,0 +1,26 @@
+// Reading a model file (YAML; the format is documented in docs/model-format.md) into a Model.
+//
+// Every error names the place (file:line:column), the field (a path such as
+// `frames[3].chain[1].rx`) and the reason, and nothing of a bad file reaches the derivations:
+// names are unique and valid C++ identifiers, expressions use only the model's own symbols
+// (parsed by GiNaC's parser against a strict table), frames form a tree rooted at K0, units
+// fit the parameter kinds, and the closure has one equation per dependent joint, split into
+// limbs whose blocks of dPhi/ds are square.
+#pragma once
+
+#include "model.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace wlx::codegen {
+
+struct ModelFileError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// `source_name` is what messages and the generated banners call the file.
+Model parse_model(const std::string& text, const std::string& source_name);
+Model load_model_file(const std::string& path);
+
+}  // namespace wlx::codegen
