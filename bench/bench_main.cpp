@@ -204,7 +204,7 @@ void BM_dependent_rates(benchmark::State& st) {
   Coordinates sdot = Coordinates::Zero();
   sdot(gen::coord::roll) = 0.1;
   for (auto _ : st) {
-    solve_dependent_rates(model, s, sdot, kPairA, d);
+    solve_dependent_rates(model, s, sdot, default_pair(), d);
     benchmark::DoNotOptimize(sdot.data());
   }
 }
@@ -215,10 +215,10 @@ void BM_dependent_accelerations(benchmark::State& st) {
   const Coordinates s = assembled_nominal(model);
   Coordinates sdot = Coordinates::Zero();
   sdot(gen::coord::roll) = 0.1;
-  solve_dependent_rates(model, s, sdot, kPairA, d);
+  solve_dependent_rates(model, s, sdot, default_pair(), d);
   Coordinates sddot = Coordinates::Zero();
   for (auto _ : st) {
-    solve_dependent_accelerations(model, s, sdot, sddot, kPairA, d);
+    solve_dependent_accelerations(model, s, sdot, sddot, default_pair(), d);
     benchmark::DoNotOptimize(sddot.data());
   }
 }

@@ -189,9 +189,36 @@ FunctionSpec derive_kinematic_update(const Model& m) {
   return fn;
 }
 
+FunctionSpec derive_clearance(const Model& m) {
+  FunctionSpec fn{"clearance", "clearance.hpp",
+                  "Ground clearance: the height above z = 0 of the lowest corner of the box attached to frame " +
+                      m.clearance->frame + " (centred on its origin, along its axes).",
+                  false, {}};
+  OutputSpec low{"lowest", "double", "height of the lowest corner above the ground, m", "", {}};
+  const Frame& f = m.frame(m.clearance->frame);
+  // Corner offsets +-size/2 along each axis: the lowest corner takes the sign that points down.
+  ex depth = 0;
+  for (int j = 0; j < 3; ++j) depth += GiNaC::abs(f.R(2, j)) * m.clearance->size[static_cast<std::size_t>(j)] / 2;
+  low.elements.emplace_back("*{}", f.r[2] - depth);
+  fn.outputs = {low};
+  return fn;
+}
+
+std::vector<Derivation> derivations(const Model& m) {
+  std::vector<Derivation> all{{"kinematics", derive_kinematics},
+                              {"closure", derive_closure},
+                              {"nonholonomic", derive_nonholonomic},
+                              {"convective", derive_convective},
+                              {"bodies", derive_bodies},
+                              {"kinematic_update", derive_kinematic_update}};
+  if (m.clearance) all.push_back({"clearance", derive_clearance});
+  return all;
+}
+
 std::vector<FunctionSpec> derive_all(const Model& m) {
-  return {derive_kinematics(m), derive_closure(m), derive_nonholonomic(m), derive_convective(m),
-          derive_bodies(m), derive_kinematic_update(m)};
+  std::vector<FunctionSpec> out;
+  for (const auto& d : derivations(m)) out.push_back(d.derive(m));
+  return out;
 }
 
 }  // namespace wlx::codegen

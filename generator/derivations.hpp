@@ -36,7 +36,16 @@ FunctionSpec derive_bodies(const Model& m);
 // subexpressions (the frames' rotations and positions) are computed once per update.
 FunctionSpec derive_kinematic_update(const Model& m);
 
-// All of the above, in that order.
+// The height of the lowest corner of the model's clearance box above the ground (z = 0 of K0).
+FunctionSpec derive_clearance(const Model& m);
+
+// The derivations that apply to a model, in emission order (clearance only with a clearance box).
+struct Derivation {
+  const char* name;
+  FunctionSpec (*derive)(const Model&);
+};
+std::vector<Derivation> derivations(const Model& m);
+// All of them, derived.
 std::vector<FunctionSpec> derive_all(const Model& m);
 
 }  // namespace wlx::codegen

@@ -296,11 +296,19 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
   p += "\n// The one place where the model's numbers live (MODEL.md sections 1 and 6).\nstruct Params {\n";
   for (const auto& par : m.parameters)
     p += fmt::format("  double {} = {};  // {}: {}\n", par.name, literal(par.default_value), par.unit, par.meaning);
-  p += "};\n\nstruct ParamInfo {\n  std::string_view name;\n  double Params::*member;\n  std::string_view unit;\n"
-       "  std::string_view meaning;\n};\n\n";
+  p += "};\n\n"
+       "// What a parameter is, which fixes its unit and the values that make sense for it: length (m, > 0),\n"
+       "// offset (m, any sign), angle (rad), mass (kg, > 0), inertia (kg*m^2, > 0), gravity (m/s^2, >= 0),\n"
+       "// other (any finite value).\n"
+       "enum class ParamKind { length, offset, angle, mass, inertia, gravity, other };\n\n"
+       "struct ParamInfo {\n  std::string_view name;\n  double Params::*member;\n  std::string_view unit;\n"
+       "  std::string_view meaning;\n  ParamKind kind;\n};\n\n";
   p += fmt::format("inline constexpr std::array<ParamInfo, {}> kParamInfo{{{{\n", m.parameters.size());
-  for (const auto& par : m.parameters)
-    p += fmt::format("    {{\"{0}\", &Params::{0}, \"{1}\", \"{2}\"}},\n", par.name, par.unit, par.meaning);
+  for (std::size_t k = 0; k < m.parameters.size(); ++k) {
+    const auto& par = m.parameters[k];
+    p += fmt::format("    {{\"{0}\", &Params::{0}, \"{1}\", \"{2}\", ParamKind::{3}}},\n", par.name, par.unit, par.meaning,
+                     kind_name(m.parameter_kinds[k]));
+  }
   p += "}};\n\n// Mass properties of each body (index with wlx::gen::body::...).\nstruct BodyMassInfo {\n"
        "  double Params::*mass;\n  std::array<double Params::*, 3> inertia;  // principal, about the CoM, body axes\n};\n\n";
   p += fmt::format("inline constexpr std::array<BodyMassInfo, {}> kBodyMass{{{{\n", nb);
@@ -443,9 +451,183 @@ EmittedFile emit_umbrella(const Model& m, const std::vector<FunctionSpec>& fns, 
     a += s.after_cse;
   }
   t += fmt::format("//   {:<14} {:>13} {:>13} {:>13}\n", "total", "", b.total(), a.total());
-  t += "#pragma once\n\n#include \"params.hpp\"\n#include \"types.hpp\"\n";
+  t += "#pragma once\n\n#include \"params.hpp\"\n#include \"structure.hpp\"\n#include \"types.hpp\"\n";
   for (const auto& f : fns) t += fmt::format("#include \"{}\"\n", f.header);
   return {"wlx/gen/all.hpp", t};
+}
+
+namespace {
+
+std::string int_list(const std::vector<int>& v) {
+  std::string s;
+  for (int x : v) s += (s.empty() ? "" : ", ") + std::to_string(x);
+  return s;
+}
+
+// Structural dependencies of one closure row: every coordinate it involves.
+std::set<int> row_coordinates(const Model& m, const ClosureCondition& c) {
+  std::set<int> out;
+  if (c.kind == ClosureCondition::Kind::CoordinateSum) return {c.coordinates.begin(), c.coordinates.end()};
+  for (const auto& j : m.frame(c.frame).joints) out.insert(j.coordinate);
+  if (c.target >= 0) out.insert(c.target);
+  return out;
+}
+
+}  // namespace
+
+EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
+  const auto name_of = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
+  std::string t = banner(m, opt, "Model structure: limbs, wheels, dependent pairs, inverse dynamics, nominal state.");
+  t += "//\n// Everything the generic runtime needs to know about this model's structure, so that it never\n"
+       "// names a coordinate, frame or parameter itself. Indices are into s (coord::), the frames (frame::),\n"
+       "// the closure rows (kClosureNames) and the bodies (body::).\n";
+  t += "#pragma once\n\n#include <array>\n#include <string_view>\n\n#include \"params.hpp\"\n#include \"types.hpp\"\n\n" +
+       namespace_open(opt) + "\n";
+
+  // Frames: parents, so that a drawing can connect them.
+  t += "// Parent of each frame of interest (-1: the ground frame K0), in frame:: order.\n";
+  std::vector<int> parents;
+  for (const auto& f : m.frames) parents.push_back(f.parent == "K0" ? -1 : m.frame_index(f.parent));
+  t += fmt::format("inline constexpr std::array<int, {}> kFrameParent{{{{{}}}}};\n\n", parents.size(), int_list(parents));
+
+  // Limbs.
+  std::size_t max_size = 1, max_inputs = 1;
+  std::vector<std::vector<int>> limb_inputs;
+  for (const auto& l : m.limbs) {
+    max_size = std::max(max_size, l.rows.size());
+    std::set<int> inputs;
+    for (int r : l.rows)
+      for (int k : row_coordinates(m, m.closure[static_cast<std::size_t>(r)]))
+        if (k < m.input_count) inputs.insert(k);
+    limb_inputs.emplace_back(inputs.begin(), inputs.end());
+    max_inputs = std::max(max_inputs, inputs.size());
+  }
+  const auto padded = [](std::vector<int> v, std::size_t n) {
+    v.resize(n, -1);
+    return v;
+  };
+  t += fmt::format(
+      "// Limbs: closure rows and the dependent joints they determine (a square diagonal block of dPhi/ds;\n"
+      "// the rows of one limb involve no other limb's joints), and the inputs those rows read.\n"
+      "inline constexpr int kLimbCount = {};\n"
+      "inline constexpr int kMaxLimbSize = {};\n"
+      "inline constexpr int kMaxLimbInputs = {};\n"
+      "struct LimbInfo {{\n"
+      "  std::string_view name;\n"
+      "  std::string_view title;  // for messages\n"
+      "  int size;                // rows = joints\n"
+      "  std::array<int, kMaxLimbSize> rows;    // closure rows (-1 past size)\n"
+      "  std::array<int, kMaxLimbSize> joints;  // dependent coordinates, in the order of the rows' unknowns\n"
+      "  int input_count;\n"
+      "  std::array<int, kMaxLimbInputs> inputs;  // the input coordinates the rows read\n"
+      "}};\n",
+      m.limbs.size(), max_size, max_inputs);
+  t += fmt::format("inline constexpr std::array<LimbInfo, {}> kLimbs{{{{\n", m.limbs.size());
+  for (std::size_t k = 0; k < m.limbs.size(); ++k) {
+    const auto& l = m.limbs[k];
+    std::string joints;
+    for (int j : l.joints) joints += (joints.empty() ? "" : ", ") + name_of(j);
+    t += fmt::format("    {{\"{}\", \"{}\", {}, {{{{{}}}}}, {{{{{}}}}}, {}, {{{{{}}}}}}},  // {}\n", l.name, l.title, l.rows.size(),
+                     int_list(padded(l.rows, max_size)), int_list(padded(l.joints, max_size)), limb_inputs[k].size(),
+                     int_list(padded(limb_inputs[k], max_inputs)), joints);
+  }
+  t += "}};\n";
+  t += "namespace limb {\n";
+  for (std::size_t k = 0; k < m.limbs.size(); ++k) t += fmt::format("inline constexpr int {} = {};\n", m.limbs[k].name, k);
+  t += "}  // namespace limb\n\n";
+
+  // Wheels.
+  t += "// Wheels rolling without sliding sideways: contact frame, the input holding the ground level\n"
+       "// under the wheel, and the rolling radius.\n"
+       "struct WheelInfo {\n  std::string_view name;\n  int contact_frame;\n  int ground;\n  double Params::*radius;\n"
+       "  int forward_axis;  // of the contact frame: 0 x, 1 y, 2 z\n  int lateral_axis;\n};\n";
+  t += fmt::format("inline constexpr std::array<WheelInfo, {}> kWheels{{{{\n", m.wheels.size());
+  for (const auto& w : m.wheels)
+    t += fmt::format("    {{\"{}\", {}, {}, &Params::{}, {}, {}}},  // contact {}, ground {}\n", w.name, m.frame_index(w.contact),
+                     w.ground, w.radius, static_cast<int>(w.forward), static_cast<int>(w.lateral), w.contact, name_of(w.ground));
+  t += "}};\n\n";
+
+  // Dependent pairs.
+  if (!m.wheels.empty()) {
+    t += fmt::format(
+        "// The input rates that may be chosen as the dependent rates of the wheel constraints, and the\n"
+        "// named choices.\n"
+        "inline constexpr std::array<int, {}> kPairCandidates{{{{{}}}}};\n"
+        "struct PairInfo {{\n  std::string_view name;\n  std::array<int, {}> coordinates;\n}};\n",
+        m.pair_candidates.size(), int_list(m.pair_candidates), m.wheels.size());
+    t += fmt::format("inline constexpr std::array<PairInfo, {}> kPairs{{{{\n", m.pairs.size());
+    int default_pair = 0;
+    for (std::size_t k = 0; k < m.pairs.size(); ++k) {
+      const auto& p = m.pairs[k];
+      if (p.name == m.default_pair) default_pair = static_cast<int>(k);
+      t += fmt::format("    {{\"{}\", {{{{{}, {}}}}}}},  // ({}', {}')\n", p.name, p.coordinates[0], p.coordinates[1],
+                       name_of(p.coordinates[0]), name_of(p.coordinates[1]));
+    }
+    t += fmt::format("}}}};\ninline constexpr int kDefaultPair = {};  // {}\n\n", default_pair, m.default_pair);
+  }
+
+  // Inverse dynamics.
+  if (m.dynamics) {
+    const Dynamics& d = *m.dynamics;
+    int pair = 0;
+    for (std::size_t k = 0; k < m.pairs.size(); ++k)
+      if (m.pairs[k].name == d.pair) pair = static_cast<int>(k);
+    std::string commanded, actuated, weights;
+    for (int k : d.commanded) commanded += (commanded.empty() ? "" : ", ") + name_of(k);
+    for (int k : d.actuated) actuated += (actuated.empty() ? "" : ", ") + name_of(k);
+    for (double w : d.weights) weights += (weights.empty() ? "" : ", ") + literal(w);
+    t += fmt::format(
+        "// Inverse dynamics: the commanded speeds u ({}), the dependent pair, the actuated joints\n"
+        "// ({}), their default weights, and gravity (along -z of K0).\n"
+        "inline constexpr bool kHasDynamics = true;\n"
+        "inline constexpr std::array<int, {}> kCommanded{{{{{}}}}};\n"
+        "inline constexpr int kDynamicsPair = {};  // {}\n"
+        "inline constexpr std::array<int, {}> kActuated{{{{{}}}}};\n"
+        "inline constexpr std::array<double, {}> kDefaultWeights{{{{{}}}}};\n"
+        "inline constexpr double Params::*kGravity = &Params::{};\n\n",
+        commanded, actuated, d.commanded.size(), int_list(d.commanded), pair, d.pair, d.actuated.size(),
+        int_list(d.actuated), d.weights.size(), weights, d.gravity);
+  } else {
+    t += "inline constexpr bool kHasDynamics = false;\n\n";
+  }
+
+  // Body Jacobian columns.
+  const int n = static_cast<int>(m.coordinates.size());
+  std::vector<std::vector<int>> columns;
+  std::size_t max_columns = 1;
+  for (const auto& b : m.bodies) {
+    const auto Lv = linear_jacobian(b.com_frame, n);
+    const auto Lw = angular_jacobian(b.com_frame, n);
+    std::vector<int> cols;
+    for (int j = 0; j < n; ++j) {
+      bool nonzero = false;
+      for (int i = 0; i < 3; ++i)
+        nonzero = nonzero || !Lv[static_cast<std::size_t>(j)][i].is_zero() || !Lw[static_cast<std::size_t>(j)][i].is_zero();
+      if (nonzero) cols.push_back(j);
+    }
+    max_columns = std::max(max_columns, cols.size());
+    columns.push_back(std::move(cols));
+  }
+  t += fmt::format(
+      "// Per body, the coordinates its velocity Jacobians Jv, Jw depend on: every other column is a\n"
+      "// structural zero (bodies() never writes it).\n"
+      "inline constexpr int kMaxBodyColumns = {};\n"
+      "struct BodyColumns {{\n  int count;\n  std::array<int, kMaxBodyColumns> index;\n}};\n",
+      max_columns);
+  t += fmt::format("inline constexpr std::array<BodyColumns, {}> kBodyColumns{{{{\n", m.bodies.size());
+  for (std::size_t k = 0; k < m.bodies.size(); ++k)
+    t += fmt::format("    {{{}, {{{{{}}}}}}},  // {}\n", columns[k].size(), int_list(padded(columns[k], max_columns)), m.bodies[k].name);
+  t += "}};\n\n";
+
+  // Nominal state.
+  std::string nominal;
+  for (double v : m.nominal) nominal += (nominal.empty() ? "" : ", ") + literal(v);
+  t += fmt::format("// The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).\n"
+                   "inline constexpr std::array<double, {}> kNominalInputs{{{{{}}}}};\n\n",
+                   m.nominal.size(), nominal);
+  t += fmt::format("inline constexpr bool kHasClearance = {};\n\n", m.clearance ? "true" : "false");
+  t += namespace_close(opt);
+  return {"wlx/gen/structure.hpp", t};
 }
 
 }  // namespace wlx::codegen

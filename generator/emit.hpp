@@ -41,6 +41,9 @@ std::string literal(double v);
 EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt);
 // Headers describing the model itself: parameters and coordinate/frame/body names and types.
 std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& opt);
+// structure.hpp: every fact about the model's structure the runtime needs, as constexpr tables
+// (limbs, wheels, dependent pairs, inverse-dynamics set-up, body Jacobian columns, nominal state).
+EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt);
 // One header per derived function; `stats` receives the numbers written into its banner.
 EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOptions& opt, FunctionStats& stats);
 // The umbrella header including everything, with the operation-count table.

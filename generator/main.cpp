@@ -81,13 +81,13 @@ int main(int argc, char** argv) {
 
     std::vector<EmittedFile> files = emit_model_headers(model, opt);
     files.push_back(emit_trig_header(model, opt));
+    files.push_back(emit_structure_header(model, opt));
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<FunctionSpec> fns;
     std::vector<FunctionStats> stats;
-    for (auto derive : {derive_kinematics, derive_closure, derive_nonholonomic, derive_convective, derive_bodies,
-                        derive_kinematic_update}) {
+    for (const Derivation& derivation : derivations(model)) {
       const auto d0 = std::chrono::steady_clock::now();
-      fns.push_back(derive(model));
+      fns.push_back(derivation.derive(model));
       const double derive_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
       FunctionStats s;
       files.push_back(emit_function(model, fns.back(), opt, s));

@@ -28,17 +28,18 @@ void inverse_dynamics(const Model& model, const Coordinates& s, const Vector4& u
   const Params& p = model.params();
   out.sdot.setZero();
   for (int k = 0; k < 4; ++k) out.sdot(kCommandedSpeeds[static_cast<std::size_t>(k)]) = u(k);
-  solve_dependent_rates(model, s, out.sdot, kPairA, d, options);
-  out.T = rate_basis(kCommandedSpeeds, kPairA, d);
+  const DependentPair pair = dynamics_pair();
+  solve_dependent_rates(model, s, out.sdot, pair, d, options);
+  out.T = rate_basis(kCommandedSpeeds, pair, d);
   Coordinates bias = Coordinates::Zero();  // s'' with u' = 0
-  solve_dependent_accelerations(model, s, out.sdot, bias, kPairA, d);
+  solve_dependent_accelerations(model, s, out.sdot, bias, pair, d);
   out.sddot = out.T * u_dot + bias;
   gen::bodies(s, out.sdot, p, &d.body_com, &d.body_rotations, &d.body_Jv, &d.body_Jw, &d.body_Jv_dot_sdot,
               &d.body_Jw_dot_sdot, false);
   out.M.setZero();
   out.b.setZero();
   out.Q_gravity.setZero();
-  const Eigen::Vector3d gravity(0, 0, -p.g);
+  const Eigen::Vector3d gravity(0, 0, -(p.*gen::kGravity));
   for (int i = 0; i < gen::kBodyCount; ++i) {
     const auto& Jv = d.body_Jv[static_cast<std::size_t>(i)];
     const auto& Jw = d.body_Jw[static_cast<std::size_t>(i)];
@@ -47,7 +48,9 @@ void inverse_dynamics(const Model& model, const Coordinates& s, const Vector4& u
     // Partial velocities dv/du = Jv T and domega/du = Jw T over the body's non-zero columns only.
     Eigen::Matrix<double, 3, 4> A = Eigen::Matrix<double, 3, 4>::Zero();
     Eigen::Matrix<double, 3, 4> B = Eigen::Matrix<double, 3, 4>::Zero();
-    for (int j : model.body_columns(i)) {
+    const gen::BodyColumns& columns = gen::kBodyColumns[static_cast<std::size_t>(i)];
+    for (int c = 0; c < columns.count; ++c) {
+      const int j = columns.index[static_cast<std::size_t>(c)];
       A.noalias() += Jv.col(j) * out.T.row(j);
       B.noalias() += Jw.col(j) * out.T.row(j);
     }
@@ -66,7 +69,7 @@ double potential_energy(const Model& model, const Coordinates& s, Data& d) {
   const Params& p = model.params();
   gen::bodies(s, Coordinates::Zero(), p, &d.body_com, nullptr, nullptr, nullptr, nullptr, nullptr, false);
   double V = 0;
-  for (int i = 0; i < gen::kBodyCount; ++i) V += mass(p, i) * p.g * d.body_com(2, i);
+  for (int i = 0; i < gen::kBodyCount; ++i) V += mass(p, i) * (p.*gen::kGravity) * d.body_com(2, i);
   return V;
 }
 
@@ -135,9 +138,13 @@ Vector8 distribute_torques(const ActuatorJacobian& J_beta, const Vector4& Qstar,
   qr.setThreshold(1e-13);  // relative to the largest pivot: only a real rank loss, not ID-3's 1e6 conditioning
   qr.compute(At);
   if (qr.rank() < 4)
+  {
+    std::string u;
+    for (int k : kCommandedSpeeds) u += fmt::format("{}{}'", u.empty() ? "" : ", ", gen::kCoordinateNames[static_cast<std::size_t>(k)]);
     throw Error("J_beta", fmt::format("the actuator Jacobian has rank {} < 4 with {}: the 8 actuators cannot produce "
-                                      "every generalized force on u = [z_C', x_C', roll', pitch'] in this pose",
-                                      qr.rank(), weighting.label()));
+                                      "every generalized force on u = [{}] in this pose",
+                                      qr.rank(), weighting.label(), u));
+  }
   const Eigen::Matrix4d R = qr.matrixR().topLeftCorner<4, 4>().triangularView<Eigen::Upper>();
   const Vector4 y = R.transpose().triangularView<Eigen::Lower>().solve(qr.colsPermutation().transpose() * Qstar);
   Vector8 x = Vector8::Zero();

@@ -14,11 +14,15 @@
 
 namespace wlx {
 
-inline constexpr std::array<int, 4> kCommandedSpeeds = {gen::coord::z_C, gen::coord::x_C, gen::coord::roll,
-                                                        gen::coord::pitch};
-inline constexpr std::array<int, 8> kActuatedJoints = {gen::coord::psi_l2,   gen::coord::psi_l3, gen::coord::psi_l4,
-                                                       gen::coord::psi_r2,   gen::coord::psi_r3, gen::coord::psi_r4,
-                                                       gen::coord::theta_l6, gen::coord::theta_r6};
+static_assert(gen::kHasDynamics, "the model file has no dynamics section");
+static_assert(gen::kHasClearance, "the model file has no clearance box");
+static_assert(gen::kCommanded.size() == 4 && gen::kActuated.size() == 8,
+              "the inverse dynamics is written for 4 commanded speeds and 8 actuators (fixed-size solves)");
+// The commanded speeds u, the actuated joints and the pair the wheels make dependent: the model
+// file's dynamics section.
+inline constexpr std::array<int, 4> kCommandedSpeeds = gen::kCommanded;
+inline constexpr std::array<int, 8> kActuatedJoints = gen::kActuated;
+inline DependentPair dynamics_pair() noexcept { return {gen::kPairs[gen::kDynamicsPair].coordinates}; }
 
 using Vector4 = Eigen::Vector4d;
 using Vector8 = Eigen::Matrix<double, 8, 1>;
@@ -61,7 +65,8 @@ struct Weighting {
   static Weighting matrix_of(const Eigen::Matrix<double, 8, 8>& W);
 };
 
-inline const Vector8 kStrongWeakDiagonal = (Vector8() << 0.01, 100, 1, 0.01, 100, 1, 0.01, 0.01).finished();
+// The model file's default weights (for the excavator, thesis 6.3.3 weighting 1).
+inline const Vector8 kStrongWeakDiagonal = Eigen::Map<const Vector8>(gen::kDefaultWeights.data());
 
 // tau = W^-1 J_beta (J_beta^T W^-1 J_beta)^-1 Q*, computed as the minimum-norm solution of the
 // row-scaled system J_beta^T S x = Q*, tau = S x with S S^T = W^-1, which stays accurate where

@@ -209,24 +209,13 @@ void solve_wheel(const Model& model, const CabinPose& cabin, Limb limb, int bran
 }  // namespace
 
 LimbBlock limb_block(Limb limb) noexcept {
-  switch (limb) {
-    case Limb::leg_l: return {0, 3, {c::psi_l2, c::psi_l3, c::psi_l4, -1}};
-    case Limb::leg_r: return {3, 3, {c::psi_r2, c::psi_r3, c::psi_r4, -1}};
-    case Limb::wheel_l: return {6, 4, {c::theta_l2, c::theta_l3, c::theta_l4, c::theta_l6}};
-    case Limb::wheel_r: return {10, 4, {c::theta_r2, c::theta_r3, c::theta_r4, c::theta_r6}};
-  }
-  return {};
+  const gen::LimbInfo& info = gen::kLimbs[static_cast<std::size_t>(limb)];
+  LimbBlock b{info.rows[0], info.size, {-1, -1, -1, -1}};
+  for (int j = 0; j < info.size; ++j) b.joints[static_cast<std::size_t>(j)] = info.joints[static_cast<std::size_t>(j)];
+  return b;
 }
 
-std::string_view limb_name(Limb limb) noexcept {
-  switch (limb) {
-    case Limb::leg_l: return "left leg";
-    case Limb::leg_r: return "right leg";
-    case Limb::wheel_l: return "left wheel";
-    case Limb::wheel_r: return "right wheel";
-  }
-  return "limb";
-}
+std::string_view limb_name(Limb limb) noexcept { return gen::kLimbs[static_cast<std::size_t>(limb)].title; }
 
 namespace {
 

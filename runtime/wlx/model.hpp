@@ -27,14 +27,10 @@ class Model {
 
   const Params& params() const noexcept { return params_; }
   double total_mass() const noexcept { return total_mass_; }
-  // The coordinates each body's velocity Jacobians depend on (the rest are structural zeros of
-  // the generated code), so the dynamics can skip them.
-  const std::vector<int>& body_columns(int body) const { return body_columns_[static_cast<std::size_t>(body)]; }
 
  private:
   Params params_;
   double total_mass_ = 0;
-  std::array<std::vector<int>, gen::kBodyCount> body_columns_;
 };
 
 // Workspace for one evaluation thread. Fixed-size members only: no heap allocation.
@@ -83,8 +79,7 @@ int frame_index(std::string_view name) noexcept;
 // A pointer to the parameter of that name, or nullptr.
 double* find_param(Params& params, std::string_view name) noexcept;
 
-// The common initial state of the thesis scenarios (MODEL.md section 8): inputs set, dependent
-// joints zero (solve them with the IK).
+// The model's nominal inputs (its file's `nominal`), dependent joints zero (solve them with the IK).
 Coordinates nominal_inputs();
 
 }  // namespace wlx

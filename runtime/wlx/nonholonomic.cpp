@@ -16,8 +16,8 @@ constexpr int kNq = kInputCount;
 
 std::string_view name_of(int coordinate) { return gen::kCoordinateNames[static_cast<std::size_t>(coordinate)]; }
 
-bool is_wheel_coupled(int coordinate) {
-  for (int k : kWheelCoupledInputs)
+bool is_pair_candidate(int coordinate) {
+  for (int k : gen::kPairCandidates)
     if (k == coordinate) return true;
   return false;
 }
@@ -80,18 +80,27 @@ std::string DependentPair::label() const {
 
 DependentPair dependent_pair(std::string_view first, std::string_view second, const std::string& field) {
   std::string valid;
-  for (int k : kWheelCoupledInputs) valid += fmt::format("{}{}", valid.empty() ? "" : ", ", name_of(k));
+  for (int k : gen::kPairCandidates) valid += fmt::format("{}{}", valid.empty() ? "" : ", ", name_of(k));
   DependentPair pair;
   const std::string_view names[2] = {first, second};
   for (int i = 0; i < 2; ++i) {
     const int k = coordinate_index(names[i]);
-    if (k < 0 || !is_wheel_coupled(k))
+    if (k < 0 || !is_pair_candidate(k))
       throw Error(field, fmt::format("'{}' cannot be a dependent rate: choose 2 of {}", names[i], valid));
     pair.index[static_cast<std::size_t>(i)] = k;
   }
   if (pair.index[0] == pair.index[1])
     throw Error(field, fmt::format("the two dependent rates must differ, got '{}' twice", first));
   return pair;
+}
+
+DependentPair named_pair(std::string_view name, const std::string& field) {
+  std::string valid;
+  for (const auto& p : gen::kPairs) {
+    if (p.name == name) return {p.coordinates};
+    valid += fmt::format("{}{}", valid.empty() ? "" : ", ", p.name);
+  }
+  throw Error(field, fmt::format("the model names no dependent pair '{}'; its pairs are {}", name, valid));
 }
 
 void solve_dependent_rates(const Model& model, const Coordinates& s, Coordinates& sdot, const DependentPair& pair,
@@ -167,13 +176,13 @@ Eigen::Matrix<double, 3, 2> contact_velocities(const Model& model, const Coordin
                                                Data& d) {
   gen::kinematics(s, model.params(), nullptr, &d.frame_rotations);
   gen::nonholonomic(s, model.params(), &d.C, &d.spin, false);
-  const Eigen::Vector2d forward = model.params().w * (d.spin * sdot), sideways = d.C * sdot;
+  const Eigen::Vector2d spin = d.spin * sdot, sideways = d.C * sdot;
   Eigen::Matrix<double, 3, 2> v;
-  const int frames[2] = {gen::frame::W_l, gen::frame::W_r};
-  const int levels[2] = {gen::coord::z_Wl, gen::coord::z_Wr};
   for (int w = 0; w < 2; ++w) {
-    const Eigen::Matrix3d& R = d.frame_rotations[static_cast<std::size_t>(frames[w])];
-    v.col(w) = R.col(0) * forward(w) + R.col(1) * sideways(w) + Eigen::Vector3d::UnitZ() * sdot(levels[w]);
+    const gen::WheelInfo& wheel = gen::kWheels[static_cast<std::size_t>(w)];
+    const Eigen::Matrix3d& R = d.frame_rotations[static_cast<std::size_t>(wheel.contact_frame)];
+    v.col(w) = R.col(wheel.forward_axis) * (model.params().*wheel.radius * spin(w)) + R.col(wheel.lateral_axis) * sideways(w) +
+               Eigen::Vector3d::UnitZ() * sdot(wheel.ground);
   }
   return v;
 }

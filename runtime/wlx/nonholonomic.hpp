@@ -16,19 +16,19 @@
 
 namespace wlx {
 
-// The 8 velocities the wheel constraints involve (MODEL.md section 5); any 2 may be dependent.
-inline constexpr std::array<int, 8> kWheelCoupledInputs = {gen::coord::x_C,   gen::coord::y_C,      gen::coord::z_C,
-                                                           gen::coord::yaw,   gen::coord::pitch,    gen::coord::roll,
-                                                           gen::coord::theta_l5, gen::coord::theta_r5};
+static_assert(gen::kWheelCount == 2, "the non-holonomic solve is written for two wheels (a 2 x 2 J_beta)");
 
+// The two input rates that the wheel constraints determine. The model file names the candidates
+// (gen::kPairCandidates) and some pairs (gen::kPairs).
 struct DependentPair {
-  std::array<int, 2> index{gen::coord::y_C, gen::coord::yaw};  // coordinate indices; default: pair A
+  std::array<int, 2> index = gen::kPairs[gen::kDefaultPair].coordinates;  // coordinate indices
   std::string label() const;  // "(y_C', yaw')"
 };
-// Validates two names of the 8 (distinct); throws wlx::Error naming `field`.
+// Validates two names of the candidates (distinct); throws wlx::Error naming `field`.
 DependentPair dependent_pair(std::string_view first, std::string_view second, const std::string& field = "dependent");
-inline const DependentPair kPairA{{gen::coord::y_C, gen::coord::yaw}};
-inline const DependentPair kPairB{{gen::coord::theta_l5, gen::coord::theta_r5}};
+// A pair the model file names (e.g. "A"); throws wlx::Error naming `field` when there is none.
+DependentPair named_pair(std::string_view name, const std::string& field = "dependent");
+inline DependentPair default_pair() noexcept { return {}; }
 
 struct NonholonomicOptions {
   // J_beta counts as singular above this condition number. The thesis scenarios reach 2.7e7

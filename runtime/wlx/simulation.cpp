@@ -139,14 +139,19 @@ void Scenario::validate() const {
                   fmt::format("{} is a dependent rate in this scenario (pair {}): it is computed, not commanded",
                               gen::kCoordinateNames[static_cast<std::size_t>(k)], pair.label()));
   if (weighting) {
-    if (pair.index != kPairA.index)
-      throw Error("dependent", fmt::format("an inverse-dynamics run needs the dependent pair (y_C', yaw') (MODEL.md "
-                                           "section 7), got {}",
-                                           pair.label()));
+    if (pair.index != dynamics_pair().index)
+      throw Error("dependent", fmt::format("an inverse-dynamics run needs the dependent pair {} (the model's dynamics "
+                                           "section), got {}",
+                                           dynamics_pair().label(), pair.label()));
     for (int k = 0; k < kInputCount; ++k)
-      if (rates(k) != 0 && std::find(kCommandedSpeeds.begin(), kCommandedSpeeds.end(), k) == kCommandedSpeeds.end())
+      if (rates(k) != 0 && std::find(kCommandedSpeeds.begin(), kCommandedSpeeds.end(), k) == kCommandedSpeeds.end()) {
+        std::string commanded;
+        for (std::size_t i = 0; i < kCommandedSpeeds.size(); ++i)
+          commanded += fmt::format("{}{}", i == 0 ? "" : i + 1 == kCommandedSpeeds.size() ? " and " : ", ",
+                                   gen::kCoordinateNames[static_cast<std::size_t>(kCommandedSpeeds[i])]);
         throw Error(fmt::format("rates.{}", gen::kCoordinateNames[static_cast<std::size_t>(k)]),
-                    "an inverse-dynamics run commands only z_C, x_C, roll and pitch; every other input is constant");
+                    fmt::format("an inverse-dynamics run commands only {}; every other input is constant", commanded));
+      }
   }
   for (int k = 0; k < kInputCount; ++k) {
     const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
@@ -156,10 +161,9 @@ void Scenario::validate() const {
 }
 
 double cabin_clearance(const Params& p, const Coordinates& s) {
-  namespace c = gen::coord;
-  // Row 2 of R_C: the z components of the cabin axes.
-  const double sp = std::sin(s(c::pitch)), cp = std::cos(s(c::pitch)), sr = std::sin(s(c::roll)), cr = std::cos(s(c::roll));
-  return s(c::z_C) - (std::abs(sp) * p.cxd / 2 + std::abs(cp * sr) * p.cyd / 2 + std::abs(cp * cr) * p.cabin_height / 2);
+  double lowest = 0;
+  gen::clearance(s, p, &lowest);
+  return lowest;
 }
 
 Trajectory simulate(const Scenario& sc, const Progress& progress) {
@@ -194,8 +198,10 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       smp.sdot = f.sdot;
       smp.cond_J_beta = data.cond_J_beta;
       forward_kinematics(model, f.s, data);
-      smp.contacts << data.frame_positions(0, gen::frame::W_l), data.frame_positions(1, gen::frame::W_l),
-          data.frame_positions(0, gen::frame::W_r), data.frame_positions(1, gen::frame::W_r);
+      for (int w = 0; w < 2; ++w) {
+        const int f = gen::kWheels[static_cast<std::size_t>(w)].contact_frame;
+        smp.contacts.segment<2>(2 * w) = data.frame_positions.col(f).head<2>();
+      }
       smp.contact_velocity = contact_velocities(model, f.s, f.sdot, data);  // also fills data.C, data.spin
       smp.nh_residual = data.C * f.sdot;
       smp.spin_rate = data.spin * f.sdot;

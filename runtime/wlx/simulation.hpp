@@ -30,7 +30,7 @@ struct Scenario {
   Params params;
   Coordinates initial = nominal_inputs();                 // inputs; dependents are solved
   Eigen::Matrix<double, kInputCount, 1> rates = Eigen::Matrix<double, kInputCount, 1>::Zero();  // commanded
-  DependentPair pair = kPairA;
+  DependentPair pair = default_pair();
   double duration = 0;  // s
   double dt = 1e-3;     // s
   Integrator integrator = Integrator::rk4;

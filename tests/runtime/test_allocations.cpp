@@ -63,8 +63,8 @@ TEST_CASE("allocations: kinematic update, dependent rates and accelerations, inv
     kinematic_update(model, s, *data);
     sdot.setZero();
     sdot(gen::coord::roll) = 0.1;
-    solve_dependent_rates(model, s, sdot, kPairA, *data);
-    solve_dependent_accelerations(model, s, sdot, sddot, kPairA, *data);
+    solve_dependent_rates(model, s, sdot, named_pair("A"), *data);
+    solve_dependent_accelerations(model, s, sdot, sddot, named_pair("A"), *data);
     inverse_dynamics(model, s, Vector4(0, 3, 0.1, 0), Vector4::Zero(), *data, terms);
     const Vector8 tau1 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
     const Vector8 tau2 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::contribution());

@@ -29,7 +29,7 @@ TEST_CASE("nonholonomic: the thesis' nominal figures: cond(J_beta) ~ 7e2 and yaw
   const Coordinates s = assembled(nominal_inputs());
   Coordinates sdot = Coordinates::Zero();
   sdot(c::theta_l5) = 0.5 * kDeg;
-  solve_dependent_rates(model, s, sdot, kPairA, d);
+  solve_dependent_rates(model, s, sdot, named_pair("A"), d);
   MESSAGE("cond(J_beta) = " << d.cond_J_beta << ", yaw' = " << sdot(c::yaw) / kDeg << " deg/s");
   CHECK(d.cond_J_beta == doctest::Approx(7e2).epsilon(0.1));
   CHECK(sdot(c::yaw) / kDeg == doctest::Approx(34).epsilon(0.03));
@@ -49,7 +49,7 @@ TEST_CASE("nonholonomic: both wheels level under a level cabin: J_beta singular,
   Coordinates sdot = Coordinates::Zero();
   sdot(c::roll) = 0.1;
   try {
-    solve_dependent_rates(model, s, sdot, kPairA, d);
+    solve_dependent_rates(model, s, sdot, named_pair("A"), d);
     FAIL("no error for a singular J_beta");
   } catch (const Error& e) {
     const std::string m = e.what();
@@ -62,7 +62,7 @@ TEST_CASE("nonholonomic: both wheels level under a level cabin: J_beta singular,
   NonholonomicOptions strict;
   strict.max_condition = 100;
   const Coordinates nominal = assembled(nominal_inputs());
-  CHECK_THROWS_AS(solve_dependent_rates(model, nominal, sdot, kPairA, d, strict), Error);
+  CHECK_THROWS_AS(solve_dependent_rates(model, nominal, sdot, named_pair("A"), d, strict), Error);
 }
 
 TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are errors") {
@@ -70,12 +70,12 @@ TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are e
   Data d;
   const Coordinates s = assembled(nominal_inputs());
   int regular = 0, singular = 0;
-  for (std::size_t i = 0; i < kWheelCoupledInputs.size(); ++i)
-    for (std::size_t j = i + 1; j < kWheelCoupledInputs.size(); ++j) {
-      const DependentPair pair{{kWheelCoupledInputs[i], kWheelCoupledInputs[j]}};
+  for (std::size_t i = 0; i < gen::kPairCandidates.size(); ++i)
+    for (std::size_t j = i + 1; j < gen::kPairCandidates.size(); ++j) {
+      const DependentPair pair{{gen::kPairCandidates[i], gen::kPairCandidates[j]}};
       CAPTURE(pair.label());
       Coordinates sdot = Coordinates::Zero();
-      for (int k : kWheelCoupledInputs) sdot(k) = 0.01 * (k + 1);  // some commanded motion
+      for (int k : gen::kPairCandidates) sdot(k) = 0.01 * (k + 1);  // some commanded motion
       sdot(pair.index[0]) = sdot(pair.index[1]) = 0;
       const Coordinates commanded = sdot;
       try {
@@ -87,7 +87,7 @@ TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are e
       }
       ++regular;
       CHECK(sideways_velocity(model, s, sdot, d).cwiseAbs().maxCoeff() <= 1e-13 * std::max(1.0, d.cond_J_beta / 1e3));
-      for (int k : kWheelCoupledInputs)
+      for (int k : gen::kPairCandidates)
         if (k != pair.index[0] && k != pair.index[1]) CHECK(sdot(k) == commanded(k));
     }
   MESSAGE(regular << " of 28 pairs regular at the nominal pose, " << singular << " singular");
@@ -96,7 +96,7 @@ TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are e
 }
 
 TEST_CASE("nonholonomic: pair names are validated") {
-  CHECK(dependent_pair("theta_l5", "theta_r5").index == kPairB.index);
+  CHECK(dependent_pair("theta_l5", "theta_r5").index == named_pair("B").index);
   const auto message = [](const char* a, const char* b) {
     try {
       dependent_pair(a, b);
@@ -155,7 +155,7 @@ TEST_CASE("nonholonomic: a limb at a singular pose is named") {
   Coordinates sdot = Coordinates::Zero();
   sdot(c::roll) = 0.1;
   try {
-    solve_dependent_rates(model, s, sdot, kPairA, d);
+    solve_dependent_rates(model, s, sdot, named_pair("A"), d);
     FAIL("no error at a straight leg");
   } catch (const Error& e) {
     CHECK(e.field() == "left leg");

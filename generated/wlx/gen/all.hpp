@@ -13,10 +13,12 @@
 //   convective               353         62310          1867
 //   bodies                   315         58902          2163
 //   kinematic_update           194         48373          1304
-//   total                               230240          7481
+//   clearance                  0            19            20
+//   total                               230259          7501
 #pragma once
 
 #include "params.hpp"
+#include "structure.hpp"
 #include "types.hpp"
 #include "kinematics.hpp"
 #include "closure.hpp"
@@ -24,3 +26,4 @@
 #include "convective.hpp"
 #include "bodies.hpp"
 #include "kinematic_update.hpp"
+#include "clearance.hpp"

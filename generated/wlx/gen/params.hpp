@@ -51,50 +51,56 @@ struct Params {
   double g = 9.81;  // m/s^2: gravity, along -z of K0
 };
 
+// What a parameter is, which fixes its unit and the values that make sense for it: length (m, > 0),
+// offset (m, any sign), angle (rad), mass (kg, > 0), inertia (kg*m^2, > 0), gravity (m/s^2, >= 0),
+// other (any finite value).
+enum class ParamKind { length, offset, angle, mass, inertia, gravity, other };
+
 struct ParamInfo {
   std::string_view name;
   double Params::*member;
   std::string_view unit;
   std::string_view meaning;
+  ParamKind kind;
 };
 
 inline constexpr std::array<ParamInfo, 36> kParamInfo{{
-    {"cxd", &Params::cxd, "m", "cabin length between front hips and rear hips"},
-    {"cyd", &Params::cyd, "m", "cabin width between left and right hips"},
-    {"thighD", &Params::thighD, "m", "hip-to-knee length of a leg"},
-    {"legD", &Params::legD, "m", "knee-to-foot length of a leg"},
-    {"wl", &Params::wl, "m", "wheel lever length"},
-    {"w", &Params::w, "m", "wheel radius: hub to contact point"},
-    {"cabin_height", &Params::cabin_height, "m", "height of the cabin block centred on the cabin frame"},
-    {"m_M1", &Params::m_M1, "kg", "mass of the cabin"},
-    {"Ixx_M1", &Params::Ixx_M1, "kg*m^2", "inertia of the cabin about its CoM, body x"},
-    {"Iyy_M1", &Params::Iyy_M1, "kg*m^2", "inertia of the cabin about its CoM, body y"},
-    {"Izz_M1", &Params::Izz_M1, "kg*m^2", "inertia of the cabin about its CoM, body z"},
-    {"m_M2", &Params::m_M2, "kg", "mass of the right thigh"},
-    {"Ixx_M2", &Params::Ixx_M2, "kg*m^2", "inertia of the right thigh about its CoM, body x"},
-    {"Iyy_M2", &Params::Iyy_M2, "kg*m^2", "inertia of the right thigh about its CoM, body y"},
-    {"Izz_M2", &Params::Izz_M2, "kg*m^2", "inertia of the right thigh about its CoM, body z"},
-    {"m_M3", &Params::m_M3, "kg", "mass of the left thigh"},
-    {"Ixx_M3", &Params::Ixx_M3, "kg*m^2", "inertia of the left thigh about its CoM, body x"},
-    {"Iyy_M3", &Params::Iyy_M3, "kg*m^2", "inertia of the left thigh about its CoM, body y"},
-    {"Izz_M3", &Params::Izz_M3, "kg*m^2", "inertia of the left thigh about its CoM, body z"},
-    {"m_M4", &Params::m_M4, "kg", "mass of the right shank"},
-    {"Ixx_M4", &Params::Ixx_M4, "kg*m^2", "inertia of the right shank about its CoM, body x"},
-    {"Iyy_M4", &Params::Iyy_M4, "kg*m^2", "inertia of the right shank about its CoM, body y"},
-    {"Izz_M4", &Params::Izz_M4, "kg*m^2", "inertia of the right shank about its CoM, body z"},
-    {"m_M5", &Params::m_M5, "kg", "mass of the left shank"},
-    {"Ixx_M5", &Params::Ixx_M5, "kg*m^2", "inertia of the left shank about its CoM, body x"},
-    {"Iyy_M5", &Params::Iyy_M5, "kg*m^2", "inertia of the left shank about its CoM, body y"},
-    {"Izz_M5", &Params::Izz_M5, "kg*m^2", "inertia of the left shank about its CoM, body z"},
-    {"m_M6", &Params::m_M6, "kg", "mass of the left lever and wheel"},
-    {"Ixx_M6", &Params::Ixx_M6, "kg*m^2", "inertia of the left lever and wheel about its CoM, body x"},
-    {"Iyy_M6", &Params::Iyy_M6, "kg*m^2", "inertia of the left lever and wheel about its CoM, body y"},
-    {"Izz_M6", &Params::Izz_M6, "kg*m^2", "inertia of the left lever and wheel about its CoM, body z"},
-    {"m_M7", &Params::m_M7, "kg", "mass of the right lever and wheel"},
-    {"Ixx_M7", &Params::Ixx_M7, "kg*m^2", "inertia of the right lever and wheel about its CoM, body x"},
-    {"Iyy_M7", &Params::Iyy_M7, "kg*m^2", "inertia of the right lever and wheel about its CoM, body y"},
-    {"Izz_M7", &Params::Izz_M7, "kg*m^2", "inertia of the right lever and wheel about its CoM, body z"},
-    {"g", &Params::g, "m/s^2", "gravity, along -z of K0"},
+    {"cxd", &Params::cxd, "m", "cabin length between front hips and rear hips", ParamKind::length},
+    {"cyd", &Params::cyd, "m", "cabin width between left and right hips", ParamKind::length},
+    {"thighD", &Params::thighD, "m", "hip-to-knee length of a leg", ParamKind::length},
+    {"legD", &Params::legD, "m", "knee-to-foot length of a leg", ParamKind::length},
+    {"wl", &Params::wl, "m", "wheel lever length", ParamKind::length},
+    {"w", &Params::w, "m", "wheel radius: hub to contact point", ParamKind::length},
+    {"cabin_height", &Params::cabin_height, "m", "height of the cabin block centred on the cabin frame", ParamKind::length},
+    {"m_M1", &Params::m_M1, "kg", "mass of the cabin", ParamKind::mass},
+    {"Ixx_M1", &Params::Ixx_M1, "kg*m^2", "inertia of the cabin about its CoM, body x", ParamKind::inertia},
+    {"Iyy_M1", &Params::Iyy_M1, "kg*m^2", "inertia of the cabin about its CoM, body y", ParamKind::inertia},
+    {"Izz_M1", &Params::Izz_M1, "kg*m^2", "inertia of the cabin about its CoM, body z", ParamKind::inertia},
+    {"m_M2", &Params::m_M2, "kg", "mass of the right thigh", ParamKind::mass},
+    {"Ixx_M2", &Params::Ixx_M2, "kg*m^2", "inertia of the right thigh about its CoM, body x", ParamKind::inertia},
+    {"Iyy_M2", &Params::Iyy_M2, "kg*m^2", "inertia of the right thigh about its CoM, body y", ParamKind::inertia},
+    {"Izz_M2", &Params::Izz_M2, "kg*m^2", "inertia of the right thigh about its CoM, body z", ParamKind::inertia},
+    {"m_M3", &Params::m_M3, "kg", "mass of the left thigh", ParamKind::mass},
+    {"Ixx_M3", &Params::Ixx_M3, "kg*m^2", "inertia of the left thigh about its CoM, body x", ParamKind::inertia},
+    {"Iyy_M3", &Params::Iyy_M3, "kg*m^2", "inertia of the left thigh about its CoM, body y", ParamKind::inertia},
+    {"Izz_M3", &Params::Izz_M3, "kg*m^2", "inertia of the left thigh about its CoM, body z", ParamKind::inertia},
+    {"m_M4", &Params::m_M4, "kg", "mass of the right shank", ParamKind::mass},
+    {"Ixx_M4", &Params::Ixx_M4, "kg*m^2", "inertia of the right shank about its CoM, body x", ParamKind::inertia},
+    {"Iyy_M4", &Params::Iyy_M4, "kg*m^2", "inertia of the right shank about its CoM, body y", ParamKind::inertia},
+    {"Izz_M4", &Params::Izz_M4, "kg*m^2", "inertia of the right shank about its CoM, body z", ParamKind::inertia},
+    {"m_M5", &Params::m_M5, "kg", "mass of the left shank", ParamKind::mass},
+    {"Ixx_M5", &Params::Ixx_M5, "kg*m^2", "inertia of the left shank about its CoM, body x", ParamKind::inertia},
+    {"Iyy_M5", &Params::Iyy_M5, "kg*m^2", "inertia of the left shank about its CoM, body y", ParamKind::inertia},
+    {"Izz_M5", &Params::Izz_M5, "kg*m^2", "inertia of the left shank about its CoM, body z", ParamKind::inertia},
+    {"m_M6", &Params::m_M6, "kg", "mass of the left lever and wheel", ParamKind::mass},
+    {"Ixx_M6", &Params::Ixx_M6, "kg*m^2", "inertia of the left lever and wheel about its CoM, body x", ParamKind::inertia},
+    {"Iyy_M6", &Params::Iyy_M6, "kg*m^2", "inertia of the left lever and wheel about its CoM, body y", ParamKind::inertia},
+    {"Izz_M6", &Params::Izz_M6, "kg*m^2", "inertia of the left lever and wheel about its CoM, body z", ParamKind::inertia},
+    {"m_M7", &Params::m_M7, "kg", "mass of the right lever and wheel", ParamKind::mass},
+    {"Ixx_M7", &Params::Ixx_M7, "kg*m^2", "inertia of the right lever and wheel about its CoM, body x", ParamKind::inertia},
+    {"Iyy_M7", &Params::Iyy_M7, "kg*m^2", "inertia of the right lever and wheel about its CoM, body y", ParamKind::inertia},
+    {"Izz_M7", &Params::Izz_M7, "kg*m^2", "inertia of the right lever and wheel about its CoM, body z", ParamKind::inertia},
+    {"g", &Params::g, "m/s^2", "gravity, along -z of K0", ParamKind::gravity},
 }};
 
 // Mass properties of each body (index with wlx::gen::body::...).
