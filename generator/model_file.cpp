@@ -99,8 +99,9 @@ struct Source {
   std::string name;
 
   [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path, const std::string& reason) const {
-    if (mark.is_null()) throw ModelFileError(fmt::format("{}: {}: {}", name, path, reason));
-    throw ModelFileError(fmt::format("{}:{}:{}: {}: {}", name, mark.line + 1, mark.column + 1, path, reason));
+    const std::string field = path.empty() ? "" : path + ": ";
+    if (mark.is_null()) throw ModelFileError(fmt::format("{}: {}{}", name, field, reason));
+    throw ModelFileError(fmt::format("{}:{}:{}: {}{}", name, mark.line + 1, mark.column + 1, field, reason));
   }
 };
 
@@ -123,7 +124,9 @@ class Item {
   bool has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined(); }
   std::size_t size() const { return node_.size(); }
 
-  Item child(const std::string& key) const { return Item(*src_, node_[key], path_ + "." + key, env_, mark()); }
+  Item child(const std::string& key) const {
+    return Item(*src_, node_[key], path_.empty() ? key : path_ + "." + key, env_, mark());
+  }
   Item element(std::size_t k) const { return Item(*src_, node_[k], fmt::format("{}[{}]", path_, k), env_, mark()); }
   Item with(Env env, const std::string& suffix) const { return Item(*src_, node_, path_ + suffix, std::move(env), fallback_); }
 
@@ -224,7 +227,7 @@ class Parser {
   explicit Parser(std::string source) : src_{std::move(source)} {}
 
   Model parse(const YAML::Node& root) {
-    const Item top(src_, root, "model file", {});
+    const Item top(src_, root, "", {});
     const Fields f(top, {"model", "description", "repeat", "parameters", "coordinates", "frames", "bodies", "closure",
                          "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "nominal"});
     m_.name = f["model"].name();
@@ -307,7 +310,9 @@ class Parser {
             if (env.count(var)) spec.fail(fmt::format("repetition variable '{}' is defined twice here", var));
             env[var] = value;
           }
-          suffix += fmt::format("{}{}={}", k ? "," : "", tables[k], index[k]);
+          // The row by its own value where the table has a variable of its name (side=l), else its index.
+          const auto own = row.find(tables[k]);
+          suffix += fmt::format("{}{}={}", k ? "," : "", tables[k], own != row.end() ? own->second : std::to_string(index[k]));
         }
         suffix += "}";
         const Item instance = e.with(env, suffix);
@@ -410,6 +415,19 @@ class Parser {
         continue;
       }
       ++i;
+    }
+    // GiNaC evaluates integer powers exactly, so 9^9^9 would not finish: exponents are small
+    // integer literals.
+    for (std::size_t i = s.find('^'); i != std::string::npos; i = s.find('^', i + 1)) {
+      std::size_t j = i + 1;
+      while (j < s.size() && s[j] == ' ') ++j;
+      if (j < s.size() && s[j] == '-') ++j;
+      const std::size_t digits = j;
+      while (j < s.size() && std::isdigit(static_cast<unsigned char>(s[j]))) ++j;
+      const std::size_t count = j - digits;
+      while (j < s.size() && s[j] == ' ') ++j;
+      if (count == 0 || count > 2 || (j < s.size() && (s[j] == '^' || s[j] == '.')))
+        it.fail(fmt::format("in '{}': an exponent is a small integer (x^2, x^-1), not an expression", excerpt(s)));
     }
     GiNaC::symtab table = params_;
     if (allow_coordinates) table.insert(coordinates_.begin(), coordinates_.end());
@@ -840,6 +858,17 @@ std::uint64_t fingerprint(const std::string& text) {
 }  // namespace
 
 Model parse_model(const std::string& text, const std::string& source_name) {
+  // yaml-cpp reads nested flow collections recursively: bound the depth before it sees the text.
+  int depth = 0, line = 1;
+  for (char c : text) {
+    if (c == '\n') ++line;
+    if (c == '[' || c == '{') {
+      if (++depth > 64)
+        throw ModelFileError(fmt::format("{}:{}: lists and maps nest more than 64 levels deep", source_name, line));
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
   YAML::Node root;
   try {
     root = YAML::Load(text);
