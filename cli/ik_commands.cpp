@@ -39,10 +39,10 @@ nlohmann::ordered_json solve(const IkRequest& r, Coordinates* warm) {
   s.array() += 0.0;  // no "-0.0" in the output
   forward_kinematics(model, s, data);
   for (int k = kInputCount; k < kCoordinateCount; ++k) out[std::string(gen::kCoordinateNames[k])] = s(k);
-  out["x_Wl"] = data.frame_positions(0, gen::frame::W_l);
-  out["y_Wl"] = data.frame_positions(1, gen::frame::W_l);
-  out["x_Wr"] = data.frame_positions(0, gen::frame::W_r);
-  out["y_Wr"] = data.frame_positions(1, gen::frame::W_r);
+  for (const auto& wheel : gen::kWheels) {  // the contact points: x_W<wheel>, y_W<wheel>
+    out["x_W" + std::string(wheel.name)] = data.frame_positions(0, wheel.contact_frame);
+    out["y_W" + std::string(wheel.name)] = data.frame_positions(1, wheel.contact_frame);
+  }
   double check = 0;
   for (Limb limb : kLimbs) check = std::max(check, analytic_check(model, limb, s, data).position_error);
   closure(model, s, data, false);
@@ -50,14 +50,14 @@ nlohmann::ordered_json solve(const IkRequest& r, Coordinates* warm) {
   out["analytic_check_error"] = check;
   out["method"] = r.method == IkMethod::closed_form ? "closed-form" : "newton";
   nlohmann::ordered_json branches;
-  const char* names[] = {"leg_l", "leg_r", "wheel_l", "wheel_r"};
-  for (Limb limb : kLimbs) branches[names[static_cast<int>(limb)]] = classify_branch(model, limb, s);
+  const auto name = [](Limb limb) { return std::string(gen::kLimbs[static_cast<std::size_t>(limb)].name); };
+  for (Limb limb : kLimbs) branches[name(limb)] = classify_branch(model, limb, s);
   out["branch"] = branches;
   if (r.method == IkMethod::newton) {
     nlohmann::ordered_json it;
     int total = 0;
     for (Limb limb : kLimbs) {
-      it[names[static_cast<int>(limb)]] = report.iterations[static_cast<std::size_t>(limb)];
+      it[name(limb)] = report.iterations[static_cast<std::size_t>(limb)];
       total += report.iterations[static_cast<std::size_t>(limb)];
     }
     out["iterations"] = it;
@@ -127,13 +127,13 @@ int run_ik(bool batch) {
 int run_verify_ik(const std::string& out_dir, const std::vector<std::string>& sweep_ids) {
   std::vector<IkSweep> sweeps;
   if (sweep_ids.empty()) {
-    sweeps = thesis_ik_sweeps();
+    sweeps = model_ik_sweeps();
   } else {
     for (const auto& id : sweep_ids) {
       const IkSweep* s = find_ik_sweep(id);
       if (s == nullptr) {
         std::vector<std::string> ids;
-        for (const auto& t : thesis_ik_sweeps()) ids.push_back(t.id);
+        for (const auto& t : model_ik_sweeps()) ids.push_back(t.id);
         const std::string hint = nearest(id, ids);
         throw Error("--sweep", fmt::format("no sweep '{}'{}", id, hint.empty() ? "" : "; did you mean '" + hint + "'?"));
       }

@@ -112,7 +112,8 @@ IkRequest parse_ik_request(const nlohmann::json& j) {
         throw Error(key, fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, n));
       r.branches.limb[static_cast<std::size_t>(limb)] = n;
     };
-    const std::vector<std::string> limbs = {"leg_l", "leg_r", "wheel_l", "wheel_r"};
+    std::vector<std::string> limbs;
+    for (const auto& l : gen::kLimbs) limbs.emplace_back(l.name);
     if (b.is_object()) {
       reject_unknown_keys(b, limbs, "branch.");
       for (std::size_t k = 0; k < limbs.size(); ++k)

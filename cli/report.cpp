@@ -131,7 +131,7 @@ class Report {
 // ---- computations -----------------------------------------------------------------------------
 
 void Report::run_ik() {
-  for (const IkSweep& sweep : thesis_ik_sweeps()) {
+  for (const IkSweep& sweep : model_ik_sweeps()) {
     if (opt_.quick && sweep.id != "IK-L3" && sweep.id != "IK-WL2") continue;
     progress(fmt::format("inverse kinematics sweep {} ({} from {:g} to {:g})", sweep.id, sweep.input,
                          sweep.degrees ? sweep.from / kDeg : sweep.from, sweep.degrees ? sweep.to / kDeg : sweep.to));
@@ -332,11 +332,10 @@ void Report::add_checks() {
 
 void Report::figures_ik() {
   for (const auto& s : sweeps_) {
-    const bool leg = s.sweep.limb == Limb::leg_l || s.sweep.limb == Limb::leg_r;
-    const char side = (s.sweep.limb == Limb::leg_l || s.sweep.limb == Limb::wheel_l) ? 'l' : 'r';
+    const LimbBlock block = limb_block(s.sweep.limb);
     std::vector<std::string> joints;
-    for (const char* n : leg ? std::vector<const char*>{"2", "3", "4"} : std::vector<const char*>{"2", "3", "4", "6"})
-      joints.push_back(fmt::format("{}_{}{}", leg ? "psi" : "theta", side, n));
+    for (int j = 0; j < block.size; ++j)
+      joints.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(block.joints[static_cast<std::size_t>(j)])]);
     const double xs = s.sweep.degrees ? 1 / kDeg : 1;
     const std::string xunit = s.sweep.degrees ? "deg" : "m";
     const std::string file = data(s.sweep.id + ".csv");

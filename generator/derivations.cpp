@@ -81,6 +81,8 @@ WheelRow wheel_row(const Model& m, const NonholonomicWheel& wheel) {
 
 }  // namespace
 
+ex closure_value(const Model& m, const ClosureCondition& c) { return closure_row(m, c).value; }
+
 FunctionSpec derive_kinematics(const Model& m) {
   FunctionSpec fn{"kinematics", "kinematics.hpp",
                   "Forward kinematics (thesis 3.4): position and orientation in K0 of every frame of "

@@ -27,6 +27,9 @@ struct FunctionSpec {
   std::vector<OutputSpec> outputs;
 };
 
+// The value Phi_i(s) of one closure condition, in the model's symbols.
+ex closure_value(const Model& m, const ClosureCondition& c);
+
 FunctionSpec derive_kinematics(const Model& m);
 FunctionSpec derive_closure(const Model& m);
 FunctionSpec derive_nonholonomic(const Model& m);

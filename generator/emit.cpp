@@ -1,4 +1,5 @@
 #include "emit.hpp"
+#include "printer.hpp"
 
 #include <fmt/format.h>
 
@@ -39,198 +40,7 @@ std::string literal(double v) {
 
 namespace {
 
-bool integer_exponent(double e) { return e == static_cast<double>(static_cast<long>(e)); }
-
-const char* call_name(const std::string& f) {
-  static const std::pair<const char*, const char*> names[] = {
-      {"sin", "std::sin"}, {"cos", "std::cos"}, {"tan", "std::tan"}, {"atan2", "std::atan2"},
-      {"atan", "std::atan"}, {"asin", "std::asin"}, {"acos", "std::acos"}, {"abs", "std::abs"},
-      {"exp", "std::exp"}, {"log", "std::log"}};
-  for (const auto& [g, c] : names)
-    if (f == g) return c;
-  throw std::runtime_error("no C++ function for GiNaC function '" + f + "'");
-}
-
-// Prints graph nodes as C++ expressions, replacing temporaries by their names, and counts the
-// operations of exactly what it prints.
-class Printer {
- public:
-  enum class Context { Root, Term, Factor };
-
-  // `precomputed`: nodes already held in named variables (sin/cos of the batched angles).
-  Printer(const ExprGraph& g, const CsePlan& plan, const std::map<int, std::string>& precomputed)
-      : g_(g), plan_(plan), precomputed_(precomputed) {}
-
-  std::string temp_name(int id) const { return fmt::format("t{}", plan_.temp_index.at(id)); }
-  bool is_temp(int id) const { return plan_.temp_index.count(id) != 0; }
-
-  // The definition of node `id` itself (temporaries among its arguments are used by name).
-  std::string define(int id, OpCount& ops) { return node(id, Context::Root, ops, nullptr); }
-  // Node `id` as an output's value: its variable if it has one, else its definition.
-  std::string value(int id, OpCount& ops) { return use(id, Context::Root, ops, nullptr); }
-
- private:
-  std::string use(int id, Context ctx, OpCount& ops, bool* negated) {
-    if (auto it = precomputed_.find(id); it != precomputed_.end()) return it->second;
-    if (is_temp(id)) return temp_name(id);
-    return node(id, ctx, ops, negated);
-  }
-
-  std::string node(int id, Context ctx, OpCount& ops, bool* negated) {
-    const Node& n = g_.node(id);
-    switch (n.kind) {
-      case NodeKind::Symbol: return n.text;
-      case NodeKind::Number: {
-        if (n.value < 0 && negated != nullptr) {
-          *negated = true;
-          return literal(-n.value);
-        }
-        return (n.value < 0 && ctx == Context::Factor) ? "(" + literal(n.value) + ")" : literal(n.value);
-      }
-      case NodeKind::Add: return sum(n, ctx, ops);
-      case NodeKind::Mul: return product(n, ctx, ops, negated);
-      case NodeKind::Pow: {
-        std::string s = power(n, ops);
-        return ctx == Context::Factor && s.find_first_of("*/") != std::string::npos ? "(" + s + ")" : s;
-      }
-      case NodeKind::Call: {
-        std::string args;
-        for (int a : n.args) args += (args.empty() ? "" : ", ") + use(a, Context::Root, ops, nullptr);
-        ++ops.calls;
-        return fmt::format("{}({})", call_name(n.text), args);
-      }
-    }
-    return {};
-  }
-
-  std::string sum(const Node& n, Context ctx, OpCount& ops) {
-    std::vector<std::pair<bool, std::string>> terms;
-    for (int a : n.args) {
-      bool neg = false;
-      std::string t = use(a, Context::Term, ops, &neg);
-      terms.emplace_back(neg, std::move(t));
-    }
-    // Lead with a positive term where there is one, so no negation is needed.
-    std::stable_partition(terms.begin(), terms.end(), [](const auto& t) { return !t.first; });
-    std::string s = terms[0].first ? "-" + terms[0].second : terms[0].second;
-    if (terms[0].first) ++ops.adds;
-    for (std::size_t i = 1; i < terms.size(); ++i) {
-      s += (terms[i].first ? " - " : " + ") + terms[i].second;
-      ++ops.adds;
-    }
-    return ctx == Context::Factor ? "(" + s + ")" : s;
-  }
-
-  std::string product(const Node& n, Context ctx, OpCount& ops, bool* negated) {
-    double coefficient = 1;
-    std::vector<std::string> numer, denom;
-    for (int a : n.args) {
-      const Node& f = g_.node(a);
-      if (f.kind == NodeKind::Number) {
-        coefficient *= f.value;
-      } else if (!is_temp(a) && f.kind == NodeKind::Pow && integer_exponent(f.value)) {
-        const std::string base = use(f.args[0], Context::Factor, ops, nullptr);
-        for (long k = 0; k < static_cast<long>(std::abs(f.value)); ++k) (f.value > 0 ? numer : denom).push_back(base);
-      } else {
-        numer.push_back(use(a, Context::Factor, ops, nullptr));
-      }
-    }
-    const bool negative = coefficient < 0;
-    if (std::abs(coefficient) != 1.0) numer.insert(numer.begin(), literal(std::abs(coefficient)));
-    auto join = [](const std::vector<std::string>& v) {
-      std::string s;
-      for (const auto& x : v) s += (s.empty() ? "" : "*") + x;
-      return s;
-    };
-    std::string s = numer.empty() ? "1.0" : join(numer);
-    if (!numer.empty()) ops.muls += static_cast<long>(numer.size()) - 1;
-    if (!denom.empty()) {
-      s += denom.size() == 1 ? "/" + denom[0] : "/(" + join(denom) + ")";
-      ops.muls += static_cast<long>(denom.size()) - 1;
-      ++ops.divs;
-    }
-    if (negative) {
-      if (negated != nullptr) {
-        *negated = true;
-      } else {
-        s = "-" + s;
-        ++ops.adds;
-      }
-    }
-    return ctx == Context::Factor && (negative && negated == nullptr) ? "(" + s + ")" : s;
-  }
-
-  std::string power(const Node& n, OpCount& ops) {
-    const std::string base = use(n.args[0], Context::Factor, ops, nullptr);
-    if (integer_exponent(n.value)) {
-      const long k = static_cast<long>(std::abs(n.value));
-      std::string s = base;
-      for (long i = 1; i < k; ++i) s += "*" + base;
-      ops.muls += k - 1;
-      if (n.value < 0) {
-        ++ops.divs;
-        return k == 1 ? "1.0/" + base : "1.0/(" + s + ")";
-      }
-      return s;
-    }
-    ++ops.calls;
-    if (n.value == 0.5) return fmt::format("std::sqrt({})", base);
-    if (n.value == -0.5) {
-      ++ops.divs;
-      return fmt::format("1.0/std::sqrt({})", base);
-    }
-    return fmt::format("std::pow({}, {})", base, literal(n.value));
-  }
-
-  const ExprGraph& g_;
-  const CsePlan& plan_;
-  const std::map<int, std::string>& precomputed_;
-};
-
-// sin and cos of coordinates, batched into one trig.hpp pass: node id -> variable name, and
-// the prologue computing them (angles in coordinate order, so the output is deterministic).
-struct TrigBatch {
-  std::map<int, std::string> names;
-  std::string prologue;
-  long calls = 0;
-};
-
-TrigBatch batch_trig(const Model& m, const ExprGraph& g, const std::vector<int>& roots) {
-  std::map<std::string, std::map<std::string, int>> by_angle;  // angle -> {"sin"/"cos" -> node}
-  std::unordered_set<int> seen;
-  std::function<void(int)> visit = [&](int id) {
-    if (!seen.insert(id).second) return;
-    const Node& n = g.node(id);
-    if (n.kind == NodeKind::Call && (n.text == "sin" || n.text == "cos") && n.args.size() == 1 &&
-        g.node(n.args[0]).kind == NodeKind::Symbol)
-      by_angle[g.node(n.args[0]).text][n.text] = id;
-    for (int a : n.args) visit(a);
-  };
-  for (int r : roots) visit(r);
-  TrigBatch b;
-  std::vector<std::string> angles;
-  for (const auto& c : m.coordinates)
-    if (by_angle.count(c.name)) angles.push_back(c.name);
-  if (angles.size() != by_angle.size()) throw std::runtime_error("sin/cos of a symbol that is not a coordinate");
-  if (angles.empty()) return b;
-  const std::size_t count = angles.size();
-  std::string list, named;
-  for (std::size_t k = 0; k < count; ++k) {
-    list += (k ? ", " : "") + angles[k];
-    for (const auto& [f, id] : by_angle[angles[k]]) {
-      b.names[id] = fmt::format("{}_{}", f, angles[k]);
-      named += fmt::format("  const double {0}_{1} = {0}_angle[{2}];\n", f, angles[k], k);
-      ++b.calls;
-    }
-  }
-  b.prologue = fmt::format(
-      "  // sin and cos of all {0} angles in one vectorized pass (trig.hpp).\n"
-      "  const std::array<double, {0}> angle{{{1}}};\n"
-      "  std::array<double, {0}> sin_angle, cos_angle;\n"
-      "  sincos(angle, sin_angle, cos_angle);\n{2}",
-      count, list, named);
-  return b;
-}
+using namespace detail;
 
 std::string op_summary(const OpCount& c) {
   return fmt::format("{} (adds {}, muls {}, divs {}, calls {})", c.total(), c.adds, c.muls, c.divs, c.calls);
@@ -451,7 +261,7 @@ EmittedFile emit_umbrella(const Model& m, const std::vector<FunctionSpec>& fns, 
     a += s.after_cse;
   }
   t += fmt::format("//   {:<14} {:>13} {:>13} {:>13}\n", "total", "", b.total(), a.total());
-  t += "#pragma once\n\n#include \"params.hpp\"\n#include \"structure.hpp\"\n#include \"types.hpp\"\n";
+  t += "#pragma once\n\n#include \"ik.hpp\"\n#include \"params.hpp\"\n#include \"structure.hpp\"\n#include \"types.hpp\"\n";
   for (const auto& f : fns) t += fmt::format("#include \"{}\"\n", f.header);
   return {"wlx/gen/all.hpp", t};
 }
@@ -617,6 +427,35 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
   t += fmt::format("inline constexpr std::array<BodyColumns, {}> kBodyColumns{{{{\n", m.bodies.size());
   for (std::size_t k = 0; k < m.bodies.size(); ++k)
     t += fmt::format("    {{{}, {{{{{}}}}}}},  // {}\n", columns[k].size(), int_list(padded(columns[k], max_columns)), m.bodies[k].name);
+  t += "}};\n\n";
+
+  // Closure rows, as the model file gives them (for checks that put a solution into the FK).
+  t += "// Each closure row: its kind, the frame it constrains, the K0 component (point) or the frame's axis\n"
+       "// (level), and the input it equals (point), else -1.\n"
+       "enum class RowKind { point, level, sum };\n"
+       "struct ClosureRowInfo {\n  RowKind kind;\n  int frame;\n  int axis;\n  int target;\n};\n";
+  t += fmt::format("inline constexpr std::array<ClosureRowInfo, {}> kClosureRows{{{{\n", m.closure.size());
+  for (const auto& c : m.closure) {
+    const char* kind = c.kind == ClosureCondition::Kind::PointEqualsCoordinate ? "point"
+                       : c.kind == ClosureCondition::Kind::AttachedDirectionLevel ? "level" : "sum";
+    t += fmt::format("    {{RowKind::{}, {}, {}, {}}},  // {}\n", kind, c.frame.empty() ? -1 : m.frame_index(c.frame),
+                     static_cast<int>(c.axis), c.target, c.name);
+  }
+  t += "}};\n\n";
+
+  // IK verification sweeps.
+  std::string start;
+  for (double v : m.sweep_start) start += (start.empty() ? "" : ", ") + literal(v);
+  t += fmt::format("// The IK verification: each sweep moves one input over [from, to] in steps (SI units), from the\n"
+                   "// inputs kSweepStart, and checks one limb.\n"
+                   "inline constexpr std::array<double, {}> kSweepStart{{{{{}}}}};\n"
+                   "struct SweepInfo {{\n  std::string_view id;\n  int input;\n  double from, to, step;\n"
+                   "  bool degrees;  // quoted in degrees\n  int limb;\n}};\n",
+                   m.sweep_start.size(), start);
+  t += fmt::format("inline constexpr std::array<SweepInfo, {}> kIkSweeps{{{{\n", m.sweeps.size());
+  for (const auto& sw : m.sweeps)
+    t += fmt::format("    {{\"{}\", {}, {}, {}, {}, {}, {}}},  // {}\n", sw.id, sw.input, literal(sw.from), literal(sw.to),
+                     literal(sw.step), sw.degrees ? "true" : "false", sw.limb, name_of(sw.input));
   t += "}};\n\n";
 
   // Nominal state.

@@ -44,6 +44,10 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
 // structure.hpp: every fact about the model's structure the runtime needs, as constexpr tables
 // (limbs, wheels, dependent pairs, inverse-dynamics set-up, body Jacobian columns, nominal state).
 EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt);
+// ik.hpp: the closed-form inverse kinematics of every limb whose chain matches one of the solvable
+// patterns (emit_ik.cpp documents them), with all its branches; `report` receives one line per
+// limb: the pattern used, or why none applies (that limb is then left to Newton's method).
+EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<std::string>& report);
 // One header per derived function; `stats` receives the numbers written into its banner.
 EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOptions& opt, FunctionStats& stats);
 // The umbrella header including everything, with the operation-count table.

@@ -94,6 +94,8 @@ int main(int argc, char** argv) {
       s.seconds += derive_s;
       stats.push_back(s);
     }
+    std::vector<std::string> ik_report;
+    files.push_back(emit_ik_header(model, opt, ik_report));
     files.push_back(emit_umbrella(model, fns, stats, opt));
     int changed = 0;
     for (const auto& f : files) changed += write_if_changed(fs::path(out_dir) / f.path, f.text);
@@ -108,6 +110,7 @@ int main(int argc, char** argv) {
         a += s.after_cse.total();
       }
       fmt::print("{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", "total", "", b, a, total);
+      for (const auto& line : ik_report) fmt::print("closed-form IK, {}\n", line);
       fmt::print("model built in {:.3f} s; {} files written to {} ({} changed)\n",
                  std::chrono::duration<double>(t1 - t0).count(), files.size(), out_dir, changed);
     }

@@ -100,6 +100,15 @@ struct ClearanceBox {
   std::array<ex, 3> size;
 };
 
+// One sweep of the IK verification: one input moved over a range, one limb checked.
+struct IkSweep {
+  std::string id;
+  int input = -1;
+  double from = 0, to = 0, step = 0;  // SI (radians for angles)
+  bool degrees = false;               // quoted in degrees
+  int limb = -1;
+};
+
 struct Model {
   std::string name;
   std::string description;
@@ -119,6 +128,8 @@ struct Model {
   std::optional<Dynamics> dynamics;
   std::optional<ClearanceBox> clearance;
   std::vector<double> nominal;  // one value per input
+  std::vector<double> sweep_start;  // the IK sweeps' initial inputs (nominal with overrides)
+  std::vector<IkSweep> sweeps;
 
   const Parameter& parameter(const std::string& name) const;
   const Coordinate& coordinate(const std::string& name) const;

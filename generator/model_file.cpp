@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -161,10 +162,25 @@ class Item {
       fail(fmt::format("'{}' is not a name: use letters, digits and _, not starting with a digit", excerpt(s)));
     return s;
   }
-  double number() const {
+  // A number; with `constant`, also an expression of numbers (such as <sign>*0.5).
+  double number(bool constant = false) const {
     const std::string s = text();
     double v = 0;
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if ((ec != std::errc() || end != s.data() + s.size()) && constant && s.size() < 64 &&
+        s.find_first_of("^abcdefghijklmnopqrstuvwxyzABCDFGHIJKLMNOPQRSTUVWXYZ_") == std::string::npos) {
+      try {
+        GiNaC::parser reader(GiNaC::symtab{}, true);
+        const ex e = GiNaC::evalf(reader(s));
+        if (GiNaC::is_a<GiNaC::numeric>(e) && GiNaC::ex_to<GiNaC::numeric>(e).is_real()) {
+          v = GiNaC::ex_to<GiNaC::numeric>(e).to_double();
+          if (!std::isfinite(v)) fail(fmt::format("must be a finite number, got {}", excerpt(s)));
+          return v;
+        }
+      } catch (const std::exception&) {
+      }
+      fail(fmt::format("'{}' is not a number", excerpt(s)));
+    }
     if (ec != std::errc() || end != s.data() + s.size()) fail(fmt::format("'{}' is not a number", excerpt(s)));
     if (!std::isfinite(v)) fail(fmt::format("must be a finite number, got {}", excerpt(s)));
     return v;
@@ -229,7 +245,7 @@ class Parser {
   Model parse(const YAML::Node& root) {
     const Item top(src_, root, "", {});
     const Fields f(top, {"model", "description", "repeat", "parameters", "coordinates", "frames", "bodies", "closure",
-                         "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "nominal"});
+                         "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "nominal", "ik_sweeps"});
     m_.name = f["model"].name();
     m_.source = src_.name;
     if (auto d = f.optional("description")) m_.description = d->text();
@@ -245,6 +261,7 @@ class Parser {
     if (auto d = f.optional("dynamics")) dynamics(*d);
     if (auto c = f.optional("clearance")) clearance(*c);
     nominal(f.optional("nominal"));
+    sweeps(f.optional("ik_sweeps"));
     return std::move(m_);
   }
 
@@ -837,6 +854,49 @@ class Parser {
       const int k = coordinate_index(key, true);
       m_.nominal[static_cast<std::size_t>(k)] = section->child(kv.first.Scalar()).number();
     }
+  }
+
+  void sweeps(const std::optional<Item>& section) {
+    m_.sweep_start = m_.nominal;
+    if (!section) return;
+    const Fields f(*section, {"start", "sweeps"});
+    if (auto start = f.optional("start")) {
+      if (!start->is_map()) start->fail("must map input names to values");
+      for (const auto& kv : start->node()) {
+        const Item key(src_, kv.first, start->path(), {});
+        m_.sweep_start[static_cast<std::size_t>(coordinate_index(key, true))] = start->child(kv.first.Scalar()).number();
+      }
+    }
+    each(f["sweeps"], [&](const Item& it) {
+      const Fields s(it, {"id", "input", "from", "to", "step", "unit", "limb"});
+      IkSweep sw;
+      sw.id = s["id"].text();
+      for (const auto& other : m_.sweeps)
+        if (other.id == sw.id) s["id"].fail(fmt::format("sweep '{}' is defined twice", sw.id));
+      sw.input = coordinate_index(s["input"], true);
+      double scale = 1;
+      if (auto unit = s.optional("unit")) {
+        const std::string u = unit->text();
+        const std::string& own = m_.coordinates[static_cast<std::size_t>(sw.input)].unit;
+        if (u == "deg" && own == "rad") {
+          sw.degrees = true;
+          scale = std::numbers::pi / 180;
+        } else if (u != own) {
+          unit->fail(fmt::format("'{}' is in {}; give the sweep in {}{}", m_.coordinates[static_cast<std::size_t>(sw.input)].name, own,
+                                 own, own == "rad" ? " or deg" : ""));
+        }
+      }
+      sw.from = s["from"].number(true) * scale;
+      sw.to = s["to"].number(true) * scale;
+      sw.step = s["step"].number(true) * scale;
+      if (!(sw.step > 0)) s["step"].fail("a step must be positive");
+      if (std::abs(sw.to - sw.from) / sw.step > 1e6) s["step"].fail("more than 10^6 points");
+      const std::string limb = s["limb"].name();
+      for (std::size_t k = 0; k < m_.limbs.size(); ++k)
+        if (m_.limbs[k].name == limb) sw.limb = static_cast<int>(k);
+      if (sw.limb < 0) s["limb"].fail(fmt::format("no limb '{}'", limb));
+      m_.sweeps.push_back(std::move(sw));
+    });
   }
 
   Source src_;

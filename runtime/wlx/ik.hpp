@@ -1,11 +1,11 @@
-// Inverse kinematics of the four limbs (thesis 3.3, MODEL.md 4): the closed form, with every
-// branch, and the thesis' iterative method (Newton on the generated Phi and dPhi/ds).
+// Inverse kinematics of the limbs: the closed form that wlx-gen derived from the model's chains
+// (the generated ik.hpp, with every branch), and the thesis' iterative method, Newton's method
+// on the generated Phi and dPhi/ds. A limb for which wlx-gen found no closed form is solved by
+// Newton's method in both.
 //
-// The closed form lives in the runtime, not in the generator: it is a structural solution of
-// this chain (hip = roll-pitch-yaw + knee, lever = pitch-straddle + parallel guidance), needs
-// branch selection and reach checks with precise error messages, and GiNaC cannot solve
-// trigonometric systems; every geometry parameter still comes from Params, and the tests put
-// each solution back into the generated forward kinematics.
+// Every closed-form solution has been put back into the limb's closure rows by the generated
+// code: one that does not satisfy them (residual above gen::kIkTolerance) is an error here,
+// never a result.
 #pragma once
 
 #include "wlx/model.hpp"
@@ -15,43 +15,41 @@
 
 namespace wlx {
 
-enum class Limb { leg_l = 0, leg_r = 1, wheel_l = 2, wheel_r = 3 };
-inline constexpr std::array<Limb, 4> kLimbs = {Limb::leg_l, Limb::leg_r, Limb::wheel_l, Limb::wheel_r};
-std::string_view limb_name(Limb limb) noexcept;  // "left leg", ...
+// A limb: an index into gen::kLimbs (gen::limb::<name>).
+using Limb = int;
+inline constexpr int kLimbCount = gen::kLimbCount;
+inline constexpr std::array<Limb, kLimbCount> kLimbs = [] {
+  std::array<Limb, kLimbCount> all{};
+  for (int k = 0; k < kLimbCount; ++k) all[static_cast<std::size_t>(k)] = k;
+  return all;
+}();
+std::string_view limb_name(Limb limb) noexcept;  // the model file's title: "left leg", ...
 
-// Branch of a limb's closed form, as bits:
-//   leg:   bit 0 set = knee below the hip-foot line (psi_4 < 0);
-//          bit 1 set = hip yaw beyond 90 degrees (|psi_3| > 90 deg).
-//   wheel: bit 0 set = lever over the other side (|theta_6 - (theta_3 + theta_6)| > 90 deg);
-//          bit 1 set = camber beyond 90 degrees (|theta_2| > 90 deg);
-//          bit 2 set = wheel upside down (hub below the contact point).
-// 0 is MODEL.md's default for every limb.
-inline constexpr int kLegBranchCount = 4;
-inline constexpr int kWheelBranchCount = 8;
-inline int branch_count(Limb limb) noexcept {
-  return limb == Limb::leg_l || limb == Limb::leg_r ? kLegBranchCount : kWheelBranchCount;
-}
+// The branches of a limb's closed form (1 without one). What each bit selects is in the
+// generated gen::kClosedForm[limb].bits; branch 0 takes, in every equation, the root nearest the
+// joint's zero.
+int branch_count(Limb limb) noexcept;
 
 // A limb's rows in Phi and its dependent joints (its block of dPhi/ds is square).
 struct LimbBlock {
-  int first_row = 0;
-  int size = 0;                 // 3 for a leg, 4 for a wheel
-  std::array<int, 4> joints{};  // coordinate indices; the 4th is unused for legs
+  int size = 0;
+  std::array<int, gen::kMaxLimbSize> rows{};
+  std::array<int, gen::kMaxLimbSize> joints{};
 };
 LimbBlock limb_block(Limb limb) noexcept;
 
 struct Branches {
-  std::array<int, 4> limb{0, 0, 0, 0};  // indexed by Limb
+  std::array<int, kLimbCount> limb{};  // indexed by Limb
 };
 
-// Solves one limb's dependent joints in s from its inputs in s. Throws wlx::Error when the
-// target is out of reach (naming the limb, the distance and the reachable interval) or an input
-// is not finite.
+// Solves one limb's dependent joints in s from its inputs in s. Throws wlx::Error when the target
+// is out of reach (naming the limb, what the target asks and what the limb reaches), an input is
+// not finite, or the branch does not exist.
 void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinates& s);
-// All four limbs.
+// All limbs.
 void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches = {});
 
-// Which branch of the closed form a solution lies on (for checking Newton results).
+// Which branch of the closed form a solution lies on (the branch whose solution is nearest).
 int classify_branch(const Model& model, Limb limb, const Coordinates& s);
 
 struct NewtonOptions {
@@ -64,7 +62,7 @@ struct NewtonOptions {
 };
 
 struct NewtonReport {
-  std::array<int, 4> iterations{0, 0, 0, 0};  // per limb
+  std::array<int, kLimbCount> iterations{};  // per limb
   double residual = 0;                        // max |Phi| over the solved limbs' equations at the end
   bool converged = false;
 };

@@ -3,26 +3,17 @@
 #include "wlx/error.hpp"
 #include "wlx/kinematics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
 namespace wlx {
 
-namespace c = gen::coord;
-
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180;
-
-// The joints a limb's closure solves for.
 std::vector<int> limb_joints(Limb limb) {
-  switch (limb) {
-    case Limb::leg_l: return {c::psi_l2, c::psi_l3, c::psi_l4};
-    case Limb::leg_r: return {c::psi_r2, c::psi_r3, c::psi_r4};
-    case Limb::wheel_l: return {c::theta_l2, c::theta_l3, c::theta_l4, c::theta_l6};
-    case Limb::wheel_r: return {c::theta_r2, c::theta_r3, c::theta_r4, c::theta_r6};
-  }
-  return {};
+  const LimbBlock b = limb_block(limb);
+  return {b.joints.begin(), b.joints.begin() + b.size};
 }
 
 }  // namespace
@@ -34,58 +25,44 @@ double IkSweep::value(int k) const {
   return n == 1 ? from : from + (to - from) * k / (n - 1);
 }
 
-const std::vector<IkSweep>& thesis_ik_sweeps() {
-  static const std::vector<IkSweep> sweeps = {
-      {"IK-L1", "x_Fl", 1.80, 4.30, 0.01, false, Limb::leg_l},
-      {"IK-L2", "y_Fl", -0.50, 3.50, 0.01, false, Limb::leg_l},
-      {"IK-L3", "z_Fl", -0.50, 3.50, 0.01, false, Limb::leg_l},
-      {"IK-L4", "psi_l1", -30 * kDeg, 30 * kDeg, 0.1 * kDeg, true, Limb::leg_l},
-      {"IK-R1", "x_Fr", 1.80, 4.30, 0.01, false, Limb::leg_r},
-      {"IK-R2", "y_Fr", 0.50, -3.50, 0.01, false, Limb::leg_r},
-      {"IK-R3", "z_Fr", -0.50, 3.50, 0.01, false, Limb::leg_r},
-      {"IK-R4", "psi_r1", -30 * kDeg, 30 * kDeg, 0.1 * kDeg, true, Limb::leg_r},
-      {"IK-WL1", "z_Wl", 0.90, -0.70, 0.01, false, Limb::wheel_l},
-      {"IK-WL2", "theta_l5", -40 * kDeg, 15 * kDeg, 0.1 * kDeg, true, Limb::wheel_l},
-      {"IK-WR1", "z_Wr", 0.90, -0.70, 0.01, false, Limb::wheel_r},
-      {"IK-WR2", "theta_r5", -40 * kDeg, 15 * kDeg, 0.1 * kDeg, true, Limb::wheel_r},
-  };
+const std::vector<IkSweep>& model_ik_sweeps() {
+  static const std::vector<IkSweep> sweeps = [] {
+    std::vector<IkSweep> out;
+    for (const auto& sw : gen::kIkSweeps)
+      out.push_back({std::string(sw.id), std::string(gen::kCoordinateNames[static_cast<std::size_t>(sw.input)]), sw.from, sw.to,
+                     sw.step, sw.degrees, sw.limb});
+    return out;
+  }();
   return sweeps;
 }
 
 const IkSweep* find_ik_sweep(const std::string& id) {
-  for (const auto& s : thesis_ik_sweeps())
+  for (const auto& s : model_ik_sweeps())
     if (s.id == id) return &s;
   return nullptr;
 }
 
 Coordinates ik_sweep_inputs() {
-  Coordinates s = nominal_inputs();
-  s(c::z_Wr) = 0.0;
+  Coordinates s = Coordinates::Zero();
+  for (int k = 0; k < kInputCount; ++k) s(k) = gen::kSweepStart[static_cast<std::size_t>(k)];
   return s;
 }
 
 LimbCheck analytic_check(const Model& model, Limb limb, const Coordinates& s, Data& data) {
   forward_kinematics(model, s, data);
   LimbCheck check;
-  switch (limb) {
-    case Limb::leg_l:
-    case Limb::leg_r: {
-      const bool left = limb == Limb::leg_l;
-      const Eigen::Vector3d target = left ? Eigen::Vector3d(s(c::x_Fl), s(c::y_Fl), s(c::z_Fl))
-                                          : Eigen::Vector3d(s(c::x_Fr), s(c::y_Fr), s(c::z_Fr));
-      check.position_error = (frame_position(data, left ? gen::frame::F_l : gen::frame::F_r) - target).norm();
-      break;
-    }
-    case Limb::wheel_l:
-    case Limb::wheel_r: {
-      const bool left = limb == Limb::wheel_l;
-      const int f = left ? gen::frame::W_l : gen::frame::W_r;
-      check.position_error = std::abs(frame_position(data, f).z() - s(left ? c::z_Wl : c::z_Wr));
-      const Eigen::Matrix3d& R = frame_rotation(data, f);
-      check.level_error = std::max(std::abs(R(2, 0)), std::abs(R(2, 1)));
-      break;
+  double squared = 0;
+  const LimbBlock b = limb_block(limb);
+  for (int i = 0; i < b.size; ++i) {
+    const gen::ClosureRowInfo& row = gen::kClosureRows[static_cast<std::size_t>(b.rows[static_cast<std::size_t>(i)])];
+    if (row.kind == gen::RowKind::point) {
+      const double e = frame_position(data, row.frame)(row.axis) - s(row.target);
+      squared += e * e;
+    } else if (row.kind == gen::RowKind::level) {
+      check.level_error = std::max(check.level_error, std::abs(frame_rotation(data, row.frame)(2, row.axis)));
     }
   }
+  check.position_error = std::sqrt(squared);
   return check;
 }
 
@@ -106,8 +83,8 @@ IkSweepResult run_ik_sweep(const Model& model, const IkSweep& sweep, Data& data)
     solve_ik_closed_form(model, s);
     pt.closed_form = s;
     pt.check_closed_form = analytic_check(model, sweep.limb, s, data);
-    pt.contacts << data.frame_positions(0, gen::frame::W_l), data.frame_positions(1, gen::frame::W_l),
-        data.frame_positions(0, gen::frame::W_r), data.frame_positions(1, gen::frame::W_r);
+    for (int w = 0; w < 2; ++w)
+      pt.contacts.segment<2>(2 * w) = data.frame_positions.col(gen::kWheels[static_cast<std::size_t>(w)].contact_frame).head<2>();
 
     Coordinates n = warm;  // continuation: start from the previous point's Newton solution
     n(input) = pt.value;

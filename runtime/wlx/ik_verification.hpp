@@ -1,6 +1,7 @@
-// The thesis' verification of the inverse kinematics (thesis 3.4, MODEL.md section 8): sweep
-// one input, solve the dependent joints, put them back into the forward kinematics and measure
-// the distance to the target; here with both the closed form and Newton's method.
+// The verification of the inverse kinematics (the thesis' method, thesis 3.4): sweep one input,
+// solve the dependent joints, put them back into the forward kinematics and measure the distance
+// to the target; here with both the closed form and Newton's method. The sweeps are the model
+// file's (gen::kIkSweeps).
 #pragma once
 
 #include "wlx/ik.hpp"
@@ -15,22 +16,22 @@ struct IkSweep {
   std::string input;   // MODEL.md name of the swept input
   double from = 0, to = 0, step = 0;  // SI units (radians for angles)
   bool degrees = false;               // the thesis quotes this sweep in degrees
-  Limb limb = Limb::leg_l;
+  Limb limb = 0;
   // Number of points, both ends included.
   int points() const;
   double value(int k) const;
 };
 
-// The 12 sweeps of MODEL.md section 8.
-const std::vector<IkSweep>& thesis_ik_sweeps();
+// The model's sweeps (its file's ik_sweeps).
+const std::vector<IkSweep>& model_ik_sweeps();
 const IkSweep* find_ik_sweep(const std::string& id);
 
-// The initial state of the IK sweeps: MODEL.md section 8 with z_Wr = 0.
+// The initial state of the IK sweeps (the model file's ik_sweeps.start).
 Coordinates ik_sweep_inputs();
 
 // The analytic check of one limb: put the solution into the generated forward kinematics and
-// measure the target error. Legs: |r_F - target| (m). Wheels: |z of r_W - z_W| (m), and the
-// level conditions |(R e_x).e_z|, |(R e_y).e_z| (dimensionless) reported separately.
+// measure the target error: over the limb's point rows the distance |r_F - target| (m), over its
+// level rows the largest |(R e_axis).e_z| (dimensionless), reported separately.
 struct LimbCheck {
   double position_error = 0;  // m
   double level_error = 0;     // wheels only

@@ -31,7 +31,7 @@ void reduce(Data& d) {
     Eigen::Matrix<double, 4, 2> rhs = Eigen::Matrix<double, 4, 2>::Zero();
     for (int j = 0; j < b.size; ++j) {
       const int joint = b.joints[static_cast<std::size_t>(j)];
-      for (int i = 0; i < b.size; ++i) block(i, j) = d.dPhi_ds(b.first_row + i, joint);
+      for (int i = 0; i < b.size; ++i) block(i, j) = d.dPhi_ds(b.rows[static_cast<std::size_t>(i)], joint);
       rhs.row(j) = d.C.col(joint).transpose();
     }
     auto& inverse = d.limb_inverse[static_cast<std::size_t>(limb)];
@@ -43,10 +43,10 @@ void reduce(Data& d) {
                   fmt::format("the closure Jacobian of this limb is singular (reciprocal condition {:.2g}): {}; its joint "
                               "rates are undefined here",
                               std::isfinite(rcond) ? rcond : 0.0,  // an exactly singular block inverts to inf/NaN
-                              b.size == 3 ? "the leg is stretched straight or folded, or its hip yaw is at 90 deg"
-                                          : "the lever stands at 90 deg to the level or is straddled to 90 deg"));
+                              "its joints cannot move its targets in every direction here (a chain stretched straight "
+                              "or folded, or two joint axes aligned)"));
     const Eigen::Matrix<double, 4, 2> lambda = inverse.transpose().lazyProduct(rhs);
-    for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.first_row + i) = lambda.row(i);
+    for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.rows[static_cast<std::size_t>(i)]) = lambda.row(i);
   }
   d.C_reduced = d.C.leftCols<kNq>() - d.wheel_adjoint.transpose().lazyProduct(d.dPhi_ds.leftCols<kNq>());
 }
@@ -56,7 +56,7 @@ void solve_closure(const Data& d, const gen::ClosureVector& v, Coordinates& out)
   for (Limb limb : kLimbs) {
     const LimbBlock b = limb_block(limb);
     Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
-    for (int i = 0; i < b.size; ++i) rhs(i) = -v(b.first_row + i);
+    for (int i = 0; i < b.size; ++i) rhs(i) = -v(b.rows[static_cast<std::size_t>(i)]);
     const Eigen::Vector4d x = d.limb_inverse[static_cast<std::size_t>(limb)] * rhs;
     for (int j = 0; j < b.size; ++j) out(b.joints[static_cast<std::size_t>(j)]) = x(j);
   }
@@ -165,7 +165,7 @@ Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& 
   for (Limb limb : kLimbs) {
     const LimbBlock b = limb_block(limb);
     Eigen::Matrix4d block_rhs = Eigen::Matrix4d::Zero();
-    for (int i = 0; i < b.size; ++i) block_rhs.row(i) = -rhs.row(b.first_row + i);
+    for (int i = 0; i < b.size; ++i) block_rhs.row(i) = -rhs.row(b.rows[static_cast<std::size_t>(i)]);
     const Eigen::Matrix4d x = d.limb_inverse[static_cast<std::size_t>(limb)].lazyProduct(block_rhs);
     for (int j = 0; j < b.size; ++j) T.row(b.joints[static_cast<std::size_t>(j)]) = x.row(j);
   }

@@ -16,6 +16,7 @@
 
 namespace wlx {
 
+static_assert(gen::kMaxLimbSize <= 4, "the limb blocks are inverted as 4 x 4 matrices");
 static_assert(gen::kWheelCount == 2, "the non-holonomic solve is written for two wheels (a 2 x 2 J_beta)");
 
 // The two input rates that the wheel constraints determine. The model file names the candidates

@@ -78,8 +78,8 @@ TEST_CASE("cli: bad input gets a message naming the field and exit code 2") {
   r = run_wlx("ik", R"({"x_Fl": 7})");
   CHECK(r.code == 2);
   CHECK(r.err ==
-        "wlx: error: left leg: foot is 5.8523 m from the hip, reach is [0.5000, 3.5000] m (|thighD - legD| to thighD + "
-        "legD)\n");
+        "wlx: error: left leg: F_l out of reach: its target is 5.8523 m from the meeting point of the axes of psi_l2 and "
+        "psi_l3, and F_l reaches [0.5000, 3.5000] m from it\n");
   r = run_wlx("ik", R"({"params": {"thighd": 2}})");
   CHECK(r.err == "wlx: error: params.thighd: unknown key; did you mean 'thighD'?\n");
   r = run_wlx("ik", R"({"params": {"w": 0}})");
@@ -105,7 +105,7 @@ TEST_CASE("cli: wlx ik --batch answers line by line and keeps going after a bad 
   REQUIRE(out.size() == 3);
   CHECK(out[0].contains("psi_l2"));
   CHECK(out[1].at("line") == 2);
-  CHECK(out[1].at("error").get<std::string>().rfind("left leg: foot is", 0) == 0);
+  CHECK(out[1].at("error").get<std::string>().rfind("left leg: F_l out of reach", 0) == 0);
   CHECK(out[2].at("closure_residual").get<double>() <= 1e-13);
   // Warm start from line 1: a small step needs few iterations.
   CHECK(out[2].at("iterations").at("leg_l").get<int>() <= 4);
@@ -160,7 +160,7 @@ TEST_CASE("cli: wlx simulate overrides, errors, and a run that fails midway") {
   r = run_wlx("simulate " + file.string() + " --out " + dir.string());
   CHECK(r.code == 2);
   CHECK(r.err.find("wlx: error: stopped at t = ") == 0);
-  CHECK(r.err.find("leg: foot is") != std::string::npos);
+  CHECK(r.err.find("leg: F_l out of reach") != std::string::npos);
   const std::string csv = slurp(dir / "trajectory.csv");
   const auto rows = std::count(csv.begin(), csv.end(), '\n');
   CHECK(rows > 10);

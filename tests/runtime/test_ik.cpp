@@ -74,10 +74,10 @@ TEST_CASE("ik: legs, 10^4 random reachable poses, every branch, closed form and 
   int recovered = 0, newton_branch_kept = 0, solved = 0, clear_count = 0;
   for (int trial = 0; trial < 10000; ++trial) {
     const Coordinates original = random_leg_pose(rng, model, data);
-    for (Limb limb : {Limb::leg_l, Limb::leg_r}) {
-      const int first = limb == Limb::leg_l ? c::psi_l2 : c::psi_r2;
+    for (Limb limb : {gen::limb::leg_l, gen::limb::leg_r}) {
+      const int first = limb == gen::limb::leg_l ? c::psi_l2 : c::psi_r2;
       const int true_branch = classify_branch(model, limb, original);
-      for (int b = 0; b < kLegBranchCount; ++b) {
+      for (int b = 0; b < branch_count(gen::limb::leg_l); ++b) {
         Coordinates s = original;
         solve_limb_closed_form(model, limb, b, s);
         const double e = analytic_check(model, limb, s, data).position_error;
@@ -129,8 +129,8 @@ TEST_CASE("ik: wheels, 10^4 random reachable poses, all 8 branches, closed form 
   int solved = 0;
   for (int trial = 0; trial < 10000; ++trial) {
     const Coordinates original = random_wheel_pose(rng, model, data);
-    for (Limb limb : {Limb::wheel_l, Limb::wheel_r}) {
-      for (int b = 0; b < kWheelBranchCount; ++b) {
+    for (Limb limb : {gen::limb::wheel_l, gen::limb::wheel_r}) {
+      for (int b = 0; b < branch_count(gen::limb::wheel_l); ++b) {
         Coordinates s = original;
         try {
           solve_limb_closed_form(model, limb, b, s);
@@ -144,8 +144,8 @@ TEST_CASE("ik: wheels, 10^4 random reachable poses, all 8 branches, closed form 
         worst_cf = std::max(worst_cf, check.position_error);
         worst_level = std::max(worst_level, check.level_error);
         CHECK(classify_branch(model, limb, s) == b);
-        const int first = limb == Limb::wheel_l ? c::theta_l2 : c::theta_r2;
-        CHECK(s(first + 2) == -s(limb == Limb::wheel_l ? c::theta_l5 : c::theta_r5));  // parallel guidance
+        const int first = limb == gen::limb::wheel_l ? c::theta_l2 : c::theta_r2;
+        CHECK(s(first + 2) == -s(limb == gen::limb::wheel_l ? c::theta_l5 : c::theta_r5));  // parallel guidance
         Coordinates n = s;
         for (int j = 0; j < 4; ++j) n(first + j) += 0.02 * std::cos(3.0 * trial + j + b);
         solve_limb_newton(model, limb, n, data);
@@ -154,7 +154,7 @@ TEST_CASE("ik: wheels, 10^4 random reachable poses, all 8 branches, closed form 
         // Away from the singular poses (lever straddled to 90 deg, lever at +-90 deg from level,
         // camber at 90 deg) Newton started 0.02 rad off must come back to the same branch.
         const double phi = std::atan2(-std::sin(s(c::pitch)), std::cos(s(c::pitch)) * std::cos(s(c::roll)));
-        const int th5 = limb == Limb::wheel_l ? c::theta_l5 : c::theta_r5;
+        const int th5 = limb == gen::limb::wheel_l ? c::theta_l5 : c::theta_r5;
         if (std::abs(std::cos(s(th5))) > 0.1 && std::abs(std::cos(s(first + 3) - phi)) > 0.1 &&
             std::abs(std::cos(s(first))) > 0.1)
           CHECK(classify_branch(model, limb, n) == b);
@@ -180,7 +180,7 @@ TEST_CASE("ik: workspace boundaries give finite solutions, never NaN") {
     solve_ik_closed_form(model, s);
     CHECK(s.allFinite());
     CHECK(s(c::psi_l4) == 0.0);
-    CHECK(analytic_check(model, Limb::leg_l, s, data).position_error <= 1e-12);
+    CHECK(analytic_check(model, gen::limb::leg_l, s, data).position_error <= 1e-12);
   }
   SUBCASE("folded leg: foot exactly |thighD - legD| from the hip") {
     Coordinates s = nominal_inputs();
@@ -189,7 +189,7 @@ TEST_CASE("ik: workspace boundaries give finite solutions, never NaN") {
     solve_ik_closed_form(model, s);
     CHECK(s.allFinite());
     CHECK(std::abs(s(c::psi_l4)) == doctest::Approx(kPi));
-    CHECK(analytic_check(model, Limb::leg_l, s, data).position_error <= 1e-12);
+    CHECK(analytic_check(model, gen::limb::leg_l, s, data).position_error <= 1e-12);
   }
   SUBCASE("lever at its reach limits (theta_6 - (theta_3 + theta_6) = +-90 deg)") {
     for (double z : {2.0 - p.w - p.wl, 2.0 - p.w + p.wl}) {
@@ -198,7 +198,7 @@ TEST_CASE("ik: workspace boundaries give finite solutions, never NaN") {
       solve_ik_closed_form(model, s);
       CHECK(s.allFinite());
       CHECK(std::abs(s(c::theta_l6)) == doctest::Approx(kPi / 2));
-      CHECK(analytic_check(model, Limb::wheel_l, s, data).position_error <= 1e-12);
+      CHECK(analytic_check(model, gen::limb::wheel_l, s, data).position_error <= 1e-12);
     }
   }
 }
@@ -206,7 +206,7 @@ TEST_CASE("ik: workspace boundaries give finite solutions, never NaN") {
 TEST_CASE("ik: the thesis sweeps are continuous and stay on the default branch") {
   const Model model;
   Data data;
-  for (const IkSweep& sweep : thesis_ik_sweeps()) {
+  for (const IkSweep& sweep : model_ik_sweeps()) {
     CAPTURE(sweep.id);
     const IkSweepResult r = run_ik_sweep(model, sweep, data);
     double largest_jump = 0;
@@ -254,24 +254,28 @@ TEST_CASE("ik: errors name the limb, the distance and the reach") {
   Data data;
   Coordinates s = nominal_inputs();
   s(c::x_Fl) = 7.0;
+  // |(7 - 1.5, 1.5 - 1.5, 0 - 2)| = 5.8523 from the hip at (1.5, 1.5, 2); reach |2 - 1.5| to 2 + 1.5.
   CHECK(error_of([&] { solve_ik_closed_form(model, s); }) ==
-        "left leg: foot is 5.8523 m from the hip, reach is [0.5000, 3.5000] m (|thighD - legD| to thighD + legD)");
+        "left leg: F_l out of reach: its target is 5.8523 m from the meeting point of the axes of psi_l2 and psi_l3, and "
+        "F_l reaches [0.5000, 3.5000] m from it");
   s = nominal_inputs();
   s(c::x_Fr) = 1.5;
   s(c::y_Fr) = -1.5;
   s(c::z_Fr) = 1.8;
   CHECK(error_of([&] { solve_ik_closed_form(model, s); }) ==
-        "right leg: foot is 0.2000 m from the hip, reach is [0.5000, 3.5000] m (|thighD - legD| to thighD + legD)");
+        "right leg: F_r out of reach: its target is 0.2000 m from the meeting point of the axes of psi_r2 and psi_r3, and "
+        "F_r reaches [0.5000, 3.5000] m from it");
   s = nominal_inputs();
   s(c::z_Wr) = 4.5;
+  // Level cabin at z_C = 2: the contact is at 2 - w + wl sin(theta_6), in [2 - 0.5 - 2.5, 2 - 0.5 + 2.5].
   CHECK(error_of([&] { solve_ik_closed_form(model, s); }) ==
-        "right wheel: ground level z_Wr = 4.5000 m is out of the lever's reach: for this cabin pose and theta_r5 = "
-        "0.00 deg the contact point reaches z_Wr in [-1.0000, 4.0000] m");
+        "right wheel: z_Wr = 4.5000 m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, theta_r5 as given, the z of "
+        "W_r reaches [-1.0000, 4.0000] m");
   s = nominal_inputs();
   s(c::roll) = std::numeric_limits<double>::quiet_NaN();
   CHECK(error_of([&] { solve_ik_closed_form(model, s); }) == "roll: must be a finite number, got nan");
   s = nominal_inputs();
-  CHECK(error_of([&] { solve_limb_closed_form(model, Limb::wheel_l, 8, s); }) ==
+  CHECK(error_of([&] { solve_limb_closed_form(model, gen::limb::wheel_l, 8, s); }) ==
         "branch: left wheel has branches 0 to 7, got 8");
   s = nominal_inputs();
   s(c::x_Fl) = 3.0;  // reachable, but one iteration from zero joints is not enough
@@ -289,8 +293,9 @@ TEST_CASE("ik: a foot within the distance range but too far beside the hip's pit
   s(c::x_Fl) = 2.0;
   s(c::y_Fl) = 0;
   s(c::z_Fl) = 0;
+  // |d| = |(0.5, -1.5, 0)| = 1.5811 fixes the knee at 128.68 deg; the foot is then at most
+  // |thighD + legD cos(psi_4)| = 1.0625 m off the hip's pitch plane, but y = -1.5.
   CHECK(error_of([&] { solve_ik_closed_form(model, s); }) ==
-        "left leg: foot out of reach: at 1.5811 m from the hip the knee must bend to psi_l4 = 128.68 deg, and the foot "
-        "can then be at most 1.0625 m beside the hip's pitch plane (the plane after the hip roll psi_l1), but it is "
-        "1.5000 m beside it");
+        "left leg: F_l out of reach: with psi_l4 at 128.68 deg (set by the target's distance) it reaches at most 1.0625 m "
+        "off the plane normal to the axis of psi_l2 (through the meeting point), but its target is 1.5000 m off it");
 }

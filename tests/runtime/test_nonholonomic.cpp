@@ -159,7 +159,7 @@ TEST_CASE("nonholonomic: a limb at a singular pose is named") {
     FAIL("no error at a straight leg");
   } catch (const Error& e) {
     CHECK(e.field() == "left leg");
-    CHECK(std::string(e.what()).find("the leg is stretched straight or folded") != std::string::npos);
+    CHECK(std::string(e.what()).find("a chain stretched straight or folded") != std::string::npos);
   }
 }
 

@@ -84,7 +84,7 @@ TEST_CASE("simulation: a run that becomes unreachable stops, keeps its samples a
   REQUIRE(!tr.samples.empty());
   CHECK(tr.samples.size() < 1001);
   CHECK(tr.error.find("stopped at t = ") == 0);
-  CHECK(tr.error.find("leg: foot is") != std::string::npos);
+  CHECK(tr.error.find("leg: F_l out of reach") != std::string::npos);
   for (const auto& smp : tr.samples) CHECK(smp.s.allFinite());
 }
 

@@ -1,0 +1,737 @@
+// Closed-form inverse kinematics, derived from the model's own chains (the way IKFast does it for
+// arms, for the limb types of walking machines) and emitted as straight-line C++ with a few calls
+// of two small solvers, with every branch.
+//
+// Patterns (each checks its preconditions on the symbolic chain; a limb that matches none is
+// reported by wlx-gen and solved by Newton's method at run time):
+//
+// point3 (a leg): the limb's three rows put one frame's origin at three input targets (x, y, z);
+//   three revolute joints drive it; the first two are consecutive steps about different axes (so
+//   their axes meet), and nothing input-driven follows the first. With d the target in the frame
+//   before the first joint, |d|^2 depends on the third joint alone: K + A cos q3 + B sin q3 = |d|^2
+//   (bit 0 picks the root); then R_a(q1) R_b(q2) v(q3) = d is two rotations about principal axes
+//   (bit 1 picks q2's root). Any fixed offsets and fixed turns between and after the joints.
+//
+// leveled lever (a wheel lever): one point row (a component of a frame's origin equals an input),
+//   two level rows on that frame (two of its axes horizontal) and sum rows that each fix one joint
+//   linearly from inputs (a parallel guidance). After the couplings, the frame's orientation from
+//   the first dependent joint on reduces to R_pre R_a(q_p + q_q) R_b(q_b), R_pre known: the level
+//   rows make the third axis vertical, two rotations again (bit 1: q_b's root, bit 2: the root of
+//   q_p + q_q), and the point row is then a cos q_p + b sin q_p = c (bit 0).
+//
+// Roots: branch 0 takes, in every equation, the root nearest the joint's zero (largest cosine; on
+// a tie the positive angle); a set bit takes the other root. Every solve ends by evaluating the
+// limb's own closure rows at the solution: a residual above kIkTolerance is reported, never
+// returned as a solution.
+#include "derivations.hpp"
+#include "emit.hpp"
+#include "printer.hpp"
+
+#include <fmt/format.h>
+
+#include <set>
+
+namespace wlx::codegen {
+
+namespace {
+
+using GiNaC::realsymbol;
+using namespace detail;
+
+struct Unsolvable {
+  std::string reason;
+};
+
+const char* axis_name(Axis a) { return a == Axis::X ? "x" : a == Axis::Y ? "y" : "z"; }
+
+// Every step from K0 to the frame, parents first.
+std::vector<ChainStep> full_chain(const Model& m, const std::string& frame) {
+  std::vector<const NamedFrame*> path;
+  for (std::string f = frame; f != "K0";) {
+    const NamedFrame& nf = m.frames[static_cast<std::size_t>(m.frame_index(f))];
+    path.push_back(&nf);
+    f = nf.parent;
+  }
+  std::vector<ChainStep> out;
+  for (auto it = path.rbegin(); it != path.rend(); ++it) out.insert(out.end(), (*it)->chain.begin(), (*it)->chain.end());
+  return out;
+}
+
+Frame apply(const Model& m, const Frame& f, const ChainStep& st) {
+  switch (st.kind) {
+    case ChainStep::Kind::Translate: return f.translated(st.offset);
+    case ChainStep::Kind::Rotate: return f.rotated(st.axis, m.coordinates[static_cast<std::size_t>(st.coordinate)]);
+    case ChainStep::Kind::Slide: return f.slid(st.axis, m.coordinates[static_cast<std::size_t>(st.coordinate)]);
+    case ChainStep::Kind::Turn: return f.turned(st.axis, st.angle);
+  }
+  return f;
+}
+
+bool driven(const ChainStep& st) { return st.kind == ChainStep::Kind::Rotate || st.kind == ChainStep::Kind::Slide; }
+
+// A rotation whose angle is an expression, for reducing orientation chains.
+struct Rot {
+  Axis axis;
+  ex angle;
+};
+
+// Adjacent rotations about the same axis add up; zero angles vanish (so a coupling q4 = -q5 between
+// Rz(q5) Rz(q4) leaves nothing, and the rotations on both sides may then merge).
+std::vector<Rot> merge(const std::vector<Rot>& seq) {
+  std::vector<Rot> out;
+  for (const Rot& r : seq) {
+    if (!out.empty() && out.back().axis == r.axis) out.back().angle = (out.back().angle + r.angle).expand();
+    else out.push_back({r.axis, r.angle.expand()});
+    if (out.back().angle.is_zero()) out.pop_back();
+  }
+  return out;
+}
+
+Mat3 product(const std::vector<Rot>& seq) {
+  Mat3 R = Mat3::identity();
+  for (const Rot& r : seq) R = R * rot(r.axis, r.angle);
+  return R;
+}
+
+Mat3 transpose(const Mat3& a) {
+  Mat3 t;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) t(i, j) = a(j, i);
+  return t;
+}
+
+// a cos q + b sin q + c = e, for e linear in cos q and sin q; throws otherwise.
+struct Sinusoid {
+  ex a, b, c;
+};
+Sinusoid sinusoid(const ex& e, const realsymbol& q, const std::string& what) {
+  const realsymbol C("ik_cos"), S("ik_sin");
+  const ex f = e.subs(GiNaC::lst{GiNaC::cos(q) == C, GiNaC::sin(q) == S});
+  if (f.has(q)) throw Unsolvable{what + " depends on " + q.get_name() + " other than through its sine and cosine"};
+  Sinusoid out;
+  out.c = f.subs(GiNaC::lst{C == 0, S == 0});
+  out.a = f.subs(GiNaC::lst{C == 1, S == 0}) - out.c;
+  out.b = f.subs(GiNaC::lst{C == 0, S == 1}) - out.c;
+  if (!(f - (out.a * C + out.b * S + out.c)).expand().is_zero())
+    throw Unsolvable{what + " is not of the form a cos " + q.get_name() + " + b sin " + q.get_name() + " + c"};
+  return out;
+}
+
+// The generated code of one limb's solve: stages of named values (expressions of the inputs, the
+// parameters and earlier stages' results) each followed by code calling a solver.
+struct Stage {
+  std::vector<std::pair<realsymbol, ex>> locals;
+  std::string code;
+  std::vector<std::string> defines;  // the variables its code computes (usable from the next stage on)
+};
+
+struct SolvedJoint {
+  int coordinate;
+  realsymbol q, c, s;  // value, cosine, sine in the generated code
+};
+
+struct Solve {
+  std::string pattern;
+  std::string summary;  // one line for wlx-gen's report
+  std::vector<std::string> doc;
+  int branches = 1;
+  std::vector<std::string> bits;  // meaning of each branch bit
+  std::vector<std::string> failures;  // message template of each failing stage (1-based in IkDiagnostics)
+  std::vector<Stage> stages;
+  std::vector<SolvedJoint> joints;
+  std::vector<std::pair<int, ex>> coupled;  // joints fixed by a sum row: coordinate, value
+};
+
+SolvedJoint joint_symbols(const Model& m, int coordinate) {
+  const std::string n = m.coordinates[static_cast<std::size_t>(coordinate)].name;
+  return {coordinate, realsymbol("ik_q_" + n), realsymbol("ik_c_" + n), realsymbol("ik_s_" + n)};
+}
+
+// An expression in the model's symbols, rewritten in the solve's results: sines and cosines of the
+// solved joints by their computed values, the joints themselves by theirs, coupled joints by
+// their expressions.
+ex in_results(const Model& m, ex e, const Solve& solve) {
+  for (const auto& [k, value] : solve.coupled) {
+    // GiNaC keeps sin(-x) as it is: write it -sin(x), so that the sine comes from the batched pass.
+    const ex q = m.coordinates[static_cast<std::size_t>(k)].q, negated = (-value).expand();
+    e = e.subs(GiNaC::lst{GiNaC::sin(q) == -GiNaC::sin(negated), GiNaC::cos(q) == GiNaC::cos(negated)});
+    e = e.subs(q == value);
+  }
+  GiNaC::lst trig, plain;
+  for (const SolvedJoint& j : solve.joints) {
+    const ex q = m.coordinates[static_cast<std::size_t>(j.coordinate)].q;
+    trig.append(GiNaC::sin(q) == j.s);
+    trig.append(GiNaC::cos(q) == j.c);
+    plain.append(q == j.q);
+  }
+  return e.subs(trig).subs(plain);
+}
+
+std::string two_axis_call(Axis a, Axis b, const std::string& v, const std::string& d, const std::string& flip,
+                          const SolvedJoint& first, const SolvedJoint& second) {
+  return fmt::format(
+      "  double {0}, {1}, {2}, {3}, {4}, {5}, ik_beside = 0, ik_room = 0;\n"
+      "  const bool ik_two_axis_ok = ik_solve_two_axis<{6}, {7}>({8}, {9}, {10}, {0}, {1}, {2}, {3}, {4}, {5}, ik_beside, ik_room);\n",
+      first.q.get_name(), first.c.get_name(), first.s.get_name(), second.q.get_name(), second.c.get_name(),
+      second.s.get_name(), static_cast<int>(a), static_cast<int>(b), v, d, flip);
+}
+
+// ---- point3 -------------------------------------------------------------------------------------
+
+Solve plan_point3(const Model& m, const Limb& limb) {
+  const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
+  if (limb.rows.size() != 3) throw Unsolvable{"point3 needs three point rows"};
+  std::string frame;
+  std::array<int, 3> target{-1, -1, -1};
+  for (int r : limb.rows) {
+    const ClosureCondition& c = m.closure[static_cast<std::size_t>(r)];
+    if (c.kind != ClosureCondition::Kind::PointEqualsCoordinate) throw Unsolvable{"point3: row " + c.name + " is not a point row"};
+    if (!frame.empty() && c.frame != frame) throw Unsolvable{"point3: the rows place different frames"};
+    frame = c.frame;
+    auto& t = target[static_cast<std::size_t>(c.axis)];
+    if (t >= 0) throw Unsolvable{"point3: two rows fix the same component"};
+    t = c.target;
+  }
+  const std::vector<ChainStep> chain = full_chain(m, frame);
+  std::vector<std::size_t> at;
+  for (std::size_t i = 0; i < chain.size(); ++i)
+    if (driven(chain[i]) && chain[i].coordinate >= m.input_count) {
+      if (chain[i].kind == ChainStep::Kind::Slide) throw Unsolvable{"point3: " + name(chain[i].coordinate) + " is prismatic"};
+      at.push_back(i);
+    }
+  if (at.size() != 3) throw Unsolvable{fmt::format("point3: {} dependent joints drive {}, not 3", at.size(), frame)};
+  const ChainStep &j1 = chain[at[0]], &j2 = chain[at[1]], &j3 = chain[at[2]];
+  if (at[1] != at[0] + 1)
+    throw Unsolvable{"point3: " + name(j1.coordinate) + " and " + name(j2.coordinate) + " are not consecutive steps, so their axes need not meet"};
+  if (j1.axis == j2.axis) throw Unsolvable{"point3: " + name(j1.coordinate) + " and " + name(j2.coordinate) + " turn about the same axis"};
+  for (std::size_t i = at[0] + 1; i < chain.size(); ++i)
+    if (driven(chain[i]) && chain[i].coordinate < m.input_count)
+      throw Unsolvable{"point3: input " + name(chain[i].coordinate) + " moves the chain after " + name(j1.coordinate)};
+
+  Frame base = Frame::ground(), mid = Frame::ground(), tip = Frame::ground();
+  for (std::size_t i = 0; i < at[0]; ++i) base = apply(m, base, chain[i]);
+  for (std::size_t i = at[1] + 1; i < at[2]; ++i) mid = apply(m, mid, chain[i]);
+  for (std::size_t i = at[2] + 1; i < chain.size(); ++i) tip = apply(m, tip, chain[i]);
+
+  Solve solve;
+  solve.pattern = "point3";
+  const SolvedJoint q1 = joint_symbols(m, j1.coordinate), q2 = joint_symbols(m, j2.coordinate), q3 = joint_symbols(m, j3.coordinate);
+  solve.joints = {q1, q2, q3};
+  const std::string n1 = name(j1.coordinate), n2 = name(j2.coordinate), n3 = name(j3.coordinate);
+  solve.summary = fmt::format("point3: {} at (x, y, z) = ({}, {}, {}) by {} ({}), {} ({}) with meeting axes, then {} ({})", frame,
+                              name(target[0]), name(target[1]), name(target[2]), n1, axis_name(j1.axis), n2, axis_name(j2.axis), n3,
+                              axis_name(j3.axis));
+  solve.doc = {
+      fmt::format("Pattern point3: the origin of {} at the targets ({}, {}, {}), placed by the joints {} and {}", frame,
+                  name(target[0]), name(target[1]), name(target[2]), n1, n2),
+      fmt::format("(about {} and {}, consecutive: their axes meet) and {} (about {}). The distance from the", axis_name(j1.axis),
+                  axis_name(j2.axis), n3, axis_name(j3.axis)),
+      fmt::format("meeting point to the target fixes {}; then {} and {} turn the limb onto it.", n3, n2, n1)};
+  solve.branches = 4;
+  solve.bits = {fmt::format("bit 0: the other root of {} (branch 0: the root nearest zero; on a tie the positive one)", n3),
+                fmt::format("bit 1: the other root of {} (branch 0: |{}| <= 90 deg where that solves)", n2, n2)};
+  solve.failures = {
+      fmt::format("{} out of reach: its target is {{value:.4f}} m from the meeting point of the axes of {} and {}, and "
+                  "{} reaches [{{low:.4f}}, {{high:.4f}}] m from it",
+                  frame, n1, n2, frame),
+      fmt::format("{} out of reach: with {} at {{aux:.2f}} deg (set by the target's distance) it reaches at most "
+                  "{{high:.4f}} m off the plane normal to the axis of {} (through the meeting point), but its target is "
+                  "{{value:.4f}} m off it",
+                  frame, n3, n1)};
+
+  // Stage 0: the target in the base frame; |d|^2 = K + A cos q3 + B sin q3.
+  Stage s0;
+  const realsymbol d[3] = {realsymbol("ik_d0"), realsymbol("ik_d1"), realsymbol("ik_d2")};
+  for (int i = 0; i < 3; ++i) {
+    ex di = 0;
+    for (int k = 0; k < 3; ++k)
+      di += base.R(k, i) * (m.coordinates[static_cast<std::size_t>(target[static_cast<std::size_t>(k)])].q - base.r[k]);
+    s0.locals.emplace_back(d[i], di);
+  }
+  const Vec3 p1 = mid.r, p2 = tip.r;
+  const ex K = dot(p1, p1) + dot(p2, p2);
+  const realsymbol angle("ik_angle");
+  const Sinusoid cross = sinusoid(2 * dot(p1, mid.R * (rot(j3.axis, angle) * p2)), angle, "the distance");
+  const realsymbol K_("ik_K"), A_("ik_A"), B_("ik_B");
+  s0.locals.emplace_back(K_, K);
+  s0.locals.emplace_back(A_, cross.a);
+  s0.locals.emplace_back(B_, cross.b);
+  s0.code = fmt::format(
+      "  const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;\n"
+      "  double {0}, {1}, {2};\n"
+      "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, {0}, {1}, {2})) {{\n"
+      "    const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
+      "    why = {{1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
+      "    return IkStatus::out_of_reach;\n"
+      "  }}\n",
+      q3.q.get_name(), q3.c.get_name(), q3.s.get_name());
+  s0.defines = {q3.q.get_name(), q3.c.get_name(), q3.s.get_name()};
+  solve.stages.push_back(s0);
+
+  // Stage 1: v = p1 + M R_c(q3) p2 in the frame after q2; two rotations take it onto d.
+  Stage s1;
+  const Vec3 v = p1 + mid.R * (rot(j3.axis, m.coordinates[static_cast<std::size_t>(j3.coordinate)].q) * p2);
+  const realsymbol vs[3] = {realsymbol("ik_v0"), realsymbol("ik_v1"), realsymbol("ik_v2")};
+  for (int i = 0; i < 3; ++i) s1.locals.emplace_back(vs[i], in_results(m, v[i], solve));
+  s1.code = "  const double ik_v[3] = {ik_v0, ik_v1, ik_v2};\n  const double ik_d[3] = {ik_d0, ik_d1, ik_d2};\n" +
+            two_axis_call(j1.axis, j2.axis, "ik_v", "ik_d", "(branch & 2) != 0", q1, q2) +
+            fmt::format("  if (!ik_two_axis_ok) {{\n    why = {{2, ik_beside, 0.0, ik_room, {} * 57.29577951308232}};\n"
+                        "    return IkStatus::out_of_reach;\n  }}\n",
+                        q3.q.get_name());
+  s1.defines = {q1.q.get_name(), q1.c.get_name(), q1.s.get_name(), q2.q.get_name(), q2.c.get_name(), q2.s.get_name()};
+  solve.stages.push_back(s1);
+  return solve;
+}
+
+// ---- leveled lever ------------------------------------------------------------------------------
+
+Solve plan_lever(const Model& m, const Limb& limb) {
+  using K = ClosureCondition::Kind;
+  const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
+  const ClosureCondition* point = nullptr;
+  std::vector<const ClosureCondition*> level;
+  Solve solve;
+  solve.pattern = "leveled-lever";
+  std::set<int> remaining(limb.joints.begin(), limb.joints.end());
+  for (int r : limb.rows) {
+    const ClosureCondition& c = m.closure[static_cast<std::size_t>(r)];
+    if (c.kind == K::PointEqualsCoordinate) {
+      if (point != nullptr) throw Unsolvable{"leveled lever: more than one point row"};
+      point = &c;
+    } else if (c.kind == K::AttachedDirectionLevel) {
+      level.push_back(&c);
+    } else {
+      int unknown = -1;
+      ex others = 0;
+      for (int k : c.coordinates) {
+        if (k >= m.input_count) {
+          if (unknown >= 0) throw Unsolvable{"leveled lever: sum row " + c.name + " has more than one dependent joint"};
+          unknown = k;
+        } else {
+          others += m.coordinates[static_cast<std::size_t>(k)].q;
+        }
+      }
+      if (unknown < 0) throw Unsolvable{"leveled lever: sum row " + c.name + " has no dependent joint"};
+      solve.coupled.emplace_back(unknown, -others);
+      remaining.erase(unknown);
+    }
+  }
+  if (point == nullptr || level.size() != 2) throw Unsolvable{"leveled lever needs one point row and two level rows"};
+  const std::string frame = point->frame;
+  for (const auto* l : level)
+    if (l->frame != frame) throw Unsolvable{"leveled lever: the level rows and the point row are on different frames"};
+  if (level[0]->axis == level[1]->axis) throw Unsolvable{"leveled lever: both level rows keep the same axis level"};
+  if (remaining.size() != 3) throw Unsolvable{"leveled lever: three joints must remain after the couplings"};
+  const Axis vertical = static_cast<Axis>(3 - static_cast<int>(level[0]->axis) - static_cast<int>(level[1]->axis));
+
+  const std::vector<ChainStep> chain = full_chain(m, frame);
+  std::size_t first = chain.size();
+  for (std::size_t i = 0; i < chain.size(); ++i)
+    if (driven(chain[i]) && chain[i].coordinate >= m.input_count) {
+      first = i;
+      break;
+    }
+  if (first == chain.size()) throw Unsolvable{"leveled lever: no dependent joint moves " + frame};
+  for (std::size_t i = first; i < chain.size(); ++i)
+    if (chain[i].kind == ChainStep::Kind::Slide) throw Unsolvable{"leveled lever: a prismatic joint after the first dependent one"};
+  Frame base = Frame::ground();
+  for (std::size_t i = 0; i < first; ++i) base = apply(m, base, chain[i]);
+
+  // Orientation from the first dependent joint on, couplings substituted.
+  const auto angle_of = [&](const ChainStep& st) -> ex {
+    if (st.kind == ChainStep::Kind::Turn) return st.angle;
+    for (const auto& [k, value] : solve.coupled)
+      if (k == st.coordinate) return value;
+    return m.coordinates[static_cast<std::size_t>(st.coordinate)].q;
+  };
+  std::vector<Rot> rotations;
+  for (std::size_t i = first; i < chain.size(); ++i)
+    if (chain[i].kind == ChainStep::Kind::Rotate || chain[i].kind == ChainStep::Kind::Turn) rotations.push_back({chain[i].axis, angle_of(chain[i])});
+  const std::vector<Rot> merged = merge(rotations);
+  const auto unknowns_in = [&](const ex& e) {
+    std::vector<int> out;
+    for (int k : remaining)
+      if (e.has(m.coordinates[static_cast<std::size_t>(k)].q)) out.push_back(k);
+    return out;
+  };
+  if (merged.size() < 2) throw Unsolvable{"leveled lever: the orientation does not reduce to two rotations"};
+  const Rot& ra = merged[merged.size() - 2];
+  const Rot& rb = merged.back();
+  const std::vector<int> in_a = unknowns_in(ra.angle), in_b = unknowns_in(rb.angle);
+  for (std::size_t i = 0; i + 2 < merged.size(); ++i)
+    if (!unknowns_in(merged[i].angle).empty())
+      throw Unsolvable{"leveled lever: the orientation does not reduce to R_pre R_a(q_p + q_q) R_b(q_b)"};
+  if (in_b.size() != 1 || !(rb.angle - m.coordinates[static_cast<std::size_t>(in_b[0])].q).is_zero())
+    throw Unsolvable{"leveled lever: the last rotation is not one joint alone"};
+  if (in_a.size() != 2) throw Unsolvable{"leveled lever: the second-to-last rotation is not the sum of two joints"};
+  if (!(ra.angle - m.coordinates[static_cast<std::size_t>(in_a[0])].q - m.coordinates[static_cast<std::size_t>(in_a[1])].q).expand().is_zero())
+    throw Unsolvable{"leveled lever: the second-to-last rotation is not exactly the sum of two joints"};
+  if (ra.axis == vertical || rb.axis == vertical)
+    throw Unsolvable{"leveled lever: the two rotations must turn about the axes that the level rows keep level"};
+  // q_p: the one of the two whose step comes first along the chain (it moves the lever's point).
+  int qp = in_a[0], qq = in_a[1];
+  for (std::size_t i = first; i < chain.size(); ++i)
+    if (driven(chain[i]) && (chain[i].coordinate == in_a[0] || chain[i].coordinate == in_a[1])) {
+      qp = chain[i].coordinate;
+      qq = qp == in_a[0] ? in_a[1] : in_a[0];
+      break;
+    }
+  const int qb = in_b[0];
+  const ex qp_sym = m.coordinates[static_cast<std::size_t>(qp)].q, qq_sym = m.coordinates[static_cast<std::size_t>(qq)].q;
+  const SolvedJoint Jp = joint_symbols(m, qp), Jq = joint_symbols(m, qq), Jb = joint_symbols(m, qb);
+  const SolvedJoint sigma{-1, realsymbol("ik_q_sum"), realsymbol("ik_c_sum"), realsymbol("ik_s_sum")};
+  std::vector<Rot> pre(merged.begin(), merged.end() - 2);
+  const Mat3 up_frame = base.R * product(pre);
+
+  const std::string np = name(qp), nq = name(qq), nb = name(qb), target = name(point->target);
+  std::string coupled_names;
+  for (const auto& [k, value] : solve.coupled) coupled_names += (coupled_names.empty() ? "" : ", ") + name(k);
+  solve.summary = fmt::format("leveled lever: {} level by {} + {} ({}) and {} ({}), {}_{} = {} by {}; coupled: {}", frame, np, nq,
+                              axis_name(ra.axis), nb, axis_name(rb.axis), frame, axis_name(point->axis), target, np,
+                              coupled_names.empty() ? "none" : coupled_names);
+  solve.doc = {
+      fmt::format("Pattern leveled lever: {} fixed by the sum rows; {}'s {} axis vertical (its other axes level)", coupled_names,
+                  frame, axis_name(vertical)),
+      fmt::format("through the rotations about {} by {} + {} and about {} by {}; then {}'s {} = {} by {}.", axis_name(ra.axis), np,
+                  nq, axis_name(rb.axis), nb, frame, axis_name(point->axis), target, np)};
+  solve.branches = 8;
+  solve.bits = {fmt::format("bit 0: the other root of {} (branch 0: the root nearest zero)", np),
+                fmt::format("bit 1: the other root of {} (branch 0: |{}| <= 90 deg)", nb, nb),
+                fmt::format("bit 2: the other root of {} + {} (branch 0: nearest zero)", np, nq)};
+  std::string inputs;
+  {
+    std::set<int> in;
+    for (const auto& st : chain)
+      if (driven(st) && st.coordinate < m.input_count) in.insert(st.coordinate);
+    for (const auto& [k, value] : solve.coupled)
+      for (const auto& kv : m.coordinates)
+        if (value.has(kv.q)) in.insert(kv.index);
+    for (int k : in) inputs += (inputs.empty() ? "" : ", ") + name(k);
+  }
+  solve.failures = {fmt::format("{} = {{value:.4f}} m is out of reach: with {} as given, the {} of {} reaches [{{low:.4f}}, "
+                                "{{high:.4f}}] m",
+                                target, inputs, axis_name(point->axis), frame)};
+
+  // Stage 0: the coupled joints; world up seen from the frame before the two rotations; solve them.
+  Stage s0;
+  for (const auto& [k, value] : solve.coupled) s0.locals.emplace_back(joint_symbols(m, k).q, value);
+  const realsymbol g[3] = {realsymbol("ik_g0"), realsymbol("ik_g1"), realsymbol("ik_g2")};
+  for (int i = 0; i < 3; ++i) s0.locals.emplace_back(g[i], up_frame(2, i));
+  const std::string unit = fmt::format("{{{}, {}, {}}}", vertical == Axis::X ? "1.0" : "0.0", vertical == Axis::Y ? "1.0" : "0.0",
+                                       vertical == Axis::Z ? "1.0" : "0.0");
+  s0.code = "  const double ik_axis[3] = " + unit + ";\n  const double ik_g[3] = {ik_g0, ik_g1, ik_g2};\n" +
+            two_axis_call(ra.axis, rb.axis, "ik_axis", "ik_g", "(branch & 2) != 0", sigma, Jb) +
+            fmt::format(
+                "  static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations\n"
+                "  // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).\n"
+                "  if ((ik_c_sum < 0) != ((branch & 4) != 0)) {{\n"
+                "    ik_q_sum = ik_wrap(ik_q_sum + 3.141592653589793);\n"
+                "    ik_c_sum = -ik_c_sum;\n    ik_s_sum = -ik_s_sum;\n"
+                "    {0} = -{0};\n    {1} = -{1};\n  }}\n",
+                Jb.q.get_name(), Jb.s.get_name());
+  s0.defines = {"ik_q_sum", "ik_c_sum", "ik_s_sum", Jb.q.get_name(), Jb.c.get_name(), Jb.s.get_name()};
+  solve.stages.push_back(s0);
+
+  // Stage 1: the point row, with q_q = sum - q_p: a cos q_p + b sin q_p + c.
+  const realsymbol sum_sym("ik_sum");
+  Vec3 pos;
+  std::vector<Rot> prefix;
+  for (std::size_t i = first; i < chain.size(); ++i) {
+    const ChainStep& st = chain[i];
+    if (st.kind == ChainStep::Kind::Translate) {
+      pos = pos + product(merge(prefix)) * st.offset;
+    } else {
+      ex a = angle_of(st);
+      a = a.subs(qq_sym == sum_sym - qp_sym);
+      prefix.push_back({st.axis, a});
+    }
+  }
+  const int k = static_cast<int>(point->axis);
+  ex height = base.r[k];
+  for (int j = 0; j < 3; ++j) height += base.R(k, j) * pos[j];
+  const Sinusoid row = sinusoid(height, GiNaC::ex_to<realsymbol>(qp_sym), "the point row");
+  Solve with_sum = solve;  // sin, cos of the sum and of q_b by their computed values
+  with_sum.joints = {Jb};
+  const auto results = [&](const ex& e) {
+    return in_results(m, e, with_sum).subs(GiNaC::lst{GiNaC::sin(sum_sym) == sigma.s, GiNaC::cos(sum_sym) == sigma.c});
+  };
+  Stage s1;
+  s1.locals = {{realsymbol("ik_alpha"), results(row.a)}, {realsymbol("ik_beta"), results(row.b)}, {realsymbol("ik_gamma"), results(row.c)}};
+  s1.code = fmt::format(
+      "  double {0}, {1}, {2};\n"
+      "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, {3} - ik_gamma, (branch & 1) != 0, {0}, {1}, {2})) {{\n"
+      "    const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);\n"
+      "    why = {{1, {3}, ik_gamma - ik_R, ik_gamma + ik_R, 0.0}};\n"
+      "    return IkStatus::out_of_reach;\n"
+      "  }}\n"
+      "  const double {4} = ik_wrap(ik_q_sum - {0});\n"
+      "  const double {5} = ik_c_sum * {1} + ik_s_sum * {2};\n"
+      "  const double {6} = ik_s_sum * {1} - ik_c_sum * {2};\n",
+      Jp.q.get_name(), Jp.c.get_name(), Jp.s.get_name(), target, Jq.q.get_name(), Jq.c.get_name(), Jq.s.get_name());
+  s1.defines = {Jp.q.get_name(), Jp.c.get_name(), Jp.s.get_name(), Jq.q.get_name(), Jq.c.get_name(), Jq.s.get_name()};
+  solve.stages.push_back(s1);
+  solve.joints = {Jp, Jq, Jb};
+  return solve;
+}
+
+// ---- emission -----------------------------------------------------------------------------------
+
+struct EmittedSolve {
+  std::string text;
+  OpCount ops;
+};
+
+EmittedSolve emit_solve(const Model& m, const Limb& limb, Solve solve, const EmitOptions& opt) {
+  // The last stage: the limb's own closure rows at the solution.
+  Stage check;
+  std::vector<std::string> rows;
+  for (std::size_t i = 0; i < limb.rows.size(); ++i) {
+    const realsymbol r(fmt::format("ik_row{}", i));
+    check.locals.emplace_back(r, in_results(m, closure_value(m, m.closure[static_cast<std::size_t>(limb.rows[i])]), solve));
+    rows.push_back(fmt::format("std::abs({})", r.get_name()));
+  }
+  check.code = fmt::format(
+      "  const double ik_residual = std::max({{{}}});\n"
+      "  if (!(ik_residual <= kIkTolerance)) {{\n"
+      "    why = {{0, ik_residual, 0.0, kIkTolerance, 0.0}};\n"
+      "    return IkStatus::residual;\n"
+      "  }}\n",
+      fmt::join(rows, ", "));
+  solve.stages.push_back(check);
+
+  // One graph for all stages: temporaries are shared across stages and placed in the first stage
+  // where everything they use exists.
+  ExprGraph g;
+  std::map<std::string, int> symbol_stage;
+  std::vector<std::vector<std::pair<std::string, int>>> locals(solve.stages.size());
+  std::vector<int> roots;
+  for (std::size_t k = 0; k < solve.stages.size(); ++k)
+    for (const auto& [sym, value] : solve.stages[k].locals) {
+      const int id = g.add(value);
+      locals[k].emplace_back(sym.get_name(), id);
+      roots.push_back(id);
+    }
+  // What a stage defines (its locals, its solvers' results) is usable from the next stage on.
+  for (std::size_t k = 0; k < solve.stages.size(); ++k) {
+    for (const auto& [sym, value] : solve.stages[k].locals) symbol_stage[sym.get_name()] = static_cast<int>(k) + 1;
+    for (const auto& n : solve.stages[k].defines) symbol_stage[n] = static_cast<int>(k) + 1;
+  }
+
+  const CsePlan plan = eliminate_common_subexpressions(g, roots);
+  const TrigBatch trig = batch_trig(m, g, roots);
+  std::map<int, int> node_stage;
+  std::function<int(int)> stage_of = [&](int id) -> int {
+    if (auto it = node_stage.find(id); it != node_stage.end()) return it->second;
+    const Node& n = g.node(id);
+    int s = 0;
+    if (n.kind == NodeKind::Symbol) {
+      if (auto it = symbol_stage.find(n.text); it != symbol_stage.end()) s = it->second;
+    }
+    for (int a : n.args) s = std::max(s, stage_of(a));
+    node_stage[id] = s;
+    return s;
+  };
+
+  Printer pr(g, plan, trig.names, "ik_t");
+  OpCount ops;
+  ops.calls += trig.calls;
+  std::set<std::string> symbols;
+  std::function<void(int)> collect = [&](int id) {
+    const Node& n = g.node(id);
+    if (n.kind == NodeKind::Symbol) symbols.insert(n.text);
+    for (int a : n.args) collect(a);
+  };
+  for (int r : roots) collect(r);
+
+  std::string body;
+  for (const auto& c : m.coordinates)
+    if (symbols.count(c.name)) body += fmt::format("  const double {} = s({});\n", c.name, c.index);
+  for (const auto& par : m.parameters) {
+    if (!symbols.count(par.name)) continue;
+    if (auto it = opt.baked.find(par.name); it != opt.baked.end())
+      body += fmt::format("  constexpr double {} = {};\n", par.name, literal(it->second));
+    else
+      body += fmt::format("  const double {0} = p.{0};\n", par.name);
+  }
+  body += trig.prologue;
+  const auto batched = [&](std::size_t k) { return trig.names.count(plan.temporaries[k]) != 0; };
+  for (std::size_t k = 0; k < solve.stages.size(); ++k) {
+    for (std::size_t t = 0; t < plan.temporaries.size(); ++t)
+      if (!batched(t) && stage_of(plan.temporaries[t]) == static_cast<int>(k))
+        body += fmt::format("  const double ik_t{} = {};\n", t, pr.define(plan.temporaries[t], ops));
+    for (const auto& [n, id] : locals[k]) body += fmt::format("  const double {} = {};\n", n, pr.value(id, ops));
+    body += solve.stages[k].code;
+  }
+  for (const SolvedJoint& j : solve.joints) body += fmt::format("  out({}) = {};\n", j.coordinate, j.q.get_name());
+  for (const auto& [k, value] : solve.coupled) body += fmt::format("  out({}) = {};\n", k, joint_symbols(m, k).q.get_name());
+  body += "  return IkStatus::ok;\n";
+
+  std::string t = fmt::format("// Closed-form inverse kinematics of limb {} ({}).\n//\n", limb.name, limb.title);
+  for (const auto& line : solve.doc) t += "// " + line + "\n";
+  t += fmt::format("// Branches 0 to {}:\n", solve.branches - 1);
+  for (const auto& b : solve.bits) t += "//   " + b + "\n";
+  t += "// Writes the limb's joints (";
+  std::vector<std::string> outs;
+  for (int j : limb.joints) outs.push_back(m.coordinates[static_cast<std::size_t>(j)].name);
+  t += fmt::format("{}) into out, which may be s itself; reads only the limb's inputs.\n", fmt::join(outs, ", "));
+  t += "// On failure returns why, with the numbers in `why` (stage 1.. as in kClosedForm's failure texts;\n"
+       "// stage 0: residual, the solution does not satisfy the closure rows).\n";
+  t += fmt::format("// Operations: {} (adds {}, muls {}, divs {}, calls {}), plus the solver calls.\n", ops.total(), ops.adds,
+                   ops.muls, ops.divs, ops.calls);
+  t += fmt::format("inline IkStatus ik_{}(const Coordinates& s, const Params& p, int branch, Coordinates& out, "
+                   "IkDiagnostics& why) noexcept {{\n",
+                   limb.name);
+  t += fmt::format("  static_cast<void>(p);\n  if (branch < 0 || branch >= {}) return IkStatus::bad_branch;\n", solve.branches);
+  t += body + "}\n\n";
+  return {t, ops};
+}
+
+const char* kSupport = R"(// Why a closed-form solve gave no solution.
+enum class IkStatus {
+  ok = 0,
+  out_of_reach,  // the target cannot be reached (why: stage, the target's value, the reachable range)
+  bad_branch,    // no such branch
+  residual,      // the solution does not satisfy the limb's closure rows (why.value: the residual)
+};
+
+struct IkDiagnostics {
+  int stage = 0;      // which equation failed (the limb's failure texts, 1-based); 0: the residual check
+  double value = 0;   // what the target asks for
+  double low = 0;     // the reachable range
+  double high = 0;
+  double aux = 0;     // a joint angle that the range depends on, in degrees
+};
+
+// Targets this close outside the reach (relative) are rounding, not user error: they are clamped
+// onto the boundary.
+inline constexpr double kIkReachSlack = 1e-12;
+// A closed-form solution must satisfy the limb's closure rows to this (m or rad); rounding leaves
+// about 1e-15.
+inline constexpr double kIkTolerance = 1e-9;
+
+inline double ik_wrap(double a) noexcept {
+  constexpr double pi = 3.141592653589793;
+  if (a > -pi && a <= pi) return a;
+  a = std::remainder(a, 2 * pi);
+  return a == -pi ? pi : a;
+}
+
+// x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie the positive one),
+// or the other root with `other`; also cos x and sin x. False when |c| exceeds sqrt(a^2 + b^2).
+inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& x, double& cos_x, double& sin_x) noexcept {
+  // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
+  // and lengths, nowhere near overflow.
+  const double r = std::sqrt(a * a + b * b);
+  if (!(r > 0)) return false;
+  double ratio = c / r;
+  if (!(std::abs(ratio) <= 1)) {
+    if (!(std::abs(ratio) <= 1 + kIkReachSlack)) return false;
+    ratio = std::copysign(1.0, ratio);
+  }
+  const double cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
+  const double sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
+  double sign = sin_psi > 0 ? -1.0 : sin_psi < 0 ? 1.0 : (cos_psi >= 0 ? 1.0 : -1.0);
+  if (other) sign = -sign;
+  cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
+  sin_x = sin_psi * ratio + sign * cos_psi * sin_delta;
+  x = std::atan2(sin_x, cos_x);  // one atan2 of the angle sum, exact to rounding
+  return true;
+}
+
+// q1, q2 with R_A(q1) R_B(q2) v = d, for principal axes A != B (0 x, 1 y, 2 z) and |v| = |d|:
+// the component of d along A fixes q2 (two roots: `flip` takes the one with cos q2 of the other sign
+// than branch 0's), then q1 turns R_B(q2) v onto d. False (with how far d is off the plane normal to
+// A, and how far it could be) when no q2 reaches d's component along A.
+template <int A, int B>
+inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& q1, double& c1, double& s1,
+                              double& q2, double& c2, double& s2, double& beside, double& room) noexcept {
+  static_assert(A != B && A >= 0 && A < 3 && B >= 0 && B < 3, "two different principal axes");
+  constexpr int C = 3 - A - B;
+  constexpr int i = (B + 1) % 3, j = (B + 2) % 3;    // R_B turns i towards j
+  constexpr int i1 = (A + 1) % 3, j1 = (A + 2) % 3;  // R_A turns i1 towards j1
+  const double across = d[i1] * d[i1] + d[j1] * d[j1];  // |d|^2 off the axis A
+  double k2 = across - v[B] * v[B];
+  if (k2 < 0) {
+    if (-k2 > kIkReachSlack * (across + v[B] * v[B])) {
+      beside = std::abs(d[A]);
+      room = std::sqrt(v[A] * v[A] + v[C] * v[C]);
+      return false;
+    }
+    k2 = 0;
+  }
+  double k = std::sqrt(k2);
+  if ((v[C] < 0) != flip) k = -k;
+  double t[3] = {0, 0, 0};
+  t[A] = d[A];
+  t[C] = k;
+  const double y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
+  const double r = std::sqrt(x * x + y * y);
+  q2 = r > 0 ? std::atan2(y, x) : 0.0;
+  c2 = r > 0 ? x / r : 1.0;
+  s2 = r > 0 ? y / r : 0.0;
+  double w[3];
+  w[B] = v[B];
+  w[i] = c2 * v[i] - s2 * v[j];
+  w[j] = s2 * v[i] + c2 * v[j];
+  const double y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
+  const double r1 = std::sqrt(x1 * x1 + y1 * y1);
+  q1 = r1 > 0 ? std::atan2(y1, x1) : 0.0;
+  c1 = r1 > 0 ? x1 / r1 : 1.0;
+  s1 = r1 > 0 ? y1 / r1 : 0.0;
+  return true;
+}
+
+)";
+
+}  // namespace
+
+EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<std::string>& report) {
+  std::string t = banner(m, opt, "Closed-form inverse kinematics of the limbs, derived from the model's chains.");
+  t += "//\n// Each limb whose chain matches a solvable pattern gets a function ik_<limb>() with all its\n"
+       "// branches; kClosedForm lists them (solve == nullptr: no pattern applies, use Newton's method).\n";
+  t += "#pragma once\n\n#include <algorithm>\n#include <array>\n#include <cmath>\n#include <string_view>\n\n"
+       "#include \"params.hpp\"\n#include \"structure.hpp\"\n#include \"trig.hpp\"\n#include \"types.hpp\"\n\n" +
+       namespace_open(opt) + "\n" + kSupport;
+  std::vector<std::string> entries;
+  for (const Limb& limb : m.limbs) {
+    std::optional<Solve> solve;
+    std::vector<std::string> reasons;
+    for (auto plan : {plan_point3, plan_lever}) {
+      try {
+        solve = plan(m, limb);
+        break;
+      } catch (const Unsolvable& u) {
+        reasons.push_back(u.reason);
+      }
+    }
+    if (!solve) {
+      report.push_back(fmt::format("{}: no closed form ({}); Newton's method at run time", limb.name, fmt::join(reasons, "; ")));
+      entries.push_back(fmt::format("    {{nullptr, 0, \"none\", {{}}, {{}}}},  // {}: {}", limb.name, fmt::join(reasons, "; ")));
+      continue;
+    }
+    const EmittedSolve e = emit_solve(m, limb, *solve, opt);
+    t += e.text;
+    report.push_back(fmt::format("{}: {} ({} branches, {} operations)", limb.name, solve->summary, solve->branches, e.ops.total()));
+    std::vector<std::string> bits, failures;
+    for (const auto& b : solve->bits) bits.push_back("\"" + b + "\"");
+    for (const auto& f : solve->failures) failures.push_back("\"" + f + "\"");
+    entries.push_back(fmt::format("    {{&ik_{}, {}, \"{}\", {{{{{}}}}}, {{{{{}}}}}}},", limb.name, solve->branches, solve->pattern,
+                                  fmt::join(bits, ", "), fmt::join(failures, ", ")));
+  }
+  t += "using IkFunction = IkStatus (*)(const Coordinates& s, const Params& p, int branch, Coordinates& out,\n"
+       "                                IkDiagnostics& why) noexcept;\n\n"
+       "struct ClosedFormInfo {\n"
+       "  IkFunction solve;  // nullptr: no closed form\n"
+       "  int branches;\n"
+       "  std::string_view pattern;\n"
+       "  std::array<std::string_view, 3> bits;      // what each branch bit selects\n"
+       "  std::array<std::string_view, 2> failures;  // message of each failing stage (IkDiagnostics::stage 1, 2),\n"
+       "                                             // with {value}, {low}, {high}, {aux} to fill in\n"
+       "};\n\n";
+  t += fmt::format("// Per limb, in the order of kLimbs.\ninline constexpr std::array<ClosedFormInfo, {}> kClosedForm{{{{\n{}\n}}}};\n\n",
+                   m.limbs.size(), fmt::join(entries, "\n"));
+  t += namespace_close(opt);
+  return {"wlx/gen/ik.hpp", t};
+}
+
+}  // namespace wlx::codegen
