@@ -19,7 +19,7 @@ std::string banner(const Model& m, const EmitOptions& opt, const std::string& wh
       "// Do not edit: change the model and rebuild (the build regenerates; commit generated/).\n",
       what, opt.generator_version, m.name, m.source);
   if (opt.baked.empty()) {
-    b += "// Parameters: symbolic, read from wlx::gen::Params at run time.\n";
+    b += "// Parameters: symbolic, read from Params at run time.\n";
   } else {
     b += "// Parameters baked in as constants (the Params members of these names are ignored):";
     for (const auto& [k, v] : opt.baked) b += fmt::format(" {}={}", k, v);
@@ -29,8 +29,15 @@ std::string banner(const Model& m, const EmitOptions& opt, const std::string& wh
   return b;
 }
 
-std::string namespace_open(const EmitOptions& opt) { return fmt::format("namespace {} {{\n", opt.name_space); }
-std::string namespace_close(const EmitOptions& opt) { return fmt::format("}}  // namespace {}\n", opt.name_space); }
+std::string namespace_open(const EmitOptions& opt) {
+  if (opt.name_space.empty()) return fmt::format("namespace wlx {{\ninline namespace {} {{\nnamespace gen {{\n", opt.model_name);
+  return fmt::format("namespace {} {{\n", opt.name_space);
+}
+std::string namespace_close(const EmitOptions& opt) {
+  if (opt.name_space.empty())
+    return fmt::format("}}  // namespace gen\n}}  // namespace {}\n}}  // namespace wlx\n", opt.model_name);
+  return fmt::format("}}  // namespace {}\n", opt.name_space);
+}
 
 std::string literal(double v) {
   std::string s = fmt::format("{}", v);

@@ -12,7 +12,10 @@ namespace wlx::codegen {
 
 struct EmitOptions {
   std::string generator_version;
-  std::string name_space = "wlx::gen";
+  // C++ namespace of the emitted code. Empty: wlx::<model>::gen, with <model> an inline namespace,
+  // so that code using one model may write wlx::gen:: and code using several names the model.
+  std::string name_space;
+  std::string model_name;  // set from the model
   // Parameters replaced by numeric constants (name -> value); empty: all read from Params.
   std::map<std::string, double> baked;
 };

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <regex>
 #include <sstream>
 
 #ifndef WLX_VERSION
@@ -48,14 +49,23 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "output root; headers go to OUT/wlx/gen/")->required();
   app.add_option("--bake", bake_args, "bake a parameter in as a constant: NAME=VALUE (repeatable)");
   app.add_flag("--bake-defaults", bake_defaults, "bake every geometry parameter (kinds length, offset, angle) in at its default");
-  app.add_option("--namespace", opt.name_space, "C++ namespace of the emitted code")->capture_default_str();
+  app.add_option("--namespace", opt.name_space,
+                 "C++ namespace of the emitted code (default: wlx::<model>::gen, <model> inline)");
   app.add_flag("--quiet", quiet, "print nothing on success");
   app.add_flag("--stats", stats_only, "print the operation-count table (always printed unless --quiet)");
   CLI11_PARSE(app, argc, argv);
 
   try {
     const auto t0 = std::chrono::steady_clock::now();
+    if (!opt.name_space.empty()) {
+      // A qualified C++ identifier, nothing else: the name is pasted into every header.
+      static const std::regex qualified("[A-Za-z_][A-Za-z0-9_]*(::[A-Za-z_][A-Za-z0-9_]*)*");
+      if (!std::regex_match(opt.name_space, qualified))
+        throw ModelFileError(fmt::format("--namespace: '{}' is not a C++ qualified name such as wlx::mine",
+                                         opt.name_space.substr(0, 60)));
+    }
     const Model model = load_model_file(model_path);
+    opt.model_name = model.name;
     if (bake_defaults)
       for (std::size_t k = 0; k < model.parameters.size(); ++k) {
         const ParameterKind kind = model.parameter_kinds[k];

@@ -9,7 +9,7 @@
 
 #include <cmath>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 namespace {
 
@@ -153,4 +153,4 @@ Vector8 distribute_torques(const ActuatorJacobian& J_beta, const Vector4& Qstar,
   return S * x;
 }
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

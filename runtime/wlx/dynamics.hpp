@@ -12,7 +12,7 @@
 #include <array>
 #include <string>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 static_assert(gen::kHasDynamics, "the model file has no dynamics section");
 static_assert(gen::kHasClearance, "the model file has no clearance box");
@@ -73,4 +73,4 @@ inline const Vector8 kStrongWeakDiagonal = Eigen::Map<const Vector8>(gen::kDefau
 // J_beta^T W^-1 J_beta is badly conditioned. Throws wlx::Error when J_beta has rank below 4.
 Vector8 distribute_torques(const ActuatorJacobian& J_beta, const Vector4& Qstar, const Weighting& weighting);
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

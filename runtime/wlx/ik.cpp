@@ -13,7 +13,7 @@
 #include <limits>
 #include <numbers>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 namespace {
 
@@ -224,4 +224,4 @@ NewtonReport solve_limb_newton(const Model& model, Limb limb, Coordinates& s, Da
   return newton(model, active, s, data, options);
 }
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

@@ -13,7 +13,7 @@
 #include <array>
 #include <string_view>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 // A limb: an index into gen::kLimbs (gen::limb::<name>).
 using Limb = int;
@@ -75,4 +75,4 @@ NewtonReport solve_ik_newton(const Model& model, Coordinates& s, Data& data, con
 NewtonReport solve_limb_newton(const Model& model, Limb limb, Coordinates& s, Data& data,
                                const NewtonOptions& options = {});
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <numbers>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 namespace {
 
@@ -122,4 +122,4 @@ IkSweepResult run_ik_sweep(const Model& model, const IkSweep& sweep, Data& data)
   return result;
 }
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 struct IkSweep {
   std::string id;      // "IK-L1", ...
@@ -62,4 +62,4 @@ struct IkSweepResult {
 
 IkSweepResult run_ik_sweep(const Model& model, const IkSweep& sweep, Data& data);
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

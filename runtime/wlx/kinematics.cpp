@@ -1,6 +1,6 @@
 #include "wlx/kinematics.hpp"
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 void forward_kinematics(const Model& model, const Coordinates& s, Data& data) noexcept {
   gen::kinematics(s, model.params(), &data.frame_positions, &data.frame_rotations);
@@ -15,4 +15,4 @@ void closure(const Model& model, const Coordinates& s, Data& data, bool with_jac
   gen::closure(s, model.params(), &data.Phi, with_jacobian ? &data.dPhi_ds : nullptr, false);
 }
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

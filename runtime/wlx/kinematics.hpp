@@ -5,7 +5,7 @@
 
 #include <Eigen/Core>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 // Fills data.frame_positions and data.frame_rotations for the coordinates s.
 void forward_kinematics(const Model& model, const Coordinates& s, Data& data) noexcept;
@@ -22,4 +22,4 @@ void kinematic_update(const Model& model, const Coordinates& s, Data& data) noex
 // Fills data.Phi and, when with_jacobian, data.dPhi_ds.
 void closure(const Model& model, const Coordinates& s, Data& data, bool with_jacobian) noexcept;
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

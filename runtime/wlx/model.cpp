@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 Model::Model(const Params& params) : params_(params) {
   // Each parameter's kind (from the model file) says which values make sense.
@@ -77,4 +77,4 @@ Coordinates nominal_inputs() {
   return s;
 }
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

@@ -3,6 +3,8 @@
 // a Data is constructed, evaluating the model allocates nothing.
 #pragma once
 
+#include "wlx/model_namespace.hpp"
+
 #include <wlx/gen/all.hpp>
 
 #include <Eigen/LU>  // Matrix4d::inverse
@@ -10,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 using gen::Coordinates;
 using gen::Params;
@@ -82,4 +84,4 @@ double* find_param(Params& params, std::string_view name) noexcept;
 // The model's nominal inputs (its file's `nominal`), dependent joints zero (solve them with the IK).
 Coordinates nominal_inputs();
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <limits>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 namespace {
 
@@ -192,4 +192,4 @@ Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, cons
   return d.C * sdot;
 }
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

@@ -14,7 +14,7 @@
 #include <string>
 #include <string_view>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 static_assert(gen::kMaxLimbSize <= 4, "the limb blocks are inverted as 4 x 4 matrices");
 static_assert(gen::kWheelCount == 2, "the non-holonomic solve is written for two wheels (a 2 x 2 J_beta)");
@@ -67,4 +67,4 @@ Eigen::Matrix<double, 3, 2> contact_velocities(const Model& model, const Coordin
 // v_W . n_W per wheel for the full sdot: the thesis' residual check of the rolling constraint.
 Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& data);
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

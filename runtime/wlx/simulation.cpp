@@ -9,7 +9,7 @@
 #include <cmath>
 #include <memory>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 namespace {
 
@@ -236,4 +236,4 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
   return out;
 }
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace wlx {
+WLX_MODEL_NAMESPACE_BEGIN
 
 // rk4 and euler take fixed steps of dt (the thesis used euler with 0.001 s). dopri5 is the
 // Dormand-Prince 5(4) pair with error control: adaptive steps between the output samples, which
@@ -84,4 +84,4 @@ Trajectory simulate_each(const Scenario& scenario, const std::function<void(cons
 // Lowest corner of the cabin block (cxd x cyd x cabin_height, centred on K_C) above the ground.
 double cabin_clearance(const Params& p, const Coordinates& s);
 
-}  // namespace wlx
+WLX_MODEL_NAMESPACE_END
