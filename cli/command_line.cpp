@@ -76,6 +76,11 @@ void check(CLI::App& app) {
     for (const CLI::Option* option : a->get_options())
       if (option->count() > 1 && !repeatable(option))
         throw Error(option->get_name(), fmt::format("given {} times; give it once", option->count()));
+    // CLI11 leaves a number option at its default for "": `--dt ""` must not run with the default.
+    for (const CLI::Option* option : a->get_options())
+      if (option->get_type_size_max() > 0)
+        for (const std::string& value : option->results())
+          if (value.empty()) throw Error(option->get_name(), "an empty value; give one");
   }
   const CLI::App* last = chain.back();
   if (!last->get_subcommands({}).empty())

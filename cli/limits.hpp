@@ -18,6 +18,7 @@ inline constexpr double kMaxPosition = 1e4;       // m: |x_C|, |x_Fl|, ... (beyo
 inline constexpr double kMaxAngle = 100;          // rad: |yaw|, |theta_l5|, ... (about 16 turns)
 inline constexpr double kMaxLinearRate = 100;     // m/s
 inline constexpr double kMaxAngularRate = 100;    // rad/s (about 16 turns per second)
+inline constexpr double kMaxWeightRatio = 1e12;   // largest / smallest diagonal torque weight
 
 // Throws wlx::Error "params.<name>: ..." for a parameter beyond its bound (`prefix` + name).
 void check_param_bounds(const Params& params, const std::string& prefix);

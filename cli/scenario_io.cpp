@@ -77,6 +77,11 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
     if (!d.is_array() || d.size() != 8) throw Error(key + ".diag", fmt::format("must be an array of 8 weights, got {}", excerpt(d)));
     Vector8 w;
     for (int i = 0; i < 8; ++i) w(i) = finite_number(d[static_cast<std::size_t>(i)], fmt::format("{}.diag[{}]", key, i));
+    // Only ratios of weights matter (a uniform scale leaves the torques unchanged); beyond this span
+    // rounding, not the weights, would decide how the torque is split.
+    if (w.minCoeff() > 0 && w.maxCoeff() / w.minCoeff() > kMaxWeightRatio)
+      throw Error(key + ".diag", fmt::format("the largest weight is {:.3g} times the smallest; at most {:g} is meaningful",
+                                             w.maxCoeff() / w.minCoeff(), kMaxWeightRatio));
     try {
       return Weighting::diagonal_of(w);
     } catch (const Error& e) {
