@@ -125,7 +125,9 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "wlx: error: {}\n", e.what());
     return 2;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "wlx: error: {}\n", e.what());
+    // Library messages (std::filesystem's) quote whole arguments: bound them like wlx's own.
+    const std::string message = e.what();
+    fmt::print(stderr, "wlx: error: {}\n", message.size() > 500 ? message.substr(0, 500) + "..." : message);
     return 2;
   }
   return 0;

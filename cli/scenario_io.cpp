@@ -43,7 +43,8 @@ std::string embedded_scenario(const std::string& id) {
 
 nlohmann::json read_scenario_json(const std::string& arg) {
   std::string text;
-  if (std::filesystem::is_regular_file(arg)) {
+  std::error_code ec;  // e.g. a name too long for a path: then it is not a file (the message excerpts it)
+  if (std::filesystem::is_regular_file(arg, ec)) {
     std::ifstream in(arg, std::ios::binary);
     if (!in) throw Error(arg, "cannot open for reading");
     text = read_all_capped(in, arg, kMaxFileBytes);
