@@ -467,6 +467,24 @@ TEST_CASE("faults: SIGINT and SIGTERM during simulate: the samples so far kept, 
   }
 }
 
+TEST_CASE("faults: SIGKILL during simulate: no trajectory.csv appears cut; only a file named .tmp is left") {
+  // Nothing can run after SIGKILL: the guarantee is that the name trajectory.csv is never given to
+  // an unfinished file.
+  const fs::path dir = work_dir() / "sigkill";
+  fs::create_directories(dir);
+  write(dir / "long.json", R"({"rates": {"roll": 0.0872664626}, "dependent": ["y_C", "yaw"], "duration": 1, "dt": 1e-6})");
+  const Spawned s = start({"simulate", (dir / "long.json").string(), "--out", (dir / "out").string()});
+  REQUIRE(wait_for([&] { return has_temporary(dir / "out"); }));
+  ::kill(s.pid, SIGKILL);
+  const Result r = finish(s);
+  CHECK(r.signal == SIGKILL);
+  CHECK(!fs::exists(dir / "out" / "trajectory.csv"));
+  int temporaries = 0;
+  for (const auto& entry : fs::directory_iterator(dir / "out")) temporaries += entry.path().extension() == ".tmp";
+  CHECK(temporaries == 1);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("faults: SIGINT during report: exit 130, said partial, no index.html (not even an earlier one), no temporaries") {
   const fs::path out = work_dir() / "report-signal";
   fs::create_directories(out);
