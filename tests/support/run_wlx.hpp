@@ -43,6 +43,7 @@ inline void write(const fs::path& p, const std::string& text) { std::ofstream(p,
 
 struct Io {
   std::string input;           // stdin's content
+  fs::path stdin_path;         // set: stdin from this file instead (large inputs not held in memory)
   std::string stdout_path;     // empty: captured; else where stdout goes (e.g. /dev/full)
   bool stdout_closed_pipe = false;  // stdout is a pipe whose reading end is already closed
   bool stdin_pipe = false;     // stdin is a pipe the test writes to (Spawned::stdin_fd)
@@ -85,7 +86,8 @@ inline Spawned start(const std::vector<std::string>& args, const Io& io = {}) {
     posix_spawn_file_actions_adddup2(&actions, in_pipe[0], STDIN_FILENO);
     posix_spawn_file_actions_addclose(&actions, in_pipe[1]);
   } else {
-    posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, in.c_str(), O_RDONLY, 0);
+    const fs::path source = io.stdin_path.empty() ? in : io.stdin_path;
+    posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, source.c_str(), O_RDONLY, 0);
   }
   if (io.stdout_closed_pipe) {
     REQUIRE(::pipe(out_pipe) == 0);
