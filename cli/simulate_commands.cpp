@@ -1,5 +1,4 @@
 // `wlx simulate` and `wlx verify nonholonomic`.
-#include "bounded_input.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "output_checks.hpp"

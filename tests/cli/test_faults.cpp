@@ -430,6 +430,20 @@ bool wait_for(Ready ready, std::chrono::milliseconds limit = 20s) {
   return false;
 }
 
+// Whether process `pid` has a handler for `signal` (the SigCgt mask of /proc/PID/status).
+bool catches(pid_t pid, int signal) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string key, mask;
+  while (status >> key) {
+    if (key == "SigCgt:") {
+      status >> mask;
+      return (std::stoull(mask, nullptr, 16) >> (signal - 1)) & 1;
+    }
+    status.ignore(4096, '\n');
+  }
+  return false;
+}
+
 bool has_temporary(const fs::path& dir) {
   if (!fs::exists(dir)) return false;
   for (const auto& entry : fs::recursive_directory_iterator(dir))
@@ -505,8 +519,10 @@ TEST_CASE("faults: SIGINT during report: exit 130, said partial, no index.html (
 TEST_CASE("faults: SIGTERM to ik --batch waiting for input: exit 143 with a message, the answers given kept") {
   const Spawned s = start({"ik", "--batch"}, {.stdin_pipe = true});
   const std::string line = "{}\n";
+  // Signalled only once wlx catches SIGTERM (before that the default action would just kill it).
+  REQUIRE(wait_for([&] { return catches(s.pid, SIGTERM); }));
   REQUIRE(::write(s.stdin_fd, line.data(), line.size()) == static_cast<ssize_t>(line.size()));
-  std::this_thread::sleep_for(300ms);  // wlx answers the line and blocks reading the next
+  std::this_thread::sleep_for(500ms);  // wlx answers the line and blocks reading the next
   ::kill(s.pid, SIGTERM);
   const Result r = finish(s);
   CAPTURE(r.err);
