@@ -5,22 +5,52 @@
 
 namespace wlx::cli {
 
+namespace {
+
+// Length of the well-formed UTF-8 sequence at text[k] (RFC 3629, table 3-7 of Unicode), or 0.
+std::size_t utf8_length(std::string_view text, std::size_t k) {
+  const auto byte = [&](std::size_t i) { return k + i < text.size() ? static_cast<unsigned char>(text[k + i]) : 0u; };
+  const unsigned c = byte(0);
+  const auto in = [](unsigned v, unsigned lo, unsigned hi) { return v >= lo && v <= hi; };
+  if (c < 0x80) return 1;
+  if (in(c, 0xC2, 0xDF)) return in(byte(1), 0x80, 0xBF) ? 2 : 0;
+  if (in(c, 0xE0, 0xEF)) {
+    const unsigned lo = c == 0xE0 ? 0xA0 : 0x80, hi = c == 0xED ? 0x9F : 0xBF;
+    return in(byte(1), lo, hi) && in(byte(2), 0x80, 0xBF) ? 3 : 0;
+  }
+  if (in(c, 0xF0, 0xF4)) {
+    const unsigned lo = c == 0xF0 ? 0x90 : 0x80, hi = c == 0xF4 ? 0x8F : 0xBF;
+    return in(byte(1), lo, hi) && in(byte(2), 0x80, 0xBF) && in(byte(3), 0x80, 0xBF) ? 4 : 0;
+  }
+  return 0;
+}
+
+}  // namespace
+
 std::string excerpt(std::string_view text) {
+  // Valid UTF-8 out, always: messages go into JSON (ik --batch's error lines), whose writer
+  // refuses ill-formed bytes. Those are shown as \xNN, control characters as \n, \u0000, ...
   std::string out;
   std::size_t k = 0;
-  for (; k < text.size() && out.size() < kExcerptBytes; ++k) {
+  while (k < text.size() && out.size() < kExcerptBytes) {
     const auto c = static_cast<unsigned char>(text[k]);
+    const std::size_t length = utf8_length(text, k);
+    if (length > 1) {
+      out.append(text.substr(k, length));
+      k += length;
+      continue;
+    }
+    ++k;
     switch (c) {
       case '\n': out += "\\n"; break;
       case '\r': out += "\\r"; break;
       case '\t': out += "\\t"; break;
       default:
-        if (c < 0x20 || c == 0x7f) out += fmt::format("\\u{:04x}", c);
+        if (length == 0) out += fmt::format("\\x{:02x}", c);
+        else if (c < 0x20 || c == 0x7f) out += fmt::format("\\u{:04x}", c);
         else out += static_cast<char>(c);
     }
   }
-  // Finish a UTF-8 character that was cut: its continuation bytes are 10xxxxxx.
-  while (k < text.size() && (static_cast<unsigned char>(text[k]) & 0xC0) == 0x80) out += text[k++];
   if (k < text.size()) out += fmt::format("... ({} bytes in all)", text.size());
   return out;
 }

@@ -117,7 +117,10 @@ int run_ik(bool batch) {
     } catch (const Error& e) {
       ++failures;
       fmt::print(stderr, "wlx ik: line {}: {}\n", number, e.what());
-      std::cout << nlohmann::ordered_json{{"error", e.what()}, {"line", number}}.dump() << "\n";
+      // replace: an ill-formed byte in a message must not end the batch (excerpts are valid UTF-8 already).
+      std::cout << nlohmann::ordered_json{{"error", e.what()}, {"line", number}}.dump(-1, ' ', false,
+                                                                                     nlohmann::json::error_handler_t::replace)
+                << "\n";
     }
   }
   throw_if_interrupted();
