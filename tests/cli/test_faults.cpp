@@ -525,6 +525,22 @@ TEST_CASE("faults: SIGINT during report: exit 130, said partial, no index.html (
   CHECK(incomplete_files(out).empty());
 }
 
+TEST_CASE("faults: SIGTERM while gnuplot renders: exit 143, no index.html, no temporary image left") {
+  const fs::path out = work_dir() / "render-signal";
+  const Spawned s = start({"report", "--out", out.string()});
+  REQUIRE(wait_for([&] { return slurp(s.out).find("rendering") != std::string::npos; }, 300s));
+  std::this_thread::sleep_for(200ms);  // some figures done, some under way
+  ::kill(s.pid, SIGTERM);
+  const Result r = finish(s);
+  CAPTURE(r.err);
+  CHECK(r.code == 143);
+  CHECK(r.err.find("SIGTERM") != std::string::npos);
+  CHECK(r.err.find("no index.html was written") != std::string::npos);
+  CHECK(!fs::exists(out / "index.html"));
+  CHECK(incomplete_files(out).empty());
+  fs::remove_all(out);
+}
+
 TEST_CASE("faults: SIGTERM to ik --batch waiting for input: exit 143 with a message, the answers given kept") {
   const Spawned s = start({"ik", "--batch"}, {.stdin_pipe = true});
   const std::string line = "{}\n";
