@@ -504,6 +504,10 @@ void Report::render_figures() {
   const fs::path scripts = root_ / "plots";
   prepare_out_dir("--out", scripts.string());
   for (const auto& f : figures_) {
+    // Figure names go into gnuplot strings ('...') and -e: wlx's own identifiers, kept to a set
+    // of characters that needs no quoting, so no future name can inject gnuplot commands.
+    if (f.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789+-_.") != std::string::npos)
+      throw Error("report", fmt::format("figure name '{}' has a character gnuplot would need quoted", f.name));
     std::string gp;
     const std::string common = "set datafile separator ','\nset grid\nset key box opaque\nset encoding utf8\n";
     gp += fmt::format("# Renders fig/{0}.png and .svg from the CSV files in data/: run `gnuplot plots/{0}.gp` in the report's\n"
