@@ -31,7 +31,16 @@ bool stdout_ok(std::string& reason) {
   const bool flushed = std::fflush(stdout) == 0;
   const int error_number = errno;
   if (flushed && !std::ferror(stdout) && std::cout.good()) return true;
-  reason = error_number != 0 ? std::strerror(error_number) : "an earlier write failed";
+  if (error_number != 0) {
+    reason = std::strerror(error_number);
+    return false;
+  }
+  // The failing write was earlier and its errno is gone: one more byte, to an output that is
+  // incomplete anyway, tells why (ENOSPC, EPIPE, ...).
+  std::clearerr(stdout);
+  errno = 0;
+  const bool retried = std::fputc('\n', stdout) != EOF && std::fflush(stdout) == 0;
+  reason = !retried && errno != 0 ? std::strerror(errno) : "an earlier write failed";
   return false;
 }
 

@@ -74,6 +74,10 @@ void dopri5_span(RightHandSide& f, InputVector& q, InputVector k1, double t, dou
       k7 = f(next);
       const InputVector error = step * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
       scaled = (error.array().abs() / (tolerance * (1 + q.array().abs().max(next.array().abs())))).maxCoeff();
+      if (!std::isfinite(scaled)) {  // an overflow, not an error estimate: shrink, and say so if it persists
+        failure = "a stage of the step became non-finite (inf or NaN)";
+        scaled = 1e10;
+      }
     } catch (const Error& e) {
       // The stages reach ahead of the step (up to 3.7 step lengths with these coefficients), so
       // a long step can probe poses the motion itself never reaches: reject and shrink. A real

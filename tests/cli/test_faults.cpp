@@ -359,12 +359,14 @@ TEST_CASE("faults: stdout that fails (/dev/full, a closed pipe) is an error with
     const Result full = run(args, {.input = input, .stdout_path = "/dev/full"});
     CHECK(full.code == 74);
     CHECK(full.err.find("stdout: writ") != std::string::npos);
+    CHECK(full.err.find("No space left on device") != std::string::npos);
     // Closed pipe: with a short output the kernel may accept it all before the reader is gone,
     // so the pipe is closed before wlx starts; the write must then fail, not kill wlx silently.
     const Result pipe = run(args, {.input = input, .stdout_closed_pipe = true});
     CHECK(pipe.signal == 0);
     CHECK(pipe.code == 74);
     CHECK(pipe.err.find("stdout: writ") != std::string::npos);
+    CHECK(pipe.err.find("Broken pipe") != std::string::npos);
   }
   // ik --batch stops reading when nobody receives its answers: a long input ends early.
   const Result batch = run({"ik", "--batch"}, {.input = repeat("{}\n", 20000), .stdout_closed_pipe = true});
