@@ -22,14 +22,21 @@ namespace wlx_test {
 
 namespace fs = std::filesystem;
 
+// A folder of this test process's own, removed when the process ends.
 inline const fs::path& work_dir() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("wlx_faults_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
+  struct Folder {
+    fs::path path = fs::temp_directory_path() / ("wlx_faults_" + std::to_string(::getpid()));
+    Folder() {
+      fs::remove_all(path);
+      fs::create_directories(path);
+    }
+    ~Folder() {
+      std::error_code ignored;  // a leftover folder in /tmp is no reason to fail at exit
+      fs::remove_all(path, ignored);
+    }
+  };
+  static const Folder folder;
+  return folder.path;
 }
 
 inline std::string slurp(const fs::path& p) {
