@@ -15,7 +15,7 @@ struct ProgramRun {
 };
 
 // Runs argv[0] (looked up in PATH) with `argv` in the folder `working_directory` (empty: this
-// process's), stdin from /dev/null, stdout and stderr appended to `log_path` (empty: /dev/null).
+// process's), stdin from /dev/null, stdout and stderr written to `log_path` (truncated first) (empty: /dev/null).
 ProgramRun run_program(const std::vector<std::string>& argv, const std::string& working_directory = {},
                        const std::string& log_path = {});
 

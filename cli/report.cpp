@@ -23,6 +23,7 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <sstream>
 #include <thread>
 #include <unistd.h>
 
