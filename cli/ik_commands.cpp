@@ -1,6 +1,9 @@
 // `wlx ik` and `wlx verify ik`.
+#include "bounded_input.hpp"
 #include "commands.hpp"
 #include "input.hpp"
+#include "interrupt.hpp"
+#include "output_checks.hpp"
 #include "outputs.hpp"
 
 #include <fmt/format.h>
@@ -86,40 +89,43 @@ void write_ik_sweep_csv(const std::string& path, const IkSweepResult& r) {
                            static_cast<double>(p.cold_newton_branch)});
     csv.row(row);
   }
+  csv.commit();
 }
 
 int run_ik(bool batch) {
   if (!batch) {
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(std::cin);
-    } catch (const nlohmann::json::exception& e) {
-      throw Error("stdin", fmt::format("not valid JSON ({})", e.what()));
-    }
+    const std::string text = read_all_capped(std::cin, "stdin", kMaxLineBytes);
+    throw_if_interrupted();  // a signal ends the read early: the text is not the whole request
+    const nlohmann::json j = parse_json_bounded(text, "stdin");
     std::cout << solve(parse_ik_request(j), nullptr).dump() << "\n";
     return 0;
   }
   std::string line;
-  int number = 0, failures = 0;
+  long number = 0, failures = 0;
   Coordinates warm = Coordinates::Constant(std::numeric_limits<double>::quiet_NaN());
-  while (std::getline(std::cin, line)) {
+  for (LineRead read; (read = read_line_capped(std::cin, line)) != LineRead::end;) {
     ++number;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    throw_if_interrupted();
+    // Stop computing for an output nobody receives (a closed pipe, a full disk).
+    if (std::ferror(stdout)) break;
+    if (read == LineRead::line && line.find_first_not_of(" \t\r") == std::string::npos) continue;
     try {
-      nlohmann::json j;
-      try {
-        j = nlohmann::json::parse(line);
-      } catch (const nlohmann::json::exception& e) {
-        throw Error("", fmt::format("not valid JSON ({})", e.what()));
-      }
+      if (read == LineRead::too_long)
+        throw Error("", fmt::format("longer than {} bytes; the line was skipped", kMaxLineBytes));
+      const nlohmann::json j = parse_json_bounded(line, "");
       std::cout << solve(parse_ik_request(j), &warm).dump() << "\n";
     } catch (const Error& e) {
       ++failures;
       fmt::print(stderr, "wlx ik: line {}: {}\n", number, e.what());
-      std::cout << nlohmann::ordered_json{{"error", e.what()}, {"line", number}}.dump() << "\n";
+      // replace: an ill-formed byte in a message must not end the batch (excerpts are valid UTF-8 already).
+      std::cout << nlohmann::ordered_json{{"error", e.what()}, {"line", number}}.dump(-1, ' ', false,
+                                                                                     nlohmann::json::error_handler_t::replace)
+                << "\n";
     }
   }
-  std::cout.flush();
+  throw_if_interrupted();
+  std::string reason;
+  if (!stdout_ok(reason)) throw OutputError("stdout", fmt::format("writing failed at input line {} ({})", number, reason));
   if (failures > 0) fmt::print(stderr, "wlx ik: {} of the input lines failed\n", failures);
   return failures > 0 ? 2 : 0;
 }
@@ -140,7 +146,7 @@ int run_verify_ik(const std::string& out_dir, const std::vector<std::string>& sw
       sweeps.push_back(*s);
     }
   }
-  std::filesystem::create_directories(out_dir);
+  prepare_out_dir("--out", out_dir);
   const Model model;
   Data data;
   constexpr double kLimit = 1e-10;  // m: the pass/fail bound of the analytic check
@@ -148,6 +154,7 @@ int run_verify_ik(const std::string& out_dir, const std::vector<std::string>& sw
   fmt::print("{:<7} {:<9} {:>6} {:>12} {:>12} {:>11} {:>12} {:>11} {:>8} {:>11}\n", "sweep", "input", "points",
              "check CF (m)", "check N (m)", "level err", "|CF-N| (rad)", "N iter avg", "N max", "cold start");
   for (const auto& sweep : sweeps) {
+    throw_if_interrupted();
     const IkSweepResult r = run_ik_sweep(model, sweep, data);
     write_ik_sweep_csv((std::filesystem::path(out_dir) / (sweep.id + ".csv")).string(), r);
     const bool pass = r.max_check_closed_form <= kLimit && r.max_check_newton <= kLimit && r.max_level_error <= kLimit &&

@@ -1,10 +1,14 @@
 #include "input.hpp"
 
+#include "bounded_input.hpp"
+#include "limits.hpp"
+
 #include <fmt/format.h>
 #include <wlx/error.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace wlx::cli {
 
@@ -59,13 +63,13 @@ void reject_unknown_keys(const nlohmann::json& object, const std::vector<std::st
   for (const auto& [key, value] : object.items()) {
     if (std::find(valid.begin(), valid.end(), key) != valid.end()) continue;
     const std::string hint = nearest(key, valid);
-    throw Error(where + key, hint.empty() ? "unknown key" : fmt::format("unknown key; did you mean '{}'?", hint));
+    throw Error(where + excerpt(key), hint.empty() ? "unknown key" : fmt::format("unknown key; did you mean '{}'?", hint));
   }
 }
 
 double finite_number(const nlohmann::json& value, const std::string& key) {
   if (!value.is_number())
-    throw Error(key, fmt::format("must be a number, got {} {}", type_name(value), value.dump()));
+    throw Error(key, fmt::format("must be a number, got {} {}", type_name(value), excerpt(value)));
   const double v = value.get<double>();
   if (!std::isfinite(v)) throw Error(key, fmt::format("must be a finite number, got {}", v));
   return v;
@@ -77,6 +81,7 @@ Params parse_params(const nlohmann::json& object, Params params) {
   for (const auto& info : gen::kParamInfo) names.emplace_back(info.name);
   reject_unknown_keys(object, names, "params.");
   for (const auto& [key, value] : object.items()) *find_param(params, key) = finite_number(value, "params." + key);
+  check_param_bounds(params, "params.");
   try {
     Model check(params);
   } catch (const Error& e) {
@@ -94,23 +99,29 @@ IkRequest parse_ik_request(const nlohmann::json& j) {
   r.s = nominal_inputs();
   for (int k = 0; k < kInputCount; ++k) {
     const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
-    if (j.contains(name)) r.s(k) = finite_number(j.at(name), name);
+    if (j.contains(name)) {
+      r.s(k) = finite_number(j.at(name), name);
+      check_input_bound(k, r.s(k), name);
+    }
   }
   if (j.contains("params")) r.params = parse_params(j.at("params"));
   if (j.contains("method")) {
     const auto& m = j.at("method");
     if (m == "closed-form") r.method = IkMethod::closed_form;
     else if (m == "newton") r.method = IkMethod::newton;
-    else throw Error("method", fmt::format("must be \"closed-form\" or \"newton\", got {}", m.dump()));
+    else throw Error("method", fmt::format("must be \"closed-form\" or \"newton\", got {}", excerpt(m)));
   }
   if (j.contains("branch")) {
     const auto& b = j.at("branch");
     const auto set = [&](Limb limb, const nlohmann::json& v, const std::string& key) {
-      if (!v.is_number_integer()) throw Error(key, fmt::format("must be an integer, got {}", v.dump()));
-      const int n = v.get<int>();
-      if (n < 0 || n >= branch_count(limb))
-        throw Error(key, fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, n));
-      r.branches.limb[static_cast<std::size_t>(limb)] = n;
+      if (!v.is_number_integer()) throw Error(key, fmt::format("must be an integer, got {}", excerpt(v)));
+      // Compared as 64-bit integers: a conversion to int first would wrap 4294967297 to 1.
+      const auto count = static_cast<std::int64_t>(branch_count(limb));
+      const bool in_range = v.is_number_unsigned() ? v.get<std::uint64_t>() < static_cast<std::uint64_t>(count)
+                                                   : v.get<std::int64_t>() >= 0 && v.get<std::int64_t>() < count;
+      if (!in_range)
+        throw Error(key, fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, excerpt(v)));
+      r.branches.limb[static_cast<std::size_t>(limb)] = static_cast<int>(v.get<std::int64_t>());
     };
     std::vector<std::string> limbs;
     for (const auto& l : gen::kLimbs) limbs.emplace_back(l.name);

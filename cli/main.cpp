@@ -1,9 +1,13 @@
 // wlx: the command-line tool over the runtime.
+#include "command_line.hpp"
 #include "commands.hpp"
+#include "interrupt.hpp"
+#include "output_checks.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <wlx/atomic_file.hpp>
 #include <wlx/error.hpp>
 #include <wlx/ik.hpp>
 #include <wlx/kinematics.hpp>
@@ -59,7 +63,7 @@ int run_fk(bool as_json) {
 
 int main(int argc, char** argv) {
   CLI::App app{"wlx: kinematics and dynamics of the walking excavator, from generated closed-form code"};
-  app.require_subcommand(1);
+  wlx::cli::prepare_command_line(app, WLX_VERSION);
   bool fk_json = false;
   auto* fk = app.add_subcommand("fk", "forward kinematics of the nominal pose (MODEL.md section 8)");
   fk->add_flag("--json", fk_json, "print JSON instead of a table");
@@ -96,23 +100,34 @@ int main(int argc, char** argv) {
   report->add_option("--out", report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
   report->add_flag("--quick", report_options.quick, "a reduced set of runs, for a fast look");
 
-  CLI11_PARSE(app, argc, argv);
   using namespace wlx::cli;
+  install_interrupt_handlers();
+  if (const auto code = parse_command_line(app, argc, argv)) return finish(*code);
   try {
-    if (fk->parsed()) return run_fk(fk_json);
-    if (ik->parsed()) return run_ik(batch);
-    if (verify_ik->parsed()) return run_verify_ik(ik_out, sweep_ids);
-    if (verify_nh->parsed()) return run_verify_nonholonomic(nh_out);
-    if (report->parsed()) return run_report(report_options);
+    if (fk->parsed()) return finish(run_fk(fk_json));
+    if (ik->parsed()) return finish(run_ik(batch));
+    if (verify_ik->parsed()) return finish(run_verify_ik(ik_out, sweep_ids));
+    if (verify_nh->parsed()) return finish(run_verify_nonholonomic(nh_out));
+    if (report->parsed()) return finish(run_report(report_options));
     if (simulate->parsed()) {
       if (!sim.list && sim.scenario.empty()) throw wlx::Error("SCENARIO", "missing: give a scenario file or id (--list shows the ids)");
-      return run_simulate(sim);
+      return finish(run_simulate(sim));
     }
+  } catch (const Interrupted& e) {
+    finish(0);
+    fmt::print(stderr, "wlx: {}: stopped before the end; the files finished before are complete, none was left cut\n",
+               e.what());
+    return e.exit_code();
+  } catch (const wlx::OutputError& e) {
+    fmt::print(stderr, "wlx: error: {}\n", e.what());
+    return kExitOutputError;
   } catch (const wlx::Error& e) {
     fmt::print(stderr, "wlx: error: {}\n", e.what());
     return 2;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "wlx: error: {}\n", e.what());
+    // Library messages (std::filesystem's) quote whole arguments: bound them like wlx's own.
+    const std::string message = e.what();
+    fmt::print(stderr, "wlx: error: {}\n", message.size() > 500 ? message.substr(0, 500) + "..." : message);
     return 2;
   }
   return 0;

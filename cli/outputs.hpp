@@ -16,6 +16,12 @@ void write_ik_sweep_csv(const std::string& path, const IkSweepResult& result);
 // (<name>_dot), cond_J_beta, cabin_clearance, the contact velocities vx_Wl..vz_Wr, and for
 // dynamics runs tau_<joint> and Qstar_<speed>.
 std::vector<std::string> trajectory_header(bool dynamics);
+std::vector<double> trajectory_row(const Sample& sample, bool dynamics);
 void write_trajectory(const std::string& path, const Trajectory& trajectory, bool dynamics);
+
+// `wlx simulate`'s run: samples streamed to <out_dir>/trajectory.csv as they are computed
+// (constant memory), the file put in place when the run ends, also when it stops early or is
+// interrupted (then marked partial by the message and the exit code). Returns the exit code.
+int stream_simulation(const Scenario& scenario, const std::string& label, const std::string& out_dir);
 
 }  // namespace wlx::cli

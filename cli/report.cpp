@@ -2,7 +2,10 @@
 // CSV behind every figure, gnuplot figures (PNG and SVG), and an index.html that opens with a
 // table of the thesis' claims beside wlx's measured values.
 #include "commands.hpp"
+#include "interrupt.hpp"
+#include "output_checks.hpp"
 #include "outputs.hpp"
+#include "process.hpp"
 #include "scenario_io.hpp"
 
 #include <fmt/format.h>
@@ -20,7 +23,9 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <sstream>
 #include <thread>
+#include <unistd.h>
 
 namespace wlx::cli {
 
@@ -85,10 +90,14 @@ class Report {
  private:
   void progress(const std::string& what) {
     ++step_;
+    throw_if_interrupted();
     fmt::print("[{:>2}/{}] {}\n", step_, total_steps_, what);
     std::fflush(stdout);
   }
   std::string data(const std::string& file) const { return (root_ / "data" / file).string(); }
+  // The same file as the gnuplot scripts name it: relative to the report folder, where gnuplot
+  // runs, so the user's path (quotes, $, newlines) never appears inside a script.
+  static std::string plot_data(const std::string& file) { return "data/" + file; }
   // A CSV column in a gnuplot `using` clause, optionally scaled.
   static std::string col(const std::string& name, double scale = 1) {
     return scale == 1 ? fmt::format("(column(\"{}\"))", name) : fmt::format("(column(\"{}\")*{})", name, scale);
@@ -201,6 +210,7 @@ void Report::compare_integrators() {
   for (const auto& r : integrators_)
     csv.row({r.id, std::string(integrator_name(r.integrator))},
             {static_cast<double>(r.samples), static_cast<double>(r.evaluations), r.inputs, r.y_C, r.theta5});
+  csv.commit();
 }
 
 void Report::add_checks() {
@@ -338,7 +348,7 @@ void Report::figures_ik() {
       joints.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(block.joints[static_cast<std::size_t>(j)])]);
     const double xs = s.sweep.degrees ? 1 / kDeg : 1;
     const std::string xunit = s.sweep.degrees ? "deg" : "m";
-    const std::string file = data(s.sweep.id + ".csv");
+    const std::string file = plot_data(s.sweep.id + ".csv");
     std::string b = "set multiplot layout 2,1\n";
     b += fmt::format("set xlabel '{} ({})'\nset ylabel 'joint angle (deg)'\nset title '{}: dependent joints (closed form)'\n",
                      s.sweep.input, xunit, s.sweep.id);
@@ -364,7 +374,7 @@ void Report::figures_nonholonomic() {
   if (ids.empty()) return;
   std::string b = fmt::format("set multiplot layout {},2\nset logscale y\nset format y '1e%L'\nset yrange [1e-19:1e-3]\n", (ids.size() + 1) / 2);
   for (const auto& id : ids) {
-    const std::string file = data(result(id).csv);
+    const std::string file = plot_data(result(id).csv);
     b += fmt::format("set title '{}: |v_W . n_W|'\nset xlabel 't (s)'\nset ylabel 'm/s'\n", id);
     b += fmt::format("plot '{0}' using {1}:{2} with lines lw 2 title 'left wheel', '{0}' using {1}:{3} with lines lw 2 title "
                      "'right wheel', 1e-5 with lines dt 2 lw 2 lc rgb 'gray40' title 'thesis (1e-5)'\n",
@@ -394,7 +404,7 @@ void Report::figures_steering() {
       b += fmt::format("set title '{}: {} over {}'\nset xlabel '{} ({})'\nset ylabel '{} ({})'\nplot ", g.id, out, g.drive, g.drive,
                        g.degrees ? "deg" : "m", out, angle ? "deg" : "m");
       for (std::size_t k = 0; k < ids.size(); ++k)
-        b += fmt::format("{}'{}' using {}:{} with lines lw 2 title '{}'", k ? ", " : "", data(result(ids[k]).csv), col(g.drive, xs),
+        b += fmt::format("{}'{}' using {}:{} with lines lw 2 title '{}'", k ? ", " : "", plot_data(result(ids[k]).csv), col(g.drive, xs),
                          col(out, angle ? 1 / kDeg : 1), ids[k]);
       b += "\n";
     }
@@ -405,7 +415,7 @@ void Report::figures_steering() {
     std::string t = fmt::format("set title '{}: top view of the paths (K0)'\nset xlabel 'x (m)'\nset ylabel 'y (m)'\nset size ratio -1\n"
                                 "set offsets graph 0.05, graph 0.05, graph 0.1, graph 0.1\nset key outside right\nplot ", g.id);
     for (std::size_t k = 0; k < ids.size(); ++k) {
-      const std::string file = data(result(ids[k]).csv);
+      const std::string file = plot_data(result(ids[k]).csv);
       t += fmt::format("{}'{}' using {}:{} with lines lw 2 title '{} cabin', '{}' using {}:{} with lines lw 2 title '{} left wheel', "
                        "'{}' using {}:{} with lines lw 2 title '{} right wheel'",
                        k ? ", " : "", file, col("x_C"), col("y_C"), ids[k], file, col("x_Wl"), col("y_Wl"), ids[k], file,
@@ -425,7 +435,7 @@ void Report::figures_dynamics() {
                                                         {"psi_r3", "psi_r4", "theta_l6", "theta_r6"}};
   for (const auto& r : runs_) {
     if (!r.scenario.weighting) continue;
-    const std::string file = data(r.csv);
+    const std::string file = plot_data(r.csv);
     std::string b = "set multiplot layout 2,1\nset xlabel 't (s)'\nset ylabel 'torque (N m)'\nset key outside right\n";
     for (std::size_t g = 0; g < groups.size(); ++g) {
       b += fmt::format("set title '{}, {}: torques {}'\nplot ", r.id.substr(0, 4), r.scenario.weighting->label(),
@@ -446,8 +456,8 @@ void Report::figures_dynamics() {
 void Report::figures_poses() {
   for (const auto& r : runs_) {
     if (r.id.size() > 4 && r.id.substr(r.id.size() - 3) == "-w2") continue;  // same motion as -w1
-    const std::string dat = data(r.id + "-pose.dat");
-    std::ofstream out(dat);
+    const std::string dat = plot_data(r.id + "-pose.dat");
+    std::ostringstream out;
     // Two blocks (start, end), each a set of segments separated by blank lines: cabin outline,
     // legs hip-knee-foot, levers hip-end-contact.
     for (const Sample* smp : {&r.trajectory.samples.front(), &r.trajectory.samples.back()}) {
@@ -470,7 +480,7 @@ void Report::figures_poses() {
       }
       out << "\n";  // two blank lines: next gnuplot index
     }
-    out.close();
+    write_file_atomically(data(r.id + "-pose.dat"), out.str());
     const std::string title = r.id.size() > 4 && r.id.substr(r.id.size() - 3) == "-w1" ? r.id.substr(0, 4) : r.id;
     std::string b = "set multiplot layout 2,1\nset size ratio -1\nset key outside right\nset offsets graph 0.03, graph 0.03, graph 0.05, graph 0.05\n";
     b += fmt::format("set title '{}: side view'\nset xlabel 'x (m)'\nset ylabel 'z (m)'\n", title);
@@ -489,35 +499,54 @@ void Report::figures_poses() {
 }
 
 void Report::render_figures() {
-  if (std::system("gnuplot --version > /dev/null 2>&1") != 0)
+  if (!run_program({"gnuplot", "--version"}).ok())
     throw Error("gnuplot", "not found: install Debian's gnuplot-nox (tools/setup.sh does)");
   const fs::path scripts = root_ / "plots";
-  fs::create_directories(scripts);
+  prepare_out_dir("--out", scripts.string());
   for (const auto& f : figures_) {
-    std::ofstream gp(scripts / (f.name + ".gp"));
+    // Figure names go into gnuplot strings ('...') and -e: wlx's own identifiers, kept to a set
+    // of characters that needs no quoting, so no future name can inject gnuplot commands.
+    if (f.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789+-_.") != std::string::npos)
+      throw Error("report", fmt::format("figure name '{}' has a character gnuplot would need quoted", f.name));
+    std::string gp;
     const std::string common = "set datafile separator ','\nset grid\nset key box opaque\nset encoding utf8\n";
-    gp << "# Renders fig/" << f.name << ".png and .svg from the CSV files in data/ (run from anywhere).\n";
-    gp << fmt::format("set terminal pngcairo size {} font 'DejaVu Sans,10' noenhanced\nset output '{}'\n{}{}", f.size,
-                      (root_ / "fig" / (f.name + ".png")).string(), common, f.body);
-    gp << "reset\n";
-    gp << fmt::format("set terminal svg size {} font 'DejaVu Sans,10' noenhanced\nset output '{}'\n{}{}", f.size,
-                      (root_ / "fig" / (f.name + ".svg")).string(), common, f.body);
+    gp += fmt::format("# Renders fig/{0}.png and .svg from the CSV files in data/: run `gnuplot plots/{0}.gp` in the report's\n"
+                      "# folder. wlx itself passes temporary output names with -e and renames the finished images.\n"
+                      "if (!exists(\"png\")) png = 'fig/{0}.png'\nif (!exists(\"svg\")) svg = 'fig/{0}.svg'\n",
+                      f.name);
+    gp += fmt::format("set terminal pngcairo size {} font 'DejaVu Sans,10' noenhanced\nset output png\n{}{}", f.size, common, f.body);
+    gp += "reset\n";
+    gp += fmt::format("set terminal svg size {} font 'DejaVu Sans,10' noenhanced\nset output svg\n{}{}", f.size, common, f.body);
+    write_file_atomically((scripts / (f.name + ".gp")).string(), gp);
   }
-  // Two at a time: these machines have two cores.
+  // Two at a time: these machines have two cores. gnuplot runs in the report folder without a
+  // shell; figure names are wlx's own identifiers, so the -e text needs no quoting beyond '...'.
   std::atomic<std::size_t> next{0};
-  std::atomic<int> done{0};
   std::vector<std::string> failures(figures_.size());
   const auto worker = [&] {
-    for (std::size_t k; (k = next++) < figures_.size();) {
-      const std::string cmd = fmt::format("gnuplot '{}' > '{}' 2>&1", (scripts / (figures_[k].name + ".gp")).string(),
-                                          (scripts / (figures_[k].name + ".log")).string());
-      if (std::system(cmd.c_str()) != 0) failures[k] = figures_[k].name;
-      ++done;
+    for (std::size_t k; interrupt_signal() == 0 && (k = next++) < figures_.size();) {
+      const std::string& name = figures_[k].name;
+      const std::string png = fmt::format("fig/{}.png.{}.tmp", name, static_cast<long>(::getpid()));
+      const std::string svg = fmt::format("fig/{}.svg.{}.tmp", name, static_cast<long>(::getpid()));
+      const ProgramRun run = run_program({"gnuplot", "-e", fmt::format("png='{}'; svg='{}'", png, svg), "plots/" + name + ".gp"},
+                                         root_.string(), (scripts / (name + ".log")).string());
+      std::error_code ec;
+      bool ok = run.ok() && fs::file_size(root_ / png, ec) > 0 && !ec && fs::file_size(root_ / svg, ec) > 0 && !ec;
+      if (ok) {
+        fs::rename(root_ / png, root_ / "fig" / (name + ".png"), ec);
+        ok = !ec;
+        if (ok) fs::rename(root_ / svg, root_ / "fig" / (name + ".svg"), ec);
+        ok = ok && !ec;
+      }
+      if (!ok) failures[k] = name;
+      fs::remove(root_ / png, ec);  // only a leftover temporary remains to remove
+      fs::remove(root_ / svg, ec);
     }
   };
   std::thread a(worker), b(worker);
   a.join();
   b.join();
+  throw_if_interrupted();  // a figure failed because its gnuplot was interrupted too: say that instead
   for (const auto& f : failures)
     if (!f.empty()) throw Error("gnuplot", fmt::format("failed on {}: see {}", f, (scripts / (f + ".log")).string()));
 }
@@ -567,6 +596,7 @@ void Report::write_html() {
          "<th>min cabin clearance (m)</th><th>CSV</th></tr>\n";
     for (const auto& r : runs_) {
       if (r.id.rfind(prefix, 0) != 0) continue;
+      if (r.trajectory.samples.empty()) continue;  // never in a report (a run that stops throws), and no sentinels
       double res = 0, cond = 0, clear = 1e300;
       for (const auto& smp : r.trajectory.samples) {
         res = std::max(res, smp.nh_residual.cwiseAbs().maxCoeff());
@@ -604,13 +634,18 @@ void Report::write_html() {
   h += "<h2 id=\"poses\">Poses at the start and the end of each run</h2>\n";
   for (const auto& n : sections_["pose"]) figure(n);
   h += "</body>\n</html>\n";
-  std::ofstream(root_ / "index.html") << h;
+  // Last of all the files: its presence says the report is complete.
+  write_file_atomically((root_ / "index.html").string(), h);
 }
 
 int Report::run() {
   const auto start = std::chrono::steady_clock::now();
-  fs::create_directories(root_ / "data");
-  fs::create_directories(root_ / "fig");
+  // An index.html from an earlier run would claim that this one is complete until it is.
+  std::error_code ec;
+  fs::remove(root_ / "index.html", ec);
+  if (ec) throw OutputError((root_ / "index.html").string(), fmt::format("cannot remove the earlier report's ({})", ec.message()));
+  prepare_out_dir("--out", (root_ / "data").string());
+  prepare_out_dir("--out", (root_ / "fig").string());
   total_steps_ = (opt_.quick ? 2 : 12) + (opt_.quick ? 6 : static_cast<int>(scenario_ids().size()) + 3 + 1) + 2;
   run_ik();
   run_simulations();
@@ -638,6 +673,16 @@ int Report::run() {
 
 }  // namespace
 
-int run_report(const ReportOptions& options) { return Report(options).run(); }
+int run_report(const ReportOptions& options) {
+  prepare_out_dir("--out", options.out_dir);
+  try {
+    return Report(options).run();
+  } catch (const Interrupted& e) {
+    std::fflush(stdout);
+    fmt::print(stderr, "wlx: {}: the report in {} is partial: no index.html was written; the files in data/ and fig/ "
+                       "that exist are complete\n", e.what(), options.out_dir);
+    return e.exit_code();
+  }
+}
 
 }  // namespace wlx::cli

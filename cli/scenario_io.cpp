@@ -1,6 +1,8 @@
 #include "scenario_io.hpp"
 
+#include "bounded_input.hpp"
 #include "input.hpp"
+#include "limits.hpp"
 
 #include <fmt/format.h>
 #include <wlx/error.hpp>
@@ -41,31 +43,28 @@ std::string embedded_scenario(const std::string& id) {
 
 nlohmann::json read_scenario_json(const std::string& arg) {
   std::string text;
-  if (std::filesystem::is_regular_file(arg)) {
-    std::ifstream in(arg);
-    std::ostringstream s;
-    s << in.rdbuf();
-    text = s.str();
+  std::error_code ec;  // e.g. a name too long for a path: then it is not a file (the message excerpts it)
+  if (std::filesystem::is_regular_file(arg, ec)) {
+    std::ifstream in(arg, std::ios::binary);
+    if (!in) throw Error(arg, "cannot open for reading");
+    text = read_all_capped(in, arg, kMaxFileBytes);
+    if (in.bad()) throw Error(arg, "reading failed");
   } else {
     text = embedded_scenario(arg);
     if (text.empty()) {
       const std::string hint = nearest(arg, scenario_ids());
-      throw Error("SCENARIO", fmt::format("'{}' is neither a file nor a scenario id{}", arg,
+      throw Error("SCENARIO", fmt::format("'{}' is neither a file nor a scenario id{}", excerpt(arg),
                                           hint.empty() ? " (wlx simulate --list shows them)" : "; did you mean '" + hint + "'?"));
     }
   }
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(arg, fmt::format("not valid JSON ({})", e.what()));
-  }
+  return parse_json_bounded(text, arg);
 }
 
 double si_value(const nlohmann::json& v, const std::string& key, bool angle) {
   if (v.is_object()) {
     if (!angle) throw Error(key, "only angles may be given in degrees; give this value in SI units");
     if (v.size() != 1 || !(v.contains("deg") || v.contains("deg/s")))
-      throw Error(key, fmt::format("expected a number or {{\"deg\": x}} / {{\"deg/s\": x}}, got {}", v.dump()));
+      throw Error(key, fmt::format("expected a number or {{\"deg\": x}} / {{\"deg/s\": x}}, got {}", excerpt(v)));
     // v.items() is a proxy: iterate it in place (a reference into a dereferenced temporary dangles).
     for (const auto& item : v.items()) return finite_number(item.value(), key + "." + item.key()) * std::numbers::pi / 180;
   }
@@ -76,9 +75,14 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
   if (v.is_number_integer() && (v == 1 || v == 2)) return v == 1 ? Weighting::strong_weak() : Weighting::contribution();
   if (v.is_object() && v.size() == 1 && v.contains("diag")) {
     const auto& d = v.at("diag");
-    if (!d.is_array() || d.size() != 8) throw Error(key + ".diag", fmt::format("must be an array of 8 weights, got {}", d.dump()));
+    if (!d.is_array() || d.size() != 8) throw Error(key + ".diag", fmt::format("must be an array of 8 weights, got {}", excerpt(d)));
     Vector8 w;
     for (int i = 0; i < 8; ++i) w(i) = finite_number(d[static_cast<std::size_t>(i)], fmt::format("{}.diag[{}]", key, i));
+    // Only ratios of weights matter (a uniform scale leaves the torques unchanged); beyond this span
+    // rounding, not the weights, would decide how the torque is split.
+    if (w.minCoeff() > 0 && w.maxCoeff() / w.minCoeff() > kMaxWeightRatio)
+      throw Error(key + ".diag", fmt::format("the largest weight is {:.3g} times the smallest; at most {:g} is meaningful",
+                                             w.maxCoeff() / w.minCoeff(), kMaxWeightRatio));
     try {
       return Weighting::diagonal_of(w);
     } catch (const Error& e) {
@@ -100,7 +104,7 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
       throw Error(key + ".matrix", std::string(e.what()).substr(e.field().size() + 2));
     }
   }
-  throw Error(key, fmt::format("must be 1, 2, {{\"diag\": [8 weights]}} or {{\"matrix\": [[8 x 8]]}}, got {}", v.dump()));
+  throw Error(key, fmt::format("must be 1, 2, {{\"diag\": [8 weights]}} or {{\"matrix\": [[8 x 8]]}}, got {}", excerpt(v)));
 }
 
 Scenario parse_scenario(const nlohmann::json& j) {
@@ -111,7 +115,7 @@ Scenario parse_scenario(const nlohmann::json& j) {
   Scenario sc;
   const auto text = [&](const char* key) {
     if (!j.contains(key)) return std::string();
-    if (!j.at(key).is_string()) throw Error(key, fmt::format("must be a string, got {}", j.at(key).dump()));
+    if (!j.at(key).is_string()) throw Error(key, fmt::format("must be a string, got {}", excerpt(j.at(key))));
     return j.at(key).get<std::string>();
   };
   sc.id = text("id");
@@ -125,6 +129,8 @@ Scenario parse_scenario(const nlohmann::json& j) {
     for (const auto& [key, value] : obj.items()) {
       const int k = coordinate_index(key);
       const double v = si_value(value, std::string(group) + "." + key, is_angle(k));
+      if (std::string(group) == "initial") check_input_bound(k, v, std::string(group) + "." + key);
+      else check_rate_bound(k, v, std::string(group) + "." + key);
       if (std::string(group) == "initial") sc.initial(k) = v;
       else sc.rates(k) = v;
     }
@@ -132,7 +138,10 @@ Scenario parse_scenario(const nlohmann::json& j) {
   if (!j.contains("dependent")) throw Error("dependent", "missing: name the two dependent rates, e.g. [\"y_C\", \"yaw\"]");
   const auto& dep = j.at("dependent");
   if (!dep.is_array() || dep.size() != 2 || !dep[0].is_string() || !dep[1].is_string())
-    throw Error("dependent", fmt::format("must be an array of 2 names, got {}", dep.dump()));
+    throw Error("dependent", fmt::format("must be an array of 2 names, got {}", excerpt(dep)));
+  for (const auto& name : dep)  // the pair's own messages quote the names in full
+    if (excerpt(name.get<std::string>()) != name.get<std::string>())
+      throw Error("dependent", fmt::format("'{}' cannot be a dependent rate", excerpt(name.get<std::string>())));
   sc.pair = dependent_pair(dep[0].get<std::string>(), dep[1].get<std::string>());
   if (!j.contains("duration")) throw Error("duration", "missing: the run's length in seconds");
   sc.duration = finite_number(j.at("duration"), "duration");
@@ -140,7 +149,7 @@ Scenario parse_scenario(const nlohmann::json& j) {
   if (j.contains("integrator")) {
     const auto& in = j.at("integrator");
     const auto integrator = in.is_string() ? integrator_from_name(in.get<std::string>()) : std::nullopt;
-    if (!integrator) throw Error("integrator", fmt::format("must be \"rk4\", \"euler\" or \"dopri5\", got {}", in.dump()));
+    if (!integrator) throw Error("integrator", fmt::format("must be \"rk4\", \"euler\" or \"dopri5\", got {}", excerpt(in)));
     sc.integrator = *integrator;
   }
   if (j.contains("tolerance")) sc.tolerance = finite_number(j.at("tolerance"), "tolerance");

@@ -1,5 +1,7 @@
 // `wlx simulate` and `wlx verify nonholonomic`.
 #include "commands.hpp"
+#include "interrupt.hpp"
+#include "output_checks.hpp"
 #include "outputs.hpp"
 #include "scenario_io.hpp"
 
@@ -48,6 +50,7 @@ std::vector<double> trajectory_row(const Sample& smp, bool dynamics) {
 void write_trajectory(const std::string& path, const Trajectory& tr, bool dynamics) {
   CsvWriter csv(path, trajectory_header(dynamics));
   for (const auto& smp : tr.samples) csv.row(trajectory_row(smp, dynamics));
+  csv.commit();
 }
 
 int run_simulate(const SimulateOptions& o) {
@@ -55,6 +58,8 @@ int run_simulate(const SimulateOptions& o) {
     for (const auto& id : scenario_ids()) {
       const auto j = nlohmann::json::parse(embedded_scenario(id));
       fmt::print("{:<8} {}\n", id, j.value("description", ""));
+      // A closed pipe or a full disk: stop and say so (main checks stdout again at the end).
+      if (std::ferror(stdout)) break;
     }
     return 0;
   }
@@ -75,44 +80,17 @@ int run_simulate(const SimulateOptions& o) {
     sc.weighting = o.weighting == "1" ? Weighting::strong_weak() : Weighting::contribution();
   }
   sc.validate();
-  std::filesystem::create_directories(o.out_dir);
-  const Trajectory tr = simulate(sc);
-  const std::string path = (std::filesystem::path(o.out_dir) / "trajectory.csv").string();
-  write_trajectory(path, tr, sc.weighting.has_value());
-  double worst = 0, worst_cond = 0, min_clearance = 1e300;
-  for (const auto& smp : tr.samples) {
-    worst = std::max(worst, smp.nh_residual.cwiseAbs().maxCoeff());
-    worst_cond = std::max(worst_cond, smp.cond_J_beta);
-    min_clearance = std::min(min_clearance, smp.cabin_clearance);
-  }
-  fmt::print("{}: {} samples ({} s, dt {} s, {}), dependent pair {}\n", sc.id.empty() ? o.scenario : sc.id,
-             tr.samples.size(), sc.duration, sc.dt, integrator_name(sc.integrator), sc.pair.label());
-  fmt::print("integration: {} steps{}, {} evaluations of the right-hand side\n", tr.steps,
-             sc.integrator == Integrator::dopri5
-                 ? fmt::format(" ({} rejected; tolerance {:.1e})", tr.rejected_steps, sc.tolerance)
-                 : std::string(),
-             tr.evaluations);
-  fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, min cabin clearance = {:.4f} m\n", worst, worst_cond,
-             min_clearance);
-  if (sc.weighting && !tr.samples.empty()) {
-    double peak = 0;
-    for (const auto& smp : tr.samples) peak = std::max(peak, smp.tau.cwiseAbs().maxCoeff());
-    fmt::print("inverse dynamics with {}: largest |tau| = {:.4g} N m\n", sc.weighting->label(), peak);
-  }
-  fmt::print("wrote {}\n", path);
-  if (!tr.complete) {
-    fmt::print(stderr, "wlx: error: {}; {} wrote the {} samples computed before\n", tr.error, path, tr.samples.size());
-    return 2;
-  }
-  return 0;
+  prepare_out_dir("--out", o.out_dir);
+  return stream_simulation(sc, sc.id.empty() ? o.scenario : sc.id, o.out_dir);
 }
 
 int run_verify_nonholonomic(const std::string& out_dir) {
   constexpr double kLimit = 1e-10;
   bool ok = true;
-  std::filesystem::create_directories(out_dir);
+  prepare_out_dir("--out", out_dir);
   fmt::print("{:<6} {:>8} {:>16} {:>16} {:>14}\n", "run", "samples", "max |res_l| m/s", "max |res_r| m/s", "max cond");
   for (const char* id : {"NH-1", "NH-2", "NH-3", "NH-4"}) {
+    throw_if_interrupted();
     const Scenario sc = parse_scenario(read_scenario_json(id));
     const Trajectory tr = simulate(sc);
     write_trajectory((std::filesystem::path(out_dir) / (std::string(id) + ".csv")).string(), tr, false);
@@ -124,8 +102,11 @@ int run_verify_nonholonomic(const std::string& out_dir) {
     }
     const bool pass = tr.complete && l <= kLimit && r <= kLimit;
     ok = ok && pass;
-    fmt::print("{:<6} {:>8} {:>16.2e} {:>16.2e} {:>14.3g}{}\n", id, tr.samples.size(), l, r, cond,
-               pass ? "" : (tr.complete ? "  FAIL" : "  FAIL: " + tr.error));
+    if (tr.samples.empty())  // nothing computed: no maxima to print
+      fmt::print("{:<6} {:>8} {:>16} {:>16} {:>14}  FAIL: {}\n", id, 0, "-", "-", "-", tr.error);
+    else
+      fmt::print("{:<6} {:>8} {:>16.2e} {:>16.2e} {:>14.3g}{}\n", id, tr.samples.size(), l, r, cond,
+                 pass ? "" : (tr.complete ? "  FAIL" : "  FAIL: " + tr.error));
   }
   fmt::print("\nresidual = v_W . n_W from the generated C(s) and the solved rates (thesis: <= 1e-5); CSV files: {}/\n{}\n",
              out_dir, ok ? "all runs pass (every residual <= 1e-10 m/s)" : "SOME RUNS FAIL");

@@ -1,6 +1,9 @@
-// A CSV writer for results: full double precision, and never a NaN or Inf in a file.
+// A CSV writer for results: full double precision, and never a NaN or Inf in a file. The file
+// appears under its name only when commit() is called (wlx::AtomicFile): a writer destroyed
+// before that (an error, an interruption) leaves nothing behind.
 #pragma once
 
+#include "wlx/atomic_file.hpp"
 #include "wlx/error.hpp"
 
 #include <fmt/format.h>
@@ -14,19 +17,18 @@ namespace wlx {
 
 class CsvWriter {
  public:
-  CsvWriter(const std::string& path, const std::vector<std::string>& header) : path_(path), columns_(header.size()) {
-    file_ = std::fopen(path.c_str(), "w");
-    if (file_ == nullptr) throw Error(path, "cannot open for writing");
+  CsvWriter(const std::string& path, const std::vector<std::string>& header)
+      : path_(path), columns_(header.size()), file_(path) {
     std::string line;
     for (const auto& h : header) line += (line.empty() ? "" : ",") + h;
-    fmt::print(file_, "{}\n", line);
+    file_.write(line + "\n");
     header_ = header;
   }
   CsvWriter(const CsvWriter&) = delete;
   CsvWriter& operator=(const CsvWriter&) = delete;
-  ~CsvWriter() {
-    if (file_ != nullptr) std::fclose(file_);
-  }
+
+  // Puts the finished file in place; throws OutputError naming it if anything was lost.
+  void commit() { file_.commit(); }
 
   // One row; a non-finite value is an error naming its column, and nothing of the row is written.
   void row(const std::vector<double>& values) { row({}, values); }
@@ -44,14 +46,14 @@ class CsvWriter {
     for (const auto& l : labels) line += (line.empty() ? "" : ",") + l;
     for (std::size_t k = 0; k < values.size(); ++k)
       line += (labels.empty() && k == 0 ? "" : ",") + fmt::format("{:.17g}", values[k]);
-    fmt::print(file_, "{}\n", line);
+    file_.write(line + "\n");
   }
 
  private:
   std::string path_;
   std::size_t columns_;
   std::vector<std::string> header_;
-  std::FILE* file_ = nullptr;
+  AtomicFile file_;
 };
 
 }  // namespace wlx

@@ -109,7 +109,9 @@ Weighting Weighting::matrix_of(const Eigen::Matrix<double, 8, 8>& W) {
   if (!W.allFinite()) throw Error("weighting", "the weight matrix has a non-finite entry");
   if ((W - W.transpose()).cwiseAbs().maxCoeff() > 1e-12 * W.cwiseAbs().maxCoeff())
     throw Error("weighting", "the weight matrix must be symmetric");
-  if (W.llt().info() != Eigen::Success) throw Error("weighting", "the weight matrix must be positive definite");
+  // Scaled to a largest entry of 1 first: entries near 1e308 would overflow in the factorization.
+  if ((W / W.cwiseAbs().maxCoeff()).llt().info() != Eigen::Success)
+    throw Error("weighting", "the weight matrix must be positive definite");
   Weighting out;
   out.kind = Kind::matrix;
   out.matrix = W;
@@ -124,9 +126,13 @@ Vector8 distribute_torques(const ActuatorJacobian& J_beta, const Vector4& Qstar,
     case Weighting::Kind::contribution:  // W_ii^-1 = |row i| directly: a zero row gets zero torque
       for (int i = 0; i < 8; ++i) S(i, i) = std::sqrt(J_beta.row(i).norm());
       break;
-    case Weighting::Kind::diagonal: S.diagonal() = weighting.diagonal.cwiseInverse().cwiseSqrt(); break;
+    // A uniform scale of W does not change the minimum-norm torques: divide it out (largest weight
+    // 1) so weights of 1e308 or 1e-307 neither overflow nor fall below the rank threshold.
+    case Weighting::Kind::diagonal:
+      S.diagonal() = (weighting.diagonal / weighting.diagonal.maxCoeff()).cwiseInverse().cwiseSqrt();
+      break;
     case Weighting::Kind::matrix: {
-      const Eigen::Matrix<double, 8, 8> L = weighting.matrix.llt().matrixL();
+      const Eigen::Matrix<double, 8, 8> L = (weighting.matrix / weighting.matrix.cwiseAbs().maxCoeff()).llt().matrixL();
       S = L.transpose().triangularView<Eigen::Upper>().solve(Eigen::Matrix<double, 8, 8>::Identity());
       break;
     }

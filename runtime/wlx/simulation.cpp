@@ -74,6 +74,10 @@ void dopri5_span(RightHandSide& f, InputVector& q, InputVector k1, double t, dou
       k7 = f(next);
       const InputVector error = step * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
       scaled = (error.array().abs() / (tolerance * (1 + q.array().abs().max(next.array().abs())))).maxCoeff();
+      if (!std::isfinite(scaled)) {  // an overflow, not an error estimate: shrink, and say so if it persists
+        failure = "a stage of the step became non-finite (inf or NaN)";
+        scaled = 1e10;
+      }
     } catch (const Error& e) {
       // The stages reach ahead of the step (up to 3.7 step lengths with these coefficients), so
       // a long step can probe poses the motion itself never reaches: reject and shrink. A real
@@ -102,6 +106,47 @@ void dopri5_span(RightHandSide& f, InputVector& q, InputVector k1, double t, dou
       }
     }
   }
+}
+
+// What drives a run's numbers, for a message about a value that became non-finite: the largest
+// commanded rate, gravity and the heaviest body.
+std::string drivers(const Scenario& sc) {
+  int fastest = 0;
+  for (int k = 1; k < kInputCount; ++k)
+    if (std::abs(sc.rates(k)) > std::abs(sc.rates(fastest))) fastest = k;
+  double heaviest = 0;
+  for (const auto& body : gen::kBodyMass) heaviest = std::max(heaviest, sc.params.*body.mass);
+  return fmt::format("inputs driving it: largest commanded rate {}' = {:g}, g = {:g} m/s^2, heaviest body {:g} kg",
+                     gen::kCoordinateNames[static_cast<std::size_t>(fastest)], sc.rates(fastest), sc.params.g, heaviest);
+}
+
+// Throws naming the first quantity of a sample (its CSV column) that is not finite: caught where
+// it arises rather than when a file is written, with the time and the inputs that drive it.
+void check_finite(const Sample& smp, const Scenario& sc) {
+  const auto fail = [&](const std::string& name, double value) {
+    throw Error(name, fmt::format("became non-finite ({}) at t = {:.6f} s; {}", value, smp.t, drivers(sc)));
+  };
+  const auto name = [](int k) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]); };
+  for (int k = 0; k < kCoordinateCount; ++k) {
+    if (!std::isfinite(smp.s(k))) fail(name(k), smp.s(k));
+    if (!std::isfinite(smp.sdot(k))) fail(name(k) + "_dot", smp.sdot(k));
+  }
+  const char* contacts[] = {"x_Wl", "y_Wl", "x_Wr", "y_Wr"};
+  for (int k = 0; k < 4; ++k)
+    if (!std::isfinite(smp.contacts(k))) fail(contacts[k], smp.contacts(k));
+  for (int w = 0; w < 2; ++w) {
+    const char side = w == 0 ? 'l' : 'r';
+    for (int i = 0; i < 3; ++i)
+      if (!std::isfinite(smp.contact_velocity(i, w))) fail(fmt::format("v{}_W{}", "xyz"[i], side), smp.contact_velocity(i, w));
+    if (!std::isfinite(smp.nh_residual(w))) fail(fmt::format("nh_residual_{}", side), smp.nh_residual(w));
+    if (!std::isfinite(smp.spin_rate(w))) fail(fmt::format("spin_rate_{}", side), smp.spin_rate(w));
+  }
+  if (!std::isfinite(smp.cond_J_beta)) fail("cond_J_beta", smp.cond_J_beta);
+  if (!std::isfinite(smp.cabin_clearance)) fail("cabin_clearance", smp.cabin_clearance);
+  for (int k = 0; k < 8; ++k)
+    if (!std::isfinite(smp.tau(k))) fail("tau_" + name(kActuatedJoints[static_cast<std::size_t>(k)]), smp.tau(k));
+  for (int k = 0; k < 4; ++k)
+    if (!std::isfinite(smp.Qstar(k))) fail("Qstar_" + name(kCommandedSpeeds[static_cast<std::size_t>(k)]), smp.Qstar(k));
 }
 
 }  // namespace
@@ -211,6 +256,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
         smp.Qstar = terms.Qstar;
         smp.tau = distribute_torques(terms.J_beta, terms.Qstar, *sc.weighting);
       }
+      check_finite(smp, sc);
       on_sample(smp);
       if (progress) progress(k + 1, n);
       if (k + 1 == n) break;
@@ -226,6 +272,12 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       } else {
         dopri5_span(f, q, k1, t, sc.dt, sc.tolerance, h, out);
       }
+      // Checked after every step: an overflow is reported in the step that made it.
+      for (int i = 0; i < kInputCount; ++i)
+        if (!std::isfinite(q(i)))
+          throw Error(std::string(gen::kCoordinateNames[static_cast<std::size_t>(i)]),
+                      fmt::format("became non-finite ({}) in the step to t = {:.6f} s; {}", q(i),
+                                  static_cast<double>(k + 1) * sc.dt, drivers(sc)));
     } catch (const Error& e) {
       out.complete = false;
       out.error = fmt::format("stopped at t = {:.4f} s (step {} of {}): {}", t, k, n - 1, e.what());

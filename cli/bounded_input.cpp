@@ -1,0 +1,131 @@
+#include "bounded_input.hpp"
+
+#include <fmt/format.h>
+#include <wlx/error.hpp>
+
+namespace wlx::cli {
+
+namespace {
+
+// Length of the well-formed UTF-8 sequence at text[k] (RFC 3629, table 3-7 of Unicode), or 0.
+std::size_t utf8_length(std::string_view text, std::size_t k) {
+  const auto byte = [&](std::size_t i) { return k + i < text.size() ? static_cast<unsigned char>(text[k + i]) : 0u; };
+  const unsigned c = byte(0);
+  const auto in = [](unsigned v, unsigned lo, unsigned hi) { return v >= lo && v <= hi; };
+  if (c < 0x80) return 1;
+  if (in(c, 0xC2, 0xDF)) return in(byte(1), 0x80, 0xBF) ? 2 : 0;
+  if (in(c, 0xE0, 0xEF)) {
+    const unsigned lo = c == 0xE0 ? 0xA0 : 0x80, hi = c == 0xED ? 0x9F : 0xBF;
+    return in(byte(1), lo, hi) && in(byte(2), 0x80, 0xBF) ? 3 : 0;
+  }
+  if (in(c, 0xF0, 0xF4)) {
+    const unsigned lo = c == 0xF0 ? 0x90 : 0x80, hi = c == 0xF4 ? 0x8F : 0xBF;
+    return in(byte(1), lo, hi) && in(byte(2), 0x80, 0xBF) && in(byte(3), 0x80, 0xBF) ? 4 : 0;
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::string excerpt(std::string_view text) {
+  // Valid UTF-8 out, always: messages go into JSON (ik --batch's error lines), whose writer
+  // refuses ill-formed bytes. Those are shown as \xNN, control characters as \n, \u0000, ...
+  std::string out;
+  std::size_t k = 0;
+  while (k < text.size() && out.size() < kExcerptBytes) {
+    const auto c = static_cast<unsigned char>(text[k]);
+    const std::size_t length = utf8_length(text, k);
+    if (length > 1) {
+      out.append(text.substr(k, length));
+      k += length;
+      continue;
+    }
+    ++k;
+    switch (c) {
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (length == 0) out += fmt::format("\\x{:02x}", c);
+        else if (c < 0x20 || c == 0x7f) out += fmt::format("\\u{:04x}", c);
+        else out += static_cast<char>(c);
+    }
+  }
+  if (k < text.size()) out += fmt::format("... ({} bytes in all)", text.size());
+  return out;
+}
+
+std::string excerpt(const nlohmann::json& value) {
+  // Replace invalid UTF-8 rather than throw: the message must not fail.
+  return excerpt(value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+}
+
+nlohmann::json parse_json_bounded(std::string_view text, const std::string& where) {
+  // A linear scan for the depth of [ and { outside strings, before the parser (iterative) builds
+  // a value that recursive code would later walk.
+  int depth = 0;
+  bool in_string = false, escaped = false;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    const char c = text[k];
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+      continue;
+    }
+    if (c == '"') in_string = true;
+    else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw Error(where, fmt::format("JSON nested deeper than {} levels (at byte {})", kMaxJsonDepth, k + 1));
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    // The parser's message quotes the token it read last, which can be the whole input.
+    const std::string message = e.what();
+    const std::size_t last = message.find("; last read: '");
+    std::string shown = message;
+    if (last != std::string::npos) {
+      const std::size_t begin = last + 14, end = message.rfind('\'');
+      const std::string token = message.substr(begin, end > begin ? end - begin : std::string::npos);
+      shown = message.substr(0, begin) + excerpt(token) + "'";
+    }
+    if (shown.size() > 400) shown = shown.substr(0, 400) + "...";
+    throw Error(where, fmt::format("not valid JSON ({})", shown));
+  }
+}
+
+LineRead read_line_capped(std::istream& in, std::string& line, std::size_t limit) {
+  line.clear();
+  bool any = false, too_long = false;
+  for (int c; (c = in.get()) != std::char_traits<char>::eof();) {
+    any = true;
+    if (c == '\n') return too_long ? LineRead::too_long : LineRead::line;
+    if (too_long) continue;
+    if (line.size() == limit) {
+      too_long = true;
+      line.clear();
+      line.shrink_to_fit();
+      continue;
+    }
+    line.push_back(static_cast<char>(c));
+  }
+  if (too_long) return LineRead::too_long;
+  return any ? LineRead::line : LineRead::end;
+}
+
+std::string read_all_capped(std::istream& in, const std::string& where, std::size_t limit) {
+  std::string text;
+  char block[65536];
+  while (in.read(block, sizeof block) || in.gcount() > 0) {
+    text.append(block, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > limit)
+      throw Error(where, fmt::format("longer than {} bytes: not an input wlx reads", limit));
+  }
+  return text;
+}
+
+}  // namespace wlx::cli

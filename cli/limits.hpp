@@ -1,0 +1,29 @@
+// Upper bounds on what a walking excavator can be or do. Values beyond them are accepted by the
+// arithmetic but make no machine (a 1e308 kg body, gravity 1e304 m/s^2, a rate of 1e200 rad/s) and
+// overflow to inf/NaN inside a step; they are rejected up front with the field named. The numbers
+// are documented in README.md ("Hardening") and scenarios/README.md.
+#pragma once
+
+#include <wlx/model.hpp>
+
+#include <string>
+
+namespace wlx::cli {
+
+inline constexpr double kMaxLength = 100;         // m: any length parameter
+inline constexpr double kMaxMass = 1e6;           // kg: any body (the default machine is 6.2 t in all)
+inline constexpr double kMaxInertia = 1e8;        // kg*m^2: kMaxMass at 10 m
+inline constexpr double kMaxGravity = 100;        // m/s^2: about 10 g
+inline constexpr double kMaxPosition = 1e4;       // m: |x_C|, |x_Fl|, ... (beyond, doubles lose the millimetre)
+inline constexpr double kMaxAngle = 100;          // rad: |yaw|, |theta_l5|, ... (about 16 turns)
+inline constexpr double kMaxLinearRate = 100;     // m/s
+inline constexpr double kMaxAngularRate = 100;    // rad/s (about 16 turns per second)
+inline constexpr double kMaxWeightRatio = 1e12;   // largest / smallest diagonal torque weight
+
+// Throws wlx::Error "params.<name>: ..." for a parameter beyond its bound (`prefix` + name).
+void check_param_bounds(const Params& params, const std::string& prefix);
+// An input coordinate's value (k < kInputCount) or its commanded rate, by the unit of the coordinate.
+void check_input_bound(int coordinate, double value, const std::string& field);
+void check_rate_bound(int coordinate, double rate, const std::string& field);
+
+}  // namespace wlx::cli

@@ -1,0 +1,22 @@
+// External programs run without a shell: an argument vector for posix_spawnp, so no character of
+// a path (quotes, spaces, $, backquotes, newlines) is ever interpreted.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace wlx::cli {
+
+struct ProgramRun {
+  bool started = false;  // false: the program was not found or could not be run
+  int exit_status = -1;  // its exit code when it exited normally
+  int signal = 0;        // the signal that ended it, if any
+  bool ok() const { return started && exit_status == 0 && signal == 0; }
+};
+
+// Runs argv[0] (looked up in PATH) with `argv` in the folder `working_directory` (empty: this
+// process's), stdin from /dev/null, stdout and stderr written to `log_path` (truncated first) (empty: /dev/null).
+ProgramRun run_program(const std::vector<std::string>& argv, const std::string& working_directory = {},
+                       const std::string& log_path = {});
+
+}  // namespace wlx::cli
