@@ -117,7 +117,7 @@ std::string drivers(const Scenario& sc) {
   double heaviest = 0;
   for (const auto& body : gen::kBodyMass) heaviest = std::max(heaviest, sc.params.*body.mass);
   return fmt::format("inputs driving it: largest commanded rate {}' = {:g}, g = {:g} m/s^2, heaviest body {:g} kg",
-                     gen::kCoordinateNames[static_cast<std::size_t>(fastest)], sc.rates(fastest), sc.params.g, heaviest);
+                     gen::kCoordinateNames[static_cast<std::size_t>(fastest)], sc.rates(fastest), sc.params.*gen::kGravity, heaviest);
 }
 
 // Throws naming the first quantity of a sample (its CSV column) that is not finite: caught where

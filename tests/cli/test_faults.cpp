@@ -315,7 +315,7 @@ TEST_CASE("faults: scenario files: physical bounds, depth, sizes, excerpts, weig
       {"number overflow", {"simulate", "{file}", "--out", "{dir}"}, "", R"({"dependent": ["y_C", "yaw"], "duration": 1e999})", 2,
        "scenario.json: not valid JSON", "overflow"},
       {"a run failing midway keeps its rows", {"simulate", "{file}", "--out", "{dir}"}, "",
-       R"({"rates": {"z_C": 3}, "dependent": ["y_C", "yaw"], "duration": 1})", 2, "wlx: error: stopped at t = ", "leg: foot is"},
+       R"({"rates": {"z_C": 3}, "dependent": ["y_C", "yaw"], "duration": 1})", 2, "wlx: error: stopped at t = ", "leg: F_l out of reach"},
   };
   for (std::size_t k = 0; k < cases.size(); ++k) check_case(cases[k], static_cast<int>(200 + k));
   MESSAGE(cases.size() << " scenario-file cases");
