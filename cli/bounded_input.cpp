@@ -1,6 +1,10 @@
 #include "bounded_input.hpp"
 
 #include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <wlx/error.hpp>
 
 namespace wlx::cli {
@@ -126,6 +130,57 @@ std::string read_all_capped(std::istream& in, const std::string& where, std::siz
       throw Error(where, fmt::format("longer than {} bytes: not an input wlx reads", limit));
   }
   return text;
+}
+
+namespace {
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) == std::tolower(static_cast<unsigned char>(b[j - 1]));
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string type_name(const nlohmann::json& v) { return v.type_name(); }
+
+}  // namespace
+
+std::string nearest(const std::string& key, const std::vector<std::string>& valid) {
+  std::string best;
+  std::size_t best_d = std::max<std::size_t>(2, key.size() / 3) + 1;
+  for (const auto& v : valid) {
+    const std::size_t d = edit_distance(key, v);
+    if (d < best_d) {
+      best_d = d;
+      best = v;
+    }
+  }
+  return best;
+}
+
+void reject_unknown_keys(const nlohmann::json& object, const std::vector<std::string>& valid, const std::string& where) {
+  for (const auto& [key, value] : object.items()) {
+    if (std::find(valid.begin(), valid.end(), key) != valid.end()) continue;
+    const std::string hint = nearest(key, valid);
+    throw Error(where + excerpt(key), hint.empty() ? "unknown key" : fmt::format("unknown key; did you mean '{}'?", hint));
+  }
+}
+
+double finite_number(const nlohmann::json& value, const std::string& key) {
+  if (!value.is_number())
+    throw Error(key, fmt::format("must be a number, got {} {}", type_name(value), excerpt(value)));
+  const double v = value.get<double>();
+  if (!std::isfinite(v)) throw Error(key, fmt::format("must be a finite number, got {}", v));
+  return v;
 }
 
 }  // namespace wlx::cli

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <istream>
 #include <string>
+#include <vector>
 #include <string_view>
 
 namespace wlx::cli {
@@ -40,5 +41,12 @@ LineRead read_line_capped(std::istream& in, std::string& line, std::size_t limit
 
 // Reads all of `in` up to `limit` bytes; throws wlx::Error naming `where` beyond it.
 std::string read_all_capped(std::istream& in, const std::string& where, std::size_t limit);
+
+// The valid name nearest to `key` (edit distance), for "did you mean" hints; empty if none is close.
+std::string nearest(const std::string& key, const std::vector<std::string>& valid);
+// Throws wlx::Error for an unknown key, suggesting the nearest valid one.
+void reject_unknown_keys(const nlohmann::json& object, const std::vector<std::string>& valid, const std::string& where);
+// A finite number at `key`, or an error naming it.
+double finite_number(const nlohmann::json& value, const std::string& key);
 
 }  // namespace wlx::cli

@@ -1,7 +1,6 @@
 #include "command_line.hpp"
 
 #include "bounded_input.hpp"
-#include "input.hpp"
 
 #include <fmt/format.h>
 #include <wlx/error.hpp>

@@ -1,15 +1,14 @@
-// The CLI's subcommands, one function each.
+// The CLI's subcommands: their options (model-independent) and the table of one model's command
+// functions. Each built-in model compiles its own functions (cli/model_commands.hpp); main.cpp
+// finds them by name in models() (the registry CMake writes from the list of built-in models).
 #pragma once
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace wlx::cli {
-
-int run_fk(bool as_json);
-int run_ik(bool batch);
-int run_verify_ik(const std::string& out_dir, const std::vector<std::string>& sweep_ids);
 
 struct SimulateOptions {
   std::string scenario;
@@ -20,13 +19,30 @@ struct SimulateOptions {
   std::string weighting;     // "1" or "2" overrides the scenario's (and makes it a dynamics run)
   bool list = false;
 };
-int run_simulate(const SimulateOptions& options);
-int run_verify_nonholonomic(const std::string& out_dir);
 
 struct ReportOptions {
   std::string out_dir = "report";
   bool quick = false;  // a reduced set of runs (for tests)
 };
-int run_report(const ReportOptions& options);
+
+// Options every command takes.
+struct ModelOptions {
+  std::string params_file;  // JSON {"name": value, ...} overriding the model's parameters; empty: defaults
+};
+
+// One model's commands. A null function: the model has no such command (yet).
+struct ModelCommands {
+  std::string_view name;
+  std::string_view description;
+  int (*fk)(const ModelOptions& model, bool as_json);
+  int (*ik)(const ModelOptions& model, bool batch);
+  int (*verify_ik)(const ModelOptions& model, const std::string& out_dir, const std::vector<std::string>& sweep_ids);
+  int (*verify_nonholonomic)(const ModelOptions& model, const std::string& out_dir);
+  int (*simulate)(const ModelOptions& model, const SimulateOptions& options);
+  int (*report)(const ModelOptions& model, const ReportOptions& options);
+};
+
+// The built-in models, the default (the thesis excavator) first.
+const std::vector<ModelCommands>& models();
 
 }  // namespace wlx::cli

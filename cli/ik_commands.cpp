@@ -1,6 +1,7 @@
 // `wlx ik` and `wlx verify ik`.
+#include "per_model.hpp"
 #include "bounded_input.hpp"
-#include "commands.hpp"
+#include "model_commands.hpp"
 #include "input.hpp"
 #include "interrupt.hpp"
 #include "output_checks.hpp"
@@ -16,7 +17,7 @@
 #include <iostream>
 #include <numbers>
 
-namespace wlx::cli {
+WLX_COMMANDS_BEGIN
 
 namespace {
 
@@ -92,12 +93,13 @@ void write_ik_sweep_csv(const std::string& path, const IkSweepResult& r) {
   csv.commit();
 }
 
-int run_ik(bool batch) {
+int run_ik(const ModelOptions& model_options, bool batch) {
+  const Params base = load_params(model_options);
   if (!batch) {
     const std::string text = read_all_capped(std::cin, "stdin", kMaxLineBytes);
     throw_if_interrupted();  // a signal ends the read early: the text is not the whole request
     const nlohmann::json j = parse_json_bounded(text, "stdin");
-    std::cout << solve(parse_ik_request(j), nullptr).dump() << "\n";
+    std::cout << solve(parse_ik_request(j, base), nullptr).dump() << "\n";
     return 0;
   }
   std::string line;
@@ -113,7 +115,7 @@ int run_ik(bool batch) {
       if (read == LineRead::too_long)
         throw Error("", fmt::format("longer than {} bytes; the line was skipped", kMaxLineBytes));
       const nlohmann::json j = parse_json_bounded(line, "");
-      std::cout << solve(parse_ik_request(j), &warm).dump() << "\n";
+      std::cout << solve(parse_ik_request(j, base), &warm).dump() << "\n";
     } catch (const Error& e) {
       ++failures;
       fmt::print(stderr, "wlx ik: line {}: {}\n", number, e.what());
@@ -130,7 +132,7 @@ int run_ik(bool batch) {
   return failures > 0 ? 2 : 0;
 }
 
-int run_verify_ik(const std::string& out_dir, const std::vector<std::string>& sweep_ids) {
+int run_verify_ik(const ModelOptions& model_options, const std::string& out_dir, const std::vector<std::string>& sweep_ids) {
   std::vector<IkSweep> sweeps;
   if (sweep_ids.empty()) {
     sweeps = model_ik_sweeps();
@@ -146,8 +148,8 @@ int run_verify_ik(const std::string& out_dir, const std::vector<std::string>& sw
       sweeps.push_back(*s);
     }
   }
+  const Model model(load_params(model_options));
   prepare_out_dir("--out", out_dir);
-  const Model model;
   Data data;
   constexpr double kLimit = 1e-10;  // m: the pass/fail bound of the analytic check
   bool ok = true;
@@ -174,4 +176,4 @@ int run_verify_ik(const std::string& out_dir, const std::vector<std::string>& sw
   return ok ? 0 : 1;
 }
 
-}  // namespace wlx::cli
+WLX_COMMANDS_END

@@ -1,3 +1,4 @@
+#include "per_model.hpp"
 #include "input.hpp"
 
 #include "bounded_input.hpp"
@@ -10,25 +11,9 @@
 #include <cmath>
 #include <cstdint>
 
-namespace wlx::cli {
+WLX_COMMANDS_BEGIN
 
 namespace {
-
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) == std::tolower(static_cast<unsigned char>(b[j - 1]));
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
 
 std::vector<std::string> input_names() {
   std::vector<std::string> v;
@@ -46,35 +31,6 @@ std::string type_name(const nlohmann::json& v) { return v.type_name(); }
 
 }  // namespace
 
-std::string nearest(const std::string& key, const std::vector<std::string>& valid) {
-  std::string best;
-  std::size_t best_d = std::max<std::size_t>(2, key.size() / 3) + 1;
-  for (const auto& v : valid) {
-    const std::size_t d = edit_distance(key, v);
-    if (d < best_d) {
-      best_d = d;
-      best = v;
-    }
-  }
-  return best;
-}
-
-void reject_unknown_keys(const nlohmann::json& object, const std::vector<std::string>& valid, const std::string& where) {
-  for (const auto& [key, value] : object.items()) {
-    if (std::find(valid.begin(), valid.end(), key) != valid.end()) continue;
-    const std::string hint = nearest(key, valid);
-    throw Error(where + excerpt(key), hint.empty() ? "unknown key" : fmt::format("unknown key; did you mean '{}'?", hint));
-  }
-}
-
-double finite_number(const nlohmann::json& value, const std::string& key) {
-  if (!value.is_number())
-    throw Error(key, fmt::format("must be a number, got {} {}", type_name(value), excerpt(value)));
-  const double v = value.get<double>();
-  if (!std::isfinite(v)) throw Error(key, fmt::format("must be a finite number, got {}", v));
-  return v;
-}
-
 Params parse_params(const nlohmann::json& object, Params params) {
   if (!object.is_object()) throw Error("params", fmt::format("must be an object, got {}", type_name(object)));
   std::vector<std::string> names;
@@ -90,12 +46,13 @@ Params parse_params(const nlohmann::json& object, Params params) {
   return params;
 }
 
-IkRequest parse_ik_request(const nlohmann::json& j) {
+IkRequest parse_ik_request(const nlohmann::json& j, const Params& base) {
   if (!j.is_object()) throw Error("", fmt::format("expected a JSON object, got {}", type_name(j)));
   auto valid = input_names();
   for (const char* k : {"params", "method", "branch", "start"}) valid.emplace_back(k);
   reject_unknown_keys(j, valid, "");
   IkRequest r;
+  r.params = base;
   r.s = nominal_inputs();
   for (int k = 0; k < kInputCount; ++k) {
     const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
@@ -104,7 +61,7 @@ IkRequest parse_ik_request(const nlohmann::json& j) {
       check_input_bound(k, r.s(k), name);
     }
   }
-  if (j.contains("params")) r.params = parse_params(j.at("params"));
+  if (j.contains("params")) r.params = parse_params(j.at("params"), base);
   if (j.contains("method")) {
     const auto& m = j.at("method");
     if (m == "closed-form") r.method = IkMethod::closed_form;
@@ -142,4 +99,4 @@ IkRequest parse_ik_request(const nlohmann::json& j) {
   return r;
 }
 
-}  // namespace wlx::cli
+WLX_COMMANDS_END

@@ -1,3 +1,4 @@
+#include "per_model.hpp"
 #include "limits.hpp"
 
 #include <fmt/format.h>
@@ -6,7 +7,7 @@
 #include <cmath>
 #include <string_view>
 
-namespace wlx::cli {
+WLX_COMMANDS_BEGIN
 
 namespace {
 
@@ -47,4 +48,4 @@ void check_rate_bound(int coordinate, double rate, const std::string& field) {
                                    bound, angle ? "rad/s" : "m/s"));
 }
 
-}  // namespace wlx::cli
+WLX_COMMANDS_END

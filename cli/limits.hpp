@@ -4,11 +4,12 @@
 // are documented in README.md ("Hardening") and scenarios/README.md.
 #pragma once
 
+#include "per_model.hpp"
 #include <wlx/model.hpp>
 
 #include <string>
 
-namespace wlx::cli {
+WLX_COMMANDS_BEGIN
 
 inline constexpr double kMaxLength = 100;         // m: any length parameter
 inline constexpr double kMaxMass = 1e6;           // kg: any body (the default machine is 6.2 t in all)
@@ -26,4 +27,4 @@ void check_param_bounds(const Params& params, const std::string& prefix);
 void check_input_bound(int coordinate, double value, const std::string& field);
 void check_rate_bound(int coordinate, double rate, const std::string& field);
 
-}  // namespace wlx::cli
+WLX_COMMANDS_END

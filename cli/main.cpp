@@ -1,4 +1,6 @@
-// wlx: the command-line tool over the runtime.
+// wlx: the command-line tool over the runtime. This file knows no model: it parses the command
+// line and runs the chosen built-in model's command (commands.hpp, models()).
+#include "bounded_input.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
@@ -6,66 +8,32 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 #include <wlx/atomic_file.hpp>
 #include <wlx/error.hpp>
-#include <wlx/ik.hpp>
-#include <wlx/kinematics.hpp>
-#include <wlx/model.hpp>
 
 #include <cmath>
 #include <iostream>
 
-namespace wlx::cli {
-
-namespace {
-
-// Rounding residue such as -1e-17 would print as "-0.0000" in a table.
-double tidy(double v) { return std::abs(v) < 5e-13 ? 0.0 : v; }
-
-}  // namespace
-
-// `wlx fk`: the nominal pose of MODEL.md section 8, dependent joints by closed-form IK, and the
-// forward kinematics of every frame of interest.
-int run_fk(bool as_json) {
-  const Model model;
-  Data data;
-  Coordinates s = nominal_inputs();
-  solve_ik_closed_form(model, s, {});
-  forward_kinematics(model, s, data);
-  closure(model, s, data, false);
-  const double residual = data.Phi.cwiseAbs().maxCoeff();
-  if (as_json) {
-    nlohmann::ordered_json out;
-    for (int k = 0; k < kCoordinateCount; ++k) out["coordinates"][std::string(gen::kCoordinateNames[k])] = s(k);
-    for (int f = 0; f < gen::kFrameCount; ++f) {
-      auto& fr = out["frames"][std::string(gen::kFrameNames[f])];
-      fr["position"] = {data.frame_positions(0, f), data.frame_positions(1, f), data.frame_positions(2, f)};
-      const auto& R = data.frame_rotations[f];
-      fr["rotation"] = {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
-    }
-    out["closure_residual"] = residual;
-    std::cout << out.dump(2) << "\n";
-    return 0;
-  }
-  fmt::print("Nominal pose (MODEL.md section 8), dependent joints by closed-form IK:\n");
-  for (int k = kInputCount; k < kCoordinateCount; ++k)
-    fmt::print("  {:<9} {:>10.4f} deg\n", gen::kCoordinateNames[k], tidy(s(k)) * 180 / M_PI);
-  fmt::print("\nForward kinematics, frame origins in K0 (m):\n  {:<12} {:>9} {:>9} {:>9}\n", "frame", "x", "y", "z");
-  for (int f = 0; f < gen::kFrameCount; ++f)
-    fmt::print("  {:<12} {:>9.4f} {:>9.4f} {:>9.4f}\n", gen::kFrameNames[f], tidy(data.frame_positions(0, f)),
-               tidy(data.frame_positions(1, f)), tidy(data.frame_positions(2, f)));
-  fmt::print("\nclosure residual max|Phi| = {:.2e}; total mass {:.2f} kg\n", residual, model.total_mass());
-  return 0;
-}
-
-}  // namespace wlx::cli
-
 int main(int argc, char** argv) {
-  CLI::App app{"wlx: kinematics and dynamics of the walking excavator, from generated closed-form code"};
+  using namespace wlx::cli;
+  CLI::App app{"wlx: kinematics and dynamics of wheeled-legged machines, from generated closed-form code"};
   wlx::cli::prepare_command_line(app, WLX_VERSION);
+  std::string model_name(models().front().name);
+  ModelOptions model_options;
+  std::string model_names;
+  for (const auto& m : models()) model_names += (model_names.empty() ? "" : ", ") + std::string(m.name);
+  // --model and --params before the subcommand or after it (each subcommand has them too, so that
+  // an unknown option of a subcommand is reported there, with its own did-you-mean).
+  const auto add_model_options = [&](CLI::App* a) {
+    a->add_option("--model", model_name, "the built-in model (" + model_names + "; wlx models lists them)")
+        ->capture_default_str();
+    a->add_option("--params", model_options.params_file,
+                  "JSON file {\"name\": value, ...} overriding the model's parameters (SI units)");
+  };
+  add_model_options(&app);
+  auto* list_models = app.add_subcommand("models", "list the built-in models");
   bool fk_json = false;
-  auto* fk = app.add_subcommand("fk", "forward kinematics of the nominal pose (MODEL.md section 8)");
+  auto* fk = app.add_subcommand("fk", "forward kinematics of a pose on stdin (JSON; {} for the nominal pose)");
   fk->add_flag("--json", fk_json, "print JSON instead of a table");
 
   bool batch = false;
@@ -100,18 +68,38 @@ int main(int argc, char** argv) {
   report->add_option("--out", report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
   report->add_flag("--quick", report_options.quick, "a reduced set of runs, for a fast look");
 
-  using namespace wlx::cli;
+  for (CLI::App* a : {fk, ik, verify_ik, verify_nh, simulate, report}) add_model_options(a);
   install_interrupt_handlers();
   if (const auto code = parse_command_line(app, argc, argv)) return finish(*code);
   try {
-    if (fk->parsed()) return finish(run_fk(fk_json));
-    if (ik->parsed()) return finish(run_ik(batch));
-    if (verify_ik->parsed()) return finish(run_verify_ik(ik_out, sweep_ids));
-    if (verify_nh->parsed()) return finish(run_verify_nonholonomic(nh_out));
-    if (report->parsed()) return finish(run_report(report_options));
+    const ModelCommands* model = nullptr;
+    std::vector<std::string> names;
+    for (const auto& m : models()) {
+      names.emplace_back(m.name);
+      if (m.name == model_name) model = &m;
+    }
+    if (model == nullptr) {
+      const std::string hint = nearest(model_name, names);
+      throw wlx::Error("--model", fmt::format("no built-in model '{}'{}; the models are {}", excerpt(model_name),
+                                              hint.empty() ? "" : " (did you mean '" + hint + "'?)", model_names));
+    }
+    if (list_models->parsed()) {
+      for (const auto& m : models()) fmt::print("{:<12} {}\n", m.name, m.description);
+      return finish(0);
+    }
+    const auto require = [&](auto function, const char* command) {
+      if (function == nullptr)
+        throw wlx::Error(command, fmt::format("not available for model '{}' yet", model->name));
+      return function;
+    };
+    if (fk->parsed()) return finish(model->fk(model_options, fk_json));
+    if (ik->parsed()) return finish(model->ik(model_options, batch));
+    if (verify_ik->parsed()) return finish(model->verify_ik(model_options, ik_out, sweep_ids));
+    if (verify_nh->parsed()) return finish(model->verify_nonholonomic(model_options, nh_out));
+    if (report->parsed()) return finish(require(model->report, "report")(model_options, report_options));
     if (simulate->parsed()) {
       if (!sim.list && sim.scenario.empty()) throw wlx::Error("SCENARIO", "missing: give a scenario file or id (--list shows the ids)");
-      return finish(run_simulate(sim));
+      return finish(model->simulate(model_options, sim));
     }
   } catch (const Interrupted& e) {
     finish(0);

@@ -1,13 +1,14 @@
 // The CSV files the CLI writes (their column names are a public interface).
 #pragma once
 
+#include "per_model.hpp"
 #include <wlx/ik_verification.hpp>
 #include <wlx/simulation.hpp>
 
 #include <string>
 #include <vector>
 
-namespace wlx::cli {
+WLX_COMMANDS_BEGIN
 
 // One row per sweep point: the swept input, the 14 dependents, contacts, check errors, Newton.
 void write_ik_sweep_csv(const std::string& path, const IkSweepResult& result);
@@ -24,4 +25,4 @@ void write_trajectory(const std::string& path, const Trajectory& trajectory, boo
 // interrupted (then marked partial by the message and the exit code). Returns the exit code.
 int stream_simulation(const Scenario& scenario, const std::string& label, const std::string& out_dir);
 
-}  // namespace wlx::cli
+WLX_COMMANDS_END

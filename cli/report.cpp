@@ -1,7 +1,8 @@
 // `wlx report`: every verification and simulation of the thesis (MODEL.md section 8), with the
 // CSV behind every figure, gnuplot figures (PNG and SVG), and an index.html that opens with a
 // table of the thesis' claims beside wlx's measured values.
-#include "commands.hpp"
+#include "per_model.hpp"
+#include "model_commands.hpp"
 #include "interrupt.hpp"
 #include "output_checks.hpp"
 #include "outputs.hpp"
@@ -27,7 +28,7 @@
 #include <thread>
 #include <unistd.h>
 
-namespace wlx::cli {
+WLX_COMMANDS_BEGIN
 
 namespace fs = std::filesystem;
 
@@ -83,7 +84,7 @@ std::string html_escape(const std::string& s) {
 
 class Report {
  public:
-  Report(const ReportOptions& o) : opt_(o), root_(o.out_dir) {}
+  Report(const ReportOptions& o, const Params& params) : opt_(o), root_(o.out_dir), model_(params) {}
 
   int run();
 
@@ -162,7 +163,7 @@ void Report::run_simulations() {
   }
   for (const auto& [id, weighting] : ids) {
     const std::string file = id.rfind("ID-", 0) == 0 ? id.substr(0, 4) : id;
-    Scenario sc = parse_scenario(read_scenario_json(file));
+    Scenario sc = parse_scenario(read_scenario_json(file), model_.params());
     if (weighting) sc.weighting = weighting;
     progress(fmt::format("simulating {}{}: {}", id, weighting ? " (" + weighting->label() + ")" : "", sc.description));
     RunResult r{id, sc, simulate(sc), id + ".csv"};
@@ -178,7 +179,7 @@ void Report::compare_integrators() {
   // and chooses its own steps in between.
   constexpr double kReferenceStep = 1e-4;
   for (const char* id : {"ST-A2+", "ST-A2-", "ST-B1+", "ST-B1-", "ST-B2+", "ST-B2-", "ST-B3+", "ST-B3-"}) {
-    Scenario sc = parse_scenario(read_scenario_json(id));
+    Scenario sc = parse_scenario(read_scenario_json(id), model_.params());
     Scenario ref_sc = sc;
     ref_sc.dt = kReferenceStep;
     const Trajectory ref = simulate(ref_sc);
@@ -673,10 +674,11 @@ int Report::run() {
 
 }  // namespace
 
-int run_report(const ReportOptions& options) {
+int run_report(const ModelOptions& model_options, const ReportOptions& options) {
+  const Params params = load_params(model_options);
   prepare_out_dir("--out", options.out_dir);
   try {
-    return Report(options).run();
+    return Report(options, params).run();
   } catch (const Interrupted& e) {
     std::fflush(stdout);
     fmt::print(stderr, "wlx: {}: the report in {} is partial: no index.html was written; the files in data/ and fig/ "
@@ -685,4 +687,4 @@ int run_report(const ReportOptions& options) {
   }
 }
 
-}  // namespace wlx::cli
+WLX_COMMANDS_END

@@ -1,3 +1,4 @@
+#include "per_model.hpp"
 #include "scenario_io.hpp"
 
 #include "bounded_input.hpp"
@@ -12,7 +13,7 @@
 #include <numbers>
 #include <sstream>
 
-namespace wlx::cli {
+WLX_COMMANDS_BEGIN
 
 // Defined in the build tree's embedded_scenarios.cpp (CMakeLists.txt writes it from scenarios/).
 extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios;
@@ -107,11 +108,14 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
   throw Error(key, fmt::format("must be 1, 2, {{\"diag\": [8 weights]}} or {{\"matrix\": [[8 x 8]]}}, got {}", excerpt(v)));
 }
 
-Scenario parse_scenario(const nlohmann::json& j) {
+Scenario parse_scenario(const nlohmann::json& j, const Params& base) {
   if (!j.is_object()) throw Error("", fmt::format("a scenario is a JSON object, got {}", j.type_name()));
-  reject_unknown_keys(j, {"id", "description", "observation", "initial", "params", "rates", "dependent", "duration", "dt",
-                          "integrator", "tolerance", "branch", "max_condition", "weighting"},
+  reject_unknown_keys(j, {"id", "description", "observation", "verify", "initial", "params", "rates", "dependent", "duration",
+                          "dt", "integrator", "tolerance", "branch", "max_condition", "weighting"},
                       "");
+  // "verify": "nonholonomic" puts the scenario into `wlx verify nonholonomic`.
+  if (j.contains("verify") && j.at("verify") != "nonholonomic")
+    throw Error("verify", fmt::format("the only verification a scenario joins is \"nonholonomic\", got {}", excerpt(j.at("verify"))));
   Scenario sc;
   const auto text = [&](const char* key) {
     if (!j.contains(key)) return std::string();
@@ -120,7 +124,8 @@ Scenario parse_scenario(const nlohmann::json& j) {
   };
   sc.id = text("id");
   sc.description = text("description");
-  if (j.contains("params")) sc.params = parse_params(j.at("params"));
+  sc.params = base;
+  if (j.contains("params")) sc.params = parse_params(j.at("params"), base);
   for (const char* group : {"initial", "rates"}) {
     if (!j.contains(group)) continue;
     const auto& obj = j.at(group);
@@ -164,4 +169,4 @@ Scenario parse_scenario(const nlohmann::json& j) {
   return sc;
 }
 
-}  // namespace wlx::cli
+WLX_COMMANDS_END

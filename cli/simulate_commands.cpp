@@ -1,5 +1,6 @@
 // `wlx simulate` and `wlx verify nonholonomic`.
-#include "commands.hpp"
+#include "per_model.hpp"
+#include "model_commands.hpp"
 #include "interrupt.hpp"
 #include "output_checks.hpp"
 #include "outputs.hpp"
@@ -12,7 +13,7 @@
 #include <filesystem>
 #include <optional>
 
-namespace wlx::cli {
+WLX_COMMANDS_BEGIN
 
 std::vector<std::string> trajectory_header(bool dynamics) {
   std::vector<std::string> h{"t"};
@@ -53,7 +54,7 @@ void write_trajectory(const std::string& path, const Trajectory& tr, bool dynami
   csv.commit();
 }
 
-int run_simulate(const SimulateOptions& o) {
+int run_simulate(const ModelOptions& model_options, const SimulateOptions& o) {
   if (o.list) {
     for (const auto& id : scenario_ids()) {
       const auto j = nlohmann::json::parse(embedded_scenario(id));
@@ -63,7 +64,7 @@ int run_simulate(const SimulateOptions& o) {
     }
     return 0;
   }
-  Scenario sc = parse_scenario(read_scenario_json(o.scenario));
+  Scenario sc = parse_scenario(read_scenario_json(o.scenario), load_params(model_options));
   if (!o.integrator.empty()) {
     const auto integrator = integrator_from_name(o.integrator);
     if (!integrator) throw Error("--integrator", fmt::format("must be rk4, euler or dopri5, got '{}'", o.integrator));
@@ -84,16 +85,21 @@ int run_simulate(const SimulateOptions& o) {
   return stream_simulation(sc, sc.id.empty() ? o.scenario : sc.id, o.out_dir);
 }
 
-int run_verify_nonholonomic(const std::string& out_dir) {
+int run_verify_nonholonomic(const ModelOptions& model_options, const std::string& out_dir) {
+  const Params params = load_params(model_options);
   constexpr double kLimit = 1e-10;
   bool ok = true;
   prepare_out_dir("--out", out_dir);
   fmt::print("{:<6} {:>8} {:>16} {:>16} {:>14}\n", "run", "samples", "max |res_l| m/s", "max |res_r| m/s", "max cond");
-  for (const char* id : {"NH-1", "NH-2", "NH-3", "NH-4"}) {
+  std::vector<std::string> ids;  // the model's scenarios marked "verify": "nonholonomic"
+  for (const auto& id : scenario_ids())
+    if (nlohmann::json::parse(embedded_scenario(id)).value("verify", "") == "nonholonomic") ids.push_back(id);
+  if (ids.empty()) throw Error("verify nonholonomic", "the model has no scenario marked \"verify\": \"nonholonomic\"");
+  for (const std::string& id : ids) {
     throw_if_interrupted();
-    const Scenario sc = parse_scenario(read_scenario_json(id));
+    const Scenario sc = parse_scenario(read_scenario_json(id), params);
     const Trajectory tr = simulate(sc);
-    write_trajectory((std::filesystem::path(out_dir) / (std::string(id) + ".csv")).string(), tr, false);
+    write_trajectory((std::filesystem::path(out_dir) / (id + ".csv")).string(), tr, false);
     double l = 0, r = 0, cond = 0;
     for (const auto& smp : tr.samples) {
       l = std::max(l, std::abs(smp.nh_residual(0)));
@@ -113,4 +119,4 @@ int run_verify_nonholonomic(const std::string& out_dir) {
   return ok ? 0 : 1;
 }
 
-}  // namespace wlx::cli
+WLX_COMMANDS_END

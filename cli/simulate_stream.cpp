@@ -1,5 +1,6 @@
 // `wlx simulate`'s run, streamed: each sample becomes a CSV row as soon as it is computed, so
 // memory does not grow with the number of steps, and the summary is accumulated on the way.
+#include "per_model.hpp"
 #include "bounded_input.hpp"
 #include "interrupt.hpp"
 #include "outputs.hpp"
@@ -13,7 +14,7 @@
 #include <filesystem>
 #include <optional>
 
-namespace wlx::cli {
+WLX_COMMANDS_BEGIN
 
 namespace {
 
@@ -102,4 +103,4 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
   return 0;
 }
 
-}  // namespace wlx::cli
+WLX_COMMANDS_END

@@ -39,6 +39,17 @@ std::string namespace_close(const EmitOptions& opt) {
   return fmt::format("}}  // namespace {}\n", opt.name_space);
 }
 
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') out += std::string("\\") + c;
+    else if (u < 0x20 || u >= 0x7f) out += fmt::format("\\{:03o}", u);  // octal: exactly three digits, no run-on
+    else out += c;
+  }
+  return out + "\"";
+}
+
 std::string literal(double v) {
   std::string s = fmt::format("{}", v);
   if (s.find_first_of(".en") == std::string::npos) s += ".0";
@@ -64,6 +75,9 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
 
   std::string t = banner(m, opt, "Model sizes, names and fixed-size types.");
   t += "#pragma once\n\n#include <Eigen/Core>\n\n#include <array>\n#include <string_view>\n\n" + namespace_open(opt);
+  t += fmt::format("\ninline constexpr std::string_view kModelName = {};\n"
+                   "inline constexpr std::string_view kModelDescription = {};\n",
+                   quoted(m.name), quoted(m.description));
   t += fmt::format(
       "\ninline constexpr int kCoordinateCount = {};  // s = [inputs q, dependent joints]\n"
       "inline constexpr int kInputCount = {};\n"
@@ -123,7 +137,7 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
   p += fmt::format("inline constexpr std::array<ParamInfo, {}> kParamInfo{{{{\n", m.parameters.size());
   for (std::size_t k = 0; k < m.parameters.size(); ++k) {
     const auto& par = m.parameters[k];
-    p += fmt::format("    {{\"{0}\", &Params::{0}, \"{1}\", \"{2}\", ParamKind::{3}}},\n", par.name, par.unit, par.meaning,
+    p += fmt::format("    {{\"{0}\", &Params::{0}, {1}, {2}, ParamKind::{3}}},\n", par.name, quoted(par.unit), quoted(par.meaning),
                      kind_name(m.parameter_kinds[k]));
   }
   p += "}};\n\n// Mass properties of each body (index with wlx::gen::body::...).\nstruct BodyMassInfo {\n"
@@ -344,7 +358,7 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
     const auto& l = m.limbs[k];
     std::string joints;
     for (int j : l.joints) joints += (joints.empty() ? "" : ", ") + name_of(j);
-    t += fmt::format("    {{\"{}\", \"{}\", {}, {{{{{}}}}}, {{{{{}}}}}, {}, {{{{{}}}}}}},  // {}\n", l.name, l.title, l.rows.size(),
+    t += fmt::format("    {{\"{}\", {}, {}, {{{{{}}}}}, {{{{{}}}}}, {}, {{{{{}}}}}}},  // {}\n", l.name, quoted(l.title), l.rows.size(),
                      int_list(padded(l.rows, max_size)), int_list(padded(l.joints, max_size)), limb_inputs[k].size(),
                      int_list(padded(limb_inputs[k], max_inputs)), joints);
   }
@@ -461,7 +475,7 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
                    m.sweep_start.size(), start);
   t += fmt::format("inline constexpr std::array<SweepInfo, {}> kIkSweeps{{{{\n", m.sweeps.size());
   for (const auto& sw : m.sweeps)
-    t += fmt::format("    {{\"{}\", {}, {}, {}, {}, {}, {}}},  // {}\n", sw.id, sw.input, literal(sw.from), literal(sw.to),
+    t += fmt::format("    {{{}, {}, {}, {}, {}, {}, {}}},  // {}\n", quoted(sw.id), sw.input, literal(sw.from), literal(sw.to),
                      literal(sw.step), sw.degrees ? "true" : "false", sw.limb, name_of(sw.input));
   t += "}};\n\n";
 

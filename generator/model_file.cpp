@@ -136,6 +136,13 @@ class Item {
     if (!node_.IsDefined() || node_.IsNull()) fail("missing: give a value");
     if (!node_.IsScalar()) fail("must be a single value, not a list or map");
     const std::string& s = node_.Scalar();
+    // Text reaches generated comments and string literals: one line of printable characters.
+    // A backslash would continue a // comment onto the next generated line.
+    for (char ch : s)
+      if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f || ch == '\\')
+        fail(fmt::format("'{}' contains a control character (a line break, a tab) or a backslash; text here is one "
+                         "plain line",
+                         excerpt(s)));
     std::string out;
     for (std::size_t i = 0; i < s.size();) {
       const std::size_t close = s[i] == '<' ? s.find('>', i) : std::string::npos;

@@ -18,7 +18,7 @@ constexpr double kDeg = std::numbers::pi / 180;
 const Trajectory& run(const std::string& id) {
   static std::map<std::string, Trajectory> cache;
   auto it = cache.find(id);
-  if (it == cache.end()) it = cache.emplace(id, simulate(cli::parse_scenario(cli::read_scenario_json(id)))).first;
+  if (it == cache.end()) it = cache.emplace(id, simulate(commands::parse_scenario(commands::read_scenario_json(id)))).first;
   return it->second;
 }
 
@@ -27,14 +27,14 @@ double end(const std::string& id, int coordinate) { return run(id).samples.back(
 }  // namespace
 
 TEST_CASE("scenarios: one file per NH and ST row of MODEL.md section 8, each sign separately") {
-  const auto ids = cli::scenario_ids();
+  const auto ids = commands::scenario_ids();
   for (const char* id : {"NH-1", "NH-2", "NH-3", "NH-4", "ST-A1+", "ST-A1-", "ST-A2+", "ST-A2-", "ST-A3+", "ST-A3-",
                          "ST-B1+", "ST-B1-", "ST-B2+", "ST-B2-", "ST-B3+", "ST-B3-"})
     CHECK(std::find(ids.begin(), ids.end(), id) != ids.end());
 }
 
 TEST_CASE("scenarios: every shipped NH/ST run completes with |v_W . n_W| <= 1e-12 at every step") {
-  for (const auto& id : cli::scenario_ids()) {
+  for (const auto& id : commands::scenario_ids()) {
     if (id.rfind("NH", 0) != 0 && id.rfind("ST", 0) != 0) continue;
     CAPTURE(id);
     const Trajectory& tr = run(id);
@@ -42,7 +42,7 @@ TEST_CASE("scenarios: every shipped NH/ST run completes with |v_W . n_W| <= 1e-1
     double worst = 0;
     for (const auto& smp : tr.samples) worst = std::max(worst, smp.nh_residual.cwiseAbs().maxCoeff());
     CHECK(worst <= 1e-12);
-    const auto sc = cli::parse_scenario(cli::read_scenario_json(id));
+    const auto sc = commands::parse_scenario(commands::read_scenario_json(id));
     CHECK(static_cast<long>(tr.samples.size()) == sc.samples());
   }
 }
@@ -96,7 +96,7 @@ TEST_CASE("scenarios: ST-B: with the straddle angles dependent, roll, yaw and y_
 TEST_CASE("scenarios: bad scenario files get messages naming the field") {
   const auto message = [](const std::string& text) {
     try {
-      cli::parse_scenario(nlohmann::json::parse(text));
+      commands::parse_scenario(nlohmann::json::parse(text));
     } catch (const Error& e) {
       return std::string(e.what());
     }
@@ -114,6 +114,6 @@ TEST_CASE("scenarios: bad scenario files get messages naming the field") {
         "dt: the duration 1 s is not a whole number of steps of 0.3 s");
   CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "params": {"m_M1": -3}})") ==
         "params.m_M1: a mass must be positive, got -3 kg");
-  CHECK_THROWS_WITH_AS(cli::read_scenario_json("NH-7"), "SCENARIO: 'NH-7' is neither a file nor a scenario id; did you mean 'NH-1'?",
+  CHECK_THROWS_WITH_AS(commands::read_scenario_json("NH-7"), "SCENARIO: 'NH-7' is neither a file nor a scenario id; did you mean 'NH-1'?",
                        Error);
 }

@@ -20,7 +20,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
     return 0;
   }
   try {
-    const cli::IkRequest r = cli::parse_ik_request(j);
+    const commands::IkRequest r = commands::parse_ik_request(j);
     const Model model(r.params);
     Coordinates s = r.s;
     solve_ik_closed_form(model, s, r.branches);
@@ -28,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
   } catch (const Error&) {
   }
   try {
-    Scenario sc = cli::parse_scenario(j);
+    Scenario sc = commands::parse_scenario(j);
     if (sc.samples() > 200) sc.duration = sc.dt * 200;  // keep each input fast
     const Trajectory tr = simulate(sc);
     for (const auto& smp : tr.samples)

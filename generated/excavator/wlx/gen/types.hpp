@@ -15,6 +15,9 @@ namespace wlx {
 inline namespace excavator {
 namespace gen {
 
+inline constexpr std::string_view kModelName = "excavator";
+inline constexpr std::string_view kModelDescription = "walking excavator with two legs and two non-holonomic wheel levers";
+
 inline constexpr int kCoordinateCount = 32;  // s = [inputs q, dependent joints]
 inline constexpr int kInputCount = 18;
 inline constexpr int kDependentCount = 14;

@@ -15,6 +15,9 @@ namespace wlx {
 inline namespace walker {
 namespace gen {
 
+inline constexpr std::string_view kModelName = "walker";
+inline constexpr std::string_view kModelDescription = "walking excavator with slewing hips below the cabin, offset knees and offset wheel hubs";
+
 inline constexpr int kCoordinateCount = 32;  // s = [inputs q, dependent joints]
 inline constexpr int kInputCount = 18;
 inline constexpr int kDependentCount = 14;

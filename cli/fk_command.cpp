@@ -1,0 +1,110 @@
+// `wlx fk`, the parameters of --params, and this model's entry in the registry of built-in models.
+#include "bounded_input.hpp"
+#include "interrupt.hpp"
+#include "input.hpp"
+#include "model_commands.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <wlx/error.hpp>
+#include <wlx/ik.hpp>
+#include <wlx/kinematics.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <numbers>
+
+WLX_COMMANDS_BEGIN
+
+namespace {
+
+// Rounding residue such as -1e-17 would print as "-0.0000" in a table.
+double tidy(double v) { return std::abs(v) < 5e-13 ? 0.0 : v; }
+
+constexpr std::size_t kMaxParamsFileBytes = std::size_t{1} << 20;
+
+}  // namespace
+
+Params load_params(const ModelOptions& model) {
+  if (model.params_file.empty()) return {};
+  std::ifstream in(model.params_file, std::ios::binary);
+  if (!in) throw Error("--params", fmt::format("cannot open '{}' for reading", excerpt(model.params_file)));
+  const std::string text = read_all_capped(in, model.params_file, kMaxParamsFileBytes);
+  if (in.bad()) throw Error("--params", fmt::format("reading '{}' failed", excerpt(model.params_file)));
+  const nlohmann::json j = parse_json_bounded(text, model.params_file);
+  // The file holds {"name": value, ...}, or the same under "params" (like an ik request).
+  try {
+    return parse_params(j.is_object() && j.contains("params") && j.size() == 1 ? j.at("params") : j);
+  } catch (const Error& e) {
+    throw Error(excerpt(model.params_file) + ": " + e.field(), std::string(e.what()).substr(e.field().size() + 2));
+  }
+}
+
+// `wlx fk`: a pose from stdin (any of the coordinates; missing inputs take the nominal state,
+// missing dependent joints are solved by the closed-form IK when none is given), its dependent
+// joints and the forward kinematics of every frame.
+int run_fk(const ModelOptions& model_options, bool as_json) {
+  const Model model(load_params(model_options));
+  const std::string text = read_all_capped(std::cin, "stdin", kMaxLineBytes);
+  throw_if_interrupted();
+  const nlohmann::json j =
+      text.find_first_not_of(" \t\r\n") == std::string::npos ? nlohmann::json::object() : parse_json_bounded(text, "stdin");
+  if (!j.is_object()) throw Error("stdin", "expected a JSON object of coordinates, e.g. {\"z_C\": 1.8}");
+  std::vector<std::string> names;
+  for (const auto& n : gen::kCoordinateNames) names.emplace_back(n);
+  reject_unknown_keys(j, names, "");
+  Coordinates s = nominal_inputs();
+  int dependents_given = 0;
+  for (int k = 0; k < kCoordinateCount; ++k) {
+    const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+    if (!j.contains(name)) continue;
+    s(k) = finite_number(j.at(name), name);
+    dependents_given += k >= kInputCount;
+  }
+  if (dependents_given == 0) solve_ik_closed_form(model, s, {});
+  else if (dependents_given != kDependentCount)
+    throw Error("stdin", fmt::format("give all {} dependent joints or none (then the closed-form IK solves them); {} given",
+                                     kDependentCount, dependents_given));
+  Data data;
+  forward_kinematics(model, s, data);
+  closure(model, s, data, false);
+  const double residual = data.Phi.cwiseAbs().maxCoeff();
+  if (as_json) {
+    nlohmann::ordered_json out;
+    for (int k = 0; k < kCoordinateCount; ++k) out["coordinates"][std::string(gen::kCoordinateNames[k])] = s(k);
+    for (int f = 0; f < gen::kFrameCount; ++f) {
+      auto& fr = out["frames"][std::string(gen::kFrameNames[f])];
+      fr["position"] = {data.frame_positions(0, f), data.frame_positions(1, f), data.frame_positions(2, f)};
+      const auto& R = data.frame_rotations[static_cast<std::size_t>(f)];
+      fr["rotation"] = {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
+    }
+    out["closure_residual"] = residual;
+    std::cout << out.dump(2) << "\n";
+    return 0;
+  }
+  fmt::print("{} pose, dependent joints{} (angles in degrees):\n", gen::kModelName,
+             dependents_given ? " as given" : " by the closed-form IK");
+  for (int k = kInputCount; k < kCoordinateCount; ++k)
+    fmt::print("  {:<12} {:>10.4f} deg\n", gen::kCoordinateNames[k], tidy(s(k)) * 180 / std::numbers::pi);
+  fmt::print("\nForward kinematics, frame origins in K0 (m):\n  {:<12} {:>9} {:>9} {:>9}\n", "frame", "x", "y", "z");
+  for (int f = 0; f < gen::kFrameCount; ++f)
+    fmt::print("  {:<12} {:>9.4f} {:>9.4f} {:>9.4f}\n", gen::kFrameNames[f], tidy(data.frame_positions(0, f)),
+               tidy(data.frame_positions(1, f)), tidy(data.frame_positions(2, f)));
+  fmt::print("\nclosure residual max|Phi| = {:.2e}; total mass {:.2f} kg\n", residual, model.total_mass());
+  return 0;
+}
+
+const ModelCommands& entry() {
+  static const ModelCommands commands{gen::kModelName, gen::kModelDescription, &run_fk, &run_ik, &run_verify_ik,
+                                      &run_verify_nonholonomic, &run_simulate,
+#ifdef WLX_THESIS_REPORT
+                                      &run_report
+#else
+                                      nullptr
+#endif
+  };
+  return commands;
+}
+
+WLX_COMMANDS_END
