@@ -3,6 +3,7 @@
 // every Jacobian and convective term against exact derivatives (jets), the closed-form IK that
 // wlx-gen derived for it against Newton's method, the dependent rates against the wheel
 // constraints and finite differences, and the inverse dynamics against power and energy balances.
+#include "../support/balance_checks.hpp"
 #include "../support/random.hpp"
 #include "../support/walker_chain.hpp"
 
@@ -337,24 +338,7 @@ TEST_CASE("walker: inverse dynamics: J_beta^T tau = Q*, power and energy balance
     const Vector8 tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
     worst_balance = std::max(worst_balance, (t.J_beta.transpose() * tau - t.Qstar).norm() / t.Qstar.norm());
     worst_power = std::max(worst_power, std::abs(tau.dot(t.J_beta * u) - t.Qstar.dot(u)) / (t.Qstar.norm() * u.norm()));
-    // Energy along the integrated motion with constant u: Q* . u = d(T + V)/dt.
-    inverse_dynamics(model, sc.initial, u, Vector4::Zero(), d, t);
-    u /= t.sdot.cwiseAbs().maxCoeff();
-    for (int k = 0; k < 4; ++k) sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]) = u(k);
-    sc.duration = 0.002;
-    sc.dt = 1e-5;
-    const Trajectory tr = simulate(sc);
-    REQUIRE(tr.complete);
-    const auto energy = [&](std::size_t k) {
-      const Sample& smp = tr.samples[k];
-      return kinetic_energy(model, smp.s, smp.sdot, d) + potential_energy(model, smp.s, d);
-    };
-    for (std::size_t k = 2; k + 2 < tr.samples.size(); k += 20) {
-      const double dEdt = (energy(k - 2) - 8 * energy(k - 1) + 8 * energy(k + 1) - energy(k + 2)) / (12 * sc.dt);
-      inverse_dynamics(model, tr.samples[k].s, u, Vector4::Zero(), d, t);
-      const double power = t.Qstar.dot(u);
-      worst_energy = std::max(worst_energy, std::abs(power - dEdt) / std::max(1.0, std::abs(power)));
-    }
+    worst_energy = std::max(worst_energy, test::energy_balance_error(model, sc.initial, u));
   }
   MESSAGE("J^T tau = Q*: " << worst_balance << ", power: " << worst_power << ", energy: " << worst_energy);
   CHECK(worst_balance <= 1e-9);  // least-norm solve of a 4 x 8 system with cond(J_beta) up to ~1e4

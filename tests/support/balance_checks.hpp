@@ -1,0 +1,44 @@
+// Checks of the inverse dynamics that do not use the Kane formula under test, for any model:
+// the power of the generalized force equals the rate of change of the energy along a motion.
+#pragma once
+
+#include <wlx/dynamics.hpp>
+#include <wlx/simulation.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace wlx::test {
+
+// Integrates the constant commanded speeds u from `initial` for 2 ms (dt = 1e-5) and returns the
+// largest |Q* . u - d(T + V)/dt| / max(1, |Q* . u|) along it, with d/dt by a five-point stencil
+// (truncation ~dt^4, rounding ~1e-16 |E| / dt: about 1e-8 for machines of a few tonnes). u is
+// scaled so that the fastest coordinate moves at 1 unit/s.
+inline double energy_balance_error(const Model& model, const Coordinates& initial, Vector4 u) {
+  Data d;
+  DynamicsTerms t;
+  inverse_dynamics(model, initial, u, Vector4::Zero(), d, t);
+  u /= t.sdot.cwiseAbs().maxCoeff();
+  Scenario sc;
+  sc.params = model.params();
+  sc.initial = initial;
+  for (int k = 0; k < 4; ++k) sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]) = u(k);
+  sc.duration = 0.002;
+  sc.dt = 1e-5;
+  const Trajectory tr = simulate(sc);
+  if (!tr.complete) return INFINITY;
+  const auto energy = [&](std::size_t k) {
+    const Sample& smp = tr.samples[k];
+    return kinetic_energy(model, smp.s, smp.sdot, d) + potential_energy(model, smp.s, d);
+  };
+  double worst = 0;
+  for (std::size_t k = 2; k + 2 < tr.samples.size(); k += 20) {
+    const double dEdt = (energy(k - 2) - 8 * energy(k - 1) + 8 * energy(k + 1) - energy(k + 2)) / (12 * sc.dt);
+    inverse_dynamics(model, tr.samples[k].s, u, Vector4::Zero(), d, t);
+    const double power = t.Qstar.dot(u);
+    worst = std::max(worst, std::abs(power - dEdt) / std::max(1.0, std::abs(power)));
+  }
+  return worst;
+}
+
+}  // namespace wlx::test
