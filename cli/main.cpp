@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
   verify->require_subcommand(1);
   std::string ik_out = "out/verify-ik";
   std::vector<std::string> sweep_ids;
-  auto* verify_ik = verify->add_subcommand("ik", "the 12 IK sweeps of MODEL.md section 8, closed form and Newton");
+  auto* verify_ik = verify->add_subcommand("ik", "the 12 IK sweeps of docs/excavator.md section 8, closed form and Newton");
   verify_ik->add_option("--out", ik_out, "folder for one CSV per sweep")->capture_default_str();
   verify_ik->add_option("--sweep", sweep_ids, "only these sweeps (IK-L1, ..., IK-WR2)");
 
@@ -53,18 +53,18 @@ int main(int argc, char** argv) {
   verify_nh->add_option("--out", nh_out, "folder for one trajectory CSV per run")->capture_default_str();
 
   wlx::cli::SimulateOptions sim;
-  auto* simulate = app.add_subcommand("simulate", "integrate a scenario (a file, or an id of MODEL.md section 8)");
+  auto* simulate = app.add_subcommand("simulate", "integrate a scenario (a file, or an id of docs/excavator.md section 8)");
   simulate->add_option("SCENARIO", sim.scenario, "scenario file or id (NH-1, ST-A1+, ...)");
   simulate->add_option("--out", sim.out_dir, "output folder for trajectory.csv")->capture_default_str();
   simulate->add_option("--integrator", sim.integrator,
                        "rk4, euler or dopri5 (adaptive Dormand-Prince 5(4)); default: the scenario's");
   simulate->add_option("--dt", sim.dt, "step in seconds, or with dopri5 the output interval (default: the scenario's)");
   simulate->add_option("--tolerance", sim.tolerance, "dopri5's local error bound per step, relative to 1 + |q| (default 1e-10)");
-  simulate->add_option("--weighting", sim.weighting, "torque weighting 1 or 2 (inverse dynamics, MODEL.md section 7)");
+  simulate->add_option("--weighting", sim.weighting, "torque weighting 1 or 2 (inverse dynamics, docs/excavator.md section 7)");
   simulate->add_flag("--list", sim.list, "list the built-in scenarios");
 
   wlx::cli::ReportOptions report_options;
-  auto* report = app.add_subcommand("report", "run everything of MODEL.md section 8 and write an HTML report with figures");
+  auto* report = app.add_subcommand("report", "run everything of docs/excavator.md section 8 and write an HTML report with figures");
   report->add_option("--out", report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
   report->add_flag("--quick", report_options.quick, "a reduced set of runs, for a fast look");
 

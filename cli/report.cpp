@@ -1,4 +1,4 @@
-// `wlx report`: every verification and simulation of the thesis (MODEL.md section 8), with the
+// `wlx report`: every verification and simulation of the thesis (docs/excavator.md section 8), with the
 // CSV behind every figure, gnuplot figures (PNG and SVG), and an index.html that opens with a
 // table of the thesis' claims beside wlx's measured values.
 #include "per_model.hpp"
@@ -37,7 +37,7 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180;
 
 struct Check {
-  std::string claim;     // the thesis' (or MODEL.md's) statement
+  std::string claim;     // the thesis' (or docs/excavator.md's) statement
   std::string expected;  // its figure
   std::string measured;  // wlx's value
   bool pass = false;
@@ -57,7 +57,7 @@ struct RunResult {
   std::string csv;  // relative path
 };
 
-// One run integrated one way, against RK4 at 0.1 ms (MODEL.md section 5's reference behaviour).
+// One run integrated one way, against RK4 at 0.1 ms (docs/excavator.md section 5's reference behaviour).
 struct IntegratorRow {
   std::string id;
   Integrator integrator;
@@ -174,7 +174,7 @@ void Report::run_simulations() {
 }
 
 void Report::compare_integrators() {
-  // MODEL.md section 5: RK4 at 1 ms is converged to ~1e-14; the thesis' explicit Euler differs by
+  // docs/excavator.md section 5: RK4 at 1 ms is converged to ~1e-14; the thesis' explicit Euler differs by
   // up to 4e-5 m in y_C (ST-A2) and 6e-4 deg in theta_5 (ST-B). dopri5 writes 10 samples per run
   // and chooses its own steps in between.
   constexpr double kReferenceStep = 1e-4;
@@ -238,7 +238,7 @@ void Report::add_checks() {
     double first = 99;
     for (const auto& p : s.points)
       if (p.cold_newton_branch == 1) first = std::min(first, p.value);
-    checks_.push_back({"IK-L3: Newton started at the nominal pose converges to psi_4 < 0 high up (MODEL.md 4)",
+    checks_.push_back({"IK-L3: Newton started at the nominal pose converges to psi_4 < 0 high up (docs/excavator.md 4)",
                        "from z_Fl = 2.63 m", fmt::format("from z_Fl = {:.2f} m", first), std::abs(first - 2.63) <= 0.05});
   }
   if (!integrators_.empty()) {
@@ -248,11 +248,11 @@ void Report::add_checks() {
       if (r.integrator == Integrator::euler && r.id.rfind("ST-A2", 0) == 0) euler_y = std::max(euler_y, r.y_C);
       if (r.integrator == Integrator::euler && r.id.rfind("ST-B", 0) == 0) euler_theta = std::max(euler_theta, r.theta5);
     }
-    checks_.push_back({"RK4 at dt = 1 ms is converged (vs RK4 at 0.1 ms; ST-A2, ST-B) (MODEL.md 5)", "~1e-14",
+    checks_.push_back({"RK4 at dt = 1 ms is converged (vs RK4 at 0.1 ms; ST-A2, ST-B) (docs/excavator.md 5)", "~1e-14",
                        sci(rk4) + " m or rad", rk4 <= 1e-12});
-    checks_.push_back({"Explicit Euler at 1 ms, the thesis' integrator, differs in y_C (ST-A2) (MODEL.md 5)", "up to 4e-5 m",
+    checks_.push_back({"Explicit Euler at 1 ms, the thesis' integrator, differs in y_C (ST-A2) (docs/excavator.md 5)", "up to 4e-5 m",
                        sci(euler_y) + " m", euler_y >= 1e-5 && euler_y <= 1e-4});
-    checks_.push_back({"... and in theta_5 (ST-B) (MODEL.md 5)", "6e-4 deg", fmt::format("{:.2e} deg", euler_theta / kDeg),
+    checks_.push_back({"... and in theta_5 (ST-B) (docs/excavator.md 5)", "6e-4 deg", fmt::format("{:.2e} deg", euler_theta / kDeg),
                        euler_theta / kDeg >= 2e-4 && euler_theta / kDeg <= 1.5e-3});
   }
   double worst_nh = 0;
@@ -272,7 +272,7 @@ void Report::add_checks() {
     std::size_t peak = 0;
     for (std::size_t k = 0; k < smp.size(); ++k)
       if (smp[k].cond_J_beta > smp[peak].cond_J_beta) peak = k;
-    checks_.push_back({"ST-A1- passes a singular J_beta where the roll cancels the 5 cm step (MODEL.md 5)",
+    checks_.push_back({"ST-A1- passes a singular J_beta where the roll cancels the 5 cm step (docs/excavator.md 5)",
                        "t ~ 0.1910 s, cond 2.7e7", fmt::format("t = {:.4f} s, cond {:.2e}", smp[peak].t, smp[peak].cond_J_beta),
                        std::abs(smp[peak].t - 0.191) <= 0.002 && smp[peak].cond_J_beta > 1e7 && smp[peak].cond_J_beta < 1e8});
   }
@@ -315,7 +315,7 @@ void Report::add_checks() {
   if (has("ID-3-w1")) {
     const double clearance = result("ID-3-w1").trajectory.samples.back().cabin_clearance;
     const double touch = 0.581 + clearance / 3.0;
-    checks_.push_back({"ID-3 stops because the cabin would touch the ground (MODEL.md 8)", "at t ~ 0.583 s",
+    checks_.push_back({"ID-3 stops because the cabin would touch the ground (docs/excavator.md 8)", "at t ~ 0.583 s",
                        fmt::format("clearance {:.4f} m at 0.581 s: touches at t = {:.4f} s", clearance, touch),
                        clearance > 0 && std::abs(touch - 0.583) <= 0.002});
   }
@@ -563,14 +563,14 @@ void Report::write_html() {
        "figure{margin:1.5em 0}figure img{max-width:100%;border:1px solid #ddd}figcaption{color:#555}\n"
        "code{background:#f4f4f4;padding:1px 3px}\n</style>\n</head>\n<body>\n";
   h += "<h1>wlx report: kinematics and dynamics of the walking excavator</h1>\n";
-  h += "<p>Every verification and simulation of the thesis (MODEL.md section 8), computed with the headers generated by "
+  h += "<p>Every verification and simulation of the thesis (docs/excavator.md section 8), computed with the headers generated by "
        "<code>wlx-gen</code>. Each figure links to its SVG; the CSV files behind the figures are in <code>data/</code>, "
        "the gnuplot scripts in <code>plots/</code>.</p>\n";
   int failed = 0;
   for (const auto& c : checks_) failed += !c.pass;
   h += fmt::format("<h2 id=\"checks\">Checks: the thesis' claims beside wlx's values</h2>\n<p>{} of {} checks pass.</p>\n",
                    checks_.size() - static_cast<std::size_t>(failed), checks_.size());
-  h += "<table>\n<tr><th>claim</th><th>thesis / MODEL.md</th><th>wlx measured</th><th>result</th></tr>\n";
+  h += "<table>\n<tr><th>claim</th><th>thesis / docs/excavator.md</th><th>wlx measured</th><th>result</th></tr>\n";
   for (const auto& c : checks_)
     h += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"{}\">{}</td></tr>\n", html_escape(c.claim),
                      html_escape(c.expected), html_escape(c.measured), c.pass ? "pass" : "fail", c.pass ? "pass" : "FAIL");
@@ -616,7 +616,7 @@ void Report::write_html() {
   runs_table("ST-");
   for (const auto& n : sections_["st"]) figure(n);
   if (!integrators_.empty()) {
-    h += "<h3 id=\"integrators\">Integrators compared (MODEL.md section 5)</h3>\n<p>Each run integrated three ways and "
+    h += "<h3 id=\"integrators\">Integrators compared (docs/excavator.md section 5)</h3>\n<p>Each run integrated three ways and "
          "compared at its samples with RK4 at 0.1 ms. The thesis used explicit Euler at 1 ms; wlx defaults to RK4; "
          "<code>dopri5</code> (adaptive Dormand-Prince 5(4)) writes 10 samples per run and chooses its steps in between. "
          "An evaluation is one closed-form IK of the four limbs plus a dependent-rate solve. "

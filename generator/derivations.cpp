@@ -85,7 +85,7 @@ ex closure_value(const Model& m, const ClosureCondition& c) { return closure_row
 
 FunctionSpec derive_kinematics(const Model& m) {
   FunctionSpec fn{"kinematics", "kinematics.hpp",
-                  "Forward kinematics (thesis 3.4): position and orientation in K0 of every frame of "
+                  "Forward kinematics: position and orientation in K0 of every frame of "
                   "interest (index with wlx::gen::frame::...).",
                   false, {}};
   OutputSpec pos{"positions", "FramePositions", "frame origins in K0, one column per frame", "", {}};
@@ -102,7 +102,7 @@ FunctionSpec derive_kinematics(const Model& m) {
 
 FunctionSpec derive_closure(const Model& m) {
   FunctionSpec fn{"closure", "closure.hpp",
-                  "Loop closure (thesis 3.3, MODEL.md 4): Phi(s) and its Jacobian dPhi/ds.", false, {}};
+                  "Loop closure: Phi(s) and its Jacobian dPhi/ds.", false, {}};
   OutputSpec phi{"Phi", "ClosureVector", "closure residuals, zero on the constraint manifold", "", {}};
   OutputSpec jac{"dPhi_ds", "ClosureJacobian", "dPhi/ds, 14 x 32", kZeroMatrix, {}};
   for (int i = 0; i < static_cast<int>(m.closure.size()); ++i) {
@@ -117,7 +117,7 @@ FunctionSpec derive_closure(const Model& m) {
 
 FunctionSpec derive_nonholonomic(const Model& m) {
   FunctionSpec fn{"nonholonomic", "nonholonomic.hpp",
-                  "Non-holonomic wheels (thesis 4, MODEL.md 5): rows C(s) with v_W . n_W = C(s) s', and "
+                  "Non-holonomic wheels: rows C(s) with v_W . n_W = C(s) s', and "
                   "the rolling rows with spin rate = (v_W . e_x,W) / w = spin(s) s'.",
                   false, {}};
   OutputSpec C{"C", "WheelRows", "cornering constraint rows, one per wheel (l, r)", kZeroMatrix, {}};
@@ -135,7 +135,7 @@ FunctionSpec derive_nonholonomic(const Model& m) {
 
 FunctionSpec derive_convective(const Model& m) {
   FunctionSpec fn{"convective", "convective.hpp",
-                  "Convective terms (thesis eqs. 6.5-6.7): (d/dt dPhi/ds) s' and (d/dt C) s', i.e. the "
+                  "Convective terms: (d/dt dPhi/ds) s' and (d/dt C) s', i.e. the "
                   "second time derivatives of Phi and of v_W . n_W with all accelerations zero.",
                   true, {}};
   OutputSpec phi{"dPhi_ds_dot_sdot", "ClosureVector", "(d/dt dPhi/ds) s'", "", {}};
@@ -150,7 +150,7 @@ FunctionSpec derive_convective(const Model& m) {
 
 FunctionSpec derive_bodies(const Model& m) {
   FunctionSpec fn{"bodies", "bodies.hpp",
-                  "Body kinematics for the dynamics (thesis 6.2-6.3): per body (index with "
+                  "Body kinematics for the dynamics: per body (index with "
                   "wlx::gen::body::...) the CoM position and orientation in K0, the Jacobians of the CoM "
                   "velocity and of the angular velocity (both in K0), and their convective terms Jdot s'.",
                   true, {}};

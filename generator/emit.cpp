@@ -99,7 +99,7 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
       "using BodyRotations = std::array<Eigen::Matrix3d, {4}>;\n"
       "using BodyJacobians = std::array<Eigen::Matrix<double, 3, {0}>, {4}>;\n\n",
       n, nf, nc, nw, nb);
-  t += "// Index of each coordinate in s (MODEL.md section 2).\nnamespace coord {\n";
+  t += "// Index of each coordinate in s (the model file's order: inputs, then dependent joints).\nnamespace coord {\n";
   for (const auto& c : m.coordinates) t += fmt::format("inline constexpr int {} = {};  // {}, {}\n", c.name, c.index, c.unit, c.meaning);
   t += "}  // namespace coord\n\n";
   t += "// Index of each frame of interest in FramePositions / FrameRotations.\nnamespace frame {\n";
@@ -122,9 +122,9 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
   t += names("kWheelNames", nw, [&](int k) { return at(m.wheels, k).name; });
   t += "\n" + namespace_close(opt);
 
-  std::string p = banner(m, opt, "Model parameters: geometry and mass properties, defaults from MODEL.md.");
+  std::string p = banner(m, opt, "Model parameters: geometry and mass properties, defaults from the model file.");
   p += "#pragma once\n\n#include <array>\n#include <string_view>\n\n" + namespace_open(opt);
-  p += "\n// The one place where the model's numbers live (MODEL.md sections 1 and 6).\nstruct Params {\n";
+  p += "\n// The model's numbers, defaults from its file; change any of them at run time.\nstruct Params {\n";
   for (const auto& par : m.parameters)
     p += fmt::format("  double {} = {};  // {}: {}\n", par.name, literal(par.default_value), par.unit, par.meaning);
   p += "};\n\n"

@@ -59,7 +59,7 @@ struct Coordinate {
   std::string meaning;
 };
 
-// A named model parameter (geometry or mass), with its default from MODEL.md.
+// A named model parameter (geometry or mass), with its default from docs/excavator.md.
 struct Parameter {
   std::string name;
   double default_value = 0;

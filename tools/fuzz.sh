@@ -25,6 +25,7 @@ for target in ik_numbers json_input model_file; do
   if ! ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
       "build-fuzz/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -max_len=4096 -timeout=10 \
       -artifact_prefix="$artifacts/" "$work" "tests/fuzz/corpus/$target" "tests/fuzz/regressions/$target" \
+      $([ "$target" = model_file ] && echo models) \
       > "build-fuzz/fuzz-$target.log" 2>&1; then
     status=1
     cp "$artifacts"/* "tests/fuzz/regressions/$target/" 2>/dev/null || true

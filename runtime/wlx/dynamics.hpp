@@ -1,4 +1,4 @@
-// Inverse dynamics with redundant actuation (thesis 6.3; MODEL.md section 7).
+// Inverse dynamics with redundant actuation (thesis 6.3; docs/excavator.md section 7).
 //
 // Commanded speeds u = [z_C', x_C', roll', pitch'], (y_C', yaw') dependent through the wheels,
 // every other input constant. Kane's method on the 7 bodies, with s' = T u + 0 and

@@ -10,7 +10,7 @@ class Error : public std::runtime_error {
  public:
   Error(std::string field, const std::string& reason)
       : std::runtime_error(field.empty() ? reason : field + ": " + reason), field_(std::move(field)) {}
-  // The input field (MODEL.md name, JSON key or option) the error is about; may be empty.
+  // The input field (docs/excavator.md name, JSON key or option) the error is about; may be empty.
   const std::string& field() const noexcept { return field_; }
 
  private:

@@ -13,7 +13,7 @@ WLX_MODEL_NAMESPACE_BEGIN
 
 struct IkSweep {
   std::string id;      // "IK-L1", ...
-  std::string input;   // MODEL.md name of the swept input
+  std::string input;   // docs/excavator.md name of the swept input
   double from = 0, to = 0, step = 0;  // SI units (radians for angles)
   bool degrees = false;               // the thesis quotes this sweep in degrees
   Limb limb = 0;

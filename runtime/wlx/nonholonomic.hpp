@@ -1,4 +1,4 @@
-// Non-holonomic wheels (thesis 4, 5; MODEL.md section 5): the two dependent rates that keep both
+// Non-holonomic wheels (thesis 4, 5; docs/excavator.md section 5): the two dependent rates that keep both
 // wheels from sliding sideways, at velocity and at acceleration level, from the generated C(s),
 // dPhi/ds and convective terms (no numeric differentiation).
 //

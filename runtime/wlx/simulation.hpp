@@ -1,4 +1,4 @@
-// Time integration of a scenario (thesis 4.2, 5; MODEL.md sections 5 and 8): the commanded input
+// Time integration of a scenario (thesis 4.2, 5; docs/excavator.md sections 5 and 8): the commanded input
 // rates and the dependent pair are integrated; the 14 holonomic dependents are re-solved by the
 // closed-form IK at every evaluation, so the loop closure cannot drift.
 #pragma once
@@ -37,7 +37,7 @@ struct Scenario {
   double tolerance = 1e-10;  // dopri5 only: local error per step, relative to 1 + |q| (m or rad)
   Branches branches;
   NonholonomicOptions nonholonomic;
-  // Set: an inverse-dynamics run (MODEL.md section 7): pair A, only u = [z_C', x_C', roll',
+  // Set: an inverse-dynamics run (docs/excavator.md section 7): pair A, only u = [z_C', x_C', roll',
   // pitch'] commanded (constant, so u' = 0), torques distributed with this weighting.
   std::optional<Weighting> weighting;
 

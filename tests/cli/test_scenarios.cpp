@@ -1,5 +1,5 @@
 // The shipped scenario files: each runs, keeps both wheels from sliding, and shows the thesis'
-// observations (MODEL.md section 8).
+// observations (docs/excavator.md section 8).
 #include <doctest/doctest.h>
 #include <scenario_io.hpp>
 #include <wlx/error.hpp>
@@ -26,7 +26,7 @@ double end(const std::string& id, int coordinate) { return run(id).samples.back(
 
 }  // namespace
 
-TEST_CASE("scenarios: one file per NH and ST row of MODEL.md section 8, each sign separately") {
+TEST_CASE("scenarios: one file per NH and ST row of docs/excavator.md section 8, each sign separately") {
   const auto ids = commands::scenario_ids();
   for (const char* id : {"NH-1", "NH-2", "NH-3", "NH-4", "ST-A1+", "ST-A1-", "ST-A2+", "ST-A2-", "ST-A3+", "ST-A3-",
                          "ST-B1+", "ST-B1-", "ST-B2+", "ST-B2-", "ST-B3+", "ST-B3-"})

@@ -6,7 +6,7 @@
 #include <wlx/gen/all.hpp>
 #include WLX_BAKED_ALL
 
-TEST_CASE("baked parameters: same results as the symbolic headers at MODEL.md's defaults") {
+TEST_CASE("baked parameters: same results as the symbolic headers at docs/excavator.md's defaults") {
   std::mt19937_64 rng(40);
   const wlx::gen::Params p;
   wlx::baked::Params ignored;

@@ -42,7 +42,7 @@ TEST_CASE("model file: the excavator reads, with the structure the thesis descri
   CHECK(m.limbs.size() == 4);
   CHECK(m.wheels.size() == 2);
   CHECK(m.parameters.size() == 36);
-  // The repetition writes the left side first, x y z inside: MODEL.md's coordinate order.
+  // The repetition writes the left side first, x y z inside: docs/excavator.md's coordinate order.
   CHECK(m.coordinates[6].name == "x_Fl");
   CHECK(m.coordinates[11].name == "z_Fr");
   CHECK(m.coordinates[31].name == "theta_r6");

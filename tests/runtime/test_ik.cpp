@@ -40,7 +40,7 @@ Coordinates random_leg_pose(std::mt19937_64& rng, const Model& model, Data& data
   return s;
 }
 
-// A random reachable wheel level: a level hub (theta_3 + theta_6 = atan2(g_x, g_z), MODEL.md 4)
+// A random reachable wheel level: a level hub (theta_3 + theta_6 = atan2(g_x, g_z), docs/excavator.md 4)
 // with a random lever pitch, put through the generated forward kinematics.
 Coordinates random_wheel_pose(std::mt19937_64& rng, const Model& model, Data& data) {
   std::uniform_real_distribution<double> tilt(-0.6, 0.6), lever(-1.4, 1.4);
@@ -224,7 +224,7 @@ TEST_CASE("ik: the thesis sweeps are continuous and stay on the default branch")
 }
 
 TEST_CASE("ik: the thesis' cold-start observation: Newton from the start pose flips the knee high up IK-L3") {
-  // MODEL.md section 4: from the nominal pose, Newton converges to psi_4 < 0 for z_F >= ~2.63 m.
+  // docs/excavator.md section 4: from the nominal pose, Newton converges to psi_4 < 0 for z_F >= ~2.63 m.
   // The basins of attraction are fractal near their boundary, so the assertion is statistical:
   // always the default branch well below, mostly the flipped knee (branch 1) above.
   const Model model;

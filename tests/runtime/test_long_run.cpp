@@ -59,7 +59,7 @@ TEST_CASE("long run: ST-A1+ in 10^6 RK4 steps: closure residual <= 1e-12 all the
   CHECK(worst_closure <= 1e-12);
   CHECK(worst_nh <= 1e-12);
   CHECK(rss_at_end - rss_at_10_percent <= 256);  // KiB: no growth with the number of steps
-  // RK4 is converged at 1 ms already (MODEL.md section 5): 500 times finer lands on the same state.
+  // RK4 is converged at 1 ms already (docs/excavator.md section 5): 500 times finer lands on the same state.
   sc.dt = 1e-3;
   const Trajectory coarse = simulate(sc);
   const double difference = (coarse.samples.back().s - last).cwiseAbs().maxCoeff();

@@ -32,7 +32,7 @@ TEST_CASE("simulation: the closure does not drift; sample count includes t = 0")
   CHECK(tr.samples.back().s(c::roll) == doctest::Approx(10 * kDeg).epsilon(1e-12));
 }
 
-TEST_CASE("simulation: RK4 at 1 ms is converged; Euler differs by ~4e-5 m in y_C (MODEL.md section 5)") {
+TEST_CASE("simulation: RK4 at 1 ms is converged; Euler differs by ~4e-5 m in y_C (docs/excavator.md section 5)") {
   Scenario sc;
   sc.rates(c::theta_l5) = 0.5 * kDeg;  // ST-A2+
   sc.duration = 0.451;

@@ -1,4 +1,4 @@
-// An independent forward-kinematics chain for the tests, written directly from MODEL.md
+// An independent forward-kinematics chain for the tests, written directly from docs/excavator.md
 // sections 3 and 6 with elementary rotation matrices, generic in the scalar (double or Jet).
 // It shares nothing with the generator but the coordinate order and parameter values.
 #pragma once
@@ -63,7 +63,7 @@ template <class T> ReferenceKinematics<T> reference_kinematics(const std::array<
   return out;
 }
 
-// The 14 closure equations of MODEL.md section 4, from the reference chain.
+// The 14 closure equations of docs/excavator.md section 4, from the reference chain.
 template <class T> std::array<T, gen::kClosureCount> reference_closure(const std::array<T, gen::kCoordinateCount>& s,
                                                                         const gen::Params& p) {
   namespace c = gen::coord;

@@ -37,7 +37,7 @@ using BodyVectors = Eigen::Matrix<double, 3, 7>;
 using BodyRotations = std::array<Eigen::Matrix3d, 7>;
 using BodyJacobians = std::array<Eigen::Matrix<double, 3, 32>, 7>;
 
-// Index of each coordinate in s (MODEL.md section 2).
+// Index of each coordinate in s (the model file's order: inputs, then dependent joints).
 namespace coord {
 inline constexpr int x_C = 0;  // m, cabin position x in K0
 inline constexpr int y_C = 1;  // m, cabin position y in K0
