@@ -9,12 +9,6 @@
 
 using namespace wlx;
 
-namespace {
-
-// vee of a skew-symmetric matrix given as a nested array.
-test::V3<double> vee(const test::M3<double>& S) { return {S[2][1], S[0][2], S[1][0]}; }
-
-}  // namespace
 
 TEST_CASE("bodies: CoM, rotation, Jv, Jw and their convective terms match exact derivatives") {
   std::mt19937_64 rng(30);
@@ -30,25 +24,11 @@ TEST_CASE("bodies: CoM, rotation, Jv, Jw and their convective terms match exact 
     const auto ref = test::reference_kinematics(test::along(s, sdot), p);
     for (int b = 0; b < gen::kBodyCount; ++b) {
       const auto& P = ref.bodies[b];
-      test::M3<double> Rv, Rd, Rdd;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-          Rv[i][j] = P.R[i][j].v;
-          Rd[i][j] = P.R[i][j].d;
-          Rdd[i][j] = P.R[i][j].dd;
-        }
-      test::M3<double> W{}, Wdot{};  // omega^ = Rdot R^T, d/dt omega^ = Rddot R^T + Rdot Rdot^T
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          for (int k = 0; k < 3; ++k) {
-            W[i][j] += Rd[i][k] * Rv[j][k];
-            Wdot[i][j] += Rdd[i][k] * Rv[j][k] + Rd[i][k] * Rd[j][k];
-          }
-      const auto omega = vee(W), alpha = vee(Wdot);
+      const auto [omega, alpha] = test::angular_rates(P.R);
       const Eigen::Vector3d v = Jv[b] * sdot, w = Jw[b] * sdot;
       for (int i = 0; i < 3; ++i) {
         worst_pose = std::max(worst_pose, std::abs(com(i, b) - P.r[i].v));
-        for (int j = 0; j < 3; ++j) worst_pose = std::max(worst_pose, std::abs(R[b](i, j) - Rv[i][j]));
+        for (int j = 0; j < 3; ++j) worst_pose = std::max(worst_pose, std::abs(R[b](i, j) - P.R[i][j].v));
         worst_v = std::max(worst_v, std::abs(v(i) - P.r[i].d));
         worst_w = std::max(worst_w, std::abs(w(i) - omega[i]));
         worst_a = std::max(worst_a, std::abs(Jv_dot(i, b) - P.r[i].dd));

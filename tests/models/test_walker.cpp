@@ -26,8 +26,6 @@ namespace c = gen::coord;
 
 namespace {
 
-test::V3<double> vee(const test::M3<double>& S) { return {S[2][1], S[0][2], S[1][0]}; }
-
 // A random admissible state around the nominal one: cabin moved and tilted, feet moved (turned
 // with the cabin's yaw), ground levels and steering moved; dependents by the closed form.
 Coordinates random_state(std::mt19937_64& rng, const Model& model) {
@@ -145,20 +143,11 @@ TEST_CASE("walker: body CoM, rotation, Jv, Jw and their convective terms match e
     const auto ref = test::walker_kinematics(test::along(s, sdot), p);
     for (int b = 0; b < gen::kBodyCount; ++b) {
       const auto& P = ref.bodies[static_cast<std::size_t>(b)];
-      test::M3<double> Rv, Rd, Rdd, W{}, Wdot{};
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) Rv[i][j] = P.R[i][j].v, Rd[i][j] = P.R[i][j].d, Rdd[i][j] = P.R[i][j].dd;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          for (int k = 0; k < 3; ++k) {
-            W[i][j] += Rd[i][k] * Rv[j][k];
-            Wdot[i][j] += Rdd[i][k] * Rv[j][k] + Rd[i][k] * Rd[j][k];
-          }
-      const auto omega = vee(W), alpha = vee(Wdot);
+      const auto [omega, alpha] = test::angular_rates(P.R);
       const Eigen::Vector3d v = Jv[static_cast<std::size_t>(b)] * sdot, w = Jw[static_cast<std::size_t>(b)] * sdot;
       for (int i = 0; i < 3; ++i) {
         worst = std::max({worst, std::abs(com(i, b) - P.r[i].v), std::abs(v(i) - P.r[i].d), std::abs(w(i) - omega[i])});
-        for (int j = 0; j < 3; ++j) worst = std::max(worst, std::abs(R[static_cast<std::size_t>(b)](i, j) - Rv[i][j]));
+        for (int j = 0; j < 3; ++j) worst = std::max(worst, std::abs(R[static_cast<std::size_t>(b)](i, j) - P.R[i][j].v));
         worst_dd = std::max({worst_dd, std::abs(Jv_dot(i, b) - P.r[i].dd), std::abs(Jw_dot(i, b) - alpha[i])});
       }
     }

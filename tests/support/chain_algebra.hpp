@@ -46,4 +46,20 @@ inline std::array<Jet, gen::kCoordinateCount> along(const gen::Coordinates& s, c
   return out;
 }
 
+// The angular velocity and acceleration of a rotation moving as a jet: omega^ = Rdot R^T and
+// alpha^ = d/dt omega^ = Rddot R^T + Rdot Rdot^T, read off the skew-symmetric matrices.
+struct AngularRates {
+  V3<double> omega, alpha;
+};
+inline AngularRates angular_rates(const M3<Jet>& R) {
+  M3<double> W{}, Wdot{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) {
+        W[i][j] += R[i][k].d * R[j][k].v;
+        Wdot[i][j] += R[i][k].dd * R[j][k].v + R[i][k].d * R[j][k].d;
+      }
+  return {{W[2][1], W[0][2], W[1][0]}, {Wdot[2][1], Wdot[0][2], Wdot[1][0]}};
+}
+
 }  // namespace wlx::test
