@@ -29,6 +29,7 @@
 
 #include <fmt/format.h>
 
+#include <regex>
 #include <set>
 
 namespace wlx::codegen {
@@ -481,8 +482,8 @@ struct EmittedSolve {
   OpCount ops;
 };
 
-EmittedSolve emit_solve(const Model& m, const Limb& limb, Solve solve, const EmitOptions& opt) {
-  // The last stage: the limb's own closure rows at the solution.
+// The last stage of a limb's solve: its own closure rows at the solution, and the check.
+Stage check_stage(const Model& m, const Limb& limb, const Solve& solve) {
   Stage check;
   std::vector<std::string> rows;
   for (std::size_t i = 0; i < limb.rows.size(); ++i) {
@@ -497,43 +498,45 @@ EmittedSolve emit_solve(const Model& m, const Limb& limb, Solve solve, const Emi
       "    return IkStatus::residual;\n"
       "  }}\n",
       fmt::join(rows, ", "));
-  solve.stages.push_back(check);
+  return check;
+}
 
-  // One graph for all stages: temporaries are shared across stages and placed in the first stage
-  // where everything they use exists.
+// The statements of a solve: input aliases, the batched sines and cosines, then every stage's
+// temporaries, values and solver calls, then the outputs. One graph for all stages, so that
+// temporaries are shared (across limbs, too, when several are fused) and placed in the first stage
+// where everything they use exists.
+std::string emit_body(const Model& m, const std::vector<Stage>& stages, const std::vector<std::pair<int, std::string>>& outputs,
+                      const EmitOptions& opt, OpCount& ops) {
   ExprGraph g;
   std::map<std::string, int> symbol_stage;
-  std::vector<std::vector<std::pair<std::string, int>>> locals(solve.stages.size());
+  std::vector<std::vector<std::pair<std::string, int>>> locals(stages.size());
   std::vector<int> roots;
-  for (std::size_t k = 0; k < solve.stages.size(); ++k)
-    for (const auto& [sym, value] : solve.stages[k].locals) {
+  for (std::size_t k = 0; k < stages.size(); ++k)
+    for (const auto& [sym, value] : stages[k].locals) {
       const int id = g.add(value);
       locals[k].emplace_back(sym.get_name(), id);
       roots.push_back(id);
     }
   // What a stage defines (its locals, its solvers' results) is usable from the next stage on.
-  for (std::size_t k = 0; k < solve.stages.size(); ++k) {
-    for (const auto& [sym, value] : solve.stages[k].locals) symbol_stage[sym.get_name()] = static_cast<int>(k) + 1;
-    for (const auto& n : solve.stages[k].defines) symbol_stage[n] = static_cast<int>(k) + 1;
+  for (std::size_t k = 0; k < stages.size(); ++k) {
+    for (const auto& [sym, value] : stages[k].locals) symbol_stage[sym.get_name()] = static_cast<int>(k) + 1;
+    for (const auto& n : stages[k].defines) symbol_stage[n] = static_cast<int>(k) + 1;
   }
-
   const CsePlan plan = eliminate_common_subexpressions(g, roots);
   const TrigBatch trig = batch_trig(m, g, roots);
   std::map<int, int> node_stage;
   std::function<int(int)> stage_of = [&](int id) -> int {
     if (auto it = node_stage.find(id); it != node_stage.end()) return it->second;
     const Node& n = g.node(id);
-    int s = 0;
+    int st = 0;
     if (n.kind == NodeKind::Symbol) {
-      if (auto it = symbol_stage.find(n.text); it != symbol_stage.end()) s = it->second;
+      if (auto it = symbol_stage.find(n.text); it != symbol_stage.end()) st = it->second;
     }
-    for (int a : n.args) s = std::max(s, stage_of(a));
-    node_stage[id] = s;
-    return s;
+    for (int a : n.args) st = std::max(st, stage_of(a));
+    node_stage[id] = st;
+    return st;
   };
-
   Printer pr(g, plan, trig.names, "ik_t");
-  OpCount ops;
   ops.calls += trig.calls;
   std::set<std::string> symbols;
   std::function<void(int)> collect = [&](int id) {
@@ -555,16 +558,72 @@ EmittedSolve emit_solve(const Model& m, const Limb& limb, Solve solve, const Emi
   }
   body += trig.prologue;
   const auto batched = [&](std::size_t k) { return trig.names.count(plan.temporaries[k]) != 0; };
-  for (std::size_t k = 0; k < solve.stages.size(); ++k) {
+  for (std::size_t k = 0; k < stages.size(); ++k) {
     for (std::size_t t = 0; t < plan.temporaries.size(); ++t)
       if (!batched(t) && stage_of(plan.temporaries[t]) == static_cast<int>(k))
         body += fmt::format("  const double ik_t{} = {};\n", t, pr.define(plan.temporaries[t], ops));
     for (const auto& [n, id] : locals[k]) body += fmt::format("  const double {} = {};\n", n, pr.value(id, ops));
-    body += solve.stages[k].code;
+    body += stages[k].code;
   }
-  for (const SolvedJoint& j : solve.joints) body += fmt::format("  out({}) = {};\n", j.coordinate, j.q.get_name());
-  for (const auto& [k, value] : solve.coupled) body += fmt::format("  out({}) = {};\n", k, joint_symbols(m, k).q.get_name());
-  body += "  return IkStatus::ok;\n";
+  for (const auto& [k, name] : outputs) body += fmt::format("  out({}) = {};\n", k, name);
+  return body + "  return IkStatus::ok;\n";
+}
+
+std::vector<std::pair<int, std::string>> solve_outputs(const Model& m, const Solve& solve) {
+  std::vector<std::pair<int, std::string>> out;
+  for (const SolvedJoint& j : solve.joints) out.emplace_back(j.coordinate, j.q.get_name());
+  for (const auto& [k, value] : solve.coupled) out.emplace_back(k, joint_symbols(m, k).q.get_name());
+  return out;
+}
+
+// One limb's stages (check included) with their local names made the limb's own (ik_<tag>_...),
+// its branch read from `ik_<tag>_branch`, and a failure reporting `failed = index`: for fusing
+// several limbs into one function. The solved joints keep their names (they are distinct already).
+std::vector<Stage> fused_stages(const Model& m, const std::vector<Stage>& stages, const std::string& tag, int index) {
+  std::set<std::string> keep = {"ik_solve_cos_sin", "ik_solve_two_axis", "ik_wrap"};
+  for (const auto& c : m.coordinates)
+    for (const char* k : {"ik_q_", "ik_c_", "ik_s_"}) keep.insert(k + c.name);
+  const auto renamed = [&](const std::string& name) { return keep.count(name) ? name : "ik_" + tag + "_" + name.substr(3); };
+  const std::regex local(R"(\bik_[A-Za-z0-9_]+)"), branch(R"(\bbranch\b)");
+  GiNaC::exmap symbols;
+  const auto rename_symbols = [&](const ex& e) {
+    for (GiNaC::const_preorder_iterator it = e.preorder_begin(); it != e.preorder_end(); ++it)
+      if (GiNaC::is_a<GiNaC::symbol>(*it)) {
+        const std::string n = GiNaC::ex_to<GiNaC::symbol>(*it).get_name();
+        if (n.rfind("ik_", 0) == 0 && renamed(n) != n && !symbols.count(*it)) symbols[*it] = realsymbol(renamed(n));
+      }
+  };
+  for (const Stage& st : stages)
+    for (const auto& [sym, value] : st.locals) {
+      rename_symbols(sym);
+      rename_symbols(value);
+    }
+  std::vector<Stage> out;
+  for (const Stage& st : stages) {
+    Stage r;
+    for (const auto& [sym, value] : st.locals)
+      r.locals.emplace_back(GiNaC::ex_to<realsymbol>(symbols.count(sym) ? symbols[sym] : ex(sym)), value.subs(symbols));
+    std::string code;
+    std::sregex_iterator it(st.code.begin(), st.code.end(), local), end;
+    std::size_t at = 0;
+    for (; it != end; ++it) {
+      code += st.code.substr(at, static_cast<std::size_t>(it->position()) - at) + renamed(it->str());
+      at = static_cast<std::size_t>(it->position() + it->length());
+    }
+    code += st.code.substr(at);
+    code = std::regex_replace(code, branch, "ik_" + tag + "_branch");
+    r.code = std::regex_replace(code, std::regex(R"(return IkStatus::)"), fmt::format("failed = {};\n    return IkStatus::", index));
+    for (const auto& n : st.defines) r.defines.push_back(renamed(n));
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+EmittedSolve emit_solve(const Model& m, const Limb& limb, Solve solve, const EmitOptions& opt) {
+  std::vector<Stage> stages = solve.stages;
+  stages.push_back(check_stage(m, limb, solve));
+  OpCount ops;
+  const std::string body = emit_body(m, stages, solve_outputs(m, solve), opt, ops);
 
   std::string t = fmt::format("// Closed-form inverse kinematics of limb {} ({}).\n//\n", limb.name, limb.title);
   for (const auto& line : solve.doc) t += "// " + line + "\n";
@@ -693,6 +752,7 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
        "#include \"params.hpp\"\n#include \"structure.hpp\"\n#include \"trig.hpp\"\n#include \"types.hpp\"\n\n" +
        namespace_open(opt) + "\n" + kSupport;
   std::vector<std::string> entries;
+  std::vector<std::pair<const Limb*, Solve>> solved;
   for (const Limb& limb : m.limbs) {
     std::optional<Solve> solve;
     std::vector<std::string> reasons;
@@ -711,6 +771,7 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
     }
     const EmittedSolve e = emit_solve(m, limb, *solve, opt);
     t += e.text;
+    solved.emplace_back(&limb, *solve);
     report.push_back(fmt::format("{}: {} ({} branches, {} operations)", limb.name, solve->summary, solve->branches, e.ops.total()));
     std::vector<std::string> bits, failures;
     for (const auto& b : solve->bits) bits.push_back("\"" + b + "\"");
@@ -730,6 +791,40 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
        "};\n\n";
   t += fmt::format("// Per limb, in the order of kLimbs.\ninline constexpr std::array<ClosedFormInfo, {}> kClosedForm{{{{\n{}\n}}}};\n\n",
                    m.limbs.size(), fmt::join(entries, "\n"));
+
+  // Every limb in one function: one pass of sines and cosines for all input angles, and the
+  // subexpressions the limbs share (the cabin's pose) computed once.
+  const bool all = !m.limbs.empty() && solved.size() == m.limbs.size();
+  t += fmt::format("inline constexpr bool kHasFusedIk = {};\n\n", all ? "true" : "false");
+  if (all) {
+    std::vector<Stage> stages;
+    std::vector<std::pair<int, std::string>> outputs;
+    std::string prologue;
+    for (std::size_t k = 0; k < solved.size(); ++k) {
+      const auto& [limb, solve] = solved[k];
+      std::vector<Stage> own = solve.stages;
+      own.push_back(check_stage(m, *limb, solve));
+      for (Stage& st : fused_stages(m, own, limb->name, static_cast<int>(k))) stages.push_back(std::move(st));
+      for (const auto& o : solve_outputs(m, solve)) outputs.push_back(o);
+      prologue += fmt::format("  const int ik_{0}_branch = branches[{1}];\n"
+                              "  if (ik_{0}_branch < 0 || ik_{0}_branch >= {2}) {{\n    failed = {1};\n    return IkStatus::bad_branch;\n  }}\n",
+                              limb->name, k, solve.branches);
+    }
+    OpCount ops;
+    const std::string body = emit_body(m, stages, outputs, opt, ops);
+    t += fmt::format(
+        "// The closed forms of all {0} limbs in one pass: what ik_<limb>() computes for each, with the sines and\n"
+        "// cosines of every input angle and the subexpressions the limbs share computed once. branches[k] is\n"
+        "// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed,\n"
+        "// `failed` its index and `why` its numbers; out is written only when every limb succeeded.\n"
+        "// Operations: {1} (adds {2}, muls {3}, divs {4}, calls {5}), plus the solver calls.\n"
+        "inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, {0}>& branches, Coordinates& out,\n"
+        "                       int& failed, IkDiagnostics& why) noexcept {{\n"
+        "  static_cast<void>(p);\n",
+        m.limbs.size(), ops.total(), ops.adds, ops.muls, ops.divs, ops.calls);
+    t += prologue + body + "}\n\n";
+    report.push_back(fmt::format("all limbs fused: {} operations", ops.total()));
+  }
   t += namespace_close(opt);
   return {"wlx/gen/ik.hpp", t};
 }

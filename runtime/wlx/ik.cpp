@@ -62,20 +62,12 @@ int branch_count(Limb limb) noexcept {
   return cf.solve == nullptr ? 1 : cf.branches;
 }
 
-void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinates& s) {
-  const gen::LimbInfo& l = info(limb);
-  for (int i = 0; i < l.input_count; ++i) require_finite(s, l.inputs[static_cast<std::size_t>(i)]);
-  if (branch < 0 || branch >= branch_count(limb))
-    throw Error("branch", fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, branch));
+namespace {
+
+// Turns a generated solver's failure into the error that names the limb and the reason.
+[[noreturn]] void throw_failure(Limb limb, int branch, gen::IkStatus status, const gen::IkDiagnostics& why) {
   const gen::ClosedFormInfo& cf = gen::kClosedForm[static_cast<std::size_t>(limb)];
-  if (cf.solve == nullptr) {  // wlx-gen found no closed form for this limb
-    Data data;
-    solve_limb_newton(model, limb, s, data);
-    return;
-  }
-  gen::IkDiagnostics why;
-  switch (cf.solve(s, model.params(), branch, s, why)) {
-    case gen::IkStatus::ok: return;
+  switch (status) {
     case gen::IkStatus::out_of_reach:
       throw Error(std::string(limb_name(limb)),
                   fmt::format(fmt::runtime(cf.failures[static_cast<std::size_t>(std::clamp(why.stage, 1, 2) - 1)]),
@@ -86,13 +78,45 @@ void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinat
                   fmt::format("the closed-form solution does not satisfy the model: the limb's closure residual is {:.3e}, "
                               "above the tolerance {:.1e}",
                               why.value, why.high));
+    case gen::IkStatus::ok:
     case gen::IkStatus::bad_branch: break;
   }
   throw Error("branch", fmt::format("{} has no branch {}", limb_name(limb), branch));
 }
 
+void check_inputs_and_branch(Limb limb, int branch, const Coordinates& s) {
+  const gen::LimbInfo& l = info(limb);
+  for (int i = 0; i < l.input_count; ++i) require_finite(s, l.inputs[static_cast<std::size_t>(i)]);
+  if (branch < 0 || branch >= branch_count(limb))
+    throw Error("branch", fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, branch));
+}
+
+}  // namespace
+
+void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinates& s) {
+  check_inputs_and_branch(limb, branch, s);
+  const gen::ClosedFormInfo& cf = gen::kClosedForm[static_cast<std::size_t>(limb)];
+  if (cf.solve == nullptr) {  // wlx-gen found no closed form for this limb
+    Data data;
+    solve_limb_newton(model, limb, s, data);
+    return;
+  }
+  gen::IkDiagnostics why;
+  const gen::IkStatus status = cf.solve(s, model.params(), branch, s, why);
+  if (status != gen::IkStatus::ok) throw_failure(limb, branch, status, why);
+}
+
 void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches) {
-  for (Limb limb : kLimbs) solve_limb_closed_form(model, limb, branches.limb[static_cast<std::size_t>(limb)], s);
+  if constexpr (gen::kHasFusedIk) {
+    // All limbs in one generated pass (the cabin pose and the sines and cosines computed once).
+    for (Limb limb : kLimbs) check_inputs_and_branch(limb, branches.limb[static_cast<std::size_t>(limb)], s);
+    int failed = 0;
+    gen::IkDiagnostics why;
+    const gen::IkStatus status = gen::ik_all(s, model.params(), branches.limb, s, failed, why);
+    if (status != gen::IkStatus::ok) throw_failure(failed, branches.limb[static_cast<std::size_t>(failed)], status, why);
+  } else {
+    for (Limb limb : kLimbs) solve_limb_closed_form(model, limb, branches.limb[static_cast<std::size_t>(limb)], s);
+  }
 }
 
 int classify_branch(const Model& model, Limb limb, const Coordinates& s) {

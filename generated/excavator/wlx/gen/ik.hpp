@@ -503,6 +503,303 @@ inline constexpr std::array<ClosedFormInfo, 4> kClosedForm{{
     {&ik_wheel_r, 8, "leveled-lever", {{"bit 0: the other root of theta_r6 (branch 0: the root nearest zero)", "bit 1: the other root of theta_r2 (branch 0: |theta_r2| <= 90 deg)", "bit 2: the other root of theta_r6 + theta_r3 (branch 0: nearest zero)"}}, {{"z_Wr = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, theta_r5 as given, the z of W_r reaches [{low:.4f}, {high:.4f}] m"}}},
 }};
 
+inline constexpr bool kHasFusedIk = true;
+
+// The closed forms of all 4 limbs in one pass: what ik_<limb>() computes for each, with the sines and
+// cosines of every input angle and the subexpressions the limbs share computed once. branches[k] is
+// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed,
+// `failed` its index and `why` its numbers; out is written only when every limb succeeded.
+// Operations: 476 (adds 170, muls 292, divs 0, calls 14), plus the solver calls.
+inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out,
+                       int& failed, IkDiagnostics& why) noexcept {
+  static_cast<void>(p);
+  const int ik_leg_l_branch = branches[0];
+  if (ik_leg_l_branch < 0 || ik_leg_l_branch >= 4) {
+    failed = 0;
+    return IkStatus::bad_branch;
+  }
+  const int ik_leg_r_branch = branches[1];
+  if (ik_leg_r_branch < 0 || ik_leg_r_branch >= 4) {
+    failed = 1;
+    return IkStatus::bad_branch;
+  }
+  const int ik_wheel_l_branch = branches[2];
+  if (ik_wheel_l_branch < 0 || ik_wheel_l_branch >= 8) {
+    failed = 2;
+    return IkStatus::bad_branch;
+  }
+  const int ik_wheel_r_branch = branches[3];
+  if (ik_wheel_r_branch < 0 || ik_wheel_r_branch >= 8) {
+    failed = 3;
+    return IkStatus::bad_branch;
+  }
+  const double x_C = s(0);
+  const double y_C = s(1);
+  const double z_C = s(2);
+  const double yaw = s(3);
+  const double pitch = s(4);
+  const double roll = s(5);
+  const double x_Fl = s(6);
+  const double y_Fl = s(7);
+  const double z_Fl = s(8);
+  const double x_Fr = s(9);
+  const double y_Fr = s(10);
+  const double z_Fr = s(11);
+  const double z_Wl = s(12);
+  const double z_Wr = s(13);
+  const double psi_l1 = s(14);
+  const double psi_r1 = s(15);
+  const double theta_l5 = s(16);
+  const double theta_r5 = s(17);
+  const double cxd = p.cxd;
+  const double cyd = p.cyd;
+  const double thighD = p.thighD;
+  const double legD = p.legD;
+  const double wl = p.wl;
+  const double w = p.w;
+  // sin and cos of all 7 angles in one vectorized pass (trig.hpp).
+  const std::array<double, 7> angle{yaw, pitch, roll, psi_l1, psi_r1, theta_l5, theta_r5};
+  std::array<double, 7> sin_angle, cos_angle;
+  sincos(angle, sin_angle, cos_angle);
+  const double cos_yaw = cos_angle[0];
+  const double sin_yaw = sin_angle[0];
+  const double cos_pitch = cos_angle[1];
+  const double sin_pitch = sin_angle[1];
+  const double cos_roll = cos_angle[2];
+  const double sin_roll = sin_angle[2];
+  const double cos_psi_l1 = cos_angle[3];
+  const double sin_psi_l1 = sin_angle[3];
+  const double cos_psi_r1 = cos_angle[4];
+  const double sin_psi_r1 = sin_angle[4];
+  const double cos_theta_l5 = cos_angle[5];
+  const double sin_theta_l5 = sin_angle[5];
+  const double cos_theta_r5 = cos_angle[6];
+  const double sin_theta_r5 = sin_angle[6];
+  const double ik_t5 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
+  const double ik_t6 = ik_t5*cyd;
+  const double ik_t8 = ik_t6 + 2.0*x_C + cos_yaw*cxd*cos_pitch - 2.0*x_Fl;
+  const double ik_t9 = -2.0*z_C;
+  const double ik_t10 = sin_pitch*cxd;
+  const double ik_t11 = 2.0*z_Fl + ik_t9 + ik_t10 - sin_roll*cyd*cos_pitch;
+  const double ik_t12 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
+  const double ik_t13 = ik_t12*cyd;
+  const double ik_t14 = ik_t13 + cxd*cos_pitch*sin_yaw + 2.0*y_C - 2.0*y_Fl;
+  const double ik_t15 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
+  const double ik_t18 = ik_t15*sin_psi_l1 + cos_psi_l1*ik_t12;
+  const double ik_t19 = sin_psi_l1*cos_roll*cos_pitch + sin_roll*cos_psi_l1*cos_pitch;
+  const double ik_t20 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
+  const double ik_t21 = ik_t20*sin_psi_l1 + cos_psi_l1*ik_t5;
+  const double ik_t22 = ik_t20*cos_psi_l1 - ik_t5*sin_psi_l1;
+  const double ik_t23 = cos_psi_l1*cos_roll*cos_pitch - sin_roll*sin_psi_l1*cos_pitch;
+  const double ik_t24 = ik_t12*sin_psi_l1 - cos_psi_l1*ik_t15;
+  const double ik_t25 = legD*legD + thighD*thighD;
+  const double ik_t26 = 2.0*thighD*legD;
+  const double ik_t27 = 0.5*cos_yaw*cxd*cos_pitch;
+  const double ik_t29 = 0.5*cxd*cos_pitch*sin_yaw;
+  const double ik_t31 = -z_C;
+  const double ik_t32 = -0.5*sin_roll*cyd*cos_pitch;
+  const double ik_t34 = 0.5*sin_pitch*cxd;
+  const double ik_t35 = 2.0*x_Fr + ik_t6 - 2.0*x_C - cos_yaw*cxd*cos_pitch;
+  const double ik_t36 = ik_t9 + 2.0*z_Fr + sin_roll*cyd*cos_pitch + ik_t10;
+  const double ik_t37 = ik_t13 + 2.0*y_Fr - 2.0*y_C - cxd*cos_pitch*sin_yaw;
+  const double ik_t40 = ik_t20*sin_psi_r1 + ik_t5*cos_psi_r1;
+  const double ik_t41 = sin_roll*cos_psi_r1*cos_pitch + sin_psi_r1*cos_roll*cos_pitch;
+  const double ik_t42 = sin_psi_r1*ik_t15 + ik_t12*cos_psi_r1;
+  const double ik_t43 = sin_roll*sin_psi_r1*cos_pitch - cos_psi_r1*cos_roll*cos_pitch;
+  const double ik_t44 = sin_psi_r1*ik_t12 - ik_t15*cos_psi_r1;
+  const double ik_t45 = ik_t20*cos_psi_r1 - sin_psi_r1*ik_t5;
+  const double ik_t49 = 0.5*sin_roll*cyd*cos_pitch;
+  const double ik_t50 = -sin_pitch;
+  const double ik_t51 = sin_roll*cos_pitch;
+  const double ik_t52 = cos_roll*cos_pitch;
+  const double ik_leg_l_d0 = -(0.5*cos_yaw*ik_t8*cos_pitch + 0.5*ik_t11*sin_pitch + 0.5*cos_pitch*sin_yaw*ik_t14);
+  const double ik_leg_l_d1 = 0.5*ik_t11*ik_t19 - 0.5*ik_t18*ik_t14 - 0.5*ik_t21*ik_t8;
+  const double ik_leg_l_d2 = -(0.5*ik_t8*ik_t22 - 0.5*ik_t11*ik_t23 - 0.5*ik_t24*ik_t14);
+  const double ik_leg_l_K = ik_t25;
+  const double ik_leg_l_A = ik_t26;
+  const double ik_leg_l_B = 0.0;
+  const double ik_leg_l_dd = ik_leg_l_d0 * ik_leg_l_d0 + ik_leg_l_d1 * ik_leg_l_d1 + ik_leg_l_d2 * ik_leg_l_d2;
+  double ik_q_psi_l4, ik_c_psi_l4, ik_s_psi_l4;
+  if (!ik_solve_cos_sin(ik_leg_l_A, ik_leg_l_B, ik_leg_l_dd - ik_leg_l_K, (ik_leg_l_branch & 1) != 0, ik_q_psi_l4, ik_c_psi_l4, ik_s_psi_l4)) {
+    const double ik_leg_l_R = std::sqrt(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
+    why = {1, std::sqrt(ik_leg_l_dd), std::sqrt(std::max(0.0, ik_leg_l_K - ik_leg_l_R)), std::sqrt(ik_leg_l_K + ik_leg_l_R), 0.0};
+    failed = 0;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_leg_l_v0 = thighD + legD*ik_c_psi_l4;
+  const double ik_leg_l_v1 = 0.0;
+  const double ik_leg_l_v2 = -ik_s_psi_l4*legD;
+  const double ik_leg_l_v[3] = {ik_leg_l_v0, ik_leg_l_v1, ik_leg_l_v2};
+  const double ik_leg_l_d[3] = {ik_leg_l_d0, ik_leg_l_d1, ik_leg_l_d2};
+  double ik_q_psi_l2, ik_c_psi_l2, ik_s_psi_l2, ik_q_psi_l3, ik_c_psi_l3, ik_s_psi_l3, ik_leg_l_beside = 0, ik_leg_l_room = 0;
+  const bool ik_leg_l_two_axis_ok = ik_solve_two_axis<1, 2>(ik_leg_l_v, ik_leg_l_d, (ik_leg_l_branch & 2) != 0, ik_q_psi_l2, ik_c_psi_l2, ik_s_psi_l2, ik_q_psi_l3, ik_c_psi_l3, ik_s_psi_l3, ik_leg_l_beside, ik_leg_l_room);
+  if (!ik_leg_l_two_axis_ok) {
+    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, ik_q_psi_l4 * 57.29577951308232};
+    failed = 0;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_t28 = ik_t21*ik_s_psi_l3 + (cos_yaw*ik_c_psi_l2*cos_pitch - ik_s_psi_l2*ik_t22)*ik_c_psi_l3;
+  const double ik_t30 = (ik_s_psi_l2*ik_t24 + ik_c_psi_l2*cos_pitch*sin_yaw)*ik_c_psi_l3 + ik_s_psi_l3*ik_t18;
+  const double ik_t33 = ik_t19*ik_s_psi_l3 - ik_c_psi_l3*(sin_pitch*ik_c_psi_l2 + ik_s_psi_l2*ik_t23);
+  const double ik_leg_l_row0 = x_C + ik_t27 + legD*(ik_t28*ik_c_psi_l4 - ik_s_psi_l4*(ik_s_psi_l2*cos_yaw*cos_pitch + ik_c_psi_l2*ik_t22)) + ik_t28*thighD + 0.5*ik_t5*cyd - x_Fl;
+  const double ik_leg_l_row1 = ik_t29 + y_C + thighD*ik_t30 + 0.5*ik_t12*cyd + legD*(ik_c_psi_l4*ik_t30 - ik_s_psi_l4*(ik_s_psi_l2*cos_pitch*sin_yaw - ik_t24*ik_c_psi_l2)) - y_Fl;
+  const double ik_leg_l_row2 = -(z_Fl + ik_t31 + ik_t32 + ik_t34 - legD*(ik_c_psi_l4*ik_t33 + ik_s_psi_l4*(ik_s_psi_l2*sin_pitch - ik_c_psi_l2*ik_t23)) - thighD*ik_t33);
+  const double ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
+  if (!(ik_leg_l_residual <= kIkTolerance)) {
+    why = {0, ik_leg_l_residual, 0.0, kIkTolerance, 0.0};
+    failed = 0;
+    return IkStatus::residual;
+  }
+  const double ik_leg_r_d0 = 0.5*cos_yaw*ik_t35*cos_pitch + 0.5*ik_t37*cos_pitch*sin_yaw - 0.5*sin_pitch*ik_t36;
+  const double ik_leg_r_d1 = 0.5*ik_t40*ik_t35 + 0.5*ik_t41*ik_t36 + 0.5*ik_t37*ik_t42;
+  const double ik_leg_r_d2 = -(0.5*ik_t43*ik_t36 + 0.5*ik_t37*ik_t44 - 0.5*ik_t35*ik_t45);
+  const double ik_leg_r_K = ik_t25;
+  const double ik_leg_r_A = ik_t26;
+  const double ik_leg_r_B = 0.0;
+  const double ik_leg_r_dd = ik_leg_r_d0 * ik_leg_r_d0 + ik_leg_r_d1 * ik_leg_r_d1 + ik_leg_r_d2 * ik_leg_r_d2;
+  double ik_q_psi_r4, ik_c_psi_r4, ik_s_psi_r4;
+  if (!ik_solve_cos_sin(ik_leg_r_A, ik_leg_r_B, ik_leg_r_dd - ik_leg_r_K, (ik_leg_r_branch & 1) != 0, ik_q_psi_r4, ik_c_psi_r4, ik_s_psi_r4)) {
+    const double ik_leg_r_R = std::sqrt(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
+    why = {1, std::sqrt(ik_leg_r_dd), std::sqrt(std::max(0.0, ik_leg_r_K - ik_leg_r_R)), std::sqrt(ik_leg_r_K + ik_leg_r_R), 0.0};
+    failed = 1;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_leg_r_v0 = thighD + legD*ik_c_psi_r4;
+  const double ik_leg_r_v1 = 0.0;
+  const double ik_leg_r_v2 = -legD*ik_s_psi_r4;
+  const double ik_leg_r_v[3] = {ik_leg_r_v0, ik_leg_r_v1, ik_leg_r_v2};
+  const double ik_leg_r_d[3] = {ik_leg_r_d0, ik_leg_r_d1, ik_leg_r_d2};
+  double ik_q_psi_r2, ik_c_psi_r2, ik_s_psi_r2, ik_q_psi_r3, ik_c_psi_r3, ik_s_psi_r3, ik_leg_r_beside = 0, ik_leg_r_room = 0;
+  const bool ik_leg_r_two_axis_ok = ik_solve_two_axis<1, 2>(ik_leg_r_v, ik_leg_r_d, (ik_leg_r_branch & 2) != 0, ik_q_psi_r2, ik_c_psi_r2, ik_s_psi_r2, ik_q_psi_r3, ik_c_psi_r3, ik_s_psi_r3, ik_leg_r_beside, ik_leg_r_room);
+  if (!ik_leg_r_two_axis_ok) {
+    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, ik_q_psi_r4 * 57.29577951308232};
+    failed = 1;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_t46 = (cos_yaw*cos_pitch*ik_c_psi_r2 - ik_s_psi_r2*ik_t45)*ik_c_psi_r3 + ik_t40*ik_s_psi_r3;
+  const double ik_t47 = (cos_pitch*sin_yaw*ik_c_psi_r2 + ik_t44*ik_s_psi_r2)*ik_c_psi_r3 + ik_t42*ik_s_psi_r3;
+  const double ik_t48 = ik_t41*ik_s_psi_r3 - (sin_pitch*ik_c_psi_r2 - ik_t43*ik_s_psi_r2)*ik_c_psi_r3;
+  const double ik_leg_r_row0 = x_C + thighD*ik_t46 + ik_t27 - 0.5*ik_t5*cyd - x_Fr - legD*(ik_s_psi_r4*(ik_c_psi_r2*ik_t45 + cos_yaw*cos_pitch*ik_s_psi_r2) - ik_c_psi_r4*ik_t46);
+  const double ik_leg_r_row1 = ik_t29 + thighD*ik_t47 + y_C - legD*(ik_s_psi_r4*(cos_pitch*sin_yaw*ik_s_psi_r2 - ik_t44*ik_c_psi_r2) - ik_t47*ik_c_psi_r4) - 0.5*ik_t12*cyd - y_Fr;
+  const double ik_leg_r_row2 = -(z_Fr + ik_t31 + ik_t34 + ik_t49 - legD*(ik_t48*ik_c_psi_r4 + ik_s_psi_r4*(sin_pitch*ik_s_psi_r2 + ik_t43*ik_c_psi_r2)) - ik_t48*thighD);
+  const double ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
+  if (!(ik_leg_r_residual <= kIkTolerance)) {
+    why = {0, ik_leg_r_residual, 0.0, kIkTolerance, 0.0};
+    failed = 1;
+    return IkStatus::residual;
+  }
+  const double ik_q_theta_l4 = -theta_l5;
+  const double ik_wheel_l_g0 = ik_t50;
+  const double ik_wheel_l_g1 = ik_t51;
+  const double ik_wheel_l_g2 = ik_t52;
+  const double ik_wheel_l_axis[3] = {0.0, 0.0, 1.0};
+  const double ik_wheel_l_g[3] = {ik_wheel_l_g0, ik_wheel_l_g1, ik_wheel_l_g2};
+  double ik_wheel_l_q_sum, ik_wheel_l_c_sum, ik_wheel_l_s_sum, ik_q_theta_l2, ik_c_theta_l2, ik_s_theta_l2, ik_wheel_l_beside = 0, ik_wheel_l_room = 0;
+  const bool ik_wheel_l_two_axis_ok = ik_solve_two_axis<1, 0>(ik_wheel_l_axis, ik_wheel_l_g, (ik_wheel_l_branch & 2) != 0, ik_wheel_l_q_sum, ik_wheel_l_c_sum, ik_wheel_l_s_sum, ik_q_theta_l2, ik_c_theta_l2, ik_s_theta_l2, ik_wheel_l_beside, ik_wheel_l_room);
+  static_cast<void>(ik_wheel_l_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
+  // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
+  if ((ik_wheel_l_c_sum < 0) != ((ik_wheel_l_branch & 4) != 0)) {
+    ik_wheel_l_q_sum = ik_wrap(ik_wheel_l_q_sum + 3.141592653589793);
+    ik_wheel_l_c_sum = -ik_wheel_l_c_sum;
+    ik_wheel_l_s_sum = -ik_wheel_l_s_sum;
+    ik_q_theta_l2 = -ik_q_theta_l2;
+    ik_s_theta_l2 = -ik_s_theta_l2;
+  }
+  const double ik_t53 = ik_wheel_l_s_sum*sin_pitch*w;
+  const double ik_t55 = -w*ik_wheel_l_c_sum*cos_roll*cos_pitch;
+  const double ik_wheel_l_alpha = -(ik_t53 - sin_pitch*(ik_wheel_l_s_sum*w + cos_theta_l5*wl));
+  const double ik_wheel_l_beta = -(cos_roll*cos_pitch*(w*ik_wheel_l_c_sum - cos_theta_l5*wl) + ik_t55);
+  const double ik_wheel_l_gamma = ik_t53 + ik_t34 + z_C + ik_t55 + ik_t49 - sin_roll*sin_theta_l5*wl*cos_pitch;
+  double ik_q_theta_l6, ik_c_theta_l6, ik_s_theta_l6;
+  if (!ik_solve_cos_sin(ik_wheel_l_alpha, ik_wheel_l_beta, z_Wl - ik_wheel_l_gamma, (ik_wheel_l_branch & 1) != 0, ik_q_theta_l6, ik_c_theta_l6, ik_s_theta_l6)) {
+    const double ik_wheel_l_R = std::sqrt(ik_wheel_l_alpha * ik_wheel_l_alpha + ik_wheel_l_beta * ik_wheel_l_beta);
+    why = {1, z_Wl, ik_wheel_l_gamma - ik_wheel_l_R, ik_wheel_l_gamma + ik_wheel_l_R, 0.0};
+    failed = 2;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_q_theta_l3 = ik_wrap(ik_wheel_l_q_sum - ik_q_theta_l6);
+  const double ik_c_theta_l3 = ik_wheel_l_c_sum * ik_c_theta_l6 + ik_wheel_l_s_sum * ik_s_theta_l6;
+  const double ik_s_theta_l3 = ik_wheel_l_s_sum * ik_c_theta_l6 - ik_wheel_l_c_sum * ik_s_theta_l6;
+  const double ik_t57 = sin_pitch*ik_c_theta_l6 + cos_roll*cos_pitch*ik_s_theta_l6;
+  const double ik_t58 = cos_theta_l5*ik_t57 - sin_roll*sin_theta_l5*cos_pitch;
+  const double ik_t59 = sin_pitch*ik_s_theta_l6 - cos_roll*ik_c_theta_l6*cos_pitch;
+  const double ik_t60 = sin_theta_l5*ik_t57 + sin_roll*cos_theta_l5*cos_pitch;
+  const double ik_t61 = ik_t58*cos_theta_l5 + sin_theta_l5*ik_t60;
+  const double ik_t62 = ik_t59*ik_c_theta_l3 + ik_t61*ik_s_theta_l3;
+  const double ik_wheel_l_row0 = ik_t58*wl + ik_t34 + z_C + ik_t49 + w*ik_t62 - z_Wl;
+  const double ik_wheel_l_row1 = -(ik_t61*ik_c_theta_l3 - ik_t59*ik_s_theta_l3);
+  const double ik_wheel_l_row2 = ik_c_theta_l2*(cos_theta_l5*ik_t60 - sin_theta_l5*ik_t58) - ik_t62*ik_s_theta_l2;
+  const double ik_wheel_l_row3 = 0.0;
+  const double ik_wheel_l_residual = std::max({std::abs(ik_wheel_l_row0), std::abs(ik_wheel_l_row1), std::abs(ik_wheel_l_row2), std::abs(ik_wheel_l_row3)});
+  if (!(ik_wheel_l_residual <= kIkTolerance)) {
+    why = {0, ik_wheel_l_residual, 0.0, kIkTolerance, 0.0};
+    failed = 2;
+    return IkStatus::residual;
+  }
+  const double ik_q_theta_r4 = -theta_r5;
+  const double ik_wheel_r_g0 = ik_t50;
+  const double ik_wheel_r_g1 = ik_t51;
+  const double ik_wheel_r_g2 = ik_t52;
+  const double ik_wheel_r_axis[3] = {0.0, 0.0, 1.0};
+  const double ik_wheel_r_g[3] = {ik_wheel_r_g0, ik_wheel_r_g1, ik_wheel_r_g2};
+  double ik_wheel_r_q_sum, ik_wheel_r_c_sum, ik_wheel_r_s_sum, ik_q_theta_r2, ik_c_theta_r2, ik_s_theta_r2, ik_wheel_r_beside = 0, ik_wheel_r_room = 0;
+  const bool ik_wheel_r_two_axis_ok = ik_solve_two_axis<1, 0>(ik_wheel_r_axis, ik_wheel_r_g, (ik_wheel_r_branch & 2) != 0, ik_wheel_r_q_sum, ik_wheel_r_c_sum, ik_wheel_r_s_sum, ik_q_theta_r2, ik_c_theta_r2, ik_s_theta_r2, ik_wheel_r_beside, ik_wheel_r_room);
+  static_cast<void>(ik_wheel_r_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
+  // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
+  if ((ik_wheel_r_c_sum < 0) != ((ik_wheel_r_branch & 4) != 0)) {
+    ik_wheel_r_q_sum = ik_wrap(ik_wheel_r_q_sum + 3.141592653589793);
+    ik_wheel_r_c_sum = -ik_wheel_r_c_sum;
+    ik_wheel_r_s_sum = -ik_wheel_r_s_sum;
+    ik_q_theta_r2 = -ik_q_theta_r2;
+    ik_s_theta_r2 = -ik_s_theta_r2;
+  }
+  const double ik_t64 = -w*ik_wheel_r_c_sum*cos_roll*cos_pitch;
+  const double ik_wheel_r_alpha = sin_pitch*(w*ik_wheel_r_s_sum + cos_theta_r5*wl) - sin_pitch*w*ik_wheel_r_s_sum;
+  const double ik_wheel_r_beta = -(ik_t64 + (w*ik_wheel_r_c_sum - cos_theta_r5*wl)*cos_roll*cos_pitch);
+  const double ik_wheel_r_gamma = ik_t32 + ik_t34 + z_C + ik_t64 + sin_pitch*w*ik_wheel_r_s_sum - sin_roll*sin_theta_r5*wl*cos_pitch;
+  double ik_q_theta_r6, ik_c_theta_r6, ik_s_theta_r6;
+  if (!ik_solve_cos_sin(ik_wheel_r_alpha, ik_wheel_r_beta, z_Wr - ik_wheel_r_gamma, (ik_wheel_r_branch & 1) != 0, ik_q_theta_r6, ik_c_theta_r6, ik_s_theta_r6)) {
+    const double ik_wheel_r_R = std::sqrt(ik_wheel_r_alpha * ik_wheel_r_alpha + ik_wheel_r_beta * ik_wheel_r_beta);
+    why = {1, z_Wr, ik_wheel_r_gamma - ik_wheel_r_R, ik_wheel_r_gamma + ik_wheel_r_R, 0.0};
+    failed = 3;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_q_theta_r3 = ik_wrap(ik_wheel_r_q_sum - ik_q_theta_r6);
+  const double ik_c_theta_r3 = ik_wheel_r_c_sum * ik_c_theta_r6 + ik_wheel_r_s_sum * ik_s_theta_r6;
+  const double ik_s_theta_r3 = ik_wheel_r_s_sum * ik_c_theta_r6 - ik_wheel_r_c_sum * ik_s_theta_r6;
+  const double ik_t66 = cos_roll*cos_pitch*ik_s_theta_r6 + ik_c_theta_r6*sin_pitch;
+  const double ik_t67 = sin_roll*sin_theta_r5*cos_pitch - cos_theta_r5*ik_t66;
+  const double ik_t68 = sin_theta_r5*ik_t66 + sin_roll*cos_theta_r5*cos_pitch;
+  const double ik_t69 = sin_theta_r5*ik_t68 - ik_t67*cos_theta_r5;
+  const double ik_t70 = sin_pitch*ik_s_theta_r6 - ik_c_theta_r6*cos_roll*cos_pitch;
+  const double ik_t71 = ik_t69*ik_s_theta_r3 + ik_c_theta_r3*ik_t70;
+  const double ik_wheel_r_row0 = -(z_Wr + ik_t31 + ik_t67*wl + ik_t49 - w*ik_t71 - 0.5*sin_pitch*cxd);
+  const double ik_wheel_r_row1 = ik_t70*ik_s_theta_r3 - ik_t69*ik_c_theta_r3;
+  const double ik_wheel_r_row2 = -(ik_t71*ik_s_theta_r2 - (cos_theta_r5*ik_t68 + ik_t67*sin_theta_r5)*ik_c_theta_r2);
+  const double ik_wheel_r_row3 = 0.0;
+  const double ik_wheel_r_residual = std::max({std::abs(ik_wheel_r_row0), std::abs(ik_wheel_r_row1), std::abs(ik_wheel_r_row2), std::abs(ik_wheel_r_row3)});
+  if (!(ik_wheel_r_residual <= kIkTolerance)) {
+    why = {0, ik_wheel_r_residual, 0.0, kIkTolerance, 0.0};
+    failed = 3;
+    return IkStatus::residual;
+  }
+  out(18) = ik_q_psi_l2;
+  out(19) = ik_q_psi_l3;
+  out(20) = ik_q_psi_l4;
+  out(21) = ik_q_psi_r2;
+  out(22) = ik_q_psi_r3;
+  out(23) = ik_q_psi_r4;
+  out(27) = ik_q_theta_l6;
+  out(25) = ik_q_theta_l3;
+  out(24) = ik_q_theta_l2;
+  out(26) = ik_q_theta_l4;
+  out(31) = ik_q_theta_r6;
+  out(29) = ik_q_theta_r3;
+  out(28) = ik_q_theta_r2;
+  out(30) = ik_q_theta_r4;
+  return IkStatus::ok;
+}
+
 }  // namespace gen
 }  // namespace excavator
 }  // namespace wlx

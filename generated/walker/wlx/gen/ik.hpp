@@ -537,6 +537,327 @@ inline constexpr std::array<ClosedFormInfo, 4> kClosedForm{{
     {&ik_lever_r, 8, "leveled-lever", {{"bit 0: the other root of swing_r (branch 0: the root nearest zero)", "bit 1: the other root of camber_r (branch 0: |camber_r| <= 90 deg)", "bit 2: the other root of swing_r + hub_r (branch 0: nearest zero)"}}, {{"ground_r = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, steer_r as given, the z of contact_r reaches [{low:.4f}, {high:.4f}] m"}}},
 }};
 
+inline constexpr bool kHasFusedIk = true;
+
+// The closed forms of all 4 limbs in one pass: what ik_<limb>() computes for each, with the sines and
+// cosines of every input angle and the subexpressions the limbs share computed once. branches[k] is
+// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed,
+// `failed` its index and `why` its numbers; out is written only when every limb succeeded.
+// Operations: 515 (adds 215, muls 286, divs 0, calls 14), plus the solver calls.
+inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out,
+                       int& failed, IkDiagnostics& why) noexcept {
+  static_cast<void>(p);
+  const int ik_leg_l_branch = branches[0];
+  if (ik_leg_l_branch < 0 || ik_leg_l_branch >= 4) {
+    failed = 0;
+    return IkStatus::bad_branch;
+  }
+  const int ik_leg_r_branch = branches[1];
+  if (ik_leg_r_branch < 0 || ik_leg_r_branch >= 4) {
+    failed = 1;
+    return IkStatus::bad_branch;
+  }
+  const int ik_lever_l_branch = branches[2];
+  if (ik_lever_l_branch < 0 || ik_lever_l_branch >= 8) {
+    failed = 2;
+    return IkStatus::bad_branch;
+  }
+  const int ik_lever_r_branch = branches[3];
+  if (ik_lever_r_branch < 0 || ik_lever_r_branch >= 8) {
+    failed = 3;
+    return IkStatus::bad_branch;
+  }
+  const double x_C = s(0);
+  const double y_C = s(1);
+  const double z_C = s(2);
+  const double yaw = s(3);
+  const double pitch = s(4);
+  const double roll = s(5);
+  const double foot_x_l = s(6);
+  const double foot_y_l = s(7);
+  const double foot_z_l = s(8);
+  const double foot_x_r = s(9);
+  const double foot_y_r = s(10);
+  const double foot_z_r = s(11);
+  const double ground_l = s(12);
+  const double ground_r = s(13);
+  const double slew_l = s(14);
+  const double slew_r = s(15);
+  const double steer_l = s(16);
+  const double steer_r = s(17);
+  const double hip_x = p.hip_x;
+  const double hip_y = p.hip_y;
+  const double hip_drop = p.hip_drop;
+  const double thigh = p.thigh;
+  const double knee_offset = p.knee_offset;
+  const double shank = p.shank;
+  const double rear_x = p.rear_x;
+  const double rear_y = p.rear_y;
+  const double rear_drop = p.rear_drop;
+  const double lever = p.lever;
+  const double lever_offset = p.lever_offset;
+  const double hub_offset = p.hub_offset;
+  const double radius = p.radius;
+  // sin and cos of all 7 angles in one vectorized pass (trig.hpp).
+  const std::array<double, 7> angle{yaw, pitch, roll, slew_l, slew_r, steer_l, steer_r};
+  std::array<double, 7> sin_angle, cos_angle;
+  sincos(angle, sin_angle, cos_angle);
+  const double cos_yaw = cos_angle[0];
+  const double sin_yaw = sin_angle[0];
+  const double cos_pitch = cos_angle[1];
+  const double sin_pitch = sin_angle[1];
+  const double cos_roll = cos_angle[2];
+  const double sin_roll = sin_angle[2];
+  const double cos_slew_l = cos_angle[3];
+  const double sin_slew_l = sin_angle[3];
+  const double cos_slew_r = cos_angle[4];
+  const double sin_slew_r = sin_angle[4];
+  const double cos_steer_l = cos_angle[5];
+  const double sin_steer_l = sin_angle[5];
+  const double cos_steer_r = cos_angle[6];
+  const double sin_steer_r = sin_angle[6];
+  const double ik_t2 = -hip_x*cos_yaw*cos_pitch;
+  const double ik_t7 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
+  const double ik_t8 = ik_t7*hip_drop;
+  const double ik_t9 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
+  const double ik_t10 = -x_C;
+  const double ik_t11 = ik_t2 + ik_t8 + foot_x_l + ik_t10 - ik_t9*hip_y;
+  const double ik_t14 = ik_t9*sin_slew_l + cos_yaw*cos_slew_l*cos_pitch;
+  const double ik_t15 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
+  const double ik_t16 = cos_slew_l*cos_pitch*sin_yaw + ik_t15*sin_slew_l;
+  const double ik_t17 = hip_x*cos_pitch*sin_yaw;
+  const double ik_t18 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
+  const double ik_t19 = -hip_drop*ik_t18;
+  const double ik_t20 = ik_t15*hip_y;
+  const double ik_t21 = -foot_y_l;
+  const double ik_t22 = ik_t17 + ik_t19 + y_C + ik_t20 + ik_t21;
+  const double ik_t23 = -z_C;
+  const double ik_t24 = hip_x*sin_pitch;
+  const double ik_t25 = hip_drop*cos_roll*cos_pitch;
+  const double ik_t26 = ik_t23 + ik_t24 + foot_z_l + ik_t25 - sin_roll*cos_pitch*hip_y;
+  const double ik_t27 = sin_pitch*cos_slew_l - sin_roll*cos_pitch*sin_slew_l;
+  const double ik_t28 = ik_t9*cos_slew_l - cos_yaw*cos_pitch*sin_slew_l;
+  const double ik_t29 = ik_t15*cos_slew_l - cos_pitch*sin_yaw*sin_slew_l;
+  const double ik_t30 = sin_roll*cos_slew_l*cos_pitch + sin_pitch*sin_slew_l;
+  const double ik_t31 = shank*shank + thigh*thigh + knee_offset*knee_offset;
+  const double ik_t32 = 2.0*shank*thigh;
+  const double ik_t35 = ik_t9*hip_y;
+  const double ik_t40 = sin_roll*cos_pitch*hip_y;
+  const double ik_t43 = cos_yaw*cos_pitch*cos_slew_r + sin_slew_r*ik_t9;
+  const double ik_t44 = ik_t2 + ik_t8 + foot_x_r + ik_t35 + ik_t10;
+  const double ik_t45 = sin_roll*sin_slew_r*cos_pitch - sin_pitch*cos_slew_r;
+  const double ik_t46 = foot_z_r + ik_t23 + ik_t24 + ik_t40 + ik_t25;
+  const double ik_t47 = cos_pitch*sin_yaw*cos_slew_r + ik_t15*sin_slew_r;
+  const double ik_t48 = -foot_y_r;
+  const double ik_t49 = -ik_t15*hip_y;
+  const double ik_t50 = ik_t48 + ik_t17 + ik_t49 + ik_t19 + y_C;
+  const double ik_t51 = sin_slew_r*cos_pitch*sin_yaw - ik_t15*cos_slew_r;
+  const double ik_t52 = sin_pitch*sin_slew_r + sin_roll*cos_pitch*cos_slew_r;
+  const double ik_t53 = ik_t9*cos_slew_r - cos_yaw*sin_slew_r*cos_pitch;
+  const double ik_t60 = -sin_pitch;
+  const double ik_t61 = sin_roll*cos_pitch;
+  const double ik_t62 = cos_roll*cos_pitch;
+  const double ik_t64 = lever_offset*sin_steer_l;
+  const double ik_t66 = cos_steer_l*lever;
+  const double ik_t67 = sin_pitch*rear_x;
+  const double ik_t68 = -cos_roll*rear_drop*cos_pitch;
+  const double ik_t73 = -sin_roll*rear_y*cos_pitch;
+  const double ik_t79 = -lever_offset*sin_steer_r;
+  const double ik_t81 = cos_steer_r*lever;
+  const double ik_leg_l_d0 = ik_t11*ik_t14 - ik_t16*ik_t22 - ik_t26*ik_t27;
+  const double ik_leg_l_d1 = ik_t28*ik_t11 + ik_t26*ik_t30 - ik_t29*ik_t22;
+  const double ik_leg_l_d2 = -(ik_t18*ik_t22 - ik_t7*ik_t11 - ik_t26*cos_roll*cos_pitch);
+  const double ik_leg_l_K = ik_t31;
+  const double ik_leg_l_A = ik_t32;
+  const double ik_leg_l_B = 0.0;
+  const double ik_leg_l_dd = ik_leg_l_d0 * ik_leg_l_d0 + ik_leg_l_d1 * ik_leg_l_d1 + ik_leg_l_d2 * ik_leg_l_d2;
+  double ik_q_knee_l, ik_c_knee_l, ik_s_knee_l;
+  if (!ik_solve_cos_sin(ik_leg_l_A, ik_leg_l_B, ik_leg_l_dd - ik_leg_l_K, (ik_leg_l_branch & 1) != 0, ik_q_knee_l, ik_c_knee_l, ik_s_knee_l)) {
+    const double ik_leg_l_R = std::sqrt(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
+    why = {1, std::sqrt(ik_leg_l_dd), std::sqrt(std::max(0.0, ik_leg_l_K - ik_leg_l_R)), std::sqrt(ik_leg_l_K + ik_leg_l_R), 0.0};
+    failed = 0;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_leg_l_v0 = thigh + shank*ik_c_knee_l;
+  const double ik_leg_l_v1 = knee_offset;
+  const double ik_leg_l_v2 = -ik_s_knee_l*shank;
+  const double ik_leg_l_v[3] = {ik_leg_l_v0, ik_leg_l_v1, ik_leg_l_v2};
+  const double ik_leg_l_d[3] = {ik_leg_l_d0, ik_leg_l_d1, ik_leg_l_d2};
+  double ik_q_abduct_l, ik_c_abduct_l, ik_s_abduct_l, ik_q_lift_l, ik_c_lift_l, ik_s_lift_l, ik_leg_l_beside = 0, ik_leg_l_room = 0;
+  const bool ik_leg_l_two_axis_ok = ik_solve_two_axis<0, 1>(ik_leg_l_v, ik_leg_l_d, (ik_leg_l_branch & 2) != 0, ik_q_abduct_l, ik_c_abduct_l, ik_s_abduct_l, ik_q_lift_l, ik_c_lift_l, ik_s_lift_l, ik_leg_l_beside, ik_leg_l_room);
+  if (!ik_leg_l_two_axis_ok) {
+    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, ik_q_knee_l * 57.29577951308232};
+    failed = 0;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_t33 = ik_t7*ik_c_abduct_l - ik_t28*ik_s_abduct_l;
+  const double ik_t34 = ik_c_lift_l*ik_t14 - ik_s_lift_l*ik_t33;
+  const double ik_t36 = ik_s_abduct_l*ik_t29 - ik_t18*ik_c_abduct_l;
+  const double ik_t37 = ik_c_lift_l*ik_t16 + ik_s_lift_l*ik_t36;
+  const double ik_t38 = ik_s_abduct_l*ik_t30 - ik_c_abduct_l*cos_roll*cos_pitch;
+  const double ik_t39 = ik_s_lift_l*ik_t38 - ik_t27*ik_c_lift_l;
+  const double ik_leg_l_row0 = (ik_t7*ik_s_abduct_l + ik_t28*ik_c_abduct_l)*knee_offset + x_C + ik_t35 + thigh*ik_t34 + hip_x*cos_yaw*cos_pitch - ik_t7*hip_drop - shank*(ik_s_knee_l*(ik_c_lift_l*ik_t33 + ik_s_lift_l*ik_t14) - ik_c_knee_l*ik_t34) - foot_x_l;
+  const double ik_leg_l_row1 = ik_t17 + (ik_t18*ik_s_abduct_l + ik_c_abduct_l*ik_t29)*knee_offset + ik_t37*thigh + ik_t19 + y_C + shank*(ik_s_knee_l*(ik_t36*ik_c_lift_l - ik_s_lift_l*ik_t16) + ik_t37*ik_c_knee_l) + ik_t20 + ik_t21;
+  const double ik_leg_l_row2 = (ik_s_abduct_l*cos_roll*cos_pitch + ik_c_abduct_l*ik_t30)*knee_offset + ik_t39*thigh + z_C + ik_t40 + shank*(ik_t39*ik_c_knee_l + ik_s_knee_l*(ik_s_lift_l*ik_t27 + ik_t38*ik_c_lift_l)) - hip_x*sin_pitch - foot_z_l - hip_drop*cos_roll*cos_pitch;
+  const double ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
+  if (!(ik_leg_l_residual <= kIkTolerance)) {
+    why = {0, ik_leg_l_residual, 0.0, kIkTolerance, 0.0};
+    failed = 0;
+    return IkStatus::residual;
+  }
+  const double ik_leg_r_d0 = -(ik_t47*ik_t50 - ik_t43*ik_t44 - ik_t45*ik_t46);
+  const double ik_leg_r_d1 = ik_t50*ik_t51 + ik_t52*ik_t46 + ik_t53*ik_t44;
+  const double ik_leg_r_d2 = ik_t46*cos_roll*cos_pitch + ik_t7*ik_t44 - ik_t50*ik_t18;
+  const double ik_leg_r_K = ik_t31;
+  const double ik_leg_r_A = ik_t32;
+  const double ik_leg_r_B = 0.0;
+  const double ik_leg_r_dd = ik_leg_r_d0 * ik_leg_r_d0 + ik_leg_r_d1 * ik_leg_r_d1 + ik_leg_r_d2 * ik_leg_r_d2;
+  double ik_q_knee_r, ik_c_knee_r, ik_s_knee_r;
+  if (!ik_solve_cos_sin(ik_leg_r_A, ik_leg_r_B, ik_leg_r_dd - ik_leg_r_K, (ik_leg_r_branch & 1) != 0, ik_q_knee_r, ik_c_knee_r, ik_s_knee_r)) {
+    const double ik_leg_r_R = std::sqrt(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
+    why = {1, std::sqrt(ik_leg_r_dd), std::sqrt(std::max(0.0, ik_leg_r_K - ik_leg_r_R)), std::sqrt(ik_leg_r_K + ik_leg_r_R), 0.0};
+    failed = 1;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_leg_r_v0 = thigh + shank*ik_c_knee_r;
+  const double ik_leg_r_v1 = -knee_offset;
+  const double ik_leg_r_v2 = -shank*ik_s_knee_r;
+  const double ik_leg_r_v[3] = {ik_leg_r_v0, ik_leg_r_v1, ik_leg_r_v2};
+  const double ik_leg_r_d[3] = {ik_leg_r_d0, ik_leg_r_d1, ik_leg_r_d2};
+  double ik_q_abduct_r, ik_c_abduct_r, ik_s_abduct_r, ik_q_lift_r, ik_c_lift_r, ik_s_lift_r, ik_leg_r_beside = 0, ik_leg_r_room = 0;
+  const bool ik_leg_r_two_axis_ok = ik_solve_two_axis<0, 1>(ik_leg_r_v, ik_leg_r_d, (ik_leg_r_branch & 2) != 0, ik_q_abduct_r, ik_c_abduct_r, ik_s_abduct_r, ik_q_lift_r, ik_c_lift_r, ik_s_lift_r, ik_leg_r_beside, ik_leg_r_room);
+  if (!ik_leg_r_two_axis_ok) {
+    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, ik_q_knee_r * 57.29577951308232};
+    failed = 1;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_t54 = ik_s_abduct_r*ik_t53 - ik_t7*ik_c_abduct_r;
+  const double ik_t55 = ik_t43*ik_c_lift_r + ik_t54*ik_s_lift_r;
+  const double ik_t56 = ik_c_abduct_r*ik_t18 + ik_s_abduct_r*ik_t51;
+  const double ik_t57 = ik_t47*ik_c_lift_r - ik_t56*ik_s_lift_r;
+  const double ik_t58 = ik_t52*ik_s_abduct_r - ik_c_abduct_r*cos_roll*cos_pitch;
+  const double ik_t59 = ik_t45*ik_c_lift_r + ik_s_lift_r*ik_t58;
+  const double ik_leg_r_row0 = -(ik_t2 + (ik_c_abduct_r*ik_t53 + ik_t7*ik_s_abduct_r)*knee_offset + ik_t8 + foot_x_r + ik_t35 + ik_t10 - thigh*ik_t55 - ((ik_t54*ik_c_lift_r - ik_s_lift_r*ik_t43)*ik_s_knee_r + ik_c_knee_r*ik_t55)*shank);
+  const double ik_leg_r_row1 = thigh*ik_t57 + ik_t48 + ik_t17 + ik_t49 + ik_t19 + y_C + shank*(ik_c_knee_r*ik_t57 - (ik_t56*ik_c_lift_r + ik_t47*ik_s_lift_r)*ik_s_knee_r) + (ik_c_abduct_r*ik_t51 - ik_t18*ik_s_abduct_r)*knee_offset;
+  const double ik_leg_r_row2 = -(foot_z_r + ik_t23 + ik_t24 + ik_t40 + (ik_s_abduct_r*cos_roll*cos_pitch + ik_c_abduct_r*ik_t52)*knee_offset + shank*((ik_t45*ik_s_lift_r - ik_c_lift_r*ik_t58)*ik_s_knee_r - ik_c_knee_r*ik_t59) + ik_t25 - thigh*ik_t59);
+  const double ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
+  if (!(ik_leg_r_residual <= kIkTolerance)) {
+    why = {0, ik_leg_r_residual, 0.0, kIkTolerance, 0.0};
+    failed = 1;
+    return IkStatus::residual;
+  }
+  const double ik_q_guide_l = -steer_l;
+  const double ik_lever_l_g0 = ik_t60;
+  const double ik_lever_l_g1 = ik_t61;
+  const double ik_lever_l_g2 = ik_t62;
+  const double ik_lever_l_axis[3] = {0.0, 0.0, 1.0};
+  const double ik_lever_l_g[3] = {ik_lever_l_g0, ik_lever_l_g1, ik_lever_l_g2};
+  double ik_lever_l_q_sum, ik_lever_l_c_sum, ik_lever_l_s_sum, ik_q_camber_l, ik_c_camber_l, ik_s_camber_l, ik_lever_l_beside = 0, ik_lever_l_room = 0;
+  const bool ik_lever_l_two_axis_ok = ik_solve_two_axis<1, 0>(ik_lever_l_axis, ik_lever_l_g, (ik_lever_l_branch & 2) != 0, ik_lever_l_q_sum, ik_lever_l_c_sum, ik_lever_l_s_sum, ik_q_camber_l, ik_c_camber_l, ik_s_camber_l, ik_lever_l_beside, ik_lever_l_room);
+  static_cast<void>(ik_lever_l_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
+  // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
+  if ((ik_lever_l_c_sum < 0) != ((ik_lever_l_branch & 4) != 0)) {
+    ik_lever_l_q_sum = ik_wrap(ik_lever_l_q_sum + 3.141592653589793);
+    ik_lever_l_c_sum = -ik_lever_l_c_sum;
+    ik_lever_l_s_sum = -ik_lever_l_s_sum;
+    ik_q_camber_l = -ik_q_camber_l;
+    ik_s_camber_l = -ik_s_camber_l;
+  }
+  const double ik_lever_l_alpha = sin_pitch*(radius*ik_lever_l_s_sum + ik_t64 + ik_t66) - radius*sin_pitch*ik_lever_l_s_sum;
+  const double ik_lever_l_beta = cos_roll*cos_pitch*(ik_t64 + ik_t66 - radius*ik_lever_l_c_sum) + radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
+  const double ik_lever_l_gamma = sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + ik_t67 + radius*sin_pitch*ik_lever_l_s_sum + ik_t68 - radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
+  double ik_q_swing_l, ik_c_swing_l, ik_s_swing_l;
+  if (!ik_solve_cos_sin(ik_lever_l_alpha, ik_lever_l_beta, ground_l - ik_lever_l_gamma, (ik_lever_l_branch & 1) != 0, ik_q_swing_l, ik_c_swing_l, ik_s_swing_l)) {
+    const double ik_lever_l_R = std::sqrt(ik_lever_l_alpha * ik_lever_l_alpha + ik_lever_l_beta * ik_lever_l_beta);
+    why = {1, ground_l, ik_lever_l_gamma - ik_lever_l_R, ik_lever_l_gamma + ik_lever_l_R, 0.0};
+    failed = 2;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_q_hub_l = ik_wrap(ik_lever_l_q_sum - ik_q_swing_l);
+  const double ik_c_hub_l = ik_lever_l_c_sum * ik_c_swing_l + ik_lever_l_s_sum * ik_s_swing_l;
+  const double ik_s_hub_l = ik_lever_l_s_sum * ik_c_swing_l - ik_lever_l_c_sum * ik_s_swing_l;
+  const double ik_t69 = sin_pitch*ik_c_swing_l + ik_s_swing_l*cos_roll*cos_pitch;
+  const double ik_t70 = cos_steer_l*ik_t69 - sin_roll*sin_steer_l*cos_pitch;
+  const double ik_t71 = sin_steer_l*ik_t69 + sin_roll*cos_steer_l*cos_pitch;
+  const double ik_t72 = sin_steer_l*ik_t70 - cos_steer_l*ik_t71;
+  const double ik_t74 = sin_steer_l*ik_t71 + ik_t70*cos_steer_l;
+  const double ik_t75 = sin_pitch*ik_s_swing_l - ik_c_swing_l*cos_roll*cos_pitch;
+  const double ik_t76 = ik_t74*ik_s_hub_l + ik_c_hub_l*ik_t75;
+  const double ik_lever_l_row0 = -(ik_t72*hub_offset + ik_t23 + ik_t73 + ground_l + cos_roll*rear_drop*cos_pitch - ik_t70*lever - radius*ik_t76 - sin_pitch*rear_x - lever_offset*ik_t71);
+  const double ik_lever_l_row1 = -(ik_t74*ik_c_hub_l - ik_s_hub_l*ik_t75);
+  const double ik_lever_l_row2 = -(ik_t72*ik_c_camber_l + ik_t76*ik_s_camber_l);
+  const double ik_lever_l_row3 = 0.0;
+  const double ik_lever_l_residual = std::max({std::abs(ik_lever_l_row0), std::abs(ik_lever_l_row1), std::abs(ik_lever_l_row2), std::abs(ik_lever_l_row3)});
+  if (!(ik_lever_l_residual <= kIkTolerance)) {
+    why = {0, ik_lever_l_residual, 0.0, kIkTolerance, 0.0};
+    failed = 2;
+    return IkStatus::residual;
+  }
+  const double ik_q_guide_r = -steer_r;
+  const double ik_lever_r_g0 = ik_t60;
+  const double ik_lever_r_g1 = ik_t61;
+  const double ik_lever_r_g2 = ik_t62;
+  const double ik_lever_r_axis[3] = {0.0, 0.0, 1.0};
+  const double ik_lever_r_g[3] = {ik_lever_r_g0, ik_lever_r_g1, ik_lever_r_g2};
+  double ik_lever_r_q_sum, ik_lever_r_c_sum, ik_lever_r_s_sum, ik_q_camber_r, ik_c_camber_r, ik_s_camber_r, ik_lever_r_beside = 0, ik_lever_r_room = 0;
+  const bool ik_lever_r_two_axis_ok = ik_solve_two_axis<1, 0>(ik_lever_r_axis, ik_lever_r_g, (ik_lever_r_branch & 2) != 0, ik_lever_r_q_sum, ik_lever_r_c_sum, ik_lever_r_s_sum, ik_q_camber_r, ik_c_camber_r, ik_s_camber_r, ik_lever_r_beside, ik_lever_r_room);
+  static_cast<void>(ik_lever_r_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
+  // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
+  if ((ik_lever_r_c_sum < 0) != ((ik_lever_r_branch & 4) != 0)) {
+    ik_lever_r_q_sum = ik_wrap(ik_lever_r_q_sum + 3.141592653589793);
+    ik_lever_r_c_sum = -ik_lever_r_c_sum;
+    ik_lever_r_s_sum = -ik_lever_r_s_sum;
+    ik_q_camber_r = -ik_q_camber_r;
+    ik_s_camber_r = -ik_s_camber_r;
+  }
+  const double ik_t77 = radius*sin_pitch*ik_lever_r_s_sum;
+  const double ik_lever_r_alpha = -(ik_t77 - (radius*ik_lever_r_s_sum + ik_t79 + ik_t81)*sin_pitch);
+  const double ik_lever_r_beta = cos_roll*cos_pitch*(ik_t79 + ik_t81 - radius*ik_lever_r_c_sum) + radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
+  const double ik_lever_r_gamma = ik_t77 + ik_t73 + z_C + ik_t67 + ik_t68 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
+  double ik_q_swing_r, ik_c_swing_r, ik_s_swing_r;
+  if (!ik_solve_cos_sin(ik_lever_r_alpha, ik_lever_r_beta, ground_r - ik_lever_r_gamma, (ik_lever_r_branch & 1) != 0, ik_q_swing_r, ik_c_swing_r, ik_s_swing_r)) {
+    const double ik_lever_r_R = std::sqrt(ik_lever_r_alpha * ik_lever_r_alpha + ik_lever_r_beta * ik_lever_r_beta);
+    why = {1, ground_r, ik_lever_r_gamma - ik_lever_r_R, ik_lever_r_gamma + ik_lever_r_R, 0.0};
+    failed = 3;
+    return IkStatus::out_of_reach;
+  }
+  const double ik_q_hub_r = ik_wrap(ik_lever_r_q_sum - ik_q_swing_r);
+  const double ik_c_hub_r = ik_lever_r_c_sum * ik_c_swing_r + ik_lever_r_s_sum * ik_s_swing_r;
+  const double ik_s_hub_r = ik_lever_r_s_sum * ik_c_swing_r - ik_lever_r_c_sum * ik_s_swing_r;
+  const double ik_t82 = ik_c_swing_r*cos_roll*cos_pitch - sin_pitch*ik_s_swing_r;
+  const double ik_t83 = cos_roll*cos_pitch*ik_s_swing_r + sin_pitch*ik_c_swing_r;
+  const double ik_t84 = sin_roll*cos_steer_r*cos_pitch + sin_steer_r*ik_t83;
+  const double ik_t85 = sin_roll*sin_steer_r*cos_pitch - cos_steer_r*ik_t83;
+  const double ik_t86 = sin_steer_r*ik_t84 - cos_steer_r*ik_t85;
+  const double ik_t87 = ik_t86*ik_s_hub_r - ik_c_hub_r*ik_t82;
+  const double ik_t88 = cos_steer_r*ik_t84 + sin_steer_r*ik_t85;
+  const double ik_lever_r_row0 = radius*ik_t87 + ik_t73 + z_C + ik_t67 + ik_t68 - ground_r - lever_offset*ik_t84 - ik_t88*hub_offset - lever*ik_t85;
+  const double ik_lever_r_row1 = -(ik_t82*ik_s_hub_r + ik_c_hub_r*ik_t86);
+  const double ik_lever_r_row2 = ik_t88*ik_c_camber_r - ik_t87*ik_s_camber_r;
+  const double ik_lever_r_row3 = 0.0;
+  const double ik_lever_r_residual = std::max({std::abs(ik_lever_r_row0), std::abs(ik_lever_r_row1), std::abs(ik_lever_r_row2), std::abs(ik_lever_r_row3)});
+  if (!(ik_lever_r_residual <= kIkTolerance)) {
+    why = {0, ik_lever_r_residual, 0.0, kIkTolerance, 0.0};
+    failed = 3;
+    return IkStatus::residual;
+  }
+  out(18) = ik_q_abduct_l;
+  out(19) = ik_q_lift_l;
+  out(20) = ik_q_knee_l;
+  out(21) = ik_q_abduct_r;
+  out(22) = ik_q_lift_r;
+  out(23) = ik_q_knee_r;
+  out(27) = ik_q_swing_l;
+  out(25) = ik_q_hub_l;
+  out(24) = ik_q_camber_l;
+  out(26) = ik_q_guide_l;
+  out(31) = ik_q_swing_r;
+  out(29) = ik_q_hub_r;
+  out(28) = ik_q_camber_r;
+  out(30) = ik_q_guide_r;
+  return IkStatus::ok;
+}
+
 }  // namespace gen
 }  // namespace walker
 }  // namespace wlx
