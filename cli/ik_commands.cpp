@@ -33,7 +33,14 @@ nlohmann::ordered_json solve(const IkRequest& r, Coordinates* warm) {
   } else {
     // Start: the previous solution in a batch, else the assembled nominal pose (as MOBILE does).
     Coordinates start = nominal_inputs();
-    solve_ik_closed_form(model, start);
+    try {
+      solve_ik_closed_form(model, start);
+    } catch (const Error&) {
+      // The nominal pose does not fit this geometry: start from the closed form at the target
+      // instead, which names the target's own problem if it has one.
+      start = s;
+      solve_ik_closed_form(model, start, r.branches);
+    }
     if (warm != nullptr && warm->allFinite()) start = *warm;
     s.tail(kDependentCount) = start.tail(kDependentCount);
     for (const auto& [index, value] : r.start) s(index) = value;
@@ -50,7 +57,12 @@ nlohmann::ordered_json solve(const IkRequest& r, Coordinates* warm) {
   double check = 0;
   for (Limb limb : kLimbs) check = std::max(check, analytic_check(model, limb, s, data).position_error);
   closure(model, s, data, false);
-  out["closure_residual"] = data.Phi.cwiseAbs().maxCoeff();
+  // A result that does not satisfy the model is an error, never an answer (1e-9: far above
+  // rounding, which leaves about 1e-15).
+  const double residual = data.Phi.cwiseAbs().maxCoeff();
+  if (!(residual <= 1e-9))
+    throw Error("closure_residual", fmt::format("{:.3e}: the solution does not satisfy the model's closure", residual));
+  out["closure_residual"] = residual;
   out["analytic_check_error"] = check;
   out["method"] = r.method == IkMethod::closed_form ? "closed-form" : "newton";
   nlohmann::ordered_json branches;

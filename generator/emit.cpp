@@ -125,8 +125,15 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
   std::string p = banner(m, opt, "Model parameters: geometry and mass properties, defaults from the model file.");
   p += "#pragma once\n\n#include <array>\n#include <string_view>\n\n" + namespace_open(opt);
   p += "\n// The model's numbers, defaults from its file; change any of them at run time.\nstruct Params {\n";
-  for (const auto& par : m.parameters)
-    p += fmt::format("  double {} = {};  // {}: {}\n", par.name, literal(par.default_value), par.unit, par.meaning);
+  for (const auto& par : m.parameters) {
+    // A baked parameter's field keeps the baked value, not a stale default that nothing uses.
+    if (auto it = opt.baked.find(par.name); it != opt.baked.end())
+      p += fmt::format("  double {} = {};  // {}: {} (baked: the generated functions use this constant; changing the "
+                       "field has no effect)\n",
+                       par.name, literal(it->second), par.unit, par.meaning);
+    else
+      p += fmt::format("  double {} = {};  // {}: {}\n", par.name, literal(par.default_value), par.unit, par.meaning);
+  }
   p += "};\n\n"
        "// What a parameter is, which fixes its unit and the values that make sense for it: length (m, > 0),\n"
        "// offset (m, any sign), angle (rad), mass (kg, > 0), inertia (kg*m^2, > 0), gravity (m/s^2, >= 0),\n"

@@ -53,7 +53,16 @@ int main(int argc, char** argv) {
                  "C++ namespace of the emitted code (default: wlx::<model>::gen, <model> inline)");
   app.add_flag("--quiet", quiet, "print nothing on success");
   app.add_flag("--stats", stats_only, "print the operation-count table (always printed unless --quiet)");
-  CLI11_PARSE(app, argc, argv);
+  app.set_version_flag("--version", WLX_VERSION, "print the version and exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help, --version
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // Like every bad input: the option and the reason, exit code 2.
+    fmt::print(stderr, "wlx-gen: error: {}\n", e.what());
+    return 2;
+  }
 
   try {
     const auto t0 = std::chrono::steady_clock::now();
@@ -74,9 +83,18 @@ int main(int argc, char** argv) {
       }
     for (const auto& arg : bake_args) {
       const auto eq = arg.find('=');
-      if (eq == std::string::npos) throw std::runtime_error("--bake " + arg + ": expected NAME=VALUE");
+      const std::string shown = arg.substr(0, 60);
+      if (eq == std::string::npos) throw ModelFileError(fmt::format("--bake {}: expected NAME=VALUE", shown));
       const std::string name = arg.substr(0, eq);
-      model.parameter(name);  // throws with the name when unknown
+      std::vector<std::string> names;
+      std::size_t index = model.parameters.size();
+      for (std::size_t k = 0; k < model.parameters.size(); ++k) {
+        names.push_back(model.parameters[k].name);
+        if (model.parameters[k].name == name) index = k;
+      }
+      if (index == model.parameters.size())
+        throw ModelFileError(fmt::format("--bake {}: the model has no parameter '{}'{}", shown, name.substr(0, 60),
+                                         did_you_mean(name, names)));
       std::size_t used = 0;
       double value = 0;
       try {
@@ -85,7 +103,13 @@ int main(int argc, char** argv) {
         used = 0;
       }
       if (used == 0 || used != arg.size() - eq - 1 || !std::isfinite(value))
-        throw std::runtime_error("--bake " + arg + ": value of '" + name + "' is not a finite number");
+        throw ModelFileError(fmt::format("--bake {}: the value of '{}' is not a finite number", shown, name));
+      // Baked values obey the rules of the parameter's kind, as values given at run time do.
+      const ParameterKind kind = model.parameter_kinds[index];
+      if ((kind == ParameterKind::length || kind == ParameterKind::mass || kind == ParameterKind::inertia) && !(value > 0))
+        throw ModelFileError(fmt::format("--bake {}: '{}' is a {}, which must be positive", shown, name, kind_name(kind)));
+      if (kind == ParameterKind::gravity && !(value >= 0))
+        throw ModelFileError(fmt::format("--bake {}: '{}' is gravity, which must be non-negative", shown, name));
       opt.baked[name] = value;
     }
 

@@ -924,6 +924,10 @@ std::uint64_t fingerprint(const std::string& text) {
 
 }  // namespace
 
+std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates) {
+  return suggestion(name, candidates);
+}
+
 Model parse_model(const std::string& text, const std::string& source_name) {
   // yaml-cpp reads nested flow collections recursively: bound the depth before it sees the text.
   int depth = 0, line = 1;

@@ -12,12 +12,16 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace wlx::codegen {
 
 struct ModelFileError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// " (did you mean 'x'?)" when one of the candidates is close to `name`, else "".
+std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates);
 
 // `source_name` is what messages and the generated banners call the file.
 Model parse_model(const std::string& text, const std::string& source_name);

@@ -222,14 +222,37 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       stalled[l] = !done[l] && !accepted[l];
     }
   }
+  // Angles into (-pi, pi], but only where that keeps the closure: a row such as theta_4 + theta_5 = 0
+  // holds for theta_4 = -pi, not for its wrapped +pi, when the input theta_5 is pi.
+  std::array<double, kLimbCount> converged{};
+  for (Limb limb : kLimbs)
+    if (active[static_cast<std::size_t>(limb)]) converged[static_cast<std::size_t>(limb)] = limb_residual(data.Phi, indices(limb));
+  const Coordinates unwrapped = s;
   for (Limb limb : kLimbs) {
     if (!active[static_cast<std::size_t>(limb)]) continue;
     const auto idx = indices(limb);
     for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = wrap(s(idx.dep[static_cast<std::size_t>(j)]));
   }
   closure(model, s, data, false);
-  for (Limb limb : kLimbs)
-    if (active[static_cast<std::size_t>(limb)]) report.residual = std::max(report.residual, limb_residual(data.Phi, indices(limb)));
+  bool reverted = false;
+  for (Limb limb : kLimbs) {
+    const auto l = static_cast<std::size_t>(limb);
+    if (!active[l] || limb_residual(data.Phi, indices(limb)) <= std::max(options.tolerance, 2 * converged[l])) continue;
+    const auto idx = indices(limb);
+    for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = unwrapped(idx.dep[static_cast<std::size_t>(j)]);
+    reverted = true;
+  }
+  if (reverted) closure(model, s, data, false);
+  for (Limb limb : kLimbs) {
+    if (!active[static_cast<std::size_t>(limb)]) continue;
+    const double r = limb_residual(data.Phi, indices(limb));
+    // Never a success whose residual is above what Newton accepts.
+    if (!(r <= options.floor_tolerance))
+      throw Error(std::string(limb_name(limb)),
+                  fmt::format("Newton's result does not satisfy the closure: residual {:.3e} above {:.1e}", r,
+                              options.floor_tolerance));
+    report.residual = std::max(report.residual, r);
+  }
   report.converged = true;
   return report;
 }

@@ -299,3 +299,18 @@ TEST_CASE("ik: a foot within the distance range but too far beside the hip's pit
         "left leg: F_l out of reach: with psi_l4 at 128.68 deg (set by the target's distance) it reaches at most 1.0625 m "
         "off the plane normal to the axis of psi_l2 (through the meeting point), but its target is 1.5000 m off it");
 }
+
+TEST_CASE("ik: Newton's angles are wrapped only where the closure still holds (theta_5 = pi)") {
+  // theta_4 = -theta_5: wrapping -pi to +pi would break the guidance row by 2 pi.
+  const Model model;
+  Data data;
+  Coordinates s = nominal_inputs();
+  solve_ik_closed_form(model, s);  // the start, as wlx ik uses it
+  s(c::theta_l5) = std::numbers::pi;
+  s(c::theta_r5) = -std::numbers::pi;
+  solve_ik_newton(model, s, data);
+  closure(model, s, data, false);
+  CHECK(data.Phi.cwiseAbs().maxCoeff() <= 1e-12);
+  CHECK(s(c::theta_l4) + s(c::theta_l5) == doctest::Approx(0).epsilon(1e-15));
+  CHECK(s(c::theta_r4) + s(c::theta_r5) == doctest::Approx(0).epsilon(1e-15));
+}
