@@ -1,6 +1,7 @@
 // wlx: the command-line tool over the runtime. This file knows no model: it parses the command
 // line and runs the chosen built-in model's command (commands.hpp, models()).
 #include "bounded_input.hpp"
+#include "app.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
@@ -17,58 +18,14 @@
 int main(int argc, char** argv) {
   using namespace wlx::cli;
   CLI::App app{"wlx: kinematics and dynamics of wheeled-legged machines, from generated closed-form code"};
-  wlx::cli::prepare_command_line(app, WLX_VERSION);
-  std::string model_name(models().front().name);
-  ModelOptions model_options;
+  std::vector<std::string> names;
+  for (const auto& m : models()) names.emplace_back(m.name);
+  Invocation inv;
+  define_command_line(app, inv, names, WLX_VERSION);
+  auto& [model_name, model_options, list_models, fk, fk_json, ik, batch, verify_ik, ik_out, sweep_ids, verify_nh, nh_out,
+         simulate, sim, report, report_options] = inv;
   std::string model_names;
-  for (const auto& m : models()) model_names += (model_names.empty() ? "" : ", ") + std::string(m.name);
-  // --model and --params before the subcommand or after it (each subcommand has them too, so that
-  // an unknown option of a subcommand is reported there, with its own did-you-mean).
-  const auto add_model_options = [&](CLI::App* a) {
-    a->add_option("--model", model_name, "the built-in model (" + model_names + "; wlx models lists them)")
-        ->capture_default_str();
-    a->add_option("--params", model_options.params_file,
-                  "JSON file {\"name\": value, ...} overriding the model's parameters (SI units)");
-  };
-  add_model_options(&app);
-  auto* list_models = app.add_subcommand("models", "list the built-in models");
-  bool fk_json = false;
-  auto* fk = app.add_subcommand("fk", "forward kinematics of a pose on stdin (JSON; {} for the nominal pose)");
-  fk->add_flag("--json", fk_json, "print JSON instead of a table");
-
-  bool batch = false;
-  auto* ik = app.add_subcommand("ik", "inverse kinematics: one JSON object of inputs on stdin, one JSON object out");
-  ik->add_flag("--batch", batch, "NDJSON: one object per line in, one per line out (Newton warm-starts along the lines)");
-
-  auto* verify = app.add_subcommand("verify", "the thesis' verifications");
-  verify->require_subcommand(1);
-  std::string ik_out = "out/verify-ik";
-  std::vector<std::string> sweep_ids;
-  auto* verify_ik = verify->add_subcommand("ik", "the 12 IK sweeps of docs/excavator.md section 8, closed form and Newton");
-  verify_ik->add_option("--out", ik_out, "folder for one CSV per sweep")->capture_default_str();
-  verify_ik->add_option("--sweep", sweep_ids, "only these sweeps (IK-L1, ..., IK-WR2)");
-
-  std::string nh_out = "out/verify-nonholonomic";
-  auto* verify_nh = verify->add_subcommand("nonholonomic", "NH-1 to NH-4: the wheels' sideways-velocity residual");
-  verify_nh->add_option("--out", nh_out, "folder for one trajectory CSV per run")->capture_default_str();
-
-  wlx::cli::SimulateOptions sim;
-  auto* simulate = app.add_subcommand("simulate", "integrate a scenario (a file, or an id of docs/excavator.md section 8)");
-  simulate->add_option("SCENARIO", sim.scenario, "scenario file or id (NH-1, ST-A1+, ...)");
-  simulate->add_option("--out", sim.out_dir, "output folder for trajectory.csv")->capture_default_str();
-  simulate->add_option("--integrator", sim.integrator,
-                       "rk4, euler or dopri5 (adaptive Dormand-Prince 5(4)); default: the scenario's");
-  simulate->add_option("--dt", sim.dt, "step in seconds, or with dopri5 the output interval (default: the scenario's)");
-  simulate->add_option("--tolerance", sim.tolerance, "dopri5's local error bound per step, relative to 1 + |q| (default 1e-10)");
-  simulate->add_option("--weighting", sim.weighting, "torque weighting 1 or 2 (inverse dynamics, docs/excavator.md section 7)");
-  simulate->add_flag("--list", sim.list, "list the built-in scenarios");
-
-  wlx::cli::ReportOptions report_options;
-  auto* report = app.add_subcommand("report", "run everything of docs/excavator.md section 8 and write an HTML report with figures");
-  report->add_option("--out", report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
-  report->add_flag("--quick", report_options.quick, "a reduced set of runs, for a fast look");
-
-  for (CLI::App* a : {fk, ik, verify_ik, verify_nh, simulate, report}) add_model_options(a);
+  for (const auto& n : names) model_names += (model_names.empty() ? "" : ", ") + n;
   install_interrupt_handlers();
   if (const auto code = parse_command_line(app, argc, argv)) return finish(*code);
   try {

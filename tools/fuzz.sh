@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Fuzzes the JSON/scenario input path, the IK on arbitrary numbers and the model-file reader with libFuzzer (clang,
+# Fuzzes the JSON/scenario input path, the IK on arbitrary numbers, the model-file reader and the
+# command-line parser with libFuzzer (clang,
 # ASan, UBSan) for SECONDS each (default 60). New interesting inputs stay in build-fuzz/; a
 # crasher stops the run, is copied to tests/fuzz/regressions/<target>/ (commit it: every test
 # run replays that folder) and the script exits 1.
@@ -18,9 +19,9 @@ if [ ! -f build-fuzz/CMakeCache.txt ]; then
   cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 -DWLX_FUZZ=ON \
         -DWLX_BUILD_BENCHMARKS=OFF > /dev/null
 fi
-cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_ik_numbers fuzz_json_input fuzz_model_file
+cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_ik_numbers fuzz_json_input fuzz_model_file fuzz_command_line
 status=0
-for target in ik_numbers json_input model_file; do
+for target in ik_numbers json_input model_file command_line; do
   work=build-fuzz/corpus-$target artifacts=build-fuzz/artifacts-$target
   mkdir -p "$work" "$artifacts" "tests/fuzz/regressions/$target"
   echo "fuzz_$target: ${seconds} s"

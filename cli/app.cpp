@@ -1,0 +1,55 @@
+#include "app.hpp"
+
+#include "command_line.hpp"
+
+namespace wlx::cli {
+
+void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::string>& model_names,
+                         const std::string& version) {
+  prepare_command_line(app, version);
+  inv.model_name = model_names.front();
+  std::string names;
+  for (const auto& n : model_names) names += (names.empty() ? "" : ", ") + n;
+  // --model and --params before the subcommand or after it (each subcommand has them too, so that
+  // an unknown option of a subcommand is reported there, with its own did-you-mean).
+  const auto add_model_options = [&](CLI::App* a) {
+    a->add_option("--model", inv.model_name, "the built-in model (" + names + "; wlx models lists them)")
+        ->capture_default_str();
+    a->add_option("--params", inv.model_options.params_file,
+                  "JSON file {\"name\": value, ...} overriding the model's parameters (SI units)");
+  };
+  add_model_options(&app);
+  inv.list_models = app.add_subcommand("models", "list the built-in models");
+  inv.fk = app.add_subcommand("fk", "forward kinematics of a pose on stdin (JSON; {} for the nominal pose)");
+  inv.fk->add_flag("--json", inv.fk_json, "print JSON instead of a table");
+
+  inv.ik = app.add_subcommand("ik", "inverse kinematics: one JSON object of inputs on stdin, one JSON object out");
+  inv.ik->add_flag("--batch", inv.batch, "NDJSON: one object per line in, one per line out (Newton warm-starts along the lines)");
+
+  auto* verify = app.add_subcommand("verify", "the verifications: IK sweeps and wheel constraints");
+  verify->require_subcommand(1);
+  inv.verify_ik = verify->add_subcommand("ik", "the model's IK sweeps (its file's ik_sweeps; the excavator's 12 of docs/excavator.md section 8), closed form and Newton");
+  inv.verify_ik->add_option("--out", inv.ik_out, "folder for one CSV per sweep")->capture_default_str();
+  inv.verify_ik->add_option("--sweep", inv.sweep_ids, "only these sweeps (ids as wlx verify ik lists them, e.g. IK-L1)");
+
+  inv.verify_nh = verify->add_subcommand("nonholonomic", "the model's scenarios marked \"verify\": \"nonholonomic\" (the excavator's NH-1..4): the wheels' sideways-velocity residual");
+  inv.verify_nh->add_option("--out", inv.nh_out, "folder for one trajectory CSV per run")->capture_default_str();
+
+  inv.simulate = app.add_subcommand("simulate", "integrate a scenario (a file, or a built-in id: --list shows them)");
+  inv.simulate->add_option("SCENARIO", inv.sim.scenario, "scenario file or id (the excavator's NH-1, ST-A1+, ...)");
+  inv.simulate->add_option("--out", inv.sim.out_dir, "output folder for trajectory.csv")->capture_default_str();
+  inv.simulate->add_option("--integrator", inv.sim.integrator,
+                       "rk4, euler or dopri5 (adaptive Dormand-Prince 5(4)); default: the scenario's");
+  inv.simulate->add_option("--dt", inv.sim.dt, "step in seconds, or with dopri5 the output interval (default: the scenario's)");
+  inv.simulate->add_option("--tolerance", inv.sim.tolerance, "dopri5's local error bound per step, relative to 1 + |q| (default 1e-10)");
+  inv.simulate->add_option("--weighting", inv.sim.weighting, "torque weighting 1 (the model file's weights) or 2 (by contribution), for inverse dynamics");
+  inv.simulate->add_flag("--list", inv.sim.list, "list the built-in scenarios");
+
+  inv.report = app.add_subcommand("report", "excavator: run every verification of the thesis and write an HTML report with figures");
+  inv.report->add_option("--out", inv.report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
+  inv.report->add_flag("--quick", inv.report_options.quick, "a reduced set of runs, for a fast look");
+
+  for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report}) add_model_options(a);
+}
+
+}  // namespace wlx::cli

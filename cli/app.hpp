@@ -1,0 +1,40 @@
+// The wlx command line: every subcommand and option, defined in one place for main.cpp and for
+// the fuzz target of the command-line parser (tests/fuzz/fuzz_command_line.cpp).
+#pragma once
+
+#include "commands.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+#include <vector>
+
+namespace wlx::cli {
+
+// What a parsed command line asks for: the option values, and the subcommands (parsed() tells
+// which was given).
+struct Invocation {
+  std::string model_name;
+  ModelOptions model_options;
+  CLI::App* list_models = nullptr;
+  CLI::App* fk = nullptr;
+  bool fk_json = false;
+  CLI::App* ik = nullptr;
+  bool batch = false;
+  CLI::App* verify_ik = nullptr;
+  std::string ik_out = "out/verify-ik";
+  std::vector<std::string> sweep_ids;
+  CLI::App* verify_nh = nullptr;
+  std::string nh_out = "out/verify-nonholonomic";
+  CLI::App* simulate = nullptr;
+  SimulateOptions sim;
+  CLI::App* report = nullptr;
+  ReportOptions report_options;
+};
+
+// Adds wlx's subcommands and options to `app` (model_names: the built-in models, the default
+// first); then parse with parse_command_line (command_line.hpp).
+void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::string>& model_names,
+                         const std::string& version);
+
+}  // namespace wlx::cli
