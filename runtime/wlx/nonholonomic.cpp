@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 WLX_MODEL_NAMESPACE_BEGIN
 
@@ -22,11 +23,22 @@ bool is_pair_candidate(int coordinate) {
   return false;
 }
 
+// Calls f(std::integral_constant<int, L>) for every limb L: the limb's rows and joints are then
+// compile-time constants (gen::kLimbs is constexpr), so the block copies below unroll with fixed
+// indices, as fast as code written for one robot.
+template <class F>
+void for_each_limb(F&& f) {
+  [&]<std::size_t... L>(std::index_sequence<L...>) {
+    (f(std::integral_constant<int, static_cast<int>(L)>{}), ...);
+  }(std::make_index_sequence<static_cast<std::size_t>(kLimbCount)>{});
+}
+
 // Factorizes each limb's block of dPhi/ds, solves the adjoint Phi_dep^T Lambda = C_dep^T and forms
 // C_hat = C_q - Lambda^T Phi_q: 2 right-hand sides instead of the 18 of Phi_dep^-1 Phi_q.
 void reduce(Data& d) {
-  for (Limb limb : kLimbs) {
-    const LimbBlock b = limb_block(limb);
+  for_each_limb([&](auto L) {
+    constexpr Limb limb = decltype(L)::value;
+    constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(limb)];
     Eigen::Matrix4d block = Eigen::Matrix4d::Identity();
     Eigen::Matrix<double, 4, 2> rhs = Eigen::Matrix<double, 4, 2>::Zero();
     for (int j = 0; j < b.size; ++j) {
@@ -47,19 +59,19 @@ void reduce(Data& d) {
                               "or folded, or two joint axes aligned)"));
     const Eigen::Matrix<double, 4, 2> lambda = inverse.transpose().lazyProduct(rhs);
     for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.rows[static_cast<std::size_t>(i)]) = lambda.row(i);
-  }
+  });
   d.C_reduced = d.C.leftCols<kNq>() - d.wheel_adjoint.transpose().lazyProduct(d.dPhi_ds.leftCols<kNq>());
 }
 
 // The dependent joints' part of s'' or s' for a closure right-hand side: Phi_dep x = -v.
 void solve_closure(const Data& d, const gen::ClosureVector& v, Coordinates& out) {
-  for (Limb limb : kLimbs) {
-    const LimbBlock b = limb_block(limb);
+  for_each_limb([&](auto L) {
+    constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(decltype(L)::value)];
     Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
     for (int i = 0; i < b.size; ++i) rhs(i) = -v(b.rows[static_cast<std::size_t>(i)]);
-    const Eigen::Vector4d x = d.limb_inverse[static_cast<std::size_t>(limb)] * rhs;
+    const Eigen::Vector4d x = d.limb_inverse[static_cast<std::size_t>(decltype(L)::value)] * rhs;
     for (int j = 0; j < b.size; ++j) out(b.joints[static_cast<std::size_t>(j)]) = x(j);
-  }
+  });
 }
 
 // 2-norm condition number of a 2 x 2 matrix in closed form: with E = |J|_F^2 and D = |det J|,
@@ -162,13 +174,13 @@ Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& 
   }
   // Dependent joints: Phi_dep T_dep = -Phi_q T_q, all four columns per limb block at once.
   const Eigen::Matrix<double, gen::kClosureCount, 4> rhs = d.dPhi_ds.leftCols<kNq>().lazyProduct(T.topRows<kNq>());
-  for (Limb limb : kLimbs) {
-    const LimbBlock b = limb_block(limb);
+  for_each_limb([&](auto L) {
+    constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(decltype(L)::value)];
     Eigen::Matrix4d block_rhs = Eigen::Matrix4d::Zero();
     for (int i = 0; i < b.size; ++i) block_rhs.row(i) = -rhs.row(b.rows[static_cast<std::size_t>(i)]);
-    const Eigen::Matrix4d x = d.limb_inverse[static_cast<std::size_t>(limb)].lazyProduct(block_rhs);
+    const Eigen::Matrix4d x = d.limb_inverse[static_cast<std::size_t>(decltype(L)::value)].lazyProduct(block_rhs);
     for (int j = 0; j < b.size; ++j) T.row(b.joints[static_cast<std::size_t>(j)]) = x.row(j);
-  }
+  });
   return T;
 }
 
