@@ -163,6 +163,7 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       const auto l = static_cast<std::size_t>(limb);
       if (!active[l]) continue;
       const auto idx = indices(limb);
+      if (done[l]) continue;  // a converged limb stays converged: the limbs do not couple
       before[l] = limb_residual(data.Phi, idx);
       done[l] = before[l] <= options.tolerance || (stalled[l] && before[l] <= options.floor_tolerance);
       if (done[l]) continue;
@@ -220,6 +221,10 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
       stalled[l] = !done[l] && !accepted[l];
+      if (!stalled[l]) continue;
+      // No step length lowered the residual: stay where the residual was lowest.
+      const auto idx = indices(limb);
+      for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]);
     }
   }
   // Angles into (-pi, pi], but only where that keeps the closure: a row such as theta_4 + theta_5 = 0

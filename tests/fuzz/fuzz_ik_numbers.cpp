@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
@@ -40,7 +41,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
     // Newton from the closed-form solution stays there.
     try {
       solve_ik_newton(model, s, data);
-    } catch (const Error&) {
+    } catch (const Error& e) {
+      std::fprintf(stderr, "Newton left the closed-form solution: %s\n", e.what());
       std::abort();
     }
   }
