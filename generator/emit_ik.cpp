@@ -30,6 +30,7 @@
 #include <fmt/format.h>
 
 #include <regex>
+#include <stdexcept>
 #include <set>
 
 namespace wlx::codegen {
@@ -92,13 +93,6 @@ Mat3 product(const std::vector<Rot>& seq) {
   Mat3 R = Mat3::identity();
   for (const Rot& r : seq) R = R * rot(r.axis, r.angle);
   return R;
-}
-
-Mat3 transpose(const Mat3& a) {
-  Mat3 t;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) t(i, j) = a(j, i);
-  return t;
 }
 
 // a cos q + b sin q + c = e, for e linear in cos q and sin q; throws otherwise.
@@ -171,10 +165,10 @@ ex in_results(const Model& m, ex e, const Solve& solve) {
 std::string two_axis_call(Axis a, Axis b, const std::string& v, const std::string& d, const std::string& flip,
                           const SolvedJoint& first, const SolvedJoint& second) {
   return fmt::format(
-      "  double {0}, {1}, {2}, {3}, {4}, {5}, ik_beside = 0, ik_room = 0;\n"
-      "  const bool ik_two_axis_ok = ik_solve_two_axis<{6}, {7}>({8}, {9}, {10}, {0}, {1}, {2}, {3}, {4}, {5}, ik_beside, ik_room);\n",
-      first.q.get_name(), first.c.get_name(), first.s.get_name(), second.q.get_name(), second.c.get_name(),
-      second.s.get_name(), static_cast<int>(a), static_cast<int>(b), v, d, flip);
+      "  double {0}, {1}, {2}, {3}, ik_beside = 0, ik_room = 0;\n"
+      "  const bool ik_two_axis_ok = ik_solve_two_axis<{4}, {5}>({6}, {7}, {8}, {0}, {1}, {2}, {3}, ik_beside, ik_room);\n",
+      first.c.get_name(), first.s.get_name(), second.c.get_name(), second.s.get_name(), static_cast<int>(a),
+      static_cast<int>(b), v, d, flip);
 }
 
 // ---- point3 -------------------------------------------------------------------------------------
@@ -259,14 +253,14 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   s0.locals.emplace_back(B_, cross.b);
   s0.code = fmt::format(
       "  const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;\n"
-      "  double {0}, {1}, {2};\n"
-      "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, {0}, {1}, {2})) {{\n"
+      "  double {0}, {1};\n"
+      "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, {0}, {1})) {{\n"
       "    const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
       "    why = {{1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
       "    return IkStatus::out_of_reach;\n"
       "  }}\n",
-      q3.q.get_name(), q3.c.get_name(), q3.s.get_name());
-  s0.defines = {q3.q.get_name(), q3.c.get_name(), q3.s.get_name()};
+      q3.c.get_name(), q3.s.get_name());
+  s0.defines = {q3.c.get_name(), q3.s.get_name()};
   solve.stages.push_back(s0);
 
   // Stage 1: v = p1 + M R_c(q3) p2 in the frame after q2; two rotations take it onto d.
@@ -276,10 +270,10 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   for (int i = 0; i < 3; ++i) s1.locals.emplace_back(vs[i], in_results(m, v[i], solve));
   s1.code = "  const double ik_v[3] = {ik_v0, ik_v1, ik_v2};\n  const double ik_d[3] = {ik_d0, ik_d1, ik_d2};\n" +
             two_axis_call(j1.axis, j2.axis, "ik_v", "ik_d", "(branch & 2) != 0", q1, q2) +
-            fmt::format("  if (!ik_two_axis_ok) {{\n    why = {{2, ik_beside, 0.0, ik_room, {} * 57.29577951308232}};\n"
+            fmt::format("  if (!ik_two_axis_ok) {{\n    why = {{2, ik_beside, 0.0, ik_room, std::atan2({}, {}) * 57.29577951308232}};\n"
                         "    return IkStatus::out_of_reach;\n  }}\n",
-                        q3.q.get_name());
-  s1.defines = {q1.q.get_name(), q1.c.get_name(), q1.s.get_name(), q2.q.get_name(), q2.c.get_name(), q2.s.get_name()};
+                        q3.s.get_name(), q3.c.get_name());
+  s1.defines = {q1.c.get_name(), q1.s.get_name(), q2.c.get_name(), q2.s.get_name()};
   solve.stages.push_back(s1);
   return solve;
 }
@@ -380,7 +374,7 @@ Solve plan_lever(const Model& m, const Limb& limb) {
   const int qb = in_b[0];
   const ex qp_sym = m.coordinates[static_cast<std::size_t>(qp)].q, qq_sym = m.coordinates[static_cast<std::size_t>(qq)].q;
   const SolvedJoint Jp = joint_symbols(m, qp), Jq = joint_symbols(m, qq), Jb = joint_symbols(m, qb);
-  const SolvedJoint sigma{-1, realsymbol("ik_q_sum"), realsymbol("ik_c_sum"), realsymbol("ik_s_sum")};
+  const SolvedJoint sigma{-1, realsymbol("ik_q_sum"), realsymbol("ik_c_sum"), realsymbol("ik_s_sum")};  // q unused
   std::vector<Rot> pre(merged.begin(), merged.end() - 2);
   const Mat3 up_frame = base.R * product(pre);
 
@@ -426,11 +420,10 @@ Solve plan_lever(const Model& m, const Limb& limb) {
                 "  static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations\n"
                 "  // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).\n"
                 "  if ((ik_c_sum < 0) != ((branch & 4) != 0)) {{\n"
-                "    ik_q_sum = ik_wrap(ik_q_sum + 3.141592653589793);\n"
                 "    ik_c_sum = -ik_c_sum;\n    ik_s_sum = -ik_s_sum;\n"
-                "    {0} = -{0};\n    {1} = -{1};\n  }}\n",
-                Jb.q.get_name(), Jb.s.get_name());
-  s0.defines = {"ik_q_sum", "ik_c_sum", "ik_s_sum", Jb.q.get_name(), Jb.c.get_name(), Jb.s.get_name()};
+                "    {0} = -{0};\n  }}\n",
+                Jb.s.get_name());
+  s0.defines = {"ik_c_sum", "ik_s_sum", Jb.c.get_name(), Jb.s.get_name()};
   solve.stages.push_back(s0);
 
   // Stage 1: the point row, with q_q = sum - q_p: a cos q_p + b sin q_p + c.
@@ -459,17 +452,16 @@ Solve plan_lever(const Model& m, const Limb& limb) {
   Stage s1;
   s1.locals = {{realsymbol("ik_alpha"), results(row.a)}, {realsymbol("ik_beta"), results(row.b)}, {realsymbol("ik_gamma"), results(row.c)}};
   s1.code = fmt::format(
-      "  double {0}, {1}, {2};\n"
-      "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, {3} - ik_gamma, (branch & 1) != 0, {0}, {1}, {2})) {{\n"
+      "  double {0}, {1};\n"
+      "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, {2} - ik_gamma, (branch & 1) != 0, {0}, {1})) {{\n"
       "    const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);\n"
-      "    why = {{1, {3}, ik_gamma - ik_R, ik_gamma + ik_R, 0.0}};\n"
+      "    why = {{1, {2}, ik_gamma - ik_R, ik_gamma + ik_R, 0.0}};\n"
       "    return IkStatus::out_of_reach;\n"
       "  }}\n"
-      "  const double {4} = ik_wrap(ik_q_sum - {0});\n"
-      "  const double {5} = ik_c_sum * {1} + ik_s_sum * {2};\n"
-      "  const double {6} = ik_s_sum * {1} - ik_c_sum * {2};\n",
-      Jp.q.get_name(), Jp.c.get_name(), Jp.s.get_name(), target, Jq.q.get_name(), Jq.c.get_name(), Jq.s.get_name());
-  s1.defines = {Jp.q.get_name(), Jp.c.get_name(), Jp.s.get_name(), Jq.q.get_name(), Jq.c.get_name(), Jq.s.get_name()};
+      "  const double {3} = ik_c_sum * {0} + ik_s_sum * {1};\n"
+      "  const double {4} = ik_s_sum * {0} - ik_c_sum * {1};\n",
+      Jp.c.get_name(), Jp.s.get_name(), target, Jq.c.get_name(), Jq.s.get_name());
+  s1.defines = {Jp.c.get_name(), Jp.s.get_name(), Jq.c.get_name(), Jq.s.get_name()};
   solve.stages.push_back(s1);
   solve.joints = {Jp, Jq, Jb};
   return solve;
@@ -481,6 +473,33 @@ struct EmittedSolve {
   std::string text;
   OpCount ops;
 };
+
+// The joint angles from their cosines and sines in one batched atan2 pass (trig.hpp), after every
+// solver stage: the stages themselves work with cosines and sines only (libm's atan2, one call per
+// joint, was over half of a four-limb solve).
+Stage angle_stage(const std::vector<Stage>& before, const std::vector<SolvedJoint>& joints) {
+  for (const Stage& st : before)
+    for (const auto& [sym, value] : st.locals)
+      for (const SolvedJoint& j : joints)
+        if (value.has(j.q))
+          throw std::logic_error("wlx-gen: " + sym.get_name() + " uses the angle " + j.q.get_name() +
+                                 " before the batched atan2 computes it");
+  std::vector<std::string> sines, cosines;
+  for (const SolvedJoint& j : joints) {
+    sines.push_back(j.s.get_name());
+    cosines.push_back(j.c.get_name());
+  }
+  Stage st;
+  st.code = fmt::format("  const std::array<double, {0}> ik_sines{{{{{1}}}}}, ik_cosines{{{{{2}}}}};\n"
+                        "  std::array<double, {0}> ik_angles;\n"
+                        "  atan2(ik_sines, ik_cosines, ik_angles);\n",
+                        joints.size(), fmt::join(sines, ", "), fmt::join(cosines, ", "));
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    st.code += fmt::format("  const double {} = ik_angles[{}];\n", joints[i].q.get_name(), i);
+    st.defines.push_back(joints[i].q.get_name());
+  }
+  return st;
+}
 
 // The last stage of a limb's solve: its own closure rows at the solution, and the check.
 Stage check_stage(const Model& m, const Limb& limb, const Solve& solve) {
@@ -580,7 +599,7 @@ std::vector<std::pair<int, std::string>> solve_outputs(const Model& m, const Sol
 // its branch read from `ik_<tag>_branch`, and a failure reporting `failed = index`: for fusing
 // several limbs into one function. The solved joints keep their names (they are distinct already).
 std::vector<Stage> fused_stages(const Model& m, const std::vector<Stage>& stages, const std::string& tag, int index) {
-  std::set<std::string> keep = {"ik_solve_cos_sin", "ik_solve_two_axis", "ik_wrap"};
+  std::set<std::string> keep = {"ik_solve_cos_sin", "ik_solve_two_axis"};
   for (const auto& c : m.coordinates)
     for (const char* k : {"ik_q_", "ik_c_", "ik_s_"}) keep.insert(k + c.name);
   const auto renamed = [&](const std::string& name) { return keep.count(name) ? name : "ik_" + tag + "_" + name.substr(3); };
@@ -621,6 +640,7 @@ std::vector<Stage> fused_stages(const Model& m, const std::vector<Stage>& stages
 
 EmittedSolve emit_solve(const Model& m, const Limb& limb, Solve solve, const EmitOptions& opt) {
   std::vector<Stage> stages = solve.stages;
+  stages.push_back(angle_stage(stages, solve.joints));
   stages.push_back(check_stage(m, limb, solve));
   OpCount ops;
   const std::string body = emit_body(m, stages, solve_outputs(m, solve), opt, ops);
@@ -668,16 +688,10 @@ inline constexpr double kIkReachSlack = 1e-12;
 // about 1e-15.
 inline constexpr double kIkTolerance = 1e-9;
 
-inline double ik_wrap(double a) noexcept {
-  constexpr double pi = 3.141592653589793;
-  if (a > -pi && a <= pi) return a;
-  a = std::remainder(a, 2 * pi);
-  return a == -pi ? pi : a;
-}
-
-// x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie the positive one),
-// or the other root with `other`; also cos x and sin x. False when |c| exceeds sqrt(a^2 + b^2).
-inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& x, double& cos_x, double& sin_x) noexcept {
+// cos x and sin x of the x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie
+// the positive one), or the other root with `other`. False when |c| exceeds sqrt(a^2 + b^2). The
+// angles themselves come from one batched atan2 pass at the end of a solve.
+inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& cos_x, double& sin_x) noexcept {
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
   const double r = std::sqrt(a * a + b * b);
@@ -693,17 +707,16 @@ inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& x
   if (other) sign = -sign;
   cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
   sin_x = sin_psi * ratio + sign * cos_psi * sin_delta;
-  x = std::atan2(sin_x, cos_x);  // one atan2 of the angle sum, exact to rounding
   return true;
 }
 
-// q1, q2 with R_A(q1) R_B(q2) v = d, for principal axes A != B (0 x, 1 y, 2 z) and |v| = |d|:
+// cos and sin of q1, q2 with R_A(q1) R_B(q2) v = d, for principal axes A != B (0 x, 1 y, 2 z) and |v| = |d|:
 // the component of d along A fixes q2 (two roots: `flip` takes the one with cos q2 of the other sign
 // than branch 0's), then q1 turns R_B(q2) v onto d. False (with how far d is off the plane normal to
 // A, and how far it could be) when no q2 reaches d's component along A.
 template <int A, int B>
-inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& q1, double& c1, double& s1,
-                              double& q2, double& c2, double& s2, double& beside, double& room) noexcept {
+inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& c1, double& s1, double& c2,
+                              double& s2, double& beside, double& room) noexcept {
   static_assert(A != B && A >= 0 && A < 3 && B >= 0 && B < 3, "two different principal axes");
   constexpr int C = 3 - A - B;
   constexpr int i = (B + 1) % 3, j = (B + 2) % 3;    // R_B turns i towards j
@@ -725,7 +738,6 @@ inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool f
   t[C] = k;
   const double y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
   const double r = std::sqrt(x * x + y * y);
-  q2 = r > 0 ? std::atan2(y, x) : 0.0;
   c2 = r > 0 ? x / r : 1.0;
   s2 = r > 0 ? y / r : 0.0;
   double w[3];
@@ -734,7 +746,6 @@ inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool f
   w[j] = s2 * v[i] + c2 * v[j];
   const double y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
   const double r1 = std::sqrt(x1 * x1 + y1 * y1);
-  q1 = r1 > 0 ? std::atan2(y1, x1) : 0.0;
   c1 = r1 > 0 ? x1 / r1 : 1.0;
   s1 = r1 > 0 ? y1 / r1 : 0.0;
   return true;
@@ -797,26 +808,31 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
   const bool all = !m.limbs.empty() && solved.size() == m.limbs.size();
   t += fmt::format("inline constexpr bool kHasFusedIk = {};\n\n", all ? "true" : "false");
   if (all) {
-    std::vector<Stage> stages;
+    // Every limb's solver stages, one atan2 pass for all their joints, then every limb's check.
+    std::vector<Stage> stages, checks;
+    std::vector<SolvedJoint> joints;
     std::vector<std::pair<int, std::string>> outputs;
     std::string prologue;
     for (std::size_t k = 0; k < solved.size(); ++k) {
       const auto& [limb, solve] = solved[k];
-      std::vector<Stage> own = solve.stages;
-      own.push_back(check_stage(m, *limb, solve));
-      for (Stage& st : fused_stages(m, own, limb->name, static_cast<int>(k))) stages.push_back(std::move(st));
+      for (Stage& st : fused_stages(m, solve.stages, limb->name, static_cast<int>(k))) stages.push_back(std::move(st));
+      for (Stage& st : fused_stages(m, {check_stage(m, *limb, solve)}, limb->name, static_cast<int>(k))) checks.push_back(std::move(st));
+      joints.insert(joints.end(), solve.joints.begin(), solve.joints.end());
       for (const auto& o : solve_outputs(m, solve)) outputs.push_back(o);
       prologue += fmt::format("  const int ik_{0}_branch = branches[{1}];\n"
                               "  if (ik_{0}_branch < 0 || ik_{0}_branch >= {2}) {{\n    failed = {1};\n    return IkStatus::bad_branch;\n  }}\n",
                               limb->name, k, solve.branches);
     }
+    stages.push_back(angle_stage(stages, joints));
+    stages.insert(stages.end(), checks.begin(), checks.end());
     OpCount ops;
     const std::string body = emit_body(m, stages, outputs, opt, ops);
     t += fmt::format(
         "// The closed forms of all {0} limbs in one pass: what ik_<limb>() computes for each, with the sines and\n"
         "// cosines of every input angle and the subexpressions the limbs share computed once. branches[k] is\n"
-        "// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed,\n"
-        "// `failed` its index and `why` its numbers; out is written only when every limb succeeded.\n"
+        "// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed\n"
+        "// (every limb's reach is tested before any limb's residual check), `failed` its index and `why`\n"
+        "// its numbers; out is written only when every limb succeeded.\n"
         "// Operations: {1} (adds {2}, muls {3}, divs {4}, calls {5}), plus the solver calls.\n"
         "inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, {0}>& branches, Coordinates& out,\n"
         "                       int& failed, IkDiagnostics& why) noexcept {{\n"

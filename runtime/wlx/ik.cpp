@@ -84,11 +84,15 @@ namespace {
   throw Error("branch", fmt::format("{} has no branch {}", limb_name(limb), branch));
 }
 
+void check_branch(Limb limb, int branch) {
+  if (branch < 0 || branch >= branch_count(limb))
+    throw Error("branch", fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, branch));
+}
+
 void check_inputs_and_branch(Limb limb, int branch, const Coordinates& s) {
   const gen::LimbInfo& l = info(limb);
   for (int i = 0; i < l.input_count; ++i) require_finite(s, l.inputs[static_cast<std::size_t>(i)]);
-  if (branch < 0 || branch >= branch_count(limb))
-    throw Error("branch", fmt::format("{} has branches 0 to {}, got {}", limb_name(limb), branch_count(limb) - 1, branch));
+  check_branch(limb, branch);
 }
 
 }  // namespace
@@ -109,7 +113,11 @@ void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinat
 void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches) {
   if constexpr (gen::kHasFusedIk) {
     // All limbs in one generated pass (the cabin pose and the sines and cosines computed once).
-    for (Limb limb : kLimbs) check_inputs_and_branch(limb, branches.limb[static_cast<std::size_t>(limb)], s);
+    if (s.head<kInputCount>().allFinite()) {  // the usual case: only the branches to check
+      for (Limb limb : kLimbs) check_branch(limb, branches.limb[static_cast<std::size_t>(limb)]);
+    } else {
+      for (Limb limb : kLimbs) check_inputs_and_branch(limb, branches.limb[static_cast<std::size_t>(limb)], s);
+    }
     int failed = 0;
     gen::IkDiagnostics why;
     const gen::IkStatus status = gen::ik_all(s, model.params(), branches.limb, s, failed, why);
@@ -144,7 +152,7 @@ namespace {
 
 NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coordinates& s, Data& data,
                     const NewtonOptions& options) {
-  for (int k = 0; k < kCoordinateCount; ++k) require_finite(s, {k});
+  for (int k = 0; k < kCoordinateCount; ++k) require_finite(s, k);
   NewtonReport report;
   std::array<bool, kLimbCount> done{}, stalled{};  // stalled: the last damped step could not descend
   for (Limb limb : kLimbs) done[static_cast<std::size_t>(limb)] = !active[static_cast<std::size_t>(limb)];

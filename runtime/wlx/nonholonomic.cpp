@@ -74,17 +74,21 @@ void solve_closure(const Data& d, const gen::ClosureVector& v, Coordinates& out)
   });
 }
 
-// 2-norm condition number of a 2 x 2 matrix in closed form: with E = |J|_F^2 and D = |det J|,
-// sigma_max^2 = (E + sqrt(E^2 - 4 D^2)) / 2 and sigma_max sigma_min = D.
-double condition_number(const Eigen::Matrix2d& J) {
-  const double E = J.squaredNorm(), D = std::abs(J.determinant());
-  if (!std::isfinite(E)) return std::numeric_limits<double>::infinity();
-  if (!(D > 0)) return std::numeric_limits<double>::infinity();
-  const double smax2 = 0.5 * (E + std::sqrt(std::max(0.0, (E - 2 * D) * (E + 2 * D))));
-  return smax2 / D;
-}
-
 }  // namespace
+
+// 2-norm condition number of a 2 x 2 matrix [a b; c d] in closed form, without cancellation:
+// sigma_max = (sqrt(p) + sqrt(q)) / 2 with p = (a + d)^2 + (b - c)^2 and q = (a - d)^2 + (b + c)^2
+// (sums of squares: accurate even where the two singular values nearly agree, where the textbook
+// sqrt(E^2 - 4 det^2) loses half the digits), and sigma_max sigma_min = |det|.
+double condition_number(const Eigen::Matrix2d& J) {
+  const double a = J(0, 0), b = J(0, 1), c = J(1, 0), d = J(1, 1);
+  const double p = (a + d) * (a + d) + (b - c) * (b - c), q = (a - d) * (a - d) + (b + c) * (b + c);
+  const double D = std::abs(J.determinant());
+  if (!std::isfinite(p + q)) return std::numeric_limits<double>::infinity();
+  if (!(D > 0)) return std::numeric_limits<double>::infinity();
+  const double smax = 0.5 * (std::sqrt(p) + std::sqrt(q));
+  return smax * smax / D;
+}
 
 std::string DependentPair::label() const {
   return fmt::format("({}', {}')", name_of(index[0]), name_of(index[1]));

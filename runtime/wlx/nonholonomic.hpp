@@ -38,6 +38,10 @@ struct NonholonomicOptions {
   double max_condition = 1e10;
 };
 
+// The 2-norm condition number sigma_max / sigma_min of a 2 x 2 matrix, in closed form and accurate
+// to a few ulp even where the singular values nearly agree; infinity for a singular matrix.
+double condition_number(const Eigen::Matrix2d& J);
+
 // Velocity level. `s`: all 32 coordinates, closure satisfied. `sdot`: the commanded input rates
 // (its pair entries are ignored). Fills the pair's rates and the 14 dependent joint rates in
 // sdot, and data.J_beta, data.cond_J_beta, data.C (and the closure Jacobian). Throws wlx::Error

@@ -5,8 +5,11 @@
 #include <wlx/nonholonomic.hpp>
 #include <wlx/simulation.hpp>
 
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 using namespace wlx;
@@ -86,6 +89,10 @@ TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are e
         continue;
       }
       ++regular;
+      // The closed-form condition number against Eigen's SVD (Jacobi: singular values to a few ulp
+      // of sigma_max, so sigma_min, and the ratio, to a few ulp times the condition number).
+      const Eigen::Vector2d sv = Eigen::JacobiSVD<Eigen::Matrix2d>(d.J_beta).singularValues();
+      CHECK(std::abs(d.cond_J_beta - sv(0) / sv(1)) <= 1e-15 * d.cond_J_beta * d.cond_J_beta + 4e-16 * d.cond_J_beta);
       CHECK(sideways_velocity(model, s, sdot, d).cwiseAbs().maxCoeff() <= 1e-13 * std::max(1.0, d.cond_J_beta / 1e3));
       for (int k : gen::kPairCandidates)
         if (k != pair.index[0] && k != pair.index[1]) CHECK(sdot(k) == commanded(k));
@@ -93,6 +100,26 @@ TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are e
   MESSAGE(regular << " of 28 pairs regular at the nominal pose, " << singular << " singular");
   CHECK(regular + singular == 28);
   CHECK(regular >= 2);
+}
+
+TEST_CASE("nonholonomic: the closed-form condition number against the SVD, nearly equal singular values included") {
+  // R(a) diag(1, 1 + e) R(b): condition number 1 + e exactly (up to the rounding of the product).
+  // The textbook sqrt(E^2 - 4 det^2) form loses half the digits here (about 1e-8 for e = 1e-9). The
+  // bound: a few ulp, times the condition number (the determinant of an ill-conditioned matrix is
+  // only that accurate).
+  for (double e : {0.0, 1e-12, 1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e8}) {
+    for (double a : {0.0, 0.3, 2.0}) {
+      CAPTURE(e);
+      CAPTURE(a);
+      const Eigen::Matrix2d J = Eigen::Rotation2Dd(a).toRotationMatrix() * Eigen::Vector2d(1.0, 1.0 + e).asDiagonal() *
+                                Eigen::Rotation2Dd(1.1 - a).toRotationMatrix();
+      const double expected = 1.0 + e;
+      CHECK(std::abs(condition_number(J) - expected) <= 8e-16 * expected * expected);
+      CHECK(condition_number(J.transpose()) == doctest::Approx(expected).epsilon(8e-16 * expected));
+    }
+  }
+  CHECK(condition_number(Eigen::Matrix2d::Zero()) == std::numeric_limits<double>::infinity());
+  CHECK(condition_number(Eigen::Matrix2d{{1.0, 2.0}, {2.0, 4.0}}) == std::numeric_limits<double>::infinity());
 }
 
 TEST_CASE("nonholonomic: pair names are validated") {

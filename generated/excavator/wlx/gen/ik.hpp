@@ -46,16 +46,10 @@ inline constexpr double kIkReachSlack = 1e-12;
 // about 1e-15.
 inline constexpr double kIkTolerance = 1e-9;
 
-inline double ik_wrap(double a) noexcept {
-  constexpr double pi = 3.141592653589793;
-  if (a > -pi && a <= pi) return a;
-  a = std::remainder(a, 2 * pi);
-  return a == -pi ? pi : a;
-}
-
-// x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie the positive one),
-// or the other root with `other`; also cos x and sin x. False when |c| exceeds sqrt(a^2 + b^2).
-inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& x, double& cos_x, double& sin_x) noexcept {
+// cos x and sin x of the x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie
+// the positive one), or the other root with `other`. False when |c| exceeds sqrt(a^2 + b^2). The
+// angles themselves come from one batched atan2 pass at the end of a solve.
+inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& cos_x, double& sin_x) noexcept {
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
   const double r = std::sqrt(a * a + b * b);
@@ -71,17 +65,16 @@ inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& x
   if (other) sign = -sign;
   cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
   sin_x = sin_psi * ratio + sign * cos_psi * sin_delta;
-  x = std::atan2(sin_x, cos_x);  // one atan2 of the angle sum, exact to rounding
   return true;
 }
 
-// q1, q2 with R_A(q1) R_B(q2) v = d, for principal axes A != B (0 x, 1 y, 2 z) and |v| = |d|:
+// cos and sin of q1, q2 with R_A(q1) R_B(q2) v = d, for principal axes A != B (0 x, 1 y, 2 z) and |v| = |d|:
 // the component of d along A fixes q2 (two roots: `flip` takes the one with cos q2 of the other sign
 // than branch 0's), then q1 turns R_B(q2) v onto d. False (with how far d is off the plane normal to
 // A, and how far it could be) when no q2 reaches d's component along A.
 template <int A, int B>
-inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& q1, double& c1, double& s1,
-                              double& q2, double& c2, double& s2, double& beside, double& room) noexcept {
+inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& c1, double& s1, double& c2,
+                              double& s2, double& beside, double& room) noexcept {
   static_assert(A != B && A >= 0 && A < 3 && B >= 0 && B < 3, "two different principal axes");
   constexpr int C = 3 - A - B;
   constexpr int i = (B + 1) % 3, j = (B + 2) % 3;    // R_B turns i towards j
@@ -103,7 +96,6 @@ inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool f
   t[C] = k;
   const double y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
   const double r = std::sqrt(x * x + y * y);
-  q2 = r > 0 ? std::atan2(y, x) : 0.0;
   c2 = r > 0 ? x / r : 1.0;
   s2 = r > 0 ? y / r : 0.0;
   double w[3];
@@ -112,7 +104,6 @@ inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool f
   w[j] = s2 * v[i] + c2 * v[j];
   const double y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
   const double r1 = std::sqrt(x1 * x1 + y1 * y1);
-  q1 = r1 > 0 ? std::atan2(y1, x1) : 0.0;
   c1 = r1 > 0 ? x1 / r1 : 1.0;
   s1 = r1 > 0 ? y1 / r1 : 0.0;
   return true;
@@ -179,8 +170,8 @@ inline IkStatus ik_leg_l(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_A = 2.0*thighD*legD;
   const double ik_B = 0.0;
   const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
-  double ik_q_psi_l4, ik_c_psi_l4, ik_s_psi_l4;
-  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_q_psi_l4, ik_c_psi_l4, ik_s_psi_l4)) {
+  double ik_c_psi_l4, ik_s_psi_l4;
+  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_psi_l4, ik_s_psi_l4)) {
     const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
     why = {1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
@@ -190,15 +181,21 @@ inline IkStatus ik_leg_l(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_v2 = -ik_s_psi_l4*legD;
   const double ik_v[3] = {ik_v0, ik_v1, ik_v2};
   const double ik_d[3] = {ik_d0, ik_d1, ik_d2};
-  double ik_q_psi_l2, ik_c_psi_l2, ik_s_psi_l2, ik_q_psi_l3, ik_c_psi_l3, ik_s_psi_l3, ik_beside = 0, ik_room = 0;
-  const bool ik_two_axis_ok = ik_solve_two_axis<1, 2>(ik_v, ik_d, (branch & 2) != 0, ik_q_psi_l2, ik_c_psi_l2, ik_s_psi_l2, ik_q_psi_l3, ik_c_psi_l3, ik_s_psi_l3, ik_beside, ik_room);
+  double ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_beside = 0, ik_room = 0;
+  const bool ik_two_axis_ok = ik_solve_two_axis<1, 2>(ik_v, ik_d, (branch & 2) != 0, ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_beside, ik_room);
   if (!ik_two_axis_ok) {
-    why = {2, ik_beside, 0.0, ik_room, ik_q_psi_l4 * 57.29577951308232};
+    why = {2, ik_beside, 0.0, ik_room, std::atan2(ik_s_psi_l4, ik_c_psi_l4) * 57.29577951308232};
     return IkStatus::out_of_reach;
   }
   const double ik_t21 = ik_t17*ik_s_psi_l3 + (cos_yaw*ik_c_psi_l2*cos_pitch - ik_s_psi_l2*ik_t18)*ik_c_psi_l3;
   const double ik_t22 = (ik_s_psi_l2*ik_t20 + ik_c_psi_l2*cos_pitch*sin_yaw)*ik_c_psi_l3 + ik_s_psi_l3*ik_t14;
   const double ik_t23 = ik_t15*ik_s_psi_l3 - ik_c_psi_l3*(sin_pitch*ik_c_psi_l2 + ik_s_psi_l2*ik_t19);
+  const std::array<double, 3> ik_sines{{ik_s_psi_l2, ik_s_psi_l3, ik_s_psi_l4}}, ik_cosines{{ik_c_psi_l2, ik_c_psi_l3, ik_c_psi_l4}};
+  std::array<double, 3> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_psi_l2 = ik_angles[0];
+  const double ik_q_psi_l3 = ik_angles[1];
+  const double ik_q_psi_l4 = ik_angles[2];
   const double ik_row0 = x_C + 0.5*cos_yaw*cxd*cos_pitch + legD*(ik_t21*ik_c_psi_l4 - ik_s_psi_l4*(ik_s_psi_l2*cos_yaw*cos_pitch + ik_c_psi_l2*ik_t18)) + ik_t21*thighD + 0.5*ik_t5*cyd - x_Fl;
   const double ik_row1 = 0.5*cxd*cos_pitch*sin_yaw + y_C + thighD*ik_t22 + 0.5*ik_t9*cyd + legD*(ik_c_psi_l4*ik_t22 - ik_s_psi_l4*(ik_s_psi_l2*cos_pitch*sin_yaw - ik_t20*ik_c_psi_l2)) - y_Fl;
   const double ik_row2 = -(z_Fl + 0.5*sin_pitch*cxd - z_C - 0.5*sin_roll*cyd*cos_pitch - legD*(ik_c_psi_l4*ik_t23 + ik_s_psi_l4*(ik_s_psi_l2*sin_pitch - ik_c_psi_l2*ik_t19)) - thighD*ik_t23);
@@ -274,8 +271,8 @@ inline IkStatus ik_leg_r(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_A = 2.0*thighD*legD;
   const double ik_B = 0.0;
   const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
-  double ik_q_psi_r4, ik_c_psi_r4, ik_s_psi_r4;
-  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_q_psi_r4, ik_c_psi_r4, ik_s_psi_r4)) {
+  double ik_c_psi_r4, ik_s_psi_r4;
+  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_psi_r4, ik_s_psi_r4)) {
     const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
     why = {1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
@@ -285,15 +282,21 @@ inline IkStatus ik_leg_r(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_v2 = -legD*ik_s_psi_r4;
   const double ik_v[3] = {ik_v0, ik_v1, ik_v2};
   const double ik_d[3] = {ik_d0, ik_d1, ik_d2};
-  double ik_q_psi_r2, ik_c_psi_r2, ik_s_psi_r2, ik_q_psi_r3, ik_c_psi_r3, ik_s_psi_r3, ik_beside = 0, ik_room = 0;
-  const bool ik_two_axis_ok = ik_solve_two_axis<1, 2>(ik_v, ik_d, (branch & 2) != 0, ik_q_psi_r2, ik_c_psi_r2, ik_s_psi_r2, ik_q_psi_r3, ik_c_psi_r3, ik_s_psi_r3, ik_beside, ik_room);
+  double ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_beside = 0, ik_room = 0;
+  const bool ik_two_axis_ok = ik_solve_two_axis<1, 2>(ik_v, ik_d, (branch & 2) != 0, ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_beside, ik_room);
   if (!ik_two_axis_ok) {
-    why = {2, ik_beside, 0.0, ik_room, ik_q_psi_r4 * 57.29577951308232};
+    why = {2, ik_beside, 0.0, ik_room, std::atan2(ik_s_psi_r4, ik_c_psi_r4) * 57.29577951308232};
     return IkStatus::out_of_reach;
   }
   const double ik_t21 = (cos_yaw*cos_pitch*ik_c_psi_r2 - ik_s_psi_r2*ik_t20)*ik_c_psi_r3 + ik_t14*ik_s_psi_r3;
   const double ik_t22 = (cos_pitch*sin_yaw*ik_c_psi_r2 + ik_t19*ik_s_psi_r2)*ik_c_psi_r3 + ik_t17*ik_s_psi_r3;
   const double ik_t23 = ik_t15*ik_s_psi_r3 - (sin_pitch*ik_c_psi_r2 - ik_t18*ik_s_psi_r2)*ik_c_psi_r3;
+  const std::array<double, 3> ik_sines{{ik_s_psi_r2, ik_s_psi_r3, ik_s_psi_r4}}, ik_cosines{{ik_c_psi_r2, ik_c_psi_r3, ik_c_psi_r4}};
+  std::array<double, 3> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_psi_r2 = ik_angles[0];
+  const double ik_q_psi_r3 = ik_angles[1];
+  const double ik_q_psi_r4 = ik_angles[2];
   const double ik_row0 = x_C + thighD*ik_t21 + 0.5*cos_yaw*cxd*cos_pitch - 0.5*ik_t5*cyd - x_Fr - legD*(ik_s_psi_r4*(ik_c_psi_r2*ik_t20 + cos_yaw*cos_pitch*ik_s_psi_r2) - ik_c_psi_r4*ik_t21);
   const double ik_row1 = 0.5*cxd*cos_pitch*sin_yaw + thighD*ik_t22 + y_C - legD*(ik_s_psi_r4*(cos_pitch*sin_yaw*ik_s_psi_r2 - ik_t19*ik_c_psi_r2) - ik_t22*ik_c_psi_r4) - 0.5*ik_t9*cyd - y_Fr;
   const double ik_row2 = -(z_Fr + 0.5*sin_pitch*cxd + 0.5*sin_roll*cyd*cos_pitch - z_C - legD*(ik_t23*ik_c_psi_r4 + ik_s_psi_r4*(sin_pitch*ik_s_psi_r2 + ik_t18*ik_c_psi_r2)) - ik_t23*thighD);
@@ -348,28 +351,25 @@ inline IkStatus ik_wheel_l(const Coordinates& s, const Params& p, int branch, Co
   const double ik_g2 = cos_roll*cos_pitch;
   const double ik_axis[3] = {0.0, 0.0, 1.0};
   const double ik_g[3] = {ik_g0, ik_g1, ik_g2};
-  double ik_q_sum, ik_c_sum, ik_s_sum, ik_q_theta_l2, ik_c_theta_l2, ik_s_theta_l2, ik_beside = 0, ik_room = 0;
-  const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_q_sum, ik_c_sum, ik_s_sum, ik_q_theta_l2, ik_c_theta_l2, ik_s_theta_l2, ik_beside, ik_room);
+  double ik_c_sum, ik_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_beside = 0, ik_room = 0;
+  const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_c_sum, ik_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_beside, ik_room);
   static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
   if ((ik_c_sum < 0) != ((branch & 4) != 0)) {
-    ik_q_sum = ik_wrap(ik_q_sum + 3.141592653589793);
     ik_c_sum = -ik_c_sum;
     ik_s_sum = -ik_s_sum;
-    ik_q_theta_l2 = -ik_q_theta_l2;
     ik_s_theta_l2 = -ik_s_theta_l2;
   }
   const double ik_t5 = ik_c_sum*w*cos_roll*cos_pitch;
   const double ik_alpha = -(sin_pitch*w*ik_s_sum - sin_pitch*(w*ik_s_sum + cos_theta_l5*wl));
   const double ik_beta = ik_t5 - cos_roll*(ik_c_sum*w - cos_theta_l5*wl)*cos_pitch;
   const double ik_gamma = -(ik_t5 + sin_roll*sin_theta_l5*wl*cos_pitch - z_C - 0.5*sin_roll*cyd*cos_pitch - 0.5*sin_pitch*cxd - sin_pitch*w*ik_s_sum);
-  double ik_q_theta_l6, ik_c_theta_l6, ik_s_theta_l6;
-  if (!ik_solve_cos_sin(ik_alpha, ik_beta, z_Wl - ik_gamma, (branch & 1) != 0, ik_q_theta_l6, ik_c_theta_l6, ik_s_theta_l6)) {
+  double ik_c_theta_l6, ik_s_theta_l6;
+  if (!ik_solve_cos_sin(ik_alpha, ik_beta, z_Wl - ik_gamma, (branch & 1) != 0, ik_c_theta_l6, ik_s_theta_l6)) {
     const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, z_Wl, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_q_theta_l3 = ik_wrap(ik_q_sum - ik_q_theta_l6);
   const double ik_c_theta_l3 = ik_c_sum * ik_c_theta_l6 + ik_s_sum * ik_s_theta_l6;
   const double ik_s_theta_l3 = ik_s_sum * ik_c_theta_l6 - ik_c_sum * ik_s_theta_l6;
   const double ik_t7 = sin_pitch*ik_c_theta_l6 + cos_roll*cos_pitch*ik_s_theta_l6;
@@ -378,6 +378,12 @@ inline IkStatus ik_wheel_l(const Coordinates& s, const Params& p, int branch, Co
   const double ik_t10 = sin_theta_l5*ik_t7 + sin_roll*cos_theta_l5*cos_pitch;
   const double ik_t11 = ik_t8*cos_theta_l5 + sin_theta_l5*ik_t10;
   const double ik_t12 = ik_t9*ik_c_theta_l3 + ik_t11*ik_s_theta_l3;
+  const std::array<double, 3> ik_sines{{ik_s_theta_l6, ik_s_theta_l3, ik_s_theta_l2}}, ik_cosines{{ik_c_theta_l6, ik_c_theta_l3, ik_c_theta_l2}};
+  std::array<double, 3> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_theta_l6 = ik_angles[0];
+  const double ik_q_theta_l3 = ik_angles[1];
+  const double ik_q_theta_l2 = ik_angles[2];
   const double ik_row0 = ik_t8*wl + 0.5*sin_pitch*cxd + z_C + 0.5*sin_roll*cyd*cos_pitch + w*ik_t12 - z_Wl;
   const double ik_row1 = -(ik_t11*ik_c_theta_l3 - ik_t9*ik_s_theta_l3);
   const double ik_row2 = ik_c_theta_l2*(cos_theta_l5*ik_t10 - sin_theta_l5*ik_t8) - ik_t12*ik_s_theta_l2;
@@ -437,28 +443,25 @@ inline IkStatus ik_wheel_r(const Coordinates& s, const Params& p, int branch, Co
   const double ik_g2 = cos_roll*cos_pitch;
   const double ik_axis[3] = {0.0, 0.0, 1.0};
   const double ik_g[3] = {ik_g0, ik_g1, ik_g2};
-  double ik_q_sum, ik_c_sum, ik_s_sum, ik_q_theta_r2, ik_c_theta_r2, ik_s_theta_r2, ik_beside = 0, ik_room = 0;
-  const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_q_sum, ik_c_sum, ik_s_sum, ik_q_theta_r2, ik_c_theta_r2, ik_s_theta_r2, ik_beside, ik_room);
+  double ik_c_sum, ik_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_beside = 0, ik_room = 0;
+  const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_c_sum, ik_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_beside, ik_room);
   static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
   if ((ik_c_sum < 0) != ((branch & 4) != 0)) {
-    ik_q_sum = ik_wrap(ik_q_sum + 3.141592653589793);
     ik_c_sum = -ik_c_sum;
     ik_s_sum = -ik_s_sum;
-    ik_q_theta_r2 = -ik_q_theta_r2;
     ik_s_theta_r2 = -ik_s_theta_r2;
   }
   const double ik_t5 = ik_c_sum*w*cos_roll*cos_pitch;
   const double ik_alpha = -(sin_pitch*w*ik_s_sum - sin_pitch*(w*ik_s_sum + cos_theta_r5*wl));
   const double ik_beta = ik_t5 - (ik_c_sum*w - cos_theta_r5*wl)*cos_roll*cos_pitch;
   const double ik_gamma = -(ik_t5 + ik_t6 + ik_t7 + sin_roll*sin_theta_r5*wl*cos_pitch + ik_t9 - sin_pitch*w*ik_s_sum);
-  double ik_q_theta_r6, ik_c_theta_r6, ik_s_theta_r6;
-  if (!ik_solve_cos_sin(ik_alpha, ik_beta, z_Wr - ik_gamma, (branch & 1) != 0, ik_q_theta_r6, ik_c_theta_r6, ik_s_theta_r6)) {
+  double ik_c_theta_r6, ik_s_theta_r6;
+  if (!ik_solve_cos_sin(ik_alpha, ik_beta, z_Wr - ik_gamma, (branch & 1) != 0, ik_c_theta_r6, ik_s_theta_r6)) {
     const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, z_Wr, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_q_theta_r3 = ik_wrap(ik_q_sum - ik_q_theta_r6);
   const double ik_c_theta_r3 = ik_c_sum * ik_c_theta_r6 + ik_s_sum * ik_s_theta_r6;
   const double ik_s_theta_r3 = ik_s_sum * ik_c_theta_r6 - ik_c_sum * ik_s_theta_r6;
   const double ik_t10 = cos_roll*cos_pitch*ik_s_theta_r6 + ik_c_theta_r6*sin_pitch;
@@ -467,6 +470,12 @@ inline IkStatus ik_wheel_r(const Coordinates& s, const Params& p, int branch, Co
   const double ik_t13 = sin_theta_r5*ik_t12 - ik_t11*cos_theta_r5;
   const double ik_t14 = sin_pitch*ik_s_theta_r6 - ik_c_theta_r6*cos_roll*cos_pitch;
   const double ik_t15 = ik_t13*ik_s_theta_r3 + ik_c_theta_r3*ik_t14;
+  const std::array<double, 3> ik_sines{{ik_s_theta_r6, ik_s_theta_r3, ik_s_theta_r2}}, ik_cosines{{ik_c_theta_r6, ik_c_theta_r3, ik_c_theta_r2}};
+  std::array<double, 3> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_theta_r6 = ik_angles[0];
+  const double ik_q_theta_r3 = ik_angles[1];
+  const double ik_q_theta_r2 = ik_angles[2];
   const double ik_row0 = -(z_Wr + ik_t6 + ik_t11*wl + ik_t7 + ik_t9 - w*ik_t15);
   const double ik_row1 = ik_t14*ik_s_theta_r3 - ik_t13*ik_c_theta_r3;
   const double ik_row2 = -(ik_t15*ik_s_theta_r2 - (cos_theta_r5*ik_t12 + ik_t11*sin_theta_r5)*ik_c_theta_r2);
@@ -507,8 +516,9 @@ inline constexpr bool kHasFusedIk = true;
 
 // The closed forms of all 4 limbs in one pass: what ik_<limb>() computes for each, with the sines and
 // cosines of every input angle and the subexpressions the limbs share computed once. branches[k] is
-// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed,
-// `failed` its index and `why` its numbers; out is written only when every limb succeeded.
+// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed
+// (every limb's reach is tested before any limb's residual check), `failed` its index and `why`
+// its numbers; out is written only when every limb succeeded.
 // Operations: 476 (adds 170, muls 292, divs 0, calls 14), plus the solver calls.
 inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out,
                        int& failed, IkDiagnostics& why) noexcept {
@@ -594,24 +604,24 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_t24 = ik_t12*sin_psi_l1 - cos_psi_l1*ik_t15;
   const double ik_t25 = legD*legD + thighD*thighD;
   const double ik_t26 = 2.0*thighD*legD;
-  const double ik_t27 = 0.5*cos_yaw*cxd*cos_pitch;
-  const double ik_t29 = 0.5*cxd*cos_pitch*sin_yaw;
-  const double ik_t31 = -z_C;
-  const double ik_t32 = -0.5*sin_roll*cyd*cos_pitch;
-  const double ik_t34 = 0.5*sin_pitch*cxd;
-  const double ik_t35 = 2.0*x_Fr + ik_t6 - 2.0*x_C - cos_yaw*cxd*cos_pitch;
-  const double ik_t36 = ik_t9 + 2.0*z_Fr + sin_roll*cyd*cos_pitch + ik_t10;
-  const double ik_t37 = ik_t13 + 2.0*y_Fr - 2.0*y_C - cxd*cos_pitch*sin_yaw;
-  const double ik_t40 = ik_t20*sin_psi_r1 + ik_t5*cos_psi_r1;
-  const double ik_t41 = sin_roll*cos_psi_r1*cos_pitch + sin_psi_r1*cos_roll*cos_pitch;
-  const double ik_t42 = sin_psi_r1*ik_t15 + ik_t12*cos_psi_r1;
-  const double ik_t43 = sin_roll*sin_psi_r1*cos_pitch - cos_psi_r1*cos_roll*cos_pitch;
-  const double ik_t44 = sin_psi_r1*ik_t12 - ik_t15*cos_psi_r1;
-  const double ik_t45 = ik_t20*cos_psi_r1 - sin_psi_r1*ik_t5;
-  const double ik_t49 = 0.5*sin_roll*cyd*cos_pitch;
-  const double ik_t50 = -sin_pitch;
-  const double ik_t51 = sin_roll*cos_pitch;
-  const double ik_t52 = cos_roll*cos_pitch;
+  const double ik_t27 = 2.0*x_Fr + ik_t6 - 2.0*x_C - cos_yaw*cxd*cos_pitch;
+  const double ik_t28 = ik_t9 + 2.0*z_Fr + sin_roll*cyd*cos_pitch + ik_t10;
+  const double ik_t29 = ik_t13 + 2.0*y_Fr - 2.0*y_C - cxd*cos_pitch*sin_yaw;
+  const double ik_t32 = ik_t20*sin_psi_r1 + ik_t5*cos_psi_r1;
+  const double ik_t33 = sin_roll*cos_psi_r1*cos_pitch + sin_psi_r1*cos_roll*cos_pitch;
+  const double ik_t34 = sin_psi_r1*ik_t15 + ik_t12*cos_psi_r1;
+  const double ik_t35 = sin_roll*sin_psi_r1*cos_pitch - cos_psi_r1*cos_roll*cos_pitch;
+  const double ik_t36 = sin_psi_r1*ik_t12 - ik_t15*cos_psi_r1;
+  const double ik_t37 = ik_t20*cos_psi_r1 - sin_psi_r1*ik_t5;
+  const double ik_t38 = -sin_pitch;
+  const double ik_t39 = sin_roll*cos_pitch;
+  const double ik_t40 = cos_roll*cos_pitch;
+  const double ik_t44 = 0.5*sin_pitch*cxd;
+  const double ik_t46 = 0.5*sin_roll*cyd*cos_pitch;
+  const double ik_t50 = -0.5*sin_roll*cyd*cos_pitch;
+  const double ik_t51 = 0.5*cos_yaw*cxd*cos_pitch;
+  const double ik_t53 = 0.5*cxd*cos_pitch*sin_yaw;
+  const double ik_t55 = -z_C;
   const double ik_leg_l_d0 = -(0.5*cos_yaw*ik_t8*cos_pitch + 0.5*ik_t11*sin_pitch + 0.5*cos_pitch*sin_yaw*ik_t14);
   const double ik_leg_l_d1 = 0.5*ik_t11*ik_t19 - 0.5*ik_t18*ik_t14 - 0.5*ik_t21*ik_t8;
   const double ik_leg_l_d2 = -(0.5*ik_t8*ik_t22 - 0.5*ik_t11*ik_t23 - 0.5*ik_t24*ik_t14);
@@ -619,8 +629,8 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_leg_l_A = ik_t26;
   const double ik_leg_l_B = 0.0;
   const double ik_leg_l_dd = ik_leg_l_d0 * ik_leg_l_d0 + ik_leg_l_d1 * ik_leg_l_d1 + ik_leg_l_d2 * ik_leg_l_d2;
-  double ik_q_psi_l4, ik_c_psi_l4, ik_s_psi_l4;
-  if (!ik_solve_cos_sin(ik_leg_l_A, ik_leg_l_B, ik_leg_l_dd - ik_leg_l_K, (ik_leg_l_branch & 1) != 0, ik_q_psi_l4, ik_c_psi_l4, ik_s_psi_l4)) {
+  double ik_c_psi_l4, ik_s_psi_l4;
+  if (!ik_solve_cos_sin(ik_leg_l_A, ik_leg_l_B, ik_leg_l_dd - ik_leg_l_K, (ik_leg_l_branch & 1) != 0, ik_c_psi_l4, ik_s_psi_l4)) {
     const double ik_leg_l_R = std::sqrt(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
     why = {1, std::sqrt(ik_leg_l_dd), std::sqrt(std::max(0.0, ik_leg_l_K - ik_leg_l_R)), std::sqrt(ik_leg_l_K + ik_leg_l_R), 0.0};
     failed = 0;
@@ -631,34 +641,25 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_leg_l_v2 = -ik_s_psi_l4*legD;
   const double ik_leg_l_v[3] = {ik_leg_l_v0, ik_leg_l_v1, ik_leg_l_v2};
   const double ik_leg_l_d[3] = {ik_leg_l_d0, ik_leg_l_d1, ik_leg_l_d2};
-  double ik_q_psi_l2, ik_c_psi_l2, ik_s_psi_l2, ik_q_psi_l3, ik_c_psi_l3, ik_s_psi_l3, ik_leg_l_beside = 0, ik_leg_l_room = 0;
-  const bool ik_leg_l_two_axis_ok = ik_solve_two_axis<1, 2>(ik_leg_l_v, ik_leg_l_d, (ik_leg_l_branch & 2) != 0, ik_q_psi_l2, ik_c_psi_l2, ik_s_psi_l2, ik_q_psi_l3, ik_c_psi_l3, ik_s_psi_l3, ik_leg_l_beside, ik_leg_l_room);
+  double ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_leg_l_beside = 0, ik_leg_l_room = 0;
+  const bool ik_leg_l_two_axis_ok = ik_solve_two_axis<1, 2>(ik_leg_l_v, ik_leg_l_d, (ik_leg_l_branch & 2) != 0, ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_leg_l_beside, ik_leg_l_room);
   if (!ik_leg_l_two_axis_ok) {
-    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, ik_q_psi_l4 * 57.29577951308232};
+    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, std::atan2(ik_s_psi_l4, ik_c_psi_l4) * 57.29577951308232};
     failed = 0;
     return IkStatus::out_of_reach;
   }
-  const double ik_t28 = ik_t21*ik_s_psi_l3 + (cos_yaw*ik_c_psi_l2*cos_pitch - ik_s_psi_l2*ik_t22)*ik_c_psi_l3;
-  const double ik_t30 = (ik_s_psi_l2*ik_t24 + ik_c_psi_l2*cos_pitch*sin_yaw)*ik_c_psi_l3 + ik_s_psi_l3*ik_t18;
-  const double ik_t33 = ik_t19*ik_s_psi_l3 - ik_c_psi_l3*(sin_pitch*ik_c_psi_l2 + ik_s_psi_l2*ik_t23);
-  const double ik_leg_l_row0 = x_C + ik_t27 + legD*(ik_t28*ik_c_psi_l4 - ik_s_psi_l4*(ik_s_psi_l2*cos_yaw*cos_pitch + ik_c_psi_l2*ik_t22)) + ik_t28*thighD + 0.5*ik_t5*cyd - x_Fl;
-  const double ik_leg_l_row1 = ik_t29 + y_C + thighD*ik_t30 + 0.5*ik_t12*cyd + legD*(ik_c_psi_l4*ik_t30 - ik_s_psi_l4*(ik_s_psi_l2*cos_pitch*sin_yaw - ik_t24*ik_c_psi_l2)) - y_Fl;
-  const double ik_leg_l_row2 = -(z_Fl + ik_t31 + ik_t32 + ik_t34 - legD*(ik_c_psi_l4*ik_t33 + ik_s_psi_l4*(ik_s_psi_l2*sin_pitch - ik_c_psi_l2*ik_t23)) - thighD*ik_t33);
-  const double ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
-  if (!(ik_leg_l_residual <= kIkTolerance)) {
-    why = {0, ik_leg_l_residual, 0.0, kIkTolerance, 0.0};
-    failed = 0;
-    return IkStatus::residual;
-  }
-  const double ik_leg_r_d0 = 0.5*cos_yaw*ik_t35*cos_pitch + 0.5*ik_t37*cos_pitch*sin_yaw - 0.5*sin_pitch*ik_t36;
-  const double ik_leg_r_d1 = 0.5*ik_t40*ik_t35 + 0.5*ik_t41*ik_t36 + 0.5*ik_t37*ik_t42;
-  const double ik_leg_r_d2 = -(0.5*ik_t43*ik_t36 + 0.5*ik_t37*ik_t44 - 0.5*ik_t35*ik_t45);
+  const double ik_t52 = ik_t21*ik_s_psi_l3 + (cos_yaw*ik_c_psi_l2*cos_pitch - ik_s_psi_l2*ik_t22)*ik_c_psi_l3;
+  const double ik_t54 = (ik_s_psi_l2*ik_t24 + ik_c_psi_l2*cos_pitch*sin_yaw)*ik_c_psi_l3 + ik_s_psi_l3*ik_t18;
+  const double ik_t56 = ik_t19*ik_s_psi_l3 - ik_c_psi_l3*(sin_pitch*ik_c_psi_l2 + ik_s_psi_l2*ik_t23);
+  const double ik_leg_r_d0 = 0.5*cos_yaw*ik_t27*cos_pitch + 0.5*ik_t29*cos_pitch*sin_yaw - 0.5*sin_pitch*ik_t28;
+  const double ik_leg_r_d1 = 0.5*ik_t32*ik_t27 + 0.5*ik_t33*ik_t28 + 0.5*ik_t29*ik_t34;
+  const double ik_leg_r_d2 = -(0.5*ik_t35*ik_t28 + 0.5*ik_t29*ik_t36 - 0.5*ik_t27*ik_t37);
   const double ik_leg_r_K = ik_t25;
   const double ik_leg_r_A = ik_t26;
   const double ik_leg_r_B = 0.0;
   const double ik_leg_r_dd = ik_leg_r_d0 * ik_leg_r_d0 + ik_leg_r_d1 * ik_leg_r_d1 + ik_leg_r_d2 * ik_leg_r_d2;
-  double ik_q_psi_r4, ik_c_psi_r4, ik_s_psi_r4;
-  if (!ik_solve_cos_sin(ik_leg_r_A, ik_leg_r_B, ik_leg_r_dd - ik_leg_r_K, (ik_leg_r_branch & 1) != 0, ik_q_psi_r4, ik_c_psi_r4, ik_s_psi_r4)) {
+  double ik_c_psi_r4, ik_s_psi_r4;
+  if (!ik_solve_cos_sin(ik_leg_r_A, ik_leg_r_B, ik_leg_r_dd - ik_leg_r_K, (ik_leg_r_branch & 1) != 0, ik_c_psi_r4, ik_s_psi_r4)) {
     const double ik_leg_r_R = std::sqrt(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
     why = {1, std::sqrt(ik_leg_r_dd), std::sqrt(std::max(0.0, ik_leg_r_K - ik_leg_r_R)), std::sqrt(ik_leg_r_K + ik_leg_r_R), 0.0};
     failed = 1;
@@ -669,102 +670,77 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_leg_r_v2 = -legD*ik_s_psi_r4;
   const double ik_leg_r_v[3] = {ik_leg_r_v0, ik_leg_r_v1, ik_leg_r_v2};
   const double ik_leg_r_d[3] = {ik_leg_r_d0, ik_leg_r_d1, ik_leg_r_d2};
-  double ik_q_psi_r2, ik_c_psi_r2, ik_s_psi_r2, ik_q_psi_r3, ik_c_psi_r3, ik_s_psi_r3, ik_leg_r_beside = 0, ik_leg_r_room = 0;
-  const bool ik_leg_r_two_axis_ok = ik_solve_two_axis<1, 2>(ik_leg_r_v, ik_leg_r_d, (ik_leg_r_branch & 2) != 0, ik_q_psi_r2, ik_c_psi_r2, ik_s_psi_r2, ik_q_psi_r3, ik_c_psi_r3, ik_s_psi_r3, ik_leg_r_beside, ik_leg_r_room);
+  double ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_leg_r_beside = 0, ik_leg_r_room = 0;
+  const bool ik_leg_r_two_axis_ok = ik_solve_two_axis<1, 2>(ik_leg_r_v, ik_leg_r_d, (ik_leg_r_branch & 2) != 0, ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_leg_r_beside, ik_leg_r_room);
   if (!ik_leg_r_two_axis_ok) {
-    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, ik_q_psi_r4 * 57.29577951308232};
+    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, std::atan2(ik_s_psi_r4, ik_c_psi_r4) * 57.29577951308232};
     failed = 1;
     return IkStatus::out_of_reach;
   }
-  const double ik_t46 = (cos_yaw*cos_pitch*ik_c_psi_r2 - ik_s_psi_r2*ik_t45)*ik_c_psi_r3 + ik_t40*ik_s_psi_r3;
-  const double ik_t47 = (cos_pitch*sin_yaw*ik_c_psi_r2 + ik_t44*ik_s_psi_r2)*ik_c_psi_r3 + ik_t42*ik_s_psi_r3;
-  const double ik_t48 = ik_t41*ik_s_psi_r3 - (sin_pitch*ik_c_psi_r2 - ik_t43*ik_s_psi_r2)*ik_c_psi_r3;
-  const double ik_leg_r_row0 = x_C + thighD*ik_t46 + ik_t27 - 0.5*ik_t5*cyd - x_Fr - legD*(ik_s_psi_r4*(ik_c_psi_r2*ik_t45 + cos_yaw*cos_pitch*ik_s_psi_r2) - ik_c_psi_r4*ik_t46);
-  const double ik_leg_r_row1 = ik_t29 + thighD*ik_t47 + y_C - legD*(ik_s_psi_r4*(cos_pitch*sin_yaw*ik_s_psi_r2 - ik_t44*ik_c_psi_r2) - ik_t47*ik_c_psi_r4) - 0.5*ik_t12*cyd - y_Fr;
-  const double ik_leg_r_row2 = -(z_Fr + ik_t31 + ik_t34 + ik_t49 - legD*(ik_t48*ik_c_psi_r4 + ik_s_psi_r4*(sin_pitch*ik_s_psi_r2 + ik_t43*ik_c_psi_r2)) - ik_t48*thighD);
-  const double ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
-  if (!(ik_leg_r_residual <= kIkTolerance)) {
-    why = {0, ik_leg_r_residual, 0.0, kIkTolerance, 0.0};
-    failed = 1;
-    return IkStatus::residual;
-  }
+  const double ik_t57 = (cos_yaw*cos_pitch*ik_c_psi_r2 - ik_s_psi_r2*ik_t37)*ik_c_psi_r3 + ik_t32*ik_s_psi_r3;
+  const double ik_t58 = (cos_pitch*sin_yaw*ik_c_psi_r2 + ik_t36*ik_s_psi_r2)*ik_c_psi_r3 + ik_t34*ik_s_psi_r3;
+  const double ik_t59 = ik_t33*ik_s_psi_r3 - (sin_pitch*ik_c_psi_r2 - ik_t35*ik_s_psi_r2)*ik_c_psi_r3;
   const double ik_q_theta_l4 = -theta_l5;
-  const double ik_wheel_l_g0 = ik_t50;
-  const double ik_wheel_l_g1 = ik_t51;
-  const double ik_wheel_l_g2 = ik_t52;
+  const double ik_wheel_l_g0 = ik_t38;
+  const double ik_wheel_l_g1 = ik_t39;
+  const double ik_wheel_l_g2 = ik_t40;
   const double ik_wheel_l_axis[3] = {0.0, 0.0, 1.0};
   const double ik_wheel_l_g[3] = {ik_wheel_l_g0, ik_wheel_l_g1, ik_wheel_l_g2};
-  double ik_wheel_l_q_sum, ik_wheel_l_c_sum, ik_wheel_l_s_sum, ik_q_theta_l2, ik_c_theta_l2, ik_s_theta_l2, ik_wheel_l_beside = 0, ik_wheel_l_room = 0;
-  const bool ik_wheel_l_two_axis_ok = ik_solve_two_axis<1, 0>(ik_wheel_l_axis, ik_wheel_l_g, (ik_wheel_l_branch & 2) != 0, ik_wheel_l_q_sum, ik_wheel_l_c_sum, ik_wheel_l_s_sum, ik_q_theta_l2, ik_c_theta_l2, ik_s_theta_l2, ik_wheel_l_beside, ik_wheel_l_room);
+  double ik_wheel_l_c_sum, ik_wheel_l_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_wheel_l_beside = 0, ik_wheel_l_room = 0;
+  const bool ik_wheel_l_two_axis_ok = ik_solve_two_axis<1, 0>(ik_wheel_l_axis, ik_wheel_l_g, (ik_wheel_l_branch & 2) != 0, ik_wheel_l_c_sum, ik_wheel_l_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_wheel_l_beside, ik_wheel_l_room);
   static_cast<void>(ik_wheel_l_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
   if ((ik_wheel_l_c_sum < 0) != ((ik_wheel_l_branch & 4) != 0)) {
-    ik_wheel_l_q_sum = ik_wrap(ik_wheel_l_q_sum + 3.141592653589793);
     ik_wheel_l_c_sum = -ik_wheel_l_c_sum;
     ik_wheel_l_s_sum = -ik_wheel_l_s_sum;
-    ik_q_theta_l2 = -ik_q_theta_l2;
     ik_s_theta_l2 = -ik_s_theta_l2;
   }
-  const double ik_t53 = ik_wheel_l_s_sum*sin_pitch*w;
-  const double ik_t55 = -w*ik_wheel_l_c_sum*cos_roll*cos_pitch;
-  const double ik_wheel_l_alpha = -(ik_t53 - sin_pitch*(ik_wheel_l_s_sum*w + cos_theta_l5*wl));
-  const double ik_wheel_l_beta = -(cos_roll*cos_pitch*(w*ik_wheel_l_c_sum - cos_theta_l5*wl) + ik_t55);
-  const double ik_wheel_l_gamma = ik_t53 + ik_t34 + z_C + ik_t55 + ik_t49 - sin_roll*sin_theta_l5*wl*cos_pitch;
-  double ik_q_theta_l6, ik_c_theta_l6, ik_s_theta_l6;
-  if (!ik_solve_cos_sin(ik_wheel_l_alpha, ik_wheel_l_beta, z_Wl - ik_wheel_l_gamma, (ik_wheel_l_branch & 1) != 0, ik_q_theta_l6, ik_c_theta_l6, ik_s_theta_l6)) {
+  const double ik_t41 = ik_wheel_l_s_sum*sin_pitch*w;
+  const double ik_t43 = -w*ik_wheel_l_c_sum*cos_roll*cos_pitch;
+  const double ik_wheel_l_alpha = -(ik_t41 - sin_pitch*(ik_wheel_l_s_sum*w + cos_theta_l5*wl));
+  const double ik_wheel_l_beta = -(cos_roll*cos_pitch*(w*ik_wheel_l_c_sum - cos_theta_l5*wl) + ik_t43);
+  const double ik_wheel_l_gamma = ik_t41 + ik_t44 + z_C + ik_t43 + ik_t46 - sin_roll*sin_theta_l5*wl*cos_pitch;
+  double ik_c_theta_l6, ik_s_theta_l6;
+  if (!ik_solve_cos_sin(ik_wheel_l_alpha, ik_wheel_l_beta, z_Wl - ik_wheel_l_gamma, (ik_wheel_l_branch & 1) != 0, ik_c_theta_l6, ik_s_theta_l6)) {
     const double ik_wheel_l_R = std::sqrt(ik_wheel_l_alpha * ik_wheel_l_alpha + ik_wheel_l_beta * ik_wheel_l_beta);
     why = {1, z_Wl, ik_wheel_l_gamma - ik_wheel_l_R, ik_wheel_l_gamma + ik_wheel_l_R, 0.0};
     failed = 2;
     return IkStatus::out_of_reach;
   }
-  const double ik_q_theta_l3 = ik_wrap(ik_wheel_l_q_sum - ik_q_theta_l6);
   const double ik_c_theta_l3 = ik_wheel_l_c_sum * ik_c_theta_l6 + ik_wheel_l_s_sum * ik_s_theta_l6;
   const double ik_s_theta_l3 = ik_wheel_l_s_sum * ik_c_theta_l6 - ik_wheel_l_c_sum * ik_s_theta_l6;
-  const double ik_t57 = sin_pitch*ik_c_theta_l6 + cos_roll*cos_pitch*ik_s_theta_l6;
-  const double ik_t58 = cos_theta_l5*ik_t57 - sin_roll*sin_theta_l5*cos_pitch;
-  const double ik_t59 = sin_pitch*ik_s_theta_l6 - cos_roll*ik_c_theta_l6*cos_pitch;
-  const double ik_t60 = sin_theta_l5*ik_t57 + sin_roll*cos_theta_l5*cos_pitch;
-  const double ik_t61 = ik_t58*cos_theta_l5 + sin_theta_l5*ik_t60;
-  const double ik_t62 = ik_t59*ik_c_theta_l3 + ik_t61*ik_s_theta_l3;
-  const double ik_wheel_l_row0 = ik_t58*wl + ik_t34 + z_C + ik_t49 + w*ik_t62 - z_Wl;
-  const double ik_wheel_l_row1 = -(ik_t61*ik_c_theta_l3 - ik_t59*ik_s_theta_l3);
-  const double ik_wheel_l_row2 = ik_c_theta_l2*(cos_theta_l5*ik_t60 - sin_theta_l5*ik_t58) - ik_t62*ik_s_theta_l2;
-  const double ik_wheel_l_row3 = 0.0;
-  const double ik_wheel_l_residual = std::max({std::abs(ik_wheel_l_row0), std::abs(ik_wheel_l_row1), std::abs(ik_wheel_l_row2), std::abs(ik_wheel_l_row3)});
-  if (!(ik_wheel_l_residual <= kIkTolerance)) {
-    why = {0, ik_wheel_l_residual, 0.0, kIkTolerance, 0.0};
-    failed = 2;
-    return IkStatus::residual;
-  }
+  const double ik_t60 = sin_pitch*ik_c_theta_l6 + cos_roll*cos_pitch*ik_s_theta_l6;
+  const double ik_t61 = cos_theta_l5*ik_t60 - sin_roll*sin_theta_l5*cos_pitch;
+  const double ik_t62 = sin_pitch*ik_s_theta_l6 - cos_roll*ik_c_theta_l6*cos_pitch;
+  const double ik_t63 = sin_theta_l5*ik_t60 + sin_roll*cos_theta_l5*cos_pitch;
+  const double ik_t64 = ik_t61*cos_theta_l5 + sin_theta_l5*ik_t63;
+  const double ik_t65 = ik_t62*ik_c_theta_l3 + ik_t64*ik_s_theta_l3;
   const double ik_q_theta_r4 = -theta_r5;
-  const double ik_wheel_r_g0 = ik_t50;
-  const double ik_wheel_r_g1 = ik_t51;
-  const double ik_wheel_r_g2 = ik_t52;
+  const double ik_wheel_r_g0 = ik_t38;
+  const double ik_wheel_r_g1 = ik_t39;
+  const double ik_wheel_r_g2 = ik_t40;
   const double ik_wheel_r_axis[3] = {0.0, 0.0, 1.0};
   const double ik_wheel_r_g[3] = {ik_wheel_r_g0, ik_wheel_r_g1, ik_wheel_r_g2};
-  double ik_wheel_r_q_sum, ik_wheel_r_c_sum, ik_wheel_r_s_sum, ik_q_theta_r2, ik_c_theta_r2, ik_s_theta_r2, ik_wheel_r_beside = 0, ik_wheel_r_room = 0;
-  const bool ik_wheel_r_two_axis_ok = ik_solve_two_axis<1, 0>(ik_wheel_r_axis, ik_wheel_r_g, (ik_wheel_r_branch & 2) != 0, ik_wheel_r_q_sum, ik_wheel_r_c_sum, ik_wheel_r_s_sum, ik_q_theta_r2, ik_c_theta_r2, ik_s_theta_r2, ik_wheel_r_beside, ik_wheel_r_room);
+  double ik_wheel_r_c_sum, ik_wheel_r_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_wheel_r_beside = 0, ik_wheel_r_room = 0;
+  const bool ik_wheel_r_two_axis_ok = ik_solve_two_axis<1, 0>(ik_wheel_r_axis, ik_wheel_r_g, (ik_wheel_r_branch & 2) != 0, ik_wheel_r_c_sum, ik_wheel_r_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_wheel_r_beside, ik_wheel_r_room);
   static_cast<void>(ik_wheel_r_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
   if ((ik_wheel_r_c_sum < 0) != ((ik_wheel_r_branch & 4) != 0)) {
-    ik_wheel_r_q_sum = ik_wrap(ik_wheel_r_q_sum + 3.141592653589793);
     ik_wheel_r_c_sum = -ik_wheel_r_c_sum;
     ik_wheel_r_s_sum = -ik_wheel_r_s_sum;
-    ik_q_theta_r2 = -ik_q_theta_r2;
     ik_s_theta_r2 = -ik_s_theta_r2;
   }
-  const double ik_t64 = -w*ik_wheel_r_c_sum*cos_roll*cos_pitch;
+  const double ik_t48 = -w*ik_wheel_r_c_sum*cos_roll*cos_pitch;
   const double ik_wheel_r_alpha = sin_pitch*(w*ik_wheel_r_s_sum + cos_theta_r5*wl) - sin_pitch*w*ik_wheel_r_s_sum;
-  const double ik_wheel_r_beta = -(ik_t64 + (w*ik_wheel_r_c_sum - cos_theta_r5*wl)*cos_roll*cos_pitch);
-  const double ik_wheel_r_gamma = ik_t32 + ik_t34 + z_C + ik_t64 + sin_pitch*w*ik_wheel_r_s_sum - sin_roll*sin_theta_r5*wl*cos_pitch;
-  double ik_q_theta_r6, ik_c_theta_r6, ik_s_theta_r6;
-  if (!ik_solve_cos_sin(ik_wheel_r_alpha, ik_wheel_r_beta, z_Wr - ik_wheel_r_gamma, (ik_wheel_r_branch & 1) != 0, ik_q_theta_r6, ik_c_theta_r6, ik_s_theta_r6)) {
+  const double ik_wheel_r_beta = -(ik_t48 + (w*ik_wheel_r_c_sum - cos_theta_r5*wl)*cos_roll*cos_pitch);
+  const double ik_wheel_r_gamma = ik_t50 + ik_t44 + z_C + ik_t48 + sin_pitch*w*ik_wheel_r_s_sum - sin_roll*sin_theta_r5*wl*cos_pitch;
+  double ik_c_theta_r6, ik_s_theta_r6;
+  if (!ik_solve_cos_sin(ik_wheel_r_alpha, ik_wheel_r_beta, z_Wr - ik_wheel_r_gamma, (ik_wheel_r_branch & 1) != 0, ik_c_theta_r6, ik_s_theta_r6)) {
     const double ik_wheel_r_R = std::sqrt(ik_wheel_r_alpha * ik_wheel_r_alpha + ik_wheel_r_beta * ik_wheel_r_beta);
     why = {1, z_Wr, ik_wheel_r_gamma - ik_wheel_r_R, ik_wheel_r_gamma + ik_wheel_r_R, 0.0};
     failed = 3;
     return IkStatus::out_of_reach;
   }
-  const double ik_q_theta_r3 = ik_wrap(ik_wheel_r_q_sum - ik_q_theta_r6);
   const double ik_c_theta_r3 = ik_wheel_r_c_sum * ik_c_theta_r6 + ik_wheel_r_s_sum * ik_s_theta_r6;
   const double ik_s_theta_r3 = ik_wheel_r_s_sum * ik_c_theta_r6 - ik_wheel_r_c_sum * ik_s_theta_r6;
   const double ik_t66 = cos_roll*cos_pitch*ik_s_theta_r6 + ik_c_theta_r6*sin_pitch;
@@ -773,7 +749,50 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_t69 = sin_theta_r5*ik_t68 - ik_t67*cos_theta_r5;
   const double ik_t70 = sin_pitch*ik_s_theta_r6 - ik_c_theta_r6*cos_roll*cos_pitch;
   const double ik_t71 = ik_t69*ik_s_theta_r3 + ik_c_theta_r3*ik_t70;
-  const double ik_wheel_r_row0 = -(z_Wr + ik_t31 + ik_t67*wl + ik_t49 - w*ik_t71 - 0.5*sin_pitch*cxd);
+  const std::array<double, 12> ik_sines{{ik_s_psi_l2, ik_s_psi_l3, ik_s_psi_l4, ik_s_psi_r2, ik_s_psi_r3, ik_s_psi_r4, ik_s_theta_l6, ik_s_theta_l3, ik_s_theta_l2, ik_s_theta_r6, ik_s_theta_r3, ik_s_theta_r2}}, ik_cosines{{ik_c_psi_l2, ik_c_psi_l3, ik_c_psi_l4, ik_c_psi_r2, ik_c_psi_r3, ik_c_psi_r4, ik_c_theta_l6, ik_c_theta_l3, ik_c_theta_l2, ik_c_theta_r6, ik_c_theta_r3, ik_c_theta_r2}};
+  std::array<double, 12> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_psi_l2 = ik_angles[0];
+  const double ik_q_psi_l3 = ik_angles[1];
+  const double ik_q_psi_l4 = ik_angles[2];
+  const double ik_q_psi_r2 = ik_angles[3];
+  const double ik_q_psi_r3 = ik_angles[4];
+  const double ik_q_psi_r4 = ik_angles[5];
+  const double ik_q_theta_l6 = ik_angles[6];
+  const double ik_q_theta_l3 = ik_angles[7];
+  const double ik_q_theta_l2 = ik_angles[8];
+  const double ik_q_theta_r6 = ik_angles[9];
+  const double ik_q_theta_r3 = ik_angles[10];
+  const double ik_q_theta_r2 = ik_angles[11];
+  const double ik_leg_l_row0 = x_C + ik_t51 + legD*(ik_t52*ik_c_psi_l4 - ik_s_psi_l4*(ik_s_psi_l2*cos_yaw*cos_pitch + ik_c_psi_l2*ik_t22)) + ik_t52*thighD + 0.5*ik_t5*cyd - x_Fl;
+  const double ik_leg_l_row1 = ik_t53 + y_C + thighD*ik_t54 + 0.5*ik_t12*cyd + legD*(ik_c_psi_l4*ik_t54 - ik_s_psi_l4*(ik_s_psi_l2*cos_pitch*sin_yaw - ik_t24*ik_c_psi_l2)) - y_Fl;
+  const double ik_leg_l_row2 = -(z_Fl + ik_t55 + ik_t50 + ik_t44 - legD*(ik_c_psi_l4*ik_t56 + ik_s_psi_l4*(ik_s_psi_l2*sin_pitch - ik_c_psi_l2*ik_t23)) - thighD*ik_t56);
+  const double ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
+  if (!(ik_leg_l_residual <= kIkTolerance)) {
+    why = {0, ik_leg_l_residual, 0.0, kIkTolerance, 0.0};
+    failed = 0;
+    return IkStatus::residual;
+  }
+  const double ik_leg_r_row0 = x_C + thighD*ik_t57 + ik_t51 - 0.5*ik_t5*cyd - x_Fr - legD*(ik_s_psi_r4*(ik_c_psi_r2*ik_t37 + cos_yaw*cos_pitch*ik_s_psi_r2) - ik_c_psi_r4*ik_t57);
+  const double ik_leg_r_row1 = ik_t53 + thighD*ik_t58 + y_C - legD*(ik_s_psi_r4*(cos_pitch*sin_yaw*ik_s_psi_r2 - ik_t36*ik_c_psi_r2) - ik_t58*ik_c_psi_r4) - 0.5*ik_t12*cyd - y_Fr;
+  const double ik_leg_r_row2 = -(z_Fr + ik_t55 + ik_t44 + ik_t46 - legD*(ik_t59*ik_c_psi_r4 + ik_s_psi_r4*(sin_pitch*ik_s_psi_r2 + ik_t35*ik_c_psi_r2)) - ik_t59*thighD);
+  const double ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
+  if (!(ik_leg_r_residual <= kIkTolerance)) {
+    why = {0, ik_leg_r_residual, 0.0, kIkTolerance, 0.0};
+    failed = 1;
+    return IkStatus::residual;
+  }
+  const double ik_wheel_l_row0 = ik_t61*wl + ik_t44 + z_C + ik_t46 + w*ik_t65 - z_Wl;
+  const double ik_wheel_l_row1 = -(ik_t64*ik_c_theta_l3 - ik_t62*ik_s_theta_l3);
+  const double ik_wheel_l_row2 = ik_c_theta_l2*(cos_theta_l5*ik_t63 - sin_theta_l5*ik_t61) - ik_t65*ik_s_theta_l2;
+  const double ik_wheel_l_row3 = 0.0;
+  const double ik_wheel_l_residual = std::max({std::abs(ik_wheel_l_row0), std::abs(ik_wheel_l_row1), std::abs(ik_wheel_l_row2), std::abs(ik_wheel_l_row3)});
+  if (!(ik_wheel_l_residual <= kIkTolerance)) {
+    why = {0, ik_wheel_l_residual, 0.0, kIkTolerance, 0.0};
+    failed = 2;
+    return IkStatus::residual;
+  }
+  const double ik_wheel_r_row0 = -(z_Wr + ik_t55 + ik_t67*wl + ik_t46 - w*ik_t71 - 0.5*sin_pitch*cxd);
   const double ik_wheel_r_row1 = ik_t70*ik_s_theta_r3 - ik_t69*ik_c_theta_r3;
   const double ik_wheel_r_row2 = -(ik_t71*ik_s_theta_r2 - (cos_theta_r5*ik_t68 + ik_t67*sin_theta_r5)*ik_c_theta_r2);
   const double ik_wheel_r_row3 = 0.0;

@@ -46,16 +46,10 @@ inline constexpr double kIkReachSlack = 1e-12;
 // about 1e-15.
 inline constexpr double kIkTolerance = 1e-9;
 
-inline double ik_wrap(double a) noexcept {
-  constexpr double pi = 3.141592653589793;
-  if (a > -pi && a <= pi) return a;
-  a = std::remainder(a, 2 * pi);
-  return a == -pi ? pi : a;
-}
-
-// x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie the positive one),
-// or the other root with `other`; also cos x and sin x. False when |c| exceeds sqrt(a^2 + b^2).
-inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& x, double& cos_x, double& sin_x) noexcept {
+// cos x and sin x of the x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie
+// the positive one), or the other root with `other`. False when |c| exceeds sqrt(a^2 + b^2). The
+// angles themselves come from one batched atan2 pass at the end of a solve.
+inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& cos_x, double& sin_x) noexcept {
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
   const double r = std::sqrt(a * a + b * b);
@@ -71,17 +65,16 @@ inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& x
   if (other) sign = -sign;
   cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
   sin_x = sin_psi * ratio + sign * cos_psi * sin_delta;
-  x = std::atan2(sin_x, cos_x);  // one atan2 of the angle sum, exact to rounding
   return true;
 }
 
-// q1, q2 with R_A(q1) R_B(q2) v = d, for principal axes A != B (0 x, 1 y, 2 z) and |v| = |d|:
+// cos and sin of q1, q2 with R_A(q1) R_B(q2) v = d, for principal axes A != B (0 x, 1 y, 2 z) and |v| = |d|:
 // the component of d along A fixes q2 (two roots: `flip` takes the one with cos q2 of the other sign
 // than branch 0's), then q1 turns R_B(q2) v onto d. False (with how far d is off the plane normal to
 // A, and how far it could be) when no q2 reaches d's component along A.
 template <int A, int B>
-inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& q1, double& c1, double& s1,
-                              double& q2, double& c2, double& s2, double& beside, double& room) noexcept {
+inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& c1, double& s1, double& c2,
+                              double& s2, double& beside, double& room) noexcept {
   static_assert(A != B && A >= 0 && A < 3 && B >= 0 && B < 3, "two different principal axes");
   constexpr int C = 3 - A - B;
   constexpr int i = (B + 1) % 3, j = (B + 2) % 3;    // R_B turns i towards j
@@ -103,7 +96,6 @@ inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool f
   t[C] = k;
   const double y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
   const double r = std::sqrt(x * x + y * y);
-  q2 = r > 0 ? std::atan2(y, x) : 0.0;
   c2 = r > 0 ? x / r : 1.0;
   s2 = r > 0 ? y / r : 0.0;
   double w[3];
@@ -112,7 +104,6 @@ inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool f
   w[j] = s2 * v[i] + c2 * v[j];
   const double y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
   const double r1 = std::sqrt(x1 * x1 + y1 * y1);
-  q1 = r1 > 0 ? std::atan2(y1, x1) : 0.0;
   c1 = r1 > 0 ? x1 / r1 : 1.0;
   s1 = r1 > 0 ? y1 / r1 : 0.0;
   return true;
@@ -185,8 +176,8 @@ inline IkStatus ik_leg_l(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_A = 2.0*shank*thigh;
   const double ik_B = 0.0;
   const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
-  double ik_q_knee_l, ik_c_knee_l, ik_s_knee_l;
-  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_q_knee_l, ik_c_knee_l, ik_s_knee_l)) {
+  double ik_c_knee_l, ik_s_knee_l;
+  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_knee_l, ik_s_knee_l)) {
     const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
     why = {1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
@@ -196,10 +187,10 @@ inline IkStatus ik_leg_l(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_v2 = -ik_s_knee_l*shank;
   const double ik_v[3] = {ik_v0, ik_v1, ik_v2};
   const double ik_d[3] = {ik_d0, ik_d1, ik_d2};
-  double ik_q_abduct_l, ik_c_abduct_l, ik_s_abduct_l, ik_q_lift_l, ik_c_lift_l, ik_s_lift_l, ik_beside = 0, ik_room = 0;
-  const bool ik_two_axis_ok = ik_solve_two_axis<0, 1>(ik_v, ik_d, (branch & 2) != 0, ik_q_abduct_l, ik_c_abduct_l, ik_s_abduct_l, ik_q_lift_l, ik_c_lift_l, ik_s_lift_l, ik_beside, ik_room);
+  double ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_beside = 0, ik_room = 0;
+  const bool ik_two_axis_ok = ik_solve_two_axis<0, 1>(ik_v, ik_d, (branch & 2) != 0, ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_beside, ik_room);
   if (!ik_two_axis_ok) {
-    why = {2, ik_beside, 0.0, ik_room, ik_q_knee_l * 57.29577951308232};
+    why = {2, ik_beside, 0.0, ik_room, std::atan2(ik_s_knee_l, ik_c_knee_l) * 57.29577951308232};
     return IkStatus::out_of_reach;
   }
   const double ik_t25 = ik_t6*ik_c_abduct_l - ik_t22*ik_s_abduct_l;
@@ -208,6 +199,12 @@ inline IkStatus ik_leg_l(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_t28 = ik_c_lift_l*ik_t13 + ik_s_lift_l*ik_t27;
   const double ik_t29 = ik_s_abduct_l*ik_t24 - ik_c_abduct_l*cos_roll*cos_pitch;
   const double ik_t30 = ik_s_lift_l*ik_t29 - ik_t21*ik_c_lift_l;
+  const std::array<double, 3> ik_sines{{ik_s_abduct_l, ik_s_lift_l, ik_s_knee_l}}, ik_cosines{{ik_c_abduct_l, ik_c_lift_l, ik_c_knee_l}};
+  std::array<double, 3> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_abduct_l = ik_angles[0];
+  const double ik_q_lift_l = ik_angles[1];
+  const double ik_q_knee_l = ik_angles[2];
   const double ik_row0 = (ik_t6*ik_s_abduct_l + ik_t22*ik_c_abduct_l)*knee_offset + x_C + ik_t7*hip_y + thigh*ik_t26 + hip_x*cos_yaw*cos_pitch - ik_t6*hip_drop - shank*(ik_s_knee_l*(ik_c_lift_l*ik_t25 + ik_s_lift_l*ik_t11) - ik_c_knee_l*ik_t26) - foot_x_l;
   const double ik_row1 = ik_t14 + (ik_t15*ik_s_abduct_l + ik_c_abduct_l*ik_t23)*knee_offset + ik_t28*thigh + ik_t16 + y_C + shank*(ik_s_knee_l*(ik_t27*ik_c_lift_l - ik_s_lift_l*ik_t13) + ik_t28*ik_c_knee_l) + ik_t17 + ik_t18;
   const double ik_row2 = (ik_s_abduct_l*cos_roll*cos_pitch + ik_c_abduct_l*ik_t24)*knee_offset + ik_t30*thigh + z_C + sin_roll*cos_pitch*hip_y + shank*(ik_t30*ik_c_knee_l + ik_s_knee_l*(ik_s_lift_l*ik_t21 + ik_t29*ik_c_lift_l)) - hip_x*sin_pitch - foot_z_l - hip_drop*cos_roll*cos_pitch;
@@ -297,8 +294,8 @@ inline IkStatus ik_leg_r(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_A = 2.0*shank*thigh;
   const double ik_B = 0.0;
   const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
-  double ik_q_knee_r, ik_c_knee_r, ik_s_knee_r;
-  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_q_knee_r, ik_c_knee_r, ik_s_knee_r)) {
+  double ik_c_knee_r, ik_s_knee_r;
+  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_knee_r, ik_s_knee_r)) {
     const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
     why = {1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
@@ -308,10 +305,10 @@ inline IkStatus ik_leg_r(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_v2 = -shank*ik_s_knee_r;
   const double ik_v[3] = {ik_v0, ik_v1, ik_v2};
   const double ik_d[3] = {ik_d0, ik_d1, ik_d2};
-  double ik_q_abduct_r, ik_c_abduct_r, ik_s_abduct_r, ik_q_lift_r, ik_c_lift_r, ik_s_lift_r, ik_beside = 0, ik_room = 0;
-  const bool ik_two_axis_ok = ik_solve_two_axis<0, 1>(ik_v, ik_d, (branch & 2) != 0, ik_q_abduct_r, ik_c_abduct_r, ik_s_abduct_r, ik_q_lift_r, ik_c_lift_r, ik_s_lift_r, ik_beside, ik_room);
+  double ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_beside = 0, ik_room = 0;
+  const bool ik_two_axis_ok = ik_solve_two_axis<0, 1>(ik_v, ik_d, (branch & 2) != 0, ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_beside, ik_room);
   if (!ik_two_axis_ok) {
-    why = {2, ik_beside, 0.0, ik_room, ik_q_knee_r * 57.29577951308232};
+    why = {2, ik_beside, 0.0, ik_room, std::atan2(ik_s_knee_r, ik_c_knee_r) * 57.29577951308232};
     return IkStatus::out_of_reach;
   }
   const double ik_t33 = ik_s_abduct_r*ik_t32 - ik_t11*ik_c_abduct_r;
@@ -320,6 +317,12 @@ inline IkStatus ik_leg_r(const Coordinates& s, const Params& p, int branch, Coor
   const double ik_t36 = ik_t23*ik_c_lift_r - ik_t35*ik_s_lift_r;
   const double ik_t37 = ik_t31*ik_s_abduct_r - ik_c_abduct_r*cos_roll*cos_pitch;
   const double ik_t38 = ik_t16*ik_c_lift_r + ik_s_lift_r*ik_t37;
+  const std::array<double, 3> ik_sines{{ik_s_abduct_r, ik_s_lift_r, ik_s_knee_r}}, ik_cosines{{ik_c_abduct_r, ik_c_lift_r, ik_c_knee_r}};
+  std::array<double, 3> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_abduct_r = ik_angles[0];
+  const double ik_q_lift_r = ik_angles[1];
+  const double ik_q_knee_r = ik_angles[2];
   const double ik_row0 = -(ik_t10 + (ik_c_abduct_r*ik_t32 + ik_t11*ik_s_abduct_r)*knee_offset + ik_t12 + foot_x_r + ik_t13 + ik_t14 - thigh*ik_t34 - ((ik_t33*ik_c_lift_r - ik_s_lift_r*ik_t9)*ik_s_knee_r + ik_c_knee_r*ik_t34)*shank);
   const double ik_row1 = thigh*ik_t36 + ik_t24 + ik_t25 + ik_t26 + ik_t28 + y_C + shank*(ik_c_knee_r*ik_t36 - (ik_t35*ik_c_lift_r + ik_t23*ik_s_lift_r)*ik_s_knee_r) + (ik_c_abduct_r*ik_t30 - ik_t27*ik_s_abduct_r)*knee_offset;
   const double ik_row2 = -(foot_z_r + ik_t17 + ik_t18 + ik_t19 + (ik_s_abduct_r*cos_roll*cos_pitch + ik_c_abduct_r*ik_t31)*knee_offset + shank*((ik_t16*ik_s_lift_r - ik_c_lift_r*ik_t37)*ik_s_knee_r - ik_c_knee_r*ik_t38) + ik_t20 - thigh*ik_t38);
@@ -377,28 +380,25 @@ inline IkStatus ik_lever_l(const Coordinates& s, const Params& p, int branch, Co
   const double ik_g2 = cos_roll*cos_pitch;
   const double ik_axis[3] = {0.0, 0.0, 1.0};
   const double ik_g[3] = {ik_g0, ik_g1, ik_g2};
-  double ik_q_sum, ik_c_sum, ik_s_sum, ik_q_camber_l, ik_c_camber_l, ik_s_camber_l, ik_beside = 0, ik_room = 0;
-  const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_q_sum, ik_c_sum, ik_s_sum, ik_q_camber_l, ik_c_camber_l, ik_s_camber_l, ik_beside, ik_room);
+  double ik_c_sum, ik_s_sum, ik_c_camber_l, ik_s_camber_l, ik_beside = 0, ik_room = 0;
+  const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_c_sum, ik_s_sum, ik_c_camber_l, ik_s_camber_l, ik_beside, ik_room);
   static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
   if ((ik_c_sum < 0) != ((branch & 4) != 0)) {
-    ik_q_sum = ik_wrap(ik_q_sum + 3.141592653589793);
     ik_c_sum = -ik_c_sum;
     ik_s_sum = -ik_s_sum;
-    ik_q_camber_l = -ik_q_camber_l;
     ik_s_camber_l = -ik_s_camber_l;
   }
   const double ik_t4 = radius*sin_pitch*ik_s_sum;
   const double ik_alpha = -(ik_t4 - sin_pitch*(lever_offset*sin_steer_l + cos_steer_l*lever + radius*ik_s_sum));
   const double ik_beta = radius*ik_c_sum*cos_roll*cos_pitch - (radius*ik_c_sum - cos_steer_l*lever - lever_offset*sin_steer_l)*cos_roll*cos_pitch;
   const double ik_gamma = ik_t4 + sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + sin_pitch*rear_x - radius*ik_c_sum*cos_roll*cos_pitch - cos_roll*rear_drop*cos_pitch;
-  double ik_q_swing_l, ik_c_swing_l, ik_s_swing_l;
-  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ground_l - ik_gamma, (branch & 1) != 0, ik_q_swing_l, ik_c_swing_l, ik_s_swing_l)) {
+  double ik_c_swing_l, ik_s_swing_l;
+  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ground_l - ik_gamma, (branch & 1) != 0, ik_c_swing_l, ik_s_swing_l)) {
     const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, ground_l, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_q_hub_l = ik_wrap(ik_q_sum - ik_q_swing_l);
   const double ik_c_hub_l = ik_c_sum * ik_c_swing_l + ik_s_sum * ik_s_swing_l;
   const double ik_s_hub_l = ik_s_sum * ik_c_swing_l - ik_c_sum * ik_s_swing_l;
   const double ik_t7 = sin_pitch*ik_c_swing_l + ik_s_swing_l*cos_roll*cos_pitch;
@@ -408,6 +408,12 @@ inline IkStatus ik_lever_l(const Coordinates& s, const Params& p, int branch, Co
   const double ik_t11 = sin_steer_l*ik_t9 + ik_t8*cos_steer_l;
   const double ik_t12 = sin_pitch*ik_s_swing_l - ik_c_swing_l*cos_roll*cos_pitch;
   const double ik_t13 = ik_t11*ik_s_hub_l + ik_c_hub_l*ik_t12;
+  const std::array<double, 3> ik_sines{{ik_s_swing_l, ik_s_hub_l, ik_s_camber_l}}, ik_cosines{{ik_c_swing_l, ik_c_hub_l, ik_c_camber_l}};
+  std::array<double, 3> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_swing_l = ik_angles[0];
+  const double ik_q_hub_l = ik_angles[1];
+  const double ik_q_camber_l = ik_angles[2];
   const double ik_row0 = -(ik_t10*hub_offset + ground_l + cos_roll*rear_drop*cos_pitch - z_C - ik_t8*lever - sin_roll*rear_y*cos_pitch - radius*ik_t13 - sin_pitch*rear_x - lever_offset*ik_t9);
   const double ik_row1 = -(ik_t11*ik_c_hub_l - ik_s_hub_l*ik_t12);
   const double ik_row2 = -(ik_t10*ik_c_camber_l + ik_t13*ik_s_camber_l);
@@ -470,28 +476,25 @@ inline IkStatus ik_lever_r(const Coordinates& s, const Params& p, int branch, Co
   const double ik_g2 = cos_roll*cos_pitch;
   const double ik_axis[3] = {0.0, 0.0, 1.0};
   const double ik_g[3] = {ik_g0, ik_g1, ik_g2};
-  double ik_q_sum, ik_c_sum, ik_s_sum, ik_q_camber_r, ik_c_camber_r, ik_s_camber_r, ik_beside = 0, ik_room = 0;
-  const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_q_sum, ik_c_sum, ik_s_sum, ik_q_camber_r, ik_c_camber_r, ik_s_camber_r, ik_beside, ik_room);
+  double ik_c_sum, ik_s_sum, ik_c_camber_r, ik_s_camber_r, ik_beside = 0, ik_room = 0;
+  const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_c_sum, ik_s_sum, ik_c_camber_r, ik_s_camber_r, ik_beside, ik_room);
   static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
   if ((ik_c_sum < 0) != ((branch & 4) != 0)) {
-    ik_q_sum = ik_wrap(ik_q_sum + 3.141592653589793);
     ik_c_sum = -ik_c_sum;
     ik_s_sum = -ik_s_sum;
-    ik_q_camber_r = -ik_q_camber_r;
     ik_s_camber_r = -ik_s_camber_r;
   }
   const double ik_t4 = radius*sin_pitch*ik_s_sum;
   const double ik_alpha = -(ik_t4 - (radius*ik_s_sum + cos_steer_r*lever - lever_offset*sin_steer_r)*sin_pitch);
   const double ik_beta = radius*ik_c_sum*cos_roll*cos_pitch - (radius*ik_c_sum + lever_offset*sin_steer_r - cos_steer_r*lever)*cos_roll*cos_pitch;
   const double ik_gamma = ik_t4 + ik_t7 + z_C + ik_t8 + ik_t9 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*ik_c_sum*cos_roll*cos_pitch;
-  double ik_q_swing_r, ik_c_swing_r, ik_s_swing_r;
-  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ground_r - ik_gamma, (branch & 1) != 0, ik_q_swing_r, ik_c_swing_r, ik_s_swing_r)) {
+  double ik_c_swing_r, ik_s_swing_r;
+  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ground_r - ik_gamma, (branch & 1) != 0, ik_c_swing_r, ik_s_swing_r)) {
     const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, ground_r, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_q_hub_r = ik_wrap(ik_q_sum - ik_q_swing_r);
   const double ik_c_hub_r = ik_c_sum * ik_c_swing_r + ik_s_sum * ik_s_swing_r;
   const double ik_s_hub_r = ik_s_sum * ik_c_swing_r - ik_c_sum * ik_s_swing_r;
   const double ik_t10 = ik_c_swing_r*cos_roll*cos_pitch - sin_pitch*ik_s_swing_r;
@@ -501,6 +504,12 @@ inline IkStatus ik_lever_r(const Coordinates& s, const Params& p, int branch, Co
   const double ik_t14 = sin_steer_r*ik_t12 - cos_steer_r*ik_t13;
   const double ik_t15 = ik_t14*ik_s_hub_r - ik_c_hub_r*ik_t10;
   const double ik_t16 = cos_steer_r*ik_t12 + sin_steer_r*ik_t13;
+  const std::array<double, 3> ik_sines{{ik_s_swing_r, ik_s_hub_r, ik_s_camber_r}}, ik_cosines{{ik_c_swing_r, ik_c_hub_r, ik_c_camber_r}};
+  std::array<double, 3> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_swing_r = ik_angles[0];
+  const double ik_q_hub_r = ik_angles[1];
+  const double ik_q_camber_r = ik_angles[2];
   const double ik_row0 = radius*ik_t15 + ik_t7 + z_C + ik_t8 + ik_t9 - ground_r - lever_offset*ik_t12 - ik_t16*hub_offset - lever*ik_t13;
   const double ik_row1 = -(ik_t10*ik_s_hub_r + ik_c_hub_r*ik_t14);
   const double ik_row2 = ik_t16*ik_c_camber_r - ik_t15*ik_s_camber_r;
@@ -541,8 +550,9 @@ inline constexpr bool kHasFusedIk = true;
 
 // The closed forms of all 4 limbs in one pass: what ik_<limb>() computes for each, with the sines and
 // cosines of every input angle and the subexpressions the limbs share computed once. branches[k] is
-// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed,
-// `failed` its index and `why` its numbers; out is written only when every limb succeeded.
+// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed
+// (every limb's reach is tested before any limb's residual check), `failed` its index and `why`
+// its numbers; out is written only when every limb succeeded.
 // Operations: 515 (adds 215, muls 286, divs 0, calls 14), plus the solver calls.
 inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out,
                        int& failed, IkDiagnostics& why) noexcept {
@@ -641,29 +651,29 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_t30 = sin_roll*cos_slew_l*cos_pitch + sin_pitch*sin_slew_l;
   const double ik_t31 = shank*shank + thigh*thigh + knee_offset*knee_offset;
   const double ik_t32 = 2.0*shank*thigh;
-  const double ik_t35 = ik_t9*hip_y;
-  const double ik_t40 = sin_roll*cos_pitch*hip_y;
-  const double ik_t43 = cos_yaw*cos_pitch*cos_slew_r + sin_slew_r*ik_t9;
-  const double ik_t44 = ik_t2 + ik_t8 + foot_x_r + ik_t35 + ik_t10;
-  const double ik_t45 = sin_roll*sin_slew_r*cos_pitch - sin_pitch*cos_slew_r;
-  const double ik_t46 = foot_z_r + ik_t23 + ik_t24 + ik_t40 + ik_t25;
-  const double ik_t47 = cos_pitch*sin_yaw*cos_slew_r + ik_t15*sin_slew_r;
-  const double ik_t48 = -foot_y_r;
-  const double ik_t49 = -ik_t15*hip_y;
-  const double ik_t50 = ik_t48 + ik_t17 + ik_t49 + ik_t19 + y_C;
-  const double ik_t51 = sin_slew_r*cos_pitch*sin_yaw - ik_t15*cos_slew_r;
-  const double ik_t52 = sin_pitch*sin_slew_r + sin_roll*cos_pitch*cos_slew_r;
-  const double ik_t53 = ik_t9*cos_slew_r - cos_yaw*sin_slew_r*cos_pitch;
-  const double ik_t60 = -sin_pitch;
-  const double ik_t61 = sin_roll*cos_pitch;
-  const double ik_t62 = cos_roll*cos_pitch;
-  const double ik_t64 = lever_offset*sin_steer_l;
-  const double ik_t66 = cos_steer_l*lever;
-  const double ik_t67 = sin_pitch*rear_x;
-  const double ik_t68 = -cos_roll*rear_drop*cos_pitch;
-  const double ik_t73 = -sin_roll*rear_y*cos_pitch;
-  const double ik_t79 = -lever_offset*sin_steer_r;
-  const double ik_t81 = cos_steer_r*lever;
+  const double ik_t35 = cos_yaw*cos_pitch*cos_slew_r + sin_slew_r*ik_t9;
+  const double ik_t36 = ik_t9*hip_y;
+  const double ik_t37 = ik_t2 + ik_t8 + foot_x_r + ik_t36 + ik_t10;
+  const double ik_t38 = sin_roll*sin_slew_r*cos_pitch - sin_pitch*cos_slew_r;
+  const double ik_t39 = sin_roll*cos_pitch*hip_y;
+  const double ik_t40 = foot_z_r + ik_t23 + ik_t24 + ik_t39 + ik_t25;
+  const double ik_t41 = cos_pitch*sin_yaw*cos_slew_r + ik_t15*sin_slew_r;
+  const double ik_t42 = -foot_y_r;
+  const double ik_t43 = -ik_t15*hip_y;
+  const double ik_t44 = ik_t42 + ik_t17 + ik_t43 + ik_t19 + y_C;
+  const double ik_t45 = sin_slew_r*cos_pitch*sin_yaw - ik_t15*cos_slew_r;
+  const double ik_t46 = sin_pitch*sin_slew_r + sin_roll*cos_pitch*cos_slew_r;
+  const double ik_t47 = ik_t9*cos_slew_r - cos_yaw*sin_slew_r*cos_pitch;
+  const double ik_t48 = -sin_pitch;
+  const double ik_t49 = sin_roll*cos_pitch;
+  const double ik_t50 = cos_roll*cos_pitch;
+  const double ik_t52 = lever_offset*sin_steer_l;
+  const double ik_t54 = cos_steer_l*lever;
+  const double ik_t55 = sin_pitch*rear_x;
+  const double ik_t56 = -cos_roll*rear_drop*cos_pitch;
+  const double ik_t59 = -lever_offset*sin_steer_r;
+  const double ik_t61 = cos_steer_r*lever;
+  const double ik_t62 = -sin_roll*rear_y*cos_pitch;
   const double ik_leg_l_d0 = ik_t11*ik_t14 - ik_t16*ik_t22 - ik_t26*ik_t27;
   const double ik_leg_l_d1 = ik_t28*ik_t11 + ik_t26*ik_t30 - ik_t29*ik_t22;
   const double ik_leg_l_d2 = -(ik_t18*ik_t22 - ik_t7*ik_t11 - ik_t26*cos_roll*cos_pitch);
@@ -671,8 +681,8 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_leg_l_A = ik_t32;
   const double ik_leg_l_B = 0.0;
   const double ik_leg_l_dd = ik_leg_l_d0 * ik_leg_l_d0 + ik_leg_l_d1 * ik_leg_l_d1 + ik_leg_l_d2 * ik_leg_l_d2;
-  double ik_q_knee_l, ik_c_knee_l, ik_s_knee_l;
-  if (!ik_solve_cos_sin(ik_leg_l_A, ik_leg_l_B, ik_leg_l_dd - ik_leg_l_K, (ik_leg_l_branch & 1) != 0, ik_q_knee_l, ik_c_knee_l, ik_s_knee_l)) {
+  double ik_c_knee_l, ik_s_knee_l;
+  if (!ik_solve_cos_sin(ik_leg_l_A, ik_leg_l_B, ik_leg_l_dd - ik_leg_l_K, (ik_leg_l_branch & 1) != 0, ik_c_knee_l, ik_s_knee_l)) {
     const double ik_leg_l_R = std::sqrt(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
     why = {1, std::sqrt(ik_leg_l_dd), std::sqrt(std::max(0.0, ik_leg_l_K - ik_leg_l_R)), std::sqrt(ik_leg_l_K + ik_leg_l_R), 0.0};
     failed = 0;
@@ -683,37 +693,28 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_leg_l_v2 = -ik_s_knee_l*shank;
   const double ik_leg_l_v[3] = {ik_leg_l_v0, ik_leg_l_v1, ik_leg_l_v2};
   const double ik_leg_l_d[3] = {ik_leg_l_d0, ik_leg_l_d1, ik_leg_l_d2};
-  double ik_q_abduct_l, ik_c_abduct_l, ik_s_abduct_l, ik_q_lift_l, ik_c_lift_l, ik_s_lift_l, ik_leg_l_beside = 0, ik_leg_l_room = 0;
-  const bool ik_leg_l_two_axis_ok = ik_solve_two_axis<0, 1>(ik_leg_l_v, ik_leg_l_d, (ik_leg_l_branch & 2) != 0, ik_q_abduct_l, ik_c_abduct_l, ik_s_abduct_l, ik_q_lift_l, ik_c_lift_l, ik_s_lift_l, ik_leg_l_beside, ik_leg_l_room);
+  double ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_leg_l_beside = 0, ik_leg_l_room = 0;
+  const bool ik_leg_l_two_axis_ok = ik_solve_two_axis<0, 1>(ik_leg_l_v, ik_leg_l_d, (ik_leg_l_branch & 2) != 0, ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_leg_l_beside, ik_leg_l_room);
   if (!ik_leg_l_two_axis_ok) {
-    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, ik_q_knee_l * 57.29577951308232};
+    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, std::atan2(ik_s_knee_l, ik_c_knee_l) * 57.29577951308232};
     failed = 0;
     return IkStatus::out_of_reach;
   }
-  const double ik_t33 = ik_t7*ik_c_abduct_l - ik_t28*ik_s_abduct_l;
-  const double ik_t34 = ik_c_lift_l*ik_t14 - ik_s_lift_l*ik_t33;
-  const double ik_t36 = ik_s_abduct_l*ik_t29 - ik_t18*ik_c_abduct_l;
-  const double ik_t37 = ik_c_lift_l*ik_t16 + ik_s_lift_l*ik_t36;
-  const double ik_t38 = ik_s_abduct_l*ik_t30 - ik_c_abduct_l*cos_roll*cos_pitch;
-  const double ik_t39 = ik_s_lift_l*ik_t38 - ik_t27*ik_c_lift_l;
-  const double ik_leg_l_row0 = (ik_t7*ik_s_abduct_l + ik_t28*ik_c_abduct_l)*knee_offset + x_C + ik_t35 + thigh*ik_t34 + hip_x*cos_yaw*cos_pitch - ik_t7*hip_drop - shank*(ik_s_knee_l*(ik_c_lift_l*ik_t33 + ik_s_lift_l*ik_t14) - ik_c_knee_l*ik_t34) - foot_x_l;
-  const double ik_leg_l_row1 = ik_t17 + (ik_t18*ik_s_abduct_l + ik_c_abduct_l*ik_t29)*knee_offset + ik_t37*thigh + ik_t19 + y_C + shank*(ik_s_knee_l*(ik_t36*ik_c_lift_l - ik_s_lift_l*ik_t16) + ik_t37*ik_c_knee_l) + ik_t20 + ik_t21;
-  const double ik_leg_l_row2 = (ik_s_abduct_l*cos_roll*cos_pitch + ik_c_abduct_l*ik_t30)*knee_offset + ik_t39*thigh + z_C + ik_t40 + shank*(ik_t39*ik_c_knee_l + ik_s_knee_l*(ik_s_lift_l*ik_t27 + ik_t38*ik_c_lift_l)) - hip_x*sin_pitch - foot_z_l - hip_drop*cos_roll*cos_pitch;
-  const double ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
-  if (!(ik_leg_l_residual <= kIkTolerance)) {
-    why = {0, ik_leg_l_residual, 0.0, kIkTolerance, 0.0};
-    failed = 0;
-    return IkStatus::residual;
-  }
-  const double ik_leg_r_d0 = -(ik_t47*ik_t50 - ik_t43*ik_t44 - ik_t45*ik_t46);
-  const double ik_leg_r_d1 = ik_t50*ik_t51 + ik_t52*ik_t46 + ik_t53*ik_t44;
-  const double ik_leg_r_d2 = ik_t46*cos_roll*cos_pitch + ik_t7*ik_t44 - ik_t50*ik_t18;
+  const double ik_t63 = ik_t7*ik_c_abduct_l - ik_t28*ik_s_abduct_l;
+  const double ik_t64 = ik_c_lift_l*ik_t14 - ik_s_lift_l*ik_t63;
+  const double ik_t65 = ik_s_abduct_l*ik_t29 - ik_t18*ik_c_abduct_l;
+  const double ik_t66 = ik_c_lift_l*ik_t16 + ik_s_lift_l*ik_t65;
+  const double ik_t67 = ik_s_abduct_l*ik_t30 - ik_c_abduct_l*cos_roll*cos_pitch;
+  const double ik_t68 = ik_s_lift_l*ik_t67 - ik_t27*ik_c_lift_l;
+  const double ik_leg_r_d0 = -(ik_t41*ik_t44 - ik_t35*ik_t37 - ik_t38*ik_t40);
+  const double ik_leg_r_d1 = ik_t44*ik_t45 + ik_t46*ik_t40 + ik_t47*ik_t37;
+  const double ik_leg_r_d2 = ik_t40*cos_roll*cos_pitch + ik_t7*ik_t37 - ik_t44*ik_t18;
   const double ik_leg_r_K = ik_t31;
   const double ik_leg_r_A = ik_t32;
   const double ik_leg_r_B = 0.0;
   const double ik_leg_r_dd = ik_leg_r_d0 * ik_leg_r_d0 + ik_leg_r_d1 * ik_leg_r_d1 + ik_leg_r_d2 * ik_leg_r_d2;
-  double ik_q_knee_r, ik_c_knee_r, ik_s_knee_r;
-  if (!ik_solve_cos_sin(ik_leg_r_A, ik_leg_r_B, ik_leg_r_dd - ik_leg_r_K, (ik_leg_r_branch & 1) != 0, ik_q_knee_r, ik_c_knee_r, ik_s_knee_r)) {
+  double ik_c_knee_r, ik_s_knee_r;
+  if (!ik_solve_cos_sin(ik_leg_r_A, ik_leg_r_B, ik_leg_r_dd - ik_leg_r_K, (ik_leg_r_branch & 1) != 0, ik_c_knee_r, ik_s_knee_r)) {
     const double ik_leg_r_R = std::sqrt(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
     why = {1, std::sqrt(ik_leg_r_dd), std::sqrt(std::max(0.0, ik_leg_r_K - ik_leg_r_R)), std::sqrt(ik_leg_r_K + ik_leg_r_R), 0.0};
     failed = 1;
@@ -724,104 +725,79 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_leg_r_v2 = -shank*ik_s_knee_r;
   const double ik_leg_r_v[3] = {ik_leg_r_v0, ik_leg_r_v1, ik_leg_r_v2};
   const double ik_leg_r_d[3] = {ik_leg_r_d0, ik_leg_r_d1, ik_leg_r_d2};
-  double ik_q_abduct_r, ik_c_abduct_r, ik_s_abduct_r, ik_q_lift_r, ik_c_lift_r, ik_s_lift_r, ik_leg_r_beside = 0, ik_leg_r_room = 0;
-  const bool ik_leg_r_two_axis_ok = ik_solve_two_axis<0, 1>(ik_leg_r_v, ik_leg_r_d, (ik_leg_r_branch & 2) != 0, ik_q_abduct_r, ik_c_abduct_r, ik_s_abduct_r, ik_q_lift_r, ik_c_lift_r, ik_s_lift_r, ik_leg_r_beside, ik_leg_r_room);
+  double ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_leg_r_beside = 0, ik_leg_r_room = 0;
+  const bool ik_leg_r_two_axis_ok = ik_solve_two_axis<0, 1>(ik_leg_r_v, ik_leg_r_d, (ik_leg_r_branch & 2) != 0, ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_leg_r_beside, ik_leg_r_room);
   if (!ik_leg_r_two_axis_ok) {
-    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, ik_q_knee_r * 57.29577951308232};
+    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, std::atan2(ik_s_knee_r, ik_c_knee_r) * 57.29577951308232};
     failed = 1;
     return IkStatus::out_of_reach;
   }
-  const double ik_t54 = ik_s_abduct_r*ik_t53 - ik_t7*ik_c_abduct_r;
-  const double ik_t55 = ik_t43*ik_c_lift_r + ik_t54*ik_s_lift_r;
-  const double ik_t56 = ik_c_abduct_r*ik_t18 + ik_s_abduct_r*ik_t51;
-  const double ik_t57 = ik_t47*ik_c_lift_r - ik_t56*ik_s_lift_r;
-  const double ik_t58 = ik_t52*ik_s_abduct_r - ik_c_abduct_r*cos_roll*cos_pitch;
-  const double ik_t59 = ik_t45*ik_c_lift_r + ik_s_lift_r*ik_t58;
-  const double ik_leg_r_row0 = -(ik_t2 + (ik_c_abduct_r*ik_t53 + ik_t7*ik_s_abduct_r)*knee_offset + ik_t8 + foot_x_r + ik_t35 + ik_t10 - thigh*ik_t55 - ((ik_t54*ik_c_lift_r - ik_s_lift_r*ik_t43)*ik_s_knee_r + ik_c_knee_r*ik_t55)*shank);
-  const double ik_leg_r_row1 = thigh*ik_t57 + ik_t48 + ik_t17 + ik_t49 + ik_t19 + y_C + shank*(ik_c_knee_r*ik_t57 - (ik_t56*ik_c_lift_r + ik_t47*ik_s_lift_r)*ik_s_knee_r) + (ik_c_abduct_r*ik_t51 - ik_t18*ik_s_abduct_r)*knee_offset;
-  const double ik_leg_r_row2 = -(foot_z_r + ik_t23 + ik_t24 + ik_t40 + (ik_s_abduct_r*cos_roll*cos_pitch + ik_c_abduct_r*ik_t52)*knee_offset + shank*((ik_t45*ik_s_lift_r - ik_c_lift_r*ik_t58)*ik_s_knee_r - ik_c_knee_r*ik_t59) + ik_t25 - thigh*ik_t59);
-  const double ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
-  if (!(ik_leg_r_residual <= kIkTolerance)) {
-    why = {0, ik_leg_r_residual, 0.0, kIkTolerance, 0.0};
-    failed = 1;
-    return IkStatus::residual;
-  }
+  const double ik_t69 = ik_s_abduct_r*ik_t47 - ik_t7*ik_c_abduct_r;
+  const double ik_t70 = ik_t35*ik_c_lift_r + ik_t69*ik_s_lift_r;
+  const double ik_t71 = ik_c_abduct_r*ik_t18 + ik_s_abduct_r*ik_t45;
+  const double ik_t72 = ik_t41*ik_c_lift_r - ik_t71*ik_s_lift_r;
+  const double ik_t73 = ik_t46*ik_s_abduct_r - ik_c_abduct_r*cos_roll*cos_pitch;
+  const double ik_t74 = ik_t38*ik_c_lift_r + ik_s_lift_r*ik_t73;
   const double ik_q_guide_l = -steer_l;
-  const double ik_lever_l_g0 = ik_t60;
-  const double ik_lever_l_g1 = ik_t61;
-  const double ik_lever_l_g2 = ik_t62;
+  const double ik_lever_l_g0 = ik_t48;
+  const double ik_lever_l_g1 = ik_t49;
+  const double ik_lever_l_g2 = ik_t50;
   const double ik_lever_l_axis[3] = {0.0, 0.0, 1.0};
   const double ik_lever_l_g[3] = {ik_lever_l_g0, ik_lever_l_g1, ik_lever_l_g2};
-  double ik_lever_l_q_sum, ik_lever_l_c_sum, ik_lever_l_s_sum, ik_q_camber_l, ik_c_camber_l, ik_s_camber_l, ik_lever_l_beside = 0, ik_lever_l_room = 0;
-  const bool ik_lever_l_two_axis_ok = ik_solve_two_axis<1, 0>(ik_lever_l_axis, ik_lever_l_g, (ik_lever_l_branch & 2) != 0, ik_lever_l_q_sum, ik_lever_l_c_sum, ik_lever_l_s_sum, ik_q_camber_l, ik_c_camber_l, ik_s_camber_l, ik_lever_l_beside, ik_lever_l_room);
+  double ik_lever_l_c_sum, ik_lever_l_s_sum, ik_c_camber_l, ik_s_camber_l, ik_lever_l_beside = 0, ik_lever_l_room = 0;
+  const bool ik_lever_l_two_axis_ok = ik_solve_two_axis<1, 0>(ik_lever_l_axis, ik_lever_l_g, (ik_lever_l_branch & 2) != 0, ik_lever_l_c_sum, ik_lever_l_s_sum, ik_c_camber_l, ik_s_camber_l, ik_lever_l_beside, ik_lever_l_room);
   static_cast<void>(ik_lever_l_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
   if ((ik_lever_l_c_sum < 0) != ((ik_lever_l_branch & 4) != 0)) {
-    ik_lever_l_q_sum = ik_wrap(ik_lever_l_q_sum + 3.141592653589793);
     ik_lever_l_c_sum = -ik_lever_l_c_sum;
     ik_lever_l_s_sum = -ik_lever_l_s_sum;
-    ik_q_camber_l = -ik_q_camber_l;
     ik_s_camber_l = -ik_s_camber_l;
   }
-  const double ik_lever_l_alpha = sin_pitch*(radius*ik_lever_l_s_sum + ik_t64 + ik_t66) - radius*sin_pitch*ik_lever_l_s_sum;
-  const double ik_lever_l_beta = cos_roll*cos_pitch*(ik_t64 + ik_t66 - radius*ik_lever_l_c_sum) + radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
-  const double ik_lever_l_gamma = sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + ik_t67 + radius*sin_pitch*ik_lever_l_s_sum + ik_t68 - radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
-  double ik_q_swing_l, ik_c_swing_l, ik_s_swing_l;
-  if (!ik_solve_cos_sin(ik_lever_l_alpha, ik_lever_l_beta, ground_l - ik_lever_l_gamma, (ik_lever_l_branch & 1) != 0, ik_q_swing_l, ik_c_swing_l, ik_s_swing_l)) {
+  const double ik_lever_l_alpha = sin_pitch*(radius*ik_lever_l_s_sum + ik_t52 + ik_t54) - radius*sin_pitch*ik_lever_l_s_sum;
+  const double ik_lever_l_beta = cos_roll*cos_pitch*(ik_t52 + ik_t54 - radius*ik_lever_l_c_sum) + radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
+  const double ik_lever_l_gamma = sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + ik_t55 + radius*sin_pitch*ik_lever_l_s_sum + ik_t56 - radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
+  double ik_c_swing_l, ik_s_swing_l;
+  if (!ik_solve_cos_sin(ik_lever_l_alpha, ik_lever_l_beta, ground_l - ik_lever_l_gamma, (ik_lever_l_branch & 1) != 0, ik_c_swing_l, ik_s_swing_l)) {
     const double ik_lever_l_R = std::sqrt(ik_lever_l_alpha * ik_lever_l_alpha + ik_lever_l_beta * ik_lever_l_beta);
     why = {1, ground_l, ik_lever_l_gamma - ik_lever_l_R, ik_lever_l_gamma + ik_lever_l_R, 0.0};
     failed = 2;
     return IkStatus::out_of_reach;
   }
-  const double ik_q_hub_l = ik_wrap(ik_lever_l_q_sum - ik_q_swing_l);
   const double ik_c_hub_l = ik_lever_l_c_sum * ik_c_swing_l + ik_lever_l_s_sum * ik_s_swing_l;
   const double ik_s_hub_l = ik_lever_l_s_sum * ik_c_swing_l - ik_lever_l_c_sum * ik_s_swing_l;
-  const double ik_t69 = sin_pitch*ik_c_swing_l + ik_s_swing_l*cos_roll*cos_pitch;
-  const double ik_t70 = cos_steer_l*ik_t69 - sin_roll*sin_steer_l*cos_pitch;
-  const double ik_t71 = sin_steer_l*ik_t69 + sin_roll*cos_steer_l*cos_pitch;
-  const double ik_t72 = sin_steer_l*ik_t70 - cos_steer_l*ik_t71;
-  const double ik_t74 = sin_steer_l*ik_t71 + ik_t70*cos_steer_l;
-  const double ik_t75 = sin_pitch*ik_s_swing_l - ik_c_swing_l*cos_roll*cos_pitch;
-  const double ik_t76 = ik_t74*ik_s_hub_l + ik_c_hub_l*ik_t75;
-  const double ik_lever_l_row0 = -(ik_t72*hub_offset + ik_t23 + ik_t73 + ground_l + cos_roll*rear_drop*cos_pitch - ik_t70*lever - radius*ik_t76 - sin_pitch*rear_x - lever_offset*ik_t71);
-  const double ik_lever_l_row1 = -(ik_t74*ik_c_hub_l - ik_s_hub_l*ik_t75);
-  const double ik_lever_l_row2 = -(ik_t72*ik_c_camber_l + ik_t76*ik_s_camber_l);
-  const double ik_lever_l_row3 = 0.0;
-  const double ik_lever_l_residual = std::max({std::abs(ik_lever_l_row0), std::abs(ik_lever_l_row1), std::abs(ik_lever_l_row2), std::abs(ik_lever_l_row3)});
-  if (!(ik_lever_l_residual <= kIkTolerance)) {
-    why = {0, ik_lever_l_residual, 0.0, kIkTolerance, 0.0};
-    failed = 2;
-    return IkStatus::residual;
-  }
+  const double ik_t75 = sin_pitch*ik_c_swing_l + ik_s_swing_l*cos_roll*cos_pitch;
+  const double ik_t76 = cos_steer_l*ik_t75 - sin_roll*sin_steer_l*cos_pitch;
+  const double ik_t77 = sin_steer_l*ik_t75 + sin_roll*cos_steer_l*cos_pitch;
+  const double ik_t78 = sin_steer_l*ik_t76 - cos_steer_l*ik_t77;
+  const double ik_t79 = sin_steer_l*ik_t77 + ik_t76*cos_steer_l;
+  const double ik_t80 = sin_pitch*ik_s_swing_l - ik_c_swing_l*cos_roll*cos_pitch;
+  const double ik_t81 = ik_t79*ik_s_hub_l + ik_c_hub_l*ik_t80;
   const double ik_q_guide_r = -steer_r;
-  const double ik_lever_r_g0 = ik_t60;
-  const double ik_lever_r_g1 = ik_t61;
-  const double ik_lever_r_g2 = ik_t62;
+  const double ik_lever_r_g0 = ik_t48;
+  const double ik_lever_r_g1 = ik_t49;
+  const double ik_lever_r_g2 = ik_t50;
   const double ik_lever_r_axis[3] = {0.0, 0.0, 1.0};
   const double ik_lever_r_g[3] = {ik_lever_r_g0, ik_lever_r_g1, ik_lever_r_g2};
-  double ik_lever_r_q_sum, ik_lever_r_c_sum, ik_lever_r_s_sum, ik_q_camber_r, ik_c_camber_r, ik_s_camber_r, ik_lever_r_beside = 0, ik_lever_r_room = 0;
-  const bool ik_lever_r_two_axis_ok = ik_solve_two_axis<1, 0>(ik_lever_r_axis, ik_lever_r_g, (ik_lever_r_branch & 2) != 0, ik_lever_r_q_sum, ik_lever_r_c_sum, ik_lever_r_s_sum, ik_q_camber_r, ik_c_camber_r, ik_s_camber_r, ik_lever_r_beside, ik_lever_r_room);
+  double ik_lever_r_c_sum, ik_lever_r_s_sum, ik_c_camber_r, ik_s_camber_r, ik_lever_r_beside = 0, ik_lever_r_room = 0;
+  const bool ik_lever_r_two_axis_ok = ik_solve_two_axis<1, 0>(ik_lever_r_axis, ik_lever_r_g, (ik_lever_r_branch & 2) != 0, ik_lever_r_c_sum, ik_lever_r_s_sum, ik_c_camber_r, ik_s_camber_r, ik_lever_r_beside, ik_lever_r_room);
   static_cast<void>(ik_lever_r_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
   if ((ik_lever_r_c_sum < 0) != ((ik_lever_r_branch & 4) != 0)) {
-    ik_lever_r_q_sum = ik_wrap(ik_lever_r_q_sum + 3.141592653589793);
     ik_lever_r_c_sum = -ik_lever_r_c_sum;
     ik_lever_r_s_sum = -ik_lever_r_s_sum;
-    ik_q_camber_r = -ik_q_camber_r;
     ik_s_camber_r = -ik_s_camber_r;
   }
-  const double ik_t77 = radius*sin_pitch*ik_lever_r_s_sum;
-  const double ik_lever_r_alpha = -(ik_t77 - (radius*ik_lever_r_s_sum + ik_t79 + ik_t81)*sin_pitch);
-  const double ik_lever_r_beta = cos_roll*cos_pitch*(ik_t79 + ik_t81 - radius*ik_lever_r_c_sum) + radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
-  const double ik_lever_r_gamma = ik_t77 + ik_t73 + z_C + ik_t67 + ik_t68 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
-  double ik_q_swing_r, ik_c_swing_r, ik_s_swing_r;
-  if (!ik_solve_cos_sin(ik_lever_r_alpha, ik_lever_r_beta, ground_r - ik_lever_r_gamma, (ik_lever_r_branch & 1) != 0, ik_q_swing_r, ik_c_swing_r, ik_s_swing_r)) {
+  const double ik_t57 = radius*sin_pitch*ik_lever_r_s_sum;
+  const double ik_lever_r_alpha = -(ik_t57 - (radius*ik_lever_r_s_sum + ik_t59 + ik_t61)*sin_pitch);
+  const double ik_lever_r_beta = cos_roll*cos_pitch*(ik_t59 + ik_t61 - radius*ik_lever_r_c_sum) + radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
+  const double ik_lever_r_gamma = ik_t57 + ik_t62 + z_C + ik_t55 + ik_t56 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
+  double ik_c_swing_r, ik_s_swing_r;
+  if (!ik_solve_cos_sin(ik_lever_r_alpha, ik_lever_r_beta, ground_r - ik_lever_r_gamma, (ik_lever_r_branch & 1) != 0, ik_c_swing_r, ik_s_swing_r)) {
     const double ik_lever_r_R = std::sqrt(ik_lever_r_alpha * ik_lever_r_alpha + ik_lever_r_beta * ik_lever_r_beta);
     why = {1, ground_r, ik_lever_r_gamma - ik_lever_r_R, ik_lever_r_gamma + ik_lever_r_R, 0.0};
     failed = 3;
     return IkStatus::out_of_reach;
   }
-  const double ik_q_hub_r = ik_wrap(ik_lever_r_q_sum - ik_q_swing_r);
   const double ik_c_hub_r = ik_lever_r_c_sum * ik_c_swing_r + ik_lever_r_s_sum * ik_s_swing_r;
   const double ik_s_hub_r = ik_lever_r_s_sum * ik_c_swing_r - ik_lever_r_c_sum * ik_s_swing_r;
   const double ik_t82 = ik_c_swing_r*cos_roll*cos_pitch - sin_pitch*ik_s_swing_r;
@@ -831,7 +807,50 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   const double ik_t86 = sin_steer_r*ik_t84 - cos_steer_r*ik_t85;
   const double ik_t87 = ik_t86*ik_s_hub_r - ik_c_hub_r*ik_t82;
   const double ik_t88 = cos_steer_r*ik_t84 + sin_steer_r*ik_t85;
-  const double ik_lever_r_row0 = radius*ik_t87 + ik_t73 + z_C + ik_t67 + ik_t68 - ground_r - lever_offset*ik_t84 - ik_t88*hub_offset - lever*ik_t85;
+  const std::array<double, 12> ik_sines{{ik_s_abduct_l, ik_s_lift_l, ik_s_knee_l, ik_s_abduct_r, ik_s_lift_r, ik_s_knee_r, ik_s_swing_l, ik_s_hub_l, ik_s_camber_l, ik_s_swing_r, ik_s_hub_r, ik_s_camber_r}}, ik_cosines{{ik_c_abduct_l, ik_c_lift_l, ik_c_knee_l, ik_c_abduct_r, ik_c_lift_r, ik_c_knee_r, ik_c_swing_l, ik_c_hub_l, ik_c_camber_l, ik_c_swing_r, ik_c_hub_r, ik_c_camber_r}};
+  std::array<double, 12> ik_angles;
+  atan2(ik_sines, ik_cosines, ik_angles);
+  const double ik_q_abduct_l = ik_angles[0];
+  const double ik_q_lift_l = ik_angles[1];
+  const double ik_q_knee_l = ik_angles[2];
+  const double ik_q_abduct_r = ik_angles[3];
+  const double ik_q_lift_r = ik_angles[4];
+  const double ik_q_knee_r = ik_angles[5];
+  const double ik_q_swing_l = ik_angles[6];
+  const double ik_q_hub_l = ik_angles[7];
+  const double ik_q_camber_l = ik_angles[8];
+  const double ik_q_swing_r = ik_angles[9];
+  const double ik_q_hub_r = ik_angles[10];
+  const double ik_q_camber_r = ik_angles[11];
+  const double ik_leg_l_row0 = (ik_t7*ik_s_abduct_l + ik_t28*ik_c_abduct_l)*knee_offset + x_C + ik_t36 + thigh*ik_t64 + hip_x*cos_yaw*cos_pitch - ik_t7*hip_drop - shank*(ik_s_knee_l*(ik_c_lift_l*ik_t63 + ik_s_lift_l*ik_t14) - ik_c_knee_l*ik_t64) - foot_x_l;
+  const double ik_leg_l_row1 = ik_t17 + (ik_t18*ik_s_abduct_l + ik_c_abduct_l*ik_t29)*knee_offset + ik_t66*thigh + ik_t19 + y_C + shank*(ik_s_knee_l*(ik_t65*ik_c_lift_l - ik_s_lift_l*ik_t16) + ik_t66*ik_c_knee_l) + ik_t20 + ik_t21;
+  const double ik_leg_l_row2 = (ik_s_abduct_l*cos_roll*cos_pitch + ik_c_abduct_l*ik_t30)*knee_offset + ik_t68*thigh + z_C + ik_t39 + shank*(ik_t68*ik_c_knee_l + ik_s_knee_l*(ik_s_lift_l*ik_t27 + ik_t67*ik_c_lift_l)) - hip_x*sin_pitch - foot_z_l - hip_drop*cos_roll*cos_pitch;
+  const double ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
+  if (!(ik_leg_l_residual <= kIkTolerance)) {
+    why = {0, ik_leg_l_residual, 0.0, kIkTolerance, 0.0};
+    failed = 0;
+    return IkStatus::residual;
+  }
+  const double ik_leg_r_row0 = -(ik_t2 + (ik_c_abduct_r*ik_t47 + ik_t7*ik_s_abduct_r)*knee_offset + ik_t8 + foot_x_r + ik_t36 + ik_t10 - thigh*ik_t70 - ((ik_t69*ik_c_lift_r - ik_s_lift_r*ik_t35)*ik_s_knee_r + ik_c_knee_r*ik_t70)*shank);
+  const double ik_leg_r_row1 = thigh*ik_t72 + ik_t42 + ik_t17 + ik_t43 + ik_t19 + y_C + shank*(ik_c_knee_r*ik_t72 - (ik_t71*ik_c_lift_r + ik_t41*ik_s_lift_r)*ik_s_knee_r) + (ik_c_abduct_r*ik_t45 - ik_t18*ik_s_abduct_r)*knee_offset;
+  const double ik_leg_r_row2 = -(foot_z_r + ik_t23 + ik_t24 + ik_t39 + (ik_s_abduct_r*cos_roll*cos_pitch + ik_c_abduct_r*ik_t46)*knee_offset + shank*((ik_t38*ik_s_lift_r - ik_c_lift_r*ik_t73)*ik_s_knee_r - ik_c_knee_r*ik_t74) + ik_t25 - thigh*ik_t74);
+  const double ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
+  if (!(ik_leg_r_residual <= kIkTolerance)) {
+    why = {0, ik_leg_r_residual, 0.0, kIkTolerance, 0.0};
+    failed = 1;
+    return IkStatus::residual;
+  }
+  const double ik_lever_l_row0 = -(ik_t78*hub_offset + ik_t23 + ik_t62 + ground_l + cos_roll*rear_drop*cos_pitch - ik_t76*lever - radius*ik_t81 - sin_pitch*rear_x - lever_offset*ik_t77);
+  const double ik_lever_l_row1 = -(ik_t79*ik_c_hub_l - ik_s_hub_l*ik_t80);
+  const double ik_lever_l_row2 = -(ik_t78*ik_c_camber_l + ik_t81*ik_s_camber_l);
+  const double ik_lever_l_row3 = 0.0;
+  const double ik_lever_l_residual = std::max({std::abs(ik_lever_l_row0), std::abs(ik_lever_l_row1), std::abs(ik_lever_l_row2), std::abs(ik_lever_l_row3)});
+  if (!(ik_lever_l_residual <= kIkTolerance)) {
+    why = {0, ik_lever_l_residual, 0.0, kIkTolerance, 0.0};
+    failed = 2;
+    return IkStatus::residual;
+  }
+  const double ik_lever_r_row0 = radius*ik_t87 + ik_t62 + z_C + ik_t55 + ik_t56 - ground_r - lever_offset*ik_t84 - ik_t88*hub_offset - lever*ik_t85;
   const double ik_lever_r_row1 = -(ik_t82*ik_s_hub_r + ik_c_hub_r*ik_t86);
   const double ik_lever_r_row2 = ik_t88*ik_c_camber_r - ik_t87*ik_s_camber_r;
   const double ik_lever_r_row3 = 0.0;
