@@ -177,7 +177,14 @@ Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& 
     T(pair.index[1], k) = pair_rates(1, k);
   }
   // Dependent joints: Phi_dep T_dep = -Phi_q T_q, all four columns per limb block at once.
-  const Eigen::Matrix<double, gen::kClosureCount, 4> rhs = d.dPhi_ds.leftCols<kNq>().lazyProduct(T.topRows<kNq>());
+  // T's input rows are zero except the commanded and the pair's: six columns of dPhi/ds, not 18.
+  Eigen::Matrix<double, gen::kClosureCount, 4> rhs = Eigen::Matrix<double, gen::kClosureCount, 4>::Zero();
+  std::array<int, 6> rows{commanded[0], commanded[1], commanded[2], commanded[3], pair.index[0], pair.index[1]};
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    bool seen = false;
+    for (std::size_t q = 0; q < r; ++q) seen = seen || rows[q] == rows[r];
+    if (!seen) rhs.noalias() += d.dPhi_ds.col(rows[r]) * T.row(rows[r]);
+  }
   for_each_limb([&](auto L) {
     constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(decltype(L)::value)];
     Eigen::Matrix4d block_rhs = Eigen::Matrix4d::Zero();
