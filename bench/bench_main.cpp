@@ -392,6 +392,10 @@ int main(int argc, char** argv) {
   for (int i = 0; i < argc; ++i) {
     if (std::strcmp(argv[i], "--json") == 0) json = true;
     else args.push_back(argv[i]);
+    if (std::strcmp(argv[i], "--help") == 0)
+      fmt::print("wlx_bench [--json] [Google Benchmark options]: runs the suite (5 repetitions each) and prints one table\n"
+                 "of medians, the numeric baseline and their ratio measured in the same run, and the generated op counts.\n"
+                 "  --json  the same table as JSON\n\nGoogle Benchmark's options:\n");
   }
   std::string reps = "--benchmark_repetitions=5";
   std::string min_time = "--benchmark_min_time=0.05";

@@ -37,7 +37,7 @@ Params load_params(const ModelOptions& model) {
   try {
     return parse_params(j.is_object() && j.contains("params") && j.size() == 1 ? j.at("params") : j);
   } catch (const Error& e) {
-    throw Error(excerpt(model.params_file) + ": " + e.field(), std::string(e.what()).substr(e.field().size() + 2));
+    throw Error(excerpt(model.params_file) + ": " + e.field(), e.reason());
   }
 }
 

@@ -3,6 +3,7 @@
 
 #include "bounded_input.hpp"
 #include "limits.hpp"
+#include "scenario_io.hpp"
 
 #include <fmt/format.h>
 #include <wlx/error.hpp>
@@ -14,12 +15,6 @@
 WLX_COMMANDS_BEGIN
 
 namespace {
-
-std::vector<std::string> input_names() {
-  std::vector<std::string> v;
-  for (int k = 0; k < kInputCount; ++k) v.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
-  return v;
-}
 
 std::vector<std::string> dependent_names() {
   std::vector<std::string> v;
@@ -41,7 +36,7 @@ Params parse_params(const nlohmann::json& object, Params params) {
   try {
     Model check(params);
   } catch (const Error& e) {
-    throw Error("params." + e.field(), std::string(e.what()).substr(e.field().size() + 2));
+    throw Error("params." + e.field(), e.reason());
   }
   return params;
 }
@@ -57,7 +52,7 @@ IkRequest parse_ik_request(const nlohmann::json& j, const Params& base) {
   for (int k = 0; k < kInputCount; ++k) {
     const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
     if (j.contains(name)) {
-      r.s(k) = finite_number(j.at(name), name);
+      r.s(k) = si_value(j.at(name), name, is_angle(k));  // the scenario files' grammar: SI or {"deg": x}
       check_input_bound(k, r.s(k), name);
     }
   }
@@ -94,7 +89,12 @@ IkRequest parse_ik_request(const nlohmann::json& j, const Params& base) {
     const auto& st = j.at("start");
     if (!st.is_object()) throw Error("start", fmt::format("must be an object of dependent joints, got {}", type_name(st)));
     reject_unknown_keys(st, dependent_names(), "start.");
-    for (const auto& [key, value] : st.items()) r.start.emplace_back(coordinate_index(key), finite_number(value, "start." + key));
+    for (const auto& [key, value] : st.items()) {
+      const int k = coordinate_index(key);
+      r.start.emplace_back(k, si_value(value, "start." + key, is_angle(k)));
+    }
+    if (r.method != IkMethod::newton)
+      throw Error("start", "is Newton's starting guess: it needs \"method\": \"newton\" (the closed form takes no start)");
   }
   return r;
 }

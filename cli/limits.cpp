@@ -9,11 +9,13 @@
 
 WLX_COMMANDS_BEGIN
 
-namespace {
-
 bool is_angle(int coordinate) { return gen::kCoordinateUnits[static_cast<std::size_t>(coordinate)] == std::string_view("rad"); }
 
-}  // namespace
+std::vector<std::string> input_names() {
+  std::vector<std::string> v;
+  for (int k = 0; k < kInputCount; ++k) v.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+  return v;
+}
 
 void check_param_bounds(const Params& params, const std::string& prefix) {
   for (const auto& info : gen::kParamInfo) {

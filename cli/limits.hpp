@@ -8,6 +8,7 @@
 #include <wlx/model.hpp>
 
 #include <string>
+#include <vector>
 
 WLX_COMMANDS_BEGIN
 
@@ -20,6 +21,11 @@ inline constexpr double kMaxAngle = 100;          // rad: |yaw|, |theta_l5|, ...
 inline constexpr double kMaxLinearRate = 100;     // m/s
 inline constexpr double kMaxAngularRate = 100;    // rad/s (about 16 turns per second)
 inline constexpr double kMaxWeightRatio = 1e12;   // largest / smallest diagonal torque weight
+
+// Whether a coordinate is an angle (unit rad): only angles may be given as {"deg": x}.
+bool is_angle(int coordinate);
+// The model's input coordinates' names, in order.
+std::vector<std::string> input_names();
 
 // Throws wlx::Error "params.<name>: ..." for a parameter beyond its bound (`prefix` + name).
 void check_param_bounds(const Params& params, const std::string& prefix);

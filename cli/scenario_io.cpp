@@ -20,13 +20,6 @@ extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios
 
 namespace {
 
-bool is_angle(int coordinate) { return gen::kCoordinateUnits[static_cast<std::size_t>(coordinate)] == std::string_view("rad"); }
-
-std::vector<std::string> input_names() {
-  std::vector<std::string> v;
-  for (int k = 0; k < kInputCount; ++k) v.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
-  return v;
-}
 
 }  // namespace
 
@@ -87,7 +80,7 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
     try {
       return Weighting::diagonal_of(w);
     } catch (const Error& e) {
-      throw Error(key + ".diag", std::string(e.what()).substr(e.field().size() + 2));
+      throw Error(key + ".diag", e.reason());
     }
   }
   if (v.is_object() && v.size() == 1 && v.contains("matrix")) {
@@ -102,7 +95,7 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
     try {
       return Weighting::matrix_of(W);
     } catch (const Error& e) {
-      throw Error(key + ".matrix", std::string(e.what()).substr(e.field().size() + 2));
+      throw Error(key + ".matrix", e.reason());
     }
   }
   throw Error(key, fmt::format("must be 1, 2, {{\"diag\": [8 weights]}} or {{\"matrix\": [[8 x 8]]}}, got {}", excerpt(v)));

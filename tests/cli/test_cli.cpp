@@ -95,6 +95,28 @@ TEST_CASE("cli: bad input gets a message naming the field and exit code 2") {
   CHECK(r.err == "wlx: error: expected a JSON object, got array\n");
 }
 
+TEST_CASE("cli: wlx ik reads the scenario files' value grammar: {\"deg\": x} for angles only; start needs Newton") {
+  const Run deg = run_wlx("ik", R"({"roll": {"deg": 3}, "theta_l5": {"deg": -10}})");
+  const Run rad = run_wlx("ik", R"({"roll": 0.05235987755982988, "theta_l5": -0.17453292519943295})");
+  REQUIRE(deg.code == 0);
+  REQUIRE(rad.code == 0);
+  CHECK(deg.out == rad.out);  // 3 deg and -10 deg are these radians to the last digit
+  Run r = run_wlx("ik", R"({"z_C": {"deg": 3}})");
+  CHECK(r.code == 2);
+  CHECK(r.err == "wlx: error: z_C: only angles may be given in degrees; give this value in SI units\n");
+  r = run_wlx("ik", R"({"roll": {"rad": 3}})");
+  CHECK(r.code == 2);
+  CHECK(r.err.find("roll: expected a number or {\"deg\": x}") != std::string::npos);
+  r = run_wlx("ik", R"({"start": {"psi_l2": 0.1}})");
+  CHECK(r.code == 2);
+  CHECK(r.err == "wlx: error: start: is Newton's starting guess: it needs \"method\": \"newton\" (the closed form takes no start)\n");
+  const Run started = run_wlx("ik", R"({"method": "newton", "start": {"psi_l2": {"deg": 14}}})");
+  const Run plain = run_wlx("ik", R"({"method": "closed-form"})");
+  REQUIRE(started.code == 0);
+  const auto a = nlohmann::json::parse(started.out), b = nlohmann::json::parse(plain.out);
+  CHECK(std::abs(a.at("psi_l2").get<double>() - b.at("psi_l2").get<double>()) <= 1e-12);  // the same solution
+}
+
 TEST_CASE("cli: wlx ik --batch answers line by line and keeps going after a bad line") {
   const Run r = run_wlx("ik --batch", "{\"z_Fl\": 0.1, \"method\": \"newton\"}\n{\"z_Fl\": 9}\n{\"z_Fl\": 0.2, \"method\": \"newton\"}\n");
   CHECK(r.code == 2);

@@ -108,3 +108,14 @@ TEST_CASE("hardening: weights scaled uniformly (1e-300 to 1e300) give the same t
   // And every split solves J^T tau = Q*: the scale did not change the problem solved.
   CHECK((J.transpose() * matrix_reference - Qstar).norm() <= 1e-9 * Qstar.norm());
 }
+
+TEST_CASE("hardening: an Error keeps its field and its reason apart") {
+  const wlx::Error named("legD", "must be positive, got -1");
+  CHECK(std::string(named.what()) == "legD: must be positive, got -1");
+  CHECK(named.field() == "legD");
+  CHECK(named.reason() == "must be positive, got -1");
+  const wlx::Error unnamed("", "closure residual is not finite");
+  CHECK(std::string(unnamed.what()) == "closure residual is not finite");
+  CHECK(unnamed.field().empty());
+  CHECK(unnamed.reason() == "closure residual is not finite");  // not cut by a field's length
+}
