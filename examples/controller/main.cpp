@@ -1,0 +1,188 @@
+// A 1 kHz controller loop on a robot of our own: the thesis excavator with longer legs
+// (CMakeLists.txt makes its model file), generated at build time by wlx_generate().
+//
+// Every millisecond the controller takes the commanded cabin speeds u = [z_C', x_C', roll',
+// pitch'] and their rates u', and computes
+//   1. the joint angles of both legs and both wheel levers for the commanded pose: the closed-form
+//      inverse kinematics wlx-gen derived from the model file,
+//   2. the rates the wheels impose (y_C', yaw') and every joint rate, the generalized force Q*
+//      (inverse dynamics, Kane's method on the 7 bodies), and
+//   3. the 8 actuator torques sharing Q* (weighted least norm, the model file's weights),
+// then advances the commanded pose by one step. The manoeuvres are the thesis' three
+// inverse-dynamics runs (ID-1 cabin forward at 3 m/s, ID-2 roll at -10 deg/s, ID-3 cabin lowered
+// at 3 m/s), each as a smooth there-and-back: u = U sin(2 pi t / T) for one period T.
+//
+// What it checks, after every step, and exits 1 if any fails:
+//   - no heap allocation inside the loop (operator new is counted; the count must stay 0);
+//   - the closure: max |Phi(s)| <= 1e-12 m (about 100 times the rounding of a 4 m chain);
+//   - the rolling constraint: both wheels' sideways velocity <= 1e-12 m/s;
+//   - the torques reproduce Q*: |J_beta^T tau - Q*| <= 1e-9 |Q*|;
+//   - the 1 ms budget: at most 1% of the steps over 1 ms (the machine may preempt us; the
+//     computation itself takes a few microseconds).
+#include <wlx/dynamics.hpp>
+#include <wlx/error.hpp>
+#include <wlx/ik.hpp>
+#include <wlx/kinematics.hpp>
+#include <wlx/nonholonomic.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <new>
+#include <numbers>
+#include <vector>
+
+// --- counting heap allocations -----------------------------------------------------------------
+namespace {
+bool counting = false;
+long allocations_while_counting = 0;
+
+void* allocate(std::size_t size, std::size_t alignment) {
+  if (counting) ++allocations_while_counting;
+  if (size == 0) size = 1;
+  void* p = alignment <= alignof(std::max_align_t) ? std::malloc(size)
+                                                   : std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+}  // namespace
+
+void* operator new(std::size_t size) { return allocate(size, alignof(std::max_align_t)); }
+void* operator new[](std::size_t size) { return allocate(size, alignof(std::max_align_t)); }
+void* operator new(std::size_t size, std::align_val_t a) { return allocate(size, static_cast<std::size_t>(a)); }
+void* operator new[](std::size_t size, std::align_val_t a) { return allocate(size, static_cast<std::size_t>(a)); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+
+namespace {
+
+namespace gen = wlx::gen;  // our model's generated code: wlx::my_excavator::gen
+
+struct Manoeuvre {
+  const char* name;
+  int coordinate;    // the commanded speed that moves
+  double amplitude;  // U, in the coordinate's unit per second
+  double period;     // T, s
+};
+
+// Which entry of u commands a coordinate (the model file's dynamics section fixes the order).
+int commanded_slot(int coordinate) {
+  for (std::size_t k = 0; k < wlx::kCommandedSpeeds.size(); ++k)
+    if (wlx::kCommandedSpeeds[k] == coordinate) return static_cast<int>(k);
+  std::fprintf(stderr, "coordinate %d is not a commanded speed of this model\n", coordinate);
+  std::exit(2);
+}
+
+struct Worst {
+  double closure = 0, sideways = 0, torque_balance = 0, torque = 0;
+};
+
+}  // namespace
+
+int main() {
+  constexpr double dt = 1e-3;  // 1 kHz
+  constexpr double deg = std::numbers::pi / 180;
+  const std::array<Manoeuvre, 3> manoeuvres{{
+      {"ID-1 cabin forward and back, x_C' = 3 sin(2 pi t) m/s", gen::coord::x_C, 3.0, 1.0},
+      {"ID-2 roll and back, roll' = -10 sin(2 pi t) deg/s", gen::coord::roll, -10 * deg, 1.0},
+      {"ID-3 cabin down and up, z_C' = -3 sin(2 pi t) m/s", gen::coord::z_C, -3.0, 1.0},
+  }};
+
+  const wlx::Model model;  // the model file's parameters (our leg lengths), validated
+  std::printf("model %s: thighD = %.3f m, legD = %.3f m, total mass %.1f kg\n", "my_excavator",
+              model.params().thighD, model.params().legD, model.total_mass());
+
+  // Everything the loop touches is allocated here, before it.
+  wlx::Data data;
+  wlx::DynamicsTerms terms;
+  const wlx::Weighting weighting = wlx::Weighting::strong_weak();  // the model file's weights
+  wlx::Coordinates s = wlx::nominal_inputs();
+  Eigen::Matrix<double, wlx::kInputCount, 1> q = s.head<wlx::kInputCount>();
+  std::vector<double> step_seconds;
+  step_seconds.reserve(10000);
+
+  bool ok = true;
+  for (const Manoeuvre& m : manoeuvres) {
+    const int slot = commanded_slot(m.coordinate);
+    const long steps = std::lround(m.period / dt);
+    step_seconds.clear();
+    Worst worst;
+    wlx::Vector8 tau = wlx::Vector8::Zero();
+    const Eigen::Matrix<double, wlx::kInputCount, 1> start = q;
+
+    counting = true;
+    try {
+      for (long k = 0; k < steps; ++k) {
+        const double phase = 2 * std::numbers::pi * static_cast<double>(k) * dt / m.period;
+        wlx::Vector4 u = wlx::Vector4::Zero(), u_dot = wlx::Vector4::Zero();
+        u(slot) = m.amplitude * std::sin(phase);
+        u_dot(slot) = m.amplitude * 2 * std::numbers::pi / m.period * std::cos(phase);
+
+        const auto begin = std::chrono::steady_clock::now();
+        s.head<wlx::kInputCount>() = q;
+        wlx::solve_ik_closed_form(model, s);                         // 1. joint angles
+        wlx::inverse_dynamics(model, s, u, u_dot, data, terms);       // 2. rates, Q*
+        tau = wlx::distribute_torques(terms.J_beta, terms.Qstar, weighting);  // 3. torques
+        q += dt * terms.sdot.head<wlx::kInputCount>();               // the next commanded pose
+        step_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
+
+        // The checks, outside the timed part.
+        wlx::closure(model, s, data, false);
+        worst.closure = std::max(worst.closure, data.Phi.cwiseAbs().maxCoeff());
+        worst.sideways = std::max(worst.sideways, wlx::sideways_velocity(model, s, terms.sdot, data).cwiseAbs().maxCoeff());
+        const double imbalance = (terms.J_beta.transpose() * tau - terms.Qstar).norm() / terms.Qstar.norm();
+        worst.torque_balance = std::max(worst.torque_balance, imbalance);
+        worst.torque = std::max(worst.torque, tau.cwiseAbs().maxCoeff());
+        if (!std::isfinite(worst.closure + worst.sideways + worst.torque_balance + worst.torque)) {
+          counting = false;
+          std::fprintf(stderr, "%s: step %ld: a result is not finite\n", m.name, k);
+          return 1;
+        }
+      }
+    } catch (const wlx::Error& e) {  // out of reach, singular wheels: never silently wrong
+      counting = false;
+      std::fprintf(stderr, "%s: %s\n", m.name, e.what());
+      return 1;
+    }
+    counting = false;
+
+    std::vector<double> sorted = step_seconds;
+    std::sort(sorted.begin(), sorted.end());
+    const double median = sorted[sorted.size() / 2], slowest = sorted.back();
+    const long over_budget = std::count_if(sorted.begin(), sorted.end(), [&](double x) { return x > dt; });
+    std::printf("\n%s\n", m.name);
+    std::printf("  %ld steps at 1 kHz: median %.2f us, worst %.2f us, %ld over the 1 ms budget\n", steps,
+                median * 1e6, slowest * 1e6, over_budget);
+    std::printf("  max |Phi| %.2e m, max sideways wheel velocity %.2e m/s, max |J^T tau - Q*| / |Q*| %.2e\n",
+                worst.closure, worst.sideways, worst.torque_balance);
+    std::printf("  peak actuator torque %.4g N m; commanded coordinate back to its start within %.1e\n",
+                worst.torque, std::abs(q(m.coordinate) - start(m.coordinate)));
+
+    const auto fail = [&](bool failed, const char* what) {
+      if (failed) {
+        std::fprintf(stderr, "%s: FAILED: %s\n", m.name, what);
+        ok = false;
+      }
+    };
+    fail(worst.closure > 1e-12, "closure residual above 1e-12 m");
+    fail(worst.sideways > 1e-12, "sideways wheel velocity above 1e-12 m/s");
+    fail(worst.torque_balance > 1e-9, "torques do not reproduce Q* to 1e-9");
+    fail(over_budget * 100 > steps, "more than 1% of the steps over the 1 ms budget");
+  }
+  std::printf("\nheap allocations inside the loop: %ld\n", allocations_while_counting);
+  if (allocations_while_counting != 0) {
+    std::fprintf(stderr, "FAILED: the control loop allocated\n");
+    ok = false;
+  }
+  std::printf(ok ? "all checks pass\n" : "some checks FAILED\n");
+  return ok ? 0 : 1;
+}

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# The ways a project takes wlx in, checked as a user would meet them (run by .ci/run after the
+# README's test command has built build/):
+#   1. the README's embedding recipe, verbatim (the sh block after "<!-- ci: embedding -->"):
+#      install into a prefix, then build and run examples/controller against it;
+#   2. add_subdirectory() of the source tree: only the runtime is configured, and the configure
+#      finds neither GiNaC nor CLI11 nor nlohmann-json (not needed, so not looked for).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+echo "-- the README's embedding recipe"
+awk '/<!-- ci: embedding -->/ {marked = 1; next}
+     marked && /^```sh/      {inside = 1; next}
+     inside && /^```/        {exit}
+     inside                  {print}' README.md > "$work/embedding.sh"
+if ! grep -q 'cmake --install' "$work/embedding.sh"; then
+  echo "README.md: no sh block after <!-- ci: embedding --> (or it does not install)" >&2
+  exit 1
+fi
+cat "$work/embedding.sh"
+bash -euo pipefail "$work/embedding.sh"
+
+echo "-- add_subdirectory(), runtime only"
+cmake -S tests/package -B "$work/subdirectory" -G Ninja -DWLX_SOURCE_DIR="$PWD" > "$work/configure.log"
+for needless in GINAC CLI11_DIR nlohmann_json_DIR yaml-cpp_DIR; do
+  if grep -q "^$needless" "$work/subdirectory/CMakeCache.txt"; then
+    echo "add_subdirectory(wlx) looked for $needless, which the runtime does not need" >&2
+    exit 1
+  fi
+done
+cmake --build "$work/subdirectory" --parallel "$(nproc)" > "$work/build.log" || { cat "$work/build.log" >&2; exit 1; }
+"$work/subdirectory/uses_wlx"
