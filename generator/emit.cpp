@@ -50,6 +50,25 @@ std::string quoted(const std::string& text) {
   return out + "\"";
 }
 
+namespace detail {
+
+// Baked parameters become constants: the expression structure stays the symbolic one (GiNaC would
+// distribute numeric factors over sums), and the compiler folds the numbers. The others are read
+// from Params (double) and converted to the scalar type once.
+std::string parameter_aliases(const Model& m, const std::set<std::string>& used, const EmitOptions& opt) {
+  std::string s;
+  for (const auto& par : m.parameters) {
+    if (!used.count(par.name)) continue;
+    if (auto it = opt.baked.find(par.name); it != opt.baked.end())
+      s += fmt::format("  const Scalar {}({});\n", par.name, literal(it->second));
+    else
+      s += fmt::format("  const Scalar {0}(p.{0});\n", par.name);
+  }
+  return s;
+}
+
+}  // namespace detail
+
 std::string literal(double v) {
   std::string s = fmt::format("{}", v);
   if (s.find_first_of(".en") == std::string::npos) s += ".0";
@@ -87,17 +106,38 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
       "inline constexpr int kBodyCount = {};\n"
       "inline constexpr int kWheelCount = {};\n\n",
       n, m.input_count, n - m.input_count, nc, nf, nb, nw);
+  // Every generated function is a template on the scalar type: double (tested, the runtime's),
+  // float (targets without double-precision hardware), automatic-differentiation numbers. The
+  // ...Of<Scalar> types are its arguments; the plain names are the double ones.
   t += fmt::format(
-      "using Coordinates = Eigen::Matrix<double, {0}, 1>;\n"
-      "using FramePositions = Eigen::Matrix<double, 3, {1}>;\n"
-      "using FrameRotations = std::array<Eigen::Matrix3d, {1}>;\n"
-      "using ClosureVector = Eigen::Matrix<double, {2}, 1>;\n"
-      "using ClosureJacobian = Eigen::Matrix<double, {2}, {0}>;\n"
-      "using WheelRows = Eigen::Matrix<double, {3}, {0}>;\n"
-      "using WheelVector = Eigen::Matrix<double, {3}, 1>;\n"
-      "using BodyVectors = Eigen::Matrix<double, 3, {4}>;\n"
-      "using BodyRotations = std::array<Eigen::Matrix3d, {4}>;\n"
-      "using BodyJacobians = std::array<Eigen::Matrix<double, 3, {0}>, {4}>;\n\n",
+      "// The types of the generated functions for scalar type Scalar.\n"
+      "template <typename Scalar> using CoordinatesOf = Eigen::Matrix<Scalar, {0}, 1>;\n"
+      "template <typename Scalar> using FramePositionsOf = Eigen::Matrix<Scalar, 3, {1}>;\n"
+      "template <typename Scalar> using FrameRotationsOf = std::array<Eigen::Matrix<Scalar, 3, 3>, {1}>;\n"
+      "template <typename Scalar> using ClosureVectorOf = Eigen::Matrix<Scalar, {2}, 1>;\n"
+      "template <typename Scalar> using ClosureJacobianOf = Eigen::Matrix<Scalar, {2}, {0}>;\n"
+      "template <typename Scalar> using WheelRowsOf = Eigen::Matrix<Scalar, {3}, {0}>;\n"
+      "template <typename Scalar> using WheelVectorOf = Eigen::Matrix<Scalar, {3}, 1>;\n"
+      "template <typename Scalar> using BodyVectorsOf = Eigen::Matrix<Scalar, 3, {4}>;\n"
+      "template <typename Scalar> using BodyRotationsOf = std::array<Eigen::Matrix<Scalar, 3, 3>, {4}>;\n"
+      "template <typename Scalar> using BodyJacobiansOf = std::array<Eigen::Matrix<Scalar, 3, {0}>, {4}>;\n\n"
+      "// The double ones: what the runtime uses.\n"
+      "using Coordinates = CoordinatesOf<double>;\n"
+      "using FramePositions = FramePositionsOf<double>;\n"
+      "using FrameRotations = FrameRotationsOf<double>;\n"
+      "using ClosureVector = ClosureVectorOf<double>;\n"
+      "using ClosureJacobian = ClosureJacobianOf<double>;\n"
+      "using WheelRows = WheelRowsOf<double>;\n"
+      "using WheelVector = WheelVectorOf<double>;\n"
+      "using BodyVectors = BodyVectorsOf<double>;\n"
+      "using BodyRotations = BodyRotationsOf<double>;\n"
+      "using BodyJacobians = BodyJacobiansOf<double>;\n\n"
+      "namespace detail {{\n"
+      "// T, but not deduced: the scalar type of a generated function comes from its coordinates, so an\n"
+      "// output pointer may be nullptr (std::type_identity_t, which C++17 lacks).\n"
+      "template <typename T> struct NonDeducedType {{ using type = T; }};\n"
+      "template <typename T> using NonDeduced = typename NonDeducedType<T>::type;\n"
+      "}}  // namespace detail\n\n",
       n, nf, nc, nw, nb);
   t += "// Index of each coordinate in s (the model file's order: inputs, then dependent joints).\nnamespace coord {\n";
   for (const auto& c : m.coordinates) t += fmt::format("inline constexpr int {} = {};  // {}, {}\n", c.name, c.index, c.unit, c.meaning);
@@ -199,7 +239,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   const auto batched = [&](std::size_t k) { return trig.names.count(plan.temporaries[k]) != 0; };
   for (std::size_t k = 0; k < plan.temporaries.size(); ++k) {
     if (users[k].size() < 2 || batched(k)) continue;
-    body += fmt::format("  const double t{} = {};\n", k, pr.define(plan.temporaries[k], shared_ops));
+    body += fmt::format("  const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], shared_ops));
   }
   for (std::size_t o = 0; o < outs.size(); ++o) {
     const auto& spec = fn.outputs[o];
@@ -208,7 +248,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
       body += "    if (zero_fill) " + fmt::format(fmt::runtime(spec.prologue), spec.name) + "\n";
     for (std::size_t k = 0; k < plan.temporaries.size(); ++k)
       if (users[k].size() == 1 && *users[k].begin() == static_cast<int>(o) && !batched(k))
-        body += fmt::format("    const double t{} = {};\n", k, pr.define(plan.temporaries[k], output_ops[o]));
+        body += fmt::format("    const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], output_ops[o]));
     for (const auto& el : outs[o]) {
       body += fmt::format("    {} = {};\n", el.lvalue, pr.value(el.id, output_ops[o]));
     }
@@ -226,18 +266,10 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
 
   std::string aliases;
   for (const auto& c : m.coordinates)
-    if (symbols.count(c.name)) aliases += fmt::format("  const double {} = s({});\n", c.name, c.index);
+    if (symbols.count(c.name)) aliases += fmt::format("  const Scalar {} = s({});\n", c.name, c.index);
   for (const auto& c : m.coordinates)
-    if (symbols.count(c.name + "_dot")) aliases += fmt::format("  const double {}_dot = sdot({});\n", c.name, c.index);
-  // Baked parameters become compile-time constants: the expression structure stays the symbolic
-  // one (GiNaC would distribute numeric factors over sums), and the compiler folds the numbers.
-  for (const auto& par : m.parameters) {
-    if (!symbols.count(par.name)) continue;
-    if (auto it = opt.baked.find(par.name); it != opt.baked.end())
-      aliases += fmt::format("  constexpr double {} = {};\n", par.name, literal(it->second));
-    else
-      aliases += fmt::format("  const double {0} = p.{0};\n", par.name);
-  }
+    if (symbols.count(c.name + "_dot")) aliases += fmt::format("  const Scalar {}_dot = sdot({});\n", c.name, c.index);
+  aliases += parameter_aliases(m, symbols, opt);
 
   std::string t = banner(m, opt, fmt::format("{}: {}", fn.name, fn.doc));
   t += "#pragma once\n\n#include <array>\n#include <cmath>\n\n#include \"params.hpp\"\n";
@@ -253,10 +285,13 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
                    stats.intermediates, shared_ops.total());
   t += fmt::format("// Operations with every output requested: {}.\n", op_summary(total));
   t += fmt::format("// The same outputs as expression trees, before CSE: {}.\n", op_summary(before));
-  std::string signature = fmt::format("inline void {}(const Coordinates& s, ", fn.name);
-  if (fn.needs_rates) signature += "const Coordinates& sdot, ";
+  t += "// Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by\n"
+       "// argument-dependent lookup; deduced from s. The parameters stay double.\n";
+  std::string signature = fmt::format("template <typename Scalar>\ninline void {}(const CoordinatesOf<Scalar>& s, ", fn.name);
+  if (fn.needs_rates) signature += "const detail::NonDeduced<CoordinatesOf<Scalar>>& sdot, ";
   signature += "const Params& p";
-  for (const auto& o : fn.outputs) signature += fmt::format(", {}* {}", o.type, o.name);
+  for (const auto& o : fn.outputs)
+    signature += fmt::format(", detail::NonDeduced<{}>* {}", o.type == "double" ? "Scalar" : o.type + "Of<Scalar>", o.name);
   const bool has_zeros = std::any_of(fn.outputs.begin(), fn.outputs.end(), [](const auto& o) { return !o.prologue.empty(); });
   if (has_zeros) {
     // Zeroing a 14 x 32 or 7 x 3 x 32 output costs more than computing its nonzeros (store
@@ -268,7 +303,26 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   t += signature + ") noexcept {\n";
   t += "  static_cast<void>(s);\n  static_cast<void>(p);\n";
   if (fn.needs_rates) t += "  static_cast<void>(sdot);\n";
-  t += aliases + body + "}\n\n";
+  t += using_declarations(pr.calls()) + aliases + body + "}\n\n";
+  // The double overload: the runtime's types, and Eigen expressions for s (which a template
+  // cannot deduce from) convert to them.
+  std::string forward = fmt::format("// {}() in double, for any Eigen expression of the coordinates.\ninline void {}(const Coordinates& s, ", fn.name, fn.name);
+  std::string arguments = "s, ";
+  if (fn.needs_rates) {
+    forward += "const Coordinates& sdot, ";
+    arguments += "sdot, ";
+  }
+  forward += "const Params& p";
+  arguments += "p";
+  for (const auto& o : fn.outputs) {
+    forward += fmt::format(", {}* {}", o.type, o.name);
+    arguments += ", " + o.name;
+  }
+  if (has_zeros) {
+    forward += ", bool zero_fill = true";
+    arguments += ", zero_fill";
+  }
+  t += forward + fmt::format(") noexcept {{\n  {}<double>({});\n}}\n\n", fn.name, arguments);
   t += fmt::format("namespace operations {{\n// Operations {}() evaluates with every output requested (adds, muls, divs, calls).\n"
                    "inline constexpr long {} = {};\n}}  // namespace operations\n\n",
                    fn.name, fn.name, total.total());

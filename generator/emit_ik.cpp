@@ -165,7 +165,7 @@ ex in_results(const Model& m, ex e, const Solve& solve) {
 std::string two_axis_call(Axis a, Axis b, const std::string& v, const std::string& d, const std::string& flip,
                           const SolvedJoint& first, const SolvedJoint& second) {
   return fmt::format(
-      "  double {0}, {1}, {2}, {3}, ik_beside = 0, ik_room = 0;\n"
+      "  Scalar {0}, {1}, {2}, {3}, ik_beside(0), ik_room(0);\n"
       "  const bool ik_two_axis_ok = ik_solve_two_axis<{4}, {5}>({6}, {7}, {8}, {0}, {1}, {2}, {3}, ik_beside, ik_room);\n",
       first.c.get_name(), first.s.get_name(), second.c.get_name(), second.s.get_name(), static_cast<int>(a),
       static_cast<int>(b), v, d, flip);
@@ -252,11 +252,11 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   s0.locals.emplace_back(A_, cross.a);
   s0.locals.emplace_back(B_, cross.b);
   s0.code = fmt::format(
-      "  const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;\n"
-      "  double {0}, {1};\n"
+      "  const Scalar ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;\n"
+      "  Scalar {0}, {1};\n"
       "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, {0}, {1})) {{\n"
-      "    const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
-      "    why = {{1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
+      "    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
+      "    why = {{1, std::sqrt(ik_dd), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
       "    return IkStatus::out_of_reach;\n"
       "  }}\n",
       q3.c.get_name(), q3.s.get_name());
@@ -268,9 +268,9 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   const Vec3 v = p1 + mid.R * (rot(j3.axis, m.coordinates[static_cast<std::size_t>(j3.coordinate)].q) * p2);
   const realsymbol vs[3] = {realsymbol("ik_v0"), realsymbol("ik_v1"), realsymbol("ik_v2")};
   for (int i = 0; i < 3; ++i) s1.locals.emplace_back(vs[i], in_results(m, v[i], solve));
-  s1.code = "  const double ik_v[3] = {ik_v0, ik_v1, ik_v2};\n  const double ik_d[3] = {ik_d0, ik_d1, ik_d2};\n" +
+  s1.code = "  const Scalar ik_v[3] = {ik_v0, ik_v1, ik_v2};\n  const Scalar ik_d[3] = {ik_d0, ik_d1, ik_d2};\n" +
             two_axis_call(j1.axis, j2.axis, "ik_v", "ik_d", "(branch & 2) != 0", q1, q2) +
-            fmt::format("  if (!ik_two_axis_ok) {{\n    why = {{2, ik_beside, 0.0, ik_room, std::atan2({}, {}) * 57.29577951308232}};\n"
+            fmt::format("  if (!ik_two_axis_ok) {{\n    why = {{2, ik_beside, 0.0, ik_room, double(std::atan2({}, {})) * 57.29577951308232}};\n"
                         "    return IkStatus::out_of_reach;\n  }}\n",
                         q3.s.get_name(), q3.c.get_name());
   s1.defines = {q1.c.get_name(), q1.s.get_name(), q2.c.get_name(), q2.s.get_name()};
@@ -412,9 +412,9 @@ Solve plan_lever(const Model& m, const Limb& limb) {
   for (const auto& [k, value] : solve.coupled) s0.locals.emplace_back(joint_symbols(m, k).q, value);
   const realsymbol g[3] = {realsymbol("ik_g0"), realsymbol("ik_g1"), realsymbol("ik_g2")};
   for (int i = 0; i < 3; ++i) s0.locals.emplace_back(g[i], up_frame(2, i));
-  const std::string unit = fmt::format("{{{}, {}, {}}}", vertical == Axis::X ? "1.0" : "0.0", vertical == Axis::Y ? "1.0" : "0.0",
-                                       vertical == Axis::Z ? "1.0" : "0.0");
-  s0.code = "  const double ik_axis[3] = " + unit + ";\n  const double ik_g[3] = {ik_g0, ik_g1, ik_g2};\n" +
+  const std::string unit = fmt::format("{{{}, {}, {}}}", vertical == Axis::X ? "Scalar(1)" : "Scalar(0)",
+                                       vertical == Axis::Y ? "Scalar(1)" : "Scalar(0)", vertical == Axis::Z ? "Scalar(1)" : "Scalar(0)");
+  s0.code = "  const Scalar ik_axis[3] = " + unit + ";\n  const Scalar ik_g[3] = {ik_g0, ik_g1, ik_g2};\n" +
             two_axis_call(ra.axis, rb.axis, "ik_axis", "ik_g", "(branch & 2) != 0", sigma, Jb) +
             fmt::format(
                 "  static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations\n"
@@ -452,14 +452,14 @@ Solve plan_lever(const Model& m, const Limb& limb) {
   Stage s1;
   s1.locals = {{realsymbol("ik_alpha"), results(row.a)}, {realsymbol("ik_beta"), results(row.b)}, {realsymbol("ik_gamma"), results(row.c)}};
   s1.code = fmt::format(
-      "  double {0}, {1};\n"
+      "  Scalar {0}, {1};\n"
       "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, {2} - ik_gamma, (branch & 1) != 0, {0}, {1})) {{\n"
-      "    const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);\n"
+      "    const Scalar ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);\n"
       "    why = {{1, {2}, ik_gamma - ik_R, ik_gamma + ik_R, 0.0}};\n"
       "    return IkStatus::out_of_reach;\n"
       "  }}\n"
-      "  const double {3} = ik_c_sum * {0} + ik_s_sum * {1};\n"
-      "  const double {4} = ik_s_sum * {0} - ik_c_sum * {1};\n",
+      "  const Scalar {3} = ik_c_sum * {0} + ik_s_sum * {1};\n"
+      "  const Scalar {4} = ik_s_sum * {0} - ik_c_sum * {1};\n",
       Jp.c.get_name(), Jp.s.get_name(), target, Jq.c.get_name(), Jq.s.get_name());
   s1.defines = {Jp.c.get_name(), Jp.s.get_name(), Jq.c.get_name(), Jq.s.get_name()};
   solve.stages.push_back(s1);
@@ -490,12 +490,12 @@ Stage angle_stage(const std::vector<Stage>& before, const std::vector<SolvedJoin
     cosines.push_back(j.c.get_name());
   }
   Stage st;
-  st.code = fmt::format("  const std::array<double, {0}> ik_sines{{{{{1}}}}}, ik_cosines{{{{{2}}}}};\n"
-                        "  std::array<double, {0}> ik_angles;\n"
+  st.code = fmt::format("  const std::array<Scalar, {0}> ik_sines{{{{{1}}}}}, ik_cosines{{{{{2}}}}};\n"
+                        "  std::array<Scalar, {0}> ik_angles;\n"
                         "  atan2(ik_sines, ik_cosines, ik_angles);\n",
                         joints.size(), fmt::join(sines, ", "), fmt::join(cosines, ", "));
   for (std::size_t i = 0; i < joints.size(); ++i) {
-    st.code += fmt::format("  const double {} = ik_angles[{}];\n", joints[i].q.get_name(), i);
+    st.code += fmt::format("  const Scalar {} = ik_angles[{}];\n", joints[i].q.get_name(), i);
     st.defines.push_back(joints[i].q.get_name());
   }
   return st;
@@ -511,9 +511,9 @@ Stage check_stage(const Model& m, const Limb& limb, const Solve& solve) {
     rows.push_back(fmt::format("std::abs({})", r.get_name()));
   }
   check.code = fmt::format(
-      "  const double ik_residual = std::max({{{}}});\n"
-      "  if (!(ik_residual <= kIkTolerance)) {{\n"
-      "    why = {{0, ik_residual, 0.0, kIkTolerance, 0.0}};\n"
+      "  const Scalar ik_residual = std::max({{{}}});\n"
+      "  if (!(ik_residual <= ik_tolerance<Scalar>())) {{\n"
+      "    why = {{0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0}};\n"
       "    return IkStatus::residual;\n"
       "  }}\n",
       fmt::join(rows, ", "));
@@ -567,25 +567,19 @@ std::string emit_body(const Model& m, const std::vector<Stage>& stages, const st
 
   std::string body;
   for (const auto& c : m.coordinates)
-    if (symbols.count(c.name)) body += fmt::format("  const double {} = s({});\n", c.name, c.index);
-  for (const auto& par : m.parameters) {
-    if (!symbols.count(par.name)) continue;
-    if (auto it = opt.baked.find(par.name); it != opt.baked.end())
-      body += fmt::format("  constexpr double {} = {};\n", par.name, literal(it->second));
-    else
-      body += fmt::format("  const double {0} = p.{0};\n", par.name);
-  }
+    if (symbols.count(c.name)) body += fmt::format("  const Scalar {} = s({});\n", c.name, c.index);
+  body += parameter_aliases(m, symbols, opt);
   body += trig.prologue;
   const auto batched = [&](std::size_t k) { return trig.names.count(plan.temporaries[k]) != 0; };
   for (std::size_t k = 0; k < stages.size(); ++k) {
     for (std::size_t t = 0; t < plan.temporaries.size(); ++t)
       if (!batched(t) && stage_of(plan.temporaries[t]) == static_cast<int>(k))
-        body += fmt::format("  const double ik_t{} = {};\n", t, pr.define(plan.temporaries[t], ops));
-    for (const auto& [n, id] : locals[k]) body += fmt::format("  const double {} = {};\n", n, pr.value(id, ops));
+        body += fmt::format("  const Scalar ik_t{} = {};\n", t, pr.define(plan.temporaries[t], ops));
+    for (const auto& [n, id] : locals[k]) body += fmt::format("  const Scalar {} = {};\n", n, pr.value(id, ops));
     body += stages[k].code;
   }
   for (const auto& [k, name] : outputs) body += fmt::format("  out({}) = {};\n", k, name);
-  return body + "  return IkStatus::ok;\n";
+  return using_declarations(pr.calls()) + body + "  return IkStatus::ok;\n";
 }
 
 std::vector<std::pair<int, std::string>> solve_outputs(const Model& m, const Solve& solve) {
@@ -599,7 +593,7 @@ std::vector<std::pair<int, std::string>> solve_outputs(const Model& m, const Sol
 // its branch read from `ik_<tag>_branch`, and a failure reporting `failed = index`: for fusing
 // several limbs into one function. The solved joints keep their names (they are distinct already).
 std::vector<Stage> fused_stages(const Model& m, const std::vector<Stage>& stages, const std::string& tag, int index) {
-  std::set<std::string> keep = {"ik_solve_cos_sin", "ik_solve_two_axis"};
+  std::set<std::string> keep = {"ik_solve_cos_sin", "ik_solve_two_axis", "ik_tolerance", "ik_reach_slack"};
   for (const auto& c : m.coordinates)
     for (const char* k : {"ik_q_", "ik_c_", "ik_s_"}) keep.insert(k + c.name);
   const auto renamed = [&](const std::string& name) { return keep.count(name) ? name : "ik_" + tag + "_" + name.substr(3); };
@@ -657,8 +651,11 @@ EmittedSolve emit_solve(const Model& m, const Limb& limb, Solve solve, const Emi
        "// stage 0: residual, the solution does not satisfy the closure rows).\n";
   t += fmt::format("// Operations: {} (adds {}, muls {}, divs {}, calls {}), plus the solver calls.\n", ops.total(), ops.adds,
                    ops.muls, ops.divs, ops.calls);
-  t += fmt::format("inline IkStatus ik_{}(const Coordinates& s, const Params& p, int branch, Coordinates& out, "
-                   "IkDiagnostics& why) noexcept {{\n",
+  t += "// Scalar: float or double (the branch choices and the reach diagnostics need real numbers).\n";
+  t += fmt::format("template <typename Scalar>\n"
+                   "inline IkStatus ik_{}(const CoordinatesOf<Scalar>& s, const Params& p, int branch, "
+                   "detail::NonDeduced<CoordinatesOf<Scalar>>& out, IkDiagnostics& why) noexcept {{\n"
+                   "  static_assert(std::is_floating_point_v<Scalar>, \"the closed-form IK is for float and double\");\n",
                    limb.name);
   t += fmt::format("  static_cast<void>(p);\n  if (branch < 0 || branch >= {}) return IkStatus::bad_branch;\n", solve.branches);
   t += body + "}\n\n";
@@ -682,28 +679,42 @@ struct IkDiagnostics {
 };
 
 // Targets this close outside the reach (relative) are rounding, not user error: they are clamped
-// onto the boundary.
+// onto the boundary. For double; ik_reach_slack<Scalar>() scales it with the type's epsilon.
 inline constexpr double kIkReachSlack = 1e-12;
 // A closed-form solution must satisfy the limb's closure rows to this (m or rad); rounding leaves
-// about 1e-15.
+// about 1e-15. For double; see ik_tolerance<Scalar>() for float.
 inline constexpr double kIkTolerance = 1e-9;
+
+// The two for scalar type Scalar. The slack is about 4500 rounding units, so it scales with the
+// type's epsilon (float: 5.4e-4). The tolerance has to stay clear of rounding (n eps times the
+// chain's length) and far below what a wrong solution leaves (millimetres and more); it scales
+// with the square root of the epsilon ratio (float: 2.3e-5 m, where rounding leaves about 1e-6).
+template <typename Scalar>
+inline Scalar ik_reach_slack() noexcept {
+  return Scalar(kIkReachSlack * (double(std::numeric_limits<Scalar>::epsilon()) / std::numeric_limits<double>::epsilon()));
+}
+template <typename Scalar>
+inline Scalar ik_tolerance() noexcept {
+  return Scalar(kIkTolerance * std::sqrt(double(std::numeric_limits<Scalar>::epsilon()) / std::numeric_limits<double>::epsilon()));
+}
 
 // cos x and sin x of the x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie
 // the positive one), or the other root with `other`. False when |c| exceeds sqrt(a^2 + b^2). The
 // angles themselves come from one batched atan2 pass at the end of a solve.
-inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& cos_x, double& sin_x) noexcept {
+template <typename Scalar>
+inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& cos_x, Scalar& sin_x) noexcept {
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
-  const double r = std::sqrt(a * a + b * b);
+  const Scalar r = std::sqrt(a * a + b * b);
   if (!(r > 0)) return false;
-  double ratio = c / r;
+  Scalar ratio = c / r;
   if (!(std::abs(ratio) <= 1)) {
-    if (!(std::abs(ratio) <= 1 + kIkReachSlack)) return false;
-    ratio = std::copysign(1.0, ratio);
+    if (!(std::abs(ratio) <= 1 + ik_reach_slack<Scalar>())) return false;
+    ratio = std::copysign(Scalar(1), ratio);
   }
-  const double cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
-  const double sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
-  double sign = sin_psi > 0 ? -1.0 : sin_psi < 0 ? 1.0 : (cos_psi >= 0 ? 1.0 : -1.0);
+  const Scalar cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
+  const Scalar sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
+  Scalar sign = sin_psi > 0 ? Scalar(-1) : sin_psi < 0 ? Scalar(1) : (cos_psi >= 0 ? Scalar(1) : Scalar(-1));
   if (other) sign = -sign;
   cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
   sin_x = sin_psi * ratio + sign * cos_psi * sin_delta;
@@ -714,40 +725,40 @@ inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& c
 // the component of d along A fixes q2 (two roots: `flip` takes the one with cos q2 of the other sign
 // than branch 0's), then q1 turns R_B(q2) v onto d. False (with how far d is off the plane normal to
 // A, and how far it could be) when no q2 reaches d's component along A.
-template <int A, int B>
-inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& c1, double& s1, double& c2,
-                              double& s2, double& beside, double& room) noexcept {
+template <int A, int B, typename Scalar>
+inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool flip, Scalar& c1, Scalar& s1, Scalar& c2,
+                              Scalar& s2, Scalar& beside, Scalar& room) noexcept {
   static_assert(A != B && A >= 0 && A < 3 && B >= 0 && B < 3, "two different principal axes");
   constexpr int C = 3 - A - B;
   constexpr int i = (B + 1) % 3, j = (B + 2) % 3;    // R_B turns i towards j
   constexpr int i1 = (A + 1) % 3, j1 = (A + 2) % 3;  // R_A turns i1 towards j1
-  const double across = d[i1] * d[i1] + d[j1] * d[j1];  // |d|^2 off the axis A
-  double k2 = across - v[B] * v[B];
+  const Scalar across = d[i1] * d[i1] + d[j1] * d[j1];  // |d|^2 off the axis A
+  Scalar k2 = across - v[B] * v[B];
   if (k2 < 0) {
-    if (-k2 > kIkReachSlack * (across + v[B] * v[B])) {
+    if (-k2 > ik_reach_slack<Scalar>() * (across + v[B] * v[B])) {
       beside = std::abs(d[A]);
       room = std::sqrt(v[A] * v[A] + v[C] * v[C]);
       return false;
     }
     k2 = 0;
   }
-  double k = std::sqrt(k2);
+  Scalar k = std::sqrt(k2);
   if ((v[C] < 0) != flip) k = -k;
-  double t[3] = {0, 0, 0};
+  Scalar t[3] = {0, 0, 0};
   t[A] = d[A];
   t[C] = k;
-  const double y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
-  const double r = std::sqrt(x * x + y * y);
-  c2 = r > 0 ? x / r : 1.0;
-  s2 = r > 0 ? y / r : 0.0;
-  double w[3];
+  const Scalar y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
+  const Scalar r = std::sqrt(x * x + y * y);
+  c2 = r > 0 ? x / r : Scalar(1);
+  s2 = r > 0 ? y / r : Scalar(0);
+  Scalar w[3];
   w[B] = v[B];
   w[i] = c2 * v[i] - s2 * v[j];
   w[j] = s2 * v[i] + c2 * v[j];
-  const double y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
-  const double r1 = std::sqrt(x1 * x1 + y1 * y1);
-  c1 = r1 > 0 ? x1 / r1 : 1.0;
-  s1 = r1 > 0 ? y1 / r1 : 0.0;
+  const Scalar y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
+  const Scalar r1 = std::sqrt(x1 * x1 + y1 * y1);
+  c1 = r1 > 0 ? x1 / r1 : Scalar(1);
+  s1 = r1 > 0 ? y1 / r1 : Scalar(0);
   return true;
 }
 
@@ -759,7 +770,7 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
   std::string t = banner(m, opt, "Closed-form inverse kinematics of the limbs, derived from the model's chains.");
   t += "//\n// Each limb whose chain matches a solvable pattern gets a function ik_<limb>() with all its\n"
        "// branches; kClosedForm lists them (solve == nullptr: no pattern applies, use Newton's method).\n";
-  t += "#pragma once\n\n#include <algorithm>\n#include <array>\n#include <cmath>\n#include <string_view>\n\n"
+  t += "#pragma once\n\n#include <algorithm>\n#include <array>\n#include <cmath>\n#include <limits>\n#include <string_view>\n#include <type_traits>\n\n"
        "#include \"params.hpp\"\n#include \"structure.hpp\"\n#include \"trig.hpp\"\n#include \"types.hpp\"\n\n" +
        namespace_open(opt) + "\n" + kSupport;
   std::vector<std::string> entries;
@@ -787,7 +798,7 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
     std::vector<std::string> bits, failures;
     for (const auto& b : solve->bits) bits.push_back("\"" + b + "\"");
     for (const auto& f : solve->failures) failures.push_back("\"" + f + "\"");
-    entries.push_back(fmt::format("    {{&ik_{}, {}, \"{}\", {{{{{}}}}}, {{{{{}}}}}}},", limb.name, solve->branches, solve->pattern,
+    entries.push_back(fmt::format("    {{&ik_{}<double>, {}, \"{}\", {{{{{}}}}}, {{{{{}}}}}}},", limb.name, solve->branches, solve->pattern,
                                   fmt::join(bits, ", "), fmt::join(failures, ", ")));
   }
   t += "using IkFunction = IkStatus (*)(const Coordinates& s, const Params& p, int branch, Coordinates& out,\n"
@@ -834,8 +845,11 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
         "// (every limb's reach is tested before any limb's residual check), `failed` its index and `why`\n"
         "// its numbers; out is written only when every limb succeeded.\n"
         "// Operations: {1} (adds {2}, muls {3}, divs {4}, calls {5}), plus the solver calls.\n"
-        "inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, {0}>& branches, Coordinates& out,\n"
-        "                       int& failed, IkDiagnostics& why) noexcept {{\n"
+        "// Scalar: float or double.\n"
+        "template <typename Scalar>\n"
+        "inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const std::array<int, {0}>& branches,\n"
+        "                       detail::NonDeduced<CoordinatesOf<Scalar>>& out, int& failed, IkDiagnostics& why) noexcept {{\n"
+        "  static_assert(std::is_floating_point_v<Scalar>, \"the closed-form IK is for float and double\");\n"
         "  static_cast<void>(p);\n",
         m.limbs.size(), ops.total(), ops.adds, ops.muls, ops.divs, ops.calls);
     t += prologue + body + "}\n\n";

@@ -102,6 +102,7 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 )";
   t += namespace_open(opt);
@@ -137,35 +138,44 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
        "typedef double Doubles __attribute__((vector_size(16)));\n"
        "typedef std::uint64_t Bits __attribute__((vector_size(16)));\n"
        "#endif\n\n"
+       "// The bits of a vector as another vector type of the same size (memcpy: no C-style vector cast,\n"
+       "// and no aliasing; compilers turn it into nothing).\n"
+       "template <typename To, typename From>\n"
+       "inline To bit_cast(From from) noexcept {\n"
+       "  static_assert(sizeof(To) == sizeof(From), \"same size\");\n"
+       "  To to;\n"
+       "  std::memcpy(&to, &from, sizeof to);\n"
+       "  return to;\n"
+       "}\n\n"
        "inline void sincos_lanes(Doubles x, Doubles& sin_x, Doubles& cos_x) noexcept {\n"
        "  const Doubles shifted = x * kTwoOverPi + kRoundToInteger;\n"
        "  const Doubles n = shifted - kRoundToInteger;          // nearest integer to x / (pi/2)\n"
-       "  const Bits quadrant = (Bits)shifted;  // its low bits: n mod 4\n"
+       "  const Bits quadrant = bit_cast<Bits>(shifted);  // its low bits: n mod 4\n"
        "  const Doubles r = ((x - n * kHalfPiHi) - n * kHalfPiMid) - n * kHalfPiLo;\n"
        "  const Doubles r2 = r * r;\n";
   // r * (1 + r2 p) rather than r + r r2 p keeps the sign of sin(-0) = -0.
   t += fmt::format("  const Doubles s = r * (1.0 + r2 * ({}));\n", horner(k.sin_coefficients));
   t += fmt::format("  const Doubles c = 1.0 - 0.5 * r2 + r2 * r2 * ({});\n", horner(k.cos_coefficients));
-  t += "  const Bits s_bits = (Bits)s, c_bits = (Bits)c;\n"
+  t += "  const Bits s_bits = bit_cast<Bits>(s), c_bits = bit_cast<Bits>(c);\n"
        "  const Bits swap = Bits{} - (quadrant & 1);  // odd quadrants exchange sin and cos\n"
        "  const Bits sin_bits = ((c_bits & swap) | (s_bits & ~swap)) ^ ((quadrant & 2) << 62);  // quadrants 2, 3: -\n"
        "  const Bits cos_bits = ((s_bits & swap) | (c_bits & ~swap)) ^ (((quadrant + 1) & 2) << 62);  // 1, 2: -\n"
-       "  sin_x = (Doubles)sin_bits;\n"
-       "  cos_x = (Doubles)cos_bits;\n"
+       "  sin_x = bit_cast<Doubles>(sin_bits);\n"
+       "  cos_x = bit_cast<Doubles>(cos_bits);\n"
        "}\n\n"
        "// Picks a where the mask is all ones, b where it is zero.\n"
-       "inline Doubles select(Bits mask, Doubles a, Doubles b) noexcept { return (Doubles)((mask & (Bits)a) | (~mask & (Bits)b)); }\n\n"
+       "inline Doubles select(Bits mask, Doubles a, Doubles b) noexcept { return bit_cast<Doubles>((mask & bit_cast<Bits>(a)) | (~mask & bit_cast<Bits>(b))); }\n\n"
        "inline Doubles atan2_lanes(Doubles y, Doubles x) noexcept {\n"
        "  const Bits sign = Bits{} + 0x8000000000000000u;\n"
-       "  const Doubles ax = (Doubles)((Bits)x & ~sign), ay = (Doubles)((Bits)y & ~sign);\n"
-       "  const Bits swap = (Bits)(ay > ax);  // above the diagonal: atan2 = pi/2 - atan(|x| / |y|)\n"
+       "  const Doubles ax = bit_cast<Doubles>(bit_cast<Bits>(x) & ~sign), ay = bit_cast<Doubles>(bit_cast<Bits>(y) & ~sign);\n"
+       "  const Bits swap = bit_cast<Bits>(ay > ax);  // above the diagonal: atan2 = pi/2 - atan(|x| / |y|)\n"
        "  const Doubles num = select(swap, ax, ay), den = select(swap, ay, ax);\n"
-       "  const Doubles t = num / (den + select((Bits)(den == 0.0), Doubles{} + 1.0, Doubles{}));  // in [0, 1]; 0 / 1 at the origin\n"
+       "  const Doubles t = num / (den + select(bit_cast<Bits>(den == 0.0), Doubles{} + 1.0, Doubles{}));  // in [0, 1]; 0 / 1 at the origin\n"
        "  const Doubles shifted = t * 8.0 + kRoundToInteger;\n"
        "  // The nearest eighth k/8, but 0 below 1/8: atan(1/8) + atan u with u near -1/16 would cancel.\n"
-       "  const Bits small = (Bits)(t < 0.125);\n"
+       "  const Bits small = bit_cast<Bits>(t < 0.125);\n"
        "  const Doubles centre = select(small, Doubles{}, (shifted - kRoundToInteger) * 0.125);\n"
-       "  const Bits k = (Bits)shifted & 15 & ~small;\n"
+       "  const Bits k = bit_cast<Bits>(shifted) & 15 & ~small;\n"
        "  // atan t = atan(k/8) + atan u; t - k/8 is exact (Sterbenz), |u| <= 1/8.\n"
        "  const Doubles u = (t - centre) / (1.0 + t * centre);\n"
        "  const Doubles u2 = u * u;\n";
@@ -177,8 +187,8 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
        "  }\n"
        "  Doubles a = head + (tail + atan_u);  // atan t, in [0, pi/4]\n"
        "  a = select(swap, (kHalfPiHead - a) + kHalfPiTail, a);\n"
-       "  a = select(Bits{} - ((Bits)x >> 63), (kPiHead - a) + kPiTail, a);  // x < 0 (and x = -0): pi - a\n"
-       "  return (Doubles)((Bits)a ^ ((Bits)(y < 0.0) & sign));  // y < 0: -a; y = -0 counts as +0\n"
+       "  a = select(Bits{} - (bit_cast<Bits>(x) >> 63), (kPiHead - a) + kPiTail, a);  // x < 0 (and x = -0): pi - a\n"
+       "  return bit_cast<Doubles>(bit_cast<Bits>(a) ^ (bit_cast<Bits>(y < 0.0) & sign));  // y < 0: -a; y = -0 counts as +0\n"
        "}\n"
        "#endif\n\n";
   t += "}  // namespace trig_detail\n\n"
@@ -212,6 +222,17 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
        "    cos_x[i] = std::cos(x[i]);\n"
        "  }\n"
        "#endif\n"
+       "}\n\n"
+       "// Any other scalar type (float, automatic-differentiation numbers): its own sin and cos, found by\n"
+       "// argument-dependent lookup, or std::sin and std::cos. The exactness guarantee above is for double.\n"
+       "template <typename Scalar, std::size_t N>\n"
+       "inline void sincos(const std::array<Scalar, N>& x, std::array<Scalar, N>& sin_x, std::array<Scalar, N>& cos_x) noexcept {\n"
+       "  using std::cos;\n"
+       "  using std::sin;\n"
+       "  for (std::size_t i = 0; i < N; ++i) {\n"
+       "    sin_x[i] = sin(x[i]);\n"
+       "    cos_x[i] = cos(x[i]);\n"
+       "  }\n"
        "}\n\n"
        "// atan2(y, x, angle) fills angle[i] = atan2(y[i], x[i]) for fixed-size arrays, in (-pi, pi]: a half\n"
        "// turn is +pi (y = -0 counts as +0), and the origin gives 0 (pi for x = -0). Accuracy: within\n"
@@ -251,6 +272,16 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
        "    if (angle[i] == -trig_detail::kPiHead) angle[i] = trig_detail::kPiHead;\n"
        "  }\n"
        "#endif\n"
+       "}\n\n"
+       "// float and long double: std::atan2, with the same conventions (a half turn is +pi).\n"
+       "template <typename Scalar, std::size_t N>\n"
+       "inline void atan2(const std::array<Scalar, N>& y, const std::array<Scalar, N>& x, std::array<Scalar, N>& angle) noexcept {\n"
+       "  static_assert(std::is_floating_point_v<Scalar>, \"atan2 of arrays is for floating-point types\");\n"
+       "  const Scalar pi = Scalar(trig_detail::kPiHead);\n"
+       "  for (std::size_t i = 0; i < N; ++i) {\n"
+       "    angle[i] = std::atan2(y[i] + Scalar(0), x[i]);  // + 0: -0 to +0, so a half turn is +pi\n"
+       "    if (angle[i] == -pi) angle[i] = pi;\n"
+       "  }\n"
        "}\n\n";
   t += namespace_close(opt);
   return {"wlx/gen/trig.hpp", t};

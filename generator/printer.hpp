@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <functional>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <unordered_set>
@@ -20,14 +21,27 @@ namespace wlx::codegen::detail {
 
 inline bool integer_exponent(double e) { return e == static_cast<double>(static_cast<long>(e)); }
 
+// The C++ function for a GiNaC function, called unqualified: the generated functions are templates
+// on the scalar type and bring in `using std::sin;` ..., so a scalar type of the user's (an
+// automatic-differentiation number) finds its own by argument-dependent lookup.
 inline const char* call_name(const std::string& f) {
-  static const std::pair<const char*, const char*> names[] = {
-      {"sin", "std::sin"}, {"cos", "std::cos"}, {"tan", "std::tan"}, {"atan2", "std::atan2"},
-      {"atan", "std::atan"}, {"asin", "std::asin"}, {"acos", "std::acos"}, {"abs", "std::abs"},
-      {"exp", "std::exp"}, {"log", "std::log"}};
-  for (const auto& [g, c] : names)
-    if (f == g) return c;
+  static const char* const names[] = {"sin", "cos", "tan", "atan2", "atan", "asin", "acos", "abs", "exp", "log"};
+  for (const char* c : names)
+    if (f == c) return c;
   throw std::runtime_error("no C++ function for GiNaC function '" + f + "'");
+}
+
+// A number in a generated function body: of the function's scalar type, so float code stays float.
+inline std::string scalar_literal(double v) { return "Scalar(" + literal(v) + ")"; }
+
+// The parameters the body uses as local constants of the scalar type (baked ones as literals).
+std::string parameter_aliases(const Model& m, const std::set<std::string>& used, const EmitOptions& opt);
+
+// `using std::f;` for each function the body calls (sorted: deterministic output).
+inline std::string using_declarations(const std::set<std::string>& calls) {
+  std::string s;
+  for (const auto& c : calls) s += fmt::format("  using std::{};\n", c);
+  return s;
 }
 
 // Prints graph nodes as C++ expressions, replacing temporaries by their names, and counts the
@@ -48,6 +62,8 @@ class Printer {
   std::string define(int id, OpCount& ops) { return node(id, Context::Root, ops, nullptr); }
   // Node `id` as an output's value: its variable if it has one, else its definition.
   std::string value(int id, OpCount& ops) { return use(id, Context::Root, ops, nullptr); }
+  // The functions the printed code calls (sqrt, ...): each needs `using std::name;`.
+  const std::set<std::string>& calls() const { return calls_; }
 
  private:
   std::string use(int id, Context ctx, OpCount& ops, bool* negated) {
@@ -63,9 +79,9 @@ class Printer {
       case NodeKind::Number: {
         if (n.value < 0 && negated != nullptr) {
           *negated = true;
-          return literal(-n.value);
+          return scalar_literal(-n.value);
         }
-        return (n.value < 0 && ctx == Context::Factor) ? "(" + literal(n.value) + ")" : literal(n.value);
+        return scalar_literal(n.value);
       }
       case NodeKind::Add: return sum(n, ctx, ops);
       case NodeKind::Mul: return product(n, ctx, ops, negated);
@@ -77,6 +93,7 @@ class Printer {
         std::string args;
         for (int a : n.args) args += (args.empty() ? "" : ", ") + use(a, Context::Root, ops, nullptr);
         ++ops.calls;
+        calls_.insert(call_name(n.text));
         return fmt::format("{}({})", call_name(n.text), args);
       }
     }
@@ -116,13 +133,13 @@ class Printer {
       }
     }
     const bool negative = coefficient < 0;
-    if (std::abs(coefficient) != 1.0) numer.insert(numer.begin(), literal(std::abs(coefficient)));
+    if (std::abs(coefficient) != 1.0) numer.insert(numer.begin(), scalar_literal(std::abs(coefficient)));
     auto join = [](const std::vector<std::string>& v) {
       std::string s;
       for (const auto& x : v) s += (s.empty() ? "" : "*") + x;
       return s;
     };
-    std::string s = numer.empty() ? "1.0" : join(numer);
+    std::string s = numer.empty() ? "Scalar(1)" : join(numer);
     if (!numer.empty()) ops.muls += static_cast<long>(numer.size()) - 1;
     if (!denom.empty()) {
       s += denom.size() == 1 ? "/" + denom[0] : "/(" + join(denom) + ")";
@@ -149,23 +166,29 @@ class Printer {
       ops.muls += k - 1;
       if (n.value < 0) {
         ++ops.divs;
-        return k == 1 ? "1.0/" + base : "1.0/(" + s + ")";
+        return k == 1 ? "Scalar(1)/" + base : "Scalar(1)/(" + s + ")";
       }
       return s;
     }
     ++ops.calls;
-    if (n.value == 0.5) return fmt::format("std::sqrt({})", base);
+    if (n.value == 0.5) {
+      calls_.insert("sqrt");
+      return fmt::format("sqrt({})", base);
+    }
     if (n.value == -0.5) {
       ++ops.divs;
-      return fmt::format("1.0/std::sqrt({})", base);
+      calls_.insert("sqrt");
+      return fmt::format("Scalar(1)/sqrt({})", base);
     }
-    return fmt::format("std::pow({}, {})", base, literal(n.value));
+    calls_.insert("pow");
+    return fmt::format("pow({}, {})", base, scalar_literal(n.value));
   }
 
   const ExprGraph& g_;
   const CsePlan& plan_;
   const std::map<int, std::string>& precomputed_;
   std::string prefix_;
+  std::set<std::string> calls_;
 };
 
 // sin and cos of coordinates, batched into one trig.hpp pass: node id -> variable name, and
@@ -200,14 +223,14 @@ inline TrigBatch batch_trig(const Model& m, const ExprGraph& g, const std::vecto
     list += (k ? ", " : "") + angles[k];
     for (const auto& [f, id] : by_angle[angles[k]]) {
       b.names[id] = fmt::format("{}_{}", f, angles[k]);
-      named += fmt::format("  const double {0}_{1} = {0}_angle[{2}];\n", f, angles[k], k);
+      named += fmt::format("  const Scalar {0}_{1} = {0}_angle[{2}];\n", f, angles[k], k);
       ++b.calls;
     }
   }
   b.prologue = fmt::format(
       "  // sin and cos of all {0} angles in one vectorized pass (trig.hpp).\n"
-      "  const std::array<double, {0}> angle{{{1}}};\n"
-      "  std::array<double, {0}> sin_angle, cos_angle;\n"
+      "  const std::array<Scalar, {0}> angle{{{1}}};\n"
+      "  std::array<Scalar, {0}> sin_angle, cos_angle;\n"
       "  sincos(angle, sin_angle, cos_angle);\n{2}",
       count, list, named);
   return b;

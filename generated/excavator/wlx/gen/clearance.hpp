@@ -25,26 +25,35 @@ namespace gen {
 // included: they are computed up front, whichever outputs are requested).
 // Operations with every output requested: 20 (adds 5, muls 8, divs 0, calls 7).
 // The same outputs as expression trees, before CSE: 19 (adds 3, muls 8, divs 0, calls 8).
-inline void clearance(const Coordinates& s, const Params& p, double* lowest) noexcept {
+// Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by
+// argument-dependent lookup; deduced from s. The parameters stay double.
+template <typename Scalar>
+inline void clearance(const CoordinatesOf<Scalar>& s, const Params& p, detail::NonDeduced<Scalar>* lowest) noexcept {
   static_cast<void>(s);
   static_cast<void>(p);
-  const double z_C = s(2);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double cxd = p.cxd;
-  const double cyd = p.cyd;
-  const double cabin_height = p.cabin_height;
+  using std::abs;
+  const Scalar z_C = s(2);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar cxd(p.cxd);
+  const Scalar cyd(p.cyd);
+  const Scalar cabin_height(p.cabin_height);
   // sin and cos of all 2 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 2> angle{pitch, roll};
-  std::array<double, 2> sin_angle, cos_angle;
+  const std::array<Scalar, 2> angle{pitch, roll};
+  std::array<Scalar, 2> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_pitch = cos_angle[0];
-  const double sin_pitch = sin_angle[0];
-  const double cos_roll = cos_angle[1];
-  const double sin_roll = sin_angle[1];
+  const Scalar cos_pitch = cos_angle[0];
+  const Scalar sin_pitch = sin_angle[0];
+  const Scalar cos_roll = cos_angle[1];
+  const Scalar sin_roll = sin_angle[1];
   if (lowest != nullptr) {
-    *lowest = -(0.5*cxd*std::abs(-sin_pitch) + 0.5*cabin_height*std::abs(cos_roll*cos_pitch) + 0.5*std::abs(sin_roll*cos_pitch)*cyd - z_C);
+    *lowest = -(Scalar(0.5)*cxd*abs(-sin_pitch) + Scalar(0.5)*cabin_height*abs(cos_roll*cos_pitch) + Scalar(0.5)*abs(sin_roll*cos_pitch)*cyd - z_C);
   }
+}
+
+// clearance() in double, for any Eigen expression of the coordinates.
+inline void clearance(const Coordinates& s, const Params& p, double* lowest) noexcept {
+  clearance<double>(s, p, lowest);
 }
 
 namespace operations {

@@ -12,7 +12,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string_view>
+#include <type_traits>
 
 #include "params.hpp"
 #include "structure.hpp"
@@ -40,28 +42,42 @@ struct IkDiagnostics {
 };
 
 // Targets this close outside the reach (relative) are rounding, not user error: they are clamped
-// onto the boundary.
+// onto the boundary. For double; ik_reach_slack<Scalar>() scales it with the type's epsilon.
 inline constexpr double kIkReachSlack = 1e-12;
 // A closed-form solution must satisfy the limb's closure rows to this (m or rad); rounding leaves
-// about 1e-15.
+// about 1e-15. For double; see ik_tolerance<Scalar>() for float.
 inline constexpr double kIkTolerance = 1e-9;
+
+// The two for scalar type Scalar. The slack is about 4500 rounding units, so it scales with the
+// type's epsilon (float: 5.4e-4). The tolerance has to stay clear of rounding (n eps times the
+// chain's length) and far below what a wrong solution leaves (millimetres and more); it scales
+// with the square root of the epsilon ratio (float: 2.3e-5 m, where rounding leaves about 1e-6).
+template <typename Scalar>
+inline Scalar ik_reach_slack() noexcept {
+  return Scalar(kIkReachSlack * (double(std::numeric_limits<Scalar>::epsilon()) / std::numeric_limits<double>::epsilon()));
+}
+template <typename Scalar>
+inline Scalar ik_tolerance() noexcept {
+  return Scalar(kIkTolerance * std::sqrt(double(std::numeric_limits<Scalar>::epsilon()) / std::numeric_limits<double>::epsilon()));
+}
 
 // cos x and sin x of the x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie
 // the positive one), or the other root with `other`. False when |c| exceeds sqrt(a^2 + b^2). The
 // angles themselves come from one batched atan2 pass at the end of a solve.
-inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& cos_x, double& sin_x) noexcept {
+template <typename Scalar>
+inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& cos_x, Scalar& sin_x) noexcept {
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
-  const double r = std::sqrt(a * a + b * b);
+  const Scalar r = std::sqrt(a * a + b * b);
   if (!(r > 0)) return false;
-  double ratio = c / r;
+  Scalar ratio = c / r;
   if (!(std::abs(ratio) <= 1)) {
-    if (!(std::abs(ratio) <= 1 + kIkReachSlack)) return false;
-    ratio = std::copysign(1.0, ratio);
+    if (!(std::abs(ratio) <= 1 + ik_reach_slack<Scalar>())) return false;
+    ratio = std::copysign(Scalar(1), ratio);
   }
-  const double cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
-  const double sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
-  double sign = sin_psi > 0 ? -1.0 : sin_psi < 0 ? 1.0 : (cos_psi >= 0 ? 1.0 : -1.0);
+  const Scalar cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
+  const Scalar sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
+  Scalar sign = sin_psi > 0 ? Scalar(-1) : sin_psi < 0 ? Scalar(1) : (cos_psi >= 0 ? Scalar(1) : Scalar(-1));
   if (other) sign = -sign;
   cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
   sin_x = sin_psi * ratio + sign * cos_psi * sin_delta;
@@ -72,40 +88,40 @@ inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& c
 // the component of d along A fixes q2 (two roots: `flip` takes the one with cos q2 of the other sign
 // than branch 0's), then q1 turns R_B(q2) v onto d. False (with how far d is off the plane normal to
 // A, and how far it could be) when no q2 reaches d's component along A.
-template <int A, int B>
-inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& c1, double& s1, double& c2,
-                              double& s2, double& beside, double& room) noexcept {
+template <int A, int B, typename Scalar>
+inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool flip, Scalar& c1, Scalar& s1, Scalar& c2,
+                              Scalar& s2, Scalar& beside, Scalar& room) noexcept {
   static_assert(A != B && A >= 0 && A < 3 && B >= 0 && B < 3, "two different principal axes");
   constexpr int C = 3 - A - B;
   constexpr int i = (B + 1) % 3, j = (B + 2) % 3;    // R_B turns i towards j
   constexpr int i1 = (A + 1) % 3, j1 = (A + 2) % 3;  // R_A turns i1 towards j1
-  const double across = d[i1] * d[i1] + d[j1] * d[j1];  // |d|^2 off the axis A
-  double k2 = across - v[B] * v[B];
+  const Scalar across = d[i1] * d[i1] + d[j1] * d[j1];  // |d|^2 off the axis A
+  Scalar k2 = across - v[B] * v[B];
   if (k2 < 0) {
-    if (-k2 > kIkReachSlack * (across + v[B] * v[B])) {
+    if (-k2 > ik_reach_slack<Scalar>() * (across + v[B] * v[B])) {
       beside = std::abs(d[A]);
       room = std::sqrt(v[A] * v[A] + v[C] * v[C]);
       return false;
     }
     k2 = 0;
   }
-  double k = std::sqrt(k2);
+  Scalar k = std::sqrt(k2);
   if ((v[C] < 0) != flip) k = -k;
-  double t[3] = {0, 0, 0};
+  Scalar t[3] = {0, 0, 0};
   t[A] = d[A];
   t[C] = k;
-  const double y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
-  const double r = std::sqrt(x * x + y * y);
-  c2 = r > 0 ? x / r : 1.0;
-  s2 = r > 0 ? y / r : 0.0;
-  double w[3];
+  const Scalar y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
+  const Scalar r = std::sqrt(x * x + y * y);
+  c2 = r > 0 ? x / r : Scalar(1);
+  s2 = r > 0 ? y / r : Scalar(0);
+  Scalar w[3];
   w[B] = v[B];
   w[i] = c2 * v[i] - s2 * v[j];
   w[j] = s2 * v[i] + c2 * v[j];
-  const double y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
-  const double r1 = std::sqrt(x1 * x1 + y1 * y1);
-  c1 = r1 > 0 ? x1 / r1 : 1.0;
-  s1 = r1 > 0 ? y1 / r1 : 0.0;
+  const Scalar y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
+  const Scalar r1 = std::sqrt(x1 * x1 + y1 * y1);
+  c1 = r1 > 0 ? x1 / r1 : Scalar(1);
+  s1 = r1 > 0 ? y1 / r1 : Scalar(0);
   return true;
 }
 
@@ -121,87 +137,90 @@ inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool f
 // On failure returns why, with the numbers in `why` (stage 1.. as in kClosedForm's failure texts;
 // stage 0: residual, the solution does not satisfy the closure rows).
 // Operations: 184 (adds 58, muls 118, divs 0, calls 8), plus the solver calls.
-inline IkStatus ik_leg_l(const Coordinates& s, const Params& p, int branch, Coordinates& out, IkDiagnostics& why) noexcept {
+// Scalar: float or double (the branch choices and the reach diagnostics need real numbers).
+template <typename Scalar>
+inline IkStatus ik_leg_l(const CoordinatesOf<Scalar>& s, const Params& p, int branch, detail::NonDeduced<CoordinatesOf<Scalar>>& out, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 4) return IkStatus::bad_branch;
-  const double x_C = s(0);
-  const double y_C = s(1);
-  const double z_C = s(2);
-  const double yaw = s(3);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double x_Fl = s(6);
-  const double y_Fl = s(7);
-  const double z_Fl = s(8);
-  const double psi_l1 = s(14);
-  const double cxd = p.cxd;
-  const double cyd = p.cyd;
-  const double thighD = p.thighD;
-  const double legD = p.legD;
+  const Scalar x_C = s(0);
+  const Scalar y_C = s(1);
+  const Scalar z_C = s(2);
+  const Scalar yaw = s(3);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar x_Fl = s(6);
+  const Scalar y_Fl = s(7);
+  const Scalar z_Fl = s(8);
+  const Scalar psi_l1 = s(14);
+  const Scalar cxd(p.cxd);
+  const Scalar cyd(p.cyd);
+  const Scalar thighD(p.thighD);
+  const Scalar legD(p.legD);
   // sin and cos of all 4 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 4> angle{yaw, pitch, roll, psi_l1};
-  std::array<double, 4> sin_angle, cos_angle;
+  const std::array<Scalar, 4> angle{yaw, pitch, roll, psi_l1};
+  std::array<Scalar, 4> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_yaw = cos_angle[0];
-  const double sin_yaw = sin_angle[0];
-  const double cos_pitch = cos_angle[1];
-  const double sin_pitch = sin_angle[1];
-  const double cos_roll = cos_angle[2];
-  const double sin_roll = sin_angle[2];
-  const double cos_psi_l1 = cos_angle[3];
-  const double sin_psi_l1 = sin_angle[3];
-  const double ik_t5 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
-  const double ik_t7 = ik_t5*cyd + 2.0*x_C + cos_yaw*cxd*cos_pitch - 2.0*x_Fl;
-  const double ik_t8 = 2.0*z_Fl + sin_pitch*cxd - 2.0*z_C - sin_roll*cyd*cos_pitch;
-  const double ik_t9 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
-  const double ik_t10 = ik_t9*cyd + cxd*cos_pitch*sin_yaw + 2.0*y_C - 2.0*y_Fl;
-  const double ik_t11 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
-  const double ik_t14 = ik_t11*sin_psi_l1 + cos_psi_l1*ik_t9;
-  const double ik_t15 = sin_psi_l1*cos_roll*cos_pitch + sin_roll*cos_psi_l1*cos_pitch;
-  const double ik_t16 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
-  const double ik_t17 = ik_t16*sin_psi_l1 + cos_psi_l1*ik_t5;
-  const double ik_t18 = ik_t16*cos_psi_l1 - ik_t5*sin_psi_l1;
-  const double ik_t19 = cos_psi_l1*cos_roll*cos_pitch - sin_roll*sin_psi_l1*cos_pitch;
-  const double ik_t20 = ik_t9*sin_psi_l1 - cos_psi_l1*ik_t11;
-  const double ik_d0 = -(0.5*cos_yaw*ik_t7*cos_pitch + 0.5*ik_t8*sin_pitch + 0.5*cos_pitch*sin_yaw*ik_t10);
-  const double ik_d1 = 0.5*ik_t8*ik_t15 - 0.5*ik_t14*ik_t10 - 0.5*ik_t17*ik_t7;
-  const double ik_d2 = -(0.5*ik_t7*ik_t18 - 0.5*ik_t8*ik_t19 - 0.5*ik_t20*ik_t10);
-  const double ik_K = legD*legD + thighD*thighD;
-  const double ik_A = 2.0*thighD*legD;
-  const double ik_B = 0.0;
-  const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
-  double ik_c_psi_l4, ik_s_psi_l4;
+  const Scalar cos_yaw = cos_angle[0];
+  const Scalar sin_yaw = sin_angle[0];
+  const Scalar cos_pitch = cos_angle[1];
+  const Scalar sin_pitch = sin_angle[1];
+  const Scalar cos_roll = cos_angle[2];
+  const Scalar sin_roll = sin_angle[2];
+  const Scalar cos_psi_l1 = cos_angle[3];
+  const Scalar sin_psi_l1 = sin_angle[3];
+  const Scalar ik_t5 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
+  const Scalar ik_t7 = ik_t5*cyd + Scalar(2.0)*x_C + cos_yaw*cxd*cos_pitch - Scalar(2.0)*x_Fl;
+  const Scalar ik_t8 = Scalar(2.0)*z_Fl + sin_pitch*cxd - Scalar(2.0)*z_C - sin_roll*cyd*cos_pitch;
+  const Scalar ik_t9 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
+  const Scalar ik_t10 = ik_t9*cyd + cxd*cos_pitch*sin_yaw + Scalar(2.0)*y_C - Scalar(2.0)*y_Fl;
+  const Scalar ik_t11 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
+  const Scalar ik_t14 = ik_t11*sin_psi_l1 + cos_psi_l1*ik_t9;
+  const Scalar ik_t15 = sin_psi_l1*cos_roll*cos_pitch + sin_roll*cos_psi_l1*cos_pitch;
+  const Scalar ik_t16 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
+  const Scalar ik_t17 = ik_t16*sin_psi_l1 + cos_psi_l1*ik_t5;
+  const Scalar ik_t18 = ik_t16*cos_psi_l1 - ik_t5*sin_psi_l1;
+  const Scalar ik_t19 = cos_psi_l1*cos_roll*cos_pitch - sin_roll*sin_psi_l1*cos_pitch;
+  const Scalar ik_t20 = ik_t9*sin_psi_l1 - cos_psi_l1*ik_t11;
+  const Scalar ik_d0 = -(Scalar(0.5)*cos_yaw*ik_t7*cos_pitch + Scalar(0.5)*ik_t8*sin_pitch + Scalar(0.5)*cos_pitch*sin_yaw*ik_t10);
+  const Scalar ik_d1 = Scalar(0.5)*ik_t8*ik_t15 - Scalar(0.5)*ik_t14*ik_t10 - Scalar(0.5)*ik_t17*ik_t7;
+  const Scalar ik_d2 = -(Scalar(0.5)*ik_t7*ik_t18 - Scalar(0.5)*ik_t8*ik_t19 - Scalar(0.5)*ik_t20*ik_t10);
+  const Scalar ik_K = legD*legD + thighD*thighD;
+  const Scalar ik_A = Scalar(2.0)*thighD*legD;
+  const Scalar ik_B = Scalar(0.0);
+  const Scalar ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
+  Scalar ik_c_psi_l4, ik_s_psi_l4;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_psi_l4, ik_s_psi_l4)) {
-    const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
+    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_v0 = thighD + legD*ik_c_psi_l4;
-  const double ik_v1 = 0.0;
-  const double ik_v2 = -ik_s_psi_l4*legD;
-  const double ik_v[3] = {ik_v0, ik_v1, ik_v2};
-  const double ik_d[3] = {ik_d0, ik_d1, ik_d2};
-  double ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_beside = 0, ik_room = 0;
+  const Scalar ik_v0 = thighD + legD*ik_c_psi_l4;
+  const Scalar ik_v1 = Scalar(0.0);
+  const Scalar ik_v2 = -ik_s_psi_l4*legD;
+  const Scalar ik_v[3] = {ik_v0, ik_v1, ik_v2};
+  const Scalar ik_d[3] = {ik_d0, ik_d1, ik_d2};
+  Scalar ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_beside(0), ik_room(0);
   const bool ik_two_axis_ok = ik_solve_two_axis<1, 2>(ik_v, ik_d, (branch & 2) != 0, ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_beside, ik_room);
   if (!ik_two_axis_ok) {
-    why = {2, ik_beside, 0.0, ik_room, std::atan2(ik_s_psi_l4, ik_c_psi_l4) * 57.29577951308232};
+    why = {2, ik_beside, 0.0, ik_room, double(std::atan2(ik_s_psi_l4, ik_c_psi_l4)) * 57.29577951308232};
     return IkStatus::out_of_reach;
   }
-  const double ik_t21 = ik_t17*ik_s_psi_l3 + (cos_yaw*ik_c_psi_l2*cos_pitch - ik_s_psi_l2*ik_t18)*ik_c_psi_l3;
-  const double ik_t22 = (ik_s_psi_l2*ik_t20 + ik_c_psi_l2*cos_pitch*sin_yaw)*ik_c_psi_l3 + ik_s_psi_l3*ik_t14;
-  const double ik_t23 = ik_t15*ik_s_psi_l3 - ik_c_psi_l3*(sin_pitch*ik_c_psi_l2 + ik_s_psi_l2*ik_t19);
-  const std::array<double, 3> ik_sines{{ik_s_psi_l2, ik_s_psi_l3, ik_s_psi_l4}}, ik_cosines{{ik_c_psi_l2, ik_c_psi_l3, ik_c_psi_l4}};
-  std::array<double, 3> ik_angles;
+  const Scalar ik_t21 = ik_t17*ik_s_psi_l3 + (cos_yaw*ik_c_psi_l2*cos_pitch - ik_s_psi_l2*ik_t18)*ik_c_psi_l3;
+  const Scalar ik_t22 = (ik_s_psi_l2*ik_t20 + ik_c_psi_l2*cos_pitch*sin_yaw)*ik_c_psi_l3 + ik_s_psi_l3*ik_t14;
+  const Scalar ik_t23 = ik_t15*ik_s_psi_l3 - ik_c_psi_l3*(sin_pitch*ik_c_psi_l2 + ik_s_psi_l2*ik_t19);
+  const std::array<Scalar, 3> ik_sines{{ik_s_psi_l2, ik_s_psi_l3, ik_s_psi_l4}}, ik_cosines{{ik_c_psi_l2, ik_c_psi_l3, ik_c_psi_l4}};
+  std::array<Scalar, 3> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_psi_l2 = ik_angles[0];
-  const double ik_q_psi_l3 = ik_angles[1];
-  const double ik_q_psi_l4 = ik_angles[2];
-  const double ik_row0 = x_C + 0.5*cos_yaw*cxd*cos_pitch + legD*(ik_t21*ik_c_psi_l4 - ik_s_psi_l4*(ik_s_psi_l2*cos_yaw*cos_pitch + ik_c_psi_l2*ik_t18)) + ik_t21*thighD + 0.5*ik_t5*cyd - x_Fl;
-  const double ik_row1 = 0.5*cxd*cos_pitch*sin_yaw + y_C + thighD*ik_t22 + 0.5*ik_t9*cyd + legD*(ik_c_psi_l4*ik_t22 - ik_s_psi_l4*(ik_s_psi_l2*cos_pitch*sin_yaw - ik_t20*ik_c_psi_l2)) - y_Fl;
-  const double ik_row2 = -(z_Fl + 0.5*sin_pitch*cxd - z_C - 0.5*sin_roll*cyd*cos_pitch - legD*(ik_c_psi_l4*ik_t23 + ik_s_psi_l4*(ik_s_psi_l2*sin_pitch - ik_c_psi_l2*ik_t19)) - thighD*ik_t23);
-  const double ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
-  if (!(ik_residual <= kIkTolerance)) {
-    why = {0, ik_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_psi_l2 = ik_angles[0];
+  const Scalar ik_q_psi_l3 = ik_angles[1];
+  const Scalar ik_q_psi_l4 = ik_angles[2];
+  const Scalar ik_row0 = x_C + Scalar(0.5)*cos_yaw*cxd*cos_pitch + legD*(ik_t21*ik_c_psi_l4 - ik_s_psi_l4*(ik_s_psi_l2*cos_yaw*cos_pitch + ik_c_psi_l2*ik_t18)) + ik_t21*thighD + Scalar(0.5)*ik_t5*cyd - x_Fl;
+  const Scalar ik_row1 = Scalar(0.5)*cxd*cos_pitch*sin_yaw + y_C + thighD*ik_t22 + Scalar(0.5)*ik_t9*cyd + legD*(ik_c_psi_l4*ik_t22 - ik_s_psi_l4*(ik_s_psi_l2*cos_pitch*sin_yaw - ik_t20*ik_c_psi_l2)) - y_Fl;
+  const Scalar ik_row2 = -(z_Fl + Scalar(0.5)*sin_pitch*cxd - z_C - Scalar(0.5)*sin_roll*cyd*cos_pitch - legD*(ik_c_psi_l4*ik_t23 + ik_s_psi_l4*(ik_s_psi_l2*sin_pitch - ik_c_psi_l2*ik_t19)) - thighD*ik_t23);
+  const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
+  if (!(ik_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     return IkStatus::residual;
   }
   out(18) = ik_q_psi_l2;
@@ -222,87 +241,90 @@ inline IkStatus ik_leg_l(const Coordinates& s, const Params& p, int branch, Coor
 // On failure returns why, with the numbers in `why` (stage 1.. as in kClosedForm's failure texts;
 // stage 0: residual, the solution does not satisfy the closure rows).
 // Operations: 183 (adds 57, muls 118, divs 0, calls 8), plus the solver calls.
-inline IkStatus ik_leg_r(const Coordinates& s, const Params& p, int branch, Coordinates& out, IkDiagnostics& why) noexcept {
+// Scalar: float or double (the branch choices and the reach diagnostics need real numbers).
+template <typename Scalar>
+inline IkStatus ik_leg_r(const CoordinatesOf<Scalar>& s, const Params& p, int branch, detail::NonDeduced<CoordinatesOf<Scalar>>& out, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 4) return IkStatus::bad_branch;
-  const double x_C = s(0);
-  const double y_C = s(1);
-  const double z_C = s(2);
-  const double yaw = s(3);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double x_Fr = s(9);
-  const double y_Fr = s(10);
-  const double z_Fr = s(11);
-  const double psi_r1 = s(15);
-  const double cxd = p.cxd;
-  const double cyd = p.cyd;
-  const double thighD = p.thighD;
-  const double legD = p.legD;
+  const Scalar x_C = s(0);
+  const Scalar y_C = s(1);
+  const Scalar z_C = s(2);
+  const Scalar yaw = s(3);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar x_Fr = s(9);
+  const Scalar y_Fr = s(10);
+  const Scalar z_Fr = s(11);
+  const Scalar psi_r1 = s(15);
+  const Scalar cxd(p.cxd);
+  const Scalar cyd(p.cyd);
+  const Scalar thighD(p.thighD);
+  const Scalar legD(p.legD);
   // sin and cos of all 4 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 4> angle{yaw, pitch, roll, psi_r1};
-  std::array<double, 4> sin_angle, cos_angle;
+  const std::array<Scalar, 4> angle{yaw, pitch, roll, psi_r1};
+  std::array<Scalar, 4> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_yaw = cos_angle[0];
-  const double sin_yaw = sin_angle[0];
-  const double cos_pitch = cos_angle[1];
-  const double sin_pitch = sin_angle[1];
-  const double cos_roll = cos_angle[2];
-  const double sin_roll = sin_angle[2];
-  const double cos_psi_r1 = cos_angle[3];
-  const double sin_psi_r1 = sin_angle[3];
-  const double ik_t5 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
-  const double ik_t7 = 2.0*x_Fr + ik_t5*cyd - 2.0*x_C - cos_yaw*cxd*cos_pitch;
-  const double ik_t8 = 2.0*z_Fr + sin_roll*cyd*cos_pitch + sin_pitch*cxd - 2.0*z_C;
-  const double ik_t9 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
-  const double ik_t10 = ik_t9*cyd + 2.0*y_Fr - 2.0*y_C - cxd*cos_pitch*sin_yaw;
-  const double ik_t11 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
-  const double ik_t14 = ik_t11*sin_psi_r1 + ik_t5*cos_psi_r1;
-  const double ik_t15 = sin_roll*cos_psi_r1*cos_pitch + sin_psi_r1*cos_roll*cos_pitch;
-  const double ik_t16 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
-  const double ik_t17 = sin_psi_r1*ik_t16 + ik_t9*cos_psi_r1;
-  const double ik_t18 = sin_roll*sin_psi_r1*cos_pitch - cos_psi_r1*cos_roll*cos_pitch;
-  const double ik_t19 = sin_psi_r1*ik_t9 - ik_t16*cos_psi_r1;
-  const double ik_t20 = ik_t11*cos_psi_r1 - sin_psi_r1*ik_t5;
-  const double ik_d0 = 0.5*cos_yaw*ik_t7*cos_pitch + 0.5*ik_t10*cos_pitch*sin_yaw - 0.5*sin_pitch*ik_t8;
-  const double ik_d1 = 0.5*ik_t14*ik_t7 + 0.5*ik_t15*ik_t8 + 0.5*ik_t10*ik_t17;
-  const double ik_d2 = -(0.5*ik_t18*ik_t8 + 0.5*ik_t10*ik_t19 - 0.5*ik_t7*ik_t20);
-  const double ik_K = legD*legD + thighD*thighD;
-  const double ik_A = 2.0*thighD*legD;
-  const double ik_B = 0.0;
-  const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
-  double ik_c_psi_r4, ik_s_psi_r4;
+  const Scalar cos_yaw = cos_angle[0];
+  const Scalar sin_yaw = sin_angle[0];
+  const Scalar cos_pitch = cos_angle[1];
+  const Scalar sin_pitch = sin_angle[1];
+  const Scalar cos_roll = cos_angle[2];
+  const Scalar sin_roll = sin_angle[2];
+  const Scalar cos_psi_r1 = cos_angle[3];
+  const Scalar sin_psi_r1 = sin_angle[3];
+  const Scalar ik_t5 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
+  const Scalar ik_t7 = Scalar(2.0)*x_Fr + ik_t5*cyd - Scalar(2.0)*x_C - cos_yaw*cxd*cos_pitch;
+  const Scalar ik_t8 = Scalar(2.0)*z_Fr + sin_roll*cyd*cos_pitch + sin_pitch*cxd - Scalar(2.0)*z_C;
+  const Scalar ik_t9 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
+  const Scalar ik_t10 = ik_t9*cyd + Scalar(2.0)*y_Fr - Scalar(2.0)*y_C - cxd*cos_pitch*sin_yaw;
+  const Scalar ik_t11 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
+  const Scalar ik_t14 = ik_t11*sin_psi_r1 + ik_t5*cos_psi_r1;
+  const Scalar ik_t15 = sin_roll*cos_psi_r1*cos_pitch + sin_psi_r1*cos_roll*cos_pitch;
+  const Scalar ik_t16 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
+  const Scalar ik_t17 = sin_psi_r1*ik_t16 + ik_t9*cos_psi_r1;
+  const Scalar ik_t18 = sin_roll*sin_psi_r1*cos_pitch - cos_psi_r1*cos_roll*cos_pitch;
+  const Scalar ik_t19 = sin_psi_r1*ik_t9 - ik_t16*cos_psi_r1;
+  const Scalar ik_t20 = ik_t11*cos_psi_r1 - sin_psi_r1*ik_t5;
+  const Scalar ik_d0 = Scalar(0.5)*cos_yaw*ik_t7*cos_pitch + Scalar(0.5)*ik_t10*cos_pitch*sin_yaw - Scalar(0.5)*sin_pitch*ik_t8;
+  const Scalar ik_d1 = Scalar(0.5)*ik_t14*ik_t7 + Scalar(0.5)*ik_t15*ik_t8 + Scalar(0.5)*ik_t10*ik_t17;
+  const Scalar ik_d2 = -(Scalar(0.5)*ik_t18*ik_t8 + Scalar(0.5)*ik_t10*ik_t19 - Scalar(0.5)*ik_t7*ik_t20);
+  const Scalar ik_K = legD*legD + thighD*thighD;
+  const Scalar ik_A = Scalar(2.0)*thighD*legD;
+  const Scalar ik_B = Scalar(0.0);
+  const Scalar ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
+  Scalar ik_c_psi_r4, ik_s_psi_r4;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_psi_r4, ik_s_psi_r4)) {
-    const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
+    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_v0 = thighD + legD*ik_c_psi_r4;
-  const double ik_v1 = 0.0;
-  const double ik_v2 = -legD*ik_s_psi_r4;
-  const double ik_v[3] = {ik_v0, ik_v1, ik_v2};
-  const double ik_d[3] = {ik_d0, ik_d1, ik_d2};
-  double ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_beside = 0, ik_room = 0;
+  const Scalar ik_v0 = thighD + legD*ik_c_psi_r4;
+  const Scalar ik_v1 = Scalar(0.0);
+  const Scalar ik_v2 = -legD*ik_s_psi_r4;
+  const Scalar ik_v[3] = {ik_v0, ik_v1, ik_v2};
+  const Scalar ik_d[3] = {ik_d0, ik_d1, ik_d2};
+  Scalar ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_beside(0), ik_room(0);
   const bool ik_two_axis_ok = ik_solve_two_axis<1, 2>(ik_v, ik_d, (branch & 2) != 0, ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_beside, ik_room);
   if (!ik_two_axis_ok) {
-    why = {2, ik_beside, 0.0, ik_room, std::atan2(ik_s_psi_r4, ik_c_psi_r4) * 57.29577951308232};
+    why = {2, ik_beside, 0.0, ik_room, double(std::atan2(ik_s_psi_r4, ik_c_psi_r4)) * 57.29577951308232};
     return IkStatus::out_of_reach;
   }
-  const double ik_t21 = (cos_yaw*cos_pitch*ik_c_psi_r2 - ik_s_psi_r2*ik_t20)*ik_c_psi_r3 + ik_t14*ik_s_psi_r3;
-  const double ik_t22 = (cos_pitch*sin_yaw*ik_c_psi_r2 + ik_t19*ik_s_psi_r2)*ik_c_psi_r3 + ik_t17*ik_s_psi_r3;
-  const double ik_t23 = ik_t15*ik_s_psi_r3 - (sin_pitch*ik_c_psi_r2 - ik_t18*ik_s_psi_r2)*ik_c_psi_r3;
-  const std::array<double, 3> ik_sines{{ik_s_psi_r2, ik_s_psi_r3, ik_s_psi_r4}}, ik_cosines{{ik_c_psi_r2, ik_c_psi_r3, ik_c_psi_r4}};
-  std::array<double, 3> ik_angles;
+  const Scalar ik_t21 = (cos_yaw*cos_pitch*ik_c_psi_r2 - ik_s_psi_r2*ik_t20)*ik_c_psi_r3 + ik_t14*ik_s_psi_r3;
+  const Scalar ik_t22 = (cos_pitch*sin_yaw*ik_c_psi_r2 + ik_t19*ik_s_psi_r2)*ik_c_psi_r3 + ik_t17*ik_s_psi_r3;
+  const Scalar ik_t23 = ik_t15*ik_s_psi_r3 - (sin_pitch*ik_c_psi_r2 - ik_t18*ik_s_psi_r2)*ik_c_psi_r3;
+  const std::array<Scalar, 3> ik_sines{{ik_s_psi_r2, ik_s_psi_r3, ik_s_psi_r4}}, ik_cosines{{ik_c_psi_r2, ik_c_psi_r3, ik_c_psi_r4}};
+  std::array<Scalar, 3> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_psi_r2 = ik_angles[0];
-  const double ik_q_psi_r3 = ik_angles[1];
-  const double ik_q_psi_r4 = ik_angles[2];
-  const double ik_row0 = x_C + thighD*ik_t21 + 0.5*cos_yaw*cxd*cos_pitch - 0.5*ik_t5*cyd - x_Fr - legD*(ik_s_psi_r4*(ik_c_psi_r2*ik_t20 + cos_yaw*cos_pitch*ik_s_psi_r2) - ik_c_psi_r4*ik_t21);
-  const double ik_row1 = 0.5*cxd*cos_pitch*sin_yaw + thighD*ik_t22 + y_C - legD*(ik_s_psi_r4*(cos_pitch*sin_yaw*ik_s_psi_r2 - ik_t19*ik_c_psi_r2) - ik_t22*ik_c_psi_r4) - 0.5*ik_t9*cyd - y_Fr;
-  const double ik_row2 = -(z_Fr + 0.5*sin_pitch*cxd + 0.5*sin_roll*cyd*cos_pitch - z_C - legD*(ik_t23*ik_c_psi_r4 + ik_s_psi_r4*(sin_pitch*ik_s_psi_r2 + ik_t18*ik_c_psi_r2)) - ik_t23*thighD);
-  const double ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
-  if (!(ik_residual <= kIkTolerance)) {
-    why = {0, ik_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_psi_r2 = ik_angles[0];
+  const Scalar ik_q_psi_r3 = ik_angles[1];
+  const Scalar ik_q_psi_r4 = ik_angles[2];
+  const Scalar ik_row0 = x_C + thighD*ik_t21 + Scalar(0.5)*cos_yaw*cxd*cos_pitch - Scalar(0.5)*ik_t5*cyd - x_Fr - legD*(ik_s_psi_r4*(ik_c_psi_r2*ik_t20 + cos_yaw*cos_pitch*ik_s_psi_r2) - ik_c_psi_r4*ik_t21);
+  const Scalar ik_row1 = Scalar(0.5)*cxd*cos_pitch*sin_yaw + thighD*ik_t22 + y_C - legD*(ik_s_psi_r4*(cos_pitch*sin_yaw*ik_s_psi_r2 - ik_t19*ik_c_psi_r2) - ik_t22*ik_c_psi_r4) - Scalar(0.5)*ik_t9*cyd - y_Fr;
+  const Scalar ik_row2 = -(z_Fr + Scalar(0.5)*sin_pitch*cxd + Scalar(0.5)*sin_roll*cyd*cos_pitch - z_C - legD*(ik_t23*ik_c_psi_r4 + ik_s_psi_r4*(sin_pitch*ik_s_psi_r2 + ik_t18*ik_c_psi_r2)) - ik_t23*thighD);
+  const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
+  if (!(ik_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     return IkStatus::residual;
   }
   out(21) = ik_q_psi_r2;
@@ -323,35 +345,38 @@ inline IkStatus ik_leg_r(const Coordinates& s, const Params& p, int branch, Coor
 // On failure returns why, with the numbers in `why` (stage 1.. as in kClosedForm's failure texts;
 // stage 0: residual, the solution does not satisfy the closure rows).
 // Operations: 87 (adds 28, muls 53, divs 0, calls 6), plus the solver calls.
-inline IkStatus ik_wheel_l(const Coordinates& s, const Params& p, int branch, Coordinates& out, IkDiagnostics& why) noexcept {
+// Scalar: float or double (the branch choices and the reach diagnostics need real numbers).
+template <typename Scalar>
+inline IkStatus ik_wheel_l(const CoordinatesOf<Scalar>& s, const Params& p, int branch, detail::NonDeduced<CoordinatesOf<Scalar>>& out, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 8) return IkStatus::bad_branch;
-  const double z_C = s(2);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double z_Wl = s(12);
-  const double theta_l5 = s(16);
-  const double cxd = p.cxd;
-  const double cyd = p.cyd;
-  const double wl = p.wl;
-  const double w = p.w;
+  const Scalar z_C = s(2);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar z_Wl = s(12);
+  const Scalar theta_l5 = s(16);
+  const Scalar cxd(p.cxd);
+  const Scalar cyd(p.cyd);
+  const Scalar wl(p.wl);
+  const Scalar w(p.w);
   // sin and cos of all 3 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 3> angle{pitch, roll, theta_l5};
-  std::array<double, 3> sin_angle, cos_angle;
+  const std::array<Scalar, 3> angle{pitch, roll, theta_l5};
+  std::array<Scalar, 3> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_pitch = cos_angle[0];
-  const double sin_pitch = sin_angle[0];
-  const double cos_roll = cos_angle[1];
-  const double sin_roll = sin_angle[1];
-  const double cos_theta_l5 = cos_angle[2];
-  const double sin_theta_l5 = sin_angle[2];
-  const double ik_q_theta_l4 = -theta_l5;
-  const double ik_g0 = -sin_pitch;
-  const double ik_g1 = sin_roll*cos_pitch;
-  const double ik_g2 = cos_roll*cos_pitch;
-  const double ik_axis[3] = {0.0, 0.0, 1.0};
-  const double ik_g[3] = {ik_g0, ik_g1, ik_g2};
-  double ik_c_sum, ik_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_beside = 0, ik_room = 0;
+  const Scalar cos_pitch = cos_angle[0];
+  const Scalar sin_pitch = sin_angle[0];
+  const Scalar cos_roll = cos_angle[1];
+  const Scalar sin_roll = sin_angle[1];
+  const Scalar cos_theta_l5 = cos_angle[2];
+  const Scalar sin_theta_l5 = sin_angle[2];
+  const Scalar ik_q_theta_l4 = -theta_l5;
+  const Scalar ik_g0 = -sin_pitch;
+  const Scalar ik_g1 = sin_roll*cos_pitch;
+  const Scalar ik_g2 = cos_roll*cos_pitch;
+  const Scalar ik_axis[3] = {Scalar(0), Scalar(0), Scalar(1)};
+  const Scalar ik_g[3] = {ik_g0, ik_g1, ik_g2};
+  Scalar ik_c_sum, ik_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_beside(0), ik_room(0);
   const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_c_sum, ik_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_beside, ik_room);
   static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
@@ -360,37 +385,37 @@ inline IkStatus ik_wheel_l(const Coordinates& s, const Params& p, int branch, Co
     ik_s_sum = -ik_s_sum;
     ik_s_theta_l2 = -ik_s_theta_l2;
   }
-  const double ik_t5 = ik_c_sum*w*cos_roll*cos_pitch;
-  const double ik_alpha = -(sin_pitch*w*ik_s_sum - sin_pitch*(w*ik_s_sum + cos_theta_l5*wl));
-  const double ik_beta = ik_t5 - cos_roll*(ik_c_sum*w - cos_theta_l5*wl)*cos_pitch;
-  const double ik_gamma = -(ik_t5 + sin_roll*sin_theta_l5*wl*cos_pitch - z_C - 0.5*sin_roll*cyd*cos_pitch - 0.5*sin_pitch*cxd - sin_pitch*w*ik_s_sum);
-  double ik_c_theta_l6, ik_s_theta_l6;
+  const Scalar ik_t5 = ik_c_sum*w*cos_roll*cos_pitch;
+  const Scalar ik_alpha = -(sin_pitch*w*ik_s_sum - sin_pitch*(w*ik_s_sum + cos_theta_l5*wl));
+  const Scalar ik_beta = ik_t5 - cos_roll*(ik_c_sum*w - cos_theta_l5*wl)*cos_pitch;
+  const Scalar ik_gamma = -(ik_t5 + sin_roll*sin_theta_l5*wl*cos_pitch - z_C - Scalar(0.5)*sin_roll*cyd*cos_pitch - Scalar(0.5)*sin_pitch*cxd - sin_pitch*w*ik_s_sum);
+  Scalar ik_c_theta_l6, ik_s_theta_l6;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, z_Wl - ik_gamma, (branch & 1) != 0, ik_c_theta_l6, ik_s_theta_l6)) {
-    const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
+    const Scalar ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, z_Wl, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_c_theta_l3 = ik_c_sum * ik_c_theta_l6 + ik_s_sum * ik_s_theta_l6;
-  const double ik_s_theta_l3 = ik_s_sum * ik_c_theta_l6 - ik_c_sum * ik_s_theta_l6;
-  const double ik_t7 = sin_pitch*ik_c_theta_l6 + cos_roll*cos_pitch*ik_s_theta_l6;
-  const double ik_t8 = cos_theta_l5*ik_t7 - sin_roll*sin_theta_l5*cos_pitch;
-  const double ik_t9 = sin_pitch*ik_s_theta_l6 - cos_roll*ik_c_theta_l6*cos_pitch;
-  const double ik_t10 = sin_theta_l5*ik_t7 + sin_roll*cos_theta_l5*cos_pitch;
-  const double ik_t11 = ik_t8*cos_theta_l5 + sin_theta_l5*ik_t10;
-  const double ik_t12 = ik_t9*ik_c_theta_l3 + ik_t11*ik_s_theta_l3;
-  const std::array<double, 3> ik_sines{{ik_s_theta_l6, ik_s_theta_l3, ik_s_theta_l2}}, ik_cosines{{ik_c_theta_l6, ik_c_theta_l3, ik_c_theta_l2}};
-  std::array<double, 3> ik_angles;
+  const Scalar ik_c_theta_l3 = ik_c_sum * ik_c_theta_l6 + ik_s_sum * ik_s_theta_l6;
+  const Scalar ik_s_theta_l3 = ik_s_sum * ik_c_theta_l6 - ik_c_sum * ik_s_theta_l6;
+  const Scalar ik_t7 = sin_pitch*ik_c_theta_l6 + cos_roll*cos_pitch*ik_s_theta_l6;
+  const Scalar ik_t8 = cos_theta_l5*ik_t7 - sin_roll*sin_theta_l5*cos_pitch;
+  const Scalar ik_t9 = sin_pitch*ik_s_theta_l6 - cos_roll*ik_c_theta_l6*cos_pitch;
+  const Scalar ik_t10 = sin_theta_l5*ik_t7 + sin_roll*cos_theta_l5*cos_pitch;
+  const Scalar ik_t11 = ik_t8*cos_theta_l5 + sin_theta_l5*ik_t10;
+  const Scalar ik_t12 = ik_t9*ik_c_theta_l3 + ik_t11*ik_s_theta_l3;
+  const std::array<Scalar, 3> ik_sines{{ik_s_theta_l6, ik_s_theta_l3, ik_s_theta_l2}}, ik_cosines{{ik_c_theta_l6, ik_c_theta_l3, ik_c_theta_l2}};
+  std::array<Scalar, 3> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_theta_l6 = ik_angles[0];
-  const double ik_q_theta_l3 = ik_angles[1];
-  const double ik_q_theta_l2 = ik_angles[2];
-  const double ik_row0 = ik_t8*wl + 0.5*sin_pitch*cxd + z_C + 0.5*sin_roll*cyd*cos_pitch + w*ik_t12 - z_Wl;
-  const double ik_row1 = -(ik_t11*ik_c_theta_l3 - ik_t9*ik_s_theta_l3);
-  const double ik_row2 = ik_c_theta_l2*(cos_theta_l5*ik_t10 - sin_theta_l5*ik_t8) - ik_t12*ik_s_theta_l2;
-  const double ik_row3 = 0.0;
-  const double ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2), std::abs(ik_row3)});
-  if (!(ik_residual <= kIkTolerance)) {
-    why = {0, ik_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_theta_l6 = ik_angles[0];
+  const Scalar ik_q_theta_l3 = ik_angles[1];
+  const Scalar ik_q_theta_l2 = ik_angles[2];
+  const Scalar ik_row0 = ik_t8*wl + Scalar(0.5)*sin_pitch*cxd + z_C + Scalar(0.5)*sin_roll*cyd*cos_pitch + w*ik_t12 - z_Wl;
+  const Scalar ik_row1 = -(ik_t11*ik_c_theta_l3 - ik_t9*ik_s_theta_l3);
+  const Scalar ik_row2 = ik_c_theta_l2*(cos_theta_l5*ik_t10 - sin_theta_l5*ik_t8) - ik_t12*ik_s_theta_l2;
+  const Scalar ik_row3 = Scalar(0.0);
+  const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2), std::abs(ik_row3)});
+  if (!(ik_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     return IkStatus::residual;
   }
   out(27) = ik_q_theta_l6;
@@ -412,38 +437,41 @@ inline IkStatus ik_wheel_l(const Coordinates& s, const Params& p, int branch, Co
 // On failure returns why, with the numbers in `why` (stage 1.. as in kClosedForm's failure texts;
 // stage 0: residual, the solution does not satisfy the closure rows).
 // Operations: 85 (adds 31, muls 48, divs 0, calls 6), plus the solver calls.
-inline IkStatus ik_wheel_r(const Coordinates& s, const Params& p, int branch, Coordinates& out, IkDiagnostics& why) noexcept {
+// Scalar: float or double (the branch choices and the reach diagnostics need real numbers).
+template <typename Scalar>
+inline IkStatus ik_wheel_r(const CoordinatesOf<Scalar>& s, const Params& p, int branch, detail::NonDeduced<CoordinatesOf<Scalar>>& out, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 8) return IkStatus::bad_branch;
-  const double z_C = s(2);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double z_Wr = s(13);
-  const double theta_r5 = s(17);
-  const double cxd = p.cxd;
-  const double cyd = p.cyd;
-  const double wl = p.wl;
-  const double w = p.w;
+  const Scalar z_C = s(2);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar z_Wr = s(13);
+  const Scalar theta_r5 = s(17);
+  const Scalar cxd(p.cxd);
+  const Scalar cyd(p.cyd);
+  const Scalar wl(p.wl);
+  const Scalar w(p.w);
   // sin and cos of all 3 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 3> angle{pitch, roll, theta_r5};
-  std::array<double, 3> sin_angle, cos_angle;
+  const std::array<Scalar, 3> angle{pitch, roll, theta_r5};
+  std::array<Scalar, 3> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_pitch = cos_angle[0];
-  const double sin_pitch = sin_angle[0];
-  const double cos_roll = cos_angle[1];
-  const double sin_roll = sin_angle[1];
-  const double cos_theta_r5 = cos_angle[2];
-  const double sin_theta_r5 = sin_angle[2];
-  const double ik_t6 = -z_C;
-  const double ik_t7 = -0.5*sin_pitch*cxd;
-  const double ik_t9 = 0.5*sin_roll*cyd*cos_pitch;
-  const double ik_q_theta_r4 = -theta_r5;
-  const double ik_g0 = -sin_pitch;
-  const double ik_g1 = sin_roll*cos_pitch;
-  const double ik_g2 = cos_roll*cos_pitch;
-  const double ik_axis[3] = {0.0, 0.0, 1.0};
-  const double ik_g[3] = {ik_g0, ik_g1, ik_g2};
-  double ik_c_sum, ik_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_beside = 0, ik_room = 0;
+  const Scalar cos_pitch = cos_angle[0];
+  const Scalar sin_pitch = sin_angle[0];
+  const Scalar cos_roll = cos_angle[1];
+  const Scalar sin_roll = sin_angle[1];
+  const Scalar cos_theta_r5 = cos_angle[2];
+  const Scalar sin_theta_r5 = sin_angle[2];
+  const Scalar ik_t6 = -z_C;
+  const Scalar ik_t7 = -Scalar(0.5)*sin_pitch*cxd;
+  const Scalar ik_t9 = Scalar(0.5)*sin_roll*cyd*cos_pitch;
+  const Scalar ik_q_theta_r4 = -theta_r5;
+  const Scalar ik_g0 = -sin_pitch;
+  const Scalar ik_g1 = sin_roll*cos_pitch;
+  const Scalar ik_g2 = cos_roll*cos_pitch;
+  const Scalar ik_axis[3] = {Scalar(0), Scalar(0), Scalar(1)};
+  const Scalar ik_g[3] = {ik_g0, ik_g1, ik_g2};
+  Scalar ik_c_sum, ik_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_beside(0), ik_room(0);
   const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_c_sum, ik_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_beside, ik_room);
   static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
@@ -452,37 +480,37 @@ inline IkStatus ik_wheel_r(const Coordinates& s, const Params& p, int branch, Co
     ik_s_sum = -ik_s_sum;
     ik_s_theta_r2 = -ik_s_theta_r2;
   }
-  const double ik_t5 = ik_c_sum*w*cos_roll*cos_pitch;
-  const double ik_alpha = -(sin_pitch*w*ik_s_sum - sin_pitch*(w*ik_s_sum + cos_theta_r5*wl));
-  const double ik_beta = ik_t5 - (ik_c_sum*w - cos_theta_r5*wl)*cos_roll*cos_pitch;
-  const double ik_gamma = -(ik_t5 + ik_t6 + ik_t7 + sin_roll*sin_theta_r5*wl*cos_pitch + ik_t9 - sin_pitch*w*ik_s_sum);
-  double ik_c_theta_r6, ik_s_theta_r6;
+  const Scalar ik_t5 = ik_c_sum*w*cos_roll*cos_pitch;
+  const Scalar ik_alpha = -(sin_pitch*w*ik_s_sum - sin_pitch*(w*ik_s_sum + cos_theta_r5*wl));
+  const Scalar ik_beta = ik_t5 - (ik_c_sum*w - cos_theta_r5*wl)*cos_roll*cos_pitch;
+  const Scalar ik_gamma = -(ik_t5 + ik_t6 + ik_t7 + sin_roll*sin_theta_r5*wl*cos_pitch + ik_t9 - sin_pitch*w*ik_s_sum);
+  Scalar ik_c_theta_r6, ik_s_theta_r6;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, z_Wr - ik_gamma, (branch & 1) != 0, ik_c_theta_r6, ik_s_theta_r6)) {
-    const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
+    const Scalar ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, z_Wr, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_c_theta_r3 = ik_c_sum * ik_c_theta_r6 + ik_s_sum * ik_s_theta_r6;
-  const double ik_s_theta_r3 = ik_s_sum * ik_c_theta_r6 - ik_c_sum * ik_s_theta_r6;
-  const double ik_t10 = cos_roll*cos_pitch*ik_s_theta_r6 + ik_c_theta_r6*sin_pitch;
-  const double ik_t11 = sin_roll*sin_theta_r5*cos_pitch - cos_theta_r5*ik_t10;
-  const double ik_t12 = sin_theta_r5*ik_t10 + sin_roll*cos_theta_r5*cos_pitch;
-  const double ik_t13 = sin_theta_r5*ik_t12 - ik_t11*cos_theta_r5;
-  const double ik_t14 = sin_pitch*ik_s_theta_r6 - ik_c_theta_r6*cos_roll*cos_pitch;
-  const double ik_t15 = ik_t13*ik_s_theta_r3 + ik_c_theta_r3*ik_t14;
-  const std::array<double, 3> ik_sines{{ik_s_theta_r6, ik_s_theta_r3, ik_s_theta_r2}}, ik_cosines{{ik_c_theta_r6, ik_c_theta_r3, ik_c_theta_r2}};
-  std::array<double, 3> ik_angles;
+  const Scalar ik_c_theta_r3 = ik_c_sum * ik_c_theta_r6 + ik_s_sum * ik_s_theta_r6;
+  const Scalar ik_s_theta_r3 = ik_s_sum * ik_c_theta_r6 - ik_c_sum * ik_s_theta_r6;
+  const Scalar ik_t10 = cos_roll*cos_pitch*ik_s_theta_r6 + ik_c_theta_r6*sin_pitch;
+  const Scalar ik_t11 = sin_roll*sin_theta_r5*cos_pitch - cos_theta_r5*ik_t10;
+  const Scalar ik_t12 = sin_theta_r5*ik_t10 + sin_roll*cos_theta_r5*cos_pitch;
+  const Scalar ik_t13 = sin_theta_r5*ik_t12 - ik_t11*cos_theta_r5;
+  const Scalar ik_t14 = sin_pitch*ik_s_theta_r6 - ik_c_theta_r6*cos_roll*cos_pitch;
+  const Scalar ik_t15 = ik_t13*ik_s_theta_r3 + ik_c_theta_r3*ik_t14;
+  const std::array<Scalar, 3> ik_sines{{ik_s_theta_r6, ik_s_theta_r3, ik_s_theta_r2}}, ik_cosines{{ik_c_theta_r6, ik_c_theta_r3, ik_c_theta_r2}};
+  std::array<Scalar, 3> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_theta_r6 = ik_angles[0];
-  const double ik_q_theta_r3 = ik_angles[1];
-  const double ik_q_theta_r2 = ik_angles[2];
-  const double ik_row0 = -(z_Wr + ik_t6 + ik_t11*wl + ik_t7 + ik_t9 - w*ik_t15);
-  const double ik_row1 = ik_t14*ik_s_theta_r3 - ik_t13*ik_c_theta_r3;
-  const double ik_row2 = -(ik_t15*ik_s_theta_r2 - (cos_theta_r5*ik_t12 + ik_t11*sin_theta_r5)*ik_c_theta_r2);
-  const double ik_row3 = 0.0;
-  const double ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2), std::abs(ik_row3)});
-  if (!(ik_residual <= kIkTolerance)) {
-    why = {0, ik_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_theta_r6 = ik_angles[0];
+  const Scalar ik_q_theta_r3 = ik_angles[1];
+  const Scalar ik_q_theta_r2 = ik_angles[2];
+  const Scalar ik_row0 = -(z_Wr + ik_t6 + ik_t11*wl + ik_t7 + ik_t9 - w*ik_t15);
+  const Scalar ik_row1 = ik_t14*ik_s_theta_r3 - ik_t13*ik_c_theta_r3;
+  const Scalar ik_row2 = -(ik_t15*ik_s_theta_r2 - (cos_theta_r5*ik_t12 + ik_t11*sin_theta_r5)*ik_c_theta_r2);
+  const Scalar ik_row3 = Scalar(0.0);
+  const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2), std::abs(ik_row3)});
+  if (!(ik_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     return IkStatus::residual;
   }
   out(31) = ik_q_theta_r6;
@@ -506,10 +534,10 @@ struct ClosedFormInfo {
 
 // Per limb, in the order of kLimbs.
 inline constexpr std::array<ClosedFormInfo, 4> kClosedForm{{
-    {&ik_leg_l, 4, "point3", {{"bit 0: the other root of psi_l4 (branch 0: the root nearest zero; on a tie the positive one)", "bit 1: the other root of psi_l3 (branch 0: |psi_l3| <= 90 deg where that solves)"}}, {{"F_l out of reach: its target is {value:.4f} m from the meeting point of the axes of psi_l2 and psi_l3, and F_l reaches [{low:.4f}, {high:.4f}] m from it", "F_l out of reach: with psi_l4 at {aux:.2f} deg (set by the target's distance) it reaches at most {high:.4f} m off the plane normal to the axis of psi_l2 (through the meeting point), but its target is {value:.4f} m off it"}}},
-    {&ik_leg_r, 4, "point3", {{"bit 0: the other root of psi_r4 (branch 0: the root nearest zero; on a tie the positive one)", "bit 1: the other root of psi_r3 (branch 0: |psi_r3| <= 90 deg where that solves)"}}, {{"F_r out of reach: its target is {value:.4f} m from the meeting point of the axes of psi_r2 and psi_r3, and F_r reaches [{low:.4f}, {high:.4f}] m from it", "F_r out of reach: with psi_r4 at {aux:.2f} deg (set by the target's distance) it reaches at most {high:.4f} m off the plane normal to the axis of psi_r2 (through the meeting point), but its target is {value:.4f} m off it"}}},
-    {&ik_wheel_l, 8, "leveled-lever", {{"bit 0: the other root of theta_l6 (branch 0: the root nearest zero)", "bit 1: the other root of theta_l2 (branch 0: |theta_l2| <= 90 deg)", "bit 2: the other root of theta_l6 + theta_l3 (branch 0: nearest zero)"}}, {{"z_Wl = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, theta_l5 as given, the z of W_l reaches [{low:.4f}, {high:.4f}] m"}}},
-    {&ik_wheel_r, 8, "leveled-lever", {{"bit 0: the other root of theta_r6 (branch 0: the root nearest zero)", "bit 1: the other root of theta_r2 (branch 0: |theta_r2| <= 90 deg)", "bit 2: the other root of theta_r6 + theta_r3 (branch 0: nearest zero)"}}, {{"z_Wr = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, theta_r5 as given, the z of W_r reaches [{low:.4f}, {high:.4f}] m"}}},
+    {&ik_leg_l<double>, 4, "point3", {{"bit 0: the other root of psi_l4 (branch 0: the root nearest zero; on a tie the positive one)", "bit 1: the other root of psi_l3 (branch 0: |psi_l3| <= 90 deg where that solves)"}}, {{"F_l out of reach: its target is {value:.4f} m from the meeting point of the axes of psi_l2 and psi_l3, and F_l reaches [{low:.4f}, {high:.4f}] m from it", "F_l out of reach: with psi_l4 at {aux:.2f} deg (set by the target's distance) it reaches at most {high:.4f} m off the plane normal to the axis of psi_l2 (through the meeting point), but its target is {value:.4f} m off it"}}},
+    {&ik_leg_r<double>, 4, "point3", {{"bit 0: the other root of psi_r4 (branch 0: the root nearest zero; on a tie the positive one)", "bit 1: the other root of psi_r3 (branch 0: |psi_r3| <= 90 deg where that solves)"}}, {{"F_r out of reach: its target is {value:.4f} m from the meeting point of the axes of psi_r2 and psi_r3, and F_r reaches [{low:.4f}, {high:.4f}] m from it", "F_r out of reach: with psi_r4 at {aux:.2f} deg (set by the target's distance) it reaches at most {high:.4f} m off the plane normal to the axis of psi_r2 (through the meeting point), but its target is {value:.4f} m off it"}}},
+    {&ik_wheel_l<double>, 8, "leveled-lever", {{"bit 0: the other root of theta_l6 (branch 0: the root nearest zero)", "bit 1: the other root of theta_l2 (branch 0: |theta_l2| <= 90 deg)", "bit 2: the other root of theta_l6 + theta_l3 (branch 0: nearest zero)"}}, {{"z_Wl = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, theta_l5 as given, the z of W_l reaches [{low:.4f}, {high:.4f}] m"}}},
+    {&ik_wheel_r<double>, 8, "leveled-lever", {{"bit 0: the other root of theta_r6 (branch 0: the root nearest zero)", "bit 1: the other root of theta_r2 (branch 0: |theta_r2| <= 90 deg)", "bit 2: the other root of theta_r6 + theta_r3 (branch 0: nearest zero)"}}, {{"z_Wr = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, theta_r5 as given, the z of W_r reaches [{low:.4f}, {high:.4f}] m"}}},
 }};
 
 inline constexpr bool kHasFusedIk = true;
@@ -520,8 +548,11 @@ inline constexpr bool kHasFusedIk = true;
 // (every limb's reach is tested before any limb's residual check), `failed` its index and `why`
 // its numbers; out is written only when every limb succeeded.
 // Operations: 476 (adds 170, muls 292, divs 0, calls 14), plus the solver calls.
-inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out,
-                       int& failed, IkDiagnostics& why) noexcept {
+// Scalar: float or double.
+template <typename Scalar>
+inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const std::array<int, 4>& branches,
+                       detail::NonDeduced<CoordinatesOf<Scalar>>& out, int& failed, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   const int ik_leg_l_branch = branches[0];
   if (ik_leg_l_branch < 0 || ik_leg_l_branch >= 4) {
@@ -543,150 +574,150 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
     failed = 3;
     return IkStatus::bad_branch;
   }
-  const double x_C = s(0);
-  const double y_C = s(1);
-  const double z_C = s(2);
-  const double yaw = s(3);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double x_Fl = s(6);
-  const double y_Fl = s(7);
-  const double z_Fl = s(8);
-  const double x_Fr = s(9);
-  const double y_Fr = s(10);
-  const double z_Fr = s(11);
-  const double z_Wl = s(12);
-  const double z_Wr = s(13);
-  const double psi_l1 = s(14);
-  const double psi_r1 = s(15);
-  const double theta_l5 = s(16);
-  const double theta_r5 = s(17);
-  const double cxd = p.cxd;
-  const double cyd = p.cyd;
-  const double thighD = p.thighD;
-  const double legD = p.legD;
-  const double wl = p.wl;
-  const double w = p.w;
+  const Scalar x_C = s(0);
+  const Scalar y_C = s(1);
+  const Scalar z_C = s(2);
+  const Scalar yaw = s(3);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar x_Fl = s(6);
+  const Scalar y_Fl = s(7);
+  const Scalar z_Fl = s(8);
+  const Scalar x_Fr = s(9);
+  const Scalar y_Fr = s(10);
+  const Scalar z_Fr = s(11);
+  const Scalar z_Wl = s(12);
+  const Scalar z_Wr = s(13);
+  const Scalar psi_l1 = s(14);
+  const Scalar psi_r1 = s(15);
+  const Scalar theta_l5 = s(16);
+  const Scalar theta_r5 = s(17);
+  const Scalar cxd(p.cxd);
+  const Scalar cyd(p.cyd);
+  const Scalar thighD(p.thighD);
+  const Scalar legD(p.legD);
+  const Scalar wl(p.wl);
+  const Scalar w(p.w);
   // sin and cos of all 7 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 7> angle{yaw, pitch, roll, psi_l1, psi_r1, theta_l5, theta_r5};
-  std::array<double, 7> sin_angle, cos_angle;
+  const std::array<Scalar, 7> angle{yaw, pitch, roll, psi_l1, psi_r1, theta_l5, theta_r5};
+  std::array<Scalar, 7> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_yaw = cos_angle[0];
-  const double sin_yaw = sin_angle[0];
-  const double cos_pitch = cos_angle[1];
-  const double sin_pitch = sin_angle[1];
-  const double cos_roll = cos_angle[2];
-  const double sin_roll = sin_angle[2];
-  const double cos_psi_l1 = cos_angle[3];
-  const double sin_psi_l1 = sin_angle[3];
-  const double cos_psi_r1 = cos_angle[4];
-  const double sin_psi_r1 = sin_angle[4];
-  const double cos_theta_l5 = cos_angle[5];
-  const double sin_theta_l5 = sin_angle[5];
-  const double cos_theta_r5 = cos_angle[6];
-  const double sin_theta_r5 = sin_angle[6];
-  const double ik_t5 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
-  const double ik_t6 = ik_t5*cyd;
-  const double ik_t8 = ik_t6 + 2.0*x_C + cos_yaw*cxd*cos_pitch - 2.0*x_Fl;
-  const double ik_t9 = -2.0*z_C;
-  const double ik_t10 = sin_pitch*cxd;
-  const double ik_t11 = 2.0*z_Fl + ik_t9 + ik_t10 - sin_roll*cyd*cos_pitch;
-  const double ik_t12 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
-  const double ik_t13 = ik_t12*cyd;
-  const double ik_t14 = ik_t13 + cxd*cos_pitch*sin_yaw + 2.0*y_C - 2.0*y_Fl;
-  const double ik_t15 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
-  const double ik_t18 = ik_t15*sin_psi_l1 + cos_psi_l1*ik_t12;
-  const double ik_t19 = sin_psi_l1*cos_roll*cos_pitch + sin_roll*cos_psi_l1*cos_pitch;
-  const double ik_t20 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
-  const double ik_t21 = ik_t20*sin_psi_l1 + cos_psi_l1*ik_t5;
-  const double ik_t22 = ik_t20*cos_psi_l1 - ik_t5*sin_psi_l1;
-  const double ik_t23 = cos_psi_l1*cos_roll*cos_pitch - sin_roll*sin_psi_l1*cos_pitch;
-  const double ik_t24 = ik_t12*sin_psi_l1 - cos_psi_l1*ik_t15;
-  const double ik_t25 = legD*legD + thighD*thighD;
-  const double ik_t26 = 2.0*thighD*legD;
-  const double ik_t27 = 2.0*x_Fr + ik_t6 - 2.0*x_C - cos_yaw*cxd*cos_pitch;
-  const double ik_t28 = ik_t9 + 2.0*z_Fr + sin_roll*cyd*cos_pitch + ik_t10;
-  const double ik_t29 = ik_t13 + 2.0*y_Fr - 2.0*y_C - cxd*cos_pitch*sin_yaw;
-  const double ik_t32 = ik_t20*sin_psi_r1 + ik_t5*cos_psi_r1;
-  const double ik_t33 = sin_roll*cos_psi_r1*cos_pitch + sin_psi_r1*cos_roll*cos_pitch;
-  const double ik_t34 = sin_psi_r1*ik_t15 + ik_t12*cos_psi_r1;
-  const double ik_t35 = sin_roll*sin_psi_r1*cos_pitch - cos_psi_r1*cos_roll*cos_pitch;
-  const double ik_t36 = sin_psi_r1*ik_t12 - ik_t15*cos_psi_r1;
-  const double ik_t37 = ik_t20*cos_psi_r1 - sin_psi_r1*ik_t5;
-  const double ik_t38 = -sin_pitch;
-  const double ik_t39 = sin_roll*cos_pitch;
-  const double ik_t40 = cos_roll*cos_pitch;
-  const double ik_t44 = 0.5*sin_pitch*cxd;
-  const double ik_t46 = 0.5*sin_roll*cyd*cos_pitch;
-  const double ik_t50 = -0.5*sin_roll*cyd*cos_pitch;
-  const double ik_t51 = 0.5*cos_yaw*cxd*cos_pitch;
-  const double ik_t53 = 0.5*cxd*cos_pitch*sin_yaw;
-  const double ik_t55 = -z_C;
-  const double ik_leg_l_d0 = -(0.5*cos_yaw*ik_t8*cos_pitch + 0.5*ik_t11*sin_pitch + 0.5*cos_pitch*sin_yaw*ik_t14);
-  const double ik_leg_l_d1 = 0.5*ik_t11*ik_t19 - 0.5*ik_t18*ik_t14 - 0.5*ik_t21*ik_t8;
-  const double ik_leg_l_d2 = -(0.5*ik_t8*ik_t22 - 0.5*ik_t11*ik_t23 - 0.5*ik_t24*ik_t14);
-  const double ik_leg_l_K = ik_t25;
-  const double ik_leg_l_A = ik_t26;
-  const double ik_leg_l_B = 0.0;
-  const double ik_leg_l_dd = ik_leg_l_d0 * ik_leg_l_d0 + ik_leg_l_d1 * ik_leg_l_d1 + ik_leg_l_d2 * ik_leg_l_d2;
-  double ik_c_psi_l4, ik_s_psi_l4;
+  const Scalar cos_yaw = cos_angle[0];
+  const Scalar sin_yaw = sin_angle[0];
+  const Scalar cos_pitch = cos_angle[1];
+  const Scalar sin_pitch = sin_angle[1];
+  const Scalar cos_roll = cos_angle[2];
+  const Scalar sin_roll = sin_angle[2];
+  const Scalar cos_psi_l1 = cos_angle[3];
+  const Scalar sin_psi_l1 = sin_angle[3];
+  const Scalar cos_psi_r1 = cos_angle[4];
+  const Scalar sin_psi_r1 = sin_angle[4];
+  const Scalar cos_theta_l5 = cos_angle[5];
+  const Scalar sin_theta_l5 = sin_angle[5];
+  const Scalar cos_theta_r5 = cos_angle[6];
+  const Scalar sin_theta_r5 = sin_angle[6];
+  const Scalar ik_t5 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
+  const Scalar ik_t6 = ik_t5*cyd;
+  const Scalar ik_t8 = ik_t6 + Scalar(2.0)*x_C + cos_yaw*cxd*cos_pitch - Scalar(2.0)*x_Fl;
+  const Scalar ik_t9 = -Scalar(2.0)*z_C;
+  const Scalar ik_t10 = sin_pitch*cxd;
+  const Scalar ik_t11 = Scalar(2.0)*z_Fl + ik_t9 + ik_t10 - sin_roll*cyd*cos_pitch;
+  const Scalar ik_t12 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
+  const Scalar ik_t13 = ik_t12*cyd;
+  const Scalar ik_t14 = ik_t13 + cxd*cos_pitch*sin_yaw + Scalar(2.0)*y_C - Scalar(2.0)*y_Fl;
+  const Scalar ik_t15 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
+  const Scalar ik_t18 = ik_t15*sin_psi_l1 + cos_psi_l1*ik_t12;
+  const Scalar ik_t19 = sin_psi_l1*cos_roll*cos_pitch + sin_roll*cos_psi_l1*cos_pitch;
+  const Scalar ik_t20 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
+  const Scalar ik_t21 = ik_t20*sin_psi_l1 + cos_psi_l1*ik_t5;
+  const Scalar ik_t22 = ik_t20*cos_psi_l1 - ik_t5*sin_psi_l1;
+  const Scalar ik_t23 = cos_psi_l1*cos_roll*cos_pitch - sin_roll*sin_psi_l1*cos_pitch;
+  const Scalar ik_t24 = ik_t12*sin_psi_l1 - cos_psi_l1*ik_t15;
+  const Scalar ik_t25 = legD*legD + thighD*thighD;
+  const Scalar ik_t26 = Scalar(2.0)*thighD*legD;
+  const Scalar ik_t27 = Scalar(2.0)*x_Fr + ik_t6 - Scalar(2.0)*x_C - cos_yaw*cxd*cos_pitch;
+  const Scalar ik_t28 = ik_t9 + Scalar(2.0)*z_Fr + sin_roll*cyd*cos_pitch + ik_t10;
+  const Scalar ik_t29 = ik_t13 + Scalar(2.0)*y_Fr - Scalar(2.0)*y_C - cxd*cos_pitch*sin_yaw;
+  const Scalar ik_t32 = ik_t20*sin_psi_r1 + ik_t5*cos_psi_r1;
+  const Scalar ik_t33 = sin_roll*cos_psi_r1*cos_pitch + sin_psi_r1*cos_roll*cos_pitch;
+  const Scalar ik_t34 = sin_psi_r1*ik_t15 + ik_t12*cos_psi_r1;
+  const Scalar ik_t35 = sin_roll*sin_psi_r1*cos_pitch - cos_psi_r1*cos_roll*cos_pitch;
+  const Scalar ik_t36 = sin_psi_r1*ik_t12 - ik_t15*cos_psi_r1;
+  const Scalar ik_t37 = ik_t20*cos_psi_r1 - sin_psi_r1*ik_t5;
+  const Scalar ik_t38 = -sin_pitch;
+  const Scalar ik_t39 = sin_roll*cos_pitch;
+  const Scalar ik_t40 = cos_roll*cos_pitch;
+  const Scalar ik_t44 = Scalar(0.5)*sin_pitch*cxd;
+  const Scalar ik_t46 = Scalar(0.5)*sin_roll*cyd*cos_pitch;
+  const Scalar ik_t50 = -Scalar(0.5)*sin_roll*cyd*cos_pitch;
+  const Scalar ik_t51 = Scalar(0.5)*cos_yaw*cxd*cos_pitch;
+  const Scalar ik_t53 = Scalar(0.5)*cxd*cos_pitch*sin_yaw;
+  const Scalar ik_t55 = -z_C;
+  const Scalar ik_leg_l_d0 = -(Scalar(0.5)*cos_yaw*ik_t8*cos_pitch + Scalar(0.5)*ik_t11*sin_pitch + Scalar(0.5)*cos_pitch*sin_yaw*ik_t14);
+  const Scalar ik_leg_l_d1 = Scalar(0.5)*ik_t11*ik_t19 - Scalar(0.5)*ik_t18*ik_t14 - Scalar(0.5)*ik_t21*ik_t8;
+  const Scalar ik_leg_l_d2 = -(Scalar(0.5)*ik_t8*ik_t22 - Scalar(0.5)*ik_t11*ik_t23 - Scalar(0.5)*ik_t24*ik_t14);
+  const Scalar ik_leg_l_K = ik_t25;
+  const Scalar ik_leg_l_A = ik_t26;
+  const Scalar ik_leg_l_B = Scalar(0.0);
+  const Scalar ik_leg_l_dd = ik_leg_l_d0 * ik_leg_l_d0 + ik_leg_l_d1 * ik_leg_l_d1 + ik_leg_l_d2 * ik_leg_l_d2;
+  Scalar ik_c_psi_l4, ik_s_psi_l4;
   if (!ik_solve_cos_sin(ik_leg_l_A, ik_leg_l_B, ik_leg_l_dd - ik_leg_l_K, (ik_leg_l_branch & 1) != 0, ik_c_psi_l4, ik_s_psi_l4)) {
-    const double ik_leg_l_R = std::sqrt(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
-    why = {1, std::sqrt(ik_leg_l_dd), std::sqrt(std::max(0.0, ik_leg_l_K - ik_leg_l_R)), std::sqrt(ik_leg_l_K + ik_leg_l_R), 0.0};
+    const Scalar ik_leg_l_R = std::sqrt(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
+    why = {1, std::sqrt(ik_leg_l_dd), std::sqrt(std::max(Scalar(0), ik_leg_l_K - ik_leg_l_R)), std::sqrt(ik_leg_l_K + ik_leg_l_R), 0.0};
     failed = 0;
     return IkStatus::out_of_reach;
   }
-  const double ik_leg_l_v0 = thighD + legD*ik_c_psi_l4;
-  const double ik_leg_l_v1 = 0.0;
-  const double ik_leg_l_v2 = -ik_s_psi_l4*legD;
-  const double ik_leg_l_v[3] = {ik_leg_l_v0, ik_leg_l_v1, ik_leg_l_v2};
-  const double ik_leg_l_d[3] = {ik_leg_l_d0, ik_leg_l_d1, ik_leg_l_d2};
-  double ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_leg_l_beside = 0, ik_leg_l_room = 0;
+  const Scalar ik_leg_l_v0 = thighD + legD*ik_c_psi_l4;
+  const Scalar ik_leg_l_v1 = Scalar(0.0);
+  const Scalar ik_leg_l_v2 = -ik_s_psi_l4*legD;
+  const Scalar ik_leg_l_v[3] = {ik_leg_l_v0, ik_leg_l_v1, ik_leg_l_v2};
+  const Scalar ik_leg_l_d[3] = {ik_leg_l_d0, ik_leg_l_d1, ik_leg_l_d2};
+  Scalar ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_leg_l_beside(0), ik_leg_l_room(0);
   const bool ik_leg_l_two_axis_ok = ik_solve_two_axis<1, 2>(ik_leg_l_v, ik_leg_l_d, (ik_leg_l_branch & 2) != 0, ik_c_psi_l2, ik_s_psi_l2, ik_c_psi_l3, ik_s_psi_l3, ik_leg_l_beside, ik_leg_l_room);
   if (!ik_leg_l_two_axis_ok) {
-    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, std::atan2(ik_s_psi_l4, ik_c_psi_l4) * 57.29577951308232};
+    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, double(std::atan2(ik_s_psi_l4, ik_c_psi_l4)) * 57.29577951308232};
     failed = 0;
     return IkStatus::out_of_reach;
   }
-  const double ik_t52 = ik_t21*ik_s_psi_l3 + (cos_yaw*ik_c_psi_l2*cos_pitch - ik_s_psi_l2*ik_t22)*ik_c_psi_l3;
-  const double ik_t54 = (ik_s_psi_l2*ik_t24 + ik_c_psi_l2*cos_pitch*sin_yaw)*ik_c_psi_l3 + ik_s_psi_l3*ik_t18;
-  const double ik_t56 = ik_t19*ik_s_psi_l3 - ik_c_psi_l3*(sin_pitch*ik_c_psi_l2 + ik_s_psi_l2*ik_t23);
-  const double ik_leg_r_d0 = 0.5*cos_yaw*ik_t27*cos_pitch + 0.5*ik_t29*cos_pitch*sin_yaw - 0.5*sin_pitch*ik_t28;
-  const double ik_leg_r_d1 = 0.5*ik_t32*ik_t27 + 0.5*ik_t33*ik_t28 + 0.5*ik_t29*ik_t34;
-  const double ik_leg_r_d2 = -(0.5*ik_t35*ik_t28 + 0.5*ik_t29*ik_t36 - 0.5*ik_t27*ik_t37);
-  const double ik_leg_r_K = ik_t25;
-  const double ik_leg_r_A = ik_t26;
-  const double ik_leg_r_B = 0.0;
-  const double ik_leg_r_dd = ik_leg_r_d0 * ik_leg_r_d0 + ik_leg_r_d1 * ik_leg_r_d1 + ik_leg_r_d2 * ik_leg_r_d2;
-  double ik_c_psi_r4, ik_s_psi_r4;
+  const Scalar ik_t52 = ik_t21*ik_s_psi_l3 + (cos_yaw*ik_c_psi_l2*cos_pitch - ik_s_psi_l2*ik_t22)*ik_c_psi_l3;
+  const Scalar ik_t54 = (ik_s_psi_l2*ik_t24 + ik_c_psi_l2*cos_pitch*sin_yaw)*ik_c_psi_l3 + ik_s_psi_l3*ik_t18;
+  const Scalar ik_t56 = ik_t19*ik_s_psi_l3 - ik_c_psi_l3*(sin_pitch*ik_c_psi_l2 + ik_s_psi_l2*ik_t23);
+  const Scalar ik_leg_r_d0 = Scalar(0.5)*cos_yaw*ik_t27*cos_pitch + Scalar(0.5)*ik_t29*cos_pitch*sin_yaw - Scalar(0.5)*sin_pitch*ik_t28;
+  const Scalar ik_leg_r_d1 = Scalar(0.5)*ik_t32*ik_t27 + Scalar(0.5)*ik_t33*ik_t28 + Scalar(0.5)*ik_t29*ik_t34;
+  const Scalar ik_leg_r_d2 = -(Scalar(0.5)*ik_t35*ik_t28 + Scalar(0.5)*ik_t29*ik_t36 - Scalar(0.5)*ik_t27*ik_t37);
+  const Scalar ik_leg_r_K = ik_t25;
+  const Scalar ik_leg_r_A = ik_t26;
+  const Scalar ik_leg_r_B = Scalar(0.0);
+  const Scalar ik_leg_r_dd = ik_leg_r_d0 * ik_leg_r_d0 + ik_leg_r_d1 * ik_leg_r_d1 + ik_leg_r_d2 * ik_leg_r_d2;
+  Scalar ik_c_psi_r4, ik_s_psi_r4;
   if (!ik_solve_cos_sin(ik_leg_r_A, ik_leg_r_B, ik_leg_r_dd - ik_leg_r_K, (ik_leg_r_branch & 1) != 0, ik_c_psi_r4, ik_s_psi_r4)) {
-    const double ik_leg_r_R = std::sqrt(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
-    why = {1, std::sqrt(ik_leg_r_dd), std::sqrt(std::max(0.0, ik_leg_r_K - ik_leg_r_R)), std::sqrt(ik_leg_r_K + ik_leg_r_R), 0.0};
+    const Scalar ik_leg_r_R = std::sqrt(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
+    why = {1, std::sqrt(ik_leg_r_dd), std::sqrt(std::max(Scalar(0), ik_leg_r_K - ik_leg_r_R)), std::sqrt(ik_leg_r_K + ik_leg_r_R), 0.0};
     failed = 1;
     return IkStatus::out_of_reach;
   }
-  const double ik_leg_r_v0 = thighD + legD*ik_c_psi_r4;
-  const double ik_leg_r_v1 = 0.0;
-  const double ik_leg_r_v2 = -legD*ik_s_psi_r4;
-  const double ik_leg_r_v[3] = {ik_leg_r_v0, ik_leg_r_v1, ik_leg_r_v2};
-  const double ik_leg_r_d[3] = {ik_leg_r_d0, ik_leg_r_d1, ik_leg_r_d2};
-  double ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_leg_r_beside = 0, ik_leg_r_room = 0;
+  const Scalar ik_leg_r_v0 = thighD + legD*ik_c_psi_r4;
+  const Scalar ik_leg_r_v1 = Scalar(0.0);
+  const Scalar ik_leg_r_v2 = -legD*ik_s_psi_r4;
+  const Scalar ik_leg_r_v[3] = {ik_leg_r_v0, ik_leg_r_v1, ik_leg_r_v2};
+  const Scalar ik_leg_r_d[3] = {ik_leg_r_d0, ik_leg_r_d1, ik_leg_r_d2};
+  Scalar ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_leg_r_beside(0), ik_leg_r_room(0);
   const bool ik_leg_r_two_axis_ok = ik_solve_two_axis<1, 2>(ik_leg_r_v, ik_leg_r_d, (ik_leg_r_branch & 2) != 0, ik_c_psi_r2, ik_s_psi_r2, ik_c_psi_r3, ik_s_psi_r3, ik_leg_r_beside, ik_leg_r_room);
   if (!ik_leg_r_two_axis_ok) {
-    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, std::atan2(ik_s_psi_r4, ik_c_psi_r4) * 57.29577951308232};
+    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, double(std::atan2(ik_s_psi_r4, ik_c_psi_r4)) * 57.29577951308232};
     failed = 1;
     return IkStatus::out_of_reach;
   }
-  const double ik_t57 = (cos_yaw*cos_pitch*ik_c_psi_r2 - ik_s_psi_r2*ik_t37)*ik_c_psi_r3 + ik_t32*ik_s_psi_r3;
-  const double ik_t58 = (cos_pitch*sin_yaw*ik_c_psi_r2 + ik_t36*ik_s_psi_r2)*ik_c_psi_r3 + ik_t34*ik_s_psi_r3;
-  const double ik_t59 = ik_t33*ik_s_psi_r3 - (sin_pitch*ik_c_psi_r2 - ik_t35*ik_s_psi_r2)*ik_c_psi_r3;
-  const double ik_q_theta_l4 = -theta_l5;
-  const double ik_wheel_l_g0 = ik_t38;
-  const double ik_wheel_l_g1 = ik_t39;
-  const double ik_wheel_l_g2 = ik_t40;
-  const double ik_wheel_l_axis[3] = {0.0, 0.0, 1.0};
-  const double ik_wheel_l_g[3] = {ik_wheel_l_g0, ik_wheel_l_g1, ik_wheel_l_g2};
-  double ik_wheel_l_c_sum, ik_wheel_l_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_wheel_l_beside = 0, ik_wheel_l_room = 0;
+  const Scalar ik_t57 = (cos_yaw*cos_pitch*ik_c_psi_r2 - ik_s_psi_r2*ik_t37)*ik_c_psi_r3 + ik_t32*ik_s_psi_r3;
+  const Scalar ik_t58 = (cos_pitch*sin_yaw*ik_c_psi_r2 + ik_t36*ik_s_psi_r2)*ik_c_psi_r3 + ik_t34*ik_s_psi_r3;
+  const Scalar ik_t59 = ik_t33*ik_s_psi_r3 - (sin_pitch*ik_c_psi_r2 - ik_t35*ik_s_psi_r2)*ik_c_psi_r3;
+  const Scalar ik_q_theta_l4 = -theta_l5;
+  const Scalar ik_wheel_l_g0 = ik_t38;
+  const Scalar ik_wheel_l_g1 = ik_t39;
+  const Scalar ik_wheel_l_g2 = ik_t40;
+  const Scalar ik_wheel_l_axis[3] = {Scalar(0), Scalar(0), Scalar(1)};
+  const Scalar ik_wheel_l_g[3] = {ik_wheel_l_g0, ik_wheel_l_g1, ik_wheel_l_g2};
+  Scalar ik_wheel_l_c_sum, ik_wheel_l_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_wheel_l_beside(0), ik_wheel_l_room(0);
   const bool ik_wheel_l_two_axis_ok = ik_solve_two_axis<1, 0>(ik_wheel_l_axis, ik_wheel_l_g, (ik_wheel_l_branch & 2) != 0, ik_wheel_l_c_sum, ik_wheel_l_s_sum, ik_c_theta_l2, ik_s_theta_l2, ik_wheel_l_beside, ik_wheel_l_room);
   static_cast<void>(ik_wheel_l_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
@@ -695,33 +726,33 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
     ik_wheel_l_s_sum = -ik_wheel_l_s_sum;
     ik_s_theta_l2 = -ik_s_theta_l2;
   }
-  const double ik_t41 = ik_wheel_l_s_sum*sin_pitch*w;
-  const double ik_t43 = -w*ik_wheel_l_c_sum*cos_roll*cos_pitch;
-  const double ik_wheel_l_alpha = -(ik_t41 - sin_pitch*(ik_wheel_l_s_sum*w + cos_theta_l5*wl));
-  const double ik_wheel_l_beta = -(cos_roll*cos_pitch*(w*ik_wheel_l_c_sum - cos_theta_l5*wl) + ik_t43);
-  const double ik_wheel_l_gamma = ik_t41 + ik_t44 + z_C + ik_t43 + ik_t46 - sin_roll*sin_theta_l5*wl*cos_pitch;
-  double ik_c_theta_l6, ik_s_theta_l6;
+  const Scalar ik_t41 = ik_wheel_l_s_sum*sin_pitch*w;
+  const Scalar ik_t43 = -w*ik_wheel_l_c_sum*cos_roll*cos_pitch;
+  const Scalar ik_wheel_l_alpha = -(ik_t41 - sin_pitch*(ik_wheel_l_s_sum*w + cos_theta_l5*wl));
+  const Scalar ik_wheel_l_beta = -(cos_roll*cos_pitch*(w*ik_wheel_l_c_sum - cos_theta_l5*wl) + ik_t43);
+  const Scalar ik_wheel_l_gamma = ik_t41 + ik_t44 + z_C + ik_t43 + ik_t46 - sin_roll*sin_theta_l5*wl*cos_pitch;
+  Scalar ik_c_theta_l6, ik_s_theta_l6;
   if (!ik_solve_cos_sin(ik_wheel_l_alpha, ik_wheel_l_beta, z_Wl - ik_wheel_l_gamma, (ik_wheel_l_branch & 1) != 0, ik_c_theta_l6, ik_s_theta_l6)) {
-    const double ik_wheel_l_R = std::sqrt(ik_wheel_l_alpha * ik_wheel_l_alpha + ik_wheel_l_beta * ik_wheel_l_beta);
+    const Scalar ik_wheel_l_R = std::sqrt(ik_wheel_l_alpha * ik_wheel_l_alpha + ik_wheel_l_beta * ik_wheel_l_beta);
     why = {1, z_Wl, ik_wheel_l_gamma - ik_wheel_l_R, ik_wheel_l_gamma + ik_wheel_l_R, 0.0};
     failed = 2;
     return IkStatus::out_of_reach;
   }
-  const double ik_c_theta_l3 = ik_wheel_l_c_sum * ik_c_theta_l6 + ik_wheel_l_s_sum * ik_s_theta_l6;
-  const double ik_s_theta_l3 = ik_wheel_l_s_sum * ik_c_theta_l6 - ik_wheel_l_c_sum * ik_s_theta_l6;
-  const double ik_t60 = sin_pitch*ik_c_theta_l6 + cos_roll*cos_pitch*ik_s_theta_l6;
-  const double ik_t61 = cos_theta_l5*ik_t60 - sin_roll*sin_theta_l5*cos_pitch;
-  const double ik_t62 = sin_pitch*ik_s_theta_l6 - cos_roll*ik_c_theta_l6*cos_pitch;
-  const double ik_t63 = sin_theta_l5*ik_t60 + sin_roll*cos_theta_l5*cos_pitch;
-  const double ik_t64 = ik_t61*cos_theta_l5 + sin_theta_l5*ik_t63;
-  const double ik_t65 = ik_t62*ik_c_theta_l3 + ik_t64*ik_s_theta_l3;
-  const double ik_q_theta_r4 = -theta_r5;
-  const double ik_wheel_r_g0 = ik_t38;
-  const double ik_wheel_r_g1 = ik_t39;
-  const double ik_wheel_r_g2 = ik_t40;
-  const double ik_wheel_r_axis[3] = {0.0, 0.0, 1.0};
-  const double ik_wheel_r_g[3] = {ik_wheel_r_g0, ik_wheel_r_g1, ik_wheel_r_g2};
-  double ik_wheel_r_c_sum, ik_wheel_r_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_wheel_r_beside = 0, ik_wheel_r_room = 0;
+  const Scalar ik_c_theta_l3 = ik_wheel_l_c_sum * ik_c_theta_l6 + ik_wheel_l_s_sum * ik_s_theta_l6;
+  const Scalar ik_s_theta_l3 = ik_wheel_l_s_sum * ik_c_theta_l6 - ik_wheel_l_c_sum * ik_s_theta_l6;
+  const Scalar ik_t60 = sin_pitch*ik_c_theta_l6 + cos_roll*cos_pitch*ik_s_theta_l6;
+  const Scalar ik_t61 = cos_theta_l5*ik_t60 - sin_roll*sin_theta_l5*cos_pitch;
+  const Scalar ik_t62 = sin_pitch*ik_s_theta_l6 - cos_roll*ik_c_theta_l6*cos_pitch;
+  const Scalar ik_t63 = sin_theta_l5*ik_t60 + sin_roll*cos_theta_l5*cos_pitch;
+  const Scalar ik_t64 = ik_t61*cos_theta_l5 + sin_theta_l5*ik_t63;
+  const Scalar ik_t65 = ik_t62*ik_c_theta_l3 + ik_t64*ik_s_theta_l3;
+  const Scalar ik_q_theta_r4 = -theta_r5;
+  const Scalar ik_wheel_r_g0 = ik_t38;
+  const Scalar ik_wheel_r_g1 = ik_t39;
+  const Scalar ik_wheel_r_g2 = ik_t40;
+  const Scalar ik_wheel_r_axis[3] = {Scalar(0), Scalar(0), Scalar(1)};
+  const Scalar ik_wheel_r_g[3] = {ik_wheel_r_g0, ik_wheel_r_g1, ik_wheel_r_g2};
+  Scalar ik_wheel_r_c_sum, ik_wheel_r_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_wheel_r_beside(0), ik_wheel_r_room(0);
   const bool ik_wheel_r_two_axis_ok = ik_solve_two_axis<1, 0>(ik_wheel_r_axis, ik_wheel_r_g, (ik_wheel_r_branch & 2) != 0, ik_wheel_r_c_sum, ik_wheel_r_s_sum, ik_c_theta_r2, ik_s_theta_r2, ik_wheel_r_beside, ik_wheel_r_room);
   static_cast<void>(ik_wheel_r_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
@@ -730,75 +761,75 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
     ik_wheel_r_s_sum = -ik_wheel_r_s_sum;
     ik_s_theta_r2 = -ik_s_theta_r2;
   }
-  const double ik_t48 = -w*ik_wheel_r_c_sum*cos_roll*cos_pitch;
-  const double ik_wheel_r_alpha = sin_pitch*(w*ik_wheel_r_s_sum + cos_theta_r5*wl) - sin_pitch*w*ik_wheel_r_s_sum;
-  const double ik_wheel_r_beta = -(ik_t48 + (w*ik_wheel_r_c_sum - cos_theta_r5*wl)*cos_roll*cos_pitch);
-  const double ik_wheel_r_gamma = ik_t50 + ik_t44 + z_C + ik_t48 + sin_pitch*w*ik_wheel_r_s_sum - sin_roll*sin_theta_r5*wl*cos_pitch;
-  double ik_c_theta_r6, ik_s_theta_r6;
+  const Scalar ik_t48 = -w*ik_wheel_r_c_sum*cos_roll*cos_pitch;
+  const Scalar ik_wheel_r_alpha = sin_pitch*(w*ik_wheel_r_s_sum + cos_theta_r5*wl) - sin_pitch*w*ik_wheel_r_s_sum;
+  const Scalar ik_wheel_r_beta = -(ik_t48 + (w*ik_wheel_r_c_sum - cos_theta_r5*wl)*cos_roll*cos_pitch);
+  const Scalar ik_wheel_r_gamma = ik_t50 + ik_t44 + z_C + ik_t48 + sin_pitch*w*ik_wheel_r_s_sum - sin_roll*sin_theta_r5*wl*cos_pitch;
+  Scalar ik_c_theta_r6, ik_s_theta_r6;
   if (!ik_solve_cos_sin(ik_wheel_r_alpha, ik_wheel_r_beta, z_Wr - ik_wheel_r_gamma, (ik_wheel_r_branch & 1) != 0, ik_c_theta_r6, ik_s_theta_r6)) {
-    const double ik_wheel_r_R = std::sqrt(ik_wheel_r_alpha * ik_wheel_r_alpha + ik_wheel_r_beta * ik_wheel_r_beta);
+    const Scalar ik_wheel_r_R = std::sqrt(ik_wheel_r_alpha * ik_wheel_r_alpha + ik_wheel_r_beta * ik_wheel_r_beta);
     why = {1, z_Wr, ik_wheel_r_gamma - ik_wheel_r_R, ik_wheel_r_gamma + ik_wheel_r_R, 0.0};
     failed = 3;
     return IkStatus::out_of_reach;
   }
-  const double ik_c_theta_r3 = ik_wheel_r_c_sum * ik_c_theta_r6 + ik_wheel_r_s_sum * ik_s_theta_r6;
-  const double ik_s_theta_r3 = ik_wheel_r_s_sum * ik_c_theta_r6 - ik_wheel_r_c_sum * ik_s_theta_r6;
-  const double ik_t66 = cos_roll*cos_pitch*ik_s_theta_r6 + ik_c_theta_r6*sin_pitch;
-  const double ik_t67 = sin_roll*sin_theta_r5*cos_pitch - cos_theta_r5*ik_t66;
-  const double ik_t68 = sin_theta_r5*ik_t66 + sin_roll*cos_theta_r5*cos_pitch;
-  const double ik_t69 = sin_theta_r5*ik_t68 - ik_t67*cos_theta_r5;
-  const double ik_t70 = sin_pitch*ik_s_theta_r6 - ik_c_theta_r6*cos_roll*cos_pitch;
-  const double ik_t71 = ik_t69*ik_s_theta_r3 + ik_c_theta_r3*ik_t70;
-  const std::array<double, 12> ik_sines{{ik_s_psi_l2, ik_s_psi_l3, ik_s_psi_l4, ik_s_psi_r2, ik_s_psi_r3, ik_s_psi_r4, ik_s_theta_l6, ik_s_theta_l3, ik_s_theta_l2, ik_s_theta_r6, ik_s_theta_r3, ik_s_theta_r2}}, ik_cosines{{ik_c_psi_l2, ik_c_psi_l3, ik_c_psi_l4, ik_c_psi_r2, ik_c_psi_r3, ik_c_psi_r4, ik_c_theta_l6, ik_c_theta_l3, ik_c_theta_l2, ik_c_theta_r6, ik_c_theta_r3, ik_c_theta_r2}};
-  std::array<double, 12> ik_angles;
+  const Scalar ik_c_theta_r3 = ik_wheel_r_c_sum * ik_c_theta_r6 + ik_wheel_r_s_sum * ik_s_theta_r6;
+  const Scalar ik_s_theta_r3 = ik_wheel_r_s_sum * ik_c_theta_r6 - ik_wheel_r_c_sum * ik_s_theta_r6;
+  const Scalar ik_t66 = cos_roll*cos_pitch*ik_s_theta_r6 + ik_c_theta_r6*sin_pitch;
+  const Scalar ik_t67 = sin_roll*sin_theta_r5*cos_pitch - cos_theta_r5*ik_t66;
+  const Scalar ik_t68 = sin_theta_r5*ik_t66 + sin_roll*cos_theta_r5*cos_pitch;
+  const Scalar ik_t69 = sin_theta_r5*ik_t68 - ik_t67*cos_theta_r5;
+  const Scalar ik_t70 = sin_pitch*ik_s_theta_r6 - ik_c_theta_r6*cos_roll*cos_pitch;
+  const Scalar ik_t71 = ik_t69*ik_s_theta_r3 + ik_c_theta_r3*ik_t70;
+  const std::array<Scalar, 12> ik_sines{{ik_s_psi_l2, ik_s_psi_l3, ik_s_psi_l4, ik_s_psi_r2, ik_s_psi_r3, ik_s_psi_r4, ik_s_theta_l6, ik_s_theta_l3, ik_s_theta_l2, ik_s_theta_r6, ik_s_theta_r3, ik_s_theta_r2}}, ik_cosines{{ik_c_psi_l2, ik_c_psi_l3, ik_c_psi_l4, ik_c_psi_r2, ik_c_psi_r3, ik_c_psi_r4, ik_c_theta_l6, ik_c_theta_l3, ik_c_theta_l2, ik_c_theta_r6, ik_c_theta_r3, ik_c_theta_r2}};
+  std::array<Scalar, 12> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_psi_l2 = ik_angles[0];
-  const double ik_q_psi_l3 = ik_angles[1];
-  const double ik_q_psi_l4 = ik_angles[2];
-  const double ik_q_psi_r2 = ik_angles[3];
-  const double ik_q_psi_r3 = ik_angles[4];
-  const double ik_q_psi_r4 = ik_angles[5];
-  const double ik_q_theta_l6 = ik_angles[6];
-  const double ik_q_theta_l3 = ik_angles[7];
-  const double ik_q_theta_l2 = ik_angles[8];
-  const double ik_q_theta_r6 = ik_angles[9];
-  const double ik_q_theta_r3 = ik_angles[10];
-  const double ik_q_theta_r2 = ik_angles[11];
-  const double ik_leg_l_row0 = x_C + ik_t51 + legD*(ik_t52*ik_c_psi_l4 - ik_s_psi_l4*(ik_s_psi_l2*cos_yaw*cos_pitch + ik_c_psi_l2*ik_t22)) + ik_t52*thighD + 0.5*ik_t5*cyd - x_Fl;
-  const double ik_leg_l_row1 = ik_t53 + y_C + thighD*ik_t54 + 0.5*ik_t12*cyd + legD*(ik_c_psi_l4*ik_t54 - ik_s_psi_l4*(ik_s_psi_l2*cos_pitch*sin_yaw - ik_t24*ik_c_psi_l2)) - y_Fl;
-  const double ik_leg_l_row2 = -(z_Fl + ik_t55 + ik_t50 + ik_t44 - legD*(ik_c_psi_l4*ik_t56 + ik_s_psi_l4*(ik_s_psi_l2*sin_pitch - ik_c_psi_l2*ik_t23)) - thighD*ik_t56);
-  const double ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
-  if (!(ik_leg_l_residual <= kIkTolerance)) {
-    why = {0, ik_leg_l_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_psi_l2 = ik_angles[0];
+  const Scalar ik_q_psi_l3 = ik_angles[1];
+  const Scalar ik_q_psi_l4 = ik_angles[2];
+  const Scalar ik_q_psi_r2 = ik_angles[3];
+  const Scalar ik_q_psi_r3 = ik_angles[4];
+  const Scalar ik_q_psi_r4 = ik_angles[5];
+  const Scalar ik_q_theta_l6 = ik_angles[6];
+  const Scalar ik_q_theta_l3 = ik_angles[7];
+  const Scalar ik_q_theta_l2 = ik_angles[8];
+  const Scalar ik_q_theta_r6 = ik_angles[9];
+  const Scalar ik_q_theta_r3 = ik_angles[10];
+  const Scalar ik_q_theta_r2 = ik_angles[11];
+  const Scalar ik_leg_l_row0 = x_C + ik_t51 + legD*(ik_t52*ik_c_psi_l4 - ik_s_psi_l4*(ik_s_psi_l2*cos_yaw*cos_pitch + ik_c_psi_l2*ik_t22)) + ik_t52*thighD + Scalar(0.5)*ik_t5*cyd - x_Fl;
+  const Scalar ik_leg_l_row1 = ik_t53 + y_C + thighD*ik_t54 + Scalar(0.5)*ik_t12*cyd + legD*(ik_c_psi_l4*ik_t54 - ik_s_psi_l4*(ik_s_psi_l2*cos_pitch*sin_yaw - ik_t24*ik_c_psi_l2)) - y_Fl;
+  const Scalar ik_leg_l_row2 = -(z_Fl + ik_t55 + ik_t50 + ik_t44 - legD*(ik_c_psi_l4*ik_t56 + ik_s_psi_l4*(ik_s_psi_l2*sin_pitch - ik_c_psi_l2*ik_t23)) - thighD*ik_t56);
+  const Scalar ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
+  if (!(ik_leg_l_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_leg_l_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     failed = 0;
     return IkStatus::residual;
   }
-  const double ik_leg_r_row0 = x_C + thighD*ik_t57 + ik_t51 - 0.5*ik_t5*cyd - x_Fr - legD*(ik_s_psi_r4*(ik_c_psi_r2*ik_t37 + cos_yaw*cos_pitch*ik_s_psi_r2) - ik_c_psi_r4*ik_t57);
-  const double ik_leg_r_row1 = ik_t53 + thighD*ik_t58 + y_C - legD*(ik_s_psi_r4*(cos_pitch*sin_yaw*ik_s_psi_r2 - ik_t36*ik_c_psi_r2) - ik_t58*ik_c_psi_r4) - 0.5*ik_t12*cyd - y_Fr;
-  const double ik_leg_r_row2 = -(z_Fr + ik_t55 + ik_t44 + ik_t46 - legD*(ik_t59*ik_c_psi_r4 + ik_s_psi_r4*(sin_pitch*ik_s_psi_r2 + ik_t35*ik_c_psi_r2)) - ik_t59*thighD);
-  const double ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
-  if (!(ik_leg_r_residual <= kIkTolerance)) {
-    why = {0, ik_leg_r_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_leg_r_row0 = x_C + thighD*ik_t57 + ik_t51 - Scalar(0.5)*ik_t5*cyd - x_Fr - legD*(ik_s_psi_r4*(ik_c_psi_r2*ik_t37 + cos_yaw*cos_pitch*ik_s_psi_r2) - ik_c_psi_r4*ik_t57);
+  const Scalar ik_leg_r_row1 = ik_t53 + thighD*ik_t58 + y_C - legD*(ik_s_psi_r4*(cos_pitch*sin_yaw*ik_s_psi_r2 - ik_t36*ik_c_psi_r2) - ik_t58*ik_c_psi_r4) - Scalar(0.5)*ik_t12*cyd - y_Fr;
+  const Scalar ik_leg_r_row2 = -(z_Fr + ik_t55 + ik_t44 + ik_t46 - legD*(ik_t59*ik_c_psi_r4 + ik_s_psi_r4*(sin_pitch*ik_s_psi_r2 + ik_t35*ik_c_psi_r2)) - ik_t59*thighD);
+  const Scalar ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
+  if (!(ik_leg_r_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_leg_r_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     failed = 1;
     return IkStatus::residual;
   }
-  const double ik_wheel_l_row0 = ik_t61*wl + ik_t44 + z_C + ik_t46 + w*ik_t65 - z_Wl;
-  const double ik_wheel_l_row1 = -(ik_t64*ik_c_theta_l3 - ik_t62*ik_s_theta_l3);
-  const double ik_wheel_l_row2 = ik_c_theta_l2*(cos_theta_l5*ik_t63 - sin_theta_l5*ik_t61) - ik_t65*ik_s_theta_l2;
-  const double ik_wheel_l_row3 = 0.0;
-  const double ik_wheel_l_residual = std::max({std::abs(ik_wheel_l_row0), std::abs(ik_wheel_l_row1), std::abs(ik_wheel_l_row2), std::abs(ik_wheel_l_row3)});
-  if (!(ik_wheel_l_residual <= kIkTolerance)) {
-    why = {0, ik_wheel_l_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_wheel_l_row0 = ik_t61*wl + ik_t44 + z_C + ik_t46 + w*ik_t65 - z_Wl;
+  const Scalar ik_wheel_l_row1 = -(ik_t64*ik_c_theta_l3 - ik_t62*ik_s_theta_l3);
+  const Scalar ik_wheel_l_row2 = ik_c_theta_l2*(cos_theta_l5*ik_t63 - sin_theta_l5*ik_t61) - ik_t65*ik_s_theta_l2;
+  const Scalar ik_wheel_l_row3 = Scalar(0.0);
+  const Scalar ik_wheel_l_residual = std::max({std::abs(ik_wheel_l_row0), std::abs(ik_wheel_l_row1), std::abs(ik_wheel_l_row2), std::abs(ik_wheel_l_row3)});
+  if (!(ik_wheel_l_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_wheel_l_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     failed = 2;
     return IkStatus::residual;
   }
-  const double ik_wheel_r_row0 = -(z_Wr + ik_t55 + ik_t67*wl + ik_t46 - w*ik_t71 - 0.5*sin_pitch*cxd);
-  const double ik_wheel_r_row1 = ik_t70*ik_s_theta_r3 - ik_t69*ik_c_theta_r3;
-  const double ik_wheel_r_row2 = -(ik_t71*ik_s_theta_r2 - (cos_theta_r5*ik_t68 + ik_t67*sin_theta_r5)*ik_c_theta_r2);
-  const double ik_wheel_r_row3 = 0.0;
-  const double ik_wheel_r_residual = std::max({std::abs(ik_wheel_r_row0), std::abs(ik_wheel_r_row1), std::abs(ik_wheel_r_row2), std::abs(ik_wheel_r_row3)});
-  if (!(ik_wheel_r_residual <= kIkTolerance)) {
-    why = {0, ik_wheel_r_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_wheel_r_row0 = -(z_Wr + ik_t55 + ik_t67*wl + ik_t46 - w*ik_t71 - Scalar(0.5)*sin_pitch*cxd);
+  const Scalar ik_wheel_r_row1 = ik_t70*ik_s_theta_r3 - ik_t69*ik_c_theta_r3;
+  const Scalar ik_wheel_r_row2 = -(ik_t71*ik_s_theta_r2 - (cos_theta_r5*ik_t68 + ik_t67*sin_theta_r5)*ik_c_theta_r2);
+  const Scalar ik_wheel_r_row3 = Scalar(0.0);
+  const Scalar ik_wheel_r_residual = std::max({std::abs(ik_wheel_r_row0), std::abs(ik_wheel_r_row1), std::abs(ik_wheel_r_row2), std::abs(ik_wheel_r_row3)});
+  if (!(ik_wheel_r_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_wheel_r_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     failed = 3;
     return IkStatus::residual;
   }

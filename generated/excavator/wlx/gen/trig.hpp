@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 namespace wlx {
 inline namespace excavator {
@@ -52,36 +53,46 @@ typedef double Doubles __attribute__((vector_size(16)));
 typedef std::uint64_t Bits __attribute__((vector_size(16)));
 #endif
 
+// The bits of a vector as another vector type of the same size (memcpy: no C-style vector cast,
+// and no aliasing; compilers turn it into nothing).
+template <typename To, typename From>
+inline To bit_cast(From from) noexcept {
+  static_assert(sizeof(To) == sizeof(From), "same size");
+  To to;
+  std::memcpy(&to, &from, sizeof to);
+  return to;
+}
+
 inline void sincos_lanes(Doubles x, Doubles& sin_x, Doubles& cos_x) noexcept {
   const Doubles shifted = x * kTwoOverPi + kRoundToInteger;
   const Doubles n = shifted - kRoundToInteger;          // nearest integer to x / (pi/2)
-  const Bits quadrant = (Bits)shifted;  // its low bits: n mod 4
+  const Bits quadrant = bit_cast<Bits>(shifted);  // its low bits: n mod 4
   const Doubles r = ((x - n * kHalfPiHi) - n * kHalfPiMid) - n * kHalfPiLo;
   const Doubles r2 = r * r;
   const Doubles s = r * (1.0 + r2 * (-0.16666666666666666 + r2 * (0.008333333333333333 + r2 * (-0.0001984126984126984 + r2 * (2.7557319223985893e-06 + r2 * (-2.505210838544172e-08 + r2 * (1.6059043836821613e-10 + r2 * (-7.647163731819816e-13))))))));
   const Doubles c = 1.0 - 0.5 * r2 + r2 * r2 * (0.041666666666666664 + r2 * (-0.001388888888888889 + r2 * (2.48015873015873e-05 + r2 * (-2.755731922398589e-07 + r2 * (2.08767569878681e-09 + r2 * (-1.1470745597729725e-11 + r2 * (4.779477332387385e-14)))))));
-  const Bits s_bits = (Bits)s, c_bits = (Bits)c;
+  const Bits s_bits = bit_cast<Bits>(s), c_bits = bit_cast<Bits>(c);
   const Bits swap = Bits{} - (quadrant & 1);  // odd quadrants exchange sin and cos
   const Bits sin_bits = ((c_bits & swap) | (s_bits & ~swap)) ^ ((quadrant & 2) << 62);  // quadrants 2, 3: -
   const Bits cos_bits = ((s_bits & swap) | (c_bits & ~swap)) ^ (((quadrant + 1) & 2) << 62);  // 1, 2: -
-  sin_x = (Doubles)sin_bits;
-  cos_x = (Doubles)cos_bits;
+  sin_x = bit_cast<Doubles>(sin_bits);
+  cos_x = bit_cast<Doubles>(cos_bits);
 }
 
 // Picks a where the mask is all ones, b where it is zero.
-inline Doubles select(Bits mask, Doubles a, Doubles b) noexcept { return (Doubles)((mask & (Bits)a) | (~mask & (Bits)b)); }
+inline Doubles select(Bits mask, Doubles a, Doubles b) noexcept { return bit_cast<Doubles>((mask & bit_cast<Bits>(a)) | (~mask & bit_cast<Bits>(b))); }
 
 inline Doubles atan2_lanes(Doubles y, Doubles x) noexcept {
   const Bits sign = Bits{} + 0x8000000000000000u;
-  const Doubles ax = (Doubles)((Bits)x & ~sign), ay = (Doubles)((Bits)y & ~sign);
-  const Bits swap = (Bits)(ay > ax);  // above the diagonal: atan2 = pi/2 - atan(|x| / |y|)
+  const Doubles ax = bit_cast<Doubles>(bit_cast<Bits>(x) & ~sign), ay = bit_cast<Doubles>(bit_cast<Bits>(y) & ~sign);
+  const Bits swap = bit_cast<Bits>(ay > ax);  // above the diagonal: atan2 = pi/2 - atan(|x| / |y|)
   const Doubles num = select(swap, ax, ay), den = select(swap, ay, ax);
-  const Doubles t = num / (den + select((Bits)(den == 0.0), Doubles{} + 1.0, Doubles{}));  // in [0, 1]; 0 / 1 at the origin
+  const Doubles t = num / (den + select(bit_cast<Bits>(den == 0.0), Doubles{} + 1.0, Doubles{}));  // in [0, 1]; 0 / 1 at the origin
   const Doubles shifted = t * 8.0 + kRoundToInteger;
   // The nearest eighth k/8, but 0 below 1/8: atan(1/8) + atan u with u near -1/16 would cancel.
-  const Bits small = (Bits)(t < 0.125);
+  const Bits small = bit_cast<Bits>(t < 0.125);
   const Doubles centre = select(small, Doubles{}, (shifted - kRoundToInteger) * 0.125);
-  const Bits k = (Bits)shifted & 15 & ~small;
+  const Bits k = bit_cast<Bits>(shifted) & 15 & ~small;
   // atan t = atan(k/8) + atan u; t - k/8 is exact (Sterbenz), |u| <= 1/8.
   const Doubles u = (t - centre) / (1.0 + t * centre);
   const Doubles u2 = u * u;
@@ -93,8 +104,8 @@ inline Doubles atan2_lanes(Doubles y, Doubles x) noexcept {
   }
   Doubles a = head + (tail + atan_u);  // atan t, in [0, pi/4]
   a = select(swap, (kHalfPiHead - a) + kHalfPiTail, a);
-  a = select(Bits{} - ((Bits)x >> 63), (kPiHead - a) + kPiTail, a);  // x < 0 (and x = -0): pi - a
-  return (Doubles)((Bits)a ^ ((Bits)(y < 0.0) & sign));  // y < 0: -a; y = -0 counts as +0
+  a = select(Bits{} - (bit_cast<Bits>(x) >> 63), (kPiHead - a) + kPiTail, a);  // x < 0 (and x = -0): pi - a
+  return bit_cast<Doubles>(bit_cast<Bits>(a) ^ (bit_cast<Bits>(y < 0.0) & sign));  // y < 0: -a; y = -0 counts as +0
 }
 #endif
 
@@ -130,6 +141,18 @@ inline void sincos(const std::array<double, N>& x, std::array<double, N>& sin_x,
     cos_x[i] = std::cos(x[i]);
   }
 #endif
+}
+
+// Any other scalar type (float, automatic-differentiation numbers): its own sin and cos, found by
+// argument-dependent lookup, or std::sin and std::cos. The exactness guarantee above is for double.
+template <typename Scalar, std::size_t N>
+inline void sincos(const std::array<Scalar, N>& x, std::array<Scalar, N>& sin_x, std::array<Scalar, N>& cos_x) noexcept {
+  using std::cos;
+  using std::sin;
+  for (std::size_t i = 0; i < N; ++i) {
+    sin_x[i] = sin(x[i]);
+    cos_x[i] = cos(x[i]);
+  }
 }
 
 // atan2(y, x, angle) fills angle[i] = atan2(y[i], x[i]) for fixed-size arrays, in (-pi, pi]: a half
@@ -170,6 +193,17 @@ inline void atan2(const std::array<double, N>& y, const std::array<double, N>& x
     if (angle[i] == -trig_detail::kPiHead) angle[i] = trig_detail::kPiHead;
   }
 #endif
+}
+
+// float and long double: std::atan2, with the same conventions (a half turn is +pi).
+template <typename Scalar, std::size_t N>
+inline void atan2(const std::array<Scalar, N>& y, const std::array<Scalar, N>& x, std::array<Scalar, N>& angle) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "atan2 of arrays is for floating-point types");
+  const Scalar pi = Scalar(trig_detail::kPiHead);
+  for (std::size_t i = 0; i < N; ++i) {
+    angle[i] = std::atan2(y[i] + Scalar(0), x[i]);  // + 0: -0 to +0, so a half turn is +pi
+    if (angle[i] == -pi) angle[i] = pi;
+  }
 }
 
 }  // namespace gen

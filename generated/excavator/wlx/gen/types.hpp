@@ -26,16 +26,36 @@ inline constexpr int kFrameCount = 13;
 inline constexpr int kBodyCount = 7;
 inline constexpr int kWheelCount = 2;
 
-using Coordinates = Eigen::Matrix<double, 32, 1>;
-using FramePositions = Eigen::Matrix<double, 3, 13>;
-using FrameRotations = std::array<Eigen::Matrix3d, 13>;
-using ClosureVector = Eigen::Matrix<double, 14, 1>;
-using ClosureJacobian = Eigen::Matrix<double, 14, 32>;
-using WheelRows = Eigen::Matrix<double, 2, 32>;
-using WheelVector = Eigen::Matrix<double, 2, 1>;
-using BodyVectors = Eigen::Matrix<double, 3, 7>;
-using BodyRotations = std::array<Eigen::Matrix3d, 7>;
-using BodyJacobians = std::array<Eigen::Matrix<double, 3, 32>, 7>;
+// The types of the generated functions for scalar type Scalar.
+template <typename Scalar> using CoordinatesOf = Eigen::Matrix<Scalar, 32, 1>;
+template <typename Scalar> using FramePositionsOf = Eigen::Matrix<Scalar, 3, 13>;
+template <typename Scalar> using FrameRotationsOf = std::array<Eigen::Matrix<Scalar, 3, 3>, 13>;
+template <typename Scalar> using ClosureVectorOf = Eigen::Matrix<Scalar, 14, 1>;
+template <typename Scalar> using ClosureJacobianOf = Eigen::Matrix<Scalar, 14, 32>;
+template <typename Scalar> using WheelRowsOf = Eigen::Matrix<Scalar, 2, 32>;
+template <typename Scalar> using WheelVectorOf = Eigen::Matrix<Scalar, 2, 1>;
+template <typename Scalar> using BodyVectorsOf = Eigen::Matrix<Scalar, 3, 7>;
+template <typename Scalar> using BodyRotationsOf = std::array<Eigen::Matrix<Scalar, 3, 3>, 7>;
+template <typename Scalar> using BodyJacobiansOf = std::array<Eigen::Matrix<Scalar, 3, 32>, 7>;
+
+// The double ones: what the runtime uses.
+using Coordinates = CoordinatesOf<double>;
+using FramePositions = FramePositionsOf<double>;
+using FrameRotations = FrameRotationsOf<double>;
+using ClosureVector = ClosureVectorOf<double>;
+using ClosureJacobian = ClosureJacobianOf<double>;
+using WheelRows = WheelRowsOf<double>;
+using WheelVector = WheelVectorOf<double>;
+using BodyVectors = BodyVectorsOf<double>;
+using BodyRotations = BodyRotationsOf<double>;
+using BodyJacobians = BodyJacobiansOf<double>;
+
+namespace detail {
+// T, but not deduced: the scalar type of a generated function comes from its coordinates, so an
+// output pointer may be nullptr (std::type_identity_t, which C++17 lacks).
+template <typename T> struct NonDeducedType { using type = T; };
+template <typename T> using NonDeduced = typename NonDeducedType<T>::type;
+}  // namespace detail
 
 // Index of each coordinate in s (the model file's order: inputs, then dependent joints).
 namespace coord {

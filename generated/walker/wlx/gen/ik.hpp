@@ -12,7 +12,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string_view>
+#include <type_traits>
 
 #include "params.hpp"
 #include "structure.hpp"
@@ -40,28 +42,42 @@ struct IkDiagnostics {
 };
 
 // Targets this close outside the reach (relative) are rounding, not user error: they are clamped
-// onto the boundary.
+// onto the boundary. For double; ik_reach_slack<Scalar>() scales it with the type's epsilon.
 inline constexpr double kIkReachSlack = 1e-12;
 // A closed-form solution must satisfy the limb's closure rows to this (m or rad); rounding leaves
-// about 1e-15.
+// about 1e-15. For double; see ik_tolerance<Scalar>() for float.
 inline constexpr double kIkTolerance = 1e-9;
+
+// The two for scalar type Scalar. The slack is about 4500 rounding units, so it scales with the
+// type's epsilon (float: 5.4e-4). The tolerance has to stay clear of rounding (n eps times the
+// chain's length) and far below what a wrong solution leaves (millimetres and more); it scales
+// with the square root of the epsilon ratio (float: 2.3e-5 m, where rounding leaves about 1e-6).
+template <typename Scalar>
+inline Scalar ik_reach_slack() noexcept {
+  return Scalar(kIkReachSlack * (double(std::numeric_limits<Scalar>::epsilon()) / std::numeric_limits<double>::epsilon()));
+}
+template <typename Scalar>
+inline Scalar ik_tolerance() noexcept {
+  return Scalar(kIkTolerance * std::sqrt(double(std::numeric_limits<Scalar>::epsilon()) / std::numeric_limits<double>::epsilon()));
+}
 
 // cos x and sin x of the x with a cos x + b sin x = c: the root nearest zero (largest cos x; on a tie
 // the positive one), or the other root with `other`. False when |c| exceeds sqrt(a^2 + b^2). The
 // angles themselves come from one batched atan2 pass at the end of a solve.
-inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& cos_x, double& sin_x) noexcept {
+template <typename Scalar>
+inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& cos_x, Scalar& sin_x) noexcept {
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
-  const double r = std::sqrt(a * a + b * b);
+  const Scalar r = std::sqrt(a * a + b * b);
   if (!(r > 0)) return false;
-  double ratio = c / r;
+  Scalar ratio = c / r;
   if (!(std::abs(ratio) <= 1)) {
-    if (!(std::abs(ratio) <= 1 + kIkReachSlack)) return false;
-    ratio = std::copysign(1.0, ratio);
+    if (!(std::abs(ratio) <= 1 + ik_reach_slack<Scalar>())) return false;
+    ratio = std::copysign(Scalar(1), ratio);
   }
-  const double cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
-  const double sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
-  double sign = sin_psi > 0 ? -1.0 : sin_psi < 0 ? 1.0 : (cos_psi >= 0 ? 1.0 : -1.0);
+  const Scalar cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
+  const Scalar sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
+  Scalar sign = sin_psi > 0 ? Scalar(-1) : sin_psi < 0 ? Scalar(1) : (cos_psi >= 0 ? Scalar(1) : Scalar(-1));
   if (other) sign = -sign;
   cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
   sin_x = sin_psi * ratio + sign * cos_psi * sin_delta;
@@ -72,40 +88,40 @@ inline bool ik_solve_cos_sin(double a, double b, double c, bool other, double& c
 // the component of d along A fixes q2 (two roots: `flip` takes the one with cos q2 of the other sign
 // than branch 0's), then q1 turns R_B(q2) v onto d. False (with how far d is off the plane normal to
 // A, and how far it could be) when no q2 reaches d's component along A.
-template <int A, int B>
-inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool flip, double& c1, double& s1, double& c2,
-                              double& s2, double& beside, double& room) noexcept {
+template <int A, int B, typename Scalar>
+inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool flip, Scalar& c1, Scalar& s1, Scalar& c2,
+                              Scalar& s2, Scalar& beside, Scalar& room) noexcept {
   static_assert(A != B && A >= 0 && A < 3 && B >= 0 && B < 3, "two different principal axes");
   constexpr int C = 3 - A - B;
   constexpr int i = (B + 1) % 3, j = (B + 2) % 3;    // R_B turns i towards j
   constexpr int i1 = (A + 1) % 3, j1 = (A + 2) % 3;  // R_A turns i1 towards j1
-  const double across = d[i1] * d[i1] + d[j1] * d[j1];  // |d|^2 off the axis A
-  double k2 = across - v[B] * v[B];
+  const Scalar across = d[i1] * d[i1] + d[j1] * d[j1];  // |d|^2 off the axis A
+  Scalar k2 = across - v[B] * v[B];
   if (k2 < 0) {
-    if (-k2 > kIkReachSlack * (across + v[B] * v[B])) {
+    if (-k2 > ik_reach_slack<Scalar>() * (across + v[B] * v[B])) {
       beside = std::abs(d[A]);
       room = std::sqrt(v[A] * v[A] + v[C] * v[C]);
       return false;
     }
     k2 = 0;
   }
-  double k = std::sqrt(k2);
+  Scalar k = std::sqrt(k2);
   if ((v[C] < 0) != flip) k = -k;
-  double t[3] = {0, 0, 0};
+  Scalar t[3] = {0, 0, 0};
   t[A] = d[A];
   t[C] = k;
-  const double y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
-  const double r = std::sqrt(x * x + y * y);
-  c2 = r > 0 ? x / r : 1.0;
-  s2 = r > 0 ? y / r : 0.0;
-  double w[3];
+  const Scalar y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
+  const Scalar r = std::sqrt(x * x + y * y);
+  c2 = r > 0 ? x / r : Scalar(1);
+  s2 = r > 0 ? y / r : Scalar(0);
+  Scalar w[3];
   w[B] = v[B];
   w[i] = c2 * v[i] - s2 * v[j];
   w[j] = s2 * v[i] + c2 * v[j];
-  const double y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
-  const double r1 = std::sqrt(x1 * x1 + y1 * y1);
-  c1 = r1 > 0 ? x1 / r1 : 1.0;
-  s1 = r1 > 0 ? y1 / r1 : 0.0;
+  const Scalar y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
+  const Scalar r1 = std::sqrt(x1 * x1 + y1 * y1);
+  c1 = r1 > 0 ? x1 / r1 : Scalar(1);
+  s1 = r1 > 0 ? y1 / r1 : Scalar(0);
   return true;
 }
 
@@ -121,96 +137,99 @@ inline bool ik_solve_two_axis(const double (&v)[3], const double (&d)[3], bool f
 // On failure returns why, with the numbers in `why` (stage 1.. as in kClosedForm's failure texts;
 // stage 0: residual, the solution does not satisfy the closure rows).
 // Operations: 189 (adds 71, muls 110, divs 0, calls 8), plus the solver calls.
-inline IkStatus ik_leg_l(const Coordinates& s, const Params& p, int branch, Coordinates& out, IkDiagnostics& why) noexcept {
+// Scalar: float or double (the branch choices and the reach diagnostics need real numbers).
+template <typename Scalar>
+inline IkStatus ik_leg_l(const CoordinatesOf<Scalar>& s, const Params& p, int branch, detail::NonDeduced<CoordinatesOf<Scalar>>& out, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 4) return IkStatus::bad_branch;
-  const double x_C = s(0);
-  const double y_C = s(1);
-  const double z_C = s(2);
-  const double yaw = s(3);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double foot_x_l = s(6);
-  const double foot_y_l = s(7);
-  const double foot_z_l = s(8);
-  const double slew_l = s(14);
-  const double hip_x = p.hip_x;
-  const double hip_y = p.hip_y;
-  const double hip_drop = p.hip_drop;
-  const double thigh = p.thigh;
-  const double knee_offset = p.knee_offset;
-  const double shank = p.shank;
+  const Scalar x_C = s(0);
+  const Scalar y_C = s(1);
+  const Scalar z_C = s(2);
+  const Scalar yaw = s(3);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar foot_x_l = s(6);
+  const Scalar foot_y_l = s(7);
+  const Scalar foot_z_l = s(8);
+  const Scalar slew_l = s(14);
+  const Scalar hip_x(p.hip_x);
+  const Scalar hip_y(p.hip_y);
+  const Scalar hip_drop(p.hip_drop);
+  const Scalar thigh(p.thigh);
+  const Scalar knee_offset(p.knee_offset);
+  const Scalar shank(p.shank);
   // sin and cos of all 4 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 4> angle{yaw, pitch, roll, slew_l};
-  std::array<double, 4> sin_angle, cos_angle;
+  const std::array<Scalar, 4> angle{yaw, pitch, roll, slew_l};
+  std::array<Scalar, 4> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_yaw = cos_angle[0];
-  const double sin_yaw = sin_angle[0];
-  const double cos_pitch = cos_angle[1];
-  const double sin_pitch = sin_angle[1];
-  const double cos_roll = cos_angle[2];
-  const double sin_roll = sin_angle[2];
-  const double cos_slew_l = cos_angle[3];
-  const double sin_slew_l = sin_angle[3];
-  const double ik_t6 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
-  const double ik_t7 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
-  const double ik_t8 = ik_t6*hip_drop + foot_x_l - hip_x*cos_yaw*cos_pitch - ik_t7*hip_y - x_C;
-  const double ik_t11 = ik_t7*sin_slew_l + cos_yaw*cos_slew_l*cos_pitch;
-  const double ik_t12 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
-  const double ik_t13 = cos_slew_l*cos_pitch*sin_yaw + ik_t12*sin_slew_l;
-  const double ik_t14 = hip_x*cos_pitch*sin_yaw;
-  const double ik_t15 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
-  const double ik_t16 = -hip_drop*ik_t15;
-  const double ik_t17 = ik_t12*hip_y;
-  const double ik_t18 = -foot_y_l;
-  const double ik_t19 = ik_t14 + ik_t16 + y_C + ik_t17 + ik_t18;
-  const double ik_t20 = hip_x*sin_pitch + foot_z_l + hip_drop*cos_roll*cos_pitch - z_C - sin_roll*cos_pitch*hip_y;
-  const double ik_t21 = sin_pitch*cos_slew_l - sin_roll*cos_pitch*sin_slew_l;
-  const double ik_t22 = ik_t7*cos_slew_l - cos_yaw*cos_pitch*sin_slew_l;
-  const double ik_t23 = ik_t12*cos_slew_l - cos_pitch*sin_yaw*sin_slew_l;
-  const double ik_t24 = sin_roll*cos_slew_l*cos_pitch + sin_pitch*sin_slew_l;
-  const double ik_d0 = ik_t8*ik_t11 - ik_t13*ik_t19 - ik_t20*ik_t21;
-  const double ik_d1 = ik_t22*ik_t8 + ik_t20*ik_t24 - ik_t23*ik_t19;
-  const double ik_d2 = -(ik_t15*ik_t19 - ik_t6*ik_t8 - ik_t20*cos_roll*cos_pitch);
-  const double ik_K = shank*shank + thigh*thigh + knee_offset*knee_offset;
-  const double ik_A = 2.0*shank*thigh;
-  const double ik_B = 0.0;
-  const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
-  double ik_c_knee_l, ik_s_knee_l;
+  const Scalar cos_yaw = cos_angle[0];
+  const Scalar sin_yaw = sin_angle[0];
+  const Scalar cos_pitch = cos_angle[1];
+  const Scalar sin_pitch = sin_angle[1];
+  const Scalar cos_roll = cos_angle[2];
+  const Scalar sin_roll = sin_angle[2];
+  const Scalar cos_slew_l = cos_angle[3];
+  const Scalar sin_slew_l = sin_angle[3];
+  const Scalar ik_t6 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
+  const Scalar ik_t7 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
+  const Scalar ik_t8 = ik_t6*hip_drop + foot_x_l - hip_x*cos_yaw*cos_pitch - ik_t7*hip_y - x_C;
+  const Scalar ik_t11 = ik_t7*sin_slew_l + cos_yaw*cos_slew_l*cos_pitch;
+  const Scalar ik_t12 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
+  const Scalar ik_t13 = cos_slew_l*cos_pitch*sin_yaw + ik_t12*sin_slew_l;
+  const Scalar ik_t14 = hip_x*cos_pitch*sin_yaw;
+  const Scalar ik_t15 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
+  const Scalar ik_t16 = -hip_drop*ik_t15;
+  const Scalar ik_t17 = ik_t12*hip_y;
+  const Scalar ik_t18 = -foot_y_l;
+  const Scalar ik_t19 = ik_t14 + ik_t16 + y_C + ik_t17 + ik_t18;
+  const Scalar ik_t20 = hip_x*sin_pitch + foot_z_l + hip_drop*cos_roll*cos_pitch - z_C - sin_roll*cos_pitch*hip_y;
+  const Scalar ik_t21 = sin_pitch*cos_slew_l - sin_roll*cos_pitch*sin_slew_l;
+  const Scalar ik_t22 = ik_t7*cos_slew_l - cos_yaw*cos_pitch*sin_slew_l;
+  const Scalar ik_t23 = ik_t12*cos_slew_l - cos_pitch*sin_yaw*sin_slew_l;
+  const Scalar ik_t24 = sin_roll*cos_slew_l*cos_pitch + sin_pitch*sin_slew_l;
+  const Scalar ik_d0 = ik_t8*ik_t11 - ik_t13*ik_t19 - ik_t20*ik_t21;
+  const Scalar ik_d1 = ik_t22*ik_t8 + ik_t20*ik_t24 - ik_t23*ik_t19;
+  const Scalar ik_d2 = -(ik_t15*ik_t19 - ik_t6*ik_t8 - ik_t20*cos_roll*cos_pitch);
+  const Scalar ik_K = shank*shank + thigh*thigh + knee_offset*knee_offset;
+  const Scalar ik_A = Scalar(2.0)*shank*thigh;
+  const Scalar ik_B = Scalar(0.0);
+  const Scalar ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
+  Scalar ik_c_knee_l, ik_s_knee_l;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_knee_l, ik_s_knee_l)) {
-    const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
+    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_v0 = thigh + shank*ik_c_knee_l;
-  const double ik_v1 = knee_offset;
-  const double ik_v2 = -ik_s_knee_l*shank;
-  const double ik_v[3] = {ik_v0, ik_v1, ik_v2};
-  const double ik_d[3] = {ik_d0, ik_d1, ik_d2};
-  double ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_beside = 0, ik_room = 0;
+  const Scalar ik_v0 = thigh + shank*ik_c_knee_l;
+  const Scalar ik_v1 = knee_offset;
+  const Scalar ik_v2 = -ik_s_knee_l*shank;
+  const Scalar ik_v[3] = {ik_v0, ik_v1, ik_v2};
+  const Scalar ik_d[3] = {ik_d0, ik_d1, ik_d2};
+  Scalar ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_beside(0), ik_room(0);
   const bool ik_two_axis_ok = ik_solve_two_axis<0, 1>(ik_v, ik_d, (branch & 2) != 0, ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_beside, ik_room);
   if (!ik_two_axis_ok) {
-    why = {2, ik_beside, 0.0, ik_room, std::atan2(ik_s_knee_l, ik_c_knee_l) * 57.29577951308232};
+    why = {2, ik_beside, 0.0, ik_room, double(std::atan2(ik_s_knee_l, ik_c_knee_l)) * 57.29577951308232};
     return IkStatus::out_of_reach;
   }
-  const double ik_t25 = ik_t6*ik_c_abduct_l - ik_t22*ik_s_abduct_l;
-  const double ik_t26 = ik_c_lift_l*ik_t11 - ik_s_lift_l*ik_t25;
-  const double ik_t27 = ik_s_abduct_l*ik_t23 - ik_t15*ik_c_abduct_l;
-  const double ik_t28 = ik_c_lift_l*ik_t13 + ik_s_lift_l*ik_t27;
-  const double ik_t29 = ik_s_abduct_l*ik_t24 - ik_c_abduct_l*cos_roll*cos_pitch;
-  const double ik_t30 = ik_s_lift_l*ik_t29 - ik_t21*ik_c_lift_l;
-  const std::array<double, 3> ik_sines{{ik_s_abduct_l, ik_s_lift_l, ik_s_knee_l}}, ik_cosines{{ik_c_abduct_l, ik_c_lift_l, ik_c_knee_l}};
-  std::array<double, 3> ik_angles;
+  const Scalar ik_t25 = ik_t6*ik_c_abduct_l - ik_t22*ik_s_abduct_l;
+  const Scalar ik_t26 = ik_c_lift_l*ik_t11 - ik_s_lift_l*ik_t25;
+  const Scalar ik_t27 = ik_s_abduct_l*ik_t23 - ik_t15*ik_c_abduct_l;
+  const Scalar ik_t28 = ik_c_lift_l*ik_t13 + ik_s_lift_l*ik_t27;
+  const Scalar ik_t29 = ik_s_abduct_l*ik_t24 - ik_c_abduct_l*cos_roll*cos_pitch;
+  const Scalar ik_t30 = ik_s_lift_l*ik_t29 - ik_t21*ik_c_lift_l;
+  const std::array<Scalar, 3> ik_sines{{ik_s_abduct_l, ik_s_lift_l, ik_s_knee_l}}, ik_cosines{{ik_c_abduct_l, ik_c_lift_l, ik_c_knee_l}};
+  std::array<Scalar, 3> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_abduct_l = ik_angles[0];
-  const double ik_q_lift_l = ik_angles[1];
-  const double ik_q_knee_l = ik_angles[2];
-  const double ik_row0 = (ik_t6*ik_s_abduct_l + ik_t22*ik_c_abduct_l)*knee_offset + x_C + ik_t7*hip_y + thigh*ik_t26 + hip_x*cos_yaw*cos_pitch - ik_t6*hip_drop - shank*(ik_s_knee_l*(ik_c_lift_l*ik_t25 + ik_s_lift_l*ik_t11) - ik_c_knee_l*ik_t26) - foot_x_l;
-  const double ik_row1 = ik_t14 + (ik_t15*ik_s_abduct_l + ik_c_abduct_l*ik_t23)*knee_offset + ik_t28*thigh + ik_t16 + y_C + shank*(ik_s_knee_l*(ik_t27*ik_c_lift_l - ik_s_lift_l*ik_t13) + ik_t28*ik_c_knee_l) + ik_t17 + ik_t18;
-  const double ik_row2 = (ik_s_abduct_l*cos_roll*cos_pitch + ik_c_abduct_l*ik_t24)*knee_offset + ik_t30*thigh + z_C + sin_roll*cos_pitch*hip_y + shank*(ik_t30*ik_c_knee_l + ik_s_knee_l*(ik_s_lift_l*ik_t21 + ik_t29*ik_c_lift_l)) - hip_x*sin_pitch - foot_z_l - hip_drop*cos_roll*cos_pitch;
-  const double ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
-  if (!(ik_residual <= kIkTolerance)) {
-    why = {0, ik_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_abduct_l = ik_angles[0];
+  const Scalar ik_q_lift_l = ik_angles[1];
+  const Scalar ik_q_knee_l = ik_angles[2];
+  const Scalar ik_row0 = (ik_t6*ik_s_abduct_l + ik_t22*ik_c_abduct_l)*knee_offset + x_C + ik_t7*hip_y + thigh*ik_t26 + hip_x*cos_yaw*cos_pitch - ik_t6*hip_drop - shank*(ik_s_knee_l*(ik_c_lift_l*ik_t25 + ik_s_lift_l*ik_t11) - ik_c_knee_l*ik_t26) - foot_x_l;
+  const Scalar ik_row1 = ik_t14 + (ik_t15*ik_s_abduct_l + ik_c_abduct_l*ik_t23)*knee_offset + ik_t28*thigh + ik_t16 + y_C + shank*(ik_s_knee_l*(ik_t27*ik_c_lift_l - ik_s_lift_l*ik_t13) + ik_t28*ik_c_knee_l) + ik_t17 + ik_t18;
+  const Scalar ik_row2 = (ik_s_abduct_l*cos_roll*cos_pitch + ik_c_abduct_l*ik_t24)*knee_offset + ik_t30*thigh + z_C + sin_roll*cos_pitch*hip_y + shank*(ik_t30*ik_c_knee_l + ik_s_knee_l*(ik_s_lift_l*ik_t21 + ik_t29*ik_c_lift_l)) - hip_x*sin_pitch - foot_z_l - hip_drop*cos_roll*cos_pitch;
+  const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
+  if (!(ik_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     return IkStatus::residual;
   }
   out(18) = ik_q_abduct_l;
@@ -231,104 +250,107 @@ inline IkStatus ik_leg_l(const Coordinates& s, const Params& p, int branch, Coor
 // On failure returns why, with the numbers in `why` (stage 1.. as in kClosedForm's failure texts;
 // stage 0: residual, the solution does not satisfy the closure rows).
 // Operations: 187 (adds 78, muls 101, divs 0, calls 8), plus the solver calls.
-inline IkStatus ik_leg_r(const Coordinates& s, const Params& p, int branch, Coordinates& out, IkDiagnostics& why) noexcept {
+// Scalar: float or double (the branch choices and the reach diagnostics need real numbers).
+template <typename Scalar>
+inline IkStatus ik_leg_r(const CoordinatesOf<Scalar>& s, const Params& p, int branch, detail::NonDeduced<CoordinatesOf<Scalar>>& out, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 4) return IkStatus::bad_branch;
-  const double x_C = s(0);
-  const double y_C = s(1);
-  const double z_C = s(2);
-  const double yaw = s(3);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double foot_x_r = s(9);
-  const double foot_y_r = s(10);
-  const double foot_z_r = s(11);
-  const double slew_r = s(15);
-  const double hip_x = p.hip_x;
-  const double hip_y = p.hip_y;
-  const double hip_drop = p.hip_drop;
-  const double thigh = p.thigh;
-  const double knee_offset = p.knee_offset;
-  const double shank = p.shank;
+  const Scalar x_C = s(0);
+  const Scalar y_C = s(1);
+  const Scalar z_C = s(2);
+  const Scalar yaw = s(3);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar foot_x_r = s(9);
+  const Scalar foot_y_r = s(10);
+  const Scalar foot_z_r = s(11);
+  const Scalar slew_r = s(15);
+  const Scalar hip_x(p.hip_x);
+  const Scalar hip_y(p.hip_y);
+  const Scalar hip_drop(p.hip_drop);
+  const Scalar thigh(p.thigh);
+  const Scalar knee_offset(p.knee_offset);
+  const Scalar shank(p.shank);
   // sin and cos of all 4 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 4> angle{yaw, pitch, roll, slew_r};
-  std::array<double, 4> sin_angle, cos_angle;
+  const std::array<Scalar, 4> angle{yaw, pitch, roll, slew_r};
+  std::array<Scalar, 4> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_yaw = cos_angle[0];
-  const double sin_yaw = sin_angle[0];
-  const double cos_pitch = cos_angle[1];
-  const double sin_pitch = sin_angle[1];
-  const double cos_roll = cos_angle[2];
-  const double sin_roll = sin_angle[2];
-  const double cos_slew_r = cos_angle[3];
-  const double sin_slew_r = sin_angle[3];
-  const double ik_t8 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
-  const double ik_t9 = cos_yaw*cos_pitch*cos_slew_r + sin_slew_r*ik_t8;
-  const double ik_t10 = -hip_x*cos_yaw*cos_pitch;
-  const double ik_t11 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
-  const double ik_t12 = ik_t11*hip_drop;
-  const double ik_t13 = ik_t8*hip_y;
-  const double ik_t14 = -x_C;
-  const double ik_t15 = ik_t10 + ik_t12 + foot_x_r + ik_t13 + ik_t14;
-  const double ik_t16 = sin_roll*sin_slew_r*cos_pitch - sin_pitch*cos_slew_r;
-  const double ik_t17 = -z_C;
-  const double ik_t18 = hip_x*sin_pitch;
-  const double ik_t19 = sin_roll*cos_pitch*hip_y;
-  const double ik_t20 = hip_drop*cos_roll*cos_pitch;
-  const double ik_t21 = foot_z_r + ik_t17 + ik_t18 + ik_t19 + ik_t20;
-  const double ik_t22 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
-  const double ik_t23 = cos_pitch*sin_yaw*cos_slew_r + ik_t22*sin_slew_r;
-  const double ik_t24 = -foot_y_r;
-  const double ik_t25 = hip_x*cos_pitch*sin_yaw;
-  const double ik_t26 = -ik_t22*hip_y;
-  const double ik_t27 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
-  const double ik_t28 = -hip_drop*ik_t27;
-  const double ik_t29 = ik_t24 + ik_t25 + ik_t26 + ik_t28 + y_C;
-  const double ik_t30 = sin_slew_r*cos_pitch*sin_yaw - ik_t22*cos_slew_r;
-  const double ik_t31 = sin_pitch*sin_slew_r + sin_roll*cos_pitch*cos_slew_r;
-  const double ik_t32 = ik_t8*cos_slew_r - cos_yaw*sin_slew_r*cos_pitch;
-  const double ik_d0 = -(ik_t23*ik_t29 - ik_t9*ik_t15 - ik_t16*ik_t21);
-  const double ik_d1 = ik_t29*ik_t30 + ik_t31*ik_t21 + ik_t32*ik_t15;
-  const double ik_d2 = ik_t21*cos_roll*cos_pitch + ik_t11*ik_t15 - ik_t29*ik_t27;
-  const double ik_K = shank*shank + thigh*thigh + knee_offset*knee_offset;
-  const double ik_A = 2.0*shank*thigh;
-  const double ik_B = 0.0;
-  const double ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
-  double ik_c_knee_r, ik_s_knee_r;
+  const Scalar cos_yaw = cos_angle[0];
+  const Scalar sin_yaw = sin_angle[0];
+  const Scalar cos_pitch = cos_angle[1];
+  const Scalar sin_pitch = sin_angle[1];
+  const Scalar cos_roll = cos_angle[2];
+  const Scalar sin_roll = sin_angle[2];
+  const Scalar cos_slew_r = cos_angle[3];
+  const Scalar sin_slew_r = sin_angle[3];
+  const Scalar ik_t8 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
+  const Scalar ik_t9 = cos_yaw*cos_pitch*cos_slew_r + sin_slew_r*ik_t8;
+  const Scalar ik_t10 = -hip_x*cos_yaw*cos_pitch;
+  const Scalar ik_t11 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
+  const Scalar ik_t12 = ik_t11*hip_drop;
+  const Scalar ik_t13 = ik_t8*hip_y;
+  const Scalar ik_t14 = -x_C;
+  const Scalar ik_t15 = ik_t10 + ik_t12 + foot_x_r + ik_t13 + ik_t14;
+  const Scalar ik_t16 = sin_roll*sin_slew_r*cos_pitch - sin_pitch*cos_slew_r;
+  const Scalar ik_t17 = -z_C;
+  const Scalar ik_t18 = hip_x*sin_pitch;
+  const Scalar ik_t19 = sin_roll*cos_pitch*hip_y;
+  const Scalar ik_t20 = hip_drop*cos_roll*cos_pitch;
+  const Scalar ik_t21 = foot_z_r + ik_t17 + ik_t18 + ik_t19 + ik_t20;
+  const Scalar ik_t22 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
+  const Scalar ik_t23 = cos_pitch*sin_yaw*cos_slew_r + ik_t22*sin_slew_r;
+  const Scalar ik_t24 = -foot_y_r;
+  const Scalar ik_t25 = hip_x*cos_pitch*sin_yaw;
+  const Scalar ik_t26 = -ik_t22*hip_y;
+  const Scalar ik_t27 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
+  const Scalar ik_t28 = -hip_drop*ik_t27;
+  const Scalar ik_t29 = ik_t24 + ik_t25 + ik_t26 + ik_t28 + y_C;
+  const Scalar ik_t30 = sin_slew_r*cos_pitch*sin_yaw - ik_t22*cos_slew_r;
+  const Scalar ik_t31 = sin_pitch*sin_slew_r + sin_roll*cos_pitch*cos_slew_r;
+  const Scalar ik_t32 = ik_t8*cos_slew_r - cos_yaw*sin_slew_r*cos_pitch;
+  const Scalar ik_d0 = -(ik_t23*ik_t29 - ik_t9*ik_t15 - ik_t16*ik_t21);
+  const Scalar ik_d1 = ik_t29*ik_t30 + ik_t31*ik_t21 + ik_t32*ik_t15;
+  const Scalar ik_d2 = ik_t21*cos_roll*cos_pitch + ik_t11*ik_t15 - ik_t29*ik_t27;
+  const Scalar ik_K = shank*shank + thigh*thigh + knee_offset*knee_offset;
+  const Scalar ik_A = Scalar(2.0)*shank*thigh;
+  const Scalar ik_B = Scalar(0.0);
+  const Scalar ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
+  Scalar ik_c_knee_r, ik_s_knee_r;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_knee_r, ik_s_knee_r)) {
-    const double ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(0.0, ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
+    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_v0 = thigh + shank*ik_c_knee_r;
-  const double ik_v1 = -knee_offset;
-  const double ik_v2 = -shank*ik_s_knee_r;
-  const double ik_v[3] = {ik_v0, ik_v1, ik_v2};
-  const double ik_d[3] = {ik_d0, ik_d1, ik_d2};
-  double ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_beside = 0, ik_room = 0;
+  const Scalar ik_v0 = thigh + shank*ik_c_knee_r;
+  const Scalar ik_v1 = -knee_offset;
+  const Scalar ik_v2 = -shank*ik_s_knee_r;
+  const Scalar ik_v[3] = {ik_v0, ik_v1, ik_v2};
+  const Scalar ik_d[3] = {ik_d0, ik_d1, ik_d2};
+  Scalar ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_beside(0), ik_room(0);
   const bool ik_two_axis_ok = ik_solve_two_axis<0, 1>(ik_v, ik_d, (branch & 2) != 0, ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_beside, ik_room);
   if (!ik_two_axis_ok) {
-    why = {2, ik_beside, 0.0, ik_room, std::atan2(ik_s_knee_r, ik_c_knee_r) * 57.29577951308232};
+    why = {2, ik_beside, 0.0, ik_room, double(std::atan2(ik_s_knee_r, ik_c_knee_r)) * 57.29577951308232};
     return IkStatus::out_of_reach;
   }
-  const double ik_t33 = ik_s_abduct_r*ik_t32 - ik_t11*ik_c_abduct_r;
-  const double ik_t34 = ik_t9*ik_c_lift_r + ik_t33*ik_s_lift_r;
-  const double ik_t35 = ik_c_abduct_r*ik_t27 + ik_s_abduct_r*ik_t30;
-  const double ik_t36 = ik_t23*ik_c_lift_r - ik_t35*ik_s_lift_r;
-  const double ik_t37 = ik_t31*ik_s_abduct_r - ik_c_abduct_r*cos_roll*cos_pitch;
-  const double ik_t38 = ik_t16*ik_c_lift_r + ik_s_lift_r*ik_t37;
-  const std::array<double, 3> ik_sines{{ik_s_abduct_r, ik_s_lift_r, ik_s_knee_r}}, ik_cosines{{ik_c_abduct_r, ik_c_lift_r, ik_c_knee_r}};
-  std::array<double, 3> ik_angles;
+  const Scalar ik_t33 = ik_s_abduct_r*ik_t32 - ik_t11*ik_c_abduct_r;
+  const Scalar ik_t34 = ik_t9*ik_c_lift_r + ik_t33*ik_s_lift_r;
+  const Scalar ik_t35 = ik_c_abduct_r*ik_t27 + ik_s_abduct_r*ik_t30;
+  const Scalar ik_t36 = ik_t23*ik_c_lift_r - ik_t35*ik_s_lift_r;
+  const Scalar ik_t37 = ik_t31*ik_s_abduct_r - ik_c_abduct_r*cos_roll*cos_pitch;
+  const Scalar ik_t38 = ik_t16*ik_c_lift_r + ik_s_lift_r*ik_t37;
+  const std::array<Scalar, 3> ik_sines{{ik_s_abduct_r, ik_s_lift_r, ik_s_knee_r}}, ik_cosines{{ik_c_abduct_r, ik_c_lift_r, ik_c_knee_r}};
+  std::array<Scalar, 3> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_abduct_r = ik_angles[0];
-  const double ik_q_lift_r = ik_angles[1];
-  const double ik_q_knee_r = ik_angles[2];
-  const double ik_row0 = -(ik_t10 + (ik_c_abduct_r*ik_t32 + ik_t11*ik_s_abduct_r)*knee_offset + ik_t12 + foot_x_r + ik_t13 + ik_t14 - thigh*ik_t34 - ((ik_t33*ik_c_lift_r - ik_s_lift_r*ik_t9)*ik_s_knee_r + ik_c_knee_r*ik_t34)*shank);
-  const double ik_row1 = thigh*ik_t36 + ik_t24 + ik_t25 + ik_t26 + ik_t28 + y_C + shank*(ik_c_knee_r*ik_t36 - (ik_t35*ik_c_lift_r + ik_t23*ik_s_lift_r)*ik_s_knee_r) + (ik_c_abduct_r*ik_t30 - ik_t27*ik_s_abduct_r)*knee_offset;
-  const double ik_row2 = -(foot_z_r + ik_t17 + ik_t18 + ik_t19 + (ik_s_abduct_r*cos_roll*cos_pitch + ik_c_abduct_r*ik_t31)*knee_offset + shank*((ik_t16*ik_s_lift_r - ik_c_lift_r*ik_t37)*ik_s_knee_r - ik_c_knee_r*ik_t38) + ik_t20 - thigh*ik_t38);
-  const double ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
-  if (!(ik_residual <= kIkTolerance)) {
-    why = {0, ik_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_abduct_r = ik_angles[0];
+  const Scalar ik_q_lift_r = ik_angles[1];
+  const Scalar ik_q_knee_r = ik_angles[2];
+  const Scalar ik_row0 = -(ik_t10 + (ik_c_abduct_r*ik_t32 + ik_t11*ik_s_abduct_r)*knee_offset + ik_t12 + foot_x_r + ik_t13 + ik_t14 - thigh*ik_t34 - ((ik_t33*ik_c_lift_r - ik_s_lift_r*ik_t9)*ik_s_knee_r + ik_c_knee_r*ik_t34)*shank);
+  const Scalar ik_row1 = thigh*ik_t36 + ik_t24 + ik_t25 + ik_t26 + ik_t28 + y_C + shank*(ik_c_knee_r*ik_t36 - (ik_t35*ik_c_lift_r + ik_t23*ik_s_lift_r)*ik_s_knee_r) + (ik_c_abduct_r*ik_t30 - ik_t27*ik_s_abduct_r)*knee_offset;
+  const Scalar ik_row2 = -(foot_z_r + ik_t17 + ik_t18 + ik_t19 + (ik_s_abduct_r*cos_roll*cos_pitch + ik_c_abduct_r*ik_t31)*knee_offset + shank*((ik_t16*ik_s_lift_r - ik_c_lift_r*ik_t37)*ik_s_knee_r - ik_c_knee_r*ik_t38) + ik_t20 - thigh*ik_t38);
+  const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
+  if (!(ik_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     return IkStatus::residual;
   }
   out(21) = ik_q_abduct_r;
@@ -349,38 +371,41 @@ inline IkStatus ik_leg_r(const Coordinates& s, const Params& p, int branch, Coor
 // On failure returns why, with the numbers in `why` (stage 1.. as in kClosedForm's failure texts;
 // stage 0: residual, the solution does not satisfy the closure rows).
 // Operations: 102 (adds 37, muls 59, divs 0, calls 6), plus the solver calls.
-inline IkStatus ik_lever_l(const Coordinates& s, const Params& p, int branch, Coordinates& out, IkDiagnostics& why) noexcept {
+// Scalar: float or double (the branch choices and the reach diagnostics need real numbers).
+template <typename Scalar>
+inline IkStatus ik_lever_l(const CoordinatesOf<Scalar>& s, const Params& p, int branch, detail::NonDeduced<CoordinatesOf<Scalar>>& out, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 8) return IkStatus::bad_branch;
-  const double z_C = s(2);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double ground_l = s(12);
-  const double steer_l = s(16);
-  const double rear_x = p.rear_x;
-  const double rear_y = p.rear_y;
-  const double rear_drop = p.rear_drop;
-  const double lever = p.lever;
-  const double lever_offset = p.lever_offset;
-  const double hub_offset = p.hub_offset;
-  const double radius = p.radius;
+  const Scalar z_C = s(2);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar ground_l = s(12);
+  const Scalar steer_l = s(16);
+  const Scalar rear_x(p.rear_x);
+  const Scalar rear_y(p.rear_y);
+  const Scalar rear_drop(p.rear_drop);
+  const Scalar lever(p.lever);
+  const Scalar lever_offset(p.lever_offset);
+  const Scalar hub_offset(p.hub_offset);
+  const Scalar radius(p.radius);
   // sin and cos of all 3 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 3> angle{pitch, roll, steer_l};
-  std::array<double, 3> sin_angle, cos_angle;
+  const std::array<Scalar, 3> angle{pitch, roll, steer_l};
+  std::array<Scalar, 3> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_pitch = cos_angle[0];
-  const double sin_pitch = sin_angle[0];
-  const double cos_roll = cos_angle[1];
-  const double sin_roll = sin_angle[1];
-  const double cos_steer_l = cos_angle[2];
-  const double sin_steer_l = sin_angle[2];
-  const double ik_q_guide_l = -steer_l;
-  const double ik_g0 = -sin_pitch;
-  const double ik_g1 = sin_roll*cos_pitch;
-  const double ik_g2 = cos_roll*cos_pitch;
-  const double ik_axis[3] = {0.0, 0.0, 1.0};
-  const double ik_g[3] = {ik_g0, ik_g1, ik_g2};
-  double ik_c_sum, ik_s_sum, ik_c_camber_l, ik_s_camber_l, ik_beside = 0, ik_room = 0;
+  const Scalar cos_pitch = cos_angle[0];
+  const Scalar sin_pitch = sin_angle[0];
+  const Scalar cos_roll = cos_angle[1];
+  const Scalar sin_roll = sin_angle[1];
+  const Scalar cos_steer_l = cos_angle[2];
+  const Scalar sin_steer_l = sin_angle[2];
+  const Scalar ik_q_guide_l = -steer_l;
+  const Scalar ik_g0 = -sin_pitch;
+  const Scalar ik_g1 = sin_roll*cos_pitch;
+  const Scalar ik_g2 = cos_roll*cos_pitch;
+  const Scalar ik_axis[3] = {Scalar(0), Scalar(0), Scalar(1)};
+  const Scalar ik_g[3] = {ik_g0, ik_g1, ik_g2};
+  Scalar ik_c_sum, ik_s_sum, ik_c_camber_l, ik_s_camber_l, ik_beside(0), ik_room(0);
   const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_c_sum, ik_s_sum, ik_c_camber_l, ik_s_camber_l, ik_beside, ik_room);
   static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
@@ -389,38 +414,38 @@ inline IkStatus ik_lever_l(const Coordinates& s, const Params& p, int branch, Co
     ik_s_sum = -ik_s_sum;
     ik_s_camber_l = -ik_s_camber_l;
   }
-  const double ik_t4 = radius*sin_pitch*ik_s_sum;
-  const double ik_alpha = -(ik_t4 - sin_pitch*(lever_offset*sin_steer_l + cos_steer_l*lever + radius*ik_s_sum));
-  const double ik_beta = radius*ik_c_sum*cos_roll*cos_pitch - (radius*ik_c_sum - cos_steer_l*lever - lever_offset*sin_steer_l)*cos_roll*cos_pitch;
-  const double ik_gamma = ik_t4 + sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + sin_pitch*rear_x - radius*ik_c_sum*cos_roll*cos_pitch - cos_roll*rear_drop*cos_pitch;
-  double ik_c_swing_l, ik_s_swing_l;
+  const Scalar ik_t4 = radius*sin_pitch*ik_s_sum;
+  const Scalar ik_alpha = -(ik_t4 - sin_pitch*(lever_offset*sin_steer_l + cos_steer_l*lever + radius*ik_s_sum));
+  const Scalar ik_beta = radius*ik_c_sum*cos_roll*cos_pitch - (radius*ik_c_sum - cos_steer_l*lever - lever_offset*sin_steer_l)*cos_roll*cos_pitch;
+  const Scalar ik_gamma = ik_t4 + sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + sin_pitch*rear_x - radius*ik_c_sum*cos_roll*cos_pitch - cos_roll*rear_drop*cos_pitch;
+  Scalar ik_c_swing_l, ik_s_swing_l;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, ground_l - ik_gamma, (branch & 1) != 0, ik_c_swing_l, ik_s_swing_l)) {
-    const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
+    const Scalar ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, ground_l, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_c_hub_l = ik_c_sum * ik_c_swing_l + ik_s_sum * ik_s_swing_l;
-  const double ik_s_hub_l = ik_s_sum * ik_c_swing_l - ik_c_sum * ik_s_swing_l;
-  const double ik_t7 = sin_pitch*ik_c_swing_l + ik_s_swing_l*cos_roll*cos_pitch;
-  const double ik_t8 = cos_steer_l*ik_t7 - sin_roll*sin_steer_l*cos_pitch;
-  const double ik_t9 = sin_steer_l*ik_t7 + sin_roll*cos_steer_l*cos_pitch;
-  const double ik_t10 = sin_steer_l*ik_t8 - cos_steer_l*ik_t9;
-  const double ik_t11 = sin_steer_l*ik_t9 + ik_t8*cos_steer_l;
-  const double ik_t12 = sin_pitch*ik_s_swing_l - ik_c_swing_l*cos_roll*cos_pitch;
-  const double ik_t13 = ik_t11*ik_s_hub_l + ik_c_hub_l*ik_t12;
-  const std::array<double, 3> ik_sines{{ik_s_swing_l, ik_s_hub_l, ik_s_camber_l}}, ik_cosines{{ik_c_swing_l, ik_c_hub_l, ik_c_camber_l}};
-  std::array<double, 3> ik_angles;
+  const Scalar ik_c_hub_l = ik_c_sum * ik_c_swing_l + ik_s_sum * ik_s_swing_l;
+  const Scalar ik_s_hub_l = ik_s_sum * ik_c_swing_l - ik_c_sum * ik_s_swing_l;
+  const Scalar ik_t7 = sin_pitch*ik_c_swing_l + ik_s_swing_l*cos_roll*cos_pitch;
+  const Scalar ik_t8 = cos_steer_l*ik_t7 - sin_roll*sin_steer_l*cos_pitch;
+  const Scalar ik_t9 = sin_steer_l*ik_t7 + sin_roll*cos_steer_l*cos_pitch;
+  const Scalar ik_t10 = sin_steer_l*ik_t8 - cos_steer_l*ik_t9;
+  const Scalar ik_t11 = sin_steer_l*ik_t9 + ik_t8*cos_steer_l;
+  const Scalar ik_t12 = sin_pitch*ik_s_swing_l - ik_c_swing_l*cos_roll*cos_pitch;
+  const Scalar ik_t13 = ik_t11*ik_s_hub_l + ik_c_hub_l*ik_t12;
+  const std::array<Scalar, 3> ik_sines{{ik_s_swing_l, ik_s_hub_l, ik_s_camber_l}}, ik_cosines{{ik_c_swing_l, ik_c_hub_l, ik_c_camber_l}};
+  std::array<Scalar, 3> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_swing_l = ik_angles[0];
-  const double ik_q_hub_l = ik_angles[1];
-  const double ik_q_camber_l = ik_angles[2];
-  const double ik_row0 = -(ik_t10*hub_offset + ground_l + cos_roll*rear_drop*cos_pitch - z_C - ik_t8*lever - sin_roll*rear_y*cos_pitch - radius*ik_t13 - sin_pitch*rear_x - lever_offset*ik_t9);
-  const double ik_row1 = -(ik_t11*ik_c_hub_l - ik_s_hub_l*ik_t12);
-  const double ik_row2 = -(ik_t10*ik_c_camber_l + ik_t13*ik_s_camber_l);
-  const double ik_row3 = 0.0;
-  const double ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2), std::abs(ik_row3)});
-  if (!(ik_residual <= kIkTolerance)) {
-    why = {0, ik_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_swing_l = ik_angles[0];
+  const Scalar ik_q_hub_l = ik_angles[1];
+  const Scalar ik_q_camber_l = ik_angles[2];
+  const Scalar ik_row0 = -(ik_t10*hub_offset + ground_l + cos_roll*rear_drop*cos_pitch - z_C - ik_t8*lever - sin_roll*rear_y*cos_pitch - radius*ik_t13 - sin_pitch*rear_x - lever_offset*ik_t9);
+  const Scalar ik_row1 = -(ik_t11*ik_c_hub_l - ik_s_hub_l*ik_t12);
+  const Scalar ik_row2 = -(ik_t10*ik_c_camber_l + ik_t13*ik_s_camber_l);
+  const Scalar ik_row3 = Scalar(0.0);
+  const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2), std::abs(ik_row3)});
+  if (!(ik_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     return IkStatus::residual;
   }
   out(27) = ik_q_swing_l;
@@ -442,41 +467,44 @@ inline IkStatus ik_lever_l(const Coordinates& s, const Params& p, int branch, Co
 // On failure returns why, with the numbers in `why` (stage 1.. as in kClosedForm's failure texts;
 // stage 0: residual, the solution does not satisfy the closure rows).
 // Operations: 97 (adds 37, muls 54, divs 0, calls 6), plus the solver calls.
-inline IkStatus ik_lever_r(const Coordinates& s, const Params& p, int branch, Coordinates& out, IkDiagnostics& why) noexcept {
+// Scalar: float or double (the branch choices and the reach diagnostics need real numbers).
+template <typename Scalar>
+inline IkStatus ik_lever_r(const CoordinatesOf<Scalar>& s, const Params& p, int branch, detail::NonDeduced<CoordinatesOf<Scalar>>& out, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 8) return IkStatus::bad_branch;
-  const double z_C = s(2);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double ground_r = s(13);
-  const double steer_r = s(17);
-  const double rear_x = p.rear_x;
-  const double rear_y = p.rear_y;
-  const double rear_drop = p.rear_drop;
-  const double lever = p.lever;
-  const double lever_offset = p.lever_offset;
-  const double hub_offset = p.hub_offset;
-  const double radius = p.radius;
+  const Scalar z_C = s(2);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar ground_r = s(13);
+  const Scalar steer_r = s(17);
+  const Scalar rear_x(p.rear_x);
+  const Scalar rear_y(p.rear_y);
+  const Scalar rear_drop(p.rear_drop);
+  const Scalar lever(p.lever);
+  const Scalar lever_offset(p.lever_offset);
+  const Scalar hub_offset(p.hub_offset);
+  const Scalar radius(p.radius);
   // sin and cos of all 3 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 3> angle{pitch, roll, steer_r};
-  std::array<double, 3> sin_angle, cos_angle;
+  const std::array<Scalar, 3> angle{pitch, roll, steer_r};
+  std::array<Scalar, 3> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_pitch = cos_angle[0];
-  const double sin_pitch = sin_angle[0];
-  const double cos_roll = cos_angle[1];
-  const double sin_roll = sin_angle[1];
-  const double cos_steer_r = cos_angle[2];
-  const double sin_steer_r = sin_angle[2];
-  const double ik_t7 = -sin_roll*rear_y*cos_pitch;
-  const double ik_t8 = sin_pitch*rear_x;
-  const double ik_t9 = -cos_roll*rear_drop*cos_pitch;
-  const double ik_q_guide_r = -steer_r;
-  const double ik_g0 = -sin_pitch;
-  const double ik_g1 = sin_roll*cos_pitch;
-  const double ik_g2 = cos_roll*cos_pitch;
-  const double ik_axis[3] = {0.0, 0.0, 1.0};
-  const double ik_g[3] = {ik_g0, ik_g1, ik_g2};
-  double ik_c_sum, ik_s_sum, ik_c_camber_r, ik_s_camber_r, ik_beside = 0, ik_room = 0;
+  const Scalar cos_pitch = cos_angle[0];
+  const Scalar sin_pitch = sin_angle[0];
+  const Scalar cos_roll = cos_angle[1];
+  const Scalar sin_roll = sin_angle[1];
+  const Scalar cos_steer_r = cos_angle[2];
+  const Scalar sin_steer_r = sin_angle[2];
+  const Scalar ik_t7 = -sin_roll*rear_y*cos_pitch;
+  const Scalar ik_t8 = sin_pitch*rear_x;
+  const Scalar ik_t9 = -cos_roll*rear_drop*cos_pitch;
+  const Scalar ik_q_guide_r = -steer_r;
+  const Scalar ik_g0 = -sin_pitch;
+  const Scalar ik_g1 = sin_roll*cos_pitch;
+  const Scalar ik_g2 = cos_roll*cos_pitch;
+  const Scalar ik_axis[3] = {Scalar(0), Scalar(0), Scalar(1)};
+  const Scalar ik_g[3] = {ik_g0, ik_g1, ik_g2};
+  Scalar ik_c_sum, ik_s_sum, ik_c_camber_r, ik_s_camber_r, ik_beside(0), ik_room(0);
   const bool ik_two_axis_ok = ik_solve_two_axis<1, 0>(ik_axis, ik_g, (branch & 2) != 0, ik_c_sum, ik_s_sum, ik_c_camber_r, ik_s_camber_r, ik_beside, ik_room);
   static_cast<void>(ik_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
@@ -485,38 +513,38 @@ inline IkStatus ik_lever_r(const Coordinates& s, const Params& p, int branch, Co
     ik_s_sum = -ik_s_sum;
     ik_s_camber_r = -ik_s_camber_r;
   }
-  const double ik_t4 = radius*sin_pitch*ik_s_sum;
-  const double ik_alpha = -(ik_t4 - (radius*ik_s_sum + cos_steer_r*lever - lever_offset*sin_steer_r)*sin_pitch);
-  const double ik_beta = radius*ik_c_sum*cos_roll*cos_pitch - (radius*ik_c_sum + lever_offset*sin_steer_r - cos_steer_r*lever)*cos_roll*cos_pitch;
-  const double ik_gamma = ik_t4 + ik_t7 + z_C + ik_t8 + ik_t9 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*ik_c_sum*cos_roll*cos_pitch;
-  double ik_c_swing_r, ik_s_swing_r;
+  const Scalar ik_t4 = radius*sin_pitch*ik_s_sum;
+  const Scalar ik_alpha = -(ik_t4 - (radius*ik_s_sum + cos_steer_r*lever - lever_offset*sin_steer_r)*sin_pitch);
+  const Scalar ik_beta = radius*ik_c_sum*cos_roll*cos_pitch - (radius*ik_c_sum + lever_offset*sin_steer_r - cos_steer_r*lever)*cos_roll*cos_pitch;
+  const Scalar ik_gamma = ik_t4 + ik_t7 + z_C + ik_t8 + ik_t9 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*ik_c_sum*cos_roll*cos_pitch;
+  Scalar ik_c_swing_r, ik_s_swing_r;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, ground_r - ik_gamma, (branch & 1) != 0, ik_c_swing_r, ik_s_swing_r)) {
-    const double ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
+    const Scalar ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, ground_r, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
-  const double ik_c_hub_r = ik_c_sum * ik_c_swing_r + ik_s_sum * ik_s_swing_r;
-  const double ik_s_hub_r = ik_s_sum * ik_c_swing_r - ik_c_sum * ik_s_swing_r;
-  const double ik_t10 = ik_c_swing_r*cos_roll*cos_pitch - sin_pitch*ik_s_swing_r;
-  const double ik_t11 = cos_roll*cos_pitch*ik_s_swing_r + sin_pitch*ik_c_swing_r;
-  const double ik_t12 = sin_roll*cos_steer_r*cos_pitch + sin_steer_r*ik_t11;
-  const double ik_t13 = sin_roll*sin_steer_r*cos_pitch - cos_steer_r*ik_t11;
-  const double ik_t14 = sin_steer_r*ik_t12 - cos_steer_r*ik_t13;
-  const double ik_t15 = ik_t14*ik_s_hub_r - ik_c_hub_r*ik_t10;
-  const double ik_t16 = cos_steer_r*ik_t12 + sin_steer_r*ik_t13;
-  const std::array<double, 3> ik_sines{{ik_s_swing_r, ik_s_hub_r, ik_s_camber_r}}, ik_cosines{{ik_c_swing_r, ik_c_hub_r, ik_c_camber_r}};
-  std::array<double, 3> ik_angles;
+  const Scalar ik_c_hub_r = ik_c_sum * ik_c_swing_r + ik_s_sum * ik_s_swing_r;
+  const Scalar ik_s_hub_r = ik_s_sum * ik_c_swing_r - ik_c_sum * ik_s_swing_r;
+  const Scalar ik_t10 = ik_c_swing_r*cos_roll*cos_pitch - sin_pitch*ik_s_swing_r;
+  const Scalar ik_t11 = cos_roll*cos_pitch*ik_s_swing_r + sin_pitch*ik_c_swing_r;
+  const Scalar ik_t12 = sin_roll*cos_steer_r*cos_pitch + sin_steer_r*ik_t11;
+  const Scalar ik_t13 = sin_roll*sin_steer_r*cos_pitch - cos_steer_r*ik_t11;
+  const Scalar ik_t14 = sin_steer_r*ik_t12 - cos_steer_r*ik_t13;
+  const Scalar ik_t15 = ik_t14*ik_s_hub_r - ik_c_hub_r*ik_t10;
+  const Scalar ik_t16 = cos_steer_r*ik_t12 + sin_steer_r*ik_t13;
+  const std::array<Scalar, 3> ik_sines{{ik_s_swing_r, ik_s_hub_r, ik_s_camber_r}}, ik_cosines{{ik_c_swing_r, ik_c_hub_r, ik_c_camber_r}};
+  std::array<Scalar, 3> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_swing_r = ik_angles[0];
-  const double ik_q_hub_r = ik_angles[1];
-  const double ik_q_camber_r = ik_angles[2];
-  const double ik_row0 = radius*ik_t15 + ik_t7 + z_C + ik_t8 + ik_t9 - ground_r - lever_offset*ik_t12 - ik_t16*hub_offset - lever*ik_t13;
-  const double ik_row1 = -(ik_t10*ik_s_hub_r + ik_c_hub_r*ik_t14);
-  const double ik_row2 = ik_t16*ik_c_camber_r - ik_t15*ik_s_camber_r;
-  const double ik_row3 = 0.0;
-  const double ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2), std::abs(ik_row3)});
-  if (!(ik_residual <= kIkTolerance)) {
-    why = {0, ik_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_swing_r = ik_angles[0];
+  const Scalar ik_q_hub_r = ik_angles[1];
+  const Scalar ik_q_camber_r = ik_angles[2];
+  const Scalar ik_row0 = radius*ik_t15 + ik_t7 + z_C + ik_t8 + ik_t9 - ground_r - lever_offset*ik_t12 - ik_t16*hub_offset - lever*ik_t13;
+  const Scalar ik_row1 = -(ik_t10*ik_s_hub_r + ik_c_hub_r*ik_t14);
+  const Scalar ik_row2 = ik_t16*ik_c_camber_r - ik_t15*ik_s_camber_r;
+  const Scalar ik_row3 = Scalar(0.0);
+  const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2), std::abs(ik_row3)});
+  if (!(ik_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     return IkStatus::residual;
   }
   out(31) = ik_q_swing_r;
@@ -540,10 +568,10 @@ struct ClosedFormInfo {
 
 // Per limb, in the order of kLimbs.
 inline constexpr std::array<ClosedFormInfo, 4> kClosedForm{{
-    {&ik_leg_l, 4, "point3", {{"bit 0: the other root of knee_l (branch 0: the root nearest zero; on a tie the positive one)", "bit 1: the other root of lift_l (branch 0: |lift_l| <= 90 deg where that solves)"}}, {{"foot_l out of reach: its target is {value:.4f} m from the meeting point of the axes of abduct_l and lift_l, and foot_l reaches [{low:.4f}, {high:.4f}] m from it", "foot_l out of reach: with knee_l at {aux:.2f} deg (set by the target's distance) it reaches at most {high:.4f} m off the plane normal to the axis of abduct_l (through the meeting point), but its target is {value:.4f} m off it"}}},
-    {&ik_leg_r, 4, "point3", {{"bit 0: the other root of knee_r (branch 0: the root nearest zero; on a tie the positive one)", "bit 1: the other root of lift_r (branch 0: |lift_r| <= 90 deg where that solves)"}}, {{"foot_r out of reach: its target is {value:.4f} m from the meeting point of the axes of abduct_r and lift_r, and foot_r reaches [{low:.4f}, {high:.4f}] m from it", "foot_r out of reach: with knee_r at {aux:.2f} deg (set by the target's distance) it reaches at most {high:.4f} m off the plane normal to the axis of abduct_r (through the meeting point), but its target is {value:.4f} m off it"}}},
-    {&ik_lever_l, 8, "leveled-lever", {{"bit 0: the other root of swing_l (branch 0: the root nearest zero)", "bit 1: the other root of camber_l (branch 0: |camber_l| <= 90 deg)", "bit 2: the other root of swing_l + hub_l (branch 0: nearest zero)"}}, {{"ground_l = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, steer_l as given, the z of contact_l reaches [{low:.4f}, {high:.4f}] m"}}},
-    {&ik_lever_r, 8, "leveled-lever", {{"bit 0: the other root of swing_r (branch 0: the root nearest zero)", "bit 1: the other root of camber_r (branch 0: |camber_r| <= 90 deg)", "bit 2: the other root of swing_r + hub_r (branch 0: nearest zero)"}}, {{"ground_r = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, steer_r as given, the z of contact_r reaches [{low:.4f}, {high:.4f}] m"}}},
+    {&ik_leg_l<double>, 4, "point3", {{"bit 0: the other root of knee_l (branch 0: the root nearest zero; on a tie the positive one)", "bit 1: the other root of lift_l (branch 0: |lift_l| <= 90 deg where that solves)"}}, {{"foot_l out of reach: its target is {value:.4f} m from the meeting point of the axes of abduct_l and lift_l, and foot_l reaches [{low:.4f}, {high:.4f}] m from it", "foot_l out of reach: with knee_l at {aux:.2f} deg (set by the target's distance) it reaches at most {high:.4f} m off the plane normal to the axis of abduct_l (through the meeting point), but its target is {value:.4f} m off it"}}},
+    {&ik_leg_r<double>, 4, "point3", {{"bit 0: the other root of knee_r (branch 0: the root nearest zero; on a tie the positive one)", "bit 1: the other root of lift_r (branch 0: |lift_r| <= 90 deg where that solves)"}}, {{"foot_r out of reach: its target is {value:.4f} m from the meeting point of the axes of abduct_r and lift_r, and foot_r reaches [{low:.4f}, {high:.4f}] m from it", "foot_r out of reach: with knee_r at {aux:.2f} deg (set by the target's distance) it reaches at most {high:.4f} m off the plane normal to the axis of abduct_r (through the meeting point), but its target is {value:.4f} m off it"}}},
+    {&ik_lever_l<double>, 8, "leveled-lever", {{"bit 0: the other root of swing_l (branch 0: the root nearest zero)", "bit 1: the other root of camber_l (branch 0: |camber_l| <= 90 deg)", "bit 2: the other root of swing_l + hub_l (branch 0: nearest zero)"}}, {{"ground_l = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, steer_l as given, the z of contact_l reaches [{low:.4f}, {high:.4f}] m"}}},
+    {&ik_lever_r<double>, 8, "leveled-lever", {{"bit 0: the other root of swing_r (branch 0: the root nearest zero)", "bit 1: the other root of camber_r (branch 0: |camber_r| <= 90 deg)", "bit 2: the other root of swing_r + hub_r (branch 0: nearest zero)"}}, {{"ground_r = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, steer_r as given, the z of contact_r reaches [{low:.4f}, {high:.4f}] m"}}},
 }};
 
 inline constexpr bool kHasFusedIk = true;
@@ -554,8 +582,11 @@ inline constexpr bool kHasFusedIk = true;
 // (every limb's reach is tested before any limb's residual check), `failed` its index and `why`
 // its numbers; out is written only when every limb succeeded.
 // Operations: 515 (adds 215, muls 286, divs 0, calls 14), plus the solver calls.
-inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out,
-                       int& failed, IkDiagnostics& why) noexcept {
+// Scalar: float or double.
+template <typename Scalar>
+inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const std::array<int, 4>& branches,
+                       detail::NonDeduced<CoordinatesOf<Scalar>>& out, int& failed, IkDiagnostics& why) noexcept {
+  static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   const int ik_leg_l_branch = branches[0];
   if (ik_leg_l_branch < 0 || ik_leg_l_branch >= 4) {
@@ -577,174 +608,174 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
     failed = 3;
     return IkStatus::bad_branch;
   }
-  const double x_C = s(0);
-  const double y_C = s(1);
-  const double z_C = s(2);
-  const double yaw = s(3);
-  const double pitch = s(4);
-  const double roll = s(5);
-  const double foot_x_l = s(6);
-  const double foot_y_l = s(7);
-  const double foot_z_l = s(8);
-  const double foot_x_r = s(9);
-  const double foot_y_r = s(10);
-  const double foot_z_r = s(11);
-  const double ground_l = s(12);
-  const double ground_r = s(13);
-  const double slew_l = s(14);
-  const double slew_r = s(15);
-  const double steer_l = s(16);
-  const double steer_r = s(17);
-  const double hip_x = p.hip_x;
-  const double hip_y = p.hip_y;
-  const double hip_drop = p.hip_drop;
-  const double thigh = p.thigh;
-  const double knee_offset = p.knee_offset;
-  const double shank = p.shank;
-  const double rear_x = p.rear_x;
-  const double rear_y = p.rear_y;
-  const double rear_drop = p.rear_drop;
-  const double lever = p.lever;
-  const double lever_offset = p.lever_offset;
-  const double hub_offset = p.hub_offset;
-  const double radius = p.radius;
+  const Scalar x_C = s(0);
+  const Scalar y_C = s(1);
+  const Scalar z_C = s(2);
+  const Scalar yaw = s(3);
+  const Scalar pitch = s(4);
+  const Scalar roll = s(5);
+  const Scalar foot_x_l = s(6);
+  const Scalar foot_y_l = s(7);
+  const Scalar foot_z_l = s(8);
+  const Scalar foot_x_r = s(9);
+  const Scalar foot_y_r = s(10);
+  const Scalar foot_z_r = s(11);
+  const Scalar ground_l = s(12);
+  const Scalar ground_r = s(13);
+  const Scalar slew_l = s(14);
+  const Scalar slew_r = s(15);
+  const Scalar steer_l = s(16);
+  const Scalar steer_r = s(17);
+  const Scalar hip_x(p.hip_x);
+  const Scalar hip_y(p.hip_y);
+  const Scalar hip_drop(p.hip_drop);
+  const Scalar thigh(p.thigh);
+  const Scalar knee_offset(p.knee_offset);
+  const Scalar shank(p.shank);
+  const Scalar rear_x(p.rear_x);
+  const Scalar rear_y(p.rear_y);
+  const Scalar rear_drop(p.rear_drop);
+  const Scalar lever(p.lever);
+  const Scalar lever_offset(p.lever_offset);
+  const Scalar hub_offset(p.hub_offset);
+  const Scalar radius(p.radius);
   // sin and cos of all 7 angles in one vectorized pass (trig.hpp).
-  const std::array<double, 7> angle{yaw, pitch, roll, slew_l, slew_r, steer_l, steer_r};
-  std::array<double, 7> sin_angle, cos_angle;
+  const std::array<Scalar, 7> angle{yaw, pitch, roll, slew_l, slew_r, steer_l, steer_r};
+  std::array<Scalar, 7> sin_angle, cos_angle;
   sincos(angle, sin_angle, cos_angle);
-  const double cos_yaw = cos_angle[0];
-  const double sin_yaw = sin_angle[0];
-  const double cos_pitch = cos_angle[1];
-  const double sin_pitch = sin_angle[1];
-  const double cos_roll = cos_angle[2];
-  const double sin_roll = sin_angle[2];
-  const double cos_slew_l = cos_angle[3];
-  const double sin_slew_l = sin_angle[3];
-  const double cos_slew_r = cos_angle[4];
-  const double sin_slew_r = sin_angle[4];
-  const double cos_steer_l = cos_angle[5];
-  const double sin_steer_l = sin_angle[5];
-  const double cos_steer_r = cos_angle[6];
-  const double sin_steer_r = sin_angle[6];
-  const double ik_t2 = -hip_x*cos_yaw*cos_pitch;
-  const double ik_t7 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
-  const double ik_t8 = ik_t7*hip_drop;
-  const double ik_t9 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
-  const double ik_t10 = -x_C;
-  const double ik_t11 = ik_t2 + ik_t8 + foot_x_l + ik_t10 - ik_t9*hip_y;
-  const double ik_t14 = ik_t9*sin_slew_l + cos_yaw*cos_slew_l*cos_pitch;
-  const double ik_t15 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
-  const double ik_t16 = cos_slew_l*cos_pitch*sin_yaw + ik_t15*sin_slew_l;
-  const double ik_t17 = hip_x*cos_pitch*sin_yaw;
-  const double ik_t18 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
-  const double ik_t19 = -hip_drop*ik_t18;
-  const double ik_t20 = ik_t15*hip_y;
-  const double ik_t21 = -foot_y_l;
-  const double ik_t22 = ik_t17 + ik_t19 + y_C + ik_t20 + ik_t21;
-  const double ik_t23 = -z_C;
-  const double ik_t24 = hip_x*sin_pitch;
-  const double ik_t25 = hip_drop*cos_roll*cos_pitch;
-  const double ik_t26 = ik_t23 + ik_t24 + foot_z_l + ik_t25 - sin_roll*cos_pitch*hip_y;
-  const double ik_t27 = sin_pitch*cos_slew_l - sin_roll*cos_pitch*sin_slew_l;
-  const double ik_t28 = ik_t9*cos_slew_l - cos_yaw*cos_pitch*sin_slew_l;
-  const double ik_t29 = ik_t15*cos_slew_l - cos_pitch*sin_yaw*sin_slew_l;
-  const double ik_t30 = sin_roll*cos_slew_l*cos_pitch + sin_pitch*sin_slew_l;
-  const double ik_t31 = shank*shank + thigh*thigh + knee_offset*knee_offset;
-  const double ik_t32 = 2.0*shank*thigh;
-  const double ik_t35 = cos_yaw*cos_pitch*cos_slew_r + sin_slew_r*ik_t9;
-  const double ik_t36 = ik_t9*hip_y;
-  const double ik_t37 = ik_t2 + ik_t8 + foot_x_r + ik_t36 + ik_t10;
-  const double ik_t38 = sin_roll*sin_slew_r*cos_pitch - sin_pitch*cos_slew_r;
-  const double ik_t39 = sin_roll*cos_pitch*hip_y;
-  const double ik_t40 = foot_z_r + ik_t23 + ik_t24 + ik_t39 + ik_t25;
-  const double ik_t41 = cos_pitch*sin_yaw*cos_slew_r + ik_t15*sin_slew_r;
-  const double ik_t42 = -foot_y_r;
-  const double ik_t43 = -ik_t15*hip_y;
-  const double ik_t44 = ik_t42 + ik_t17 + ik_t43 + ik_t19 + y_C;
-  const double ik_t45 = sin_slew_r*cos_pitch*sin_yaw - ik_t15*cos_slew_r;
-  const double ik_t46 = sin_pitch*sin_slew_r + sin_roll*cos_pitch*cos_slew_r;
-  const double ik_t47 = ik_t9*cos_slew_r - cos_yaw*sin_slew_r*cos_pitch;
-  const double ik_t48 = -sin_pitch;
-  const double ik_t49 = sin_roll*cos_pitch;
-  const double ik_t50 = cos_roll*cos_pitch;
-  const double ik_t52 = lever_offset*sin_steer_l;
-  const double ik_t54 = cos_steer_l*lever;
-  const double ik_t55 = sin_pitch*rear_x;
-  const double ik_t56 = -cos_roll*rear_drop*cos_pitch;
-  const double ik_t59 = -lever_offset*sin_steer_r;
-  const double ik_t61 = cos_steer_r*lever;
-  const double ik_t62 = -sin_roll*rear_y*cos_pitch;
-  const double ik_leg_l_d0 = ik_t11*ik_t14 - ik_t16*ik_t22 - ik_t26*ik_t27;
-  const double ik_leg_l_d1 = ik_t28*ik_t11 + ik_t26*ik_t30 - ik_t29*ik_t22;
-  const double ik_leg_l_d2 = -(ik_t18*ik_t22 - ik_t7*ik_t11 - ik_t26*cos_roll*cos_pitch);
-  const double ik_leg_l_K = ik_t31;
-  const double ik_leg_l_A = ik_t32;
-  const double ik_leg_l_B = 0.0;
-  const double ik_leg_l_dd = ik_leg_l_d0 * ik_leg_l_d0 + ik_leg_l_d1 * ik_leg_l_d1 + ik_leg_l_d2 * ik_leg_l_d2;
-  double ik_c_knee_l, ik_s_knee_l;
+  const Scalar cos_yaw = cos_angle[0];
+  const Scalar sin_yaw = sin_angle[0];
+  const Scalar cos_pitch = cos_angle[1];
+  const Scalar sin_pitch = sin_angle[1];
+  const Scalar cos_roll = cos_angle[2];
+  const Scalar sin_roll = sin_angle[2];
+  const Scalar cos_slew_l = cos_angle[3];
+  const Scalar sin_slew_l = sin_angle[3];
+  const Scalar cos_slew_r = cos_angle[4];
+  const Scalar sin_slew_r = sin_angle[4];
+  const Scalar cos_steer_l = cos_angle[5];
+  const Scalar sin_steer_l = sin_angle[5];
+  const Scalar cos_steer_r = cos_angle[6];
+  const Scalar sin_steer_r = sin_angle[6];
+  const Scalar ik_t2 = -hip_x*cos_yaw*cos_pitch;
+  const Scalar ik_t7 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
+  const Scalar ik_t8 = ik_t7*hip_drop;
+  const Scalar ik_t9 = sin_roll*sin_pitch*cos_yaw - cos_roll*sin_yaw;
+  const Scalar ik_t10 = -x_C;
+  const Scalar ik_t11 = ik_t2 + ik_t8 + foot_x_l + ik_t10 - ik_t9*hip_y;
+  const Scalar ik_t14 = ik_t9*sin_slew_l + cos_yaw*cos_slew_l*cos_pitch;
+  const Scalar ik_t15 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
+  const Scalar ik_t16 = cos_slew_l*cos_pitch*sin_yaw + ik_t15*sin_slew_l;
+  const Scalar ik_t17 = hip_x*cos_pitch*sin_yaw;
+  const Scalar ik_t18 = sin_pitch*cos_roll*sin_yaw - sin_roll*cos_yaw;
+  const Scalar ik_t19 = -hip_drop*ik_t18;
+  const Scalar ik_t20 = ik_t15*hip_y;
+  const Scalar ik_t21 = -foot_y_l;
+  const Scalar ik_t22 = ik_t17 + ik_t19 + y_C + ik_t20 + ik_t21;
+  const Scalar ik_t23 = -z_C;
+  const Scalar ik_t24 = hip_x*sin_pitch;
+  const Scalar ik_t25 = hip_drop*cos_roll*cos_pitch;
+  const Scalar ik_t26 = ik_t23 + ik_t24 + foot_z_l + ik_t25 - sin_roll*cos_pitch*hip_y;
+  const Scalar ik_t27 = sin_pitch*cos_slew_l - sin_roll*cos_pitch*sin_slew_l;
+  const Scalar ik_t28 = ik_t9*cos_slew_l - cos_yaw*cos_pitch*sin_slew_l;
+  const Scalar ik_t29 = ik_t15*cos_slew_l - cos_pitch*sin_yaw*sin_slew_l;
+  const Scalar ik_t30 = sin_roll*cos_slew_l*cos_pitch + sin_pitch*sin_slew_l;
+  const Scalar ik_t31 = shank*shank + thigh*thigh + knee_offset*knee_offset;
+  const Scalar ik_t32 = Scalar(2.0)*shank*thigh;
+  const Scalar ik_t35 = cos_yaw*cos_pitch*cos_slew_r + sin_slew_r*ik_t9;
+  const Scalar ik_t36 = ik_t9*hip_y;
+  const Scalar ik_t37 = ik_t2 + ik_t8 + foot_x_r + ik_t36 + ik_t10;
+  const Scalar ik_t38 = sin_roll*sin_slew_r*cos_pitch - sin_pitch*cos_slew_r;
+  const Scalar ik_t39 = sin_roll*cos_pitch*hip_y;
+  const Scalar ik_t40 = foot_z_r + ik_t23 + ik_t24 + ik_t39 + ik_t25;
+  const Scalar ik_t41 = cos_pitch*sin_yaw*cos_slew_r + ik_t15*sin_slew_r;
+  const Scalar ik_t42 = -foot_y_r;
+  const Scalar ik_t43 = -ik_t15*hip_y;
+  const Scalar ik_t44 = ik_t42 + ik_t17 + ik_t43 + ik_t19 + y_C;
+  const Scalar ik_t45 = sin_slew_r*cos_pitch*sin_yaw - ik_t15*cos_slew_r;
+  const Scalar ik_t46 = sin_pitch*sin_slew_r + sin_roll*cos_pitch*cos_slew_r;
+  const Scalar ik_t47 = ik_t9*cos_slew_r - cos_yaw*sin_slew_r*cos_pitch;
+  const Scalar ik_t48 = -sin_pitch;
+  const Scalar ik_t49 = sin_roll*cos_pitch;
+  const Scalar ik_t50 = cos_roll*cos_pitch;
+  const Scalar ik_t52 = lever_offset*sin_steer_l;
+  const Scalar ik_t54 = cos_steer_l*lever;
+  const Scalar ik_t55 = sin_pitch*rear_x;
+  const Scalar ik_t56 = -cos_roll*rear_drop*cos_pitch;
+  const Scalar ik_t59 = -lever_offset*sin_steer_r;
+  const Scalar ik_t61 = cos_steer_r*lever;
+  const Scalar ik_t62 = -sin_roll*rear_y*cos_pitch;
+  const Scalar ik_leg_l_d0 = ik_t11*ik_t14 - ik_t16*ik_t22 - ik_t26*ik_t27;
+  const Scalar ik_leg_l_d1 = ik_t28*ik_t11 + ik_t26*ik_t30 - ik_t29*ik_t22;
+  const Scalar ik_leg_l_d2 = -(ik_t18*ik_t22 - ik_t7*ik_t11 - ik_t26*cos_roll*cos_pitch);
+  const Scalar ik_leg_l_K = ik_t31;
+  const Scalar ik_leg_l_A = ik_t32;
+  const Scalar ik_leg_l_B = Scalar(0.0);
+  const Scalar ik_leg_l_dd = ik_leg_l_d0 * ik_leg_l_d0 + ik_leg_l_d1 * ik_leg_l_d1 + ik_leg_l_d2 * ik_leg_l_d2;
+  Scalar ik_c_knee_l, ik_s_knee_l;
   if (!ik_solve_cos_sin(ik_leg_l_A, ik_leg_l_B, ik_leg_l_dd - ik_leg_l_K, (ik_leg_l_branch & 1) != 0, ik_c_knee_l, ik_s_knee_l)) {
-    const double ik_leg_l_R = std::sqrt(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
-    why = {1, std::sqrt(ik_leg_l_dd), std::sqrt(std::max(0.0, ik_leg_l_K - ik_leg_l_R)), std::sqrt(ik_leg_l_K + ik_leg_l_R), 0.0};
+    const Scalar ik_leg_l_R = std::sqrt(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
+    why = {1, std::sqrt(ik_leg_l_dd), std::sqrt(std::max(Scalar(0), ik_leg_l_K - ik_leg_l_R)), std::sqrt(ik_leg_l_K + ik_leg_l_R), 0.0};
     failed = 0;
     return IkStatus::out_of_reach;
   }
-  const double ik_leg_l_v0 = thigh + shank*ik_c_knee_l;
-  const double ik_leg_l_v1 = knee_offset;
-  const double ik_leg_l_v2 = -ik_s_knee_l*shank;
-  const double ik_leg_l_v[3] = {ik_leg_l_v0, ik_leg_l_v1, ik_leg_l_v2};
-  const double ik_leg_l_d[3] = {ik_leg_l_d0, ik_leg_l_d1, ik_leg_l_d2};
-  double ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_leg_l_beside = 0, ik_leg_l_room = 0;
+  const Scalar ik_leg_l_v0 = thigh + shank*ik_c_knee_l;
+  const Scalar ik_leg_l_v1 = knee_offset;
+  const Scalar ik_leg_l_v2 = -ik_s_knee_l*shank;
+  const Scalar ik_leg_l_v[3] = {ik_leg_l_v0, ik_leg_l_v1, ik_leg_l_v2};
+  const Scalar ik_leg_l_d[3] = {ik_leg_l_d0, ik_leg_l_d1, ik_leg_l_d2};
+  Scalar ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_leg_l_beside(0), ik_leg_l_room(0);
   const bool ik_leg_l_two_axis_ok = ik_solve_two_axis<0, 1>(ik_leg_l_v, ik_leg_l_d, (ik_leg_l_branch & 2) != 0, ik_c_abduct_l, ik_s_abduct_l, ik_c_lift_l, ik_s_lift_l, ik_leg_l_beside, ik_leg_l_room);
   if (!ik_leg_l_two_axis_ok) {
-    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, std::atan2(ik_s_knee_l, ik_c_knee_l) * 57.29577951308232};
+    why = {2, ik_leg_l_beside, 0.0, ik_leg_l_room, double(std::atan2(ik_s_knee_l, ik_c_knee_l)) * 57.29577951308232};
     failed = 0;
     return IkStatus::out_of_reach;
   }
-  const double ik_t63 = ik_t7*ik_c_abduct_l - ik_t28*ik_s_abduct_l;
-  const double ik_t64 = ik_c_lift_l*ik_t14 - ik_s_lift_l*ik_t63;
-  const double ik_t65 = ik_s_abduct_l*ik_t29 - ik_t18*ik_c_abduct_l;
-  const double ik_t66 = ik_c_lift_l*ik_t16 + ik_s_lift_l*ik_t65;
-  const double ik_t67 = ik_s_abduct_l*ik_t30 - ik_c_abduct_l*cos_roll*cos_pitch;
-  const double ik_t68 = ik_s_lift_l*ik_t67 - ik_t27*ik_c_lift_l;
-  const double ik_leg_r_d0 = -(ik_t41*ik_t44 - ik_t35*ik_t37 - ik_t38*ik_t40);
-  const double ik_leg_r_d1 = ik_t44*ik_t45 + ik_t46*ik_t40 + ik_t47*ik_t37;
-  const double ik_leg_r_d2 = ik_t40*cos_roll*cos_pitch + ik_t7*ik_t37 - ik_t44*ik_t18;
-  const double ik_leg_r_K = ik_t31;
-  const double ik_leg_r_A = ik_t32;
-  const double ik_leg_r_B = 0.0;
-  const double ik_leg_r_dd = ik_leg_r_d0 * ik_leg_r_d0 + ik_leg_r_d1 * ik_leg_r_d1 + ik_leg_r_d2 * ik_leg_r_d2;
-  double ik_c_knee_r, ik_s_knee_r;
+  const Scalar ik_t63 = ik_t7*ik_c_abduct_l - ik_t28*ik_s_abduct_l;
+  const Scalar ik_t64 = ik_c_lift_l*ik_t14 - ik_s_lift_l*ik_t63;
+  const Scalar ik_t65 = ik_s_abduct_l*ik_t29 - ik_t18*ik_c_abduct_l;
+  const Scalar ik_t66 = ik_c_lift_l*ik_t16 + ik_s_lift_l*ik_t65;
+  const Scalar ik_t67 = ik_s_abduct_l*ik_t30 - ik_c_abduct_l*cos_roll*cos_pitch;
+  const Scalar ik_t68 = ik_s_lift_l*ik_t67 - ik_t27*ik_c_lift_l;
+  const Scalar ik_leg_r_d0 = -(ik_t41*ik_t44 - ik_t35*ik_t37 - ik_t38*ik_t40);
+  const Scalar ik_leg_r_d1 = ik_t44*ik_t45 + ik_t46*ik_t40 + ik_t47*ik_t37;
+  const Scalar ik_leg_r_d2 = ik_t40*cos_roll*cos_pitch + ik_t7*ik_t37 - ik_t44*ik_t18;
+  const Scalar ik_leg_r_K = ik_t31;
+  const Scalar ik_leg_r_A = ik_t32;
+  const Scalar ik_leg_r_B = Scalar(0.0);
+  const Scalar ik_leg_r_dd = ik_leg_r_d0 * ik_leg_r_d0 + ik_leg_r_d1 * ik_leg_r_d1 + ik_leg_r_d2 * ik_leg_r_d2;
+  Scalar ik_c_knee_r, ik_s_knee_r;
   if (!ik_solve_cos_sin(ik_leg_r_A, ik_leg_r_B, ik_leg_r_dd - ik_leg_r_K, (ik_leg_r_branch & 1) != 0, ik_c_knee_r, ik_s_knee_r)) {
-    const double ik_leg_r_R = std::sqrt(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
-    why = {1, std::sqrt(ik_leg_r_dd), std::sqrt(std::max(0.0, ik_leg_r_K - ik_leg_r_R)), std::sqrt(ik_leg_r_K + ik_leg_r_R), 0.0};
+    const Scalar ik_leg_r_R = std::sqrt(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
+    why = {1, std::sqrt(ik_leg_r_dd), std::sqrt(std::max(Scalar(0), ik_leg_r_K - ik_leg_r_R)), std::sqrt(ik_leg_r_K + ik_leg_r_R), 0.0};
     failed = 1;
     return IkStatus::out_of_reach;
   }
-  const double ik_leg_r_v0 = thigh + shank*ik_c_knee_r;
-  const double ik_leg_r_v1 = -knee_offset;
-  const double ik_leg_r_v2 = -shank*ik_s_knee_r;
-  const double ik_leg_r_v[3] = {ik_leg_r_v0, ik_leg_r_v1, ik_leg_r_v2};
-  const double ik_leg_r_d[3] = {ik_leg_r_d0, ik_leg_r_d1, ik_leg_r_d2};
-  double ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_leg_r_beside = 0, ik_leg_r_room = 0;
+  const Scalar ik_leg_r_v0 = thigh + shank*ik_c_knee_r;
+  const Scalar ik_leg_r_v1 = -knee_offset;
+  const Scalar ik_leg_r_v2 = -shank*ik_s_knee_r;
+  const Scalar ik_leg_r_v[3] = {ik_leg_r_v0, ik_leg_r_v1, ik_leg_r_v2};
+  const Scalar ik_leg_r_d[3] = {ik_leg_r_d0, ik_leg_r_d1, ik_leg_r_d2};
+  Scalar ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_leg_r_beside(0), ik_leg_r_room(0);
   const bool ik_leg_r_two_axis_ok = ik_solve_two_axis<0, 1>(ik_leg_r_v, ik_leg_r_d, (ik_leg_r_branch & 2) != 0, ik_c_abduct_r, ik_s_abduct_r, ik_c_lift_r, ik_s_lift_r, ik_leg_r_beside, ik_leg_r_room);
   if (!ik_leg_r_two_axis_ok) {
-    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, std::atan2(ik_s_knee_r, ik_c_knee_r) * 57.29577951308232};
+    why = {2, ik_leg_r_beside, 0.0, ik_leg_r_room, double(std::atan2(ik_s_knee_r, ik_c_knee_r)) * 57.29577951308232};
     failed = 1;
     return IkStatus::out_of_reach;
   }
-  const double ik_t69 = ik_s_abduct_r*ik_t47 - ik_t7*ik_c_abduct_r;
-  const double ik_t70 = ik_t35*ik_c_lift_r + ik_t69*ik_s_lift_r;
-  const double ik_t71 = ik_c_abduct_r*ik_t18 + ik_s_abduct_r*ik_t45;
-  const double ik_t72 = ik_t41*ik_c_lift_r - ik_t71*ik_s_lift_r;
-  const double ik_t73 = ik_t46*ik_s_abduct_r - ik_c_abduct_r*cos_roll*cos_pitch;
-  const double ik_t74 = ik_t38*ik_c_lift_r + ik_s_lift_r*ik_t73;
-  const double ik_q_guide_l = -steer_l;
-  const double ik_lever_l_g0 = ik_t48;
-  const double ik_lever_l_g1 = ik_t49;
-  const double ik_lever_l_g2 = ik_t50;
-  const double ik_lever_l_axis[3] = {0.0, 0.0, 1.0};
-  const double ik_lever_l_g[3] = {ik_lever_l_g0, ik_lever_l_g1, ik_lever_l_g2};
-  double ik_lever_l_c_sum, ik_lever_l_s_sum, ik_c_camber_l, ik_s_camber_l, ik_lever_l_beside = 0, ik_lever_l_room = 0;
+  const Scalar ik_t69 = ik_s_abduct_r*ik_t47 - ik_t7*ik_c_abduct_r;
+  const Scalar ik_t70 = ik_t35*ik_c_lift_r + ik_t69*ik_s_lift_r;
+  const Scalar ik_t71 = ik_c_abduct_r*ik_t18 + ik_s_abduct_r*ik_t45;
+  const Scalar ik_t72 = ik_t41*ik_c_lift_r - ik_t71*ik_s_lift_r;
+  const Scalar ik_t73 = ik_t46*ik_s_abduct_r - ik_c_abduct_r*cos_roll*cos_pitch;
+  const Scalar ik_t74 = ik_t38*ik_c_lift_r + ik_s_lift_r*ik_t73;
+  const Scalar ik_q_guide_l = -steer_l;
+  const Scalar ik_lever_l_g0 = ik_t48;
+  const Scalar ik_lever_l_g1 = ik_t49;
+  const Scalar ik_lever_l_g2 = ik_t50;
+  const Scalar ik_lever_l_axis[3] = {Scalar(0), Scalar(0), Scalar(1)};
+  const Scalar ik_lever_l_g[3] = {ik_lever_l_g0, ik_lever_l_g1, ik_lever_l_g2};
+  Scalar ik_lever_l_c_sum, ik_lever_l_s_sum, ik_c_camber_l, ik_s_camber_l, ik_lever_l_beside(0), ik_lever_l_room(0);
   const bool ik_lever_l_two_axis_ok = ik_solve_two_axis<1, 0>(ik_lever_l_axis, ik_lever_l_g, (ik_lever_l_branch & 2) != 0, ik_lever_l_c_sum, ik_lever_l_s_sum, ik_c_camber_l, ik_s_camber_l, ik_lever_l_beside, ik_lever_l_room);
   static_cast<void>(ik_lever_l_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
@@ -753,32 +784,32 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
     ik_lever_l_s_sum = -ik_lever_l_s_sum;
     ik_s_camber_l = -ik_s_camber_l;
   }
-  const double ik_lever_l_alpha = sin_pitch*(radius*ik_lever_l_s_sum + ik_t52 + ik_t54) - radius*sin_pitch*ik_lever_l_s_sum;
-  const double ik_lever_l_beta = cos_roll*cos_pitch*(ik_t52 + ik_t54 - radius*ik_lever_l_c_sum) + radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
-  const double ik_lever_l_gamma = sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + ik_t55 + radius*sin_pitch*ik_lever_l_s_sum + ik_t56 - radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
-  double ik_c_swing_l, ik_s_swing_l;
+  const Scalar ik_lever_l_alpha = sin_pitch*(radius*ik_lever_l_s_sum + ik_t52 + ik_t54) - radius*sin_pitch*ik_lever_l_s_sum;
+  const Scalar ik_lever_l_beta = cos_roll*cos_pitch*(ik_t52 + ik_t54 - radius*ik_lever_l_c_sum) + radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
+  const Scalar ik_lever_l_gamma = sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + ik_t55 + radius*sin_pitch*ik_lever_l_s_sum + ik_t56 - radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
+  Scalar ik_c_swing_l, ik_s_swing_l;
   if (!ik_solve_cos_sin(ik_lever_l_alpha, ik_lever_l_beta, ground_l - ik_lever_l_gamma, (ik_lever_l_branch & 1) != 0, ik_c_swing_l, ik_s_swing_l)) {
-    const double ik_lever_l_R = std::sqrt(ik_lever_l_alpha * ik_lever_l_alpha + ik_lever_l_beta * ik_lever_l_beta);
+    const Scalar ik_lever_l_R = std::sqrt(ik_lever_l_alpha * ik_lever_l_alpha + ik_lever_l_beta * ik_lever_l_beta);
     why = {1, ground_l, ik_lever_l_gamma - ik_lever_l_R, ik_lever_l_gamma + ik_lever_l_R, 0.0};
     failed = 2;
     return IkStatus::out_of_reach;
   }
-  const double ik_c_hub_l = ik_lever_l_c_sum * ik_c_swing_l + ik_lever_l_s_sum * ik_s_swing_l;
-  const double ik_s_hub_l = ik_lever_l_s_sum * ik_c_swing_l - ik_lever_l_c_sum * ik_s_swing_l;
-  const double ik_t75 = sin_pitch*ik_c_swing_l + ik_s_swing_l*cos_roll*cos_pitch;
-  const double ik_t76 = cos_steer_l*ik_t75 - sin_roll*sin_steer_l*cos_pitch;
-  const double ik_t77 = sin_steer_l*ik_t75 + sin_roll*cos_steer_l*cos_pitch;
-  const double ik_t78 = sin_steer_l*ik_t76 - cos_steer_l*ik_t77;
-  const double ik_t79 = sin_steer_l*ik_t77 + ik_t76*cos_steer_l;
-  const double ik_t80 = sin_pitch*ik_s_swing_l - ik_c_swing_l*cos_roll*cos_pitch;
-  const double ik_t81 = ik_t79*ik_s_hub_l + ik_c_hub_l*ik_t80;
-  const double ik_q_guide_r = -steer_r;
-  const double ik_lever_r_g0 = ik_t48;
-  const double ik_lever_r_g1 = ik_t49;
-  const double ik_lever_r_g2 = ik_t50;
-  const double ik_lever_r_axis[3] = {0.0, 0.0, 1.0};
-  const double ik_lever_r_g[3] = {ik_lever_r_g0, ik_lever_r_g1, ik_lever_r_g2};
-  double ik_lever_r_c_sum, ik_lever_r_s_sum, ik_c_camber_r, ik_s_camber_r, ik_lever_r_beside = 0, ik_lever_r_room = 0;
+  const Scalar ik_c_hub_l = ik_lever_l_c_sum * ik_c_swing_l + ik_lever_l_s_sum * ik_s_swing_l;
+  const Scalar ik_s_hub_l = ik_lever_l_s_sum * ik_c_swing_l - ik_lever_l_c_sum * ik_s_swing_l;
+  const Scalar ik_t75 = sin_pitch*ik_c_swing_l + ik_s_swing_l*cos_roll*cos_pitch;
+  const Scalar ik_t76 = cos_steer_l*ik_t75 - sin_roll*sin_steer_l*cos_pitch;
+  const Scalar ik_t77 = sin_steer_l*ik_t75 + sin_roll*cos_steer_l*cos_pitch;
+  const Scalar ik_t78 = sin_steer_l*ik_t76 - cos_steer_l*ik_t77;
+  const Scalar ik_t79 = sin_steer_l*ik_t77 + ik_t76*cos_steer_l;
+  const Scalar ik_t80 = sin_pitch*ik_s_swing_l - ik_c_swing_l*cos_roll*cos_pitch;
+  const Scalar ik_t81 = ik_t79*ik_s_hub_l + ik_c_hub_l*ik_t80;
+  const Scalar ik_q_guide_r = -steer_r;
+  const Scalar ik_lever_r_g0 = ik_t48;
+  const Scalar ik_lever_r_g1 = ik_t49;
+  const Scalar ik_lever_r_g2 = ik_t50;
+  const Scalar ik_lever_r_axis[3] = {Scalar(0), Scalar(0), Scalar(1)};
+  const Scalar ik_lever_r_g[3] = {ik_lever_r_g0, ik_lever_r_g1, ik_lever_r_g2};
+  Scalar ik_lever_r_c_sum, ik_lever_r_s_sum, ik_c_camber_r, ik_s_camber_r, ik_lever_r_beside(0), ik_lever_r_room(0);
   const bool ik_lever_r_two_axis_ok = ik_solve_two_axis<1, 0>(ik_lever_r_axis, ik_lever_r_g, (ik_lever_r_branch & 2) != 0, ik_lever_r_c_sum, ik_lever_r_s_sum, ik_c_camber_r, ik_s_camber_r, ik_lever_r_beside, ik_lever_r_room);
   static_cast<void>(ik_lever_r_two_axis_ok);  // cannot fail: the axis is perpendicular to both rotations
   // The sum's other root: a half turn, with the last joint mirrored (the vertical axis flips).
@@ -787,76 +818,76 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
     ik_lever_r_s_sum = -ik_lever_r_s_sum;
     ik_s_camber_r = -ik_s_camber_r;
   }
-  const double ik_t57 = radius*sin_pitch*ik_lever_r_s_sum;
-  const double ik_lever_r_alpha = -(ik_t57 - (radius*ik_lever_r_s_sum + ik_t59 + ik_t61)*sin_pitch);
-  const double ik_lever_r_beta = cos_roll*cos_pitch*(ik_t59 + ik_t61 - radius*ik_lever_r_c_sum) + radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
-  const double ik_lever_r_gamma = ik_t57 + ik_t62 + z_C + ik_t55 + ik_t56 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
-  double ik_c_swing_r, ik_s_swing_r;
+  const Scalar ik_t57 = radius*sin_pitch*ik_lever_r_s_sum;
+  const Scalar ik_lever_r_alpha = -(ik_t57 - (radius*ik_lever_r_s_sum + ik_t59 + ik_t61)*sin_pitch);
+  const Scalar ik_lever_r_beta = cos_roll*cos_pitch*(ik_t59 + ik_t61 - radius*ik_lever_r_c_sum) + radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
+  const Scalar ik_lever_r_gamma = ik_t57 + ik_t62 + z_C + ik_t55 + ik_t56 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
+  Scalar ik_c_swing_r, ik_s_swing_r;
   if (!ik_solve_cos_sin(ik_lever_r_alpha, ik_lever_r_beta, ground_r - ik_lever_r_gamma, (ik_lever_r_branch & 1) != 0, ik_c_swing_r, ik_s_swing_r)) {
-    const double ik_lever_r_R = std::sqrt(ik_lever_r_alpha * ik_lever_r_alpha + ik_lever_r_beta * ik_lever_r_beta);
+    const Scalar ik_lever_r_R = std::sqrt(ik_lever_r_alpha * ik_lever_r_alpha + ik_lever_r_beta * ik_lever_r_beta);
     why = {1, ground_r, ik_lever_r_gamma - ik_lever_r_R, ik_lever_r_gamma + ik_lever_r_R, 0.0};
     failed = 3;
     return IkStatus::out_of_reach;
   }
-  const double ik_c_hub_r = ik_lever_r_c_sum * ik_c_swing_r + ik_lever_r_s_sum * ik_s_swing_r;
-  const double ik_s_hub_r = ik_lever_r_s_sum * ik_c_swing_r - ik_lever_r_c_sum * ik_s_swing_r;
-  const double ik_t82 = ik_c_swing_r*cos_roll*cos_pitch - sin_pitch*ik_s_swing_r;
-  const double ik_t83 = cos_roll*cos_pitch*ik_s_swing_r + sin_pitch*ik_c_swing_r;
-  const double ik_t84 = sin_roll*cos_steer_r*cos_pitch + sin_steer_r*ik_t83;
-  const double ik_t85 = sin_roll*sin_steer_r*cos_pitch - cos_steer_r*ik_t83;
-  const double ik_t86 = sin_steer_r*ik_t84 - cos_steer_r*ik_t85;
-  const double ik_t87 = ik_t86*ik_s_hub_r - ik_c_hub_r*ik_t82;
-  const double ik_t88 = cos_steer_r*ik_t84 + sin_steer_r*ik_t85;
-  const std::array<double, 12> ik_sines{{ik_s_abduct_l, ik_s_lift_l, ik_s_knee_l, ik_s_abduct_r, ik_s_lift_r, ik_s_knee_r, ik_s_swing_l, ik_s_hub_l, ik_s_camber_l, ik_s_swing_r, ik_s_hub_r, ik_s_camber_r}}, ik_cosines{{ik_c_abduct_l, ik_c_lift_l, ik_c_knee_l, ik_c_abduct_r, ik_c_lift_r, ik_c_knee_r, ik_c_swing_l, ik_c_hub_l, ik_c_camber_l, ik_c_swing_r, ik_c_hub_r, ik_c_camber_r}};
-  std::array<double, 12> ik_angles;
+  const Scalar ik_c_hub_r = ik_lever_r_c_sum * ik_c_swing_r + ik_lever_r_s_sum * ik_s_swing_r;
+  const Scalar ik_s_hub_r = ik_lever_r_s_sum * ik_c_swing_r - ik_lever_r_c_sum * ik_s_swing_r;
+  const Scalar ik_t82 = ik_c_swing_r*cos_roll*cos_pitch - sin_pitch*ik_s_swing_r;
+  const Scalar ik_t83 = cos_roll*cos_pitch*ik_s_swing_r + sin_pitch*ik_c_swing_r;
+  const Scalar ik_t84 = sin_roll*cos_steer_r*cos_pitch + sin_steer_r*ik_t83;
+  const Scalar ik_t85 = sin_roll*sin_steer_r*cos_pitch - cos_steer_r*ik_t83;
+  const Scalar ik_t86 = sin_steer_r*ik_t84 - cos_steer_r*ik_t85;
+  const Scalar ik_t87 = ik_t86*ik_s_hub_r - ik_c_hub_r*ik_t82;
+  const Scalar ik_t88 = cos_steer_r*ik_t84 + sin_steer_r*ik_t85;
+  const std::array<Scalar, 12> ik_sines{{ik_s_abduct_l, ik_s_lift_l, ik_s_knee_l, ik_s_abduct_r, ik_s_lift_r, ik_s_knee_r, ik_s_swing_l, ik_s_hub_l, ik_s_camber_l, ik_s_swing_r, ik_s_hub_r, ik_s_camber_r}}, ik_cosines{{ik_c_abduct_l, ik_c_lift_l, ik_c_knee_l, ik_c_abduct_r, ik_c_lift_r, ik_c_knee_r, ik_c_swing_l, ik_c_hub_l, ik_c_camber_l, ik_c_swing_r, ik_c_hub_r, ik_c_camber_r}};
+  std::array<Scalar, 12> ik_angles;
   atan2(ik_sines, ik_cosines, ik_angles);
-  const double ik_q_abduct_l = ik_angles[0];
-  const double ik_q_lift_l = ik_angles[1];
-  const double ik_q_knee_l = ik_angles[2];
-  const double ik_q_abduct_r = ik_angles[3];
-  const double ik_q_lift_r = ik_angles[4];
-  const double ik_q_knee_r = ik_angles[5];
-  const double ik_q_swing_l = ik_angles[6];
-  const double ik_q_hub_l = ik_angles[7];
-  const double ik_q_camber_l = ik_angles[8];
-  const double ik_q_swing_r = ik_angles[9];
-  const double ik_q_hub_r = ik_angles[10];
-  const double ik_q_camber_r = ik_angles[11];
-  const double ik_leg_l_row0 = (ik_t7*ik_s_abduct_l + ik_t28*ik_c_abduct_l)*knee_offset + x_C + ik_t36 + thigh*ik_t64 + hip_x*cos_yaw*cos_pitch - ik_t7*hip_drop - shank*(ik_s_knee_l*(ik_c_lift_l*ik_t63 + ik_s_lift_l*ik_t14) - ik_c_knee_l*ik_t64) - foot_x_l;
-  const double ik_leg_l_row1 = ik_t17 + (ik_t18*ik_s_abduct_l + ik_c_abduct_l*ik_t29)*knee_offset + ik_t66*thigh + ik_t19 + y_C + shank*(ik_s_knee_l*(ik_t65*ik_c_lift_l - ik_s_lift_l*ik_t16) + ik_t66*ik_c_knee_l) + ik_t20 + ik_t21;
-  const double ik_leg_l_row2 = (ik_s_abduct_l*cos_roll*cos_pitch + ik_c_abduct_l*ik_t30)*knee_offset + ik_t68*thigh + z_C + ik_t39 + shank*(ik_t68*ik_c_knee_l + ik_s_knee_l*(ik_s_lift_l*ik_t27 + ik_t67*ik_c_lift_l)) - hip_x*sin_pitch - foot_z_l - hip_drop*cos_roll*cos_pitch;
-  const double ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
-  if (!(ik_leg_l_residual <= kIkTolerance)) {
-    why = {0, ik_leg_l_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_q_abduct_l = ik_angles[0];
+  const Scalar ik_q_lift_l = ik_angles[1];
+  const Scalar ik_q_knee_l = ik_angles[2];
+  const Scalar ik_q_abduct_r = ik_angles[3];
+  const Scalar ik_q_lift_r = ik_angles[4];
+  const Scalar ik_q_knee_r = ik_angles[5];
+  const Scalar ik_q_swing_l = ik_angles[6];
+  const Scalar ik_q_hub_l = ik_angles[7];
+  const Scalar ik_q_camber_l = ik_angles[8];
+  const Scalar ik_q_swing_r = ik_angles[9];
+  const Scalar ik_q_hub_r = ik_angles[10];
+  const Scalar ik_q_camber_r = ik_angles[11];
+  const Scalar ik_leg_l_row0 = (ik_t7*ik_s_abduct_l + ik_t28*ik_c_abduct_l)*knee_offset + x_C + ik_t36 + thigh*ik_t64 + hip_x*cos_yaw*cos_pitch - ik_t7*hip_drop - shank*(ik_s_knee_l*(ik_c_lift_l*ik_t63 + ik_s_lift_l*ik_t14) - ik_c_knee_l*ik_t64) - foot_x_l;
+  const Scalar ik_leg_l_row1 = ik_t17 + (ik_t18*ik_s_abduct_l + ik_c_abduct_l*ik_t29)*knee_offset + ik_t66*thigh + ik_t19 + y_C + shank*(ik_s_knee_l*(ik_t65*ik_c_lift_l - ik_s_lift_l*ik_t16) + ik_t66*ik_c_knee_l) + ik_t20 + ik_t21;
+  const Scalar ik_leg_l_row2 = (ik_s_abduct_l*cos_roll*cos_pitch + ik_c_abduct_l*ik_t30)*knee_offset + ik_t68*thigh + z_C + ik_t39 + shank*(ik_t68*ik_c_knee_l + ik_s_knee_l*(ik_s_lift_l*ik_t27 + ik_t67*ik_c_lift_l)) - hip_x*sin_pitch - foot_z_l - hip_drop*cos_roll*cos_pitch;
+  const Scalar ik_leg_l_residual = std::max({std::abs(ik_leg_l_row0), std::abs(ik_leg_l_row1), std::abs(ik_leg_l_row2)});
+  if (!(ik_leg_l_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_leg_l_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     failed = 0;
     return IkStatus::residual;
   }
-  const double ik_leg_r_row0 = -(ik_t2 + (ik_c_abduct_r*ik_t47 + ik_t7*ik_s_abduct_r)*knee_offset + ik_t8 + foot_x_r + ik_t36 + ik_t10 - thigh*ik_t70 - ((ik_t69*ik_c_lift_r - ik_s_lift_r*ik_t35)*ik_s_knee_r + ik_c_knee_r*ik_t70)*shank);
-  const double ik_leg_r_row1 = thigh*ik_t72 + ik_t42 + ik_t17 + ik_t43 + ik_t19 + y_C + shank*(ik_c_knee_r*ik_t72 - (ik_t71*ik_c_lift_r + ik_t41*ik_s_lift_r)*ik_s_knee_r) + (ik_c_abduct_r*ik_t45 - ik_t18*ik_s_abduct_r)*knee_offset;
-  const double ik_leg_r_row2 = -(foot_z_r + ik_t23 + ik_t24 + ik_t39 + (ik_s_abduct_r*cos_roll*cos_pitch + ik_c_abduct_r*ik_t46)*knee_offset + shank*((ik_t38*ik_s_lift_r - ik_c_lift_r*ik_t73)*ik_s_knee_r - ik_c_knee_r*ik_t74) + ik_t25 - thigh*ik_t74);
-  const double ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
-  if (!(ik_leg_r_residual <= kIkTolerance)) {
-    why = {0, ik_leg_r_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_leg_r_row0 = -(ik_t2 + (ik_c_abduct_r*ik_t47 + ik_t7*ik_s_abduct_r)*knee_offset + ik_t8 + foot_x_r + ik_t36 + ik_t10 - thigh*ik_t70 - ((ik_t69*ik_c_lift_r - ik_s_lift_r*ik_t35)*ik_s_knee_r + ik_c_knee_r*ik_t70)*shank);
+  const Scalar ik_leg_r_row1 = thigh*ik_t72 + ik_t42 + ik_t17 + ik_t43 + ik_t19 + y_C + shank*(ik_c_knee_r*ik_t72 - (ik_t71*ik_c_lift_r + ik_t41*ik_s_lift_r)*ik_s_knee_r) + (ik_c_abduct_r*ik_t45 - ik_t18*ik_s_abduct_r)*knee_offset;
+  const Scalar ik_leg_r_row2 = -(foot_z_r + ik_t23 + ik_t24 + ik_t39 + (ik_s_abduct_r*cos_roll*cos_pitch + ik_c_abduct_r*ik_t46)*knee_offset + shank*((ik_t38*ik_s_lift_r - ik_c_lift_r*ik_t73)*ik_s_knee_r - ik_c_knee_r*ik_t74) + ik_t25 - thigh*ik_t74);
+  const Scalar ik_leg_r_residual = std::max({std::abs(ik_leg_r_row0), std::abs(ik_leg_r_row1), std::abs(ik_leg_r_row2)});
+  if (!(ik_leg_r_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_leg_r_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     failed = 1;
     return IkStatus::residual;
   }
-  const double ik_lever_l_row0 = -(ik_t78*hub_offset + ik_t23 + ik_t62 + ground_l + cos_roll*rear_drop*cos_pitch - ik_t76*lever - radius*ik_t81 - sin_pitch*rear_x - lever_offset*ik_t77);
-  const double ik_lever_l_row1 = -(ik_t79*ik_c_hub_l - ik_s_hub_l*ik_t80);
-  const double ik_lever_l_row2 = -(ik_t78*ik_c_camber_l + ik_t81*ik_s_camber_l);
-  const double ik_lever_l_row3 = 0.0;
-  const double ik_lever_l_residual = std::max({std::abs(ik_lever_l_row0), std::abs(ik_lever_l_row1), std::abs(ik_lever_l_row2), std::abs(ik_lever_l_row3)});
-  if (!(ik_lever_l_residual <= kIkTolerance)) {
-    why = {0, ik_lever_l_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_lever_l_row0 = -(ik_t78*hub_offset + ik_t23 + ik_t62 + ground_l + cos_roll*rear_drop*cos_pitch - ik_t76*lever - radius*ik_t81 - sin_pitch*rear_x - lever_offset*ik_t77);
+  const Scalar ik_lever_l_row1 = -(ik_t79*ik_c_hub_l - ik_s_hub_l*ik_t80);
+  const Scalar ik_lever_l_row2 = -(ik_t78*ik_c_camber_l + ik_t81*ik_s_camber_l);
+  const Scalar ik_lever_l_row3 = Scalar(0.0);
+  const Scalar ik_lever_l_residual = std::max({std::abs(ik_lever_l_row0), std::abs(ik_lever_l_row1), std::abs(ik_lever_l_row2), std::abs(ik_lever_l_row3)});
+  if (!(ik_lever_l_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_lever_l_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     failed = 2;
     return IkStatus::residual;
   }
-  const double ik_lever_r_row0 = radius*ik_t87 + ik_t62 + z_C + ik_t55 + ik_t56 - ground_r - lever_offset*ik_t84 - ik_t88*hub_offset - lever*ik_t85;
-  const double ik_lever_r_row1 = -(ik_t82*ik_s_hub_r + ik_c_hub_r*ik_t86);
-  const double ik_lever_r_row2 = ik_t88*ik_c_camber_r - ik_t87*ik_s_camber_r;
-  const double ik_lever_r_row3 = 0.0;
-  const double ik_lever_r_residual = std::max({std::abs(ik_lever_r_row0), std::abs(ik_lever_r_row1), std::abs(ik_lever_r_row2), std::abs(ik_lever_r_row3)});
-  if (!(ik_lever_r_residual <= kIkTolerance)) {
-    why = {0, ik_lever_r_residual, 0.0, kIkTolerance, 0.0};
+  const Scalar ik_lever_r_row0 = radius*ik_t87 + ik_t62 + z_C + ik_t55 + ik_t56 - ground_r - lever_offset*ik_t84 - ik_t88*hub_offset - lever*ik_t85;
+  const Scalar ik_lever_r_row1 = -(ik_t82*ik_s_hub_r + ik_c_hub_r*ik_t86);
+  const Scalar ik_lever_r_row2 = ik_t88*ik_c_camber_r - ik_t87*ik_s_camber_r;
+  const Scalar ik_lever_r_row3 = Scalar(0.0);
+  const Scalar ik_lever_r_residual = std::max({std::abs(ik_lever_r_row0), std::abs(ik_lever_r_row1), std::abs(ik_lever_r_row2), std::abs(ik_lever_r_row3)});
+  if (!(ik_lever_r_residual <= ik_tolerance<Scalar>())) {
+    why = {0, ik_lever_r_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
     failed = 3;
     return IkStatus::residual;
   }
