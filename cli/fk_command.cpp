@@ -2,7 +2,9 @@
 #include "bounded_input.hpp"
 #include "interrupt.hpp"
 #include "input.hpp"
+#include "limits.hpp"
 #include "model_commands.hpp"
+#include "scenario_io.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -59,7 +61,7 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
   for (int k = 0; k < kCoordinateCount; ++k) {
     const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
     if (!j.contains(name)) continue;
-    s(k) = finite_number(j.at(name), name);
+    s(k) = si_value(j.at(name), name, is_angle(k));  // one grammar with ik and scenarios: SI or {"deg": x}
     dependents_given += k >= kInputCount;
   }
   if (dependents_given == 0) solve_ik_closed_form(model, s, {});

@@ -19,10 +19,7 @@
 
 WLX_COMMANDS_BEGIN
 
-namespace {
-
-// Solves one request. `warm` (batch mode) is Newton's start from the previous line, if any.
-nlohmann::ordered_json solve(const IkRequest& r, Coordinates* warm) {
+nlohmann::ordered_json solve_ik_request(const IkRequest& r, Coordinates* warm, Coordinates* solution) {
   const Model model(r.params);
   Data data;
   Coordinates s = r.s;
@@ -48,6 +45,7 @@ nlohmann::ordered_json solve(const IkRequest& r, Coordinates* warm) {
     if (warm != nullptr) *warm = s;
   }
   s.array() += 0.0;  // no "-0.0" in the output
+  if (solution != nullptr) *solution = s;
   forward_kinematics(model, s, data);
   for (int k = kInputCount; k < kCoordinateCount; ++k) out[std::string(gen::kCoordinateNames[k])] = s(k);
   for (const auto& wheel : gen::kWheels) {  // the contact points: x_W<wheel>, y_W<wheel>
@@ -82,8 +80,6 @@ nlohmann::ordered_json solve(const IkRequest& r, Coordinates* warm) {
   return out;
 }
 
-}  // namespace
-
 void write_ik_sweep_csv(const std::string& path, const IkSweepResult& r) {
   std::vector<std::string> header{r.sweep.input};
   for (int k = kInputCount; k < kCoordinateCount; ++k) header.emplace_back(gen::kCoordinateNames[k]);
@@ -111,7 +107,7 @@ int run_ik(const ModelOptions& model_options, bool batch) {
     const std::string text = read_all_capped(std::cin, "stdin", kMaxLineBytes);
     throw_if_interrupted();  // a signal ends the read early: the text is not the whole request
     const nlohmann::json j = parse_json_bounded(text, "stdin");
-    std::cout << solve(parse_ik_request(j, base), nullptr).dump() << "\n";
+    std::cout << solve_ik_request(parse_ik_request(j, base), nullptr).dump() << "\n";
     return 0;
   }
   std::string line;
@@ -127,7 +123,7 @@ int run_ik(const ModelOptions& model_options, bool batch) {
       if (read == LineRead::too_long)
         throw Error("", fmt::format("longer than {} bytes; the line was skipped", kMaxLineBytes));
       const nlohmann::json j = parse_json_bounded(line, "");
-      std::cout << solve(parse_ik_request(j, base), &warm).dump() << "\n";
+      std::cout << solve_ik_request(parse_ik_request(j, base), &warm).dump() << "\n";
     } catch (const Error& e) {
       ++failures;
       fmt::print(stderr, "wlx ik: line {}: {}\n", number, e.what());

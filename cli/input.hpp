@@ -28,4 +28,10 @@ struct IkRequest {
 // `base`: the parameters the request's "params" override (the defaults, or those of --params).
 IkRequest parse_ik_request(const nlohmann::json& j, const Params& base = {});
 
+// Solves a request: what `wlx ik` prints (the dependents by name, contacts, residual, check error,
+// branches, Newton's iterations). `warm`: Newton's start from a previous solution (batch mode), or
+// nullptr; `solution`: receives all coordinates, or nullptr. Throws wlx::Error for a target out of
+// reach, and for a result that does not satisfy the closure (residual above 1e-9).
+nlohmann::ordered_json solve_ik_request(const IkRequest& request, Coordinates* warm, Coordinates* solution = nullptr);
+
 WLX_COMMANDS_END

@@ -16,7 +16,7 @@ if [ -n "${missing[*]:-}" ]; then
   apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 if [ ! -f build-fuzz/CMakeCache.txt ]; then
-  cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 -DWLX_FUZZ=ON \
+  cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 -DWLX_FUZZ=ON -DWLX_BUILD_PYTHON=OFF \
         -DWLX_BUILD_BENCHMARKS=OFF > /dev/null
 fi
 cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_ik_numbers fuzz_json_input fuzz_model_file fuzz_command_line

@@ -5,7 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ ninja-build pkg-config libginac-dev libeigen3-dev libfmt-dev doctest-dev
-          libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev gnuplot-nox fonts-dejavu-core)
+          libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev gnuplot-nox fonts-dejavu-core
+          python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

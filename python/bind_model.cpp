@@ -1,0 +1,154 @@
+// One model's Python functions (compiled once per model, like the runtime: WLX_MODEL names it).
+// They take the same JSON the command line reads (the Python package turns dicts into it), and
+// reuse the command line's parsing and solving, so the grammar, the checks and the error messages
+// are the CLI's own.
+#include "../cli/input.hpp"
+#include "../cli/outputs.hpp"
+#include "../cli/scenario_io.hpp"
+
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <wlx/dynamics.hpp>
+#include <wlx/error.hpp>
+#include <wlx/kinematics.hpp>
+#include <wlx/nonholonomic.hpp>
+
+#include <string>
+
+namespace py = pybind11;
+
+WLX_COMMANDS_BEGIN
+
+namespace {
+
+nlohmann::json parse_json(const std::string& text, const char* what) {
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(what, std::string("not JSON: ") + e.what());
+  }
+}
+
+Params params_of(const std::string& params_json) { return parse_params(parse_json(params_json, "params")); }
+
+Coordinates coordinates_of(const Eigen::VectorXd& s, const char* field) {
+  if (s.size() != kCoordinateCount)
+    throw Error(field, "has " + std::to_string(s.size()) + " entries; the model has " + std::to_string(kCoordinateCount) +
+                           " coordinates");
+  if (!s.allFinite()) throw Error(field, "has an entry that is not a finite number");
+  return s;
+}
+
+}  // namespace
+
+void bind_python(py::module_& parent) {
+  py::module_ m = parent.def_submodule(std::string(gen::kModelName).c_str(), std::string(gen::kModelDescription).c_str());
+
+  py::dict info;
+  py::list coordinates, units, frames, parameters, scenarios;
+  for (auto n : gen::kCoordinateNames) coordinates.append(std::string(n));
+  for (auto u : gen::kCoordinateUnits) units.append(std::string(u));
+  for (auto f : gen::kFrameNames) frames.append(std::string(f));
+  py::dict defaults;
+  const Params p;
+  for (const auto& info_p : gen::kParamInfo) defaults[py::str(std::string(info_p.name))] = p.*info_p.member;
+  for (const auto& id : scenario_ids()) scenarios.append(id);
+  info["name"] = std::string(gen::kModelName);
+  info["description"] = std::string(gen::kModelDescription);
+  info["coordinates"] = coordinates;
+  info["units"] = units;
+  info["input_count"] = kInputCount;
+  info["frames"] = frames;
+  info["params"] = defaults;
+  info["scenarios"] = scenarios;
+  m.attr("info") = info;
+
+  m.def(
+      "ik",
+      [](const std::string& request_json) {
+        Coordinates s;
+        const auto result = solve_ik_request(parse_ik_request(parse_json(request_json, "request")), nullptr, &s);
+        return py::make_tuple(Eigen::VectorXd(s), result.dump());
+      },
+      "ik(request_json) -> (s, result_json): what `wlx ik` answers for that request, and all coordinates");
+
+  m.def(
+      "fk",
+      [](const Eigen::VectorXd& s_in, const std::string& params_json) {
+        const Model model(params_of(params_json));
+        Data data;
+        forward_kinematics(model, coordinates_of(s_in, "s"), data);
+        py::list rotations;
+        for (const auto& R : data.frame_rotations) rotations.append(Eigen::Matrix3d(R));
+        return py::make_tuple(Eigen::MatrixXd(data.frame_positions.transpose()), rotations);
+      },
+      "fk(s, params_json) -> (positions (frames x 3), [rotation 3 x 3 per frame])");
+
+  m.def(
+      "dependent_rates",
+      [](const Eigen::VectorXd& s_in, const Eigen::VectorXd& rates, const std::vector<std::string>& pair,
+         const std::string& params_json) {
+        const Model model(params_of(params_json));
+        Data data;
+        const Coordinates s = coordinates_of(s_in, "s");
+        if (rates.size() != kInputCount) throw Error("rates", "needs one entry per input (" + std::to_string(kInputCount) + ")");
+        Coordinates sdot = Coordinates::Zero();
+        sdot.head<kInputCount>() = rates;
+        const DependentPair dependent = pair.empty() ? default_pair() : pair.size() == 2 ? dependent_pair(pair[0], pair[1])
+                                                                                        : throw Error("dependent", "needs two names");
+        solve_dependent_rates(model, s, sdot, dependent, data);
+        return py::make_tuple(Eigen::VectorXd(sdot), data.cond_J_beta);
+      },
+      "dependent_rates(s, input_rates, pair, params_json) -> (sdot, cond_J_beta)");
+
+  m.def(
+      "inverse_dynamics",
+      [](const Eigen::VectorXd& s_in, const Eigen::Vector4d& u, const Eigen::Vector4d& u_dot, const std::string& params_json,
+         const std::string& weighting_json) {
+        const Model model(params_of(params_json));
+        Data data;
+        DynamicsTerms terms;
+        inverse_dynamics(model, coordinates_of(s_in, "s"), u, u_dot, data, terms);
+        const Vector8 tau = distribute_torques(terms.J_beta, terms.Qstar, parse_weighting(parse_json(weighting_json, "weighting"), "weighting"));
+        py::dict out;
+        out["tau"] = Eigen::VectorXd(tau);
+        out["Qstar"] = Eigen::VectorXd(terms.Qstar);
+        out["M"] = Eigen::MatrixXd(terms.M);
+        out["b"] = Eigen::VectorXd(terms.b);
+        out["Q_gravity"] = Eigen::VectorXd(terms.Q_gravity);
+        out["J_beta"] = Eigen::MatrixXd(terms.J_beta);
+        out["sdot"] = Eigen::VectorXd(terms.sdot);
+        return out;
+      },
+      "inverse_dynamics(s, u, u_dot, params_json, weighting_json) -> dict tau, Qstar, M, b, Q_gravity, J_beta, sdot");
+
+  m.def(
+      "simulate",
+      [](const std::string& scenario_json) {
+        const nlohmann::json j = parse_json(scenario_json, "scenario");
+        const Scenario sc = parse_scenario(j.is_string() ? read_scenario_json(j.get<std::string>()) : j);
+        const bool dynamics = sc.weighting.has_value();
+        const std::vector<std::string> header = trajectory_header(dynamics);
+        Eigen::MatrixXd table(sc.samples(), static_cast<Eigen::Index>(header.size()));
+        Eigen::Index rows = 0;
+        const Trajectory run = simulate_each(sc, [&](const Sample& smp) {
+          const std::vector<double> row = trajectory_row(smp, dynamics);
+          for (std::size_t c = 0; c < row.size(); ++c) table(rows, static_cast<Eigen::Index>(c)) = row[c];
+          ++rows;
+        });
+        py::dict columns;
+        for (std::size_t c = 0; c < header.size(); ++c)
+          columns[py::str(header[c])] = Eigen::VectorXd(table.col(static_cast<Eigen::Index>(c)).head(rows));
+        py::dict out;
+        out["columns"] = columns;
+        out["id"] = sc.id;
+        out["complete"] = run.complete;
+        out["stopped"] = run.error;
+        out["evaluations"] = run.evaluations;
+        return out;
+      },
+      "simulate(scenario_json) -> dict: columns (the CSV's, as arrays), complete, stopped (why, if early)");
+}
+
+WLX_COMMANDS_END

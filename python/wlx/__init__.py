@@ -1,0 +1,117 @@
+"""wlx from Python: the built-in models' kinematics, inverse kinematics, wheel rates, inverse
+dynamics and simulations, computed by the same C++ as the `wlx` command (same inputs, same checks,
+same error messages), with NumPy arrays out.
+
+    import wlx
+    robot = wlx.model("excavator")
+    s = robot.ik({"z_C": 1.8, "params": {"legD": 1.7}})["s"]
+    run = robot.simulate("NH-1")            # or a scenario dict, as in scenarios/*.json
+    run["t"], run["x_C"], run["tau_psi_l2"]
+
+Values follow the command line's grammar: SI numbers, or {"deg": x} / {"deg/s": x} for angles.
+Errors raise wlx.Error (a ValueError) with the command line's message, which names the field.
+"""
+
+import json as _json
+
+import numpy as _np
+
+from . import _wlx
+from ._wlx import Error
+
+__all__ = ["Error", "Model", "model", "models"]
+
+
+def models():
+    """The names of the built-in models."""
+    return list(_wlx.models)
+
+
+def model(name="excavator"):
+    """The built-in model of that name."""
+    if name not in _wlx.models:
+        raise Error(f"model: unknown model {name!r}; the built-in ones: {', '.join(_wlx.models)}")
+    return Model(getattr(_wlx, name))
+
+
+def _to_json(value, field):
+    try:
+        return _json.dumps(value, allow_nan=False)
+    except (TypeError, ValueError) as e:  # NaN, infinities, objects JSON has no form for
+        raise Error(f"{field}: {e}") from None
+
+
+def _params_json(params):
+    return _to_json(params or {}, "params")
+
+
+class Model:
+    """One built-in model: its tables (names, units, parameters) and its computations."""
+
+    def __init__(self, module):
+        self._m = module
+        info = module.info
+        self.name = info["name"]
+        self.description = info["description"]
+        self.coordinates = list(info["coordinates"])  # s = [inputs, dependent joints]
+        self.units = list(info["units"])
+        self.input_count = info["input_count"]
+        self.inputs = self.coordinates[: self.input_count]
+        self.frames = list(info["frames"])
+        self.params = dict(info["params"])  # defaults, SI units
+        self.scenarios = list(info["scenarios"])
+
+    def __repr__(self):
+        return f"wlx.model({self.name!r})"
+
+    def ik(self, request=None, **values):
+        """Inverse kinematics: `wlx ik`'s request (inputs by name, "params", "method": "closed-form"
+        or "newton", "branch": {limb: n}, "start"), as a dict and/or keywords. Returns `wlx ik`'s
+        answer as a dict, plus "s": all coordinates as an array."""
+        req = dict(request or {})
+        req.update(values)
+        s, answer = self._m.ik(_to_json(req, "request"))
+        out = _json.loads(answer)
+        out["s"] = s
+        return out
+
+    def fk(self, s, params=None):
+        """Frame origins and orientations in K0 at coordinates s (all of them, e.g. ik()["s"]):
+        {"positions": (frames x 3), "rotations": (frames x 3 x 3), "frames": names}."""
+        positions, rotations = self._m.fk(_np.asarray(s, dtype=float), _params_json(params))
+        return {"positions": positions, "rotations": _np.array(rotations), "frames": self.frames}
+
+    def dependent_rates(self, s, rates, dependent=None, params=None):
+        """All coordinate rates s' from the input rates (a dict by name or an array of the inputs'
+        rates); `dependent`: the input pair the wheels make dependent (default: the model's).
+        Returns (sdot, cond_J_beta)."""
+        if isinstance(rates, dict):
+            r = _np.zeros(self.input_count)
+            for k, v in rates.items():
+                if k not in self.inputs:
+                    raise Error(f"rates.{k}: not an input of {self.name}")
+                r[self.inputs.index(k)] = v
+            rates = r
+        return self._m.dependent_rates(_np.asarray(s, dtype=float), _np.asarray(rates, dtype=float),
+                                       list(dependent or []), _params_json(params))
+
+    def inverse_dynamics(self, s, u, u_dot=(0, 0, 0, 0), params=None, weighting=1):
+        """Q* and the actuator torques at s for the commanded speeds u and their rates u_dot (the
+        model file's dynamics section orders them); `weighting` as in scenario files (1, 2,
+        {"diag": [...]}, {"matrix": [[...]]})."""
+        return self._m.inverse_dynamics(_np.asarray(s, dtype=float), _np.asarray(u, dtype=float),
+                                        _np.asarray(u_dot, dtype=float), _params_json(params), _to_json(weighting, "weighting"))
+
+    def simulate(self, scenario):
+        """Runs a scenario: an embedded id ("NH-1"), a path to a JSON file, or a dict in the scenario
+        format. Returns the CSV's columns as arrays by name, plus "complete", "stopped" (why a run
+        ended early) and "evaluations"."""
+        if isinstance(scenario, dict):
+            text = _to_json(scenario, "scenario")
+        else:
+            text = _to_json(str(scenario), "scenario")
+        result = self._m.simulate(text)
+        out = dict(result["columns"])
+        for k in ("id", "complete", "stopped", "evaluations"):
+            out[k] = result[k]
+        return out

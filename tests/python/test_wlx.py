@@ -1,0 +1,182 @@
+"""The Python package against the command line: the same requests give the same answers (the same
+C++ computes both, so numbers agree exactly or to the last digit of the CLI's output), and the same
+bad inputs give the same messages. Run by ctest (tests/CMakeLists.txt) with PYTHONPATH at the
+built package and WLX_BINARY the built `wlx`."""
+
+import csv
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import wlx
+
+WLX = os.environ["WLX_BINARY"]
+README = Path(__file__).resolve().parents[2] / "README.md"
+
+
+def cli(args, stdin=""):
+    return subprocess.run([WLX, *args], input=stdin, capture_output=True, text=True, check=False)
+
+
+def cli_json(args, request):
+    done = cli(args, json.dumps(request))
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+@pytest.fixture(scope="module", params=wlx.models())
+def robot(request):
+    return wlx.model(request.param)
+
+
+def test_models_and_tables(robot):
+    listed = cli(["models"]).stdout
+    assert robot.name in listed
+    assert len(robot.coordinates) == len(robot.units) > robot.input_count > 0
+    assert all(math.isfinite(v) for v in robot.params.values())
+
+
+IK_REQUESTS = [
+    {},
+    {"z_C": 1.8, "pitch": {"deg": 3}},
+    {"params": "first parameter 2% larger"},
+    {"method": "newton", "x_C": 0.2},
+]
+
+
+@pytest.mark.parametrize("request_", IK_REQUESTS, ids=lambda r: json.dumps(r))
+def test_ik_answers_what_wlx_ik_answers(robot, request_):
+    if request_.get("params") == "first parameter 2% larger":  # each model has its own names
+        name, value = next(iter(robot.params.items()))
+        request_ = {"params": {name: value * 1.02}}
+    expected = cli_json(["ik", "--model", robot.name], request_)
+    got = robot.ik(request_)
+    s = got.pop("s")
+    assert got == expected  # the same dict: the CLI prints doubles round-trip exact
+    for k in range(robot.input_count, len(robot.coordinates)):
+        assert s[k] == expected[robot.coordinates[k]]
+
+
+def test_ik_branches_give_other_solutions():
+    robot = wlx.model("excavator")
+    first = robot.ik({"branch": {"leg_l": 0}})
+    other = robot.ik({"branch": {"leg_l": 1}})
+    assert other["branch"]["leg_l"] == 1
+    assert not np.allclose(first["s"], other["s"])
+    assert other["closure_residual"] <= 1e-12
+    assert other == {**cli_json(["ik"], {"branch": {"leg_l": 1}}), "s": other["s"]}
+
+
+def test_fk_gives_what_wlx_fk_gives(robot):
+    request = {"z_C": 1.9, "roll": {"deg": 2}}
+    expected = cli_json(["fk", "--json", "--model", robot.name], request)
+    s = robot.ik(request)["s"]
+    got = robot.fk(s)
+    assert got["positions"].shape == (len(robot.frames), 3)
+    for i, name in enumerate(robot.frames):
+        frame = expected["frames"][name]
+        np.testing.assert_array_equal(got["positions"][i], frame["position"])
+        np.testing.assert_array_equal(got["rotations"][i], np.array(frame["rotation"]))
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+@pytest.mark.parametrize("model_and_id", [("excavator", "NH-1"), ("excavator", "ID-1"), ("walker", None)])
+def test_simulate_gives_the_csv_of_wlx_simulate(tmp_path, model_and_id):
+    name, scenario = model_and_id
+    robot = wlx.model(name)
+    scenario = scenario or robot.scenarios[0]
+    done = cli(["simulate", scenario, "--model", name, "--out", str(tmp_path)])
+    assert done.returncode == 0, done.stderr
+    header, table = read_csv(tmp_path / "trajectory.csv")
+    run = robot.simulate(scenario)
+    assert run["complete"] and run["stopped"] == ""
+    for c, column in enumerate(header):
+        np.testing.assert_array_equal(run[column], table[:, c], err_msg=column)
+
+
+def test_simulate_takes_a_scenario_dict_like_a_file(tmp_path):
+    robot = wlx.model("excavator")
+    scenario = {"id": "mine", "rates": {"x_C": 1.0, "z_C": -0.5, "pitch": {"deg/s": 5}}, "dependent": ["y_C", "yaw"],
+                "duration": 0.2}
+    path = tmp_path / "mine.json"
+    path.write_text(json.dumps(scenario))
+    from_dict, from_file = robot.simulate(scenario), robot.simulate(str(path))
+    for column in ("t", "x_C", "yaw", "pitch", "theta_l3"):
+        np.testing.assert_array_equal(from_dict[column], from_file[column])
+    assert from_dict["t"][-1] == pytest.approx(0.2, abs=1e-12)
+
+
+def test_inverse_dynamics_and_rates_match_the_simulation():
+    # ID-1 at t = 0: the pose is the nominal one, u = [z_C', x_C', roll', pitch'] = [0, 3, 0, 0], u' = 0.
+    robot = wlx.model("excavator")
+    run = robot.simulate("ID-1")
+    s = np.array([run[name][0] for name in robot.coordinates])
+    dyn = robot.inverse_dynamics(s, [0.0, 3.0, 0.0, 0.0])
+    taus = [c for c in run if c.startswith("tau_")]
+    assert len(taus) == len(dyn["tau"]) == 8
+    np.testing.assert_allclose(dyn["tau"], [run[c][0] for c in taus], rtol=1e-12, atol=1e-9)
+    # The torques reproduce Q*: J_beta^T tau = Q*.
+    np.testing.assert_allclose(dyn["J_beta"].T @ dyn["tau"], dyn["Qstar"], rtol=1e-10, atol=1e-6)
+    sdot, cond = robot.dependent_rates(s, {"x_C": 3.0}, dependent=["y_C", "yaw"])
+    for k, name in enumerate(robot.inputs):
+        assert sdot[k] == pytest.approx(run[name + "_dot"][0], abs=1e-12)
+    assert cond == pytest.approx(run["cond_J_beta"][0], rel=1e-12)
+
+
+BAD_IK = [
+    {"legD": 1},
+    {"params": {"legD": -1}},
+    {"z_C": "high"},
+    {"pitch": {"deg": "x"}},
+    {"x_Fl": 40.0},
+    {"method": "newton", "start": {"psi_l2": "x"}},
+    {"branch": {"leg_l": 7}},
+]
+
+
+@pytest.mark.parametrize("request_", BAD_IK, ids=lambda r: json.dumps(r))
+def test_errors_are_wlx_errors_with_the_cli_message(request_):
+    robot = wlx.model("excavator")
+    done = cli(["ik"], json.dumps(request_))
+    assert done.returncode == 2
+    message = done.stderr.strip().removeprefix("wlx: error: ")
+    with pytest.raises(wlx.Error) as caught:
+        robot.ik(request_)
+    assert str(caught.value) == message
+    assert isinstance(caught.value, ValueError)
+
+
+def test_array_arguments_are_checked():
+    robot = wlx.model("excavator")
+    with pytest.raises(wlx.Error, match=r"^s: has 3 entries"):
+        robot.fk([0.0, 1.0, 2.0])
+    s = robot.ik()["s"]
+    s[2] = float("nan")
+    with pytest.raises(wlx.Error, match="not a finite number"):
+        robot.fk(s)
+    with pytest.raises(wlx.Error, match=r"^model: unknown model"):
+        wlx.model("tractor")
+
+
+def test_readme_python_example_runs(tmp_path):
+    # The README's Python example (the python block after "<!-- ci: python -->"), run as it stands.
+    text = README.read_text()
+    block = re.search(r"<!-- ci: python -->\s*```python\n(.*?)```", text, re.S)
+    assert block, "README.md: no python block after <!-- ci: python -->"
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    done = subprocess.run([sys.executable, "-c", block.group(1)], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "legD_sweep.png").stat().st_size > 10000
+    assert "legD" in done.stdout
