@@ -3,7 +3,8 @@
 # README's test command has built build/):
 #   1. the README's embedding recipe, verbatim (the sh block after "<!-- ci: embedding -->"):
 #      install into a prefix, then build and run examples/controller against it;
-#   2. add_subdirectory() of the source tree: only the runtime is configured, and the configure
+#   2. the installed Python package imports from the prefix and solves;
+#   3. add_subdirectory() of the source tree: only the runtime is configured, and the configure
 #      finds neither GiNaC nor CLI11 nor nlohmann-json (not needed, so not looked for).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,6 +22,18 @@ if ! grep -q 'cmake --install' "$work/embedding.sh"; then
 fi
 cat "$work/embedding.sh"
 bash -euo pipefail "$work/embedding.sh"
+
+echo "-- the installed Python package"
+if [ -d build/install/lib/python3/dist-packages/wlx ]; then
+  PYTHONPATH="$PWD/build/install/lib/python3/dist-packages" /usr/bin/python3 -c '
+import wlx
+answer = wlx.model("excavator").ik({"z_C": 1.8})
+assert answer["closure_residual"] <= 1e-12, answer
+print("installed wlx:", wlx.__file__, "ik closure residual", answer["closure_residual"])'
+else
+  echo "no Python package installed (pybind11 or Python headers missing at configure time)" >&2
+  exit 1
+fi
 
 echo "-- add_subdirectory(), runtime only"
 cmake -S tests/package -B "$work/subdirectory" -G Ninja -DWLX_SOURCE_DIR="$PWD" > "$work/configure.log"
