@@ -18,11 +18,6 @@ WLX_COMMANDS_BEGIN
 // Defined in the build tree's embedded_scenarios.cpp (CMakeLists.txt writes it from scenarios/).
 extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios;
 
-namespace {
-
-
-}  // namespace
-
 std::vector<std::string> scenario_ids() {
   std::vector<std::string> ids;
   for (const auto& [id, text] : kEmbeddedScenarios) ids.push_back(id);

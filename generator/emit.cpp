@@ -52,6 +52,17 @@ std::string quoted(const std::string& text) {
 
 namespace detail {
 
+// The coordinates (from s) and their rates (<name>_dot, from sdot) the body uses, as local
+// constants of the scalar type.
+std::string coordinate_aliases(const Model& m, const std::set<std::string>& used) {
+  std::string s;
+  for (const auto& c : m.coordinates)
+    if (used.count(c.name)) s += fmt::format("  const Scalar {} = s({});\n", c.name, c.index);
+  for (const auto& c : m.coordinates)
+    if (used.count(c.name + "_dot")) s += fmt::format("  const Scalar {}_dot = sdot({});\n", c.name, c.index);
+  return s;
+}
+
 // Baked parameters become constants: the expression structure stays the symbolic one (GiNaC would
 // distribute numeric factors over sums), and the compiler folds the numbers. The others are read
 // from Params (double) and converted to the scalar type once.
@@ -264,12 +275,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   stats.before_cse = before;
   stats.after_cse = total;
 
-  std::string aliases;
-  for (const auto& c : m.coordinates)
-    if (symbols.count(c.name)) aliases += fmt::format("  const Scalar {} = s({});\n", c.name, c.index);
-  for (const auto& c : m.coordinates)
-    if (symbols.count(c.name + "_dot")) aliases += fmt::format("  const Scalar {}_dot = sdot({});\n", c.name, c.index);
-  aliases += parameter_aliases(m, symbols, opt);
+  const std::string aliases = coordinate_aliases(m, symbols) + parameter_aliases(m, symbols, opt);
 
   std::string t = banner(m, opt, fmt::format("{}: {}", fn.name, fn.doc));
   t += "#pragma once\n\n#include <array>\n#include <cmath>\n\n#include \"params.hpp\"\n";
@@ -287,42 +293,38 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   t += fmt::format("// The same outputs as expression trees, before CSE: {}.\n", op_summary(before));
   t += "// Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by\n"
        "// argument-dependent lookup; deduced from s. The parameters stay double.\n";
-  std::string signature = fmt::format("template <typename Scalar>\ninline void {}(const CoordinatesOf<Scalar>& s, ", fn.name);
-  if (fn.needs_rates) signature += "const detail::NonDeduced<CoordinatesOf<Scalar>>& sdot, ";
-  signature += "const Params& p";
+  // One parameter list, printed twice: the template (Scalar deduced from s alone, so the other
+  // arguments, nullptr among them, are not deduced from) and the double overload, whose plain types
+  // take Eigen expressions for s, which a template cannot deduce from.
+  struct Parameter {
+    std::string templated, plain, name;
+  };
+  std::vector<Parameter> parameters{{"const CoordinatesOf<Scalar>&", "const Coordinates&", "s"}};
+  if (fn.needs_rates) parameters.push_back({"const detail::NonDeduced<CoordinatesOf<Scalar>>&", "const Coordinates&", "sdot"});
+  parameters.push_back({"const Params&", "const Params&", "p"});
   for (const auto& o : fn.outputs)
-    signature += fmt::format(", detail::NonDeduced<{}>* {}", o.type == "double" ? "Scalar" : o.type + "Of<Scalar>", o.name);
+    parameters.push_back({fmt::format("detail::NonDeduced<{}>*", o.type == "double" ? "Scalar" : o.type + "Of<Scalar>"), o.type + "*", o.name});
   const bool has_zeros = std::any_of(fn.outputs.begin(), fn.outputs.end(), [](const auto& o) { return !o.prologue.empty(); });
   if (has_zeros) {
     // Zeroing a 14 x 32 or 7 x 3 x 32 output costs more than computing its nonzeros (store
     // bandwidth), so a workspace that keeps its zeros can skip it.
     t += "// zero_fill: write the structural zeros of the matrix outputs too. Pass false when they are\n"
          "// zero already (a workspace zeroed once at setup): this function never writes them.\n";
-    signature += ", bool zero_fill = true";
+    parameters.push_back({"bool", "bool", "zero_fill"});
   }
-  t += signature + ") noexcept {\n";
+  std::vector<std::string> templated, plain, arguments;
+  for (const auto& par : parameters) {
+    const std::string default_value = par.name == "zero_fill" ? " = true" : "";
+    templated.push_back(par.templated + " " + par.name + default_value);
+    plain.push_back(par.plain + " " + par.name + default_value);
+    arguments.push_back(par.name);
+  }
+  t += fmt::format("template <typename Scalar>\ninline void {}({}) noexcept {{\n", fn.name, fmt::join(templated, ", "));
   t += "  static_cast<void>(s);\n  static_cast<void>(p);\n";
   if (fn.needs_rates) t += "  static_cast<void>(sdot);\n";
   t += using_declarations(pr.calls()) + aliases + body + "}\n\n";
-  // The double overload: the runtime's types, and Eigen expressions for s (which a template
-  // cannot deduce from) convert to them.
-  std::string forward = fmt::format("// {}() in double, for any Eigen expression of the coordinates.\ninline void {}(const Coordinates& s, ", fn.name, fn.name);
-  std::string arguments = "s, ";
-  if (fn.needs_rates) {
-    forward += "const Coordinates& sdot, ";
-    arguments += "sdot, ";
-  }
-  forward += "const Params& p";
-  arguments += "p";
-  for (const auto& o : fn.outputs) {
-    forward += fmt::format(", {}* {}", o.type, o.name);
-    arguments += ", " + o.name;
-  }
-  if (has_zeros) {
-    forward += ", bool zero_fill = true";
-    arguments += ", zero_fill";
-  }
-  t += forward + fmt::format(") noexcept {{\n  {}<double>({});\n}}\n\n", fn.name, arguments);
+  t += fmt::format("// {0}() in double, for any Eigen expression of the coordinates.\ninline void {0}({1}) noexcept {{\n  {0}<double>({2});\n}}\n\n",
+                   fn.name, fmt::join(plain, ", "), fmt::join(arguments, ", "));
   t += fmt::format("namespace operations {{\n// Operations {}() evaluates with every output requested (adds, muls, divs, calls).\n"
                    "inline constexpr long {} = {};\n}}  // namespace operations\n\n",
                    fn.name, fn.name, total.total());

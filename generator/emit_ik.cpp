@@ -566,9 +566,7 @@ std::string emit_body(const Model& m, const std::vector<Stage>& stages, const st
   for (int r : roots) collect(r);
 
   std::string body;
-  for (const auto& c : m.coordinates)
-    if (symbols.count(c.name)) body += fmt::format("  const Scalar {} = s({});\n", c.name, c.index);
-  body += parameter_aliases(m, symbols, opt);
+  body += coordinate_aliases(m, symbols) + parameter_aliases(m, symbols, opt);
   body += trig.prologue;
   const auto batched = [&](std::size_t k) { return trig.names.count(plan.temporaries[k]) != 0; };
   for (std::size_t k = 0; k < stages.size(); ++k) {

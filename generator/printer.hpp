@@ -34,6 +34,8 @@ inline const char* call_name(const std::string& f) {
 // A number in a generated function body: of the function's scalar type, so float code stays float.
 inline std::string scalar_literal(double v) { return "Scalar(" + literal(v) + ")"; }
 
+// The coordinates and coordinate rates the body uses as local constants of the scalar type.
+std::string coordinate_aliases(const Model& m, const std::set<std::string>& used);
 // The parameters the body uses as local constants of the scalar type (baked ones as literals).
 std::string parameter_aliases(const Model& m, const std::set<std::string>& used, const EmitOptions& opt);
 
