@@ -147,7 +147,7 @@ void BM_full_kinematic_update(benchmark::State& st) {
   Coordinates s = moved_target();
   for (auto _ : st) {
     solve_ik_closed_form(model, s);
-    kinematic_update(model, s, d);
+    kinematic_update(model, d, s);
     benchmark::DoNotOptimize(d.C.data());
   }
 }
@@ -169,7 +169,7 @@ void BM_ik_newton_cold_4_limbs(benchmark::State& st) {
   long iterations = 0;
   for (auto _ : st) {
     Coordinates s = start;
-    const NewtonReport r = solve_ik_newton(model, s, d);
+    const NewtonReport r = solve_ik_newton(model, d, s);
     iterations += r.iterations[0] + r.iterations[1] + r.iterations[2] + r.iterations[3];
     benchmark::DoNotOptimize(s.data());
   }
@@ -189,7 +189,7 @@ void BM_ik_newton_warm_4_limbs(benchmark::State& st) {
   long iterations = 0;
   for (auto _ : st) {
     Coordinates s = start;
-    const NewtonReport r = solve_ik_newton(model, s, d);
+    const NewtonReport r = solve_ik_newton(model, d, s);
     iterations += r.iterations[0] + r.iterations[1] + r.iterations[2] + r.iterations[3];
     benchmark::DoNotOptimize(s.data());
   }
@@ -204,7 +204,7 @@ void BM_dependent_rates(benchmark::State& st) {
   Coordinates sdot = Coordinates::Zero();
   sdot(gen::coord::roll) = 0.1;
   for (auto _ : st) {
-    solve_dependent_rates(model, s, sdot, default_pair(), d);
+    solve_dependent_rates(model, d, s, sdot, default_pair());
     benchmark::DoNotOptimize(sdot.data());
   }
 }
@@ -215,10 +215,10 @@ void BM_dependent_accelerations(benchmark::State& st) {
   const Coordinates s = assembled_nominal(model);
   Coordinates sdot = Coordinates::Zero();
   sdot(gen::coord::roll) = 0.1;
-  solve_dependent_rates(model, s, sdot, default_pair(), d);
+  solve_dependent_rates(model, d, s, sdot, default_pair());
   Coordinates sddot = Coordinates::Zero();
   for (auto _ : st) {
-    solve_dependent_accelerations(model, s, sdot, sddot, default_pair(), d);
+    solve_dependent_accelerations(model, d, s, sdot, sddot, default_pair());
     benchmark::DoNotOptimize(sddot.data());
   }
 }
@@ -241,11 +241,11 @@ void BM_inverse_dynamics_step(benchmark::State& st) {
   DynamicsTerms terms;
   Coordinates s = nominal_inputs();
   s(gen::coord::x_C) = 0.3;
-  const Vector4 u(0, 3, 0, 0);
+  const CommandVector u(0, 3, 0, 0);
   for (auto _ : st) {
     solve_ik_closed_form(model, s);
-    inverse_dynamics(model, s, u, Vector4::Zero(), d, terms);
-    const Vector8 tau = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
+    inverse_dynamics(model, d, s, u, CommandVector::Zero(), terms);
+    const TorqueVector tau = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
     benchmark::DoNotOptimize(tau.data());
   }
 }

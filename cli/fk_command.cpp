@@ -69,8 +69,8 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
     throw Error("stdin", fmt::format("give all {} dependent joints or none (then the closed-form IK solves them); {} given",
                                      kDependentCount, dependents_given));
   Data data;
-  forward_kinematics(model, s, data);
-  closure(model, s, data, false);
+  forward_kinematics(model, data, s);
+  closure(model, data, s, false);
   const double residual = data.Phi.cwiseAbs().maxCoeff();
   if (as_json) {
     nlohmann::ordered_json out;

@@ -41,20 +41,20 @@ nlohmann::ordered_json solve_ik_request(const IkRequest& r, Coordinates* warm, C
     if (warm != nullptr && warm->allFinite()) start = *warm;
     s.tail(kDependentCount) = start.tail(kDependentCount);
     for (const auto& [index, value] : r.start) s(index) = value;
-    report = solve_ik_newton(model, s, data);
+    report = solve_ik_newton(model, data, s);
     if (warm != nullptr) *warm = s;
   }
   s.array() += 0.0;  // no "-0.0" in the output
   if (solution != nullptr) *solution = s;
-  forward_kinematics(model, s, data);
+  forward_kinematics(model, data, s);
   for (int k = kInputCount; k < kCoordinateCount; ++k) out[std::string(gen::kCoordinateNames[k])] = s(k);
   for (const auto& wheel : gen::kWheels) {  // the contact points: x_W<wheel>, y_W<wheel>
     out["x_W" + std::string(wheel.name)] = data.frame_positions(0, wheel.contact_frame);
     out["y_W" + std::string(wheel.name)] = data.frame_positions(1, wheel.contact_frame);
   }
   double check = 0;
-  for (Limb limb : kLimbs) check = std::max(check, analytic_check(model, limb, s, data).position_error);
-  closure(model, s, data, false);
+  for (Limb limb : kLimbs) check = std::max(check, analytic_check(model, data, limb, s).position_error);
+  closure(model, data, s, false);
   // A result that does not satisfy the model is an error, never an answer (1e-9: far above
   // rounding, which leaves about 1e-15).
   const double residual = data.Phi.cwiseAbs().maxCoeff();
@@ -83,15 +83,17 @@ nlohmann::ordered_json solve_ik_request(const IkRequest& r, Coordinates* warm, C
 void write_ik_sweep_csv(const std::string& path, const IkSweepResult& r) {
   std::vector<std::string> header{r.sweep.input};
   for (int k = kInputCount; k < kCoordinateCount; ++k) header.emplace_back(gen::kCoordinateNames[k]);
-  for (const char* h : {"x_Wl", "y_Wl", "x_Wr", "y_Wr", "check_error_closed_form", "check_error_newton",
-                        "level_error_closed_form", "level_error_newton", "newton_minus_closed_form", "newton_iterations",
-                        "newton_branch", "cold_start_branch"})
+  for (int w = 0; w < kWheelCount; ++w)
+    for (const char* axis : {"x_", "y_"}) header.push_back(axis + contact_column_stem(w));
+  for (const char* h :
+       {"check_error_closed_form", "check_error_newton", "level_error_closed_form", "level_error_newton",
+        "newton_minus_closed_form", "newton_iterations", "newton_branch", "cold_start_branch"})
     header.emplace_back(h);
   CsvWriter csv(path, header);
   for (const auto& p : r.points) {
     std::vector<double> row{p.value};
     for (int k = kInputCount; k < kCoordinateCount; ++k) row.push_back(p.closed_form(k));
-    for (int k = 0; k < 4; ++k) row.push_back(p.contacts(k));
+    for (int k = 0; k < p.contacts.size(); ++k) row.push_back(p.contacts(k));
     row.insert(row.end(), {p.check_closed_form.position_error, p.check_newton.position_error,
                            p.check_closed_form.level_error, p.check_newton.level_error, p.newton_difference,
                            static_cast<double>(p.newton_iterations), static_cast<double>(p.newton_branch),
@@ -165,7 +167,7 @@ int run_verify_ik(const ModelOptions& model_options, const std::string& out_dir,
              "check CF (m)", "check N (m)", "level err", "|CF-N| (rad)", "N iter avg", "N max", "cold start");
   for (const auto& sweep : sweeps) {
     throw_if_interrupted();
-    const IkSweepResult r = run_ik_sweep(model, sweep, data);
+    const IkSweepResult r = run_ik_sweep(model, data, sweep);
     write_ik_sweep_csv((std::filesystem::path(out_dir) / (sweep.id + ".csv")).string(), r);
     const bool pass = r.max_check_closed_form <= kLimit && r.max_check_newton <= kLimit && r.max_level_error <= kLimit &&
                       r.newton_branch_changes == 0;

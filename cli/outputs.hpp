@@ -13,8 +13,8 @@ WLX_COMMANDS_BEGIN
 // One row per sweep point: the swept input, the 14 dependents, contacts, check errors, Newton.
 void write_ik_sweep_csv(const std::string& path, const IkSweepResult& result);
 
-// t, the 32 coordinates, x_Wl..y_Wr, nh_residual_l/r, spin_rate_l/r, the 18 input rates
-// (<name>_dot), cond_J_beta, cabin_clearance, the contact velocities vx_Wl..vz_Wr, and for
+// t, the coordinates, per wheel x_/y_<contact> (x_Wl, y_Wl, ...), nh_residual_<wheel>, spin_rate_<wheel>,
+// the input rates (<name>_dot), cond_J_beta, cabin_clearance, the contact velocities vx_/vy_/vz_<contact>, and for
 // dynamics runs tau_<joint> and Qstar_<speed>.
 std::vector<std::string> trajectory_header(bool dynamics);
 std::vector<double> trajectory_row(const Sample& sample, bool dynamics);

@@ -145,7 +145,7 @@ void Report::run_ik() {
     if (opt_.quick && sweep.id != "IK-L3" && sweep.id != "IK-WL2") continue;
     progress(fmt::format("inverse kinematics sweep {} ({} from {:g} to {:g})", sweep.id, sweep.input,
                          sweep.degrees ? sweep.from / kDeg : sweep.from, sweep.degrees ? sweep.to / kDeg : sweep.to));
-    sweeps_.push_back(run_ik_sweep(model_, sweep, data_));
+    sweeps_.push_back(run_ik_sweep(model_, data_, sweep));
     write_ik_sweep_csv(data(sweep.id + ".csv"), sweeps_.back());
   }
 }
@@ -323,8 +323,8 @@ void Report::add_checks() {
     Coordinates s = nominal_inputs();
     solve_ik_closed_form(model_, s);
     DynamicsTerms t;
-    inverse_dynamics(model_, s, Vector4::Zero(), Vector4::Zero(), data_, t);
-    const Vector8 tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+    inverse_dynamics(model_, data_, s, CommandVector::Zero(), CommandVector::Zero(), t);
+    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
     const double estimate = model_.params().cxd / 2 * model_.total_mass() * model_.params().g / 2;
     const double hip = std::max(std::abs(tau(0)), std::abs(tau(3)));
     checks_.push_back({"Static hip-pitch torque, 2D estimate (cxd/2)(m g/2) (thesis eq. 6.34)", fmt::format("{:.3g} N m", estimate),
@@ -462,7 +462,7 @@ void Report::figures_poses() {
     // Two blocks (start, end), each a set of segments separated by blank lines: cabin outline,
     // legs hip-knee-foot, levers hip-end-contact.
     for (const Sample* smp : {&r.trajectory.samples.front(), &r.trajectory.samples.back()}) {
-      forward_kinematics(model_, smp->s, data_);
+      forward_kinematics(model_, data_, smp->s);
       const auto P = [&](int f) { return data_.frame_positions.col(f); };
       const Eigen::Matrix3d& R = data_.frame_rotations[gen::frame::C];
       const Params& p = model_.params();

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <wlx/error.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -65,7 +66,7 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
   if (v.is_object() && v.size() == 1 && v.contains("diag")) {
     const auto& d = v.at("diag");
     if (!d.is_array() || d.size() != 8) throw Error(key + ".diag", fmt::format("must be an array of 8 weights, got {}", excerpt(d)));
-    Vector8 w;
+    TorqueVector w;
     for (int i = 0; i < 8; ++i) w(i) = finite_number(d[static_cast<std::size_t>(i)], fmt::format("{}.diag[{}]", key, i));
     // Only ratios of weights matter (a uniform scale leaves the torques unchanged); beyond this span
     // rounding, not the weights, would decide how the torque is split.
@@ -128,14 +129,20 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base) {
       else sc.rates(k) = v;
     }
   }
-  if (!j.contains("dependent")) throw Error("dependent", "missing: name the two dependent rates, e.g. [\"y_C\", \"yaw\"]");
+  if (!j.contains("dependent"))
+    throw Error("dependent", fmt::format("missing: name the {} dependent rates (one per wheel), e.g. {}", kWheelCount,
+                                         default_pair().label()));
   const auto& dep = j.at("dependent");
-  if (!dep.is_array() || dep.size() != 2 || !dep[0].is_string() || !dep[1].is_string())
-    throw Error("dependent", fmt::format("must be an array of 2 names, got {}", excerpt(dep)));
-  for (const auto& name : dep)  // the pair's own messages quote the names in full
+  if (!dep.is_array() || dep.size() != static_cast<std::size_t>(kWheelCount) ||
+      !std::all_of(dep.begin(), dep.end(), [](const auto& name) { return name.is_string(); }))
+    throw Error("dependent", fmt::format("must be an array of {} names, got {}", kWheelCount, excerpt(dep)));
+  std::vector<std::string> names;
+  for (const auto& name : dep) {  // the pair's own messages quote the names in full
     if (excerpt(name.get<std::string>()) != name.get<std::string>())
       throw Error("dependent", fmt::format("'{}' cannot be a dependent rate", excerpt(name.get<std::string>())));
-  sc.pair = dependent_pair(dep[0].get<std::string>(), dep[1].get<std::string>());
+    names.push_back(name.get<std::string>());
+  }
+  sc.pair = dependent_pair(names);
   if (!j.contains("duration")) throw Error("duration", "missing: the run's length in seconds");
   sc.duration = finite_number(j.at("duration"), "duration");
   if (j.contains("dt")) sc.dt = finite_number(j.at("dt"), "dt");

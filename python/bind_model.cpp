@@ -78,7 +78,7 @@ void bind_python(py::module_& parent) {
       [](const Eigen::VectorXd& s_in, const std::string& params_json) {
         const Model model(params_of(params_json));
         Data data;
-        forward_kinematics(model, coordinates_of(s_in, "s"), data);
+        forward_kinematics(model, data, coordinates_of(s_in, "s"));
         py::list rotations;
         for (const auto& R : data.frame_rotations) rotations.append(Eigen::Matrix3d(R));
         return py::make_tuple(Eigen::MatrixXd(data.frame_positions.transpose()), rotations);
@@ -95,9 +95,8 @@ void bind_python(py::module_& parent) {
         if (rates.size() != kInputCount) throw Error("rates", "needs one entry per input (" + std::to_string(kInputCount) + ")");
         Coordinates sdot = Coordinates::Zero();
         sdot.head<kInputCount>() = rates;
-        const DependentPair dependent = pair.empty() ? default_pair() : pair.size() == 2 ? dependent_pair(pair[0], pair[1])
-                                                                                        : throw Error("dependent", "needs two names");
-        solve_dependent_rates(model, s, sdot, dependent, data);
+        const DependentPair dependent = pair.empty() ? default_pair() : dependent_pair(pair);
+        solve_dependent_rates(model, data, s, sdot, dependent);
         return py::make_tuple(Eigen::VectorXd(sdot), data.cond_J_beta);
       },
       "dependent_rates(s, input_rates, pair, params_json) -> (sdot, cond_J_beta)");
@@ -109,8 +108,9 @@ void bind_python(py::module_& parent) {
         const Model model(params_of(params_json));
         Data data;
         DynamicsTerms terms;
-        inverse_dynamics(model, coordinates_of(s_in, "s"), u, u_dot, data, terms);
-        const Vector8 tau = distribute_torques(terms.J_beta, terms.Qstar, parse_weighting(parse_json(weighting_json, "weighting"), "weighting"));
+        inverse_dynamics(model, data, coordinates_of(s_in, "s"), u, u_dot, terms);
+        const TorqueVector tau = distribute_torques(
+            terms.J_beta, terms.Qstar, parse_weighting(parse_json(weighting_json, "weighting"), "weighting"));
         py::dict out;
         out["tau"] = Eigen::VectorXd(tau);
         out["Qstar"] = Eigen::VectorXd(terms.Qstar);

@@ -116,29 +116,30 @@ int main() {
     const long steps = std::lround(m.period / dt);
     step_seconds.clear();
     Worst worst;
-    wlx::Vector8 tau = wlx::Vector8::Zero();
+    wlx::TorqueVector tau = wlx::TorqueVector::Zero();
     const Eigen::Matrix<double, wlx::kInputCount, 1> start = q;
 
     counting = true;
     try {
       for (long k = 0; k < steps; ++k) {
         const double phase = 2 * std::numbers::pi * static_cast<double>(k) * dt / m.period;
-        wlx::Vector4 u = wlx::Vector4::Zero(), u_dot = wlx::Vector4::Zero();
+        wlx::CommandVector u = wlx::CommandVector::Zero(), u_dot = wlx::CommandVector::Zero();
         u(slot) = m.amplitude * std::sin(phase);
         u_dot(slot) = m.amplitude * 2 * std::numbers::pi / m.period * std::cos(phase);
 
         const auto begin = std::chrono::steady_clock::now();
         s.head<wlx::kInputCount>() = q;
         wlx::solve_ik_closed_form(model, s);                         // 1. joint angles
-        wlx::inverse_dynamics(model, s, u, u_dot, data, terms);       // 2. rates, Q*
+        wlx::inverse_dynamics(model, data, s, u, u_dot, terms);      // 2. rates, Q*
         tau = wlx::distribute_torques(terms.J_beta, terms.Qstar, weighting);  // 3. torques
         q += dt * terms.sdot.head<wlx::kInputCount>();               // the next commanded pose
         step_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
 
         // The checks, outside the timed part.
-        wlx::closure(model, s, data, false);
+        wlx::closure(model, data, s, false);
         worst.closure = std::max(worst.closure, data.Phi.cwiseAbs().maxCoeff());
-        worst.sideways = std::max(worst.sideways, wlx::sideways_velocity(model, s, terms.sdot, data).cwiseAbs().maxCoeff());
+        worst.sideways =
+            std::max(worst.sideways, wlx::sideways_velocity(model, data, s, terms.sdot).cwiseAbs().maxCoeff());
         const double imbalance = (terms.J_beta.transpose() * tau - terms.Qstar).norm() / terms.Qstar.norm();
         worst.torque_balance = std::max(worst.torque_balance, imbalance);
         worst.torque = std::max(worst.torque, tau.cwiseAbs().maxCoeff());

@@ -33,16 +33,16 @@ void for_each_body(F&& f) {
 
 }  // namespace
 
-void inverse_dynamics(const Model& model, const Coordinates& s, const Vector4& u, const Vector4& u_dot, Data& d,
-                      DynamicsTerms& out, const NonholonomicOptions& options) {
+void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const CommandVector& u,
+                      const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options) {
   const Params& p = model.params();
   out.sdot.setZero();
-  for (int k = 0; k < 4; ++k) out.sdot(kCommandedSpeeds[static_cast<std::size_t>(k)]) = u(k);
+  for (int k = 0; k < kCommandedCount; ++k) out.sdot(kCommandedSpeeds[static_cast<std::size_t>(k)]) = u(k);
   const DependentPair pair = dynamics_pair();
-  solve_dependent_rates(model, s, out.sdot, pair, d, options);
-  out.T = rate_basis(kCommandedSpeeds, pair, d);
+  solve_dependent_rates(model, d, s, out.sdot, pair, options);
+  out.T = rate_basis(d, kCommandedSpeeds, pair);
   Coordinates bias = Coordinates::Zero();  // s'' with u' = 0
-  solve_dependent_accelerations(model, s, out.sdot, bias, pair, d);
+  solve_dependent_accelerations(model, d, s, out.sdot, bias, pair);
   out.sddot = out.T * u_dot + bias;
   gen::bodies(s, out.sdot, p, &d.body_com, &d.body_rotations, &d.body_Jv, &d.body_Jw, &d.body_Jv_dot_sdot,
               &d.body_Jw_dot_sdot, false);
@@ -60,8 +60,8 @@ void inverse_dynamics(const Model& model, const Coordinates& s, const Vector4& u
     const double m = mass(p, i);
     const Eigen::Matrix3d inertia = world_inertia(p, i, d.body_rotations[static_cast<std::size_t>(i)]);
     // Partial velocities dv/du = Jv T and domega/du = Jw T; omega = Jw s'; Jv s'' and Jw s'' for u' = 0.
-    Eigen::Matrix<double, 3, 4> A = Eigen::Matrix<double, 3, 4>::Zero();
-    Eigen::Matrix<double, 3, 4> B = Eigen::Matrix<double, 3, 4>::Zero();
+    Eigen::Matrix<double, 3, kCommandedCount> A = Eigen::Matrix<double, 3, kCommandedCount>::Zero();
+    Eigen::Matrix<double, 3, kCommandedCount> B = Eigen::Matrix<double, 3, kCommandedCount>::Zero();
     Eigen::Vector3d omega = Eigen::Vector3d::Zero(), a_bias = d.body_Jv_dot_sdot.col(i),
                     alpha_bias = d.body_Jw_dot_sdot.col(i);
     for (int c = 0; c < columns.count; ++c) {
@@ -77,10 +77,10 @@ void inverse_dynamics(const Model& model, const Coordinates& s, const Vector4& u
     out.Q_gravity.noalias() += A.transpose() * (m * gravity);
   });
   out.Qstar = out.M * u_dot + out.b - out.Q_gravity;
-  for (int r = 0; r < 8; ++r) out.J_beta.row(r) = out.T.row(kActuatedJoints[static_cast<std::size_t>(r)]);
+  for (int r = 0; r < kActuatedCount; ++r) out.J_beta.row(r) = out.T.row(kActuatedJoints[static_cast<std::size_t>(r)]);
 }
 
-double potential_energy(const Model& model, const Coordinates& s, Data& d) {
+double potential_energy(const Model& model, Data& d, const Coordinates& s) {
   const Params& p = model.params();
   gen::bodies(s, Coordinates::Zero(), p, &d.body_com, nullptr, nullptr, nullptr, nullptr, nullptr, false);
   double V = 0;
@@ -88,7 +88,7 @@ double potential_energy(const Model& model, const Coordinates& s, Data& d) {
   return V;
 }
 
-double kinetic_energy(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& d) {
+double kinetic_energy(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot) {
   const Params& p = model.params();
   gen::bodies(s, sdot, p, nullptr, &d.body_rotations, &d.body_Jv, &d.body_Jw, nullptr, nullptr, false);
   double T = 0;
@@ -110,8 +110,8 @@ std::string Weighting::label() const {
   return {};
 }
 
-Weighting Weighting::diagonal_of(const Vector8& w) {
-  for (int i = 0; i < 8; ++i)
+Weighting Weighting::diagonal_of(const TorqueVector& w) {
+  for (int i = 0; i < kActuatedCount; ++i)
     if (!(std::isfinite(w(i)) && w(i) > 0))
       throw Error(fmt::format("weighting[{}]", i), fmt::format("a weight must be positive and finite, got {}", w(i)));
   Weighting out;
@@ -120,7 +120,7 @@ Weighting Weighting::diagonal_of(const Vector8& w) {
   return out;
 }
 
-Weighting Weighting::matrix_of(const Eigen::Matrix<double, 8, 8>& W) {
+Weighting Weighting::matrix_of(const TorqueMatrix& W) {
   if (!W.allFinite()) throw Error("weighting", "the weight matrix has a non-finite entry");
   if ((W - W.transpose()).cwiseAbs().maxCoeff() > 1e-12 * W.cwiseAbs().maxCoeff())
     throw Error("weighting", "the weight matrix must be symmetric");
@@ -133,13 +133,15 @@ Weighting Weighting::matrix_of(const Eigen::Matrix<double, 8, 8>& W) {
   return out;
 }
 
-Vector8 distribute_torques(const ActuatorJacobian& J_beta, const Vector4& Qstar, const Weighting& weighting) {
+TorqueVector distribute_torques(const ActuatorJacobian& J_beta, const CommandVector& Qstar,
+                                const Weighting& weighting) {
+  constexpr int kU = kCommandedCount;
   // S with S S^T = W^-1: tau = S x and |x| = sqrt(tau^T W tau).
-  Eigen::Matrix<double, 8, 8> S = Eigen::Matrix<double, 8, 8>::Zero();
+  TorqueMatrix S = TorqueMatrix::Zero();
   switch (weighting.kind) {
     case Weighting::Kind::strong_weak: S.diagonal() = kStrongWeakDiagonal.cwiseInverse().cwiseSqrt(); break;
     case Weighting::Kind::contribution:  // W_ii^-1 = |row i| directly: a zero row gets zero torque
-      for (int i = 0; i < 8; ++i) S(i, i) = std::sqrt(J_beta.row(i).norm());
+      for (int i = 0; i < kActuatedCount; ++i) S(i, i) = std::sqrt(J_beta.row(i).norm());
       break;
     // A uniform scale of W does not change the minimum-norm torques: divide it out (largest weight
     // 1) so weights of 1e308 or 1e-307 neither overflow nor fall below the rank threshold.
@@ -147,29 +149,28 @@ Vector8 distribute_torques(const ActuatorJacobian& J_beta, const Vector4& Qstar,
       S.diagonal() = (weighting.diagonal / weighting.diagonal.maxCoeff()).cwiseInverse().cwiseSqrt();
       break;
     case Weighting::Kind::matrix: {
-      const Eigen::Matrix<double, 8, 8> L = (weighting.matrix / weighting.matrix.cwiseAbs().maxCoeff()).llt().matrixL();
-      S = L.transpose().triangularView<Eigen::Upper>().solve(Eigen::Matrix<double, 8, 8>::Identity());
+      const TorqueMatrix L = (weighting.matrix / weighting.matrix.cwiseAbs().maxCoeff()).llt().matrixL();
+      S = L.transpose().triangularView<Eigen::Upper>().solve(TorqueMatrix::Identity());
       break;
     }
   }
-  // Minimum-norm solution of A x = Q* with A = J_beta^T S (4 x 8): from A^T P = Q R (column-pivoted,
-  // rank-revealing QR), x = Q [R^-T P^T Q*; 0].
-  const Eigen::Matrix<double, 8, 4> At = S.transpose() * J_beta;
-  Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 8, 4>> qr;
+  // Minimum-norm solution of A x = Q* with A = J_beta^T S (commanded x actuated): from A^T P = Q R
+  // (column-pivoted, rank-revealing QR), x = Q [R^-T P^T Q*; 0].
+  const ActuatorJacobian At = S.transpose() * J_beta;
+  Eigen::ColPivHouseholderQR<ActuatorJacobian> qr;
   qr.setThreshold(1e-13);  // relative to the largest pivot: only a real rank loss, not ID-3's 1e6 conditioning
   qr.compute(At);
-  if (qr.rank() < 4)
-  {
+  if (qr.rank() < kU) {
     std::string u;
     for (int k : kCommandedSpeeds) u += fmt::format("{}{}'", u.empty() ? "" : ", ", gen::kCoordinateNames[static_cast<std::size_t>(k)]);
-    throw Error("J_beta", fmt::format("the actuator Jacobian has rank {} < 4 with {}: the 8 actuators cannot produce "
+    throw Error("J_beta", fmt::format("the actuator Jacobian has rank {} < {} with {}: the {} actuators cannot produce "
                                       "every generalized force on u = [{}] in this pose",
-                                      qr.rank(), weighting.label(), u));
+                                      qr.rank(), kU, weighting.label(), kActuatedCount, u));
   }
-  const Eigen::Matrix4d R = qr.matrixR().topLeftCorner<4, 4>().triangularView<Eigen::Upper>();
-  const Vector4 y = R.transpose().triangularView<Eigen::Lower>().solve(qr.colsPermutation().transpose() * Qstar);
-  Vector8 x = Vector8::Zero();
-  x.head<4>() = y;
+  const CommandMatrix R = qr.matrixR().topLeftCorner<kU, kU>().triangularView<Eigen::Upper>();
+  const CommandVector y = R.transpose().triangularView<Eigen::Lower>().solve(qr.colsPermutation().transpose() * Qstar);
+  TorqueVector x = TorqueVector::Zero();
+  x.head<kU>() = y;
   x.applyOnTheLeft(qr.householderQ());
   return S * x;
 }

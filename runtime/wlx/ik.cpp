@@ -18,6 +18,8 @@ WLX_MODEL_NAMESPACE_BEGIN
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+using LimbMatrix = Eigen::Matrix<double, gen::kMaxLimbSize, gen::kMaxLimbSize>;
+using LimbVector = Eigen::Matrix<double, gen::kMaxLimbSize, 1>;
 
 double wrap(double a) {
   if (a > -kPi && a <= kPi) return a;  // the usual case, without the slow remainder
@@ -102,7 +104,7 @@ void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinat
   const gen::ClosedFormInfo& cf = gen::kClosedForm[static_cast<std::size_t>(limb)];
   if (cf.solve == nullptr) {  // wlx-gen found no closed form for this limb
     Data data;
-    solve_limb_newton(model, limb, s, data);
+    solve_limb_newton(model, data, limb, s);
     return;
   }
   gen::IkDiagnostics why;
@@ -162,10 +164,10 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
     return r;
   };
   for (int iteration = 0;; ++iteration) {
-    closure(model, s, data, true);
+    closure(model, data, s, true);
     if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
     bool all_done = true;
-    std::array<Eigen::Vector4d, kLimbCount> step;
+    std::array<LimbVector, kLimbCount> step;
     std::array<double, kLimbCount> before{};
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
@@ -183,19 +185,19 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
                                 "use the closed form",
                                 options.max_iterations, before[l], options.tolerance));
       // The limb's block of dPhi/ds: its rows against its own dependent joints.
-      Eigen::Matrix4d J = Eigen::Matrix4d::Identity();
-      Eigen::Vector4d r = Eigen::Vector4d::Zero();
+      LimbMatrix J = LimbMatrix::Identity();  // a smaller limb padded with a unit diagonal
+      LimbVector r = LimbVector::Zero();
       for (int i = 0; i < idx.count; ++i) {
         const int row = idx.rows[static_cast<std::size_t>(i)];
         r(i) = data.Phi(row);
         for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
       }
-      const Eigen::FullPivLU<Eigen::Matrix4d> lu(J);
+      const Eigen::FullPivLU<LimbMatrix> lu(J);
       if (lu.rcond() > 1e-12) {
         step[l] = -lu.solve(r);
       } else {  // at a singular pose (straight leg, lever at 90 deg): Levenberg-Marquardt step
         const double mu = 1e-8 * std::max(1.0, J.squaredNorm());
-        step[l] = -(J.transpose() * J + mu * Eigen::Matrix4d::Identity()).ldlt().solve(J.transpose() * r);
+        step[l] = -(J.transpose() * J + mu * LimbMatrix::Identity()).ldlt().solve(J.transpose() * r);
       }
       ++report.iterations[l];
     }
@@ -214,7 +216,7 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
           s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]) + lambda[l] * step[l](j);
       }
       if (!options.damped) break;
-      closure(model, s, data, false);
+      closure(model, data, s, false);
       bool all_accepted = true;
       for (Limb limb : kLimbs) {
         const auto l = static_cast<std::size_t>(limb);
@@ -246,7 +248,7 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
     const auto idx = indices(limb);
     for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = wrap(s(idx.dep[static_cast<std::size_t>(j)]));
   }
-  closure(model, s, data, false);
+  closure(model, data, s, false);
   bool reverted = false;
   for (Limb limb : kLimbs) {
     const auto l = static_cast<std::size_t>(limb);
@@ -255,7 +257,7 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
     for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = unwrapped(idx.dep[static_cast<std::size_t>(j)]);
     reverted = true;
   }
-  if (reverted) closure(model, s, data, false);
+  if (reverted) closure(model, data, s, false);
   for (Limb limb : kLimbs) {
     if (!active[static_cast<std::size_t>(limb)]) continue;
     const double r = limb_residual(data.Phi, indices(limb));
@@ -272,13 +274,14 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
 
 }  // namespace
 
-NewtonReport solve_ik_newton(const Model& model, Coordinates& s, Data& data, const NewtonOptions& options) {
+NewtonReport solve_ik_newton(const Model& model, Data& data, Coordinates& s, const NewtonOptions& options) {
   std::array<bool, kLimbCount> all;
   all.fill(true);
   return newton(model, all, s, data, options);
 }
 
-NewtonReport solve_limb_newton(const Model& model, Limb limb, Coordinates& s, Data& data, const NewtonOptions& options) {
+NewtonReport solve_limb_newton(const Model& model, Data& data, Limb limb, Coordinates& s,
+                               const NewtonOptions& options) {
   std::array<bool, kLimbCount> active{};
   active[static_cast<std::size_t>(limb)] = true;
   return newton(model, active, s, data, options);

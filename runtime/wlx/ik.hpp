@@ -70,9 +70,9 @@ struct NewtonReport {
 // Newton's method on Phi with the generated dPhi/ds, limb by limb (the limbs decouple), starting
 // from the dependent joints already in s (warm start). Throws wlx::Error if a limb does not
 // converge within max_iterations (naming the limb, its residual and the iterations).
-NewtonReport solve_ik_newton(const Model& model, Coordinates& s, Data& data, const NewtonOptions& options = {});
+NewtonReport solve_ik_newton(const Model& model, Data& data, Coordinates& s, const NewtonOptions& options = {});
 // The same for one limb only; the other limbs' joints are left as they are.
-NewtonReport solve_limb_newton(const Model& model, Limb limb, Coordinates& s, Data& data,
+NewtonReport solve_limb_newton(const Model& model, Data& data, Limb limb, Coordinates& s,
                                const NewtonOptions& options = {});
 
 WLX_MODEL_NAMESPACE_END

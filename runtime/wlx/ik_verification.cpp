@@ -48,8 +48,8 @@ Coordinates ik_sweep_inputs() {
   return s;
 }
 
-LimbCheck analytic_check(const Model& model, Limb limb, const Coordinates& s, Data& data) {
-  forward_kinematics(model, s, data);
+LimbCheck analytic_check(const Model& model, Data& data, Limb limb, const Coordinates& s) {
+  forward_kinematics(model, data, s);
   LimbCheck check;
   double squared = 0;
   const LimbBlock b = limb_block(limb);
@@ -66,7 +66,7 @@ LimbCheck analytic_check(const Model& model, Limb limb, const Coordinates& s, Da
   return check;
 }
 
-IkSweepResult run_ik_sweep(const Model& model, const IkSweep& sweep, Data& data) {
+IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep) {
   IkSweepResult result{sweep, {}, 0, 0, 0, 0, 0, 0, 0, 0};
   const int input = coordinate_index(sweep.input);
   const auto joints = limb_joints(sweep.limb);
@@ -82,17 +82,17 @@ IkSweepResult run_ik_sweep(const Model& model, const IkSweep& sweep, Data& data)
     s(input) = pt.value;
     solve_ik_closed_form(model, s);
     pt.closed_form = s;
-    pt.check_closed_form = analytic_check(model, sweep.limb, s, data);
-    for (int w = 0; w < 2; ++w)
+    pt.check_closed_form = analytic_check(model, data, sweep.limb, s);
+    for (int w = 0; w < kWheelCount; ++w)
       pt.contacts.segment<2>(2 * w) = data.frame_positions.col(gen::kWheels[static_cast<std::size_t>(w)].contact_frame).head<2>();
 
     Coordinates n = warm;  // continuation: start from the previous point's Newton solution
     n(input) = pt.value;
-    const NewtonReport report = solve_ik_newton(model, n, data);
+    const NewtonReport report = solve_ik_newton(model, data, n);
     pt.newton = n;
     pt.newton_iterations = report.iterations[static_cast<std::size_t>(sweep.limb)];
     pt.newton_branch = classify_branch(model, sweep.limb, n);
-    pt.check_newton = analytic_check(model, sweep.limb, n, data);
+    pt.check_newton = analytic_check(model, data, sweep.limb, n);
     for (int j : joints)
       pt.newton_difference = std::max(pt.newton_difference, std::abs(std::remainder(s(j) - n(j), 2 * std::numbers::pi)));
     warm = n;
@@ -100,7 +100,7 @@ IkSweepResult run_ik_sweep(const Model& model, const IkSweep& sweep, Data& data)
     Coordinates cold = start;  // the thesis' way: every point from the same start pose
     cold(input) = pt.value;
     try {
-      solve_ik_newton(model, cold, data);
+      solve_ik_newton(model, data, cold);
       pt.cold_newton_branch = classify_branch(model, sweep.limb, cold);
     } catch (const Error&) {
       pt.cold_newton_branch = -1;

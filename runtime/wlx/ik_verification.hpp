@@ -36,13 +36,13 @@ struct LimbCheck {
   double position_error = 0;  // m
   double level_error = 0;     // wheels only
 };
-LimbCheck analytic_check(const Model& model, Limb limb, const Coordinates& s, Data& data);
+LimbCheck analytic_check(const Model& model, Data& data, Limb limb, const Coordinates& s);
 
 struct IkSweepPoint {
   double value = 0;                 // the swept input
   Coordinates closed_form;          // all 32 coordinates
   Coordinates newton;               // Newton, warm-started from the previous point (continuation)
-  Eigen::Vector4d contacts;         // x_Wl, y_Wl, x_Wr, y_Wr (closed form)
+  Eigen::Matrix<double, 2 * kWheelCount, 1> contacts;  // per wheel x, y of its contact point (closed form)
   LimbCheck check_closed_form, check_newton;
   double newton_difference = 0;     // max |closed form - Newton| over the limb's joints (rad)
   int newton_iterations = 0;
@@ -60,6 +60,6 @@ struct IkSweepResult {
   int cold_start_off_default = 0;      // points where a cold start lands off the default branch
 };
 
-IkSweepResult run_ik_sweep(const Model& model, const IkSweep& sweep, Data& data);
+IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep);
 
 WLX_MODEL_NAMESPACE_END

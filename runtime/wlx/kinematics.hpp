@@ -8,7 +8,7 @@
 WLX_MODEL_NAMESPACE_BEGIN
 
 // Fills data.frame_positions and data.frame_rotations for the coordinates s.
-void forward_kinematics(const Model& model, const Coordinates& s, Data& data) noexcept;
+void forward_kinematics(const Model& model, Data& data, const Coordinates& s) noexcept;
 
 // Position and orientation in K0 of one frame after forward_kinematics.
 inline Eigen::Vector3d frame_position(const Data& data, int frame) { return data.frame_positions.col(frame); }
@@ -17,9 +17,9 @@ inline const Eigen::Matrix3d& frame_rotation(const Data& data, int frame) {
 }
 
 // The per-step kinematic update in one generated pass: frame poses, Phi, dPhi/ds and C(s).
-void kinematic_update(const Model& model, const Coordinates& s, Data& data) noexcept;
+void kinematic_update(const Model& model, Data& data, const Coordinates& s) noexcept;
 
 // Fills data.Phi and, when with_jacobian, data.dPhi_ds.
-void closure(const Model& model, const Coordinates& s, Data& data, bool with_jacobian) noexcept;
+void closure(const Model& model, Data& data, const Coordinates& s, bool with_jacobian) noexcept;
 
 WLX_MODEL_NAMESPACE_END

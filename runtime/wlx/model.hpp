@@ -20,6 +20,8 @@ using gen::Params;
 inline constexpr int kCoordinateCount = gen::kCoordinateCount;
 inline constexpr int kInputCount = gen::kInputCount;
 inline constexpr int kDependentCount = gen::kDependentCount;
+inline constexpr int kWheelCount = gen::kWheelCount;
+using WheelVector = Eigen::Matrix<double, kWheelCount, 1>;  // one entry per wheel, in gen::kWheels' order
 
 class Model {
  public:
@@ -63,14 +65,14 @@ struct Data {
   gen::BodyVectors body_Jv_dot_sdot;
   gen::BodyVectors body_Jw_dot_sdot;
 
-  // Non-holonomic solve (nonholonomic.hpp): the inverses of the closure's per-limb blocks (legs
-  // padded to 4 x 4 with a unit diagonal; at this size products beat factorizations), the adjoint
-  // Lambda = Phi_dep^-T C_dep^T, the wheel rows reduced to the inputs C_hat = C_q - Lambda^T Phi_q,
-  // and J_beta.
-  std::array<Eigen::Matrix4d, 4> limb_inverse;
+  // Non-holonomic solve (nonholonomic.hpp): the inverses of the closure's per-limb blocks (smaller
+  // limbs padded to the largest with a unit diagonal; at these sizes products beat factorizations),
+  // the adjoint Lambda = Phi_dep^-T C_dep^T, the wheel rows reduced to the inputs
+  // C_hat = C_q - Lambda^T Phi_q, and J_beta (one row and column per wheel).
+  std::array<Eigen::Matrix<double, gen::kMaxLimbSize, gen::kMaxLimbSize>, gen::kLimbCount> limb_inverse;
   Eigen::Matrix<double, gen::kDependentCount, gen::kWheelCount> wheel_adjoint;
   Eigen::Matrix<double, gen::kWheelCount, gen::kInputCount> C_reduced;
-  Eigen::Matrix2d J_beta;
+  Eigen::Matrix<double, gen::kWheelCount, gen::kWheelCount> J_beta;
   double cond_J_beta = 0;
 };
 

@@ -3,6 +3,7 @@
 #include "wlx/error.hpp"
 #include "wlx/ik.hpp"
 
+#include <Eigen/SVD>
 #include <fmt/format.h>
 
 #include <cmath>
@@ -14,6 +15,9 @@ WLX_MODEL_NAMESPACE_BEGIN
 namespace {
 
 constexpr int kNq = kInputCount;
+constexpr int kLimbMax = gen::kMaxLimbSize;
+using LimbMatrix = Eigen::Matrix<double, kLimbMax, kLimbMax>;
+using LimbVector = Eigen::Matrix<double, kLimbMax, 1>;
 
 std::string_view name_of(int coordinate) { return gen::kCoordinateNames[static_cast<std::size_t>(coordinate)]; }
 
@@ -34,13 +38,13 @@ void for_each_limb(F&& f) {
 }
 
 // Factorizes each limb's block of dPhi/ds, solves the adjoint Phi_dep^T Lambda = C_dep^T and forms
-// C_hat = C_q - Lambda^T Phi_q: 2 right-hand sides instead of the 18 of Phi_dep^-1 Phi_q.
+// C_hat = C_q - Lambda^T Phi_q: one right-hand side per wheel instead of one per input (Phi_dep^-1 Phi_q).
 void reduce(Data& d) {
   for_each_limb([&](auto L) {
     constexpr Limb limb = decltype(L)::value;
     constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(limb)];
-    Eigen::Matrix4d block = Eigen::Matrix4d::Identity();
-    Eigen::Matrix<double, 4, 2> rhs = Eigen::Matrix<double, 4, 2>::Zero();
+    LimbMatrix block = LimbMatrix::Identity();
+    Eigen::Matrix<double, kLimbMax, kWheelCount> rhs = Eigen::Matrix<double, kLimbMax, kWheelCount>::Zero();
     for (int j = 0; j < b.size; ++j) {
       const int joint = b.joints[static_cast<std::size_t>(j)];
       for (int i = 0; i < b.size; ++i) block(i, j) = d.dPhi_ds(b.rows[static_cast<std::size_t>(i)], joint);
@@ -57,7 +61,7 @@ void reduce(Data& d) {
                               std::isfinite(rcond) ? rcond : 0.0,  // an exactly singular block inverts to inf/NaN
                               "its joints cannot move its targets in every direction here (a chain stretched straight "
                               "or folded, or two joint axes aligned)"));
-    const Eigen::Matrix<double, 4, 2> lambda = inverse.transpose().lazyProduct(rhs);
+    const Eigen::Matrix<double, kLimbMax, kWheelCount> lambda = inverse.transpose().lazyProduct(rhs);
     for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.rows[static_cast<std::size_t>(i)]) = lambda.row(i);
   });
   d.C_reduced = d.C.leftCols<kNq>() - d.wheel_adjoint.transpose().lazyProduct(d.dPhi_ds.leftCols<kNq>());
@@ -67,46 +71,58 @@ void reduce(Data& d) {
 void solve_closure(const Data& d, const gen::ClosureVector& v, Coordinates& out) {
   for_each_limb([&](auto L) {
     constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(decltype(L)::value)];
-    Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
+    LimbVector rhs = LimbVector::Zero();
     for (int i = 0; i < b.size; ++i) rhs(i) = -v(b.rows[static_cast<std::size_t>(i)]);
-    const Eigen::Vector4d x = d.limb_inverse[static_cast<std::size_t>(decltype(L)::value)] * rhs;
+    const LimbVector x = d.limb_inverse[static_cast<std::size_t>(decltype(L)::value)] * rhs;
     for (int j = 0; j < b.size; ++j) out(b.joints[static_cast<std::size_t>(j)]) = x(j);
   });
 }
 
 }  // namespace
 
-// 2-norm condition number of a 2 x 2 matrix [a b; c d] in closed form, without cancellation:
+// Two wheels: the 2-norm condition number of [a b; c d] in closed form, without cancellation:
 // sigma_max = (sqrt(p) + sqrt(q)) / 2 with p = (a + d)^2 + (b - c)^2 and q = (a - d)^2 + (b + c)^2
 // (sums of squares: accurate even where the two singular values nearly agree, where the textbook
 // sqrt(E^2 - 4 det^2) loses half the digits), and sigma_max sigma_min = |det|.
-double condition_number(const Eigen::Matrix2d& J) {
-  const double a = J(0, 0), b = J(0, 1), c = J(1, 0), d = J(1, 1);
-  const double p = (a + d) * (a + d) + (b - c) * (b - c), q = (a - d) * (a - d) + (b + c) * (b + c);
-  const double D = std::abs(J.determinant());
-  if (!std::isfinite(p + q)) return std::numeric_limits<double>::infinity();
-  if (!(D > 0)) return std::numeric_limits<double>::infinity();
-  const double smax = 0.5 * (std::sqrt(p) + std::sqrt(q));
-  return smax * smax / D;
+double condition_number(const WheelMatrix& J) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  if constexpr (kWheelCount == 2) {
+    const double a = J(0, 0), b = J(0, 1), c = J(1, 0), d = J(1, 1);
+    const double p = (a + d) * (a + d) + (b - c) * (b - c), q = (a - d) * (a - d) + (b + c) * (b + c);
+    const double D = std::abs(a * d - b * c);
+    if (!std::isfinite(p + q) || !(D > 0)) return kInfinity;
+    const double smax = 0.5 * (std::sqrt(p) + std::sqrt(q));
+    return smax * smax / D;
+  } else {
+    if (!J.allFinite()) return kInfinity;
+    const Eigen::JacobiSVD<WheelMatrix> svd(J);
+    const double smin = svd.singularValues().minCoeff();
+    return smin > 0 ? svd.singularValues().maxCoeff() / smin : kInfinity;
+  }
 }
 
 std::string DependentPair::label() const {
-  return fmt::format("({}', {}')", name_of(index[0]), name_of(index[1]));
+  std::string names;
+  for (int k : index) names += fmt::format("{}{}'", names.empty() ? "" : ", ", name_of(k));
+  return "(" + names + ")";
 }
 
-DependentPair dependent_pair(std::string_view first, std::string_view second, const std::string& field) {
+DependentPair dependent_pair(const std::vector<std::string>& names, const std::string& field) {
   std::string valid;
   for (int k : gen::kPairCandidates) valid += fmt::format("{}{}", valid.empty() ? "" : ", ", name_of(k));
+  if (names.size() != static_cast<std::size_t>(kWheelCount))
+    throw Error(field, fmt::format("needs {} names, one dependent rate per wheel, got {}: choose from {}", kWheelCount,
+                                   names.size(), valid));
   DependentPair pair;
-  const std::string_view names[2] = {first, second};
-  for (int i = 0; i < 2; ++i) {
+  for (std::size_t i = 0; i < names.size(); ++i) {
     const int k = coordinate_index(names[i]);
     if (k < 0 || !is_pair_candidate(k))
-      throw Error(field, fmt::format("'{}' cannot be a dependent rate: choose 2 of {}", names[i], valid));
-    pair.index[static_cast<std::size_t>(i)] = k;
+      throw Error(field, fmt::format("'{}' cannot be a dependent rate: choose {} of {}", names[i], kWheelCount, valid));
+    for (std::size_t j = 0; j < i; ++j)
+      if (pair.index[j] == k)
+        throw Error(field, fmt::format("the dependent rates must differ, got '{}' twice", names[i]));
+    pair.index[i] = k;
   }
-  if (pair.index[0] == pair.index[1])
-    throw Error(field, fmt::format("the two dependent rates must differ, got '{}' twice", first));
   return pair;
 }
 
@@ -119,67 +135,80 @@ DependentPair named_pair(std::string_view name, const std::string& field) {
   throw Error(field, fmt::format("the model names no dependent pair '{}'; its pairs are {}", name, valid));
 }
 
-void solve_dependent_rates(const Model& model, const Coordinates& s, Coordinates& sdot, const DependentPair& pair,
-                           Data& d, const NonholonomicOptions& options) {
+// The singular-J_beta hint, from the model: the wheels' ground-level inputs, and those the nominal
+// pose sets off the ground plane (the excavator's raises one wheel for exactly this reason).
+std::string raise_a_wheel_hint() {
+  std::string grounds, nominal;
+  for (const gen::WheelInfo& wheel : gen::kWheels) {
+    grounds += fmt::format("{}{}", grounds.empty() ? "" : ", ", name_of(wheel.ground));
+    const double z = gen::kNominalInputs[static_cast<std::size_t>(wheel.ground)];
+    if (z != 0) nominal += fmt::format("{}{} = {:g} m", nominal.empty() ? "" : ", ", name_of(wheel.ground), z);
+  }
+  return fmt::format("Raise one wheel ({}{}) or choose another dependent pair.", grounds,
+                     nominal.empty() ? "" : "; the model's nominal pose has " + nominal);
+}
+
+void solve_dependent_rates(const Model& model, Data& d, const Coordinates& s, Coordinates& sdot,
+                           const DependentPair& pair, const NonholonomicOptions& options) {
   // dPhi/ds and C(s) from the fused generated function: they share most subexpressions.
   gen::kinematic_update(s, model.params(), nullptr, nullptr, nullptr, &d.dPhi_ds, &d.C, false);
   reduce(d);
   Eigen::Matrix<double, kNq, 1> q_rate = sdot.head<kNq>();
-  q_rate(pair.index[0]) = 0;
-  q_rate(pair.index[1]) = 0;
-  d.J_beta.col(0) = d.C_reduced.col(pair.index[0]);
-  d.J_beta.col(1) = d.C_reduced.col(pair.index[1]);
+  for (int k = 0; k < kWheelCount; ++k) {
+    q_rate(pair.index[k]) = 0;
+    d.J_beta.col(k) = d.C_reduced.col(pair.index[k]);
+  }
   d.cond_J_beta = condition_number(d.J_beta);
   if (!(d.cond_J_beta <= options.max_condition))
-    throw Error("dependent",
-                fmt::format("J_beta for the dependent pair {} is singular: condition number {:.3g} exceeds the threshold "
-                            "{:.3g}. The two wheels' sideways constraint lines coincide (collinear wheel axes, thesis "
-                            "4.1.4), e.g. both wheels on the same level under a level cabin. Raise one wheel (the "
-                            "thesis uses z_Wr = 0.05 m) or choose another dependent pair.",
-                            pair.label(), d.cond_J_beta, options.max_condition));
-  const Eigen::Vector2d phi_hat = d.C_reduced * q_rate;
-  const Eigen::Vector2d pair_rate = -d.J_beta.partialPivLu().solve(phi_hat);
-  q_rate(pair.index[0]) = pair_rate(0);
-  q_rate(pair.index[1]) = pair_rate(1);
+    throw Error(
+        "dependent",
+        fmt::format("J_beta for the dependent pair {} is singular: condition number {:.3g} exceeds the threshold "
+                    "{:.3g}. The wheels' sideways constraint lines coincide (collinear wheel axes, thesis "
+                    "4.1.4), e.g. wheels on the same level under a level cabin. {}",
+                    pair.label(), d.cond_J_beta, options.max_condition, raise_a_wheel_hint()));
+  const WheelVector phi_hat = d.C_reduced * q_rate;
+  const WheelVector pair_rate = -d.J_beta.partialPivLu().solve(phi_hat);
+  for (int k = 0; k < kWheelCount; ++k) q_rate(pair.index[k]) = pair_rate(k);
   sdot.head<kNq>() = q_rate;
   const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>() * q_rate;
   solve_closure(d, closure_rhs, sdot);
 }
 
-void solve_dependent_accelerations(const Model& model, const Coordinates& s, const Coordinates& sdot,
-                                   Coordinates& sddot, const DependentPair& pair, Data& d) {
+void solve_dependent_accelerations(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot,
+                                   Coordinates& sddot, const DependentPair& pair) {
   gen::convective(s, sdot, model.params(), &d.dPhi_ds_dot_sdot, &d.C_dot_sdot);
   Eigen::Matrix<double, kNq, 1> q_acc = sddot.head<kNq>();
-  q_acc(pair.index[0]) = 0;
-  q_acc(pair.index[1]) = 0;
+  for (int k : pair.index) q_acc(k) = 0;
   // Phi_dep s''_dep = -(Phi_q q'' + conv_Phi) and C s'' + conv_C = 0 give
   // C_hat q'' = -(conv_C - Lambda^T conv_Phi).
-  const Eigen::Vector2d rhs =
-      d.C_reduced * q_acc + d.C_dot_sdot - d.wheel_adjoint.transpose() * d.dPhi_ds_dot_sdot;
-  const Eigen::Vector2d pair_acc = -d.J_beta.partialPivLu().solve(rhs);
-  q_acc(pair.index[0]) = pair_acc(0);
-  q_acc(pair.index[1]) = pair_acc(1);
+  const WheelVector rhs = d.C_reduced * q_acc + d.C_dot_sdot - d.wheel_adjoint.transpose() * d.dPhi_ds_dot_sdot;
+  const WheelVector pair_acc = -d.J_beta.partialPivLu().solve(rhs);
+  for (int k = 0; k < kWheelCount; ++k) q_acc(pair.index[k]) = pair_acc(k);
   sddot.head<kNq>() = q_acc;
   const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>() * q_acc + d.dPhi_ds_dot_sdot;
   solve_closure(d, closure_rhs, sddot);
 }
 
-Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& commanded, const DependentPair& pair,
-                                                      const Data& d) {
+template <std::size_t N>
+Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> rate_basis(const Data& d,
+                                                                        const std::array<int, N>& commanded,
+                                                                        const DependentPair& pair) {
+  constexpr int kU = static_cast<int>(N);
   // Input-rate columns: a unit commanded rate, and the pair's answer to it.
-  Eigen::Matrix<double, 2, 4> ch;
-  for (int k = 0; k < 4; ++k) ch.col(k) = d.C_reduced.col(commanded[static_cast<std::size_t>(k)]);
-  const Eigen::Matrix<double, 2, 4> pair_rates = -d.J_beta.partialPivLu().solve(ch);
-  Eigen::Matrix<double, kCoordinateCount, 4> T = Eigen::Matrix<double, kCoordinateCount, 4>::Zero();
-  for (int k = 0; k < 4; ++k) {
+  Eigen::Matrix<double, kWheelCount, kU> ch;
+  for (int k = 0; k < kU; ++k) ch.col(k) = d.C_reduced.col(commanded[static_cast<std::size_t>(k)]);
+  const Eigen::Matrix<double, kWheelCount, kU> pair_rates = -d.J_beta.partialPivLu().solve(ch);
+  Eigen::Matrix<double, kCoordinateCount, kU> T = Eigen::Matrix<double, kCoordinateCount, kU>::Zero();
+  for (int k = 0; k < kU; ++k) {
     T(commanded[static_cast<std::size_t>(k)], k) = 1;
-    T(pair.index[0], k) = pair_rates(0, k);
-    T(pair.index[1], k) = pair_rates(1, k);
+    for (int w = 0; w < kWheelCount; ++w) T(pair.index[static_cast<std::size_t>(w)], k) = pair_rates(w, k);
   }
-  // Dependent joints: Phi_dep T_dep = -Phi_q T_q, all four columns per limb block at once.
-  // T's input rows are zero except the commanded and the pair's: six columns of dPhi/ds, not 18.
-  Eigen::Matrix<double, gen::kClosureCount, 4> rhs = Eigen::Matrix<double, gen::kClosureCount, 4>::Zero();
-  std::array<int, 6> rows{commanded[0], commanded[1], commanded[2], commanded[3], pair.index[0], pair.index[1]};
+  // Dependent joints: Phi_dep T_dep = -Phi_q T_q, all columns per limb block at once. T's input
+  // rows are zero except the commanded and the pair's: those columns of dPhi/ds, not all inputs.
+  Eigen::Matrix<double, gen::kClosureCount, kU> rhs = Eigen::Matrix<double, gen::kClosureCount, kU>::Zero();
+  std::array<int, N + kWheelCount> rows{};
+  for (std::size_t k = 0; k < N; ++k) rows[k] = commanded[k];
+  for (std::size_t w = 0; w < static_cast<std::size_t>(kWheelCount); ++w) rows[N + w] = pair.index[w];
   for (std::size_t r = 0; r < rows.size(); ++r) {
     bool seen = false;
     for (std::size_t q = 0; q < r; ++q) seen = seen || rows[q] == rows[r];
@@ -187,30 +216,42 @@ Eigen::Matrix<double, kCoordinateCount, 4> rate_basis(const std::array<int, 4>& 
   }
   for_each_limb([&](auto L) {
     constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(decltype(L)::value)];
-    Eigen::Matrix4d block_rhs = Eigen::Matrix4d::Zero();
+    Eigen::Matrix<double, kLimbMax, kU> block_rhs = Eigen::Matrix<double, kLimbMax, kU>::Zero();
     for (int i = 0; i < b.size; ++i) block_rhs.row(i) = -rhs.row(b.rows[static_cast<std::size_t>(i)]);
-    const Eigen::Matrix4d x = d.limb_inverse[static_cast<std::size_t>(decltype(L)::value)].lazyProduct(block_rhs);
+    const Eigen::Matrix<double, kLimbMax, kU> x =
+        d.limb_inverse[static_cast<std::size_t>(decltype(L)::value)].lazyProduct(block_rhs);
     for (int j = 0; j < b.size; ++j) T.row(b.joints[static_cast<std::size_t>(j)]) = x.row(j);
   });
   return T;
 }
 
-Eigen::Matrix<double, 3, 2> contact_velocities(const Model& model, const Coordinates& s, const Coordinates& sdot,
-                                               Data& d) {
+// The dynamics' commanded speeds are the one set the runtime asks a basis for.
+template Eigen::Matrix<double, kCoordinateCount, static_cast<int>(gen::kCommanded.size())> rate_basis(
+    const Data&, const std::array<int, gen::kCommanded.size()>&, const DependentPair&);
+
+Eigen::Matrix<double, 3, kWheelCount> contact_velocities(const Model& model, Data& d, const Coordinates& s,
+                                                         const Coordinates& sdot) {
   gen::kinematics(s, model.params(), nullptr, &d.frame_rotations);
   gen::nonholonomic(s, model.params(), &d.C, &d.spin, false);
-  const Eigen::Vector2d spin = d.spin * sdot, sideways = d.C * sdot;
-  Eigen::Matrix<double, 3, 2> v;
-  for (int w = 0; w < 2; ++w) {
+  const WheelVector spin = d.spin * sdot, sideways = d.C * sdot;
+  Eigen::Matrix<double, 3, kWheelCount> v;
+  for (int w = 0; w < kWheelCount; ++w) {
     const gen::WheelInfo& wheel = gen::kWheels[static_cast<std::size_t>(w)];
     const Eigen::Matrix3d& R = d.frame_rotations[static_cast<std::size_t>(wheel.contact_frame)];
-    v.col(w) = R.col(wheel.forward_axis) * (model.params().*wheel.radius * spin(w)) + R.col(wheel.lateral_axis) * sideways(w) +
-               Eigen::Vector3d::UnitZ() * sdot(wheel.ground);
+    v.col(w) = R.col(wheel.forward_axis) * (model.params().*wheel.radius * spin(w)) +
+               R.col(wheel.lateral_axis) * sideways(w) + Eigen::Vector3d::UnitZ() * sdot(wheel.ground);
   }
   return v;
 }
 
-Eigen::Vector2d sideways_velocity(const Model& model, const Coordinates& s, const Coordinates& sdot, Data& d) {
+std::string contact_column_stem(int wheel) {
+  std::string stem(
+      gen::kFrameNames[static_cast<std::size_t>(gen::kWheels[static_cast<std::size_t>(wheel)].contact_frame)]);
+  std::erase(stem, '_');
+  return stem;
+}
+
+WheelVector sideways_velocity(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot) {
   gen::nonholonomic(s, model.params(), &d.C, nullptr, false);
   return d.C * sdot;
 }

@@ -27,7 +27,7 @@ struct RightHandSide {
     s.head<kInputCount>() = q;
     solve_ik_closed_form(model, s, sc.branches);
     sdot.head<kInputCount>() = sc.rates;
-    solve_dependent_rates(model, s, sdot, sc.pair, data, sc.nonholonomic);
+    solve_dependent_rates(model, data, s, sdot, sc.pair, sc.nonholonomic);
     rate = sdot.head<kInputCount>();
     return rate;
   }
@@ -131,21 +131,22 @@ void check_finite(const Sample& smp, const Scenario& sc) {
     if (!std::isfinite(smp.s(k))) fail(name(k), smp.s(k));
     if (!std::isfinite(smp.sdot(k))) fail(name(k) + "_dot", smp.sdot(k));
   }
-  const char* contacts[] = {"x_Wl", "y_Wl", "x_Wr", "y_Wr"};
-  for (int k = 0; k < 4; ++k)
-    if (!std::isfinite(smp.contacts(k))) fail(contacts[k], smp.contacts(k));
-  for (int w = 0; w < 2; ++w) {
-    const char side = w == 0 ? 'l' : 'r';
+  for (int w = 0; w < kWheelCount; ++w) {
+    const std::string stem = contact_column_stem(w);
+    const std::string_view wheel = gen::kWheels[static_cast<std::size_t>(w)].name;
+    for (int i = 0; i < 2; ++i)
+      if (!std::isfinite(smp.contacts(2 * w + i))) fail(fmt::format("{}_{}", "xy"[i], stem), smp.contacts(2 * w + i));
     for (int i = 0; i < 3; ++i)
-      if (!std::isfinite(smp.contact_velocity(i, w))) fail(fmt::format("v{}_W{}", "xyz"[i], side), smp.contact_velocity(i, w));
-    if (!std::isfinite(smp.nh_residual(w))) fail(fmt::format("nh_residual_{}", side), smp.nh_residual(w));
-    if (!std::isfinite(smp.spin_rate(w))) fail(fmt::format("spin_rate_{}", side), smp.spin_rate(w));
+      if (!std::isfinite(smp.contact_velocity(i, w)))
+        fail(fmt::format("v{}_{}", "xyz"[i], stem), smp.contact_velocity(i, w));
+    if (!std::isfinite(smp.nh_residual(w))) fail(fmt::format("nh_residual_{}", wheel), smp.nh_residual(w));
+    if (!std::isfinite(smp.spin_rate(w))) fail(fmt::format("spin_rate_{}", wheel), smp.spin_rate(w));
   }
   if (!std::isfinite(smp.cond_J_beta)) fail("cond_J_beta", smp.cond_J_beta);
   if (!std::isfinite(smp.cabin_clearance)) fail("cabin_clearance", smp.cabin_clearance);
-  for (int k = 0; k < 8; ++k)
+  for (int k = 0; k < kActuatedCount; ++k)
     if (!std::isfinite(smp.tau(k))) fail("tau_" + name(kActuatedJoints[static_cast<std::size_t>(k)]), smp.tau(k));
-  for (int k = 0; k < 4; ++k)
+  for (int k = 0; k < kCommandedCount; ++k)
     if (!std::isfinite(smp.Qstar(k))) fail("Qstar_" + name(kCommandedSpeeds[static_cast<std::size_t>(k)]), smp.Qstar(k));
 }
 
@@ -230,8 +231,8 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
   const long n = sc.samples();
   InputVector q = sc.initial.head<kInputCount>();
   DynamicsTerms terms;
-  Vector4 u;
-  for (int k = 0; k < 4; ++k) u(k) = sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]);
+  CommandVector u;
+  for (int k = 0; k < kCommandedCount; ++k) u(k) = sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]);
   double h = sc.dt;  // dopri5's step, adapted as it goes
   for (long k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) * sc.dt;
@@ -242,17 +243,17 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       smp.s = f.s;
       smp.sdot = f.sdot;
       smp.cond_J_beta = data.cond_J_beta;
-      forward_kinematics(model, f.s, data);
-      for (int w = 0; w < 2; ++w) {
+      forward_kinematics(model, data, f.s);
+      for (int w = 0; w < kWheelCount; ++w) {
         const int f = gen::kWheels[static_cast<std::size_t>(w)].contact_frame;
         smp.contacts.segment<2>(2 * w) = data.frame_positions.col(f).head<2>();
       }
-      smp.contact_velocity = contact_velocities(model, f.s, f.sdot, data);  // also fills data.C, data.spin
+      smp.contact_velocity = contact_velocities(model, data, f.s, f.sdot);  // also fills data.C, data.spin
       smp.nh_residual = data.C * f.sdot;
       smp.spin_rate = data.spin * f.sdot;
       smp.cabin_clearance = cabin_clearance(model.params(), f.s);
       if (sc.weighting) {
-        inverse_dynamics(model, f.s, u, Vector4::Zero(), data, terms, sc.nonholonomic);
+        inverse_dynamics(model, data, f.s, u, CommandVector::Zero(), terms, sc.nonholonomic);
         smp.Qstar = terms.Qstar;
         smp.tau = distribute_torques(terms.J_beta, terms.Qstar, *sc.weighting);
       }

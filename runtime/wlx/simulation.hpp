@@ -49,17 +49,17 @@ struct Scenario {
 
 struct Sample {
   double t = 0;
-  Coordinates s;                 // all 32 coordinates
-  Coordinates sdot;              // their rates
-  Eigen::Vector4d contacts;      // x_Wl, y_Wl, x_Wr, y_Wr
-  Eigen::Matrix<double, 3, 2> contact_velocity;  // v_W in K0, columns l, r
-  Eigen::Vector2d nh_residual;   // v_W . n_W per wheel (should be 0)
-  Eigen::Vector2d spin_rate;     // wheel spin rates, rad/s
+  Coordinates s;                                           // all coordinates
+  Coordinates sdot;                                        // their rates
+  Eigen::Matrix<double, 2 * kWheelCount, 1> contacts;      // per wheel x, y of its contact point (x_Wl, y_Wl, ...)
+  Eigen::Matrix<double, 3, kWheelCount> contact_velocity;  // v_W in K0, one column per wheel
+  WheelVector nh_residual;                                 // v_W . n_W per wheel (should be 0)
+  WheelVector spin_rate;                                   // wheel spin rates, rad/s
   double cond_J_beta = 0;
-  double cabin_clearance = 0;    // lowest cabin corner above z = 0, m
+  double cabin_clearance = 0;  // lowest cabin corner above z = 0, m
   // Inverse-dynamics runs only:
-  Vector8 tau = Vector8::Zero();   // actuator torques, order of kActuatedJoints
-  Vector4 Qstar = Vector4::Zero(); // generalized forces on u
+  TorqueVector tau = TorqueVector::Zero();      // actuator torques, order of kActuatedJoints
+  CommandVector Qstar = CommandVector::Zero();  // generalized forces on u
 };
 
 struct Trajectory {

@@ -36,11 +36,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
   }
   if (!s.allFinite()) std::abort();  // a NaN escaped without an error
   if (sane < 1e3) {
-    closure(model, s, data, false);
+    closure(model, data, s, false);
     if (!(data.Phi.cwiseAbs().maxCoeff() <= 1e-9 * (1 + sane))) std::abort();
     // Newton from the closed-form solution stays there.
     try {
-      solve_ik_newton(model, s, data);
+      solve_ik_newton(model, data, s);
     } catch (const Error& e) {
       std::fprintf(stderr, "Newton left the closed-form solution: %s\n", e.what());
       std::abort();

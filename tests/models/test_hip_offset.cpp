@@ -34,7 +34,7 @@ TEST_CASE("hip offset: the edited model file reached the generated code") {
     Coordinates s = Coordinates::Zero();
     for (int k = 0; k < 6; ++k) s(k) = u(rng);
     for (int k = kInputCount; k < kCoordinateCount; ++k) s(k) = u(rng);
-    forward_kinematics(model, s, data);
+    forward_kinematics(model, data, s);
     const Eigen::Matrix3d& R_C = data.frame_rotations[f::C];
     const Eigen::Vector3d r_C(s(c::x_C), s(c::y_C), s(c::z_C));
     for (const auto& [frame, side] : {std::pair{f::hip_l, 1.0}, std::pair{f::hip_r, -1.0}}) {
@@ -51,7 +51,7 @@ TEST_CASE("hip offset: closed-form IK and Newton follow it") {
   Data data;
   Coordinates s = nominal_inputs();
   solve_ik_closed_form(model, s);
-  forward_kinematics(model, s, data);
+  forward_kinematics(model, data, s);
   // The nominal feet reached, and the knee of the law of cosines over the hip-foot distance,
   // which the offset changes: from (cxd/2, cyd/2, z_C + hip_z) to (x_Fl, y_Fl, z_Fl).
   CHECK((data.frame_positions.col(f::F_l) - Eigen::Vector3d(s(c::x_Fl), s(c::y_Fl), s(c::z_Fl))).norm() <= 1e-12);
@@ -65,7 +65,7 @@ TEST_CASE("hip offset: closed-form IK and Newton follow it") {
   Coordinates n = s;
   for (int k = kInputCount; k < kCoordinateCount; ++k) n(k) += 0.01;
   n(c::theta_l4) = -n(c::theta_l5) + 0.01;
-  const NewtonReport report = solve_ik_newton(model, n, data);
+  const NewtonReport report = solve_ik_newton(model, data, n);
   CHECK(report.converged);
   CHECK((n.tail(kDependentCount) - s.tail(kDependentCount)).cwiseAbs().maxCoeff() <= 1e-10);
   // The parameter is a run-time one too: hip_z = 0 is the excavator, whose nominal knee follows
@@ -85,12 +85,12 @@ TEST_CASE("hip offset: the dependent rates keep the wheels rolling; the dynamics
   Coordinates sdot = Coordinates::Zero();
   sdot(c::roll) = 0.1;
   sdot(c::theta_l5) = 0.05;
-  solve_dependent_rates(model, s, sdot, default_pair(), d);
+  solve_dependent_rates(model, d, s, sdot, default_pair());
   gen::WheelRows C;
   gen::nonholonomic(s, model.params(), &C, nullptr);
   const double scale = d.cond_J_beta * sdot.cwiseAbs().maxCoeff();
   CHECK((C * sdot).cwiseAbs().maxCoeff() <= 1e-14 * scale);
-  closure(model, s, d, true);
+  closure(model, d, s, true);
   CHECK((d.dPhi_ds * sdot).cwiseAbs().maxCoeff() <= 1e-14 * scale);
-  CHECK(test::energy_balance_error(model, s, Vector4(0.1, -0.2, 0.05, 0.03)) <= 1e-6);
+  CHECK(test::energy_balance_error(model, s, CommandVector(0.1, -0.2, 0.05, 0.03)) <= 1e-6);
 }

@@ -178,7 +178,7 @@ TEST_CASE("walker: the derived closed-form IK, every branch, 10^4 random poses: 
     for (int k = kInputCount; k < kCoordinateCount; ++k) truth(k) = 3.0 * u(rng);
     truth(c::guide_l) = -truth(c::steer_l);
     truth(c::guide_r) = -truth(c::steer_r);
-    forward_kinematics(model, truth, data);
+    forward_kinematics(model, data, truth);
     for (int i = 0; i < 3; ++i) {
       truth(c::foot_x_l + i) = data.frame_positions(i, gen::frame::foot_l);
       truth(c::foot_x_r + i) = data.frame_positions(i, gen::frame::foot_r);
@@ -208,7 +208,7 @@ TEST_CASE("walker: the derived closed-form IK, every branch, 10^4 random poses: 
       // Newton from 1 mrad away returns to the same joints where the solution is locally unique:
       // skip poses whose limb block of dPhi/ds has a condition number above 1e6 (a stretched leg,
       // aligned axes), where the joints are not determined to better than sqrt(rounding).
-      closure(model, s, data, true);
+      closure(model, data, s, true);
       Eigen::Matrix4d block = Eigen::Matrix4d::Identity();
       for (int i = 0; i < b.size; ++i)
         for (int j = 0; j < b.size; ++j)
@@ -218,7 +218,7 @@ TEST_CASE("walker: the derived closed-form IK, every branch, 10^4 random poses: 
       if (svd.singularValues()(0) > 1e6 * svd.singularValues()(3)) continue;
       Coordinates n = s;
       for (int j = 0; j < b.size; ++j) n(b.joints[static_cast<std::size_t>(j)]) += 1e-3 * u(rng);
-      solve_limb_newton(model, limb, n, data);
+      solve_limb_newton(model, data, limb, n);
       // Near a nearly straight knee the other root is closer than the start's offset: compare with
       // the closed form of the branch Newton arrived on.
       Coordinates same_branch = n;
@@ -247,7 +247,7 @@ TEST_CASE("walker: the model's IK sweeps: closed form and Newton agree to 1e-12,
   REQUIRE(model_ik_sweeps().size() == 10);
   for (const IkSweep& sweep : model_ik_sweeps()) {
     CAPTURE(sweep.id);
-    const IkSweepResult r = run_ik_sweep(model, sweep, data);
+    const IkSweepResult r = run_ik_sweep(model, data, sweep);
     MESSAGE(sweep.id << ": " << r.points.size() << " points, analytic check " << r.max_check_closed_form << " m, level "
                      << r.max_level_error << ", |closed form - Newton| " << r.max_newton_difference << " rad");
     CHECK(r.max_check_closed_form <= 1e-12);
@@ -267,7 +267,7 @@ TEST_CASE("walker: dependent rates keep both wheels from sliding and match finit
     Coordinates sdot = test::random_rates(rng);
     sdot.tail(kDependentCount).setZero();
     try {
-      solve_dependent_rates(model, s, sdot, default_pair(), d);
+      solve_dependent_rates(model, d, s, sdot, default_pair());
     } catch (const Error&) {
       continue;  // a singular J_beta is refused with its reason (tested with the excavator)
     }
@@ -276,7 +276,7 @@ TEST_CASE("walker: dependent rates keep both wheels from sliding and match finit
     gen::WheelRows C;
     gen::nonholonomic(s, model.params(), &C, nullptr);
     worst_side = std::max(worst_side, (C * sdot).cwiseAbs().maxCoeff() / scale);
-    closure(model, s, d, true);
+    closure(model, d, s, true);
     worst_closure = std::max(worst_closure, (d.dPhi_ds * sdot).cwiseAbs().maxCoeff() / scale);
   }
   MESSAGE("max |v_W . n_W| / (cond |s'|) " << worst_side << ", max |dPhi/ds s'| / (cond |s'|) " << worst_closure);
@@ -298,8 +298,8 @@ TEST_CASE("walker: dependent rates keep both wheels from sliding and match finit
     const Coordinates fd_v = (tr.samples[k + 1].s - tr.samples[k - 1].s) / (2 * sc.dt);
     const Coordinates fd_a = (tr.samples[k + 1].sdot - tr.samples[k - 1].sdot) / (2 * sc.dt);
     Coordinates sdot = tr.samples[k].sdot, sddot = Coordinates::Zero();
-    solve_dependent_rates(model, tr.samples[k].s, sdot, sc.pair, d);
-    solve_dependent_accelerations(model, tr.samples[k].s, sdot, sddot, sc.pair, d);
+    solve_dependent_rates(model, d, tr.samples[k].s, sdot, sc.pair);
+    solve_dependent_accelerations(model, d, tr.samples[k].s, sdot, sddot, sc.pair);
     worst_v = std::max(worst_v, (fd_v - sdot).cwiseAbs().maxCoeff());
     worst_a = std::max(worst_a, (fd_a - sddot).cwiseAbs().maxCoeff());
     scale_v = std::max(scale_v, sdot.cwiseAbs().maxCoeff());
@@ -322,9 +322,9 @@ TEST_CASE("walker: inverse dynamics: J_beta^T tau = Q*, power and energy balance
   for (int trial = 0; trial < 10; ++trial) {
     Scenario sc;
     sc.initial = random_state(rng, model);
-    Vector4 u(d4(rng), d4(rng), d4(rng), d4(rng)), u_dot(d4(rng), d4(rng), d4(rng), d4(rng));
-    inverse_dynamics(model, sc.initial, u, u_dot, d, t);
-    const Vector8 tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+    CommandVector u(d4(rng), d4(rng), d4(rng), d4(rng)), u_dot(d4(rng), d4(rng), d4(rng), d4(rng));
+    inverse_dynamics(model, d, sc.initial, u, u_dot, t);
+    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
     worst_balance = std::max(worst_balance, (t.J_beta.transpose() * tau - t.Qstar).norm() / t.Qstar.norm());
     worst_power = std::max(worst_power, std::abs(tau.dot(t.J_beta * u) - t.Qstar.dot(u)) / (t.Qstar.norm() * u.norm()));
     worst_energy = std::max(worst_energy, test::energy_balance_error(model, sc.initial, u));

@@ -10,7 +10,7 @@ int main() {
   wlx::Data data;
   wlx::Coordinates s = wlx::nominal_inputs();
   wlx::solve_ik_closed_form(model, s);
-  wlx::closure(model, s, data, false);
+  wlx::closure(model, data, s, false);
   const double residual = data.Phi.cwiseAbs().maxCoeff();
   std::printf("excavator at its nominal pose: max |Phi| = %.2e m\n", residual);
   return residual <= 1e-12 ? 0 : 1;

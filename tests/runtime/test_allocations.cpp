@@ -60,14 +60,14 @@ TEST_CASE("allocations: kinematic update, dependent rates and accelerations, inv
   for (int k = 0; k < 100; ++k) {
     s(gen::coord::roll) = 0.001 * k;
     solve_ik_closed_form(model, s);
-    kinematic_update(model, s, *data);
+    kinematic_update(model, *data, s);
     sdot.setZero();
     sdot(gen::coord::roll) = 0.1;
-    solve_dependent_rates(model, s, sdot, named_pair("A"), *data);
-    solve_dependent_accelerations(model, s, sdot, sddot, named_pair("A"), *data);
-    inverse_dynamics(model, s, Vector4(0, 3, 0.1, 0), Vector4::Zero(), *data, terms);
-    const Vector8 tau1 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
-    const Vector8 tau2 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::contribution());
+    solve_dependent_rates(model, *data, s, sdot, named_pair("A"));
+    solve_dependent_accelerations(model, *data, s, sdot, sddot, named_pair("A"));
+    inverse_dynamics(model, *data, s, CommandVector(0, 3, 0.1, 0), CommandVector::Zero(), terms);
+    const TorqueVector tau1 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
+    const TorqueVector tau2 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::contribution());
     CHECK(tau1.allFinite());
     CHECK(tau2.allFinite());
   }
@@ -82,7 +82,7 @@ TEST_CASE("allocations: Newton IK from a warm start: none") {
   const long before = g_allocations;
   for (int k = 0; k < 50; ++k) {
     s(gen::coord::x_Fl) = 3.5 + 0.001 * k;
-    solve_ik_newton(model, s, *data);
+    solve_ik_newton(model, *data, s);
   }
   CHECK(g_allocations - before == 0);
 }

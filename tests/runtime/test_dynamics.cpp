@@ -48,9 +48,9 @@ Coordinates random_state(std::mt19937_64& rng, const Model& model) {
   }
 }
 
-Vector4 random4(std::mt19937_64& rng, double scale) {
+CommandVector random4(std::mt19937_64& rng, double scale) {
   std::uniform_real_distribution<double> d(-scale, scale);
-  return Vector4(d(rng), d(rng), d(rng), d(rng));
+  return CommandVector(d(rng), d(rng), d(rng), d(rng));
 }
 
 }  // namespace
@@ -62,18 +62,18 @@ TEST_CASE("dynamics: J_beta^T tau = Q* and the power balance tau . beta' = Q* . 
   DynamicsTerms t;
   Eigen::Matrix<double, 8, 8> G = Eigen::Matrix<double, 8, 8>::Random();
   const Weighting weightings[] = {Weighting::strong_weak(), Weighting::contribution(),
-                                  Weighting::diagonal_of((Vector8() << 1, 2, 3, 4, 5, 6, 7, 8).finished()),
+                                  Weighting::diagonal_of((TorqueVector() << 1, 2, 3, 4, 5, 6, 7, 8).finished()),
                                   Weighting::matrix_of(G * G.transpose() + Eigen::Matrix<double, 8, 8>::Identity())};
   double worst_force = 0, worst_power = 0;
   for (int trial = 0; trial < 200; ++trial) {
     const Coordinates s = random_state(rng, model);
-    const Vector4 u = random4(rng, 1.0), u_dot = random4(rng, 2.0);
-    inverse_dynamics(model, s, u, u_dot, d, t);
-    const Vector8 beta_dot = t.J_beta * u;
+    const CommandVector u = random4(rng, 1.0), u_dot = random4(rng, 2.0);
+    inverse_dynamics(model, d, s, u, u_dot, t);
+    const TorqueVector beta_dot = t.J_beta * u;
     // beta' really is the actuated joints' rate of the solved motion.
     for (int r = 0; r < 8; ++r) CHECK(beta_dot(r) == doctest::Approx(t.sdot(kActuatedJoints[r])).epsilon(1e-12).scale(1));
     for (const Weighting& w : weightings) {
-      const Vector8 tau = distribute_torques(t.J_beta, t.Qstar, w);
+      const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, w);
       const double scale = t.Qstar.cwiseAbs().maxCoeff();
       worst_force = std::max(worst_force, (t.J_beta.transpose() * tau - t.Qstar).cwiseAbs().maxCoeff() / scale);
       worst_power = std::max(worst_power, std::abs(tau.dot(beta_dot) - t.Qstar.dot(u)) / (scale * u.norm()));
@@ -90,9 +90,9 @@ TEST_CASE("dynamics: the weighted least norm is the optimum (no other solution h
   Data d;
   DynamicsTerms t;
   const Coordinates s = random_state(rng, model);
-  inverse_dynamics(model, s, Vector4(0.1, 0.5, 0.05, 0.0), Vector4::Zero(), d, t);
-  const Vector8 tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
-  const auto cost = [](const Vector8& x) { return x.dot(kStrongWeakDiagonal.asDiagonal() * x); };
+  inverse_dynamics(model, d, s, CommandVector(0.1, 0.5, 0.05, 0.0), CommandVector::Zero(), t);
+  const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+  const auto cost = [](const TorqueVector& x) { return x.dot(kStrongWeakDiagonal.asDiagonal() * x); };
   // Add null-space directions of J_beta^T: the constraint still holds, the cost only grows.
   const Eigen::FullPivLU<Eigen::Matrix<double, 4, 8>> lu(t.J_beta.transpose());
   const Eigen::MatrixXd null = lu.kernel();
@@ -109,9 +109,9 @@ TEST_CASE("dynamics: M is the Hessian of the kinetic energy: T = u^T M u / 2") {
   double worst = 0;
   for (int trial = 0; trial < 100; ++trial) {
     const Coordinates s = random_state(rng, model);
-    const Vector4 u = random4(rng, 1.0);
-    inverse_dynamics(model, s, u, Vector4::Zero(), d, t);
-    const double T = kinetic_energy(model, s, t.sdot, d);
+    const CommandVector u = random4(rng, 1.0);
+    inverse_dynamics(model, d, s, u, CommandVector::Zero(), t);
+    const double T = kinetic_energy(model, d, s, t.sdot);
     worst = std::max(worst, std::abs(T - 0.5 * u.dot(t.M * u)) / T);
     CHECK((t.M - t.M.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * t.M.cwiseAbs().maxCoeff());
   }
@@ -128,8 +128,8 @@ TEST_CASE("dynamics: statics: at rest Q* . u is the rate of change of V along th
   DynamicsTerms t;
   for (int trial = 0; trial < 20; ++trial) {
     const Coordinates s = random_state(rng, model);
-    const Vector4 u = random4(rng, 0.5);
-    inverse_dynamics(model, s, Vector4::Zero(), Vector4::Zero(), d, t);
+    const CommandVector u = random4(rng, 0.5);
+    inverse_dynamics(model, d, s, CommandVector::Zero(), CommandVector::Zero(), t);
     const double predicted = t.Qstar.dot(u);
     // Near a singular J_beta the dependent rates are large: shorten h so that the motion's third
     // derivative (~|s'|^3) does not dominate the difference quotient.
@@ -143,7 +143,7 @@ TEST_CASE("dynamics: statics: at rest Q* . u is the rate of change of V along th
       for (int k = 0; k < 4; ++k) sc.rates(kCommandedSpeeds[k]) = (sign ? -1 : 1) * u(k);
       const Trajectory tr = simulate(sc);
       REQUIRE(tr.complete);
-      V[sign] = potential_energy(model, tr.samples.back().s, d);
+      V[sign] = potential_energy(model, d, tr.samples.back().s);
     }
     const double measured = (V[0] - V[1]) / (2 * sc.duration);
     CAPTURE(d.cond_J_beta);
@@ -161,10 +161,10 @@ TEST_CASE("dynamics: energy: Q* . u = d(T + V)/dt along integrated motions with 
   for (int trial = 0; trial < 10; ++trial) {
     Scenario sc;
     sc.initial = random_state(rng, model);
-    Vector4 u = random4(rng, 0.5);
+    CommandVector u = random4(rng, 0.5);
     // Scale u so the fastest coordinate moves at 1 unit/s: the central differences below then
     // have truncation errors ~dt^2 = 1e-8 whatever the conditioning of J_beta.
-    inverse_dynamics(model, sc.initial, u, Vector4::Zero(), d, t);
+    inverse_dynamics(model, d, sc.initial, u, CommandVector::Zero(), t);
     u /= t.sdot.cwiseAbs().maxCoeff();
     for (int k = 0; k < 4; ++k) sc.rates(kCommandedSpeeds[k]) = u(k);
     sc.duration = 0.002;
@@ -173,12 +173,12 @@ TEST_CASE("dynamics: energy: Q* . u = d(T + V)/dt along integrated motions with 
     REQUIRE(tr.complete);
     const auto energy = [&](std::size_t k) {
       const Sample& smp = tr.samples[k];
-      return kinetic_energy(model, smp.s, smp.sdot, d) + potential_energy(model, smp.s, d);
+      return kinetic_energy(model, d, smp.s, smp.sdot) + potential_energy(model, d, smp.s);
     };
     for (std::size_t k = 2; k + 2 < tr.samples.size(); k += 20) {
       // Five-point stencil: truncation ~dt^4 |E^(5)| / 30, rounding ~1e-16 |E| / dt.
       const double dEdt = (energy(k - 2) - 8 * energy(k - 1) + 8 * energy(k + 1) - energy(k + 2)) / (12 * sc.dt);
-      inverse_dynamics(model, tr.samples[k].s, u, Vector4::Zero(), d, t);
+      inverse_dynamics(model, d, tr.samples[k].s, u, CommandVector::Zero(), t);
       const double power = t.Qstar.dot(u);
       worst = std::max(worst, std::abs(power - dEdt) / std::max(1.0, std::abs(power)));
     }
@@ -193,8 +193,8 @@ TEST_CASE("dynamics: the thesis' magnitudes: static torques ~2.8e4 N m (2D estim
   DynamicsTerms t;
   Coordinates s = nominal_inputs();
   solve_ik_closed_form(model, s);
-  inverse_dynamics(model, s, Vector4::Zero(), Vector4::Zero(), d, t);
-  const Vector8 tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+  inverse_dynamics(model, d, s, CommandVector::Zero(), CommandVector::Zero(), t);
+  const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
   const double estimate = model.params().cxd / 2 * model.total_mass() * model.params().g / 2;  // thesis eq. 6.34
   CHECK(estimate == doctest::Approx(4.53e4).epsilon(1e-3));
   for (int k : {0, 3, 6, 7}) {  // psi_l2, psi_r2, theta_l6, theta_r6
@@ -204,7 +204,7 @@ TEST_CASE("dynamics: the thesis' magnitudes: static torques ~2.8e4 N m (2D estim
   }
   // Weighting 1 loads the strong joints (weight 0.01) and spares the weak hip yaw (weight 100).
   for (int k : {1, 4}) CHECK(std::abs(tau(k)) < 1e-3 * std::abs(tau(0)));
-  const Vector8 tau2 = distribute_torques(t.J_beta, t.Qstar, Weighting::contribution());
+  const TorqueVector tau2 = distribute_torques(t.J_beta, t.Qstar, Weighting::contribution());
   CHECK(std::abs(tau2(1)) > 100 * std::abs(tau(1)));
 }
 
@@ -243,16 +243,16 @@ TEST_CASE("dynamics: ID-3 ends 7 mm above the ground: the cabin would touch it a
 TEST_CASE("dynamics: a rank-deficient J_beta and bad weights are clear errors; zero rows get zero torque") {
   ActuatorJacobian J = ActuatorJacobian::Zero();
   J(0, 0) = J(1, 1) = J(2, 2) = 1;  // nothing acts on pitch
-  CHECK_THROWS_WITH_AS(distribute_torques(J, Vector4(1, 2, 3, 4), Weighting::strong_weak()),
+  CHECK_THROWS_WITH_AS(distribute_torques(J, CommandVector(1, 2, 3, 4), Weighting::strong_weak()),
                        "J_beta: the actuator Jacobian has rank 3 < 4 with weighting 1 (strong/weak): the 8 actuators "
                        "cannot produce every generalized force on u = [z_C', x_C', roll', pitch'] in this pose",
                        Error);
   J(3, 3) = 2;
-  const Vector8 tau = distribute_torques(J, Vector4(1, 2, 3, 4), Weighting::contribution());
+  const TorqueVector tau = distribute_torques(J, CommandVector(1, 2, 3, 4), Weighting::contribution());
   for (int r = 4; r < 8; ++r) CHECK(tau(r) == 0.0);
-  CHECK((J.transpose() * tau - Vector4(1, 2, 3, 4)).norm() <= 1e-15);
-  CHECK_THROWS_WITH_AS(Weighting::diagonal_of(Vector8::Constant(-1)), "weighting[0]: a weight must be positive and finite, got -1",
-                       Error);
+  CHECK((J.transpose() * tau - CommandVector(1, 2, 3, 4)).norm() <= 1e-15);
+  CHECK_THROWS_WITH_AS(Weighting::diagonal_of(TorqueVector::Constant(-1)),
+                       "weighting[0]: a weight must be positive and finite, got -1", Error);
   Eigen::Matrix<double, 8, 8> W = Eigen::Matrix<double, 8, 8>::Identity();
   W(7, 7) = -1;
   CHECK_THROWS_WITH_AS(Weighting::matrix_of(W), "weighting: the weight matrix must be positive definite", Error);

@@ -25,7 +25,7 @@ ActuatorJacobian sample_jacobian() {
   return J;
 }
 
-double relative_difference(const Vector8& a, const Vector8& b) { return (a - b).norm() / b.norm(); }
+double relative_difference(const TorqueVector& a, const TorqueVector& b) { return (a - b).norm() / b.norm(); }
 
 }  // namespace
 
@@ -75,34 +75,34 @@ TEST_CASE("hardening: a sample quantity that is not finite is named where it ari
 
 TEST_CASE("hardening: weights scaled uniformly (1e-300 to 1e300) give the same torques; no false rank loss") {
   const ActuatorJacobian J = sample_jacobian();
-  const Vector4 Qstar(1e4, -3e3, 2e4, 5e3);
-  Vector8 w;
+  const CommandVector Qstar(1e4, -3e3, 2e4, 5e3);
+  TorqueVector w;
   w << 0.01, 100, 1, 0.01, 100, 1, 0.01, 0.01;  // weighting 1's spread
-  const Vector8 reference = distribute_torques(J, Qstar, Weighting::diagonal_of(w));
+  const TorqueVector reference = distribute_torques(J, Qstar, Weighting::diagonal_of(w));
   // The solution is the same point for every scale; what differs is the rounding of w / max(w)
   // (one division per weight, <= 1 ulp) carried through a QR of a well-conditioned 8 x 4 matrix:
   // far below 1e-12 relative. Before normalization 1e-300 failed with "rank 0".
   for (double scale : {1e-300, 1e-200, 1e-100, 3.0, 1e100, 1e200, 1e300}) {
     CAPTURE(scale);
-    const Vector8 tau = distribute_torques(J, Qstar, Weighting::diagonal_of(w * scale));
+    const TorqueVector tau = distribute_torques(J, Qstar, Weighting::diagonal_of(w * scale));
     CHECK(tau.allFinite());
     CHECK(relative_difference(tau, reference) <= 1e-12);
   }
   // The issue's extremes: every weight 1e308 or 1e-307 is weighting with the identity.
-  const Vector8 identity = distribute_torques(J, Qstar, Weighting::diagonal_of(Vector8::Ones()));
+  const TorqueVector identity = distribute_torques(J, Qstar, Weighting::diagonal_of(TorqueVector::Ones()));
   for (double weight : {1e-307, 1e-305, 1e306, 1e308}) {
     CAPTURE(weight);
-    Vector8 tau;
-    REQUIRE_NOTHROW(tau = distribute_torques(J, Qstar, Weighting::diagonal_of(Vector8::Constant(weight))));
+    TorqueVector tau;
+    REQUIRE_NOTHROW(tau = distribute_torques(J, Qstar, Weighting::diagonal_of(TorqueVector::Constant(weight))));
     CHECK(relative_difference(tau, identity) <= 1e-12);
   }
   // The same for a full weight matrix (symmetric positive definite, off-diagonal terms).
   Eigen::Matrix<double, 8, 8> W = Eigen::Matrix<double, 8, 8>::Identity() * 4;
   for (int r = 0; r + 1 < 8; ++r) W(r, r + 1) = W(r + 1, r) = 1;
-  const Vector8 matrix_reference = distribute_torques(J, Qstar, Weighting::matrix_of(W));
+  const TorqueVector matrix_reference = distribute_torques(J, Qstar, Weighting::matrix_of(W));
   for (double scale : {1e-300, 1e300}) {
     CAPTURE(scale);
-    const Vector8 tau = distribute_torques(J, Qstar, Weighting::matrix_of(W * scale));
+    const TorqueVector tau = distribute_torques(J, Qstar, Weighting::matrix_of(W * scale));
     CHECK(relative_difference(tau, matrix_reference) <= 1e-12);
   }
   // And every split solves J^T tau = Q*: the scale did not change the problem solved.

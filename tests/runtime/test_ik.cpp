@@ -32,7 +32,7 @@ std::string error_of(const std::function<void()>& f) {
 // A random reachable leg target: random joints put through the generated forward kinematics.
 Coordinates random_leg_pose(std::mt19937_64& rng, const Model& model, Data& data) {
   Coordinates s = test::random_coordinates(rng);
-  forward_kinematics(model, s, data);
+  forward_kinematics(model, data, s);
   for (int i = 0; i < 3; ++i) {
     s(c::x_Fl + i) = data.frame_positions(i, gen::frame::F_l);
     s(c::x_Fr + i) = data.frame_positions(i, gen::frame::F_r);
@@ -56,7 +56,7 @@ Coordinates random_wheel_pose(std::mt19937_64& rng, const Model& model, Data& da
     joints(left ? c::theta_l3 : c::theta_r3) = sigma - joints(th6);
     joints(left ? c::theta_l4 : c::theta_r4) = -joints(left ? c::theta_l5 : c::theta_r5);
   }
-  forward_kinematics(model, joints, data);
+  forward_kinematics(model, data, joints);
   s(c::z_Wl) = data.frame_positions(2, gen::frame::W_l);
   s(c::z_Wr) = data.frame_positions(2, gen::frame::W_r);
   return s;
@@ -80,7 +80,7 @@ TEST_CASE("ik: legs, 10^4 random reachable poses, every branch, closed form and 
       for (int b = 0; b < branch_count(gen::limb::leg_l); ++b) {
         Coordinates s = original;
         solve_limb_closed_form(model, limb, b, s);
-        const double e = analytic_check(model, limb, s, data).position_error;
+        const double e = analytic_check(model, data, limb, s).position_error;
         worst_cf = std::max(worst_cf, e);
         ++solved;
         // Well-conditioned poses: the branch is recognisable and, for the original's branch, the
@@ -98,15 +98,15 @@ TEST_CASE("ik: legs, 10^4 random reachable poses, every branch, closed form and 
         if (clear) {
           Coordinates n = s;
           for (int j = 0; j < 3; ++j) n(first + j) += 0.02 * std::sin(7.0 * trial + j + b);
-          solve_limb_newton(model, limb, n, data);
-          worst_newton = std::max(worst_newton, analytic_check(model, limb, n, data).position_error);
+          solve_limb_newton(model, data, limb, n);
+          worst_newton = std::max(worst_newton, analytic_check(model, data, limb, n).position_error);
           ++clear_count;
           if (classify_branch(model, limb, n) == b) ++newton_branch_kept;
         }
         // From the exact solution, Newton stays put even at near-singular poses.
         Coordinates exact = s;
-        solve_limb_newton(model, limb, exact, data);
-        worst_newton_any = std::max(worst_newton_any, analytic_check(model, limb, exact, data).position_error);
+        solve_limb_newton(model, data, limb, exact);
+        worst_newton_any = std::max(worst_newton_any, analytic_check(model, data, limb, exact).position_error);
       }
     }
   }
@@ -140,7 +140,7 @@ TEST_CASE("ik: wheels, 10^4 random reachable poses, all 8 branches, closed form 
           continue;
         }
         ++solved;
-        const LimbCheck check = analytic_check(model, limb, s, data);
+        const LimbCheck check = analytic_check(model, data, limb, s);
         worst_cf = std::max(worst_cf, check.position_error);
         worst_level = std::max(worst_level, check.level_error);
         CHECK(classify_branch(model, limb, s) == b);
@@ -148,8 +148,8 @@ TEST_CASE("ik: wheels, 10^4 random reachable poses, all 8 branches, closed form 
         CHECK(s(first + 2) == -s(limb == gen::limb::wheel_l ? c::theta_l5 : c::theta_r5));  // parallel guidance
         Coordinates n = s;
         for (int j = 0; j < 4; ++j) n(first + j) += 0.02 * std::cos(3.0 * trial + j + b);
-        solve_limb_newton(model, limb, n, data);
-        const LimbCheck nc = analytic_check(model, limb, n, data);
+        solve_limb_newton(model, data, limb, n);
+        const LimbCheck nc = analytic_check(model, data, limb, n);
         worst_newton = std::max({worst_newton, nc.position_error, nc.level_error});
         // Away from the singular poses (lever straddled to 90 deg, lever at +-90 deg from level,
         // camber at 90 deg) Newton started 0.02 rad off must come back to the same branch.
@@ -180,7 +180,7 @@ TEST_CASE("ik: workspace boundaries give finite solutions, never NaN") {
     solve_ik_closed_form(model, s);
     CHECK(s.allFinite());
     CHECK(s(c::psi_l4) == 0.0);
-    CHECK(analytic_check(model, gen::limb::leg_l, s, data).position_error <= 1e-12);
+    CHECK(analytic_check(model, data, gen::limb::leg_l, s).position_error <= 1e-12);
   }
   SUBCASE("folded leg: foot exactly |thighD - legD| from the hip") {
     Coordinates s = nominal_inputs();
@@ -189,7 +189,7 @@ TEST_CASE("ik: workspace boundaries give finite solutions, never NaN") {
     solve_ik_closed_form(model, s);
     CHECK(s.allFinite());
     CHECK(std::abs(s(c::psi_l4)) == doctest::Approx(kPi));
-    CHECK(analytic_check(model, gen::limb::leg_l, s, data).position_error <= 1e-12);
+    CHECK(analytic_check(model, data, gen::limb::leg_l, s).position_error <= 1e-12);
   }
   SUBCASE("lever at its reach limits (theta_6 - (theta_3 + theta_6) = +-90 deg)") {
     for (double z : {2.0 - p.w - p.wl, 2.0 - p.w + p.wl}) {
@@ -198,7 +198,7 @@ TEST_CASE("ik: workspace boundaries give finite solutions, never NaN") {
       solve_ik_closed_form(model, s);
       CHECK(s.allFinite());
       CHECK(std::abs(s(c::theta_l6)) == doctest::Approx(kPi / 2));
-      CHECK(analytic_check(model, gen::limb::wheel_l, s, data).position_error <= 1e-12);
+      CHECK(analytic_check(model, data, gen::limb::wheel_l, s).position_error <= 1e-12);
     }
   }
 }
@@ -208,7 +208,7 @@ TEST_CASE("ik: the thesis sweeps are continuous and stay on the default branch")
   Data data;
   for (const IkSweep& sweep : model_ik_sweeps()) {
     CAPTURE(sweep.id);
-    const IkSweepResult r = run_ik_sweep(model, sweep, data);
+    const IkSweepResult r = run_ik_sweep(model, data, sweep);
     double largest_jump = 0;
     for (std::size_t k = 1; k < r.points.size(); ++k)
       for (int j = kInputCount; j < kCoordinateCount; ++j)
@@ -231,7 +231,7 @@ TEST_CASE("ik: the thesis' cold-start observation: Newton from the start pose fl
   Data data;
   for (const char* id : {"IK-L3", "IK-R3"}) {
     CAPTURE(id);
-    const IkSweepResult r = run_ik_sweep(model, *find_ik_sweep(id), data);
+    const IkSweepResult r = run_ik_sweep(model, data, *find_ik_sweep(id));
     int above = 0, flipped = 0;
     double first_flip = 99;
     for (const auto& pt : r.points) {
@@ -281,7 +281,7 @@ TEST_CASE("ik: errors name the limb, the distance and the reach") {
   s(c::x_Fl) = 3.0;  // reachable, but one iteration from zero joints is not enough
   NewtonOptions once;
   once.max_iterations = 1;
-  const std::string newton = error_of([&] { solve_ik_newton(model, s, data, once); });
+  const std::string newton = error_of([&] { solve_ik_newton(model, data, s, once); });
   CHECK(newton.rfind("left leg: Newton did not converge in 1 iterations (residual", 0) == 0);
 }
 
@@ -308,8 +308,8 @@ TEST_CASE("ik: Newton's angles are wrapped only where the closure still holds (t
   solve_ik_closed_form(model, s);  // the start, as wlx ik uses it
   s(c::theta_l5) = std::numbers::pi;
   s(c::theta_r5) = -std::numbers::pi;
-  solve_ik_newton(model, s, data);
-  closure(model, s, data, false);
+  solve_ik_newton(model, data, s);
+  closure(model, data, s, false);
   CHECK(data.Phi.cwiseAbs().maxCoeff() <= 1e-12);
   CHECK(s(c::theta_l4) + s(c::theta_l5) == doctest::Approx(0).epsilon(1e-15));
   CHECK(s(c::theta_r4) + s(c::theta_r5) == doctest::Approx(0).epsilon(1e-15));

@@ -44,7 +44,7 @@ TEST_CASE("long run: ST-A1+ in 10^6 RK4 steps: closure residual <= 1e-12 all the
   const Trajectory status = simulate_each(sc, [&](const Sample& smp) {
     ++samples;
     if (samples % 97 == 0) {  // the closure is solved in closed form every step; check a spread of them
-      closure(model, smp.s, data, false);
+      closure(model, data, smp.s, false);
       worst_closure = std::max(worst_closure, data.Phi.cwiseAbs().maxCoeff());
     }
     worst_nh = std::max(worst_nh, smp.nh_residual.cwiseAbs().maxCoeff());

@@ -53,7 +53,7 @@ TEST_CASE("kinematics: the runtime wrapper fills the workspace") {
   const Model model;
   Data data;
   Coordinates s = nominal_inputs();
-  forward_kinematics(model, s, data);
+  forward_kinematics(model, data, s);
   // With all joints at zero the cabin frame sits at r_C and the left hip at r_C + (cxd/2, cyd/2, 0).
   CHECK(frame_position(data, gen::frame::C) == Eigen::Vector3d(0, 0, 2));
   CHECK(frame_position(data, gen::frame::hip_l) == Eigen::Vector3d(1.5, 1.5, 2));

@@ -32,13 +32,13 @@ TEST_CASE("nonholonomic: the thesis' nominal figures: cond(J_beta) ~ 7e2 and yaw
   const Coordinates s = assembled(nominal_inputs());
   Coordinates sdot = Coordinates::Zero();
   sdot(c::theta_l5) = 0.5 * kDeg;
-  solve_dependent_rates(model, s, sdot, named_pair("A"), d);
+  solve_dependent_rates(model, d, s, sdot, named_pair("A"));
   MESSAGE("cond(J_beta) = " << d.cond_J_beta << ", yaw' = " << sdot(c::yaw) / kDeg << " deg/s");
   CHECK(d.cond_J_beta == doctest::Approx(7e2).epsilon(0.1));
   CHECK(sdot(c::yaw) / kDeg == doctest::Approx(34).epsilon(0.03));
   CHECK(sdot(c::theta_l5) == 0.5 * kDeg);  // commanded rates come back untouched
   // Both constraints hold, and so does the linearised closure.
-  CHECK(sideways_velocity(model, s, sdot, d).cwiseAbs().maxCoeff() <= 1e-15);
+  CHECK(sideways_velocity(model, d, s, sdot).cwiseAbs().maxCoeff() <= 1e-15);
   gen::closure(s, model.params(), nullptr, &d.dPhi_ds);
   CHECK((d.dPhi_ds * sdot).cwiseAbs().maxCoeff() <= 1e-15);
 }
@@ -52,20 +52,22 @@ TEST_CASE("nonholonomic: both wheels level under a level cabin: J_beta singular,
   Coordinates sdot = Coordinates::Zero();
   sdot(c::roll) = 0.1;
   try {
-    solve_dependent_rates(model, s, sdot, named_pair("A"), d);
+    solve_dependent_rates(model, d, s, sdot, named_pair("A"));
     FAIL("no error for a singular J_beta");
   } catch (const Error& e) {
     const std::string m = e.what();
     CHECK(e.field() == "dependent");
     CHECK(m.find("J_beta for the dependent pair (y_C', yaw') is singular: condition number") != std::string::npos);
     CHECK(m.find("exceeds the threshold 1e+10") != std::string::npos);
-    CHECK(m.find("Raise one wheel (the thesis uses z_Wr = 0.05 m) or choose another dependent pair.") != std::string::npos);
+    // The hint names the ground levels and the nominal pose's raised wheel, from the model file.
+    CHECK(m.find("Raise one wheel (z_Wl, z_Wr; the model's nominal pose has z_Wr = 0.05 m) or choose another "
+                 "dependent pair.") != std::string::npos);
   }
   // A documented, configurable threshold: below the nominal 7e2, even the nominal state is singular.
   NonholonomicOptions strict;
   strict.max_condition = 100;
   const Coordinates nominal = assembled(nominal_inputs());
-  CHECK_THROWS_AS(solve_dependent_rates(model, nominal, sdot, named_pair("A"), d, strict), Error);
+  CHECK_THROWS_AS(solve_dependent_rates(model, d, nominal, sdot, named_pair("A"), strict), Error);
 }
 
 TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are errors") {
@@ -82,7 +84,7 @@ TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are e
       sdot(pair.index[0]) = sdot(pair.index[1]) = 0;
       const Coordinates commanded = sdot;
       try {
-        solve_dependent_rates(model, s, sdot, pair, d);
+        solve_dependent_rates(model, d, s, sdot, pair);
       } catch (const Error&) {
         ++singular;
         CHECK(!(d.cond_J_beta <= 1e10));
@@ -93,7 +95,7 @@ TEST_CASE("nonholonomic: every regular pair of the 8 solves, singular ones are e
       // of sigma_max, so sigma_min, and the ratio, to a few ulp times the condition number).
       const Eigen::Vector2d sv = Eigen::JacobiSVD<Eigen::Matrix2d>(d.J_beta).singularValues();
       CHECK(std::abs(d.cond_J_beta - sv(0) / sv(1)) <= 1e-15 * d.cond_J_beta * d.cond_J_beta + 4e-16 * d.cond_J_beta);
-      CHECK(sideways_velocity(model, s, sdot, d).cwiseAbs().maxCoeff() <= 1e-13 * std::max(1.0, d.cond_J_beta / 1e3));
+      CHECK(sideways_velocity(model, d, s, sdot).cwiseAbs().maxCoeff() <= 1e-13 * std::max(1.0, d.cond_J_beta / 1e3));
       for (int k : gen::kPairCandidates)
         if (k != pair.index[0] && k != pair.index[1]) CHECK(sdot(k) == commanded(k));
     }
@@ -123,16 +125,24 @@ TEST_CASE("nonholonomic: the closed-form condition number against the SVD, nearl
 }
 
 TEST_CASE("nonholonomic: pair names are validated") {
-  CHECK(dependent_pair("theta_l5", "theta_r5").index == named_pair("B").index);
+  CHECK(dependent_pair({"theta_l5", "theta_r5"}).index == named_pair("B").index);
   const auto message = [](const char* a, const char* b) {
     try {
-      dependent_pair(a, b);
+      dependent_pair({a, b});
     } catch (const Error& e) {
       return std::string(e.what());
     }
     return std::string();
   };
-  CHECK(message("y_C", "y_C") == "dependent: the two dependent rates must differ, got 'y_C' twice");
+  CHECK(message("y_C", "y_C") == "dependent: the dependent rates must differ, got 'y_C' twice");
+  try {
+    dependent_pair({"y_C"});
+    FAIL("one name accepted for two wheels");
+  } catch (const Error& e) {
+    CHECK(std::string(e.what()) ==
+          "dependent: needs 2 names, one dependent rate per wheel, got 1: choose from x_C, y_C, z_C, yaw, pitch, roll, "
+          "theta_l5, theta_r5");
+  }
   CHECK(message("y_C", "psi_l2") ==
         "dependent: 'psi_l2' cannot be a dependent rate: choose 2 of x_C, y_C, z_C, yaw, pitch, roll, theta_l5, theta_r5");
 }
@@ -157,9 +167,9 @@ TEST_CASE("nonholonomic: rates and accelerations against finite differences alon
     const Coordinates fd_v = (next.s - prev.s) / (2 * sc.dt);
     const Coordinates fd_a = (next.sdot - prev.sdot) / (2 * sc.dt);
     Coordinates sdot = now.sdot;
-    solve_dependent_rates(model, now.s, sdot, sc.pair, d);
+    solve_dependent_rates(model, d, now.s, sdot, sc.pair);
     Coordinates sddot = Coordinates::Zero();  // constant commanded rates
-    solve_dependent_accelerations(model, now.s, sdot, sddot, sc.pair, d);
+    solve_dependent_accelerations(model, d, now.s, sdot, sddot, sc.pair);
     worst_v = std::max(worst_v, (fd_v - now.sdot).cwiseAbs().maxCoeff());
     worst_a = std::max(worst_a, (fd_a - sddot).cwiseAbs().maxCoeff());
     scale_v = std::max(scale_v, now.sdot.cwiseAbs().maxCoeff());
@@ -182,7 +192,7 @@ TEST_CASE("nonholonomic: a limb at a singular pose is named") {
   Coordinates sdot = Coordinates::Zero();
   sdot(c::roll) = 0.1;
   try {
-    solve_dependent_rates(model, s, sdot, named_pair("A"), d);
+    solve_dependent_rates(model, d, s, sdot, named_pair("A"));
     FAIL("no error at a straight leg");
   } catch (const Error& e) {
     CHECK(e.field() == "left leg");

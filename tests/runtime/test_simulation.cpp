@@ -25,7 +25,7 @@ TEST_CASE("simulation: the closure does not drift; sample count includes t = 0")
   Data d;
   double worst = 0;
   for (const auto& smp : tr.samples) {
-    closure(model, smp.s, d, false);
+    closure(model, d, smp.s, false);
     worst = std::max(worst, d.Phi.cwiseAbs().maxCoeff());
   }
   CHECK(worst <= 1e-13);
