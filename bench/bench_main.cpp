@@ -47,7 +47,7 @@ void BM_gen_kinematics_positions(benchmark::State& st) {
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::kinematics(s, model.params(), &d.frame_positions, nullptr);
+    gen::kinematics(s, model.params(), {.positions = &d.frame_positions});
     benchmark::DoNotOptimize(d.frame_positions.data());
   }
 }
@@ -56,7 +56,7 @@ void BM_gen_kinematics_all(benchmark::State& st) {
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::kinematics(s, model.params(), &d.frame_positions, &d.frame_rotations);
+    gen::kinematics(s, model.params(), {.positions = &d.frame_positions, .rotations = &d.frame_rotations});
     benchmark::DoNotOptimize(d.frame_positions.data());
     benchmark::DoNotOptimize(d.frame_rotations.data());
   }
@@ -66,7 +66,7 @@ void BM_gen_closure(benchmark::State& st) {
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::closure(s, model.params(), &d.Phi, &d.dPhi_ds, false);
+    gen::closure(s, model.params(), {.Phi = &d.Phi, .dPhi_ds = &d.dPhi_ds}, false);
     benchmark::DoNotOptimize(d.dPhi_ds.data());
   }
 }
@@ -75,7 +75,7 @@ void BM_gen_nonholonomic(benchmark::State& st) {
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::nonholonomic(s, model.params(), &d.C, &d.spin, false);
+    gen::nonholonomic(s, model.params(), {.C = &d.C, .spin = &d.spin}, false);
     benchmark::DoNotOptimize(d.C.data());
   }
 }
@@ -85,7 +85,7 @@ void BM_gen_convective(benchmark::State& st) {
   const Coordinates s = assembled_nominal(model);
   const Coordinates sdot = Coordinates::Constant(0.1);
   for (auto _ : st) {
-    gen::convective(s, sdot, model.params(), &d.dPhi_ds_dot_sdot, &d.C_dot_sdot);
+    gen::convective(s, sdot, model.params(), {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot});
     benchmark::DoNotOptimize(d.C_dot_sdot.data());
   }
 }
@@ -95,8 +95,14 @@ void BM_gen_bodies(benchmark::State& st) {
   const Coordinates s = assembled_nominal(model);
   const Coordinates sdot = Coordinates::Constant(0.1);
   for (auto _ : st) {
-    gen::bodies(s, sdot, model.params(), &d.body_com, &d.body_rotations, &d.body_Jv, &d.body_Jw, &d.body_Jv_dot_sdot,
-                &d.body_Jw_dot_sdot, false);
+    gen::bodies(s, sdot, model.params(),
+                {.com = &d.body_com,
+                 .rotations = &d.body_rotations,
+                 .Jv = &d.body_Jv,
+                 .Jw = &d.body_Jw,
+                 .Jv_dot_sdot = &d.body_Jv_dot_sdot,
+                 .Jw_dot_sdot = &d.body_Jw_dot_sdot},
+                false);
     benchmark::DoNotOptimize(d.body_Jv.data());
   }
 }
@@ -111,7 +117,13 @@ void BM_gen_kinematic_update_fused(benchmark::State& st) {
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::kinematic_update(s, model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds, &d.C, zero_fill);
+    gen::kinematic_update(s, model.params(),
+                          {.positions = &d.frame_positions,
+                           .rotations = &d.frame_rotations,
+                           .Phi = &d.Phi,
+                           .dPhi_ds = &d.dPhi_ds,
+                           .C = &d.C},
+                          zero_fill);
     benchmark::DoNotOptimize(d.C.data());
   }
 }
@@ -124,8 +136,13 @@ void BM_gen_kinematic_update_fused_random_poses(benchmark::State& st) {
   for (auto& s : poses) s = Coordinates::NullaryExpr([&] { return angle(rng); });
   std::size_t k = 0;
   for (auto _ : st) {
-    gen::kinematic_update(poses[k++ & 63], model.params(), &d.frame_positions, &d.frame_rotations, &d.Phi, &d.dPhi_ds,
-                          &d.C, false);
+    gen::kinematic_update(poses[k++ & 63], model.params(),
+                          {.positions = &d.frame_positions,
+                           .rotations = &d.frame_rotations,
+                           .Phi = &d.Phi,
+                           .dPhi_ds = &d.dPhi_ds,
+                           .C = &d.C},
+                          false);
     benchmark::DoNotOptimize(d.C.data());
   }
 }
@@ -134,9 +151,9 @@ void BM_gen_kinematic_update_separate(benchmark::State& st) {
   Data d;
   const Coordinates s = assembled_nominal(model);
   for (auto _ : st) {
-    gen::kinematics(s, model.params(), &d.frame_positions, &d.frame_rotations);
-    gen::closure(s, model.params(), &d.Phi, &d.dPhi_ds, false);
-    gen::nonholonomic(s, model.params(), &d.C, nullptr, false);
+    gen::kinematics(s, model.params(), {.positions = &d.frame_positions, .rotations = &d.frame_rotations});
+    gen::closure(s, model.params(), {.Phi = &d.Phi, .dPhi_ds = &d.dPhi_ds}, false);
+    gen::nonholonomic(s, model.params(), {.C = &d.C}, false);
     benchmark::DoNotOptimize(d.C.data());
   }
 }

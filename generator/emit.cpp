@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <functional>
 #include <set>
@@ -89,6 +90,21 @@ std::string literal(double v) {
 namespace {
 
 using namespace detail;
+
+// bodies -> BodiesOutputs, kinematic_update -> KinematicUpdateOutputs.
+std::string outputs_struct_name(const std::string& function) {
+  std::string name;
+  bool upper = true;
+  for (char c : function) {
+    if (c == '_') {
+      upper = true;
+      continue;
+    }
+    name += upper ? static_cast<char>(std::toupper(static_cast<unsigned char>(c))) : c;
+    upper = false;
+  }
+  return name + "Outputs";
+}
 
 std::string op_summary(const OpCount& c) {
   return fmt::format("{} (adds {}, muls {}, divs {}, calls {})", c.total(), c.adds, c.muls, c.divs, c.calls);
@@ -282,7 +298,11 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   t += trig.names.empty() ? "" : "#include \"trig.hpp\"\n";
   t += "#include \"types.hpp\"\n\n" + namespace_open(opt) + "\n";
   t += fmt::format("// {}\n//\n", fn.doc);
-  t += "// Outputs, each computed only when its pointer is non-null:\n";
+  const std::string outputs_type = outputs_struct_name(fn.name);
+  t += fmt::format(
+      "// Outputs, members of {}Of<Scalar> ({} for double), each computed only when its\n"
+      "// pointer is set (C++20: {}(..., {{.{} = &x}})):\n",
+      outputs_type, outputs_type, fn.name, fn.outputs.front().name);
   for (std::size_t o = 0; o < outs.size(); ++o)
     t += fmt::format("//   {:<18} {} (own operations: {}, nonzero entries: {})\n", fn.outputs[o].name, fn.outputs[o].doc,
                      output_ops[o].total(), outs[o].size());
@@ -302,8 +322,9 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   std::vector<Parameter> parameters{{"const CoordinatesOf<Scalar>&", "const Coordinates&", "s"}};
   if (fn.needs_rates) parameters.push_back({"const detail::NonDeduced<CoordinatesOf<Scalar>>&", "const Coordinates&", "sdot"});
   parameters.push_back({"const Params&", "const Params&", "p"});
-  for (const auto& o : fn.outputs)
-    parameters.push_back({fmt::format("detail::NonDeduced<{}>*", o.type == "double" ? "Scalar" : o.type + "Of<Scalar>"), o.type + "*", o.name});
+  // The outputs by name in one struct, not as positional pointers of look-alike types.
+  parameters.push_back({fmt::format("const detail::NonDeduced<{}Of<Scalar>>&", outputs_type),
+                        fmt::format("const {}&", outputs_type), "out"});
   const bool has_zeros = std::any_of(fn.outputs.begin(), fn.outputs.end(), [](const auto& o) { return !o.prologue.empty(); });
   if (has_zeros) {
     // Zeroing a 14 x 32 or 7 x 3 x 32 output costs more than computing its nonzeros (store
@@ -319,8 +340,22 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
     plain.push_back(par.plain + " " + par.name + default_value);
     arguments.push_back(par.name);
   }
+  t += fmt::format(
+      "// Where {}() writes: set the outputs you want; a null pointer skips that output and the\n"
+      "// work only it needs.\ntemplate <typename Scalar>\nstruct {}Of {{\n",
+      fn.name, outputs_type);
+  std::vector<std::string> members;
+  std::size_t width = 0;
+  for (const auto& o : fn.outputs) {
+    members.push_back(fmt::format("{}* {} = nullptr;", o.type == "double" ? "Scalar" : o.type + "Of<Scalar>", o.name));
+    width = std::max(width, members.back().size());
+  }
+  for (std::size_t o = 0; o < members.size(); ++o)
+    t += fmt::format("  {:<{}}  // {}\n", members[o], width, fn.outputs[o].doc);
+  t += fmt::format("}};\nusing {0} = {0}Of<double>;\n\n", outputs_type);
   t += fmt::format("template <typename Scalar>\ninline void {}({}) noexcept {{\n", fn.name, fmt::join(templated, ", "));
   t += "  static_cast<void>(s);\n  static_cast<void>(p);\n";
+  for (const auto& o : fn.outputs) t += fmt::format("  const auto {0} = out.{0};\n", o.name);
   if (fn.needs_rates) t += "  static_cast<void>(sdot);\n";
   t += using_declarations(pr.calls()) + aliases + body + "}\n\n";
   t += fmt::format("// {0}() in double, for any Eigen expression of the coordinates.\ninline void {0}({1}) noexcept {{\n  {0}<double>({2});\n}}\n\n",

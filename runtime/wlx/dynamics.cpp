@@ -44,8 +44,14 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   Coordinates bias = Coordinates::Zero();  // s'' with u' = 0
   solve_dependent_accelerations(model, d, s, out.sdot, bias, pair);
   out.sddot = out.T * u_dot + bias;
-  gen::bodies(s, out.sdot, p, &d.body_com, &d.body_rotations, &d.body_Jv, &d.body_Jw, &d.body_Jv_dot_sdot,
-              &d.body_Jw_dot_sdot, false);
+  gen::bodies(s, out.sdot, p,
+              {.com = &d.body_com,
+               .rotations = &d.body_rotations,
+               .Jv = &d.body_Jv,
+               .Jw = &d.body_Jw,
+               .Jv_dot_sdot = &d.body_Jv_dot_sdot,
+               .Jw_dot_sdot = &d.body_Jw_dot_sdot},
+              false);
   out.M.setZero();
   out.b.setZero();
   out.Q_gravity.setZero();
@@ -82,7 +88,7 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
 
 double potential_energy(const Model& model, Data& d, const Coordinates& s) {
   const Params& p = model.params();
-  gen::bodies(s, Coordinates::Zero(), p, &d.body_com, nullptr, nullptr, nullptr, nullptr, nullptr, false);
+  gen::bodies(s, Coordinates::Zero(), p, {.com = &d.body_com}, false);
   double V = 0;
   for (int i = 0; i < gen::kBodyCount; ++i) V += mass(p, i) * (p.*gen::kGravity) * d.body_com(2, i);
   return V;
@@ -90,7 +96,7 @@ double potential_energy(const Model& model, Data& d, const Coordinates& s) {
 
 double kinetic_energy(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot) {
   const Params& p = model.params();
-  gen::bodies(s, sdot, p, nullptr, &d.body_rotations, &d.body_Jv, &d.body_Jw, nullptr, nullptr, false);
+  gen::bodies(s, sdot, p, {.rotations = &d.body_rotations, .Jv = &d.body_Jv, .Jw = &d.body_Jw}, false);
   double T = 0;
   for (int i = 0; i < gen::kBodyCount; ++i) {
     const Eigen::Vector3d v = d.body_Jv[static_cast<std::size_t>(i)] * sdot;

@@ -151,7 +151,7 @@ std::string raise_a_wheel_hint() {
 void solve_dependent_rates(const Model& model, Data& d, const Coordinates& s, Coordinates& sdot,
                            const DependentPair& pair, const NonholonomicOptions& options) {
   // dPhi/ds and C(s) from the fused generated function: they share most subexpressions.
-  gen::kinematic_update(s, model.params(), nullptr, nullptr, nullptr, &d.dPhi_ds, &d.C, false);
+  gen::kinematic_update(s, model.params(), {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
   reduce(d);
   Eigen::Matrix<double, kNq, 1> q_rate = sdot.head<kNq>();
   for (int k = 0; k < kWheelCount; ++k) {
@@ -176,7 +176,7 @@ void solve_dependent_rates(const Model& model, Data& d, const Coordinates& s, Co
 
 void solve_dependent_accelerations(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot,
                                    Coordinates& sddot, const DependentPair& pair) {
-  gen::convective(s, sdot, model.params(), &d.dPhi_ds_dot_sdot, &d.C_dot_sdot);
+  gen::convective(s, sdot, model.params(), {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot});
   Eigen::Matrix<double, kNq, 1> q_acc = sddot.head<kNq>();
   for (int k : pair.index) q_acc(k) = 0;
   // Phi_dep s''_dep = -(Phi_q q'' + conv_Phi) and C s'' + conv_C = 0 give
@@ -231,8 +231,8 @@ template Eigen::Matrix<double, kCoordinateCount, static_cast<int>(gen::kCommande
 
 Eigen::Matrix<double, 3, kWheelCount> contact_velocities(const Model& model, Data& d, const Coordinates& s,
                                                          const Coordinates& sdot) {
-  gen::kinematics(s, model.params(), nullptr, &d.frame_rotations);
-  gen::nonholonomic(s, model.params(), &d.C, &d.spin, false);
+  gen::kinematics(s, model.params(), {.rotations = &d.frame_rotations});
+  gen::nonholonomic(s, model.params(), {.C = &d.C, .spin = &d.spin}, false);
   const WheelVector spin = d.spin * sdot, sideways = d.C * sdot;
   Eigen::Matrix<double, 3, kWheelCount> v;
   for (int w = 0; w < kWheelCount; ++w) {
@@ -252,7 +252,7 @@ std::string contact_column_stem(int wheel) {
 }
 
 WheelVector sideways_velocity(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot) {
-  gen::nonholonomic(s, model.params(), &d.C, nullptr, false);
+  gen::nonholonomic(s, model.params(), {.C = &d.C}, false);
   return d.C * sdot;
 }
 

@@ -208,7 +208,7 @@ void Scenario::validate() const {
 
 double cabin_clearance(const Params& p, const Coordinates& s) {
   double lowest = 0;
-  gen::clearance(s, p, &lowest);
+  gen::clearance(s, p, {.lowest = &lowest});
   return lowest;
 }
 

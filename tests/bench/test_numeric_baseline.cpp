@@ -24,19 +24,19 @@ TEST_CASE("numeric baseline: frames, Jacobians, C(s), convective terms and bodie
   for (int trial = 0; trial < 50; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng), sdot = test::random_rates(rng);
     baseline::frames(p, s, w);
-    gen::kinematics(s, p, &pos, nullptr);
+    gen::kinematics(s, p, {.positions = &pos});
     for (int f = 0; f < gen::kFrameCount; ++f) e_pos = std::max(e_pos, (pos.col(f) - w.r[f]).cwiseAbs().maxCoeff());
-    gen::closure(s, p, nullptr, &J);
+    gen::closure(s, p, {.dPhi_ds = &J});
     baseline::closure_jacobian(p, s, Jn, w);
     e_J = std::max(e_J, (J - Jn).cwiseAbs().maxCoeff());
-    gen::nonholonomic(s, p, &C, nullptr);
+    gen::nonholonomic(s, p, {.C = &C});
     baseline::nonholonomic_rows(p, s, Cn, w);
     e_C = std::max(e_C, (C - Cn).cwiseAbs().maxCoeff());
-    gen::convective(s, sdot, p, &conv, &Cc);
+    gen::convective(s, sdot, p, {.dPhi_ds_dot_sdot = &conv, .C_dot_sdot = &Cc});
     baseline::convective(p, s, sdot, conv_n, Cc_n, w);
     e_conv = std::max({e_conv, (conv - conv_n).cwiseAbs().maxCoeff() / (1 + conv.cwiseAbs().maxCoeff()),
                        (Cc - Cc_n).cwiseAbs().maxCoeff() / (1 + Cc.cwiseAbs().maxCoeff())});
-    gen::bodies(s, sdot, p, nullptr, nullptr, &Jv, &Jw, nullptr, nullptr);
+    gen::bodies(s, sdot, p, {.Jv = &Jv, .Jw = &Jw});
     baseline::body_jacobians(p, s, Jv_n, Jw_n, w);
     for (int k = 0; k < gen::kBodyCount; ++k)
       e_body = std::max({e_body, (Jv[k] - Jv_n[k]).cwiseAbs().maxCoeff(), (Jw[k] - Jw_n[k]).cwiseAbs().maxCoeff()});

@@ -51,7 +51,7 @@ TEST_CASE("cli: wlx ik solves the nominal state; the numbers put back into the F
   for (int k = wlx::gen::kInputCount; k < wlx::gen::kCoordinateCount; ++k)
     s(k) = j.at(std::string(wlx::gen::kCoordinateNames[k])).get<double>();
   wlx::gen::FramePositions pos;
-  wlx::gen::kinematics(s, wlx::gen::Params{}, &pos, nullptr);
+  wlx::gen::kinematics(s, wlx::gen::Params{}, {.positions = &pos});
   CHECK((pos.col(wlx::gen::frame::F_l) - Eigen::Vector3d(3.5, 1.5, 0)).norm() <= 1e-12);
   CHECK((pos.col(wlx::gen::frame::F_r) - Eigen::Vector3d(3.5, -1.5, 0)).norm() <= 1e-12);
   CHECK(std::abs(pos(2, wlx::gen::frame::W_r) - 0.05) <= 1e-12);

@@ -20,7 +20,8 @@ TEST_CASE("bodies: CoM, rotation, Jv, Jw and their convective terms match exact 
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng);
     const gen::Coordinates sdot = test::random_rates(rng);
-    gen::bodies(s, sdot, p, &com, &R, &Jv, &Jw, &Jv_dot, &Jw_dot);
+    gen::bodies(s, sdot, p,
+                {.com = &com, .rotations = &R, .Jv = &Jv, .Jw = &Jw, .Jv_dot_sdot = &Jv_dot, .Jw_dot_sdot = &Jw_dot});
     const auto ref = test::reference_kinematics(test::along(s, sdot), p);
     for (int b = 0; b < gen::kBodyCount; ++b) {
       const auto& P = ref.bodies[b];
@@ -53,7 +54,7 @@ TEST_CASE("bodies: each Jacobian column alone matches the exact partial derivati
   double worst = 0;
   for (int trial = 0; trial < 50; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng);
-    gen::bodies(s, gen::Coordinates::Zero(), p, nullptr, nullptr, &Jv, nullptr, nullptr, nullptr);
+    gen::bodies(s, gen::Coordinates::Zero(), p, {.Jv = &Jv});
     for (int j = 0; j < gen::kCoordinateCount; ++j) {
       const auto ref = test::reference_kinematics(test::along(s, gen::Coordinates::Unit(j)), p);
       for (int b = 0; b < gen::kBodyCount; ++b)

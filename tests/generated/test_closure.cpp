@@ -23,8 +23,8 @@ TEST_CASE("closure: Phi, dPhi/ds and (d/dt dPhi/ds) s' match exact derivatives o
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng);
     const gen::Coordinates sdot = test::random_rates(rng);
-    gen::closure(s, p, &Phi, &J);
-    gen::convective(s, sdot, p, &conv, &C_conv);
+    gen::closure(s, p, {.Phi = &Phi, .dPhi_ds = &J});
+    gen::convective(s, sdot, p, {.dPhi_ds_dot_sdot = &conv, .C_dot_sdot = &C_conv});
     for (int j = 0; j < gen::kCoordinateCount; ++j) {
       const auto ref = test::reference_closure(test::along(s, gen::Coordinates::Unit(j)), p);
       for (int i = 0; i < gen::kClosureCount; ++i) worst_J = std::max(worst_J, std::abs(J(i, j) - ref[i].d));
@@ -52,10 +52,10 @@ TEST_CASE("closure: dPhi/ds agrees with central finite differences of the genera
   const double h = 1e-6;
   for (int trial = 0; trial < 100; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng);
-    gen::closure(s, p, nullptr, &J);
+    gen::closure(s, p, {.dPhi_ds = &J});
     for (int j = 0; j < gen::kCoordinateCount; ++j) {
-      gen::closure(s + h * gen::Coordinates::Unit(j), p, &plus, nullptr);
-      gen::closure(s - h * gen::Coordinates::Unit(j), p, &minus, nullptr);
+      gen::closure(s + h * gen::Coordinates::Unit(j), p, {.Phi = &plus});
+      gen::closure(s - h * gen::Coordinates::Unit(j), p, {.Phi = &minus});
       worst = std::max(worst, ((plus - minus) / (2 * h) - J.col(j)).cwiseAbs().maxCoeff());
     }
   }
@@ -70,7 +70,7 @@ TEST_CASE("closure: the guidance rows are exactly theta_4 + theta_5") {
   s(gen::coord::theta_l5) = -0.25;
   s(gen::coord::theta_r4) = 0.5;
   gen::ClosureVector Phi;
-  gen::closure(s, p, &Phi, nullptr);
+  gen::closure(s, p, {.Phi = &Phi});
   CHECK(Phi(9) == 0.0);
   CHECK(Phi(13) == 0.5);
 }

@@ -22,10 +22,10 @@ TEST_CASE("kinematic_update: identical to the separate functions") {
   double worst = 0;
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng);
-    gen::kinematic_update(s, p, &pos_a, &rot_a, &phi_a, &J_a, &C_a);
-    gen::kinematics(s, p, &pos_b, &rot_b);
-    gen::closure(s, p, &phi_b, &J_b);
-    gen::nonholonomic(s, p, &C_b, nullptr);
+    gen::kinematic_update(s, p, {.positions = &pos_a, .rotations = &rot_a, .Phi = &phi_a, .dPhi_ds = &J_a, .C = &C_a});
+    gen::kinematics(s, p, {.positions = &pos_b, .rotations = &rot_b});
+    gen::closure(s, p, {.Phi = &phi_b, .dPhi_ds = &J_b});
+    gen::nonholonomic(s, p, {.C = &C_b});
     worst = std::max({worst, (pos_a - pos_b).cwiseAbs().maxCoeff(), (phi_a - phi_b).cwiseAbs().maxCoeff(),
                       (J_a - J_b).cwiseAbs().maxCoeff(), (C_a - C_b).cwiseAbs().maxCoeff()});
     for (int f = 0; f < gen::kFrameCount; ++f) worst = std::max(worst, (rot_a[f] - rot_b[f]).cwiseAbs().maxCoeff());
@@ -34,10 +34,10 @@ TEST_CASE("kinematic_update: identical to the separate functions") {
   // Requesting only some outputs computes the same values for those (the shared temporaries
   // are still evaluated when an output needs them).
   const gen::Coordinates s = test::random_coordinates(rng);
-  gen::kinematic_update(s, p, &pos_a, &rot_a, &phi_a, &J_a, &C_a);
+  gen::kinematic_update(s, p, {.positions = &pos_a, .rotations = &rot_a, .Phi = &phi_a, .dPhi_ds = &J_a, .C = &C_a});
   J_b.setConstant(7.0);
   C_b.setConstant(7.0);
-  gen::kinematic_update(s, p, nullptr, nullptr, nullptr, &J_b, &C_b);
+  gen::kinematic_update(s, p, {.dPhi_ds = &J_b, .C = &C_b});
   CHECK(J_a == J_b);
   CHECK(C_a == C_b);
 }
@@ -70,23 +70,23 @@ TEST_CASE("zero_fill = false writes the nonzeros only, and the same values") {
     long untouched = 0;
     gen::ClosureJacobian J_full, J_sparse = gen::ClosureJacobian::Constant(nan);
     gen::WheelRows C_full, C_sparse = gen::WheelRows::Constant(nan), spin_full, spin_sparse = gen::WheelRows::Constant(nan);
-    gen::kinematic_update(s, p, nullptr, nullptr, nullptr, &J_full, &C_full);
-    gen::kinematic_update(s, p, nullptr, nullptr, nullptr, &J_sparse, &C_sparse, false);
+    gen::kinematic_update(s, p, {.dPhi_ds = &J_full, .C = &C_full});
+    gen::kinematic_update(s, p, {.dPhi_ds = &J_sparse, .C = &C_sparse}, false);
     check_pattern(J_full, J_sparse, untouched);
     check_pattern(C_full, C_sparse, untouched);
     J_sparse.setConstant(nan);
-    gen::closure(s, p, nullptr, &J_sparse, false);
+    gen::closure(s, p, {.dPhi_ds = &J_sparse}, false);
     check_pattern(J_full, J_sparse, untouched);
     C_sparse.setConstant(nan);
-    gen::nonholonomic(s, p, &C_full, &spin_full);
-    gen::nonholonomic(s, p, &C_sparse, &spin_sparse, false);
+    gen::nonholonomic(s, p, {.C = &C_full, .spin = &spin_full});
+    gen::nonholonomic(s, p, {.C = &C_sparse, .spin = &spin_sparse}, false);
     check_pattern(C_full, C_sparse, untouched);
     check_pattern(spin_full, spin_sparse, untouched);
     gen::BodyJacobians Jv_full, Jw_full, Jv_sparse, Jw_sparse;
     for (auto& m : Jv_sparse) m.setConstant(nan);
     for (auto& m : Jw_sparse) m.setConstant(nan);
-    gen::bodies(s, sdot, p, nullptr, nullptr, &Jv_full, &Jw_full, nullptr, nullptr);
-    gen::bodies(s, sdot, p, nullptr, nullptr, &Jv_sparse, &Jw_sparse, nullptr, nullptr, false);
+    gen::bodies(s, sdot, p, {.Jv = &Jv_full, .Jw = &Jw_full});
+    gen::bodies(s, sdot, p, {.Jv = &Jv_sparse, .Jw = &Jw_sparse}, false);
     for (std::size_t b = 0; b < Jv_full.size(); ++b) {
       check_pattern(Jv_full[b], Jv_sparse[b], untouched);
       check_pattern(Jw_full[b], Jw_sparse[b], untouched);

@@ -30,7 +30,7 @@ TEST_CASE("kinematics: every frame matches the reference chain at 1000 random co
   double worst_r = 0, worst_R = 0;
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng);
-    gen::kinematics(s, p, &pos, &rot);
+    gen::kinematics(s, p, {.positions = &pos, .rotations = &rot});
     const auto ref = test::reference_kinematics(as_array(s), p);
     for (int f = 0; f < gen::kFrameCount; ++f) {
       for (int i = 0; i < 3; ++i) {
@@ -50,9 +50,9 @@ TEST_CASE("kinematics: positions only, rotations only") {
   const gen::Coordinates s = test::random_coordinates(rng);
   gen::FramePositions pos_both, pos_only;
   gen::FrameRotations rot_both, rot_only;
-  gen::kinematics(s, p, &pos_both, &rot_both);
-  gen::kinematics(s, p, &pos_only, nullptr);
-  gen::kinematics(s, p, nullptr, &rot_only);
+  gen::kinematics(s, p, {.positions = &pos_both, .rotations = &rot_both});
+  gen::kinematics(s, p, {.positions = &pos_only});
+  gen::kinematics(s, p, {.rotations = &rot_only});
   CHECK(pos_only == pos_both);
   for (int f = 0; f < gen::kFrameCount; ++f) CHECK(rot_only[f] == rot_both[f]);
 }
@@ -78,7 +78,7 @@ TEST_CASE("kinematics: the left foot follows the thesis' printed equations 3.9-3
     const double x_F = s(c::x_C) - (cr * sy - cy * sp * sr) * A + B * (sr * sy + cr * cy * sp) + cp * cy * X;  // (3.9)
     const double y_F = s(c::y_C) + (cr * cy + sy * sp * sr) * A - B * (sr * cy - cr * sy * sp) + cp * sy * X;  // (3.10)
     const double z_F = s(c::z_C) - sp * X + cp * sr * A + cp * cr * B;                                        // (3.11)
-    gen::kinematics(s, p, &pos, nullptr);
+    gen::kinematics(s, p, {.positions = &pos});
     worst = std::max({worst, std::abs(pos(0, gen::frame::F_l) - x_F), std::abs(pos(1, gen::frame::F_l) - y_F),
                       std::abs(pos(2, gen::frame::F_l) - z_F)});
   }

@@ -21,8 +21,8 @@ TEST_CASE("nonholonomic: C s' = v_W . n_W, spin s' = v_W . e_x / w, (d/dt C) s' 
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng);
     const gen::Coordinates sdot = test::random_rates(rng);
-    gen::nonholonomic(s, p, &C, &spin);
-    gen::convective(s, sdot, p, &conv_phi, &conv_C);
+    gen::nonholonomic(s, p, {.C = &C, .spin = &spin});
+    gen::convective(s, sdot, p, {.dPhi_ds_dot_sdot = &conv_phi, .C_dot_sdot = &conv_C});
     const auto ref = test::reference_kinematics(test::along(s, sdot), p);
     for (int w = 0; w < 2; ++w) {
       const auto& P = ref.frames[contact[w]];
@@ -50,7 +50,7 @@ TEST_CASE("nonholonomic: C has the structural zeros of the model") {
   std::mt19937_64 rng(21);
   const gen::Params p;
   gen::WheelRows C;
-  gen::nonholonomic(test::random_coordinates(rng), p, &C, nullptr);
+  gen::nonholonomic(test::random_coordinates(rng), p, {.C = &C});
   namespace c = gen::coord;
   for (int j : {c::psi_l2, c::psi_l3, c::psi_l4, c::x_Fl, c::theta_r2, c::theta_r5, c::z_Wl}) CHECK(C(0, j) == 0.0);
   CHECK(C(0, c::theta_l5) != 0.0);

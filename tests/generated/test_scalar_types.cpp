@@ -39,44 +39,44 @@ TEST_CASE("float: every generated function agrees with double to float precision
 
     gen::FramePositionsOf<float> pos_f;
     gen::FramePositions pos;
-    gen::kinematics(s_f, p, &pos_f, nullptr);
-    gen::kinematics(s, p, &pos, nullptr);
+    gen::kinematics(s_f, p, {.positions = &pos_f});
+    gen::kinematics(s, p, {.positions = &pos});
     worst[0] = std::max(worst[0], scaled_difference(pos_f, pos));
 
     gen::ClosureVectorOf<float> Phi_f;
     gen::ClosureJacobianOf<float> J_f;
     gen::ClosureVector Phi;
     gen::ClosureJacobian J;
-    gen::closure(s_f, p, &Phi_f, &J_f);
-    gen::closure(s, p, &Phi, &J);
+    gen::closure(s_f, p, {.Phi = &Phi_f, .dPhi_ds = &J_f});
+    gen::closure(s, p, {.Phi = &Phi, .dPhi_ds = &J});
     worst[1] = std::max({worst[1], scaled_difference(Phi_f, Phi), scaled_difference(J_f, J)});
 
     gen::WheelRowsOf<float> C_f;
     gen::WheelRows C;
-    gen::nonholonomic(s_f, p, &C_f, nullptr);
-    gen::nonholonomic(s, p, &C, nullptr);
+    gen::nonholonomic(s_f, p, {.C = &C_f});
+    gen::nonholonomic(s, p, {.C = &C});
     worst[2] = std::max(worst[2], scaled_difference(C_f, C));
 
     gen::ClosureVectorOf<float> conv_f;
     gen::ClosureVector conv;
-    gen::convective(s_f, sdot_f, p, &conv_f, nullptr);
-    gen::convective(s, sdot, p, &conv, nullptr);
+    gen::convective(s_f, sdot_f, p, {.dPhi_ds_dot_sdot = &conv_f});
+    gen::convective(s, sdot, p, {.dPhi_ds_dot_sdot = &conv});
     worst[3] = std::max(worst[3], scaled_difference(conv_f, conv));
 
     gen::BodyVectorsOf<float> com_f;
     gen::BodyJacobiansOf<float> Jv_f;
     gen::BodyVectors com;
     gen::BodyJacobians Jv;
-    gen::bodies(s_f, sdot_f, p, &com_f, nullptr, &Jv_f, nullptr, nullptr, nullptr);
-    gen::bodies(s, sdot, p, &com, nullptr, &Jv, nullptr, nullptr, nullptr);
+    gen::bodies(s_f, sdot_f, p, {.com = &com_f, .Jv = &Jv_f});
+    gen::bodies(s, sdot, p, {.com = &com, .Jv = &Jv});
     worst[4] = std::max(worst[4], scaled_difference(com_f, com));
     for (int b = 0; b < gen::kBodyCount; ++b)
       worst[4] = std::max(worst[4], scaled_difference(Jv_f[static_cast<std::size_t>(b)], Jv[static_cast<std::size_t>(b)]));
 
     float lowest_f = 0;
     double lowest = 0;
-    gen::clearance(s_f, p, &lowest_f);
-    gen::clearance(s, p, &lowest);
+    gen::clearance(s_f, p, {.lowest = &lowest_f});
+    gen::clearance(s, p, {.lowest = &lowest});
     worst[5] = std::max(worst[5], std::abs(double(lowest_f) - lowest) / std::max(1.0, std::abs(lowest)));
   }
   MESSAGE("float vs double, relative to scale: kinematics " << worst[0] << ", closure " << worst[1] << ", nonholonomic "
@@ -111,7 +111,7 @@ TEST_CASE("float: the closed-form IK solves what double solves, to the float IK'
     REQUIRE(gen::ik_all(s_f, p, branches, s_f, failed, why) == gen::IkStatus::ok);
     ++solved;
     gen::ClosureVector Phi;
-    gen::closure(s_f.cast<double>().eval(), p, &Phi, nullptr);
+    gen::closure(s_f.cast<double>().eval(), p, {.Phi = &Phi});
     worst_residual = std::max(worst_residual, Phi.cwiseAbs().maxCoeff());
     worst_joint = std::max(worst_joint, (s_f.cast<double>() - s).tail<gen::kDependentCount>().cwiseAbs().maxCoeff());
   }
@@ -136,11 +136,11 @@ TEST_CASE("Jet: a dual number through the generated functions gives their genera
     for (int i = 0; i < gen::kCoordinateCount; ++i) s_jet(i) = test::Jet(s(i), u(i), 0.0);
 
     gen::ClosureVectorOf<test::Jet> Phi_jet;
-    gen::closure(s_jet, p, &Phi_jet, nullptr);
+    gen::closure(s_jet, p, {.Phi = &Phi_jet});
     gen::ClosureJacobian J;
     gen::ClosureVector conv;
-    gen::closure(s, p, nullptr, &J);
-    gen::convective(s, u, p, &conv, nullptr);
+    gen::closure(s, p, {.dPhi_ds = &J});
+    gen::convective(s, u, p, {.dPhi_ds_dot_sdot = &conv});
     const gen::ClosureVector Ju = J * u;
     for (int i = 0; i < gen::kClosureCount; ++i) {
       worst_first = std::max(worst_first, std::abs(Phi_jet(i).d - Ju(i)));
@@ -148,10 +148,10 @@ TEST_CASE("Jet: a dual number through the generated functions gives their genera
     }
 
     gen::BodyVectorsOf<test::Jet> com_jet;
-    gen::bodies(s_jet, gen::CoordinatesOf<test::Jet>(u.cast<test::Jet>()), p, &com_jet, nullptr, nullptr, nullptr, nullptr, nullptr);
+    gen::bodies(s_jet, gen::CoordinatesOf<test::Jet>(u.cast<test::Jet>()), p, {.com = &com_jet});
     gen::BodyJacobians Jv;
     gen::BodyVectors Jv_dot_u;
-    gen::bodies(s, u, p, nullptr, nullptr, &Jv, nullptr, &Jv_dot_u, nullptr);
+    gen::bodies(s, u, p, {.Jv = &Jv, .Jv_dot_sdot = &Jv_dot_u});
     for (int b = 0; b < gen::kBodyCount; ++b) {
       const Eigen::Vector3d v = Jv[static_cast<std::size_t>(b)] * u;
       for (int k = 0; k < 3; ++k) {

@@ -36,13 +36,21 @@ bool evaluate_all(const gen::Params& p, gen::CoordinatesOf<Scalar>& s) {
   gen::BodyRotationsOf<Scalar> body_rotations;
   gen::BodyJacobiansOf<Scalar> Jv, Jw;
   Scalar lowest = 0;
-  gen::kinematics(s, p, &positions, &rotations);
-  gen::closure(s, p, &Phi, &dPhi_ds);
-  gen::nonholonomic(s, p, &C, &spin);
-  gen::convective(s, sdot, p, &dPhi_ds_dot_sdot, &C_dot_sdot);
-  gen::bodies(s, sdot, p, &com, &body_rotations, &Jv, &Jw, &Jv_dot_sdot, &Jw_dot_sdot);
-  gen::kinematic_update(s, p, &positions, &rotations, &Phi, &dPhi_ds, &C);
-  gen::clearance(s, p, &lowest);
+  gen::kinematics(s, p, {&positions, &rotations});
+  gen::closure(s, p, {&Phi, &dPhi_ds});
+  gen::nonholonomic(s, p, {&C, &spin});
+  gen::convective(s, sdot, p, {&dPhi_ds_dot_sdot, &C_dot_sdot});
+  // C++17 names the outputs by assignment (C++20: {.com = &com, .Jv = &Jv, ...}).
+  gen::BodiesOutputsOf<Scalar> bodies_outputs;
+  bodies_outputs.com = &com;
+  bodies_outputs.rotations = &body_rotations;
+  bodies_outputs.Jv = &Jv;
+  bodies_outputs.Jw = &Jw;
+  bodies_outputs.Jv_dot_sdot = &Jv_dot_sdot;
+  bodies_outputs.Jw_dot_sdot = &Jw_dot_sdot;
+  gen::bodies(s, sdot, p, bodies_outputs);
+  gen::kinematic_update(s, p, {&positions, &rotations, &Phi, &dPhi_ds, &C});
+  gen::clearance(s, p, {&lowest});
   bool finite = positions.allFinite() && Phi.allFinite() && dPhi_ds.allFinite() && C.allFinite() && spin.allFinite() &&
                 dPhi_ds_dot_sdot.allFinite() && C_dot_sdot.allFinite() && com.allFinite() && Jv_dot_sdot.allFinite() &&
                 Jw_dot_sdot.allFinite() && std::isfinite(lowest);
@@ -61,7 +69,9 @@ int main() {
     if (limb.solve != nullptr && limb.solve(s, p, 0, s, why) != gen::IkStatus::ok) return 1;
   // The float solution, put into the closure in double: within the float IK's own tolerance.
   gen::ClosureVector Phi;
-  gen::closure(s_float.cast<double>().eval(), p, &Phi, nullptr);
+  gen::ClosureOutputs closure_outputs;  // the one output wanted; dPhi_ds stays null and is not computed
+  closure_outputs.Phi = &Phi;
+  gen::closure(s_float.cast<double>().eval(), p, closure_outputs);
   const double residual = Phi.cwiseAbs().maxCoeff();
   std::printf("%.*s: float IK at the nominal state: closure residual %.2e (tolerance %.2e); double: joints within %.2e\n",
               static_cast<int>(gen::kModelName.size()), gen::kModelName.data(), residual, double(gen::ik_tolerance<float>()),

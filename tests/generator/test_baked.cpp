@@ -17,12 +17,12 @@ TEST_CASE("baked parameters: same results as the symbolic headers at docs/excava
     wlx::gen::ClosureJacobian J1, J2;
     wlx::gen::ClosureVector c1, c2;
     wlx::gen::BodyJacobians Jv1, Jv2;
-    wlx::gen::closure(s, p, nullptr, &J1);
-    wlx::baked::closure(s, ignored, nullptr, &J2);
-    wlx::gen::convective(s, sdot, p, &c1, nullptr);
-    wlx::baked::convective(s, sdot, ignored, &c2, nullptr);
-    wlx::gen::bodies(s, sdot, p, nullptr, nullptr, &Jv1, nullptr, nullptr, nullptr);
-    wlx::baked::bodies(s, sdot, ignored, nullptr, nullptr, &Jv2, nullptr, nullptr, nullptr);
+    wlx::gen::closure(s, p, {.dPhi_ds = &J1});
+    wlx::baked::closure(s, ignored, {.dPhi_ds = &J2});
+    wlx::gen::convective(s, sdot, p, {.dPhi_ds_dot_sdot = &c1});
+    wlx::baked::convective(s, sdot, ignored, {.dPhi_ds_dot_sdot = &c2});
+    wlx::gen::bodies(s, sdot, p, {.Jv = &Jv1});
+    wlx::baked::bodies(s, sdot, ignored, {.Jv = &Jv2});
     worst = std::max({worst, (J1 - J2).cwiseAbs().maxCoeff(), (c1 - c2).cwiseAbs().maxCoeff()});
     for (int b = 0; b < wlx::gen::kBodyCount; ++b) worst = std::max(worst, (Jv1[b] - Jv2[b]).cwiseAbs().maxCoeff());
   }

@@ -87,7 +87,7 @@ TEST_CASE("hip offset: the dependent rates keep the wheels rolling; the dynamics
   sdot(c::theta_l5) = 0.05;
   solve_dependent_rates(model, d, s, sdot, default_pair());
   gen::WheelRows C;
-  gen::nonholonomic(s, model.params(), &C, nullptr);
+  gen::nonholonomic(s, model.params(), {.C = &C});
   const double scale = d.cond_J_beta * sdot.cwiseAbs().maxCoeff();
   CHECK((C * sdot).cwiseAbs().maxCoeff() <= 1e-14 * scale);
   closure(model, d, s, true);

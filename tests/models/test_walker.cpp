@@ -69,7 +69,7 @@ TEST_CASE("walker: every frame of the generated FK matches the independent chain
   double worst = 0;
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng);
-    gen::kinematics(s, p, &pos, &R);
+    gen::kinematics(s, p, {.positions = &pos, .rotations = &R});
     std::array<double, gen::kCoordinateCount> x;
     for (int k = 0; k < gen::kCoordinateCount; ++k) x[static_cast<std::size_t>(k)] = s(k);
     const auto ref = test::walker_kinematics(x, p);
@@ -93,9 +93,9 @@ TEST_CASE("walker: Phi, dPhi/ds, the convective terms and the wheel rows match e
   double worst_phi = 0, worst_J = 0, worst_conv = 0, worst_C = 0, worst_spin = 0, worst_C_conv = 0;
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng), sdot = test::random_rates(rng);
-    gen::closure(s, p, &Phi, &J);
-    gen::convective(s, sdot, p, &conv, &C_conv);
-    gen::nonholonomic(s, p, &C, &spin);
+    gen::closure(s, p, {.Phi = &Phi, .dPhi_ds = &J});
+    gen::convective(s, sdot, p, {.dPhi_ds_dot_sdot = &conv, .C_dot_sdot = &C_conv});
+    gen::nonholonomic(s, p, {.C = &C, .spin = &spin});
     for (int j = 0; j < gen::kCoordinateCount; ++j) {
       const auto ref = test::walker_closure(test::along(s, gen::Coordinates::Unit(j)), p);
       for (int i = 0; i < gen::kClosureCount; ++i) worst_J = std::max(worst_J, std::abs(J(i, j) - ref[static_cast<std::size_t>(i)].d));
@@ -139,7 +139,8 @@ TEST_CASE("walker: body CoM, rotation, Jv, Jw and their convective terms match e
   double worst = 0, worst_dd = 0;
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng), sdot = test::random_rates(rng);
-    gen::bodies(s, sdot, p, &com, &R, &Jv, &Jw, &Jv_dot, &Jw_dot);
+    gen::bodies(s, sdot, p,
+                {.com = &com, .rotations = &R, .Jv = &Jv, .Jw = &Jw, .Jv_dot_sdot = &Jv_dot, .Jw_dot_sdot = &Jw_dot});
     const auto ref = test::walker_kinematics(test::along(s, sdot), p);
     for (int b = 0; b < gen::kBodyCount; ++b) {
       const auto& P = ref.bodies[static_cast<std::size_t>(b)];
@@ -274,7 +275,7 @@ TEST_CASE("walker: dependent rates keep both wheels from sliding and match finit
     // Rounding in the solve scales with cond(J_beta) and the rates: measure relative to both.
     const double scale = d.cond_J_beta * sdot.cwiseAbs().maxCoeff();
     gen::WheelRows C;
-    gen::nonholonomic(s, model.params(), &C, nullptr);
+    gen::nonholonomic(s, model.params(), {.C = &C});
     worst_side = std::max(worst_side, (C * sdot).cwiseAbs().maxCoeff() / scale);
     closure(model, d, s, true);
     worst_closure = std::max(worst_closure, (d.dPhi_ds * sdot).cwiseAbs().maxCoeff() / scale);

@@ -39,7 +39,7 @@ TEST_CASE("nonholonomic: the thesis' nominal figures: cond(J_beta) ~ 7e2 and yaw
   CHECK(sdot(c::theta_l5) == 0.5 * kDeg);  // commanded rates come back untouched
   // Both constraints hold, and so does the linearised closure.
   CHECK(sideways_velocity(model, d, s, sdot).cwiseAbs().maxCoeff() <= 1e-15);
-  gen::closure(s, model.params(), nullptr, &d.dPhi_ds);
+  gen::closure(s, model.params(), {.dPhi_ds = &d.dPhi_ds});
   CHECK((d.dPhi_ds * sdot).cwiseAbs().maxCoeff() <= 1e-15);
 }
 

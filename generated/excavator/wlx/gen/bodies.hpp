@@ -19,7 +19,8 @@ namespace gen {
 
 // Body kinematics for the dynamics: per body (index with wlx::gen::body::...) the CoM position and orientation in K0, the Jacobians of the CoM velocity and of the angular velocity (both in K0), and their convective terms Jdot s'.
 //
-// Outputs, each computed only when its pointer is non-null:
+// Outputs, members of BodiesOutputsOf<Scalar> (BodiesOutputs for double), each computed only when its
+// pointer is set (C++20: bodies(..., {.com = &x})):
 //   com                CoM positions in K0, one column per body (own operations: 95, nonzero entries: 21)
 //   rotations          body orientations in K0 (own operations: 43, nonzero entries: 63)
 //   Jv                 CoM velocity Jacobians, v = Jv s' (own operations: 697, nonzero entries: 123)
@@ -34,10 +35,29 @@ namespace gen {
 // argument-dependent lookup; deduced from s. The parameters stay double.
 // zero_fill: write the structural zeros of the matrix outputs too. Pass false when they are
 // zero already (a workspace zeroed once at setup): this function never writes them.
+// Where bodies() writes: set the outputs you want; a null pointer skips that output and the
+// work only it needs.
 template <typename Scalar>
-inline void bodies(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<CoordinatesOf<Scalar>>& sdot, const Params& p, detail::NonDeduced<BodyVectorsOf<Scalar>>* com, detail::NonDeduced<BodyRotationsOf<Scalar>>* rotations, detail::NonDeduced<BodyJacobiansOf<Scalar>>* Jv, detail::NonDeduced<BodyJacobiansOf<Scalar>>* Jw, detail::NonDeduced<BodyVectorsOf<Scalar>>* Jv_dot_sdot, detail::NonDeduced<BodyVectorsOf<Scalar>>* Jw_dot_sdot, bool zero_fill = true) noexcept {
+struct BodiesOutputsOf {
+  BodyVectorsOf<Scalar>* com = nullptr;          // CoM positions in K0, one column per body
+  BodyRotationsOf<Scalar>* rotations = nullptr;  // body orientations in K0
+  BodyJacobiansOf<Scalar>* Jv = nullptr;         // CoM velocity Jacobians, v = Jv s'
+  BodyJacobiansOf<Scalar>* Jw = nullptr;         // angular velocity Jacobians, omega = Jw s'
+  BodyVectorsOf<Scalar>* Jv_dot_sdot = nullptr;  // CoM convective accelerations (d/dt Jv) s'
+  BodyVectorsOf<Scalar>* Jw_dot_sdot = nullptr;  // convective angular accelerations (d/dt Jw) s'
+};
+using BodiesOutputs = BodiesOutputsOf<double>;
+
+template <typename Scalar>
+inline void bodies(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<CoordinatesOf<Scalar>>& sdot, const Params& p, const detail::NonDeduced<BodiesOutputsOf<Scalar>>& out, bool zero_fill = true) noexcept {
   static_cast<void>(s);
   static_cast<void>(p);
+  const auto com = out.com;
+  const auto rotations = out.rotations;
+  const auto Jv = out.Jv;
+  const auto Jw = out.Jw;
+  const auto Jv_dot_sdot = out.Jv_dot_sdot;
+  const auto Jw_dot_sdot = out.Jw_dot_sdot;
   static_cast<void>(sdot);
   const Scalar x_C = s(0);
   const Scalar y_C = s(1);
@@ -788,8 +808,8 @@ inline void bodies(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<Coor
 }
 
 // bodies() in double, for any Eigen expression of the coordinates.
-inline void bodies(const Coordinates& s, const Coordinates& sdot, const Params& p, BodyVectors* com, BodyRotations* rotations, BodyJacobians* Jv, BodyJacobians* Jw, BodyVectors* Jv_dot_sdot, BodyVectors* Jw_dot_sdot, bool zero_fill = true) noexcept {
-  bodies<double>(s, sdot, p, com, rotations, Jv, Jw, Jv_dot_sdot, Jw_dot_sdot, zero_fill);
+inline void bodies(const Coordinates& s, const Coordinates& sdot, const Params& p, const BodiesOutputs& out, bool zero_fill = true) noexcept {
+  bodies<double>(s, sdot, p, out, zero_fill);
 }
 
 namespace operations {

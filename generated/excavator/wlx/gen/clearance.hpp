@@ -19,7 +19,8 @@ namespace gen {
 
 // Ground clearance: the height above z = 0 of the lowest corner of the box attached to frame C (centred on its origin, along its axes).
 //
-// Outputs, each computed only when its pointer is non-null:
+// Outputs, members of ClearanceOutputsOf<Scalar> (ClearanceOutputs for double), each computed only when its
+// pointer is set (C++20: clearance(..., {.lowest = &x})):
 //   lowest             height of the lowest corner above the ground, m (own operations: 16, nonzero entries: 1)
 // Intermediate terms: 0; shared by several outputs: 4 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).
@@ -27,10 +28,19 @@ namespace gen {
 // The same outputs as expression trees, before CSE: 19 (adds 3, muls 8, divs 0, calls 8).
 // Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by
 // argument-dependent lookup; deduced from s. The parameters stay double.
+// Where clearance() writes: set the outputs you want; a null pointer skips that output and the
+// work only it needs.
 template <typename Scalar>
-inline void clearance(const CoordinatesOf<Scalar>& s, const Params& p, detail::NonDeduced<Scalar>* lowest) noexcept {
+struct ClearanceOutputsOf {
+  Scalar* lowest = nullptr;  // height of the lowest corner above the ground, m
+};
+using ClearanceOutputs = ClearanceOutputsOf<double>;
+
+template <typename Scalar>
+inline void clearance(const CoordinatesOf<Scalar>& s, const Params& p, const detail::NonDeduced<ClearanceOutputsOf<Scalar>>& out) noexcept {
   static_cast<void>(s);
   static_cast<void>(p);
+  const auto lowest = out.lowest;
   using std::abs;
   const Scalar z_C = s(2);
   const Scalar pitch = s(4);
@@ -52,8 +62,8 @@ inline void clearance(const CoordinatesOf<Scalar>& s, const Params& p, detail::N
 }
 
 // clearance() in double, for any Eigen expression of the coordinates.
-inline void clearance(const Coordinates& s, const Params& p, double* lowest) noexcept {
-  clearance<double>(s, p, lowest);
+inline void clearance(const Coordinates& s, const Params& p, const ClearanceOutputs& out) noexcept {
+  clearance<double>(s, p, out);
 }
 
 namespace operations {

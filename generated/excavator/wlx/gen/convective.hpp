@@ -19,7 +19,8 @@ namespace gen {
 
 // Convective terms: (d/dt dPhi/ds) s' and (d/dt C) s', i.e. the second time derivatives of Phi and of v_W . n_W with all accelerations zero.
 //
-// Outputs, each computed only when its pointer is non-null:
+// Outputs, members of ConvectiveOutputsOf<Scalar> (ConvectiveOutputs for double), each computed only when its
+// pointer is set (C++20: convective(..., {.dPhi_ds_dot_sdot = &x})):
 //   dPhi_ds_dot_sdot   (d/dt dPhi/ds) s' (own operations: 800, nonzero entries: 14)
 //   C_dot_sdot         (d/dt C) s', one per wheel (l, r) (own operations: 433, nonzero entries: 2)
 // Intermediate terms: 353; shared by several outputs: 634 operations (sin and cos of all angles
@@ -28,10 +29,21 @@ namespace gen {
 // The same outputs as expression trees, before CSE: 62310 (adds 9592, muls 23588, divs 0, calls 29130).
 // Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by
 // argument-dependent lookup; deduced from s. The parameters stay double.
+// Where convective() writes: set the outputs you want; a null pointer skips that output and the
+// work only it needs.
 template <typename Scalar>
-inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<CoordinatesOf<Scalar>>& sdot, const Params& p, detail::NonDeduced<ClosureVectorOf<Scalar>>* dPhi_ds_dot_sdot, detail::NonDeduced<WheelVectorOf<Scalar>>* C_dot_sdot) noexcept {
+struct ConvectiveOutputsOf {
+  ClosureVectorOf<Scalar>* dPhi_ds_dot_sdot = nullptr;  // (d/dt dPhi/ds) s'
+  WheelVectorOf<Scalar>* C_dot_sdot = nullptr;          // (d/dt C) s', one per wheel (l, r)
+};
+using ConvectiveOutputs = ConvectiveOutputsOf<double>;
+
+template <typename Scalar>
+inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<CoordinatesOf<Scalar>>& sdot, const Params& p, const detail::NonDeduced<ConvectiveOutputsOf<Scalar>>& out) noexcept {
   static_cast<void>(s);
   static_cast<void>(p);
+  const auto dPhi_ds_dot_sdot = out.dPhi_ds_dot_sdot;
+  const auto C_dot_sdot = out.C_dot_sdot;
   static_cast<void>(sdot);
   const Scalar yaw = s(3);
   const Scalar pitch = s(4);
@@ -506,8 +518,8 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
 }
 
 // convective() in double, for any Eigen expression of the coordinates.
-inline void convective(const Coordinates& s, const Coordinates& sdot, const Params& p, ClosureVector* dPhi_ds_dot_sdot, WheelVector* C_dot_sdot) noexcept {
-  convective<double>(s, sdot, p, dPhi_ds_dot_sdot, C_dot_sdot);
+inline void convective(const Coordinates& s, const Coordinates& sdot, const Params& p, const ConvectiveOutputs& out) noexcept {
+  convective<double>(s, sdot, p, out);
 }
 
 namespace operations {

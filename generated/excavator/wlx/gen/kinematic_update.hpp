@@ -19,7 +19,8 @@ namespace gen {
 
 // The per-step kinematic update in one pass: frame positions and orientations, Phi, dPhi/ds and the non-holonomic rows C(s) (the outputs of kinematics, closure and nonholonomic, sharing their common subexpressions).
 //
-// Outputs, each computed only when its pointer is non-null:
+// Outputs, members of KinematicUpdateOutputsOf<Scalar> (KinematicUpdateOutputs for double), each computed only when its
+// pointer is set (C++20: kinematic_update(..., {.positions = &x})):
 //   positions          frame origins in K0, one column per frame (own operations: 131, nonzero entries: 39)
 //   rotations          frame orientations in K0 (columns: frame axes) (own operations: 54, nonzero entries: 117)
 //   Phi                closure residuals, zero on the constraint manifold (own operations: 50, nonzero entries: 14)
@@ -33,10 +34,27 @@ namespace gen {
 // argument-dependent lookup; deduced from s. The parameters stay double.
 // zero_fill: write the structural zeros of the matrix outputs too. Pass false when they are
 // zero already (a workspace zeroed once at setup): this function never writes them.
+// Where kinematic_update() writes: set the outputs you want; a null pointer skips that output and the
+// work only it needs.
 template <typename Scalar>
-inline void kinematic_update(const CoordinatesOf<Scalar>& s, const Params& p, detail::NonDeduced<FramePositionsOf<Scalar>>* positions, detail::NonDeduced<FrameRotationsOf<Scalar>>* rotations, detail::NonDeduced<ClosureVectorOf<Scalar>>* Phi, detail::NonDeduced<ClosureJacobianOf<Scalar>>* dPhi_ds, detail::NonDeduced<WheelRowsOf<Scalar>>* C, bool zero_fill = true) noexcept {
+struct KinematicUpdateOutputsOf {
+  FramePositionsOf<Scalar>* positions = nullptr;  // frame origins in K0, one column per frame
+  FrameRotationsOf<Scalar>* rotations = nullptr;  // frame orientations in K0 (columns: frame axes)
+  ClosureVectorOf<Scalar>* Phi = nullptr;         // closure residuals, zero on the constraint manifold
+  ClosureJacobianOf<Scalar>* dPhi_ds = nullptr;   // dPhi/ds, 14 x 32
+  WheelRowsOf<Scalar>* C = nullptr;               // cornering constraint rows, one per wheel (l, r)
+};
+using KinematicUpdateOutputs = KinematicUpdateOutputsOf<double>;
+
+template <typename Scalar>
+inline void kinematic_update(const CoordinatesOf<Scalar>& s, const Params& p, const detail::NonDeduced<KinematicUpdateOutputsOf<Scalar>>& out, bool zero_fill = true) noexcept {
   static_cast<void>(s);
   static_cast<void>(p);
+  const auto positions = out.positions;
+  const auto rotations = out.rotations;
+  const auto Phi = out.Phi;
+  const auto dPhi_ds = out.dPhi_ds;
+  const auto C = out.C;
   const Scalar x_C = s(0);
   const Scalar y_C = s(1);
   const Scalar z_C = s(2);
@@ -618,8 +636,8 @@ inline void kinematic_update(const CoordinatesOf<Scalar>& s, const Params& p, de
 }
 
 // kinematic_update() in double, for any Eigen expression of the coordinates.
-inline void kinematic_update(const Coordinates& s, const Params& p, FramePositions* positions, FrameRotations* rotations, ClosureVector* Phi, ClosureJacobian* dPhi_ds, WheelRows* C, bool zero_fill = true) noexcept {
-  kinematic_update<double>(s, p, positions, rotations, Phi, dPhi_ds, C, zero_fill);
+inline void kinematic_update(const Coordinates& s, const Params& p, const KinematicUpdateOutputs& out, bool zero_fill = true) noexcept {
+  kinematic_update<double>(s, p, out, zero_fill);
 }
 
 namespace operations {

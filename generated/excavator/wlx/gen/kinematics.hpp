@@ -19,7 +19,8 @@ namespace gen {
 
 // Forward kinematics: position and orientation in K0 of every frame of interest (index with wlx::gen::frame::...).
 //
-// Outputs, each computed only when its pointer is non-null:
+// Outputs, members of KinematicsOutputsOf<Scalar> (KinematicsOutputs for double), each computed only when its
+// pointer is set (C++20: kinematics(..., {.positions = &x})):
 //   positions          frame origins in K0, one column per frame (own operations: 182, nonzero entries: 39)
 //   rotations          frame orientations in K0 (columns: frame axes) (own operations: 128, nonzero entries: 117)
 // Intermediate terms: 126; shared by several outputs: 306 operations (sin and cos of all angles
@@ -28,10 +29,21 @@ namespace gen {
 // The same outputs as expression trees, before CSE: 9681 (adds 1338, muls 3534, divs 0, calls 4809).
 // Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by
 // argument-dependent lookup; deduced from s. The parameters stay double.
+// Where kinematics() writes: set the outputs you want; a null pointer skips that output and the
+// work only it needs.
 template <typename Scalar>
-inline void kinematics(const CoordinatesOf<Scalar>& s, const Params& p, detail::NonDeduced<FramePositionsOf<Scalar>>* positions, detail::NonDeduced<FrameRotationsOf<Scalar>>* rotations) noexcept {
+struct KinematicsOutputsOf {
+  FramePositionsOf<Scalar>* positions = nullptr;  // frame origins in K0, one column per frame
+  FrameRotationsOf<Scalar>* rotations = nullptr;  // frame orientations in K0 (columns: frame axes)
+};
+using KinematicsOutputs = KinematicsOutputsOf<double>;
+
+template <typename Scalar>
+inline void kinematics(const CoordinatesOf<Scalar>& s, const Params& p, const detail::NonDeduced<KinematicsOutputsOf<Scalar>>& out) noexcept {
   static_cast<void>(s);
   static_cast<void>(p);
+  const auto positions = out.positions;
+  const auto rotations = out.rotations;
   const Scalar x_C = s(0);
   const Scalar y_C = s(1);
   const Scalar z_C = s(2);
@@ -397,8 +409,8 @@ inline void kinematics(const CoordinatesOf<Scalar>& s, const Params& p, detail::
 }
 
 // kinematics() in double, for any Eigen expression of the coordinates.
-inline void kinematics(const Coordinates& s, const Params& p, FramePositions* positions, FrameRotations* rotations) noexcept {
-  kinematics<double>(s, p, positions, rotations);
+inline void kinematics(const Coordinates& s, const Params& p, const KinematicsOutputs& out) noexcept {
+  kinematics<double>(s, p, out);
 }
 
 namespace operations {

@@ -19,7 +19,8 @@ namespace gen {
 
 // Loop closure: Phi(s) and its Jacobian dPhi/ds.
 //
-// Outputs, each computed only when its pointer is non-null:
+// Outputs, members of ClosureOutputsOf<Scalar> (ClosureOutputs for double), each computed only when its
+// pointer is set (C++20: closure(..., {.Phi = &x})):
 //   Phi                closure residuals, zero on the constraint manifold (own operations: 150, nonzero entries: 14)
 //   dPhi_ds            dPhi/ds, 14 x 32 (own operations: 514, nonzero entries: 98)
 // Intermediate terms: 167; shared by several outputs: 242 operations (sin and cos of all angles
@@ -30,10 +31,21 @@ namespace gen {
 // argument-dependent lookup; deduced from s. The parameters stay double.
 // zero_fill: write the structural zeros of the matrix outputs too. Pass false when they are
 // zero already (a workspace zeroed once at setup): this function never writes them.
+// Where closure() writes: set the outputs you want; a null pointer skips that output and the
+// work only it needs.
 template <typename Scalar>
-inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, detail::NonDeduced<ClosureVectorOf<Scalar>>* Phi, detail::NonDeduced<ClosureJacobianOf<Scalar>>* dPhi_ds, bool zero_fill = true) noexcept {
+struct ClosureOutputsOf {
+  ClosureVectorOf<Scalar>* Phi = nullptr;        // closure residuals, zero on the constraint manifold
+  ClosureJacobianOf<Scalar>* dPhi_ds = nullptr;  // dPhi/ds, 14 x 32
+};
+using ClosureOutputs = ClosureOutputsOf<double>;
+
+template <typename Scalar>
+inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detail::NonDeduced<ClosureOutputsOf<Scalar>>& out, bool zero_fill = true) noexcept {
   static_cast<void>(s);
   static_cast<void>(p);
+  const auto Phi = out.Phi;
+  const auto dPhi_ds = out.dPhi_ds;
   const Scalar x_C = s(0);
   const Scalar y_C = s(1);
   const Scalar z_C = s(2);
@@ -412,8 +424,8 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, detail::Non
 }
 
 // closure() in double, for any Eigen expression of the coordinates.
-inline void closure(const Coordinates& s, const Params& p, ClosureVector* Phi, ClosureJacobian* dPhi_ds, bool zero_fill = true) noexcept {
-  closure<double>(s, p, Phi, dPhi_ds, zero_fill);
+inline void closure(const Coordinates& s, const Params& p, const ClosureOutputs& out, bool zero_fill = true) noexcept {
+  closure<double>(s, p, out, zero_fill);
 }
 
 namespace operations {

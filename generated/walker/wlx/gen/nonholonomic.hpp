@@ -19,7 +19,8 @@ namespace gen {
 
 // Non-holonomic wheels: rows C(s) with v_W . n_W = C(s) s', and the rolling rows with spin rate = (v_W . e_x,W) / w = spin(s) s'.
 //
-// Outputs, each computed only when its pointer is non-null:
+// Outputs, members of NonholonomicOutputsOf<Scalar> (NonholonomicOutputs for double), each computed only when its
+// pointer is set (C++20: nonholonomic(..., {.C = &x})):
 //   C                  cornering constraint rows, one per wheel (l, r) (own operations: 95, nonzero entries: 20)
 //   spin               wheel spin-rate rows, one per wheel (l, r) (own operations: 120, nonzero entries: 20)
 // Intermediate terms: 135; shared by several outputs: 403 operations (sin and cos of all angles
@@ -30,10 +31,21 @@ namespace gen {
 // argument-dependent lookup; deduced from s. The parameters stay double.
 // zero_fill: write the structural zeros of the matrix outputs too. Pass false when they are
 // zero already (a workspace zeroed once at setup): this function never writes them.
+// Where nonholonomic() writes: set the outputs you want; a null pointer skips that output and the
+// work only it needs.
 template <typename Scalar>
-inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, detail::NonDeduced<WheelRowsOf<Scalar>>* C, detail::NonDeduced<WheelRowsOf<Scalar>>* spin, bool zero_fill = true) noexcept {
+struct NonholonomicOutputsOf {
+  WheelRowsOf<Scalar>* C = nullptr;     // cornering constraint rows, one per wheel (l, r)
+  WheelRowsOf<Scalar>* spin = nullptr;  // wheel spin-rate rows, one per wheel (l, r)
+};
+using NonholonomicOutputs = NonholonomicOutputsOf<double>;
+
+template <typename Scalar>
+inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const detail::NonDeduced<NonholonomicOutputsOf<Scalar>>& out, bool zero_fill = true) noexcept {
   static_cast<void>(s);
   static_cast<void>(p);
+  const auto C = out.C;
+  const auto spin = out.spin;
   const Scalar yaw = s(3);
   const Scalar pitch = s(4);
   const Scalar roll = s(5);
@@ -268,8 +280,8 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, detail
 }
 
 // nonholonomic() in double, for any Eigen expression of the coordinates.
-inline void nonholonomic(const Coordinates& s, const Params& p, WheelRows* C, WheelRows* spin, bool zero_fill = true) noexcept {
-  nonholonomic<double>(s, p, C, spin, zero_fill);
+inline void nonholonomic(const Coordinates& s, const Params& p, const NonholonomicOutputs& out, bool zero_fill = true) noexcept {
+  nonholonomic<double>(s, p, out, zero_fill);
 }
 
 namespace operations {
