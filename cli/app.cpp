@@ -45,9 +45,11 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
   inv.simulate->add_option("--weighting", inv.sim.weighting, "torque weighting 1 (the model file's weights) or 2 (by contribution), for inverse dynamics");
   inv.simulate->add_flag("--list", inv.sim.list, "list the built-in scenarios");
 
-  inv.report = app.add_subcommand("report", "excavator: run every verification of the thesis and write an HTML report with figures");
+  inv.report = app.add_subcommand("report", "run the model's verifications and scenarios, check its claims (the excavator's: the thesis'), and write an HTML report with figures");
   inv.report->add_option("--out", inv.report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
   inv.report->add_flag("--quick", inv.report_options.quick, "a reduced set of runs, for a fast look");
+  inv.report->add_option("--claims", inv.report_options.claims_file,
+                         "a report file (claims and figure layout, format of scenarios/<model>/report.yaml) instead of the model's own");
 
   for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report}) add_model_options(a);
 }
