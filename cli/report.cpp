@@ -43,15 +43,17 @@ report::ReportSpec load_spec(const std::string& claims_file) {
   return report::parse_report_spec(text.str(), claims_file);
 }
 
-// Enough significant digits to resolve the criterion's tolerance.
+// Small and large values to 3 significant digits, others to 6; more where a "near" criterion's
+// tolerance needs them to be seen.
 std::string format_value(const Measured& m, const std::optional<report::Criterion>& c) {
-  int digits = 6;
-  if (c && c->kind == report::Criterion::Kind::near && c->a != 0)
-    digits = std::clamp(static_cast<int>(std::ceil(std::log10(std::abs(c->a) / c->b))) + 2, 6, 15);
   const std::string unit = m.unit.empty() ? "" : " " + m.unit;
   if (!std::isfinite(m.value)) return "none" + unit;
   const double a = std::abs(m.value);
-  if (a != 0 && (a < 1e-3 || a >= 1e6)) return fmt::format("{:.{}e}{}", m.value, digits - 1, unit);
+  const bool scientific = a != 0 && (a < 1e-3 || a >= 1e6);
+  int digits = scientific ? 3 : 6;
+  if (c && c->kind == report::Criterion::Kind::near && c->a != 0)
+    digits = std::clamp(static_cast<int>(std::ceil(std::log10(std::abs(c->a) / c->b))) + 2, digits, 15);
+  if (scientific) return fmt::format("{:.{}e}{}", m.value, digits - 1, unit);
   return fmt::format("{:.{}g}{}", m.value, digits, unit);
 }
 
@@ -173,7 +175,7 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
       header.push_back("CSV");
       report::Table t{header, {}};
       for (const auto& r : runner_.integrators()) {
-        std::vector<report::Cell> row{{r.id}, {std::string(integrator_name(r.integrator)) + (r.integrator == Integrator::euler ? " (thesis)" : "")},
+        std::vector<report::Cell> row{{r.id}, {std::string(integrator_name(r.integrator))},
                                       {r.setting}, {std::to_string(r.samples)}, {std::to_string(r.evaluations)}, {fmt::format("{:.2e}", r.inputs)}};
         for (std::size_t k = 0; k < r.coordinates.size(); ++k)
           row.push_back({fmt::format("{:.2e}", r.coordinates[k] * display_scale(runner_.compared_coordinates()[k]))});
@@ -181,11 +183,11 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
         t.rows.push_back(row);
       }
       s.subsections.push_back({"integrators", "Integrators compared",
-                               fmt::format("Each run integrated three ways and compared at its samples with RK4 at {:g} s. The thesis "
-                                           "used explicit Euler at 1 ms; wlx defaults to RK4; dopri5 (adaptive Dormand-Prince 5(4)) "
-                                           "writes 10 samples per run and chooses its steps in between. An evaluation is one "
-                                           "closed-form IK of every limb plus a dependent-rate solve.",
-                                           spec_.reference_step),
+                               fmt::format("Each run integrated three ways and compared at its samples with RK4 at {:g} s: "
+                                           "explicit Euler and RK4 (wlx's default) at the run's step, and dopri5 (adaptive "
+                                           "Dormand-Prince 5(4)), which writes 10 samples per run and chooses its steps in between. "
+                                           "An evaluation is one closed-form IK of every limb plus a dependent-rate solve. {}",
+                                           spec_.reference_step, spec_.integrator_note),
                                {t}, {}, {}});
     }
     out.push_back(s);

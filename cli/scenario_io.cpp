@@ -128,7 +128,12 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base) {
       else sc.rates(k) = v;
     }
   }
-  if (!j.contains("dependent")) throw Error("dependent", "missing: name the two dependent rates, e.g. [\"y_C\", \"yaw\"]");
+  if (!j.contains("dependent")) {
+    const auto pair = default_pair().index;
+    throw Error("dependent", fmt::format("missing: name the two dependent rates, e.g. [\"{}\", \"{}\"]",
+                                         gen::kCoordinateNames[static_cast<std::size_t>(pair[0])],
+                                         gen::kCoordinateNames[static_cast<std::size_t>(pair[1])]));
+  }
   const auto& dep = j.at("dependent");
   if (!dep.is_array() || dep.size() != 2 || !dep[0].is_string() || !dep[1].is_string())
     throw Error("dependent", fmt::format("must be an array of 2 names, got {}", excerpt(dep)));

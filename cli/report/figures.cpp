@@ -148,6 +148,15 @@ class Figures {
     return s;
   }
 
+  // ", <value> with lines ... title '<label>'" for the report file's line of that key, or "".
+  std::string reference_line(const std::string& key) const {
+    const auto it = spec_.reference_lines.find(key);
+    if (it == spec_.reference_lines.end()) return "";
+    std::string label = it->second.label;
+    std::replace(label.begin(), label.end(), '\'', '"');  // inside a gnuplot '...' string
+    return fmt::format(", {:g} with lines dt 2 lw 2 lc rgb 'gray40' title '{}'", it->second.value, label);
+  }
+
   void ik(std::vector<FigureSpec>& out) {
     for (const auto& s : runner_.sweeps()) {
       const LimbBlock block = limb_block(s.sweep.limb);
@@ -171,8 +180,9 @@ class Figures {
       b += "\nset logscale y\nset format y '1e%L'\nset yrange [1e-18:1e-3]\nset ylabel 'analytic check error (m)'\n";
       b += fmt::format("set title '{}: |target - FK(solution)| (zeros drawn at 1e-18)'\n", s.sweep.id);
       b += fmt::format("plot '{0}' using {1}:{2} with lines lw 2 title 'closed form', '{0}' using {1}:{3} with points pt 7 ps 0.4 "
-                       "title 'Newton', 1e-5 with lines dt 2 lw 2 lc rgb 'gray40' title 'thesis (~1e-5 m)'\n",
-                       file, column(s.sweep.input, xs), log_column("check_error_closed_form"), log_column("check_error_newton"));
+                       "title 'Newton'{4}\n",
+                       file, column(s.sweep.input, xs), log_column("check_error_closed_form"), log_column("check_error_newton"),
+                       reference_line("ik_check_error"));
       b += "unset multiplot\n";
       out.push_back({"ik-" + s.sweep.id, fmt::format("{}: {} swept; closed form and Newton", s.sweep.id, s.sweep.input), "1000,800", b});
     }
@@ -190,9 +200,9 @@ class Figures {
       const std::string file = data_path(r->csv);
       b += fmt::format("set title '{}: |v_W . n_W|'\nset xlabel 't (s)'\nset ylabel 'm/s'\nplot ", r->id);
       for (std::size_t w = 0; w < gen::kWheelNames.size(); ++w)
-        b += fmt::format("'{}' using {}:{} with lines lw 2 dt {} title 'wheel {}', ", file, column("t"),
+        b += fmt::format("{}'{}' using {}:{} with lines lw 2 dt {} title 'wheel {}'", w ? ", " : "", file, column("t"),
                          log_column(fmt::format("nh_residual_{}", gen::kWheelNames[w])), dash(w), gen::kWheelNames[w]);
-      b += "1e-5 with lines dt 2 lw 2 lc rgb 'gray40' title 'thesis (1e-5)'\n";
+      b += reference_line("wheel_residual") + "\n";
     }
     b += "unset multiplot\n";
     out.push_back({"nh-residuals", "Wheel constraint residual per wheel (zeros drawn at 1e-19)", fmt::format("1000,{}", 330 * ((runs.size() + 1) / 2)), b});

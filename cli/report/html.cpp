@@ -104,7 +104,7 @@ std::string render_html(const Document& d) {
   std::vector<Section> toc;
   toc.push_back({"checks", "Checks", "", {}, {}, {}});
   toc.push_back({"inputs", "Inputs and set-up (not checks)", "", {}, {}, {}});
-  toc.push_back({"observations", "Observations: where wlx differs from the thesis", "", {}, {}, {}});
+  toc.push_back({"observations", "Observations: where wlx differs from its sources", "", {}, {}, {}});
   for (const auto& s : d.sections) toc.push_back(s);
   toc.push_back({"parameters", "Parameters", "", {}, {}, {}});
   h += "<nav>\n<h2 id=\"contents\">Contents</h2>\n";
@@ -126,12 +126,12 @@ std::string render_html(const Document& d) {
                                       : "");
     h += claims_table(d.checks, true);
   }
-  h += "<h2 id=\"inputs\">Inputs and set-up (not checks)</h2>\n<p>Values the thesis reports that follow from the "
+  h += "<h2 id=\"inputs\">Inputs and set-up (not checks)</h2>\n<p>Values the sources report that follow from the "
        "inputs of a run (a commanded rate times the duration, a coordinate held constant, a sum of input masses): "
        "wlx reproduces them by construction, so they cannot fail and are not counted as checks.</p>\n";
   if (!d.inputs.empty()) h += claims_table(d.inputs, false);
-  h += "<h2 id=\"observations\">Observations: where wlx differs from the thesis</h2>\n<p>Where wlx deliberately "
-       "computes something else than the thesis, or the thesis gives no number to hold wlx against.</p>\n";
+  h += "<h2 id=\"observations\">Observations: where wlx differs from its sources</h2>\n<p>Where wlx deliberately "
+       "computes something else than the source, or the source gives no number to hold wlx against.</p>\n";
   if (!d.observations.empty()) h += claims_table(d.observations, false);
   for (const auto& s : d.sections) section(h, s, 2);
   h += "<h2 id=\"parameters\">Parameters</h2>\n" + table(d.parameters);

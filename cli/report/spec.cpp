@@ -239,7 +239,8 @@ class Parser {
     ReportSpec s;
     s.file = file_;
     if (!root || root.IsNull()) return s;
-    keys(root, "(top level)", {"title", "quick", "integrator_comparison", "sections", "run_figures", "torque_figures", "pose", "claims"});
+    keys(root, "(top level)", {"title", "quick", "integrator_comparison", "sections", "reference_lines", "run_figures", "torque_figures",
+                               "pose", "claims"});
     s.title = optional_text(root, "title", "");
     if (const YAML::Node q = root["quick"]) {
       keys(q, "quick", {"sweeps", "scenarios"});
@@ -247,7 +248,8 @@ class Parser {
       if (q["scenarios"]) s.quick_scenarios = names(q["scenarios"], "quick.scenarios");
     }
     if (const YAML::Node ic = root["integrator_comparison"]) {
-      keys(ic, "integrator_comparison", {"scenarios", "reference_step", "coordinates"});
+      keys(ic, "integrator_comparison", {"scenarios", "reference_step", "coordinates", "note"});
+      s.integrator_note = optional_text(ic, "note", "integrator_comparison");
       s.integrator_scenarios = names(required(ic, "scenarios", "integrator_comparison"), "integrator_comparison.scenarios");
       if (ic["coordinates"]) s.integrator_coordinates = names(ic["coordinates"], "integrator_comparison.coordinates");
       if (ic["reference_step"]) {
@@ -259,6 +261,16 @@ class Parser {
     if (const YAML::Node sec = root["sections"]) {
       keys(sec, "sections", {"ik", "nonholonomic", "kinematic", "dynamics"});
       for (const auto& kv : sec) s.section_titles[kv.first.as<std::string>()] = text(kv.second, "sections." + kv.first.as<std::string>());
+    }
+    if (const YAML::Node lines = root["reference_lines"]) {
+      keys(lines, "reference_lines", {"ik_check_error", "wheel_residual"});
+      for (const auto& kv : lines) {
+        const std::string path = "reference_lines." + kv.first.as<std::string>();
+        keys(kv.second, path, {"value", "label"});
+        const double v = number(required(kv.second, "value", path), path + ".value");
+        if (v <= 0) fail(kv.second["value"], path + ".value", "must be positive (the figures have log axes)");
+        s.reference_lines[kv.first.as<std::string>()] = {v, text(required(kv.second, "label", path), path + ".label")};
+      }
     }
     if (const YAML::Node figs = root["run_figures"]) {
       if (!figs.IsSequence()) fail(figs, "run_figures", "must be a list");
@@ -352,10 +364,10 @@ bool Criterion::passes(double v) const {
 std::string Criterion::describe(const std::string& unit) const {
   const std::string u = unit.empty() ? "" : " " + unit;
   switch (kind) {
-    case Kind::at_most: return fmt::format("<= {}{}", number_text(a), u);
-    case Kind::at_least: return fmt::format(">= {}{}", number_text(a), u);
+    case Kind::at_most: return fmt::format("\u2264 {}{}", number_text(a), u);
+    case Kind::at_least: return fmt::format("\u2265 {}{}", number_text(a), u);
     case Kind::between: return fmt::format("in [{}, {}]{}", number_text(a), number_text(b), u);
-    case Kind::near: return fmt::format("= {} +- {}{}", number_text(a), number_text(b), u);
+    case Kind::near: return fmt::format("{} \u00b1 {}{}", number_text(a), number_text(b), u);
     case Kind::negative: return "< 0";
     case Kind::positive: return "> 0";
   }

@@ -18,7 +18,7 @@ struct Criterion {
   Kind kind = Kind::at_most;
   double a = 0, b = 0;  // at_most/at_least: a; between: [a, b]; near: a +- b
   bool passes(double value) const;
-  // "<= 1e-10", "in [a, b]", "= 2.63 +- 0.005", "< 0", "> 0" (with the unit where it has one).
+  // "≤ 1e-10", "≥ 1", "in [a, b]", "2.63 ± 0.005", "< 0", "> 0" (with the unit where it has one).
   std::string describe(const std::string& unit) const;
 };
 
@@ -66,12 +66,21 @@ struct TorqueReference {
   int line = 0;
 };
 
+// A horizontal line in a figure: a value the sources quote (the thesis' error level, ...).
+struct ReferenceLine {
+  double value = 0;
+  std::string label;
+};
+
 struct ReportSpec {
   std::string file;   // for messages: "scenarios/excavator/report.yaml" or the user's path
   std::string title;  // "the walking excavator of the diploma thesis"
   std::optional<std::vector<std::string>> quick_sweeps, quick_scenarios;  // unset: all
   std::vector<std::string> integrator_scenarios, integrator_coordinates;
   double reference_step = 1e-4;
+  std::string integrator_note;  // what the sources say about the integrators (text), may be empty
+  // Keyed by the figure they go into: ik_check_error (IK sweeps), wheel_residual (wheel constraint runs).
+  std::map<std::string, ReferenceLine> reference_lines;
   std::map<std::string, std::string> section_titles;  // ik, nonholonomic, kinematic, dynamics
   std::vector<RunFigure> run_figures;
   std::vector<std::vector<std::string>> torque_panels;
