@@ -107,7 +107,8 @@ class Figures {
   static std::string title_of(const ReportRun& r) { return r.scenario_id; }
 
   // data/<run>-pose.dat: index 0 the start, index 1 the end; in each, the body outline then one
-  // segment per frame from its parent (the skeleton), blank lines between segments.
+  // segment per frame from its parent (the skeleton), blank lines between segments; index 2 the
+  // body frame's path.
   void write_poses() {
     for (const auto& r : runner_.runs()) {
       if (duplicate_motion(r)) continue;
@@ -131,6 +132,14 @@ class Figures {
         }
         out << "\n";  // two blank lines: the next gnuplot index
         headings_[r.id].push_back({p.frames[static_cast<std::size_t>(body_frame_)], p.heading});
+      }
+      // Index 2: the path of the body frame, every sample.
+      out << "# body frame path\n";
+      for (const auto& smp : r.trajectory.samples) {
+        forward_kinematics(runner_.model(), smp.s, runner_.data());
+        const Eigen::Vector3d q = runner_.data().frame_positions.col(body_frame_);
+        out << fmt::format("{},{},{}\n", q.x(), q.y(), q.z());
+        bounds_[r.id].add(q);
       }
       write_file_atomically(data_dir_ + "/" + r.id + "-pose.dat", out.str());
     }
@@ -193,9 +202,9 @@ class Figures {
     for (const auto& r : runner_.runs())
       if (r.nonholonomic_verification) runs.push_back(&r);
     if (runs.empty()) return;
-    std::string b = fmt::format("set multiplot layout {},2\nset logscale y\nset format y '1e%L'\nset yrange [1e-19:1e-3]\n"
+    std::string b = fmt::format("set multiplot layout {},1\nset logscale y\nset format y '1e%L'\nset yrange [1e-19:1e-3]\n"
                                 "set key outside right top\n",
-                                (runs.size() + 1) / 2);
+                                runs.size());
     for (const ReportRun* r : runs) {
       const std::string file = data_path(r->csv);
       b += fmt::format("set title '{}: |v_W . n_W|'\nset xlabel 't (s)'\nset ylabel 'm/s'\nplot ", r->id);
@@ -205,7 +214,7 @@ class Figures {
       b += reference_line("wheel_residual") + "\n";
     }
     b += "unset multiplot\n";
-    out.push_back({"nh-residuals", "Wheel constraint residual per wheel (zeros drawn at 1e-19)", fmt::format("1000,{}", 330 * ((runs.size() + 1) / 2)), b});
+    out.push_back({"nh-residuals", "Wheel constraint residual per wheel (zeros drawn at 1e-19)", fmt::format("1000,{}", 260 * runs.size()), b});
   }
 
   void runs(std::vector<FigureSpec>& out) {
@@ -233,7 +242,7 @@ class Figures {
     }
   }
 
-  // The contact paths and the cabin path seen from above, with the machine at the start and the
+  // The contact paths and the body frame's path seen from above, with the machine at the start and the
   // end of each run, on equal axis scales.
   FigureSpec top_view(const std::string& id, const std::vector<const ReportRun*>& runs) {
     Bounds b;
@@ -254,8 +263,8 @@ class Figures {
       const std::string file = data_path(runs[k]->csv);
       t += fmt::format(", '{}' index 1 using 1:2 with lines lw 1 dt {} lc {} title '{} machine at the end'",
                        data_path(runs[k]->id + "-pose.dat"), dash(k), k + 1, runs[k]->id);
-      t += fmt::format(", '{}' using {}:{} with lines lw 3 dt {} lc {} title '{} cabin path'", file, column("x_C"), column("y_C"),
-                       dash(k), k + 1, runs[k]->id);
+      t += fmt::format(", '{}' index 2 using 1:2 with lines lw 3 dt {} lc {} title '{} {} path'", data_path(runs[k]->id + "-pose.dat"),
+                       dash(k), k + 1, runs[k]->id, gen::kFrameNames[static_cast<std::size_t>(body_frame_)]);
       for (std::size_t w = 0; w < gen::kWheelNames.size(); ++w) {
         const std::string wheel(gen::kWheelNames[w]);
         t += fmt::format(", '{}' using {}:{} with lines lw 2 dt {} lc {} title '{} wheel {} contact'", file, column("x_W" + wheel),
@@ -263,7 +272,8 @@ class Figures {
       }
     }
     t += "\n";
-    return {"run-" + id + "-top", id + ": wheel contact paths and cabin path seen from above, with the machine at the start and the end",
+    return {"run-" + id + "-top", fmt::format("{}: wheel contact paths and the path of frame {} seen from above, with the machine at the start "
+                                              "and the end", id, gen::kFrameNames[static_cast<std::size_t>(body_frame_)]),
             "1100,650", t};
   }
 
@@ -330,7 +340,7 @@ class Figures {
       b += "unset multiplot\n";
       out.push_back({"pose-" + title, title + ": the machine (body outline and the frames of the generated forward kinematics, each joined "
                                               "to its parent) at the start and the end",
-                     "1200,560", b});
+                     "1200,450", b});
     }
   }
 
