@@ -109,7 +109,7 @@ void Report::evaluate_claims(report::Document& d) {
       }
       row.measured.push_back(format_value(*m, t.criterion));
       if (t.criterion) {
-        row.criteria.push_back(t.criterion->describe(c.unit.empty() ? m->unit : c.unit));
+        row.criteria.push_back(t.criterion->describe(m->unit));
         pass = pass && t.criterion->passes(m->value);
       }
     }

@@ -191,7 +191,7 @@ class Parser {
   }
 
   Claim claim(const YAML::Node& n, const std::string& path) const {
-    keys(n, path, {"id", "kind", "claim", "source", "thesis", "spec", "measure", "criterion", "tests", "why", "unit"});
+    keys(n, path, {"id", "kind", "claim", "source", "thesis", "spec", "measure", "criterion", "tests", "why"});
     Claim c;
     c.line = line(n);
     c.id = text(required(n, "id", path), path + ".id");
@@ -210,7 +210,6 @@ class Parser {
     c.spec = optional_text(n, "spec", path);
     if (c.thesis.empty() && c.spec.empty()) fail(n, path, "must give the claimed value as 'thesis' or 'spec'");
     c.why = text(required(n, "why", path), path + ".why");
-    c.unit = optional_text(n, "unit", path);
     if (n["tests"]) {
       if (n["measure"] || n["criterion"]) fail(n, path, "give either 'tests' or 'measure' (and 'criterion'), not both");
       const YAML::Node tests = n["tests"];
@@ -367,7 +366,14 @@ std::string Criterion::describe(const std::string& unit) const {
     case Kind::at_most: return fmt::format("\u2264 {}{}", number_text(a), u);
     case Kind::at_least: return fmt::format("\u2265 {}{}", number_text(a), u);
     case Kind::between: return fmt::format("in [{}, {}]{}", number_text(a), number_text(b), u);
-    case Kind::near: return fmt::format("{} \u00b1 {}{}", number_text(a), number_text(b), u);
+    case Kind::near: {
+      // Very small or large values with a common exponent, "(6.0 ± 0.5)e-04", so the two compare at a glance.
+      if (a == 0 || (std::abs(a) >= 1e-3 && std::abs(a) < 1e6)) return fmt::format("{} \u00b1 {}{}", number_text(a), number_text(b), u);
+      const int exponent = static_cast<int>(std::floor(std::log10(std::abs(a))));
+      const double scale = std::pow(10.0, exponent);
+      const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(b / scale))));
+      return fmt::format("({:.{}f} \u00b1 {:.{}f})e{:+03d}{}", a / scale, decimals, b / scale, decimals, exponent, u);
+    }
     case Kind::negative: return "< 0";
     case Kind::positive: return "> 0";
   }

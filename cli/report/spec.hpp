@@ -48,7 +48,6 @@ struct Claim {
   std::string source;  // "thesis section 3.4, Tables 3-2 to 3-13", "spec section 5"
   std::string thesis, spec;  // the values as the sources give them (text)
   std::string why;           // why the criterion, or where the value comes from
-  std::string unit;          // overrides the measure's unit in the display (e.g. "m or rad")
   std::vector<Test> tests;
   int line = 0;
 };

@@ -171,6 +171,8 @@ TEST_CASE("report file: a check fails when the measured value is outside its cri
     CHECK(!c.passes(std::nan("")));
   // The criterion as the report states it.
   CHECK(near.describe("s") == "0.583 \u00b1 0.0005 s");
+  CHECK((Criterion{Criterion::Kind::near, 6e-4, 0.5e-4}.describe("deg")) == "(6.0 \u00b1 0.5)e-04 deg");
+  CHECK((Criterion{Criterion::Kind::near, 2.7e7, 0.05e7}.describe("")) == "(2.70 \u00b1 0.05)e+07");
   CHECK(at_most.describe("m") == "\u2264 1e-10 m");
   CHECK(Criterion{Criterion::Kind::negative}.describe("deg") == "< 0");
 }
