@@ -99,10 +99,15 @@ void ReportRunner::validate() const {
         for (const auto& r : m.runs)
           if (std::find(spec_.integrator_scenarios.begin(), spec_.integrator_scenarios.end(), r) == spec_.integrator_scenarios.end())
             throw Error(report::where(spec_, m.line, path + ".runs"), fmt::format("'{}' is not in integrator_comparison.scenarios", r));
-        for (const auto& name : m.coordinates)
+        for (const auto& name : m.coordinates) {
           if (std::find(spec_.integrator_coordinates.begin(), spec_.integrator_coordinates.end(), name) == spec_.integrator_coordinates.end())
             throw Error(report::where(spec_, m.line, path + ".coordinates"),
                         fmt::format("'{}' is not in integrator_comparison.coordinates", name));
+          // One value in one unit: a criterion cannot hold metres and degrees at once.
+          if (display_unit(coordinate_index(name)) != display_unit(coordinate_index(m.coordinates.front())))
+            throw Error(report::where(spec_, m.line, path + ".coordinates"),
+                        fmt::format("'{}' and '{}' have different units: give them in separate tests", m.coordinates.front(), name));
+        }
       }
     }
   }
