@@ -53,7 +53,7 @@ std::string claims_table(const std::vector<ClaimRow>& rows, bool with_criterion)
                      escape(r.claim), escape(r.source), escape(r.thesis), escape(r.spec), lines(r.measured));
     if (with_criterion) {
       const bool pass = r.result == ClaimRow::Result::pass;
-      h += fmt::format("<td>{}</td><td class=\"{}\">{}</td>", lines(r.criteria), pass ? "pass" : "fail", pass ? "pass" : "FAIL");
+      h += fmt::format("<td class=\"criterion\">{}</td><td class=\"{}\">{}</td>", lines(r.criteria), pass ? "pass" : "fail", pass ? "pass" : "FAIL");
     }
     h += fmt::format("<td class=\"why\">{}</td></tr>\n", escape(r.why));
   }
@@ -90,7 +90,7 @@ std::string render_html(const Document& d) {
   h += "<style>\nbody{font-family:sans-serif;max-width:1250px;margin:2em auto;padding:0 1em;color:#222}\n"
        "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:4px 8px;vertical-align:top}\n"
        "th{background:#eee}.pass{color:#176b17;font-weight:bold}.fail{color:#b00;font-weight:bold}\n"
-       "td.why{color:#555;font-size:90%;max-width:24em}td.wlx{white-space:nowrap}\n"
+       "td.why{color:#555;font-size:90%;max-width:24em}td.wlx,td.criterion{white-space:nowrap}\n"
        "figure{margin:1.5em 0}figure img{max-width:100%;border:1px solid #ddd}figcaption{color:#555}\n"
        "nav{background:#f6f6f6;padding:0.5em 1em;border:1px solid #ddd}\n"
        "code{background:#f4f4f4;padding:1px 3px}\n</style>\n</head>\n<body>\n";
