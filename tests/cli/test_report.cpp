@@ -2,6 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <cstdlib>
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -11,6 +12,11 @@
 namespace fs = std::filesystem;
 
 namespace {
+
+// A folder of this test process's own: other builds on the machine run these tests at the same time.
+fs::path temp_dir(const std::string& name) {
+  return fs::temp_directory_path() / (name + "_" + std::to_string(static_cast<long>(::getpid())));
+}
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);
@@ -47,7 +53,7 @@ std::string markup_problem(const std::string& html) {
 }  // namespace
 
 TEST_CASE("report: the full report runs, every image exists, every check passes, the HTML is well formed") {
-  const fs::path dir = fs::temp_directory_path() / "wlx_report_test";
+  const fs::path dir = temp_dir("wlx_report_test");
   fs::remove_all(dir);
   const std::string cmd = std::string(WLX_BINARY) + " report --out " + dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
   const int status = std::system(cmd.c_str());
@@ -106,7 +112,7 @@ std::string claims_with_mass_check(const std::string& criterion) {
 }  // namespace
 
 TEST_CASE("report: a check whose measured value is outside its criterion fails the report (exit 1)") {
-  const fs::path dir = fs::temp_directory_path() / "wlx_report_failing_check";
+  const fs::path dir = temp_dir("wlx_report_failing_check");
   fs::remove_all(dir);
   fs::create_directories(dir);
   // The mass of the default parameters is several tonnes: 1 kg at most cannot hold.
@@ -122,7 +128,7 @@ TEST_CASE("report: a check whose measured value is outside its criterion fails t
 }
 
 TEST_CASE("report: a malformed or inapplicable report file is a bad input (exit 2) naming file, line and field") {
-  const fs::path dir = fs::temp_directory_path() / "wlx_report_bad_claims";
+  const fs::path dir = temp_dir("wlx_report_bad_claims");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string claims = (dir / "claims.yaml").string();
@@ -142,7 +148,7 @@ TEST_CASE("report: a malformed or inapplicable report file is a bad input (exit 
 }
 
 TEST_CASE("report: the gnuplot scripts run from their own folder") {
-  const fs::path dir = fs::temp_directory_path() / "wlx_report_scripts";
+  const fs::path dir = temp_dir("wlx_report_scripts");
   fs::remove_all(dir);
   REQUIRE(run(std::string(WLX_BINARY) + " report --quick --out " + dir.string(), dir.string() + ".log") == 0);
   std::vector<fs::path> scripts;
@@ -161,7 +167,7 @@ TEST_CASE("report: the gnuplot scripts run from their own folder") {
 }
 
 TEST_CASE("report: a model without a report file still gets a report of its runs") {
-  const fs::path dir = fs::temp_directory_path() / "wlx_report_walker";
+  const fs::path dir = temp_dir("wlx_report_walker");
   fs::remove_all(dir);
   const int code = run(std::string(WLX_BINARY) + " --model walker report --out " + dir.string(), dir.string() + ".log");
   INFO(slurp(dir.string() + ".log"));
