@@ -28,15 +28,15 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
 
   auto* verify = app.add_subcommand("verify", "the verifications: IK sweeps and wheel constraints");
   verify->require_subcommand(1);
-  inv.verify_ik = verify->add_subcommand("ik", "the model's IK sweeps (its file's ik_sweeps; the excavator's 12 of docs/excavator.md section 8), closed form and Newton");
+  inv.verify_ik = verify->add_subcommand("ik", "the model's IK sweeps (its file's ik_sweeps), closed form and Newton");
   inv.verify_ik->add_option("--out", inv.ik_out, "folder for one CSV per sweep")->capture_default_str();
-  inv.verify_ik->add_option("--sweep", inv.sweep_ids, "only these sweeps (ids as wlx verify ik lists them, e.g. IK-L1)");
+  inv.verify_ik->add_option("--sweep", inv.sweep_ids, "only these sweeps (ids as wlx verify ik lists them)");
 
-  inv.verify_nh = verify->add_subcommand("nonholonomic", "the model's scenarios marked \"verify\": \"nonholonomic\" (the excavator's NH-1..4): the wheels' sideways-velocity residual");
+  inv.verify_nh = verify->add_subcommand("nonholonomic", "the model's scenarios marked \"verify\": \"nonholonomic\": the wheels' sideways-velocity residual");
   inv.verify_nh->add_option("--out", inv.nh_out, "folder for one trajectory CSV per run")->capture_default_str();
 
   inv.simulate = app.add_subcommand("simulate", "integrate a scenario (a file, or a built-in id: --list shows them)");
-  inv.simulate->add_option("SCENARIO", inv.sim.scenario, "scenario file or id (the excavator's NH-1, ST-A1+, ...)");
+  inv.simulate->add_option("SCENARIO", inv.sim.scenario, "scenario file or id (--list shows the model's ids)");
   inv.simulate->add_option("--out", inv.sim.out_dir, "output folder for trajectory.csv")->capture_default_str();
   inv.simulate->add_option("--integrator", inv.sim.integrator,
                        "rk4, euler or dopri5 (adaptive Dormand-Prince 5(4)); default: the scenario's");
@@ -45,9 +45,11 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
   inv.simulate->add_option("--weighting", inv.sim.weighting, "torque weighting 1 (the model file's weights) or 2 (by contribution), for inverse dynamics");
   inv.simulate->add_flag("--list", inv.sim.list, "list the built-in scenarios");
 
-  inv.report = app.add_subcommand("report", "excavator: run every verification of the thesis and write an HTML report with figures");
+  inv.report = app.add_subcommand("report", "run the model's verifications and scenarios, check the claims of its report file, and write an HTML report with figures");
   inv.report->add_option("--out", inv.report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
   inv.report->add_flag("--quick", inv.report_options.quick, "a reduced set of runs, for a fast look");
+  inv.report->add_option("--claims", inv.report_options.claims_file,
+                         "a report file (claims and figure layout, format of scenarios/<model>/report.yaml) instead of the model's own");
 
   for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report}) add_model_options(a);
 }

@@ -22,7 +22,10 @@ struct SimulateOptions {
 
 struct ReportOptions {
   std::string out_dir = "report";
-  bool quick = false;  // a reduced set of runs (for tests)
+  bool quick = false;        // a reduced set of runs (for tests)
+  std::string claims_file;   // a report file to use instead of the model's embedded one
+  std::string command_line;  // as invoked, and wlx's version: recorded in the report
+  std::string version;
 };
 
 // Options every command takes.

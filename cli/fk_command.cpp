@@ -52,7 +52,7 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
   throw_if_interrupted();
   const nlohmann::json j =
       text.find_first_not_of(" \t\r\n") == std::string::npos ? nlohmann::json::object() : parse_json_bounded(text, "stdin");
-  if (!j.is_object()) throw Error("stdin", "expected a JSON object of coordinates, e.g. {\"z_C\": 1.8}");
+  if (!j.is_object()) throw Error("stdin", fmt::format("expected a JSON object of coordinates, e.g. {{\"{}\": 1.8}}", gen::kCoordinateNames[0]));
   std::vector<std::string> names;
   for (const auto& n : gen::kCoordinateNames) names.emplace_back(n);
   reject_unknown_keys(j, names, "");
@@ -99,13 +99,7 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
 
 const ModelCommands& entry() {
   static const ModelCommands commands{gen::kModelName, gen::kModelDescription, &run_fk, &run_ik, &run_verify_ik,
-                                      &run_verify_nonholonomic, &run_simulate,
-#ifdef WLX_THESIS_REPORT
-                                      &run_report
-#else
-                                      nullptr
-#endif
-  };
+                                      &run_verify_nonholonomic, &run_simulate, &run_report};
   return commands;
 }
 

@@ -178,9 +178,9 @@ int run_verify_ik(const ModelOptions& model_options, const std::string& out_dir,
                fmt::format("{} off", r.cold_start_off_default),
                pass ? "" : (r.newton_branch_changes ? "  FAIL (Newton changed branch)" : "  FAIL"));
   }
-  fmt::print("\n'check' is |target - FK(solution)| with the generated forward kinematics (thesis: ~1e-5 m);\n"
+  fmt::print("\n'check' is |target - FK(solution)| with the generated forward kinematics \n"
              "Newton is warm-started along the sweep; 'cold start' counts points where Newton started from the\n"
-             "sweep's start pose lands off the default branch (docs/excavator.md section 4). CSV files: {}/\n"
+             "sweep's start pose lands off the default branch. CSV files: {}/\n"
              "{}\n",
              out_dir, ok ? "all sweeps pass (every error <= 1e-10 m)" : "SOME SWEEPS FAIL");
   return ok ? 0 : 1;

@@ -28,6 +28,12 @@ int main(int argc, char** argv) {
   for (const auto& n : names) model_names += (model_names.empty() ? "" : ", ") + n;
   install_interrupt_handlers();
   if (const auto code = parse_command_line(app, argc, argv)) return finish(*code);
+  report_options.version = WLX_VERSION;
+  for (int k = 0; k < argc; ++k) {
+    const std::string arg = argv[k];
+    const bool plain = !arg.empty() && arg.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789+-_./=:,") == std::string::npos;
+    report_options.command_line += (k ? " " : "") + (plain ? arg : "'" + arg + "'");
+  }
   try {
     const ModelCommands* model = nullptr;
     std::vector<std::string> names;

@@ -129,9 +129,13 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base) {
       else sc.rates(k) = v;
     }
   }
-  if (!j.contains("dependent"))
-    throw Error("dependent", fmt::format("missing: name the {} dependent rates (one per wheel), e.g. {}", kWheelCount,
-                                         default_pair().label()));
+  if (!j.contains("dependent")) {
+    std::string example;
+    for (int k : default_pair().index)
+      example += fmt::format("{}\"{}\"", example.empty() ? "" : ", ", gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+    throw Error("dependent",
+                fmt::format("missing: name the {} dependent rates (one per wheel), e.g. [{}]", kWheelCount, example));
+  }
   const auto& dep = j.at("dependent");
   if (!dep.is_array() || dep.size() != static_cast<std::size_t>(kWheelCount) ||
       !std::all_of(dep.begin(), dep.end(), [](const auto& name) { return name.is_string(); }))

@@ -124,7 +124,7 @@ int run_verify_nonholonomic(const ModelOptions& model_options, const std::string
     else
       fmt::print("{} {:>14.3g}{}\n", line, cond, pass ? "" : (tr.complete ? "  FAIL" : "  FAIL: " + tr.error));
   }
-  fmt::print("\nresidual = v_W . n_W from the generated C(s) and the solved rates (thesis: <= 1e-5); CSV files: {}/\n{}\n",
+  fmt::print("\nresidual = v_W . n_W from the generated C(s) and the solved rates; CSV files: {}/\n{}\n",
              out_dir, ok ? "all runs pass (every residual <= 1e-10 m/s)" : "SOME RUNS FAIL");
   return ok ? 0 : 1;
 }

@@ -2,6 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <cstdlib>
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -11,6 +12,11 @@
 namespace fs = std::filesystem;
 
 namespace {
+
+// A folder of this test process's own: other builds on the machine run these tests at the same time.
+fs::path temp_dir(const std::string& name) {
+  return fs::temp_directory_path() / (name + "_" + std::to_string(static_cast<long>(::getpid())));
+}
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);
@@ -47,7 +53,7 @@ std::string markup_problem(const std::string& html) {
 }  // namespace
 
 TEST_CASE("report: the full report runs, every image exists, every check passes, the HTML is well formed") {
-  const fs::path dir = fs::temp_directory_path() / "wlx_report_test";
+  const fs::path dir = temp_dir("wlx_report_test");
   fs::remove_all(dir);
   const std::string cmd = std::string(WLX_BINARY) + " report --out " + dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
   const int status = std::system(cmd.c_str());
@@ -81,4 +87,95 @@ TEST_CASE("report: the full report runs, every image exists, every check passes,
   CHECK(std::regex_search(log, std::regex(R"(\[(\d+)/\1\] rendering)")));
   CHECK(html.find("Integrators compared") != std::string::npos);
   CHECK(log.find("open " + fs::absolute(dir / "index.html").string()) != std::string::npos);
+}
+
+namespace {
+
+// Runs `command` through the shell with its output in `log`; returns the exit code.
+int run(const std::string& command, const fs::path& log) {
+  const int status = std::system((command + " > " + log.string() + " 2>&1").c_str());
+  return WEXITSTATUS(status);
+}
+
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream out(p);
+  out << text;
+}
+
+// A report file with one check whose criterion the measured value meets or not.
+std::string claims_with_mass_check(const std::string& criterion) {
+  return "claims:\n  - id: mass\n    kind: check\n    claim: the total mass\n    source: {thesis: Table 6-1}\n"
+         "    thesis: 6153.98 kg\n    measure: {quantity: total_mass}\n    criterion: " +
+         criterion + "\n    why: a test\n";
+}
+
+}  // namespace
+
+TEST_CASE("report: a check whose measured value is outside its criterion fails the report (exit 1)") {
+  const fs::path dir = temp_dir("wlx_report_failing_check");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // The mass of the default parameters is several tonnes: 1 kg at most cannot hold.
+  write(dir / "claims.yaml", claims_with_mass_check("{at_most: 1}"));
+  const int code = run(std::string(WLX_BINARY) + " report --quick --claims " + (dir / "claims.yaml").string() + " --out " +
+                           (dir / "out").string(), dir / "log");
+  INFO(slurp(dir / "log"));
+  CHECK(code == 1);
+  const std::string html = slurp(dir / "out" / "index.html");
+  CHECK(html.find("class=\"fail\"") != std::string::npos);
+  CHECK(html.find("0 of 1 checks pass") != std::string::npos);
+  CHECK(slurp(dir / "log").find("check failed: mass") != std::string::npos);
+}
+
+TEST_CASE("report: a malformed or inapplicable report file is a bad input (exit 2) naming file, line and field") {
+  const fs::path dir = temp_dir("wlx_report_bad_claims");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string claims = (dir / "claims.yaml").string();
+  const std::string command = std::string(WLX_BINARY) + " report --quick --claims " + claims + " --out " + (dir / "out").string();
+  write(claims, claims_with_mass_check("{near: 6000}"));
+  CHECK(run(command, dir / "log") == 2);
+  CHECK(slurp(dir / "log").find(claims + ":8: claims[0].criterion: 'near' needs a 'tolerance'") != std::string::npos);
+  // Well formed, but the name is not one of the model's coordinates.
+  write(claims, "run_figures:\n  - {id: F, runs: [NH-1], x: rol, y: [yaw]}\n");
+  CHECK(run(command, dir / "log") == 2);
+  CHECK(slurp(dir / "log").find(claims + ":2: run_figures.F.x: 'rol' is not a coordinate of model excavator (did you mean 'roll'?)") !=
+        std::string::npos);
+  CHECK(!fs::exists(dir / "out" / "index.html"));
+  write(claims, "claims: [\n");
+  CHECK(run(command, dir / "log") == 2);
+  CHECK(slurp(dir / "log").find(claims + ":") != std::string::npos);
+}
+
+TEST_CASE("report: the gnuplot scripts run from their own folder") {
+  const fs::path dir = temp_dir("wlx_report_scripts");
+  fs::remove_all(dir);
+  REQUIRE(run(std::string(WLX_BINARY) + " report --quick --out " + dir.string(), dir.string() + ".log") == 0);
+  std::vector<fs::path> scripts;
+  for (const auto& e : fs::directory_iterator(dir / "plots"))
+    if (e.path().extension() == ".gp") scripts.push_back(e.path());
+  REQUIRE(!scripts.empty());
+  for (const fs::path& script : {scripts.front(), scripts.back()}) {
+    const std::string stem = script.stem().string();
+    fs::remove(dir / "fig" / (stem + ".png"));
+    fs::remove(dir / "fig" / (stem + ".svg"));
+    CAPTURE(stem);
+    CHECK(run("cd " + (dir / "plots").string() + " && gnuplot " + stem + ".gp", dir / (stem + ".log")) == 0);
+    CHECK(fs::file_size(dir / "fig" / (stem + ".png")) > 1000);
+    CHECK(fs::file_size(dir / "fig" / (stem + ".svg")) > 1000);
+  }
+}
+
+TEST_CASE("report: a model without a report file still gets a report of its runs") {
+  const fs::path dir = temp_dir("wlx_report_walker");
+  fs::remove_all(dir);
+  const int code = run(std::string(WLX_BINARY) + " --model walker report --out " + dir.string(), dir.string() + ".log");
+  INFO(slurp(dir.string() + ".log"));
+  REQUIRE(code == 0);
+  const std::string html = slurp(dir / "index.html");
+  CHECK(markup_problem(html).empty());
+  CHECK(html.find("has no report file with claims") != std::string::npos);
+  CHECK(html.find("class=\"fail\"") == std::string::npos);
+  CHECK(html.find("<img src=\"fig/pose-") != std::string::npos);
+  CHECK(html.find("<img src=\"fig/id-") != std::string::npos);
 }

@@ -1,0 +1,361 @@
+// The report's figures (report/figures.hpp). Curves that may coincide get distinct dash patterns,
+// and a legend entry says "identical to" when two curves are the same to rounding; legends sit
+// outside the plots; top views show the whole machine with equal axis scales and its heading.
+#include "report/figures.hpp"
+
+#include <fmt/format.h>
+#include <wlx/atomic_file.hpp>
+#include <wlx/dynamics.hpp>
+#include <wlx/kinematics.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+WLX_COMMANDS_BEGIN
+
+namespace {
+
+using report::column;
+using report::data_path;
+using report::FigureSpec;
+using report::log_column;
+
+constexpr double kDegPerRad = 180 / std::numbers::pi;
+
+std::string name_of(int coordinate) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(coordinate)]); }
+
+// The legend titles of curves given as sample vectors: "<name> (identical to <earlier>)" where a
+// curve equals an earlier one to `tolerance`, since the later one is drawn over it.
+std::vector<std::string> legend_titles(const std::vector<std::string>& names, const std::vector<std::vector<double>>& curves,
+                                       double tolerance) {
+  std::vector<std::string> titles = names;
+  for (std::size_t k = 0; k < curves.size(); ++k)
+    for (std::size_t e = 0; e < k; ++e) {
+      double diff = 0;
+      for (std::size_t i = 0; i < curves[k].size(); ++i) diff = std::max(diff, std::abs(curves[k][i] - curves[e][i]));
+      if (diff <= tolerance) {
+        titles[k] += " (identical to " + names[e] + ")";
+        break;
+      }
+    }
+  return titles;
+}
+
+// A dash pattern per curve index, so that coinciding curves stay distinguishable.
+int dash(std::size_t k) { return static_cast<int>(k % 5) + 1; }
+
+struct Bounds {
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300, z0 = 0, z1 = -1e300;
+  void add(const Eigen::Vector3d& p) {
+    x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
+    z0 = std::min(z0, p.z()), z1 = std::max(z1, p.z());
+  }
+  void add(double x, double y) { add(Eigen::Vector3d(x, y, 0)); }
+  // gnuplot ranges with a margin, the ground z = 0 included in the side view.
+  std::string xy(double margin) const {
+    return fmt::format("set xrange [{:.3f}:{:.3f}]\nset yrange [{:.3f}:{:.3f}]\n", x0 - margin, x1 + margin, y0 - margin, y1 + margin);
+  }
+  std::string xz(double margin) const {
+    return fmt::format("set xrange [{:.3f}:{:.3f}]\nset yrange [{:.3f}:{:.3f}]\n", x0 - margin, x1 + margin, z0 - margin, z1 + margin);
+  }
+};
+
+class Figures {
+ public:
+  Figures(ReportRunner& runner, const report::ReportSpec& spec, std::string data_dir)
+      : runner_(runner), spec_(spec), data_dir_(std::move(data_dir)) {
+    body_frame_ = spec.pose_frame.empty() ? 0 : frame_index(spec.pose_frame);
+  }
+
+  ReportFigures all() {
+    ReportFigures f;
+    write_poses();
+    ik(f.ik);
+    nonholonomic(f.nonholonomic);
+    runs(f.kinematic);
+    dynamics(f.dynamics);
+    poses(f.poses);
+    return f;
+  }
+
+ private:
+  struct Pose {
+    std::vector<Eigen::Vector3d> frames;
+    Eigen::Vector3d heading;  // the body frame's x axis
+    std::vector<Eigen::Vector3d> outline;
+  };
+
+  Pose pose_at(const Coordinates& s) {
+    Data& data = runner_.data();
+    forward_kinematics(runner_.model(), data, s);
+    Pose p;
+    for (int f = 0; f < gen::kFrameCount; ++f) p.frames.emplace_back(data.frame_positions.col(f));
+    const Eigen::Matrix3d& R = data.frame_rotations[static_cast<std::size_t>(body_frame_)];
+    p.heading = R.col(0);
+    if (spec_.pose_outline.size() == 2) {
+      Params params = runner_.model().params();
+      const double length = *find_param(params, spec_.pose_outline[0]), width = *find_param(params, spec_.pose_outline[1]);
+      for (auto [x, y] : {std::pair{1, 1}, std::pair{1, -1}, std::pair{-1, -1}, std::pair{-1, 1}, std::pair{1, 1}})
+        p.outline.push_back(p.frames[static_cast<std::size_t>(body_frame_)] + R * Eigen::Vector3d(x * length / 2, y * width / 2, 0));
+    }
+    return p;
+  }
+
+  static bool duplicate_motion(const ReportRun& r) { return r.id.size() > 3 && r.id.substr(r.id.size() - 3) == "-w2"; }
+  static std::string title_of(const ReportRun& r) { return r.scenario_id; }
+
+  // data/<run>-pose.dat: index 0 the start, index 1 the end; in each, the body outline then one
+  // segment per frame from its parent (the skeleton), blank lines between segments; index 2 the
+  // body frame's path.
+  void write_poses() {
+    for (const auto& r : runner_.runs()) {
+      if (duplicate_motion(r)) continue;
+      std::ostringstream out;
+      for (const Sample* smp : {&r.trajectory.samples.front(), &r.trajectory.samples.back()}) {
+        const Pose p = pose_at(smp->s);
+        Bounds& b = bounds_[r.id];
+        for (const auto& q : p.frames) b.add(q);
+        for (const auto& q : p.outline) b.add(q);
+        out << "# body outline\n";
+        for (const auto& q : p.outline) out << fmt::format("{},{},{}\n", q.x(), q.y(), q.z());
+        out << "\n";
+        for (int f = 0; f < gen::kFrameCount; ++f) {
+          const int parent = gen::kFrameParent[static_cast<std::size_t>(f)];
+          if (parent < 0) continue;
+          for (int g : {parent, f}) {
+            const auto& q = p.frames[static_cast<std::size_t>(g)];
+            out << fmt::format("{},{},{}\n", q.x(), q.y(), q.z());
+          }
+          out << "\n";
+        }
+        out << "\n";  // two blank lines: the next gnuplot index
+        headings_[r.id].push_back({p.frames[static_cast<std::size_t>(body_frame_)], p.heading});
+      }
+      // Index 2: the path of the body frame, every sample.
+      out << "# body frame path\n";
+      for (const auto& smp : r.trajectory.samples) {
+        forward_kinematics(runner_.model(), runner_.data(), smp.s);
+        const Eigen::Vector3d q = runner_.data().frame_positions.col(body_frame_);
+        out << fmt::format("{},{},{}\n", q.x(), q.y(), q.z());
+        bounds_[r.id].add(q);
+      }
+      write_file_atomically(data_dir_ + "/" + r.id + "-pose.dat", out.str());
+    }
+  }
+
+  // gnuplot arrows for the heading at the start (gray) and the end (blue), in the view (a, b).
+  std::string heading_arrows(const std::string& run, int a, int b, double length) {
+    std::string s;
+    const auto& h = headings_[run];
+    for (std::size_t k = 0; k < h.size(); ++k) {
+      const Eigen::Vector3d from = h[k].first, to = h[k].first + length * h[k].second;
+      s += fmt::format("set arrow from {:.4f},{:.4f} to {:.4f},{:.4f} head filled size screen 0.015,25 lw 3 lc rgb '{}' front\n", from(a),
+                       from(b), to(a), to(b), k == 0 ? "gray50" : "#b4371f");
+    }
+    return s;
+  }
+
+  // ", <value> with lines ... title '<label>'" for the report file's line of that key, or "".
+  std::string reference_line(const std::string& key) const {
+    const auto it = spec_.reference_lines.find(key);
+    if (it == spec_.reference_lines.end()) return "";
+    std::string label = it->second.label;
+    std::replace(label.begin(), label.end(), '\'', '"');  // inside a gnuplot '...' string
+    return fmt::format(", {:g} with lines dt 2 lw 2 lc rgb 'gray40' title '{}'", it->second.value, label);
+  }
+
+  void ik(std::vector<FigureSpec>& out) {
+    for (const auto& s : runner_.sweeps()) {
+      const LimbBlock block = limb_block(s.sweep.limb);
+      std::vector<std::string> joints;
+      std::vector<std::vector<double>> curves;
+      for (int j = 0; j < block.size; ++j) {
+        const int c = block.joints[static_cast<std::size_t>(j)];
+        joints.push_back(name_of(c));
+        curves.emplace_back();
+        for (const auto& p : s.points) curves.back().push_back(p.closed_form(c));
+      }
+      const auto titles = legend_titles(joints, curves, 1e-9);
+      const double xs = s.sweep.degrees ? kDegPerRad : 1;
+      const std::string file = data_path(s.sweep.id + ".csv");
+      std::string b = "set multiplot layout 2,1\nset key outside right top\n";
+      b += fmt::format("set xlabel '{} ({})'\nset ylabel 'joint angle (deg)'\nset title '{}: dependent joints (closed form)'\nplot ",
+                       s.sweep.input, s.sweep.degrees ? "deg" : "m", s.sweep.id);
+      for (std::size_t k = 0; k < joints.size(); ++k)
+        b += fmt::format("{}'{}' using {}:{} with lines lw 2 dt {} title '{}'", k ? ", " : "", file, column(s.sweep.input, xs),
+                         column(joints[k], kDegPerRad), dash(k), titles[k]);
+      b += "\nset logscale y\nset format y '1e%L'\nset yrange [1e-18:1e-3]\nset ylabel 'analytic check error (m)'\n";
+      b += fmt::format("set title '{}: |target - FK(solution)| (zeros drawn at 1e-18)'\n", s.sweep.id);
+      b += fmt::format("plot '{0}' using {1}:{2} with lines lw 2 title 'closed form', '{0}' using {1}:{3} with points pt 7 ps 0.4 "
+                       "title 'Newton'{4}\n",
+                       file, column(s.sweep.input, xs), log_column("check_error_closed_form"), log_column("check_error_newton"),
+                       reference_line("ik_check_error"));
+      b += "unset multiplot\n";
+      out.push_back({"ik-" + s.sweep.id, fmt::format("{}: {} swept; closed form and Newton", s.sweep.id, s.sweep.input), "1000,800", b});
+    }
+  }
+
+  void nonholonomic(std::vector<FigureSpec>& out) {
+    std::vector<const ReportRun*> runs;
+    for (const auto& r : runner_.runs())
+      if (r.nonholonomic_verification) runs.push_back(&r);
+    if (runs.empty()) return;
+    std::string b = fmt::format("set multiplot layout {},1\nset logscale y\nset format y '1e%L'\nset yrange [1e-19:1e-3]\n"
+                                "set key outside right top\n",
+                                runs.size());
+    for (const ReportRun* r : runs) {
+      const std::string file = data_path(r->csv);
+      b += fmt::format("set title '{}: |v_W . n_W|'\nset xlabel 't (s)'\nset ylabel 'm/s'\nplot ", r->id);
+      for (std::size_t w = 0; w < gen::kWheelNames.size(); ++w)
+        b += fmt::format("{}'{}' using {}:{} with lines lw 2 dt {} title 'wheel {}'", w ? ", " : "", file, column("t"),
+                         log_column(fmt::format("nh_residual_{}", gen::kWheelNames[w])), dash(w), gen::kWheelNames[w]);
+      b += reference_line("wheel_residual") + "\n";
+    }
+    b += "unset multiplot\n";
+    out.push_back({"nh-residuals", "Wheel constraint residual per wheel (zeros drawn at 1e-19)", fmt::format("1000,{}", 260 * runs.size()), b});
+  }
+
+  void runs(std::vector<FigureSpec>& out) {
+    for (const auto& g : spec_.run_figures) {
+      std::vector<const ReportRun*> runs;
+      for (const auto& id : g.runs)
+        if (const ReportRun* r = runner_.find_run(id)) runs.push_back(r);
+      if (runs.empty()) continue;
+      const int x = coordinate_index(g.x);
+      std::string b = fmt::format("set multiplot layout 1,{}\nset key outside right top\n", g.y.size());
+      for (const auto& name : g.y) {
+        const int y = coordinate_index(name);
+        b += fmt::format("set title '{}: {} over {}'\nset xlabel '{} ({})'\nset ylabel '{} ({})'\nplot ", g.id, name, g.x, g.x,
+                         display_unit(x), name, display_unit(y));
+        for (std::size_t k = 0; k < runs.size(); ++k)
+          b += fmt::format("{}'{}' using {}:{} with lines lw 2 dt {} title '{}'", k ? ", " : "", data_path(runs[k]->csv),
+                           column(g.x, display_scale(x)), column(name, display_scale(y)), dash(k), runs[k]->id);
+        b += "\n";
+      }
+      b += "unset multiplot\n";
+      std::string caption = fmt::format("{}: {} over the driving input {}", g.id, fmt::format("{}", fmt::join(g.y, " and ")), g.x);
+      if (!g.thesis.empty()) caption += "; cf. thesis " + g.thesis;
+      out.push_back({"run-" + g.id, caption, "1100,450", b});
+      out.push_back(top_view(g.id, runs));
+    }
+  }
+
+  // The contact paths and the body frame's path seen from above, with the machine at the start and the
+  // end of each run, on equal axis scales.
+  FigureSpec top_view(const std::string& id, const std::vector<const ReportRun*>& runs) {
+    Bounds b;
+    std::string arrows;
+    for (const ReportRun* r : runs) {
+      const Bounds& rb = bounds_[r->id];
+      b.add(rb.x0, rb.y0), b.add(rb.x1, rb.y1);
+      for (const auto& smp : r->trajectory.samples)
+        for (int w = 0; w < gen::kWheelCount; ++w) b.add(smp.contacts(2 * w), smp.contacts(2 * w + 1));
+      arrows += heading_arrows(r->id, 0, 1, 1.0);
+    }
+    std::string t = fmt::format("set title '{}: top view (K0): paths, and the machine at the start and the end; arrows: heading'\n"
+                                "set xlabel 'x (m)'\nset ylabel 'y (m)'\nset size ratio -1\nset key outside right top\n{}{}plot ",
+                                id, b.xy(0.4), arrows);
+    const std::string start_pose = data_path(runs.front()->id + "-pose.dat");
+    t += fmt::format("'{}' index 0 using 1:2 with lines lw 1 lc rgb 'gray60' title 'machine at t = 0'", start_pose);
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      const std::string file = data_path(runs[k]->csv);
+      t += fmt::format(", '{}' index 1 using 1:2 with lines lw 1 dt {} lc {} title '{} machine at the end'",
+                       data_path(runs[k]->id + "-pose.dat"), dash(k), k + 1, runs[k]->id);
+      t += fmt::format(", '{}' index 2 using 1:2 with lines lw 3 dt {} lc {} title '{} {} path'", data_path(runs[k]->id + "-pose.dat"),
+                       dash(k), k + 1, runs[k]->id, gen::kFrameNames[static_cast<std::size_t>(body_frame_)]);
+      for (std::size_t w = 0; w < gen::kWheelNames.size(); ++w) {
+        const std::string wheel(gen::kWheelNames[w]);
+        t += fmt::format(", '{}' using {}:{} with lines lw 2 dt {} lc {} title '{} wheel {} contact'", file, column("x_W" + wheel),
+                         column("y_W" + wheel), dash(k), k + 3 + 2 * static_cast<int>(w), runs[k]->id, wheel);
+      }
+    }
+    t += "\n";
+    return {"run-" + id + "-top", fmt::format("{}: wheel contact paths and the path of frame {} seen from above, with the machine at the start "
+                                              "and the end", id, gen::kFrameNames[static_cast<std::size_t>(body_frame_)]),
+            "1100,650", t};
+  }
+
+  void dynamics(std::vector<FigureSpec>& out) {
+    std::vector<std::vector<std::string>> panels = spec_.torque_panels;
+    if (panels.empty()) {  // no report file: the actuated joints in two halves
+      panels.resize(2);
+      for (std::size_t k = 0; k < kActuatedJoints.size(); ++k) panels[k * 2 / kActuatedJoints.size()].push_back(name_of(kActuatedJoints[k]));
+    }
+    for (const auto& r : runner_.runs()) {
+      if (!r.scenario.weighting) continue;
+      const int weighting = duplicate_motion(r) ? 2 : 1;
+      const report::TorqueReference* reference = nullptr;
+      for (const auto& ref : spec_.torque_references)
+        if (ref.scenario == r.scenario_id && ref.weighting == weighting) reference = &ref;
+      double scale = 0;
+      for (const auto& smp : r.trajectory.samples) scale = std::max(scale, smp.tau.cwiseAbs().maxCoeff());
+      std::string b = fmt::format("set multiplot layout {},1\nset xlabel 't (s)'\nset ylabel 'torque (N m)'\nset key outside right top\n",
+                                  panels.size());
+      for (std::size_t p = 0; p < panels.size(); ++p) {
+        std::vector<std::string> names;
+        std::vector<std::vector<double>> curves;
+        for (const auto& joint : panels[p]) {
+          const auto at = std::find(kActuatedJoints.begin(), kActuatedJoints.end(), coordinate_index(joint)) - kActuatedJoints.begin();
+          names.push_back("tau_" + joint);
+          curves.emplace_back();
+          for (const auto& smp : r.trajectory.samples) curves.back().push_back(smp.tau(at));
+        }
+        // Equal to rounding: 1e-9 of the largest torque of the run.
+        const auto titles = legend_titles(names, curves, 1e-9 * std::max(scale, 1.0));
+        b += fmt::format("set title '{}, {}: torques{}'\nplot ", r.scenario_id, r.scenario.weighting->label(),
+                         reference ? " (cf. thesis " + reference->figures[p] + ")" : "");
+        for (std::size_t k = 0; k < names.size(); ++k)
+          b += fmt::format("{}'{}' using {}:{} with lines lw 2 dt {} title '{}'", k ? ", " : "", data_path(r.csv), column("t"),
+                           column(names[k]), dash(k), titles[k]);
+        b += "\n";
+      }
+      b += "unset multiplot\n";
+      std::string caption = fmt::format("{}: actuator torques with {}", r.scenario_id, r.scenario.weighting->label());
+      if (reference) caption += fmt::format("; cf. thesis {}", fmt::join(reference->figures, ", "));
+      out.push_back({"id-" + r.id, caption, fmt::format("1100,{}", 380 * panels.size()), b});
+    }
+  }
+
+  void poses(std::vector<FigureSpec>& out) {
+    for (const auto& r : runner_.runs()) {
+      if (duplicate_motion(r)) continue;
+      const std::string dat = data_path(r.id + "-pose.dat");
+      const Bounds& bounds = bounds_[r.id];
+      const std::string title = title_of(r);
+      const double end = r.trajectory.samples.back().t;
+      std::string b = "set multiplot layout 1,2\nset size ratio -1\nset key outside bottom center horizontal\n";
+      b += fmt::format("set title '{}: side view'\nset xlabel 'x (m)'\nset ylabel 'z (m)'\n{}{}", title, bounds.xz(0.3),
+                       heading_arrows(r.id, 0, 2, 1.0));
+      b += fmt::format("plot '{0}' index 0 using 1:3 with linespoints lw 2 pt 7 ps 0.6 lc rgb 'gray60' title 'start t = 0', '{0}' index 1 "
+                       "using 1:3 with linespoints lw 2 pt 7 ps 0.6 lc rgb '#1f5fb4' title 'end t = {1} s', 0 with lines lc rgb 'black' "
+                       "title 'ground z = 0'\n",
+                       dat, end);
+      b += fmt::format("unset arrow\nset title '{}: top view; arrows: heading'\nset xlabel 'x (m)'\nset ylabel 'y (m)'\n{}{}", title,
+                       bounds.xy(0.3), heading_arrows(r.id, 0, 1, 1.0));
+      b += fmt::format("plot '{0}' index 0 using 1:2 with linespoints lw 2 pt 7 ps 0.6 lc rgb 'gray60' title 'start', '{0}' index 1 using "
+                       "1:2 with linespoints lw 2 pt 7 ps 0.6 lc rgb '#1f5fb4' title 'end'\n",
+                       dat);
+      b += "unset multiplot\n";
+      out.push_back({"pose-" + title, title + ": the machine (body outline and the frames of the generated forward kinematics, each joined "
+                                              "to its parent) at the start and the end",
+                     "1200,450", b});
+    }
+  }
+
+  ReportRunner& runner_;
+  const report::ReportSpec& spec_;
+  std::string data_dir_;
+  int body_frame_ = 0;
+  std::map<std::string, Bounds> bounds_;
+  std::map<std::string, std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>> headings_;
+};
+
+}  // namespace
+
+ReportFigures make_figures(ReportRunner& runner, const report::ReportSpec& spec, const std::string& data_dir) {
+  return Figures(runner, spec, data_dir).all();
+}
+
+WLX_COMMANDS_END

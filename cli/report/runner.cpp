@@ -1,0 +1,331 @@
+// The report's runs and measurements (report/runner.hpp).
+#include "report/runner.hpp"
+
+#include "bounded_input.hpp"
+#include "outputs.hpp"
+#include "scenario_io.hpp"
+
+#include <fmt/format.h>
+#include <wlx/csv.hpp>
+#include <wlx/dynamics.hpp>
+#include <wlx/error.hpp>
+#include <wlx/kinematics.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+WLX_COMMANDS_BEGIN
+
+namespace {
+
+constexpr double kDegPerRad = 180 / std::numbers::pi;
+
+bool is_dynamics(const std::string& scenario_id) {
+  return nlohmann::json::parse(embedded_scenario(scenario_id)).contains("weighting");
+}
+
+std::string name_of(int coordinate) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(coordinate)]); }
+
+}  // namespace
+
+std::string display_unit(int c) { return gen::kCoordinateUnits[static_cast<std::size_t>(c)] == "rad" ? "deg" : std::string(gen::kCoordinateUnits[static_cast<std::size_t>(c)]); }
+double display_scale(int c) { return gen::kCoordinateUnits[static_cast<std::size_t>(c)] == "rad" ? kDegPerRad : 1; }
+
+ReportRunner::ReportRunner(const Params& params, const report::ReportSpec& spec, bool quick, Progress progress)
+    : spec_(spec), quick_(quick), progress_(std::move(progress)), model_(params) {
+  for (const auto& name : spec_.integrator_coordinates) compared_.push_back(coordinate_index(name));
+}
+
+// ---- names --------------------------------------------------------------------------------------
+
+void ReportRunner::validate() const {
+  const auto fail = [&](int line, const std::string& path, const std::string& what, const std::string& name,
+                        const std::vector<std::string>& valid) {
+    const std::string near = nearest(name, valid);
+    throw Error(report::where(spec_, line, path), fmt::format("'{}' is not {} of model {}{}", name, what, gen::kModelName,
+                                                              near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+  };
+  std::vector<std::string> coordinates(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end());
+  std::vector<std::string> scenarios = scenario_ids();
+  std::vector<std::string> runs;
+  for (const auto& id : scenarios) {
+    if (is_dynamics(id)) {
+      runs.push_back(id + "-w1");
+      runs.push_back(id + "-w2");
+    } else {
+      runs.push_back(id);
+    }
+  }
+  std::vector<std::string> sweeps, params, joints;
+  for (const auto& s : model_ik_sweeps()) sweeps.push_back(s.id);
+  for (const auto& p : gen::kParamInfo) params.emplace_back(p.name);
+  for (int j : kActuatedJoints) joints.push_back(name_of(j));
+  const auto check = [&](const std::vector<std::string>& names, const std::vector<std::string>& valid, int line,
+                         const std::string& path, const std::string& what) {
+    for (const auto& n : names)
+      if (std::find(valid.begin(), valid.end(), n) == valid.end()) fail(line, path, what, n, valid);
+  };
+  if (spec_.quick_sweeps) check(*spec_.quick_sweeps, sweeps, 1, "quick.sweeps", "an IK sweep");
+  if (spec_.quick_scenarios) check(*spec_.quick_scenarios, scenarios, 1, "quick.scenarios", "a scenario");
+  check(spec_.integrator_scenarios, scenarios, 1, "integrator_comparison.scenarios", "a scenario");
+  check(spec_.integrator_coordinates, coordinates, 1, "integrator_comparison.coordinates", "a coordinate");
+  for (const auto& f : spec_.run_figures) {
+    check(f.runs, runs, f.line, "run_figures." + f.id + ".runs", "a run");
+    check({f.x}, coordinates, f.line, "run_figures." + f.id + ".x", "a coordinate");
+    check(f.y, coordinates, f.line, "run_figures." + f.id + ".y", "a coordinate");
+  }
+  for (const auto& p : spec_.torque_panels) check(p, joints, 1, "torque_figures.panels", "an actuated joint");
+  for (const auto& r : spec_.torque_references) check({r.scenario}, scenarios, r.line, "torque_figures.thesis.scenario", "a scenario");
+  if (!spec_.pose_frame.empty() && frame_index(spec_.pose_frame) < 0) {
+    std::vector<std::string> frames(gen::kFrameNames.begin(), gen::kFrameNames.end());
+    fail(spec_.pose_line, "pose.body_frame", "a frame", spec_.pose_frame, frames);
+  }
+  check(spec_.pose_outline, params, spec_.pose_line, "pose.outline", "a parameter");
+  const std::vector<std::string> integrators{"rk4", "euler", "dopri5"};
+  for (const auto& c : spec_.claims) {
+    for (const auto& t : c.tests) {
+      const report::Measure& m = t.measure;
+      const std::string path = "claims." + c.id + ".measure";
+      if (!m.run.empty()) check({m.run}, runs, m.line, path + ".run", "a run");
+      if (!m.of_run.empty()) check({m.of_run}, runs, m.line, path + ".of_run", "a run");
+      check(m.runs, runs, m.line, path + ".runs", "a run");
+      check(m.coordinates, coordinates, m.line, path + ".coordinates", "a coordinate");
+      check(m.joints, joints, m.line, path + ".joints", "an actuated joint");
+      check(m.params, params, m.line, path + ".params", "a parameter");
+      if (!m.sweep.empty()) check({m.sweep}, sweeps, m.line, path + ".sweep", "an IK sweep");
+      if (!m.integrator.empty()) check({m.integrator}, integrators, m.line, path + ".integrator", "an integrator");
+      if (m.quantity == "integrator_deviation") {
+        for (const auto& r : m.runs)
+          if (std::find(spec_.integrator_scenarios.begin(), spec_.integrator_scenarios.end(), r) == spec_.integrator_scenarios.end())
+            throw Error(report::where(spec_, m.line, path + ".runs"), fmt::format("'{}' is not in integrator_comparison.scenarios", r));
+        for (const auto& name : m.coordinates) {
+          if (std::find(spec_.integrator_coordinates.begin(), spec_.integrator_coordinates.end(), name) == spec_.integrator_coordinates.end())
+            throw Error(report::where(spec_, m.line, path + ".coordinates"),
+                        fmt::format("'{}' is not in integrator_comparison.coordinates", name));
+          // One value in one unit: a criterion cannot hold metres and degrees at once.
+          if (display_unit(coordinate_index(name)) != display_unit(coordinate_index(m.coordinates.front())))
+            throw Error(report::where(spec_, m.line, path + ".coordinates"),
+                        fmt::format("'{}' and '{}' have different units: give them in separate tests", m.coordinates.front(), name));
+        }
+      }
+    }
+  }
+}
+
+// ---- runs ---------------------------------------------------------------------------------------
+
+std::vector<const IkSweep*> ReportRunner::selected_sweeps() const {
+  std::vector<const IkSweep*> out;
+  for (const IkSweep& s : model_ik_sweeps())
+    if (!quick_ || !spec_.quick_sweeps || std::count(spec_.quick_sweeps->begin(), spec_.quick_sweeps->end(), s.id)) out.push_back(&s);
+  return out;
+}
+
+std::vector<std::string> ReportRunner::selected_scenarios() const {
+  std::vector<std::string> out;
+  for (const auto& id : scenario_ids())
+    if (!quick_ || !spec_.quick_scenarios || std::count(spec_.quick_scenarios->begin(), spec_.quick_scenarios->end(), id)) out.push_back(id);
+  return out;
+}
+
+int ReportRunner::steps() const {
+  int n = static_cast<int>(selected_sweeps().size());
+  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? 2 : 1;
+  if (!quick_ && !spec_.integrator_scenarios.empty()) ++n;
+  return n;
+}
+
+void ReportRunner::run_all(const std::string& data_dir) {
+  const auto data_file = [&](const std::string& name) { return data_dir + "/" + name; };
+  for (const IkSweep* sweep : selected_sweeps()) {
+    progress_(fmt::format("inverse kinematics sweep {} ({} from {:g} to {:g})", sweep->id, sweep->input,
+                          sweep->degrees ? sweep->from * kDegPerRad : sweep->from, sweep->degrees ? sweep->to * kDegPerRad : sweep->to));
+    sweeps_.push_back(run_ik_sweep(model_, data_, *sweep));
+    write_ik_sweep_csv(data_file(sweep->id + ".csv"), sweeps_.back());
+  }
+  for (const auto& scenario_id : selected_scenarios()) {
+    const nlohmann::json json = read_scenario_json(scenario_id);
+    const bool verify = json.value("verify", "") == "nonholonomic";
+    std::vector<std::pair<std::string, std::optional<Weighting>>> variants;
+    if (json.contains("weighting")) {
+      variants.emplace_back(scenario_id + "-w1", Weighting::strong_weak());
+      variants.emplace_back(scenario_id + "-w2", Weighting::contribution());
+    } else {
+      variants.emplace_back(scenario_id, std::nullopt);
+    }
+    for (const auto& [id, weighting] : variants) {
+      Scenario sc = parse_scenario(json, model_.params());
+      if (weighting) sc.weighting = weighting;
+      progress_(fmt::format("simulating {}{}: {}", id, weighting ? " (" + weighting->label() + ")" : "", sc.description));
+      ReportRun r{id, scenario_id, sc, simulate(sc), id + ".csv", verify};
+      if (!r.trajectory.complete) throw Error(id, r.trajectory.error);
+      write_trajectory(data_file(r.csv), r.trajectory, sc.weighting.has_value());
+      runs_.push_back(std::move(r));
+    }
+  }
+  if (!quick_ && !spec_.integrator_scenarios.empty()) {
+    progress_(fmt::format("comparing integrators: Euler, RK4, dopri5 against RK4 at {:g} s on {} runs", spec_.reference_step,
+                          spec_.integrator_scenarios.size()));
+    compare_integrators(data_dir);
+  }
+}
+
+void ReportRunner::compare_integrators(const std::string& data_dir) {
+  const double step = spec_.reference_step;
+  for (const auto& id : spec_.integrator_scenarios) {
+    Scenario sc = parse_scenario(read_scenario_json(id), model_.params());
+    Scenario ref_sc = sc;
+    ref_sc.dt = step;
+    const Trajectory ref = simulate(ref_sc);
+    if (!ref.complete) throw Error(id, ref.error);
+    const auto compare = [&](const std::string& setting, const Scenario& run) {
+      const Trajectory tr = simulate(run);
+      if (!tr.complete) throw Error(id, tr.error);
+      IntegratorRow row{id, run.integrator, setting, static_cast<long>(tr.samples.size()), tr.evaluations, 0,
+                        std::vector<double>(compared_.size(), 0.0)};
+      for (const auto& smp : tr.samples) {
+        const auto& r = ref.samples[static_cast<std::size_t>(std::lround(smp.t / step))];
+        const Coordinates d = (smp.s - r.s).cwiseAbs();
+        row.inputs = std::max(row.inputs, d.head<kInputCount>().maxCoeff());
+        for (std::size_t k = 0; k < compared_.size(); ++k) row.coordinates[k] = std::max(row.coordinates[k], d(compared_[k]));
+      }
+      integrators_.push_back(row);
+    };
+    Scenario euler = sc, rk4 = sc, dopri = sc;
+    euler.integrator = Integrator::euler;
+    rk4.integrator = Integrator::rk4;
+    compare(fmt::format("dt {} s", sc.dt), euler);
+    compare(fmt::format("dt {} s", sc.dt), rk4);
+    // dopri5 writes 10 samples per run and chooses its own steps in between.
+    dopri.integrator = Integrator::dopri5;
+    dopri.dt = sc.duration / 10;
+    compare(fmt::format("tolerance {:.0e}", dopri.tolerance), dopri);
+  }
+  std::vector<std::string> header{"run", "integrator", "samples", "evaluations", "max_input_deviation"};
+  for (int c : compared_) header.push_back("max_" + name_of(c) + "_deviation");
+  CsvWriter csv(data_dir + "/integrators.csv", header);
+  for (const auto& r : integrators_) {
+    std::vector<double> values{static_cast<double>(r.samples), static_cast<double>(r.evaluations), r.inputs};
+    values.insert(values.end(), r.coordinates.begin(), r.coordinates.end());
+    csv.row({r.id, std::string(integrator_name(r.integrator))}, values);
+  }
+  csv.commit();
+}
+
+const ReportRun* ReportRunner::find_run(const std::string& id) const {
+  for (const auto& r : runs_)
+    if (r.id == id) return &r;
+  return nullptr;
+}
+
+// ---- measurements -------------------------------------------------------------------------------
+
+std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
+  const std::string& q = m.quantity;
+  const int c = m.coordinates.empty() ? -1 : coordinate_index(m.coordinates.front());
+  if (q == "total_mass") return Measured{model_.total_mass(), "kg"};
+  if (q == "param_product") {
+    Params p = model_.params();
+    double v = m.factor * (m.times_total_mass ? model_.total_mass() : 1);
+    for (const auto& name : m.params) v *= *find_param(p, name);
+    return Measured{v, m.unit};
+  }
+  if (q == "max_ik_check_error" || q == "max_ik_method_difference") {
+    if (sweeps_.empty()) return std::nullopt;
+    double worst = 0;
+    for (const auto& s : sweeps_)
+      worst = std::max(worst, q == "max_ik_check_error" ? std::max(s.max_check_closed_form, s.max_check_newton) : s.max_newton_difference);
+    return Measured{worst, q == "max_ik_check_error" ? "m" : "rad"};
+  }
+  if (q == "newton_branch_switch" || q == "newton_branch_settled") {
+    for (const auto& s : sweeps_) {
+      if (s.sweep.id != m.sweep) continue;
+      // In the sweep's order; no switch: NaN, which no criterion passes.
+      double first = NAN;
+      for (std::size_t k = 0; k < s.points.size(); ++k) {
+        const bool off_default = s.points[k].cold_newton_branch == 1;
+        if (q == "newton_branch_switch" && off_default && std::isnan(first)) first = s.points[k].value;
+        if (q == "newton_branch_settled") first = off_default ? (std::isnan(first) ? s.points[k].value : first) : NAN;
+      }
+      const double scale = s.sweep.degrees ? kDegPerRad : 1;
+      return Measured{first * scale, s.sweep.degrees ? "deg" : "m"};
+    }
+    return std::nullopt;
+  }
+  if (q == "max_wheel_residual") {
+    if (runs_.empty()) return std::nullopt;
+    double worst = 0;
+    for (const auto& r : runs_)
+      for (const auto& smp : r.trajectory.samples) worst = std::max(worst, smp.nh_residual.cwiseAbs().maxCoeff());
+    return Measured{worst, "m/s"};
+  }
+  if (q == "integrator_deviation") {
+    if (integrators_.empty()) return std::nullopt;
+    const Integrator integrator = *integrator_from_name(m.integrator);
+    double worst = 0;
+    std::string unit = "m or rad";
+    for (const auto& r : integrators_) {
+      if (r.integrator != integrator || (!m.runs.empty() && std::find(m.runs.begin(), m.runs.end(), r.id) == m.runs.end())) continue;
+      if (m.coordinates.empty()) {
+        worst = std::max(worst, r.inputs);
+        continue;
+      }
+      for (const auto& name : m.coordinates) {
+        const int k = coordinate_index(name);
+        const auto at = std::find(compared_.begin(), compared_.end(), k) - compared_.begin();
+        worst = std::max(worst, r.coordinates[static_cast<std::size_t>(at)] * display_scale(k));
+        unit = display_unit(k);
+      }
+    }
+    return Measured{worst, unit};
+  }
+  if (q == "static_torque") {
+    Coordinates s = nominal_inputs();
+    solve_ik_closed_form(model_, s);
+    DynamicsTerms t;
+    inverse_dynamics(model_, data_, s, CommandVector::Zero(), CommandVector::Zero(), t);
+    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, m.weighting == 1 ? Weighting::strong_weak() : Weighting::contribution());
+    double worst = 0;
+    for (const auto& name : m.joints) {
+      const auto at = std::find(kActuatedJoints.begin(), kActuatedJoints.end(), coordinate_index(name)) - kActuatedJoints.begin();
+      worst = std::max(worst, std::abs(tau(at)));
+    }
+    return Measured{worst, "N m"};
+  }
+  if (q == "peak_torque") {
+    double worst = 0;
+    for (const auto& id : m.runs) {
+      const ReportRun* r = find_run(id);
+      if (!r) return std::nullopt;
+      for (const auto& smp : r->trajectory.samples) worst = std::max(worst, smp.tau.cwiseAbs().maxCoeff());
+    }
+    return Measured{worst, "N m"};
+  }
+  // The rest concern one run.
+  const ReportRun* run = find_run(m.run);
+  if (!run) return std::nullopt;
+  const auto& samples = run->trajectory.samples;
+  if (q == "end_value") return Measured{samples.back().s(c) * display_scale(c), display_unit(c)};
+  if (q == "end_ratio") {
+    const ReportRun* of = find_run(m.of_run);
+    if (!of) return std::nullopt;
+    return Measured{samples.back().s(c) / of->trajectory.samples.back().s(c), ""};
+  }
+  if (q == "peak_condition" || q == "peak_condition_time") {
+    std::size_t peak = 0;
+    for (std::size_t k = 0; k < samples.size(); ++k)
+      if (samples[k].cond_J_beta > samples[peak].cond_J_beta) peak = k;
+    return q == "peak_condition" ? Measured{samples[peak].cond_J_beta, ""} : Measured{samples[peak].t, "s"};
+  }
+  if (q == "ground_contact_time") {
+    if (samples.size() < 2) return Measured{NAN, "s"};
+    const Sample& a = samples[samples.size() - 2];
+    const Sample& b = samples.back();
+    const double rate = (b.cabin_clearance - a.cabin_clearance) / (b.t - a.t);  // negative while the cabin sinks
+    return Measured{rate < 0 ? b.t - b.cabin_clearance / rate : NAN, "s"};
+  }
+  throw Error(report::where(spec_, m.line, "quantity"), "not measured by this build: " + q);
+}
+
+WLX_COMMANDS_END

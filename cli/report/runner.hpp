@@ -1,0 +1,88 @@
+// The computations of `wlx report` for one model: its IK sweeps, its scenarios (inverse-dynamics
+// scenarios with both weightings), the integrator comparison of its report file, and the
+// measurements its claims name. Compiled per model (cli/per_model.hpp); names of coordinates,
+// runs and sweeps come from the report file and are looked up in the generated tables.
+#pragma once
+
+#include "per_model.hpp"
+#include "report/spec.hpp"
+
+#include <wlx/ik_verification.hpp>
+#include <wlx/simulation.hpp>
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+WLX_COMMANDS_BEGIN
+
+struct ReportRun {
+  std::string id;           // the scenario's id, "<id>-w1"/"<id>-w2" for inverse dynamics
+  std::string scenario_id;  // the scenario file's id
+  Scenario scenario;
+  Trajectory trajectory;
+  std::string csv;  // file name in data/
+  bool nonholonomic_verification = false;  // the scenario is marked "verify": "nonholonomic"
+};
+
+// One run integrated one way, against RK4 at the reference step.
+struct IntegratorRow {
+  std::string id;
+  Integrator integrator;
+  std::string setting;
+  long samples = 0, evaluations = 0;
+  double inputs = 0;                // max |q - q_ref| over the samples, m or rad
+  std::vector<double> coordinates;  // max |s_c - ref| per compared coordinate
+};
+
+// A measured value in the unit the report shows it in.
+struct Measured {
+  double value = 0;
+  std::string unit;
+};
+
+class ReportRunner {
+ public:
+  using Progress = std::function<void(const std::string&)>;
+  ReportRunner(const Params& params, const report::ReportSpec& spec, bool quick, Progress progress);
+
+  // Throws wlx::Error naming the report file's line for a name that is not the model's.
+  void validate() const;
+  // How many progress steps run_all() reports.
+  int steps() const;
+  // Everything, writing the CSV files into data_dir.
+  void run_all(const std::string& data_dir);
+
+  // The value of a claim's measure, or nothing if it concerns a run or sweep this report did not make.
+  std::optional<Measured> measure(const report::Measure& m);
+
+  const std::vector<IkSweepResult>& sweeps() const { return sweeps_; }
+  const std::vector<ReportRun>& runs() const { return runs_; }
+  const std::vector<IntegratorRow>& integrators() const { return integrators_; }
+  const std::vector<int>& compared_coordinates() const { return compared_; }
+  const Model& model() const { return model_; }
+  Data& data() { return data_; }
+  const ReportRun* find_run(const std::string& id) const;
+
+ private:
+  std::vector<const IkSweep*> selected_sweeps() const;
+  std::vector<std::string> selected_scenarios() const;
+  void compare_integrators(const std::string& data_dir);
+
+  const report::ReportSpec& spec_;
+  bool quick_;
+  Progress progress_;
+  Model model_;
+  Data data_;
+  std::vector<int> compared_;
+  std::vector<IkSweepResult> sweeps_;
+  std::vector<ReportRun> runs_;
+  std::vector<IntegratorRow> integrators_;
+};
+
+// The unit a coordinate is shown in ("deg" for angles, "m") and the factor from SI to it.
+std::string display_unit(int coordinate);
+double display_scale(int coordinate);
+
+WLX_COMMANDS_END

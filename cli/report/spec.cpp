@@ -1,0 +1,389 @@
+// Parsing a report file (report/spec.hpp). yaml-cpp gives every node its line, so each error
+// names the file, the line and the key.
+#include "report/spec.hpp"
+
+#include "bounded_input.hpp"
+
+#include <fmt/format.h>
+#include <wlx/error.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <set>
+
+namespace wlx::cli::report {
+
+namespace {
+
+// Quantity -> the measure keys it requires (beyond `quantity`), and the ones it may take.
+struct QuantityRule {
+  std::string name;
+  std::vector<std::string> required, optional;
+};
+// total_mass: the model's mass (kg). max_ik_check_error, max_ik_method_difference: over every
+// sweep run (m, rad). newton_branch_switch: the first value of `sweep`'s input where Newton from
+// the start pose lands off the default branch; newton_branch_settled: the value from which it
+// always does. max_wheel_residual: |v_W . n_W| over every sample
+// of every run (m/s). end_value: `coordinate` at the end of `run`. end_ratio: that over the same
+// of `of_run`. peak_condition(_time): the largest cond(J_beta) of `run` (and when). ground_contact_time:
+// when the cabin's lowest corner, extrapolated from `run`'s last two samples, reaches z = 0.
+// integrator_deviation: the largest deviation of `integrator` from the reference over `runs` (default:
+// all compared) in `coordinates` (default: every input). static_torque: the largest |tau| of `joints`
+// at the nominal pose at rest with `weighting`. peak_torque: the largest |tau| over `runs`.
+// param_product: factor x the product of `params` (x the total mass).
+const std::vector<QuantityRule>& rules() {
+  static const std::vector<QuantityRule> all{
+      {"total_mass", {}, {}},
+      {"max_ik_check_error", {}, {}},
+      {"max_ik_method_difference", {}, {}},
+      {"newton_branch_switch", {"sweep"}, {}},
+      {"newton_branch_settled", {"sweep"}, {}},
+      {"max_wheel_residual", {}, {}},
+      {"end_value", {"run", "coordinate"}, {}},
+      {"end_ratio", {"run", "of_run", "coordinate"}, {}},
+      {"peak_condition", {"run"}, {}},
+      {"peak_condition_time", {"run"}, {}},
+      {"ground_contact_time", {"run"}, {}},
+      {"integrator_deviation", {"integrator"}, {"runs", "coordinate", "coordinates"}},
+      {"static_torque", {"joints"}, {"weighting"}},
+      {"peak_torque", {"runs"}, {}},
+      {"param_product", {"params"}, {"factor", "times_total_mass", "unit"}},
+  };
+  return all;
+}
+
+class Parser {
+ public:
+  explicit Parser(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& path, const std::string& reason) const {
+    throw Error(fmt::format("{}:{}: {}", file_, at.Mark().line + 1, path), reason);
+  }
+  int line(const YAML::Node& n) const { return n.Mark().line + 1; }
+
+  void keys(const YAML::Node& map, const std::string& path, const std::vector<std::string>& valid) const {
+    if (!map.IsMap()) fail(map, path, "must be a mapping (key: value)");
+    for (const auto& kv : map) {
+      const std::string key = kv.first.as<std::string>();
+      if (std::find(valid.begin(), valid.end(), key) != valid.end()) continue;
+      const std::string near = nearest(key, valid);
+      fail(kv.first, path, fmt::format("unknown key '{}'{}", key, near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+    }
+  }
+  YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& path) const {
+    const YAML::Node n = map[key];
+    if (!n) fail(map, path, fmt::format("missing key '{}'", key));
+    return n;
+  }
+  std::string text(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsScalar()) fail(n, path, "must be a text");
+    const std::string s = n.as<std::string>();
+    if (s.empty()) fail(n, path, "must not be empty");
+    return s;
+  }
+  double number(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsScalar()) fail(n, path, "must be a number");
+    double v = 0;
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(n, path, fmt::format("must be a number, got '{}'", n.as<std::string>()));
+    }
+    if (!std::isfinite(v)) fail(n, path, "must be finite");
+    return v;
+  }
+  bool flag(const YAML::Node& n, const std::string& path) const {
+    try {
+      return n.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail(n, path, "must be true or false");
+    }
+  }
+  std::vector<std::string> names(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsSequence() || n.size() == 0) fail(n, path, "must be a non-empty list of names");
+    std::vector<std::string> out;
+    for (std::size_t k = 0; k < n.size(); ++k) out.push_back(text(n[k], fmt::format("{}[{}]", path, k)));
+    return out;
+  }
+  std::string optional_text(const YAML::Node& map, const std::string& key, const std::string& path) const {
+    return map[key] ? text(map[key], path + "." + key) : std::string();
+  }
+
+  Criterion criterion(const YAML::Node& n, const std::string& path) const {
+    keys(n, path, {"at_most", "at_least", "between", "near", "tolerance", "negative", "positive"});
+    Criterion c;
+    int kinds = 0;
+    if (n["at_most"]) c = {Criterion::Kind::at_most, number(n["at_most"], path + ".at_most")}, ++kinds;
+    if (n["at_least"]) c = {Criterion::Kind::at_least, number(n["at_least"], path + ".at_least")}, ++kinds;
+    if (n["between"]) {
+      const YAML::Node b = n["between"];
+      if (!b.IsSequence() || b.size() != 2) fail(b, path + ".between", "must be a list [low, high]");
+      c = {Criterion::Kind::between, number(b[0], path + ".between[0]"), number(b[1], path + ".between[1]")};
+      if (c.a > c.b) fail(b, path + ".between", "low must not exceed high");
+      ++kinds;
+    }
+    if (n["near"]) {
+      if (!n["tolerance"]) fail(n, path, "'near' needs a 'tolerance'");
+      c = {Criterion::Kind::near, number(n["near"], path + ".near"), number(n["tolerance"], path + ".tolerance")};
+      if (c.b <= 0) fail(n["tolerance"], path + ".tolerance", "must be positive");
+      ++kinds;
+    } else if (n["tolerance"]) {
+      fail(n["tolerance"], path + ".tolerance", "only goes with 'near'");
+    }
+    for (const char* sign : {"negative", "positive"}) {
+      if (!n[sign]) continue;
+      if (!flag(n[sign], path + "." + sign)) fail(n[sign], path + "." + sign, "must be true (leave it out otherwise)");
+      c = {std::string(sign) == "negative" ? Criterion::Kind::negative : Criterion::Kind::positive};
+      ++kinds;
+    }
+    if (kinds != 1) fail(n, path, "must give exactly one of at_most, at_least, between, near, negative, positive");
+    return c;
+  }
+
+  Measure measure(const YAML::Node& n, const std::string& path) const {
+    keys(n, path, {"quantity", "run", "of_run", "coordinate", "sweep", "integrator", "unit", "runs", "coordinates", "joints",
+                   "params", "factor", "times_total_mass", "weighting"});
+    Measure m;
+    m.line = line(n);
+    m.quantity = text(required(n, "quantity", path), path + ".quantity");
+    const auto rule = std::find_if(rules().begin(), rules().end(), [&](const QuantityRule& r) { return r.name == m.quantity; });
+    if (rule == rules().end()) {
+      const std::string near = nearest(m.quantity, quantities());
+      fail(n["quantity"], path + ".quantity",
+           fmt::format("unknown quantity '{}'{}", m.quantity, near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+    }
+    for (const auto& key : rule->required) required(n, key, path);
+    for (const auto& kv : n) {
+      const std::string key = kv.first.as<std::string>();
+      if (key == "quantity") continue;
+      if (std::find(rule->required.begin(), rule->required.end(), key) == rule->required.end() &&
+          std::find(rule->optional.begin(), rule->optional.end(), key) == rule->optional.end())
+        fail(kv.first, path + "." + key, fmt::format("does not apply to quantity '{}'", m.quantity));
+    }
+    m.run = optional_text(n, "run", path);
+    m.of_run = optional_text(n, "of_run", path);
+    m.coordinate = optional_text(n, "coordinate", path);
+    m.sweep = optional_text(n, "sweep", path);
+    m.integrator = optional_text(n, "integrator", path);
+    m.unit = optional_text(n, "unit", path);
+    if (n["runs"]) m.runs = names(n["runs"], path + ".runs");
+    if (n["coordinates"]) m.coordinates = names(n["coordinates"], path + ".coordinates");
+    if (!m.coordinate.empty()) m.coordinates.insert(m.coordinates.begin(), m.coordinate);
+    if (n["joints"]) m.joints = names(n["joints"], path + ".joints");
+    if (n["params"]) m.params = names(n["params"], path + ".params");
+    if (n["factor"]) m.factor = number(n["factor"], path + ".factor");
+    if (n["times_total_mass"]) m.times_total_mass = flag(n["times_total_mass"], path + ".times_total_mass");
+    if (n["weighting"]) {
+      const double w = number(n["weighting"], path + ".weighting");
+      if (w != 1 && w != 2) fail(n["weighting"], path + ".weighting", "must be 1 (strong/weak) or 2 (by contribution)");
+      m.weighting = static_cast<int>(w);
+    }
+    return m;
+  }
+
+  Test test(const YAML::Node& n, const std::string& path, ClaimKind kind) const {
+    keys(n, path, {"measure", "criterion"});
+    Test t{measure(required(n, "measure", path), path + ".measure"), std::nullopt};
+    if (kind == ClaimKind::check) t.criterion = criterion(required(n, "criterion", path), path + ".criterion");
+    else if (n["criterion"])
+      fail(n["criterion"], path + ".criterion", "only a check has a criterion (inputs and observations are not checks)");
+    return t;
+  }
+
+  Claim claim(const YAML::Node& n, const std::string& path) const {
+    keys(n, path, {"id", "kind", "claim", "source", "thesis", "spec", "measure", "criterion", "tests", "why"});
+    Claim c;
+    c.line = line(n);
+    c.id = text(required(n, "id", path), path + ".id");
+    const std::string kind = text(required(n, "kind", path), path + ".kind");
+    if (kind == "check") c.kind = ClaimKind::check;
+    else if (kind == "input") c.kind = ClaimKind::input;
+    else if (kind == "observation") c.kind = ClaimKind::observation;
+    else fail(n["kind"], path + ".kind", fmt::format("must be check, input or observation, got '{}'", kind));
+    c.claim = text(required(n, "claim", path), path + ".claim");
+    const YAML::Node source = required(n, "source", path);
+    keys(source, path + ".source", {"thesis", "spec"});
+    for (const char* doc : {"thesis", "spec"})
+      if (source[doc]) c.source += (c.source.empty() ? "" : "; ") + std::string(doc) + " " + text(source[doc], path + ".source." + doc);
+    if (c.source.empty()) fail(source, path + ".source", "must name the thesis or the spec (with section, figure or table)");
+    c.thesis = optional_text(n, "thesis", path);
+    c.spec = optional_text(n, "spec", path);
+    if (c.thesis.empty() && c.spec.empty()) fail(n, path, "must give the claimed value as 'thesis' or 'spec'");
+    c.why = text(required(n, "why", path), path + ".why");
+    if (n["tests"]) {
+      if (n["measure"] || n["criterion"]) fail(n, path, "give either 'tests' or 'measure' (and 'criterion'), not both");
+      const YAML::Node tests = n["tests"];
+      if (!tests.IsSequence() || tests.size() == 0) fail(tests, path + ".tests", "must be a non-empty list");
+      for (std::size_t k = 0; k < tests.size(); ++k) c.tests.push_back(test(tests[k], fmt::format("{}.tests[{}]", path, k), c.kind));
+    } else {
+      YAML::Node single;
+      single["measure"] = required(n, "measure", path);
+      if (n["criterion"]) single["criterion"] = n["criterion"];
+      if (c.kind == ClaimKind::check && !n["criterion"]) fail(n, path, "a check needs a 'criterion'");
+      if (c.kind != ClaimKind::check && n["criterion"])
+        fail(n["criterion"], path + ".criterion", "only a check has a criterion (inputs and observations are not checks)");
+      c.tests.push_back({measure(n["measure"], path + ".measure"),
+                         n["criterion"] ? std::optional(criterion(n["criterion"], path + ".criterion")) : std::nullopt});
+    }
+    return c;
+  }
+
+  ReportSpec parse(const std::string& text_in) const {
+    YAML::Node root;
+    try {
+      root = YAML::Load(text_in);
+    } catch (const YAML::ParserException& e) {
+      throw Error(fmt::format("{}:{}", file_, e.mark.line + 1), e.msg);
+    }
+    ReportSpec s;
+    s.file = file_;
+    if (!root || root.IsNull()) return s;
+    keys(root, "(top level)", {"title", "quick", "integrator_comparison", "sections", "reference_lines", "run_figures", "torque_figures",
+                               "pose", "claims"});
+    s.title = optional_text(root, "title", "");
+    if (const YAML::Node q = root["quick"]) {
+      keys(q, "quick", {"sweeps", "scenarios"});
+      if (q["sweeps"]) s.quick_sweeps = names(q["sweeps"], "quick.sweeps");
+      if (q["scenarios"]) s.quick_scenarios = names(q["scenarios"], "quick.scenarios");
+    }
+    if (const YAML::Node ic = root["integrator_comparison"]) {
+      keys(ic, "integrator_comparison", {"scenarios", "reference_step", "coordinates", "note"});
+      s.integrator_note = optional_text(ic, "note", "integrator_comparison");
+      s.integrator_scenarios = names(required(ic, "scenarios", "integrator_comparison"), "integrator_comparison.scenarios");
+      if (ic["coordinates"]) s.integrator_coordinates = names(ic["coordinates"], "integrator_comparison.coordinates");
+      if (ic["reference_step"]) {
+        s.reference_step = number(ic["reference_step"], "integrator_comparison.reference_step");
+        if (s.reference_step <= 0 || s.reference_step > 1e-2)
+          fail(ic["reference_step"], "integrator_comparison.reference_step", "must be in (0, 0.01] s");
+      }
+    }
+    if (const YAML::Node sec = root["sections"]) {
+      keys(sec, "sections", {"ik", "nonholonomic", "kinematic", "dynamics"});
+      for (const auto& kv : sec) s.section_titles[kv.first.as<std::string>()] = text(kv.second, "sections." + kv.first.as<std::string>());
+    }
+    if (const YAML::Node lines = root["reference_lines"]) {
+      keys(lines, "reference_lines", {"ik_check_error", "wheel_residual"});
+      for (const auto& kv : lines) {
+        const std::string path = "reference_lines." + kv.first.as<std::string>();
+        keys(kv.second, path, {"value", "label"});
+        const double v = number(required(kv.second, "value", path), path + ".value");
+        if (v <= 0) fail(kv.second["value"], path + ".value", "must be positive (the figures have log axes)");
+        s.reference_lines[kv.first.as<std::string>()] = {v, text(required(kv.second, "label", path), path + ".label")};
+      }
+    }
+    if (const YAML::Node figs = root["run_figures"]) {
+      if (!figs.IsSequence()) fail(figs, "run_figures", "must be a list");
+      for (std::size_t k = 0; k < figs.size(); ++k) {
+        const std::string path = fmt::format("run_figures[{}]", k);
+        keys(figs[k], path, {"id", "runs", "x", "y", "thesis"});
+        RunFigure f;
+        f.line = line(figs[k]);
+        f.id = text(required(figs[k], "id", path), path + ".id");
+        f.runs = names(required(figs[k], "runs", path), path + ".runs");
+        f.x = text(required(figs[k], "x", path), path + ".x");
+        f.y = names(required(figs[k], "y", path), path + ".y");
+        f.thesis = optional_text(figs[k], "thesis", path);
+        s.run_figures.push_back(f);
+      }
+    }
+    if (const YAML::Node tf = root["torque_figures"]) {
+      keys(tf, "torque_figures", {"panels", "thesis"});
+      const YAML::Node panels = required(tf, "panels", "torque_figures");
+      if (!panels.IsSequence() || panels.size() == 0) fail(panels, "torque_figures.panels", "must be a non-empty list of lists");
+      for (std::size_t k = 0; k < panels.size(); ++k) s.torque_panels.push_back(names(panels[k], fmt::format("torque_figures.panels[{}]", k)));
+      if (const YAML::Node refs = tf["thesis"]) {
+        if (!refs.IsSequence()) fail(refs, "torque_figures.thesis", "must be a list");
+        for (std::size_t k = 0; k < refs.size(); ++k) {
+          const std::string path = fmt::format("torque_figures.thesis[{}]", k);
+          keys(refs[k], path, {"scenario", "weighting", "figures"});
+          TorqueReference r;
+          r.line = line(refs[k]);
+          r.scenario = text(required(refs[k], "scenario", path), path + ".scenario");
+          const double w = number(required(refs[k], "weighting", path), path + ".weighting");
+          if (w != 1 && w != 2) fail(refs[k]["weighting"], path + ".weighting", "must be 1 or 2");
+          r.weighting = static_cast<int>(w);
+          r.figures = names(required(refs[k], "figures", path), path + ".figures");
+          if (r.figures.size() != s.torque_panels.size())
+            fail(refs[k]["figures"], path + ".figures", fmt::format("must name one figure per panel ({})", s.torque_panels.size()));
+          s.torque_references.push_back(r);
+        }
+      }
+    }
+    if (const YAML::Node pose = root["pose"]) {
+      keys(pose, "pose", {"body_frame", "outline"});
+      s.pose_line = line(pose);
+      s.pose_frame = text(required(pose, "body_frame", "pose"), "pose.body_frame");
+      if (pose["outline"]) {
+        s.pose_outline = names(pose["outline"], "pose.outline");
+        if (s.pose_outline.size() != 2) fail(pose["outline"], "pose.outline", "must name two parameters: the length along x and the width along y");
+      }
+    }
+    if (const YAML::Node claims = root["claims"]) {
+      if (!claims.IsSequence()) fail(claims, "claims", "must be a list");
+      std::set<std::string> ids;
+      for (std::size_t k = 0; k < claims.size(); ++k) {
+        Claim c = claim(claims[k], fmt::format("claims[{}]", k));
+        if (!ids.insert(c.id).second) fail(claims[k]["id"], fmt::format("claims[{}].id", k), fmt::format("'{}' is given twice", c.id));
+        s.claims.push_back(std::move(c));
+      }
+    }
+    return s;
+  }
+
+ private:
+  std::string file_;
+};
+
+std::string number_text(double v) { return fmt::format("{:g}", v); }
+
+}  // namespace
+
+const std::vector<std::string>& quantities() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const auto& r : rules()) out.push_back(r.name);
+    return out;
+  }();
+  return names;
+}
+
+bool Criterion::passes(double v) const {
+  if (!std::isfinite(v)) return false;
+  switch (kind) {
+    case Kind::at_most: return v <= a;
+    case Kind::at_least: return v >= a;
+    case Kind::between: return v >= a && v <= b;
+    case Kind::near: return std::abs(v - a) <= b;
+    case Kind::negative: return v < 0;
+    case Kind::positive: return v > 0;
+  }
+  return false;
+}
+
+std::string Criterion::describe(const std::string& unit) const {
+  const std::string u = unit.empty() ? "" : " " + unit;
+  switch (kind) {
+    case Kind::at_most: return fmt::format("\u2264 {}{}", number_text(a), u);
+    case Kind::at_least: return fmt::format("\u2265 {}{}", number_text(a), u);
+    case Kind::between: return fmt::format("in [{}, {}]{}", number_text(a), number_text(b), u);
+    case Kind::near: {
+      // Very small or large values with a common exponent, "(6.0 ± 0.5)e-04", so the two compare at a glance.
+      if (a == 0 || (std::abs(a) >= 1e-3 && std::abs(a) < 1e6)) return fmt::format("{} \u00b1 {}{}", number_text(a), number_text(b), u);
+      const int exponent = static_cast<int>(std::floor(std::log10(std::abs(a))));
+      const double scale = std::pow(10.0, exponent);
+      const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(b / scale))));
+      return fmt::format("({:.{}f} \u00b1 {:.{}f})e{:+03d}{}", a / scale, decimals, b / scale, decimals, exponent, u);
+    }
+    case Kind::negative: return "< 0";
+    case Kind::positive: return "> 0";
+  }
+  return "?";
+}
+
+ReportSpec parse_report_spec(const std::string& text, const std::string& file) { return Parser(file).parse(text); }
+
+std::string where(const ReportSpec& spec, int line, const std::string& path) {
+  return fmt::format("{}:{}: {}", spec.file, line, path);
+}
+
+}  // namespace wlx::cli::report
