@@ -49,7 +49,11 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
   inv.report->add_option("--out", inv.report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
   inv.report->add_flag("--quick", inv.report_options.quick, "a reduced set of runs, for a fast look");
 
-  for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report}) add_model_options(a);
+  inv.viewer = app.add_subcommand("viewer", "the 3D viewer (viewer.html, drag-and-drop IK in WebAssembly) written to a folder, with runs to play");
+  inv.viewer->add_option("RUN", inv.viewer_options.runs, "scenario files or ids to simulate and show (wlx simulate --list shows the ids)");
+  inv.viewer->add_option("--out", inv.viewer_options.out_dir, "output folder (viewer.html, viewer.js, wasm/, runs/)")->capture_default_str();
+
+  for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report, inv.viewer}) add_model_options(a);
 }
 
 }  // namespace wlx::cli

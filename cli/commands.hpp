@@ -25,6 +25,11 @@ struct ReportOptions {
   bool quick = false;  // a reduced set of runs (for tests)
 };
 
+struct ViewerOptions {
+  std::string out_dir = "out/viewer";
+  std::vector<std::string> runs;  // scenario files or ids, simulated and written as runs/<id>.js
+};
+
 // Options every command takes.
 struct ModelOptions {
   std::string params_file;  // JSON {"name": value, ...} overriding the model's parameters; empty: defaults
@@ -40,6 +45,7 @@ struct ModelCommands {
   int (*verify_nonholonomic)(const ModelOptions& model, const std::string& out_dir);
   int (*simulate)(const ModelOptions& model, const SimulateOptions& options);
   int (*report)(const ModelOptions& model, const ReportOptions& options);
+  int (*viewer)(const ModelOptions& model, const ViewerOptions& options);
 };
 
 // The built-in models, the default (the thesis excavator) first.

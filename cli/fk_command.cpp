@@ -105,7 +105,8 @@ const ModelCommands& entry() {
 #else
                                       nullptr
 #endif
-  };
+                                      ,
+                                      &run_viewer};
   return commands;
 }
 

@@ -78,6 +78,7 @@ const app = {
   speed: 1,
   ikTimes: [],       // ms per IK solve during drags
   handles: [],       // draggable handles
+  tracks: [],        // the wheels' ground tracks drawn: start, end, number of distinct points
   selected: null,
 };
 
@@ -111,8 +112,9 @@ const materials = {
   wheel: new THREE.MeshStandardMaterial({ color: 0x222222, roughness: 0.9 }),
   foot: new THREE.MeshStandardMaterial({ color: 0x2a7f62 }),
   com: new THREE.MeshStandardMaterial({ color: 0xd0306a }),
-  handle: new THREE.MeshStandardMaterial({ color: 0xff7a1a, transparent: true, opacity: 0.85 }),
-  handleSelected: new THREE.MeshStandardMaterial({ color: 0xff2a00 }),
+  // Handles are drawn over everything (depthTest off): the cabin's sits inside the cabin box.
+  handle: new THREE.MeshStandardMaterial({ color: 0xff7a1a, transparent: true, opacity: 0.85, depthTest: false }),
+  handleSelected: new THREE.MeshStandardMaterial({ color: 0xff2a00, transparent: true, opacity: 0.95, depthTest: false }),
   ground: new THREE.MeshStandardMaterial({ color: 0x8a6d3b, transparent: true, opacity: 0.45, side: THREE.DoubleSide }),
 };
 
@@ -276,7 +278,7 @@ function makeHandles(info) {
   }
   const seen = new Set();
   for (const h of app.handles) {
-    h.object.userData.handle = h;
+    h.object.renderOrder = 10;
     if (!seen.has(h.object)) scene.add(h.object);
     seen.add(h.object);
   }
@@ -440,15 +442,22 @@ function prepareRun(run) {
   for (let i = 0; i < n; ++i) frames.push(Float64Array.from(info.coordinates, (c) => run.columns[c.name][i]));
   // The wheels' ground tracks: their contact points by the model's forward kinematics.
   tracks.clear();
+  app.tracks = [];
   for (const w of info.wheels) {
     const points = frames.map((s) => {
       const p = app.model.forwardKinematics(s).positions;
       const f = w.contactFrame;
       return new THREE.Vector3(p[3 * f], p[3 * f + 1], p[3 * f + 2] + 0.01);
     });
-    const line = new THREE.Line(new THREE.BufferGeometry().setFromPoints(points), new THREE.LineBasicMaterial({ color: 0x1565c0 }));
-    line.name = `track ${w.name}`;
-    tracks.add(line);
+    // A thin tube rather than a line: WebGL draws lines one pixel wide whatever is asked.
+    const distinct = points.filter((p, i) => i === 0 || p.distanceTo(points[i - 1]) > 1e-6);
+    app.tracks.push({ wheel: w.name, start: points[0].toArray(), end: points[points.length - 1].toArray(), distinct: distinct.length });
+    if (distinct.length < 2) continue;  // the wheel did not move
+    const path = new THREE.CatmullRomCurve3(distinct, false, 'centripetal');
+    const tube = new THREE.Mesh(new THREE.TubeGeometry(path, Math.min(4 * distinct.length, 2000), 0.03, 6, false),
+                                new THREE.MeshStandardMaterial({ color: 0x1565c0 }));
+    tube.name = `track ${w.name}`;
+    tracks.add(tube);
   }
   return { ...run, frames, t: run.columns.t };
 }
@@ -592,7 +601,9 @@ viewer.api = {
     selectHandle(id);
     let result = { ok: true, message: '' };
     for (let k = 1; k <= steps; ++k) {
-      const proxy = h.object.clone();
+      const proxy = new THREE.Object3D();
+      proxy.position.copy(h.object.position);
+      proxy.quaternion.copy(h.object.quaternion);
       proxy.position.x += (delta.x || 0) / steps;
       proxy.position.y += (delta.y || 0) / steps;
       proxy.position.z += (delta.z || 0) / steps;
@@ -611,6 +622,16 @@ viewer.api = {
   setSpeed: (v) => { app.speed = v; },
   runInfo: () => app.run && { id: app.run.id, samples: app.run.t.length, start: app.run.t[0], end: app.run.t[app.run.t.length - 1], plot: app.run.plot },
   ikTimes: () => app.ikTimes.slice(),
+  tracks: () => app.tracks,
+  // Mean milliseconds of one IK solve of the current inputs through the module, over n solves
+  // (one drag step is one solve; a single call is below performance.now()'s resolution).
+  timeIk(n = 2000) {
+    const t0 = performance.now();
+    for (let k = 0; k < n; ++k) app.model.solve(app.inputs, app.branches);
+    return (performance.now() - t0) / n;
+  },
+  // A view from above onto the wheels' tracks (for screenshots).
+  lookFromAbove() { camera.position.set(orbit.target.x + 0.01, orbit.target.y - 0.01, 16); orbit.update(); },
   loadMs: () => app.loadMs,
   // Pixels of the 3D view that differ from the background, for a blank-canvas check.
   paintedPixels() {

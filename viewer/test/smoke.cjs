@@ -1,4 +1,5 @@
-import puppeteer from 'puppeteer-core';
+const puppeteer = require('puppeteer-core');
+(async () => {
 const [dir, query = ''] = process.argv.slice(2);
 const browser = await puppeteer.launch({ executablePath: '/usr/bin/chromium', headless: true,
   args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--allow-file-access-from-files'] });
@@ -12,3 +13,4 @@ await new Promise((r) => setTimeout(r, 500));
 console.log(await page.evaluate(() => JSON.stringify({ msg: wlxViewer.api.message(), px: wlxViewer.api.paintedPixels(), h: wlxViewer.api.handles() })));
 await page.screenshot({ path: '/tmp/smoke.png' });
 await browser.close();
+})();
