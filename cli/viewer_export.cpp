@@ -68,10 +68,12 @@ std::map<std::string, std::vector<double>> read_columns(const ViewerRun& run, co
     if (!columns.contains(name)) targets.emplace_back(it->second, &columns[name]);
   }
   long row = 1;  // the header is row 1, as an editor counts lines
+  long samples = 0;
   while (std::getline(in, line)) {
     ++row;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
+    ++samples;
     const std::vector<std::string> cells = split(line);
     if (cells.size() != header.size())
       throw Error("run " + run.id, fmt::format("row {} of the trajectory CSV has {} values for {} columns", row, cells.size(),
@@ -86,7 +88,7 @@ std::map<std::string, std::vector<double>> read_columns(const ViewerRun& run, co
       values->push_back(v);
     }
   }
-  if (columns.empty() || columns.begin()->second.empty()) throw Error("run " + run.id, "the trajectory CSV has no samples");
+  if (samples == 0) throw Error("run " + run.id, "the trajectory CSV has no samples");
   return columns;
 }
 

@@ -179,8 +179,8 @@ function buildMachine(info) {
     return mesh;
   });
   let cabin = null;
-  if (info.cabinBoxHalfExtents) {
-    const [hx, hy, hz] = info.cabinBoxHalfExtents;
+  if (info.cabinBox) {
+    const [hx, hy, hz] = info.cabinBox.halfExtents;
     cabin = new THREE.Mesh(new THREE.BoxGeometry(2 * hx, 2 * hy, 2 * hz), materials.cabin);
     cabin.matrixAutoUpdate = false;
     cabin.add(new THREE.AxesHelper(0.6));
@@ -225,7 +225,7 @@ function placeMachine() {
     link.mesh.scale.set(0.055, length, 0.055);
   }
   parts.joints.forEach((mesh, f) => mesh.position.copy(origin(f)));
-  if (parts.cabin) frameMatrix(positions, rotations, 0, parts.cabin.matrix);
+  if (parts.cabin) frameMatrix(positions, rotations, info.cabinBox.frame, parts.cabin.matrix);
   for (const w of parts.wheels) {
     // A disc in the contact frame: its axle along the lateral axis, its centre a radius above
     // the contact point along the frame's remaining (normal) axis.
@@ -588,6 +588,7 @@ requestAnimationFrame(frame);
 // --- the page's API (for tests and scripting) -----------------------------------------------
 viewer.ready = ready;
 viewer.api = {
+  info: () => app.info,
   handles: () => app.handles.map((h) => ({ id: h.id, label: h.label })),
   coordinates: () => Object.fromEntries(app.info.coordinates.map((c, k) => [c.name, app.s[k]])),
   inputs: () => Array.from(app.inputs),
@@ -623,6 +624,13 @@ viewer.api = {
   runInfo: () => app.run && { id: app.run.id, samples: app.run.t.length, start: app.run.t[0], end: app.run.t[app.run.t.length - 1], plot: app.run.plot },
   ikTimes: () => app.ikTimes.slice(),
   tracks: () => app.tracks,
+  // Where a handle is on the page, in CSS pixels (to drag it with the mouse).
+  screenPoint(id) {
+    const h = app.handles.find((x) => x.id === id);
+    const p = h.object.position.clone().project(camera);
+    const rect = renderer.domElement.getBoundingClientRect();
+    return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height };
+  },
   // Mean milliseconds of one IK solve of the current inputs through the module, over n solves
   // (one drag step is one solve; a single call is below performance.now()'s resolution).
   timeIk(n = 2000) {

@@ -75,6 +75,11 @@ function cliIk(inputs) {
     check((await api(page, () => wlxViewer.api.message())) === '', 'no message after loading NH-1');
     const pixels = await api(page, () => wlxViewer.api.paintedPixels());
     check(pixels.painted > 0.03 * pixels.total, 'the 3D view is not blank', `${pixels.painted} of ${pixels.total} pixels drawn`);
+    // The cabin box, found by the module from the generated clearance function: models/excavator.yaml's
+    // clearance is frame C (frame 0) of size cxd x cyd x cabin_height = 3 x 3 x 0.5 m.
+    const box = (await api(page, () => wlxViewer.api.info())).cabinBox;
+    check(box && box.frame === 0 && box.halfExtents.every((h, i) => Math.abs(h - [1.5, 1.5, 0.25][i]) < 1e-9),
+          'the cabin box is the clearance box of the model file', JSON.stringify(box));
     const run = await api(page, () => wlxViewer.api.runInfo());
     check(run && run.samples > 100 && run.plot.columns.length === 2, 'NH-1 loaded with its dependent rates plotted', JSON.stringify(run));
     // The wheels' tracks run through their contact points from the first sample to the last, as
@@ -127,6 +132,23 @@ function cliIk(inputs) {
       check(result.ok && residual < 1e-9 && moved.length >= 2, `drag ${handle} ${JSON.stringify(delta)}`,
             `ok ${result.ok}, residual ${residual.toExponential(2)}, changed ${moved.join(' ')}`);
     }
+    // A real mouse drag: pick the right foot's target by its button, grab the gizmo's centre
+    // (it moves in the view plane) and pull it 60 px to the right.
+    {
+      const before = await api(page, () => wlxViewer.api.coordinates());
+      await page.click('button[data-handle="target-F_r"]');
+      const at = await api(page, () => wlxViewer.api.screenPoint('target-F_r'));
+      await page.mouse.move(at.x, at.y);
+      await page.mouse.down();
+      await page.mouse.move(at.x + 60, at.y, { steps: 12 });
+      await page.mouse.up();
+      const after = await api(page, () => wlxViewer.api.coordinates());
+      const residual = await api(page, () => wlxViewer.api.residual());
+      const moved = Object.keys(after).filter((k) => Math.abs(after[k] - before[k]) > 1e-6);
+      check(moved.some((k) => /^[xyz]_Fr$/.test(k)) && moved.some((k) => k.startsWith('psi_r')) && residual < 1e-9,
+            'a mouse drag of the gizmo moves the target and the leg follows', `changed ${moved.join(' ')}, residual ${residual.toExponential(2)}`);
+      await page.screenshot({ path: path.join(outDir, 'mouse-drag.png') });
+    }
     // The page's pose is what `wlx ik` computes for the same inputs.
     const inputs = await api(page, () => wlxViewer.api.inputs());
     const names = Object.keys(await api(page, () => wlxViewer.api.coordinates()));
@@ -168,6 +190,17 @@ function cliIk(inputs) {
     check(dynamicsRun.plot.columns.every((c) => c.startsWith('tau_')) && dynamicsRun.plot.columns.length === 8, 'ID-1 plots the joint torques', dynamicsRun.plot.columns.join(' '));
     await api(dynamics, (t) => wlxViewer.api.seek(t), (dynamicsRun.start + dynamicsRun.end) / 2);
     await dynamics.screenshot({ path: path.join(outDir, 'dynamics-run.png') });
+    // --- the second built-in model: its own tables, its own module ---------------------------------
+    const walker = await open('?model=walker');
+    const walkerPixels = await api(walker, () => wlxViewer.api.paintedPixels());
+    check(walkerPixels.painted > 0.03 * walkerPixels.total, 'the walker renders', `${walkerPixels.painted} pixels`);
+    const walkerHandles = await api(walker, () => wlxViewer.api.handles());
+    const walkerCoordinates = Object.keys(await api(walker, () => wlxViewer.api.coordinates()));
+    check(walkerCoordinates.includes('hub_l') && !walkerCoordinates.includes('psi_l2'), 'the walker page shows the walker\'s coordinates');
+    const cabinDrag = await api(walker, () => wlxViewer.api.drag('cabin-move', { z: -0.2 }, 5));
+    check(cabinDrag.ok && (await api(walker, () => wlxViewer.api.residual())) < 1e-9, 'dragging the walker\'s body keeps its closure',
+          walkerHandles.map((h) => h.id).join(' '));
+    await walker.screenshot({ path: path.join(outDir, 'walker.png') });
   } finally {
     await browser.close();
   }

@@ -15,13 +15,14 @@
 #include <wlx/model.hpp>
 
 #include <Eigen/Geometry>  // AngleAxisd
+#include <Eigen/QR>
 #include <emscripten/emscripten.h>
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace {
 
@@ -75,20 +76,48 @@ std::string array(const Range& range, Print print) {
 
 std::string integer(int v) { return std::to_string(v); }
 
-// Half the cabin box's extent along each axis of the clearance frame, read off the generated
-// clearance function (the height of the box's lowest corner above z = 0): with the frame at the
-// origin, upright, the lowest corner is half the height down; pitched a quarter turn, half the
-// length; rolled a quarter turn, half the width. The model file's parameter names never appear here.
-std::array<double, 3> clearance_box_half_extents() {
-  const auto lowest = [](double pitch, double roll) {
+// The box of the generated clearance function (the model file's `clearance`: a frame and a size):
+// clearance(s) = z_f - sum_i h_i |R_f(2, i)| for the box's frame f and half extents h. The tables
+// do not name the frame, so it is found here: for each frame, h is fitted to the clearance at a few
+// poses of the cabin (each solved by the IK) and checked against all of them; the first frame the
+// formula fits to 1e-9 m is the box's. The model file's parameter names never appear here.
+struct ClearanceBox {
+  int frame = -1;
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();
+};
+
+ClearanceBox clearance_box() {
+  const std::array<std::array<double, 3>, 6> turns{{{0.3, 0.1, 0.2}, {-0.2, 0.25, -0.4}, {0.1, -0.3, 0.7},
+                                                   {0.35, 0.2, -0.1}, {-0.15, -0.1, 0.3}, {0.05, 0.02, 0.0}}};
+  std::vector<Coordinates> poses;
+  std::vector<double> lowest;
+  for (const auto& [pitch, roll, yaw] : turns) {
     Coordinates s = nominal_inputs();
-    s.head<6>() << 0, 0, 0, 0, pitch, roll;
+    s(3) += yaw, s(4) += pitch, s(5) += roll;
+    try {
+      solve_ik_closed_form(model(), s);
+    } catch (const Error&) {
+      continue;  // out of reach at this pose: the others decide
+    }
     double value = 0;
     gen::clearance(s, model().params(), &value);
-    return -value;
-  };
-  constexpr double quarter = std::numbers::pi / 2;
-  return {lowest(quarter, 0), lowest(0, quarter), lowest(0, 0)};
+    poses.push_back(s);
+    lowest.push_back(value);
+  }
+  const int n = static_cast<int>(poses.size());
+  if (n < 4) return {};
+  for (int f = 0; f < gen::kFrameCount; ++f) {
+    Eigen::MatrixXd A(n, 3);
+    Eigen::VectorXd b(n);
+    for (int k = 0; k < n; ++k) {
+      forward_kinematics(model(), poses[static_cast<std::size_t>(k)], data());
+      A.row(k) = frame_rotation(data(), f).row(2).cwiseAbs();
+      b(k) = frame_position(data(), f).z() - lowest[static_cast<std::size_t>(k)];
+    }
+    const Eigen::Vector3d h = A.colPivHouseholderQr().solve(b);
+    if ((A * h - b).cwiseAbs().maxCoeff() < 1e-9 && (h.array() >= 0).all() && h.maxCoeff() > 0) return {f, h};
+  }
+  return {};
 }
 
 // Whether the first six inputs are the pose of frame 0 as position and Rz(yaw) Ry(pitch) Rx(roll)
@@ -145,7 +174,12 @@ std::string build_info_json() {
                 ",\"axis\":" + integer(r.axis) + ",\"target\":" + integer(r.target) + "}";
        });
   j += ",\"nominalInputs\":" + array(gen::kNominalInputs, number);
-  if (gen::kHasClearance) j += ",\"cabinBoxHalfExtents\":" + array(clearance_box_half_extents(), number);
+  if (gen::kHasClearance) {
+    const ClearanceBox box = clearance_box();
+    if (box.frame >= 0)
+      j += ",\"cabinBox\":{\"frame\":" + integer(box.frame) + ",\"halfExtents\":" +
+           array(std::array<double, 3>{box.half_extents(0), box.half_extents(1), box.half_extents(2)}, number) + "}";
+  }
   j += ",\"cabinPoseInputs\":" + std::string(cabin_pose_is_first_six_inputs() ? "true" : "false");
   j += ",\"ikTolerance\":" + number(gen::kIkTolerance);
   return j + "}";
