@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <sstream>
 
 namespace wlx::cli {
@@ -221,6 +222,10 @@ void write_viewer_run(const fs::path& dir, const ViewerRun& run, std::span<const
   const fs::path runs = dir / "runs";
   create_folder(runs);
   write_file_atomically((runs / (run.id + ".js")).string(), text);
+  // One writer at a time for the index (read, updated, rewritten): a report may export its runs
+  // from several threads.
+  static std::mutex index_mutex;
+  const std::lock_guard lock(index_mutex);
   auto entries = read_index(runs / "index.js");
   nlohmann::json entry = {{"id", run.id}, {"model", run.model}, {"description", run.description}};
   const auto same = std::find_if(entries.begin(), entries.end(), [&](const nlohmann::json& e) { return e["id"] == run.id; });

@@ -8,7 +8,8 @@
 //   runs/index.js                   wlxViewer.registerIndex([{"id", "model", "description"}, ...])
 //   runs/<id>.js                    wlxViewer.registerRun({...}) (format below)
 // Everything loads by <script> tags, so the page works opened from file:// with no server; open
-// viewer.html?run=<id> for one run (the id URI-encoded), viewer.html?model=<name> for a model's
+// viewer.html?run=<id> for one run (the id URI-encoded: ST-A1%2B; a bare '+' is accepted too),
+// viewer.html?model=<name> for a model's
 // nominal pose.
 //
 // runs/<id>.js holds one object: {"format": "wlx-viewer-run 1", "id", "model", "description",
@@ -44,6 +45,7 @@ struct ViewerRun {
 // number; throws wlx::Error naming the run, the column or row and the reason, wlx::OutputError if a
 // file cannot be written. The page draws the run with the model's default parameters: a run whose
 // parameters differ from them must not be exported (the caller knows its parameters; the CSV does not).
+// Safe to call from several threads for different runs (the index update is serialized).
 void write_viewer_run(const std::filesystem::path& dir, const ViewerRun& run,
                       std::span<const std::string_view> coordinate_names, std::size_t max_samples = 1000);
 

@@ -3,10 +3,13 @@
 
 #include "viewer_export.hpp"
 
+#include "../support/run_wlx.hpp"
+
 #include <nlohmann/json.hpp>
 #include <wlx/error.hpp>
 
 #include <array>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -143,4 +146,22 @@ TEST_CASE("copy_viewer_files: a missing build says how to get one") {
   CHECK(registered(copy / "runs" / "index.js", "wlxViewer.registerIndex(").empty());
   fs::remove_all(source);
   fs::remove_all(copy);
+}
+
+TEST_CASE("wlx viewer: bad requests exit 2 naming the option or run") {
+  const fs::path out = wlx_test::work_dir() / "viewer";
+  auto r = wlx_test::run({"viewer", "--out", out.string(), "NH-9"});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("did you mean 'NH-1'") != std::string::npos);
+  wlx_test::write(wlx_test::work_dir() / "params.json", R"({"legD": 1.6})");
+  r = wlx_test::run({"viewer", "--out", out.string(), "--params", (wlx_test::work_dir() / "params.json").string()});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("wlx: error: --params: the viewer draws the model with its default parameters") == 0);
+  // A viewer that was not built: the message says where it looked and how to build it.
+  ::setenv("WLX_VIEWER_DIR", (wlx_test::work_dir() / "no-viewer").c_str(), 1);
+  r = wlx_test::run({"viewer", "--out", out.string()});
+  ::unsetenv("WLX_VIEWER_DIR");
+  CHECK(r.code == 2);
+  CHECK(r.err.find("viewer.html is missing") != std::string::npos);
+  CHECK(r.err.find("WLX_BUILD_VIEWER") != std::string::npos);
 }

@@ -545,7 +545,9 @@ const ready = (async () => {
     registry.index = [];  // no runs exported: the page still poses the model
   }
   const index = registry.index || [];
-  const runId = params.get('run') || (params.get('model') ? null : index[0]?.id ?? null);
+  let runId = params.get('run') || (params.get('model') ? null : index[0]?.id ?? null);
+  // A '+' left unencoded in a link (?run=ST-A1+) reads back as a space; run ids have no spaces.
+  if (runId && !index.some((r) => r.id === runId)) runId = runId.replace(/ /g, '+');
   const entry = runId ? index.find((r) => r.id === runId) : null;
   if (runId && !entry) throw new Error(`run '${runId}' is not in runs/index.js (runs: ${index.map((r) => r.id).join(', ') || 'none'})`);
   const modelName = entry ? entry.model : (params.get('model') || index[0]?.model || window.WLX_VIEWER_MODELS[0]);
