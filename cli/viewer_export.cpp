@@ -237,7 +237,16 @@ void write_viewer_run(const fs::path& dir, const ViewerRun& run, std::span<const
 fs::path built_viewer_dir() {
   if (const char* env = std::getenv("WLX_VIEWER_DIR"); env != nullptr && *env != '\0') return env;
 #ifdef WLX_VIEWER_BUILD_DIR
-  return WLX_VIEWER_BUILD_DIR;
+  const fs::path build_tree = WLX_VIEWER_BUILD_DIR;
+  std::error_code ec;
+  if (fs::is_regular_file(build_tree / "viewer.html", ec)) return build_tree;
+  // An installed wlx: <prefix>/bin/wlx finds <prefix>/share/wlx/viewer.
+  const fs::path executable = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = (executable.parent_path() / WLX_VIEWER_FROM_BINDIR).lexically_normal();
+    if (fs::is_regular_file(installed / "viewer.html", ec)) return installed;
+  }
+  return build_tree;  // neither: the error names the build tree's folder
 #else
   return {};
 #endif

@@ -49,8 +49,9 @@ struct ViewerRun {
 void write_viewer_run(const std::filesystem::path& dir, const ViewerRun& run,
                       std::span<const std::string_view> coordinate_names, std::size_t max_samples = 1000);
 
-// The folder the build put the viewer into (CMake: WLX_BUILD_VIEWER), overridden by the
-// environment variable WLX_VIEWER_DIR; empty when the viewer was not built.
+// The built viewer's folder: the environment variable WLX_VIEWER_DIR if set, else the build tree's
+// (CMake: WLX_BUILD_VIEWER), else an installation's <prefix>/share/wlx/viewer beside <prefix>/bin/wlx;
+// empty when this wlx was built without the viewer.
 std::filesystem::path built_viewer_dir();
 
 // Copies viewer.html, viewer.js and wasm/*.js from `source` (default: built_viewer_dir()) into DIR

@@ -40,8 +40,8 @@ function cliIk(inputs) {
   const folder = path.join(outDir, 'viewer');
   fs.rmSync(outDir, { recursive: true, force: true });
   fs.mkdirSync(outDir, { recursive: true });
-  execFileSync(wlx, ['viewer', '--out', folder, 'NH-1', 'ID-1'], { stdio: 'inherit' });
-  for (const f of ['viewer.html', 'viewer.js', 'wasm/wlx_excavator.js', 'runs/index.js', 'runs/NH-1.js', 'runs/ID-1.js'])
+  execFileSync(wlx, ['viewer', '--out', folder, 'NH-1', 'ID-1', 'ST-A1+'], { stdio: 'inherit' });
+  for (const f of ['viewer.html', 'viewer.js', 'wasm/wlx_excavator.js', 'runs/index.js', 'runs/NH-1.js', 'runs/ID-1.js', 'runs/ST-A1+.js'])
     check(fs.existsSync(path.join(folder, f)), `wlx viewer wrote ${f}`);
   console.log(`sizes: viewer.js ${fs.statSync(path.join(folder, 'viewer.js')).size} B, wasm/wlx_excavator.js ` +
               `${fs.statSync(path.join(folder, 'wasm/wlx_excavator.js')).size} B, runs/NH-1.js ${fs.statSync(path.join(folder, 'runs/NH-1.js')).size} B`);
@@ -190,6 +190,19 @@ function cliIk(inputs) {
     check(dynamicsRun.plot.columns.every((c) => c.startsWith('tau_')) && dynamicsRun.plot.columns.length === 8, 'ID-1 plots the joint torques', dynamicsRun.plot.columns.join(' '));
     await api(dynamics, (t) => wlxViewer.api.seek(t), (dynamicsRun.start + dynamicsRun.end) / 2);
     await dynamics.screenshot({ path: path.join(outDir, 'dynamics-run.png') });
+    // --- a run id with '+', encoded in the link as the report writes it; the scrub bar ------------
+    const plus = await open('?run=' + encodeURIComponent('ST-A1+'));
+    const plusRun = await api(plus, () => wlxViewer.api.runInfo());
+    check(plusRun && plusRun.id === 'ST-A1+', 'viewer.html?run=ST-A1%2B opens run ST-A1+');
+    await api(plus, () => { const s = document.getElementById('scrub'); s.value = '500'; s.dispatchEvent(new Event('input')); });
+    const scrubbed = await api(plus, () => wlxViewer.api.time());
+    check(Math.abs(scrubbed - (plusRun.start + plusRun.end) / 2) < 0.01 * (plusRun.end - plusRun.start) + 1e-9,
+          'the scrub bar at its middle shows the run\'s middle', `t = ${scrubbed}`);
+    // The centres of mass, when shown, are drawn without an error.
+    await plus.click('#show-com');
+    check((await api(plus, () => wlxViewer.api.message())) === '', 'showing the centres of mass');
+    await plus.screenshot({ path: path.join(outDir, 'centres-of-mass.png') });
+
     // --- the second built-in model: its own tables, its own module ---------------------------------
     const walker = await open('?model=walker');
     const walkerPixels = await api(walker, () => wlxViewer.api.paintedPixels());
