@@ -177,6 +177,19 @@ function cliIk(inputs) {
     const residualStopped = await api(page, () => wlxViewer.api.residual());
     check(!stepped.ok && stoppedAt.z_Fl > reachable.z_Fl && stoppedAt.z_Fl < reachable.z_Fl + 8 && residualStopped < 1e-9,
           'a drag past the reach stops at the last reachable step', `z_Fl ${reachable.z_Fl} -> ${stoppedAt.z_Fl}, residual ${residualStopped}`);
+    // Another branch of the left leg's closed form, picked in the side panel: `wlx ik`'s pose for it.
+    {
+      await page.select('#branches label:first-child select', '1');
+      const q = await api(page, () => wlxViewer.api.inputs());
+      const pose = await api(page, () => wlxViewer.api.coordinates());
+      const cli = cliIk({ ...Object.fromEntries(q.map((v, k) => [names[k], v])), branch: { leg_l: 1 } });
+      const cliPose = JSON.parse(cli.stdout || '{}');
+      const difference = Math.max(...dependentNames.map((n) => Math.abs(cliPose[n] - pose[n])));
+      check(cli.status === 0 && difference < 1e-12 && Math.abs(pose.psi_l4 - reachable.psi_l4) > 1e-3,
+            'branch 1 of the left leg gives `wlx ik`\'s pose for branch 1', `max difference ${difference}, psi_l4 ${pose.psi_l4}`);
+      await page.screenshot({ path: path.join(outDir, 'left-leg-branch-1.png') });
+      await page.select('#branches label:first-child select', '0');
+    }
     const times = await api(page, () => wlxViewer.api.ikTimes());
     times.sort((a, b) => a - b);
     const perSolve = await api(page, () => wlxViewer.api.timeIk(2000));
