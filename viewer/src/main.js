@@ -94,6 +94,7 @@ camera.position.set(9, -11, 7);
 const orbit = new OrbitControls(camera, renderer.domElement);
 orbit.target.set(0, 0, 1);
 orbit.update();
+orbit.saveState();  // what resetView() returns to
 scene.add(new THREE.HemisphereLight(0xffffff, 0x8090a0, 2.2));
 const sun = new THREE.DirectionalLight(0xffffff, 1.6);
 sun.position.set(5, -8, 12);
@@ -642,6 +643,7 @@ viewer.api = {
   },
   // A view from above onto the wheels' tracks (for screenshots).
   lookFromAbove() { camera.position.set(orbit.target.x + 0.01, orbit.target.y - 0.01, 16); orbit.update(); },
+  resetView() { orbit.reset(); },
   loadMs: () => app.loadMs,
   // Pixels of the 3D view that differ from the background, for a blank-canvas check.
   paintedPixels() {

@@ -107,6 +107,7 @@ function cliIk(inputs) {
     await api(page, () => wlxViewer.api.lookFromAbove());
     await sleep(200);
     await page.screenshot({ path: path.join(outDir, 'run-tracks-from-above.png') });
+    await api(page, () => wlxViewer.api.resetView());
     await api(page, (t) => wlxViewer.api.seek(t), run.end);
     const atEnd = await api(page, () => wlxViewer.api.coordinates());
     const residualAtEnd = await api(page, () => wlxViewer.api.residual());
