@@ -51,7 +51,11 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
   inv.report->add_option("--claims", inv.report_options.claims_file,
                          "a report file (claims and figure layout, format of scenarios/<model>/report.yaml) instead of the model's own");
 
-  for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report}) add_model_options(a);
+  inv.viewer = app.add_subcommand("viewer", "the 3D viewer (viewer.html, drag-and-drop IK in WebAssembly) written to a folder, with runs to play");
+  inv.viewer->add_option("RUN", inv.viewer_options.runs, "scenario files or ids to simulate and show (wlx simulate --list shows the ids)");
+  inv.viewer->add_option("--out", inv.viewer_options.out_dir, "output folder (viewer.html, viewer.js, wasm/, runs/)")->capture_default_str();
+
+  for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report, inv.viewer}) add_model_options(a);
 }
 
 }  // namespace wlx::cli

@@ -30,6 +30,8 @@ struct Invocation {
   SimulateOptions sim;
   CLI::App* report = nullptr;
   ReportOptions report_options;
+  CLI::App* viewer = nullptr;
+  ViewerOptions viewer_options;
 };
 
 // Adds wlx's subcommands and options to `app` (model_names: the built-in models, the default

@@ -28,6 +28,11 @@ struct ReportOptions {
   std::string version;
 };
 
+struct ViewerOptions {
+  std::string out_dir = "out/viewer";
+  std::vector<std::string> runs;  // scenario files or ids, simulated and written as runs/<id>.js
+};
+
 // Options every command takes.
 struct ModelOptions {
   std::string params_file;  // JSON {"name": value, ...} overriding the model's parameters; empty: defaults
@@ -43,6 +48,7 @@ struct ModelCommands {
   int (*verify_nonholonomic)(const ModelOptions& model, const std::string& out_dir);
   int (*simulate)(const ModelOptions& model, const SimulateOptions& options);
   int (*report)(const ModelOptions& model, const ReportOptions& options);
+  int (*viewer)(const ModelOptions& model, const ViewerOptions& options);
 };
 
 // The built-in models, the default (the thesis excavator) first.

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   Invocation inv;
   define_command_line(app, inv, names, WLX_VERSION);
   auto& [model_name, model_options, list_models, fk, fk_json, ik, batch, verify_ik, ik_out, sweep_ids, verify_nh, nh_out,
-         simulate, sim, report, report_options] = inv;
+         simulate, sim, report, report_options, viewer, viewer_options] = inv;
   std::string model_names;
   for (const auto& n : names) model_names += (model_names.empty() ? "" : ", ") + n;
   install_interrupt_handlers();
@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
     if (ik->parsed()) return finish(model->ik(model_options, batch));
     if (verify_ik->parsed()) return finish(model->verify_ik(model_options, ik_out, sweep_ids));
     if (verify_nh->parsed()) return finish(model->verify_nonholonomic(model_options, nh_out));
+    if (viewer->parsed()) return finish(require(model->viewer, "viewer")(model_options, viewer_options));
     if (report->parsed()) return finish(require(model->report, "report")(model_options, report_options));
     if (simulate->parsed()) {
       if (!sim.list && sim.scenario.empty()) throw wlx::Error("SCENARIO", "missing: give a scenario file or id (--list shows the ids)");

@@ -5,6 +5,10 @@
 #include "per_model.hpp"
 
 #include <wlx/model.hpp>
+#include <wlx/simulation.hpp>
+
+#include <filesystem>
+#include <string>
 
 WLX_COMMANDS_BEGIN
 
@@ -18,6 +22,14 @@ int run_verify_ik(const ModelOptions& model, const std::string& out_dir, const s
 int run_verify_nonholonomic(const ModelOptions& model, const std::string& out_dir);
 int run_simulate(const ModelOptions& model, const SimulateOptions& options);
 int run_report(const ModelOptions& model, const ReportOptions& options);
+int run_viewer(const ModelOptions& model, const ViewerOptions& options);
+
+// The text of a trajectory CSV (`wlx simulate`'s columns), for write_viewer_run (viewer_export.hpp).
+std::string trajectory_csv_text(const Trajectory& trajectory, bool dynamics);
+// Writes DIR/runs/<scenario.id>.js for the viewer: the run's coordinates and, beside them, its
+// dependent pair's rates (or, for an inverse-dynamics run, its joint torques). Throws wlx::Error
+// for a scenario with parameters other than the model's defaults (the viewer draws those).
+void write_viewer_run(const std::filesystem::path& dir, const Scenario& scenario, const Trajectory& trajectory);
 
 // This model's entry in the registry.
 const ModelCommands& entry();

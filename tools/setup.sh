@@ -7,6 +7,13 @@ cd "$(dirname "$0")/.."
 packages=(cmake g++ ninja-build pkg-config libginac-dev libeigen3-dev libfmt-dev doctest-dev
           libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev gnuplot-nox fonts-dejavu-core
           python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib)
+# The 3D viewer (viewer/, CMake option WLX_BUILD_VIEWER): emscripten compiles the model's WebAssembly,
+# node and npm bundle the page (`npm ci` from viewer/package-lock.json runs inside the build, into
+# the build tree, only when the lock file changes), chromium runs its browser test.
+packages+=(emscripten chromium)
+# node and npm may come from elsewhere (NodeSource's nodejs carries npm): Debian's only if absent.
+command -v node >/dev/null || packages+=(nodejs)
+command -v npm >/dev/null || packages+=(npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,0 +1,662 @@
+// The wlx viewer: draws a model from its generated forward kinematics, plays the runs written by
+// `wlx viewer` / `wlx report` (runs/<id>.js), and lets the user drag the cabin, the foot targets
+// and the wheels' ground levels while the limbs follow by wlx's closed-form IK (the WebAssembly
+// module built from the generated headers and the runtime's sources, wasm/wlx_<model>.js).
+//
+// Nothing about a robot is written here: names, the frame tree, limbs, wheels, the cabin box and
+// the nominal pose come from the module (wlx_model_info_json). Loading is by <script> tags only,
+// so the page works from file:// with no server.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { TransformControls } from 'three/examples/jsm/controls/TransformControls.js';
+import { WasmModel } from './wasm_model.js';
+import { drawPlot } from './plot.js';
+
+THREE.Object3D.DEFAULT_UP.set(0, 0, 1);  // K0: z up
+
+// --- registration of data scripts (runs/index.js, runs/<id>.js) ------------------------------
+const registry = { index: null, runs: new Map(), waiting: new Map() };
+const viewer = (window.wlxViewer = window.wlxViewer || {});
+viewer.registerIndex = (list) => { registry.index = list; };
+viewer.registerRun = (run) => {
+  registry.runs.set(run.id, run);
+  const resolve = registry.waiting.get(run.id);
+  if (resolve) resolve(run);
+};
+
+function loadScript(src) {
+  return new Promise((resolve, reject) => {
+    const el = document.createElement('script');
+    el.src = src;
+    el.onload = () => resolve();
+    el.onerror = () => reject(new Error(`could not load ${src} (is it beside viewer.html?)`));
+    document.head.appendChild(el);
+  });
+}
+
+// File names of runs: the export writes runs/<id>.js with the id as given (ids are checked there).
+function runScript(id) { return 'runs/' + encodeURIComponent(id).replace(/%2B/gi, '+') + '.js'; }
+
+async function loadRun(id) {
+  if (registry.runs.has(id)) return registry.runs.get(id);
+  const done = new Promise((resolve) => registry.waiting.set(id, resolve));
+  await loadScript(runScript(id));
+  const run = await Promise.race([done, new Promise((r) => setTimeout(() => r(null), 0))]);
+  if (!run) throw new Error(`runs/${id}.js did not register run '${id}'`);
+  return run;
+}
+
+// --- formatting: never NaN on screen -------------------------------------------------------------
+function fmt(v, digits = 4) {
+  if (!Number.isFinite(v)) return '—';
+  const a = Math.abs(v);
+  if (a !== 0 && (a < 1e-3 || a >= 1e5)) return v.toExponential(2);
+  return v.toFixed(digits);
+}
+
+const ui = (id) => document.getElementById(id);
+
+function showMessage(text) {
+  const el = ui('message');
+  el.textContent = text || '';
+  el.style.display = text ? 'block' : 'none';
+  app.message = text || '';
+}
+
+// --- the application state --------------------------------------------------------------------
+const app = {
+  model: null,       // WasmModel
+  info: null,        // the model's tables
+  inputs: null,      // Float64Array(inputCount): the last reachable inputs
+  s: null,           // Float64Array(coordinateCount): the pose shown
+  branches: null,    // Int32Array(limbs)
+  residual: NaN,
+  message: '',
+  run: null,         // the run being played, with .frames (Float64Array per sample) and .t
+  time: 0,
+  playing: false,
+  speed: 1,
+  ikTimes: [],       // ms per IK solve during drags
+  handles: [],       // draggable handles
+  tracks: [],        // the wheels' ground tracks drawn: start, end, number of distinct points
+  selected: null,
+};
+
+// --- scene -----------------------------------------------------------------------------------
+const sceneEl = ui('scene');
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio || 1);
+sceneEl.appendChild(renderer.domElement);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0xeef1f5);
+const camera = new THREE.PerspectiveCamera(45, 1, 0.05, 500);
+camera.position.set(9, -11, 7);
+const orbit = new OrbitControls(camera, renderer.domElement);
+orbit.target.set(0, 0, 1);
+orbit.update();
+orbit.saveState();  // what resetView() returns to
+scene.add(new THREE.HemisphereLight(0xffffff, 0x8090a0, 2.2));
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+sun.position.set(5, -8, 12);
+scene.add(sun);
+
+const grid = new THREE.GridHelper(40, 40, 0x8890a0, 0xc4c9d2);
+grid.rotation.x = Math.PI / 2;  // GridHelper lies in x-z; K0's ground is x-y
+scene.add(grid);
+const axes = new THREE.AxesHelper(1.0);  // K0: x red, y green, z blue
+scene.add(axes);
+
+const materials = {
+  cabin: new THREE.MeshStandardMaterial({ color: 0xf2b33d, roughness: 0.6, transparent: true, opacity: 0.9 }),
+  link: new THREE.MeshStandardMaterial({ color: 0x3b4a63, roughness: 0.5 }),
+  joint: new THREE.MeshStandardMaterial({ color: 0x6d7f9c }),
+  wheel: new THREE.MeshStandardMaterial({ color: 0x222222, roughness: 0.9 }),
+  foot: new THREE.MeshStandardMaterial({ color: 0x2a7f62 }),
+  com: new THREE.MeshStandardMaterial({ color: 0xd0306a }),
+  // Handles are drawn over everything (depthTest off): the cabin's sits inside the cabin box.
+  handle: new THREE.MeshStandardMaterial({ color: 0xff7a1a, transparent: true, opacity: 0.85, depthTest: false }),
+  handleSelected: new THREE.MeshStandardMaterial({ color: 0xff2a00, transparent: true, opacity: 0.95, depthTest: false }),
+  ground: new THREE.MeshStandardMaterial({ color: 0x8a6d3b, transparent: true, opacity: 0.45, side: THREE.DoubleSide }),
+};
+
+const machine = new THREE.Group();
+scene.add(machine);
+const tracks = new THREE.Group();
+scene.add(tracks);
+const comGroup = new THREE.Group();
+comGroup.visible = false;
+scene.add(comGroup);
+
+let parts = null;  // meshes made from the model's tables
+
+function frameMatrix(positions, rotations, f, out) {
+  const R = rotations, o = 9 * f;
+  // rotations are column-major (columns: the frame's axes); Matrix4.set takes rows.
+  out.set(R[o], R[o + 3], R[o + 6], positions[3 * f],
+          R[o + 1], R[o + 4], R[o + 7], positions[3 * f + 1],
+          R[o + 2], R[o + 5], R[o + 8], positions[3 * f + 2],
+          0, 0, 0, 1);
+  return out;
+}
+
+function frameAxis(rotations, f, axis) {
+  const o = 9 * f + 3 * axis;
+  return new THREE.Vector3(rotations[o], rotations[o + 1], rotations[o + 2]);
+}
+
+// The frames whose origin is put at three input targets (feet), and those with a height target
+// only (wheel contacts on their ground level), from the closure rows.
+function targetsFromClosureRows(info) {
+  const byFrame = new Map();
+  for (const row of info.closureRows) {
+    if (row.kind !== 'point') continue;
+    if (!byFrame.has(row.frame)) byFrame.set(row.frame, [-1, -1, -1]);
+    byFrame.get(row.frame)[row.axis] = row.target;
+  }
+  const points = [], grounds = [];
+  for (const [frame, targets] of byFrame) {
+    if (targets.every((t) => t >= 0)) points.push({ frame, targets });
+    else if (targets[2] >= 0 && targets[0] < 0 && targets[1] < 0) grounds.push({ frame, target: targets[2] });
+  }
+  return { points, grounds };
+}
+
+function buildMachine(info) {
+  machine.clear();
+  comGroup.clear();
+  const unitCylinder = new THREE.CylinderGeometry(1, 1, 1, 16);  // along y, scaled per link
+  const links = [];
+  info.frames.forEach((frame, f) => {
+    if (frame.parent < 0) return;
+    const mesh = new THREE.Mesh(unitCylinder, materials.link);
+    mesh.name = `link ${info.frames[frame.parent].name}-${frame.name}`;
+    machine.add(mesh);
+    links.push({ mesh, from: frame.parent, to: f });
+  });
+  const joints = info.frames.map((frame) => {
+    const mesh = new THREE.Mesh(new THREE.SphereGeometry(0.09, 16, 12), materials.joint);
+    mesh.name = `frame ${frame.name}`;
+    machine.add(mesh);
+    return mesh;
+  });
+  let cabin = null;
+  if (info.cabinBox) {
+    const [hx, hy, hz] = info.cabinBox.halfExtents;
+    cabin = new THREE.Mesh(new THREE.BoxGeometry(2 * hx, 2 * hy, 2 * hz), materials.cabin);
+    cabin.matrixAutoUpdate = false;
+    cabin.add(new THREE.AxesHelper(0.6));
+    machine.add(cabin);
+  }
+  const wheels = info.wheels.map((w) => {
+    const disc = new THREE.Mesh(new THREE.CylinderGeometry(w.radius, w.radius, 0.18, 40), materials.wheel);
+    disc.name = `wheel ${w.name}`;
+    machine.add(disc);
+    return { info: w, disc };
+  });
+  const { points, grounds } = targetsFromClosureRows(info);
+  const feet = points.map((p) => {
+    const mesh = new THREE.Mesh(new THREE.SphereGeometry(0.14, 20, 14), materials.foot);
+    machine.add(mesh);
+    return { ...p, mesh };
+  });
+  const coms = info.bodies.map((b) => {
+    const mesh = new THREE.Mesh(new THREE.SphereGeometry(0.1, 16, 12), materials.com);
+    mesh.name = `com ${b.name}`;
+    comGroup.add(mesh);
+    return mesh;
+  });
+  parts = { links, joints, cabin, wheels, feet, grounds, coms };
+}
+
+const _m = new THREE.Matrix4(), _a = new THREE.Vector3(), _b = new THREE.Vector3(), _y = new THREE.Vector3(0, 1, 0);
+
+function placeMachine() {
+  const info = app.info;
+  const { positions, rotations } = app.model.forwardKinematics(app.s);
+  const origin = (f) => new THREE.Vector3(positions[3 * f], positions[3 * f + 1], positions[3 * f + 2]);
+  for (const link of parts.links) {
+    _a.copy(origin(link.from));
+    _b.copy(origin(link.to));
+    const d = _b.clone().sub(_a);
+    const length = d.length();
+    link.mesh.visible = length > 1e-9;
+    if (!link.mesh.visible) continue;
+    link.mesh.position.copy(_a).addScaledVector(d, 0.5);
+    link.mesh.quaternion.setFromUnitVectors(_y, d.normalize());
+    link.mesh.scale.set(0.055, length, 0.055);
+  }
+  parts.joints.forEach((mesh, f) => mesh.position.copy(origin(f)));
+  if (parts.cabin) frameMatrix(positions, rotations, info.cabinBox.frame, parts.cabin.matrix);
+  for (const w of parts.wheels) {
+    // A disc in the contact frame: its axle along the lateral axis, its centre a radius above
+    // the contact point along the frame's remaining (normal) axis.
+    const f = w.info.contactFrame;
+    const lateral = frameAxis(rotations, f, w.info.lateralAxis);
+    let normal = frameAxis(rotations, f, 3 - w.info.forwardAxis - w.info.lateralAxis);
+    if (normal.z < 0) normal.negate();
+    w.disc.position.copy(origin(f)).addScaledVector(normal, w.info.radius);
+    w.disc.quaternion.setFromUnitVectors(_y, lateral.normalize());
+  }
+  for (const foot of parts.feet) foot.mesh.position.copy(origin(foot.frame));
+  if (comGroup.visible) {
+    const com = app.model.bodyCentres(app.s);
+    parts.coms.forEach((mesh, b) => mesh.position.set(com[3 * b], com[3 * b + 1], com[3 * b + 2]));
+  }
+  app.residual = app.model.closureResidual(app.s);
+  placeHandles(positions, rotations);
+  updatePanel();
+}
+
+// --- handles: cabin, foot targets, ground levels ------------------------------------------------
+const gizmo = new TransformControls(camera, renderer.domElement);
+gizmo.setSize(0.8);
+scene.add(gizmo.getHelper());
+gizmo.addEventListener('dragging-changed', (e) => { orbit.enabled = !e.value; });
+gizmo.addEventListener('objectChange', () => { if (app.selected) dragHandleTo(app.selected, app.selected.object); });
+
+function makeHandles(info) {
+  for (const h of app.handles) scene.remove(h.object);
+  app.handles = [];
+  const names = info.coordinates.map((c) => c.name);
+  if (info.cabinPoseInputs) {
+    const object = new THREE.Mesh(new THREE.OctahedronGeometry(0.22), materials.handle);
+    app.handles.push({ id: 'cabin-move', label: `cabin: move (${names.slice(0, 3).join(', ')})`, kind: 'cabin', mode: 'translate', object });
+    app.handles.push({ id: 'cabin-turn', label: `cabin: turn (${names.slice(3, 6).join(', ')})`, kind: 'cabin', mode: 'rotate', object });
+  }
+  const { points, grounds } = targetsFromClosureRows(info);
+  for (const p of points) {
+    const object = new THREE.Mesh(new THREE.SphereGeometry(0.2, 20, 14), materials.handle);
+    const frame = info.frames[p.frame].name;
+    app.handles.push({ id: `target-${frame}`, label: `target of ${frame} (${p.targets.map((t) => names[t]).join(', ')})`,
+                       kind: 'point', mode: 'translate', targets: p.targets, frame: p.frame, object });
+  }
+  for (const g of grounds) {
+    const object = new THREE.Mesh(new THREE.CylinderGeometry(0.45, 0.45, 0.02, 32), materials.ground);
+    object.quaternion.setFromUnitVectors(_y, new THREE.Vector3(0, 0, 1));
+    const frame = info.frames[g.frame].name;
+    app.handles.push({ id: `ground-${frame}`, label: `ground under ${frame} (${names[g.target]})`, kind: 'ground',
+                       mode: 'translate', target: g.target, frame: g.frame, object });
+  }
+  const seen = new Set();
+  for (const h of app.handles) {
+    h.object.renderOrder = 10;
+    if (!seen.has(h.object)) scene.add(h.object);
+    seen.add(h.object);
+  }
+  const box = ui('handles');
+  box.textContent = '';
+  for (const h of app.handles) {
+    const b = document.createElement('button');
+    b.textContent = h.label;
+    b.style.display = 'block';
+    b.style.margin = '2px 0';
+    b.dataset.handle = h.id;
+    b.onclick = () => selectHandle(h.id);
+    box.appendChild(b);
+  }
+}
+
+// Puts each handle where its inputs say (the last reachable inputs).
+function placeHandles(positions, rotations) {
+  const q = app.inputs;
+  for (const h of app.handles) {
+    if (app.selected === h && gizmo.dragging) continue;  // the pointer moves it
+    if (h.kind === 'cabin') {
+      h.object.position.set(q[0], q[1], q[2]);
+      h.object.rotation.set(q[5], q[4], q[3], 'ZYX');  // R = Rz(yaw) Ry(pitch) Rx(roll), checked by the module
+    } else if (h.kind === 'point') {
+      h.object.position.set(q[h.targets[0]], q[h.targets[1]], q[h.targets[2]]);
+    } else if (h.kind === 'ground') {
+      h.object.position.set(positions[3 * h.frame], positions[3 * h.frame + 1], q[h.target]);
+    }
+  }
+}
+
+function selectHandle(id) {
+  const h = app.handles.find((x) => x.id === id) || null;
+  app.selected = h;
+  for (const x of app.handles) x.object.material = x.object === h?.object ? materials.handleSelected : (x.kind === 'ground' ? materials.ground : materials.handle);
+  for (const b of ui('handles').children) b.classList.toggle('on', b.dataset.handle === id);
+  if (!h) { gizmo.detach(); return; }
+  pause();
+  gizmo.attach(h.object);
+  gizmo.setMode(h.mode);
+  gizmo.setSpace(h.mode === 'rotate' ? 'local' : 'world');
+  gizmo.showX = gizmo.showY = h.kind !== 'ground';
+  gizmo.showZ = true;
+}
+
+// The inputs a handle's pose asks for.
+function inputsForHandle(h, object) {
+  const q = Float64Array.from(app.inputs);
+  if (h.kind === 'cabin') {
+    q[0] = object.position.x; q[1] = object.position.y; q[2] = object.position.z;
+    const e = new THREE.Euler().setFromQuaternion(object.quaternion, 'ZYX');
+    q[3] = e.z; q[4] = e.y; q[5] = e.x;
+  } else if (h.kind === 'point') {
+    q[h.targets[0]] = object.position.x; q[h.targets[1]] = object.position.y; q[h.targets[2]] = object.position.z;
+  } else if (h.kind === 'ground') {
+    q[h.target] = object.position.z;
+  }
+  return q;
+}
+
+// Solves the IK for new inputs; on success the pose follows, otherwise the pose stays at the last
+// reachable one and the CLI's message is shown. Returns { ok, message }.
+function trySolve(q) {
+  const t0 = performance.now();
+  const result = app.model.solve(q, app.branches);
+  app.ikTimes.push(performance.now() - t0);
+  if (app.ikTimes.length > 1000) app.ikTimes.shift();
+  if (!result.ok) {
+    showMessage(result.message);
+    placeMachine();  // puts the dragged handle back at the last reachable inputs
+    return { ok: false, message: result.message };
+  }
+  showMessage('');
+  app.inputs = Float64Array.from(q);
+  app.s = result.s;
+  placeMachine();
+  return { ok: true, message: '' };
+}
+
+function dragHandleTo(h, object) {
+  const result = trySolve(inputsForHandle(h, object));
+  if (!result.ok && gizmo.dragging) {
+    // Keep the gizmo at the last reachable pose: the next pointer move starts from there.
+    const keep = app.selected;
+    app.selected = null;
+    placeHandles(app.model.forwardKinematics(app.s).positions, null);
+    app.selected = keep;
+  }
+  return result;
+}
+
+// Picking a handle by clicking it.
+const raycaster = new THREE.Raycaster();
+renderer.domElement.addEventListener('pointerdown', (event) => {
+  if (gizmo.dragging || gizmo.axis) return;
+  const rect = renderer.domElement.getBoundingClientRect();
+  const pointer = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1, -((event.clientY - rect.top) / rect.height) * 2 + 1);
+  raycaster.setFromCamera(pointer, camera);
+  const hit = raycaster.intersectObjects(app.handles.map((h) => h.object), false)[0];
+  if (!hit) return;
+  const candidates = app.handles.filter((h) => h.object === hit.object);
+  // A second click on the cabin handle switches between moving and turning.
+  const next = candidates.length > 1 && candidates.includes(app.selected)
+    ? candidates[(candidates.indexOf(app.selected) + 1) % candidates.length] : candidates[0];
+  selectHandle(next.id);
+});
+
+// --- side panel -----------------------------------------------------------------------------
+let valueCells = [];
+function buildPanel(info) {
+  ui('model-name').textContent = info.name;
+  ui('model-description').textContent = info.description;
+  const table = ui('coordinates');
+  table.textContent = '';
+  valueCells = info.coordinates.map((c, k) => {
+    const tr = document.createElement('tr');
+    tr.className = (k < info.inputCount ? 'input' : 'dependent') + (k === info.inputCount ? ' sep' : '');
+    const name = document.createElement('td'); name.textContent = c.name;
+    const value = document.createElement('td'); value.className = 'v';
+    const unit = document.createElement('td'); unit.className = 'muted';
+    const deg = document.createElement('td'); deg.className = 'v muted';
+    unit.textContent = c.unit;
+    tr.append(name, value, unit, deg);
+    table.appendChild(tr);
+    return { value, deg, angle: c.unit === 'rad' };
+  });
+  const branches = ui('branches');
+  branches.textContent = '';
+  info.limbs.forEach((limb, k) => {
+    const label = document.createElement('label');
+    label.style.display = 'block';
+    const select = document.createElement('select');
+    for (let b = 0; b < limb.branches; ++b) select.add(new Option(String(b), String(b)));
+    select.onchange = () => {
+      const previous = app.branches[k];
+      app.branches[k] = Number(select.value);
+      if (!trySolve(app.inputs).ok) { app.branches[k] = previous; select.value = String(previous); }
+    };
+    label.append(`${limb.title} `, select);
+    branches.appendChild(label);
+  });
+}
+
+function updatePanel() {
+  valueCells.forEach((cell, k) => {
+    cell.value.textContent = fmt(app.s[k]);
+    cell.deg.textContent = cell.angle ? fmt((app.s[k] * 180) / Math.PI, 2) + '°' : '';
+  });
+  ui('residual').textContent = Number.isFinite(app.residual) ? app.residual.toExponential(2) + ' (m or rad)' : '—';
+}
+
+// --- runs: playback, plot, tracks ----------------------------------------------------------------
+function prepareRun(run) {
+  const info = app.info;
+  const missing = info.coordinates.map((c) => c.name).filter((n) => !run.columns[n]);
+  if (run.model !== info.name) throw new Error(`run '${run.id}': made with model '${run.model}', the page shows '${info.name}'`);
+  if (missing.length) throw new Error(`run '${run.id}': columns missing: ${missing.join(', ')}`);
+  const n = run.columns.t.length;
+  const frames = [];
+  for (let i = 0; i < n; ++i) frames.push(Float64Array.from(info.coordinates, (c) => run.columns[c.name][i]));
+  // The wheels' ground tracks: their contact points by the model's forward kinematics.
+  tracks.clear();
+  app.tracks = [];
+  for (const w of info.wheels) {
+    const points = frames.map((s) => {
+      const p = app.model.forwardKinematics(s).positions;
+      const f = w.contactFrame;
+      return new THREE.Vector3(p[3 * f], p[3 * f + 1], p[3 * f + 2] + 0.01);
+    });
+    // A thin tube rather than a line: WebGL draws lines one pixel wide whatever is asked.
+    const distinct = points.filter((p, i) => i === 0 || p.distanceTo(points[i - 1]) > 1e-6);
+    app.tracks.push({ wheel: w.name, start: points[0].toArray(), end: points[points.length - 1].toArray(), distinct: distinct.length });
+    if (distinct.length < 2) continue;  // the wheel did not move
+    const path = new THREE.CatmullRomCurve3(distinct, false, 'centripetal');
+    const tube = new THREE.Mesh(new THREE.TubeGeometry(path, Math.min(4 * distinct.length, 2000), 0.03, 6, false),
+                                new THREE.MeshStandardMaterial({ color: 0x1565c0 }));
+    tube.name = `track ${w.name}`;
+    tracks.add(tube);
+  }
+  return { ...run, frames, t: run.columns.t };
+}
+
+function sampleIndex(t) {
+  const ts = app.run.t;
+  let lo = 0, hi = ts.length - 1;
+  while (lo < hi) {  // last sample with ts <= t
+    const mid = (lo + hi + 1) >> 1;
+    if (ts[mid] <= t) lo = mid; else hi = mid - 1;
+  }
+  return lo;
+}
+
+function showTime(t) {
+  if (!app.run) return;
+  const ts = app.run.t, t0 = ts[0], t1 = ts[ts.length - 1];
+  app.time = Math.min(Math.max(t, t0), t1);
+  const i = sampleIndex(app.time);
+  app.s = Float64Array.from(app.run.frames[i]);
+  app.inputs = app.s.slice(0, app.info.inputCount);
+  showMessage('');
+  placeMachine();
+  ui('scrub').value = String(Math.round(((app.time - t0) / Math.max(t1 - t0, 1e-12)) * 1000));
+  ui('time').textContent = `t = ${app.time.toFixed(3)} s of ${t1.toFixed(3)} s`;
+  drawPlot(ui('plot'), app.run, app.time);
+}
+
+function play() {
+  if (!app.run) return;
+  if (app.time >= app.run.t[app.run.t.length - 1]) app.time = app.run.t[0];
+  app.playing = true;
+  ui('play').textContent = 'pause';
+  gizmo.detach();
+  app.selected = null;
+}
+
+function pause() {
+  app.playing = false;
+  ui('play').textContent = 'play';
+}
+
+ui('play').onclick = () => (app.playing ? pause() : play());
+ui('speed').onchange = () => { app.speed = Number(ui('speed').value); };
+ui('scrub').oninput = () => {
+  if (!app.run) return;
+  pause();
+  const ts = app.run.t;
+  showTime(ts[0] + (Number(ui('scrub').value) / 1000) * (ts[ts.length - 1] - ts[0]));
+};
+ui('show-com').onchange = () => { comGroup.visible = ui('show-com').checked; placeMachine(); };
+ui('show-tracks').onchange = () => { tracks.visible = ui('show-tracks').checked; };
+
+// --- frame loop -------------------------------------------------------------------------------
+let lastFrame = performance.now();
+function resize() {
+  const w = sceneEl.clientWidth, h = sceneEl.clientHeight;
+  if (renderer.domElement.width !== Math.floor(w * renderer.getPixelRatio()) || renderer.domElement.height !== Math.floor(h * renderer.getPixelRatio())) {
+    renderer.setSize(w, h, false);
+    camera.aspect = w / Math.max(h, 1);
+    camera.updateProjectionMatrix();
+    if (app.run) drawPlot(ui('plot'), app.run, app.time);
+  }
+}
+function frame(now) {
+  const dt = Math.min((now - lastFrame) / 1000, 0.1);
+  lastFrame = now;
+  resize();
+  if (app.playing && app.run) {
+    const end = app.run.t[app.run.t.length - 1];
+    showTime(app.time + dt * app.speed);
+    if (app.time >= end) pause();
+  }
+  renderer.render(scene, camera);
+  requestAnimationFrame(frame);
+}
+
+// --- start ------------------------------------------------------------------------------------
+const params = new URLSearchParams(window.location.search);
+const ready = (async () => {
+  const t0 = performance.now();
+  try {
+    await loadScript('runs/index.js');
+  } catch (e) {
+    registry.index = [];  // no runs exported: the page still poses the model
+  }
+  const index = registry.index || [];
+  let runId = params.get('run') || (params.get('model') ? null : index[0]?.id ?? null);
+  // A '+' left unencoded in a link (?run=ST-A1+) reads back as a space; run ids have no spaces.
+  if (runId && !index.some((r) => r.id === runId)) runId = runId.replace(/ /g, '+');
+  const entry = runId ? index.find((r) => r.id === runId) : null;
+  if (runId && !entry) throw new Error(`run '${runId}' is not in runs/index.js (runs: ${index.map((r) => r.id).join(', ') || 'none'})`);
+  const modelName = entry ? entry.model : (params.get('model') || index[0]?.model || window.WLX_VIEWER_MODELS[0]);
+  if (!window.WLX_VIEWER_MODELS.includes(modelName))
+    throw new Error(`model '${modelName}': this viewer was built for ${window.WLX_VIEWER_MODELS.join(', ')}`);
+  app.model = await WasmModel.load(modelName, loadScript);
+  app.info = app.model.info;
+  app.branches = new Int32Array(app.info.limbs.length);
+  buildMachine(app.info);
+  makeHandles(app.info);
+  buildPanel(app.info);
+  const select = ui('run-select');
+  for (const r of index.filter((r) => r.model === app.info.name)) select.add(new Option(`${r.id}${r.description ? ' — ' + r.description : ''}`, r.id));
+  select.add(new Option('(no run: nominal pose)', ''));
+  select.value = runId || '';
+  select.onchange = () => {
+    const url = new URL(window.location.href);
+    if (select.value) url.searchParams.set('run', select.value); else { url.searchParams.delete('run'); url.searchParams.set('model', app.info.name); }
+    window.location.href = url.toString();
+  };
+  // The nominal pose first, so that a run that fails to load still leaves a machine on screen.
+  const nominal = app.model.solve(Float64Array.from(app.info.nominalInputs), app.branches);
+  if (!nominal.ok) throw new Error(`the nominal pose: ${nominal.message}`);
+  app.inputs = Float64Array.from(app.info.nominalInputs);
+  app.s = nominal.s;
+  placeMachine();
+  if (runId) {
+    app.run = prepareRun(await loadRun(runId));
+    showTime(app.run.t[0]);
+  } else {
+    ui('controls').style.opacity = 0.4;
+    drawPlot(ui('plot'), null, 0);
+  }
+  app.loadMs = performance.now() - t0;
+  return true;
+})();
+ready.catch((e) => showMessage(`viewer: ${e.message}`));
+requestAnimationFrame(frame);
+
+// --- the page's API (for tests and scripting) -----------------------------------------------
+viewer.ready = ready;
+viewer.api = {
+  info: () => app.info,
+  handles: () => app.handles.map((h) => ({ id: h.id, label: h.label })),
+  coordinates: () => Object.fromEntries(app.info.coordinates.map((c, k) => [c.name, app.s[k]])),
+  inputs: () => Array.from(app.inputs),
+  residual: () => app.residual,
+  message: () => app.message,
+  // Moves a handle by (dx, dy, dz) in K0 (and, for the cabin, by (dyaw, dpitch, droll)) in
+  // `steps` equal steps, each going through the same path as a mouse drag of the gizmo.
+  drag(id, delta, steps = 10) {
+    const h = app.handles.find((x) => x.id === id);
+    if (!h) throw new Error(`no handle '${id}' (handles: ${app.handles.map((x) => x.id).join(', ')})`);
+    selectHandle(id);
+    let result = { ok: true, message: '' };
+    for (let k = 1; k <= steps; ++k) {
+      const proxy = new THREE.Object3D();
+      proxy.position.copy(h.object.position);
+      proxy.quaternion.copy(h.object.quaternion);
+      proxy.position.x += (delta.x || 0) / steps;
+      proxy.position.y += (delta.y || 0) / steps;
+      proxy.position.z += (delta.z || 0) / steps;
+      if (delta.yaw || delta.pitch || delta.roll) {
+        const e = new THREE.Euler().setFromQuaternion(proxy.quaternion, 'ZYX');
+        proxy.rotation.set(e.x + (delta.roll || 0) / steps, e.y + (delta.pitch || 0) / steps, e.z + (delta.yaw || 0) / steps, 'ZYX');
+      }
+      result = dragHandleTo(h, proxy);
+    }
+    return result;
+  },
+  play, pause,
+  seek: (t) => { pause(); showTime(t); },
+  time: () => app.time,
+  playing: () => app.playing,
+  setSpeed: (v) => { app.speed = v; },
+  runInfo: () => app.run && { id: app.run.id, samples: app.run.t.length, start: app.run.t[0], end: app.run.t[app.run.t.length - 1], plot: app.run.plot },
+  ikTimes: () => app.ikTimes.slice(),
+  tracks: () => app.tracks,
+  // Where a handle is on the page, in CSS pixels (to drag it with the mouse).
+  screenPoint(id) {
+    const h = app.handles.find((x) => x.id === id);
+    const p = h.object.position.clone().project(camera);
+    const rect = renderer.domElement.getBoundingClientRect();
+    return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height };
+  },
+  // Mean milliseconds of one IK solve of the current inputs through the module, over n solves
+  // (one drag step is one solve; a single call is below performance.now()'s resolution).
+  timeIk(n = 2000) {
+    const t0 = performance.now();
+    for (let k = 0; k < n; ++k) app.model.solve(app.inputs, app.branches);
+    return (performance.now() - t0) / n;
+  },
+  // A view from above onto the wheels' tracks (for screenshots).
+  lookFromAbove() { camera.position.set(orbit.target.x + 0.01, orbit.target.y - 0.01, 16); orbit.update(); },
+  resetView() { orbit.reset(); },
+  loadMs: () => app.loadMs,
+  // Pixels of the 3D view that differ from the background, for a blank-canvas check.
+  paintedPixels() {
+    renderer.render(scene, camera);
+    const c = document.createElement('canvas');
+    c.width = renderer.domElement.width; c.height = renderer.domElement.height;
+    const g = c.getContext('2d');
+    g.drawImage(renderer.domElement, 0, 0);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    const srgb = scene.background.getRGB({}, THREE.SRGBColorSpace);  // what the canvas holds
+    const [r0, g0, b0] = [srgb.r, srgb.g, srgb.b].map((v) => Math.round(v * 255));
+    let painted = 0;
+    for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - r0) + Math.abs(d[i + 1] - g0) + Math.abs(d[i + 2] - b0) > 24) ++painted;
+    return { painted, total: c.width * c.height };
+  },
+};
