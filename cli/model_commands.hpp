@@ -29,7 +29,10 @@ std::string trajectory_csv_text(const Trajectory& trajectory, bool dynamics);
 // Writes DIR/runs/<scenario.id>.js for the viewer: the run's coordinates and, beside them, its
 // dependent pair's rates (or, for an inverse-dynamics run, its joint torques). Throws wlx::Error
 // for a scenario with parameters other than the model's defaults (the viewer draws those).
-void write_viewer_run(const std::filesystem::path& dir, const Scenario& scenario, const Trajectory& trajectory);
+// `id` and `description` replace the scenario's when given (the report runs one scenario twice,
+// once per weighting, as <id>-w1 and <id>-w2).
+void write_viewer_run(const std::filesystem::path& dir, const Scenario& scenario, const Trajectory& trajectory,
+                      const std::string& id = {}, const std::string& description = {});
 
 // This model's entry in the registry.
 const ModelCommands& entry();

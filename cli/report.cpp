@@ -12,6 +12,7 @@
 #include "report/html.hpp"
 #include "report/runner.hpp"
 #include "report/spec.hpp"
+#include "viewer_export.hpp"
 
 #include <fmt/format.h>
 #include <wlx/atomic_file.hpp>
@@ -89,8 +90,13 @@ class Report {
   report::Document document(const ReportFigures& figures);
   std::vector<report::Section> sections(const ReportFigures& figures) const;
 
+  void write_viewer();
+  // The run's page in the 3D viewer, relative to index.html; empty without the viewer.
+  std::string viewer_link(const std::string& run_id) const;
+
   const ModelOptions& model_options_;
   ReportOptions options_;
+  std::string viewer_missing_;  // why the report has no 3D viewer (empty: it has one)
   fs::path root_;
   report::ReportSpec spec_;
   ReportRunner runner_;
@@ -146,7 +152,9 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
     out.push_back({"ik", title("ik", "Inverse kinematics sweeps"), "", {t}, figures.ik, {}});
   }
   const auto runs_table = [&](auto keep) {
-    report::Table t{{"run", "description", "samples", "max |v_W . n_W| (m/s)", "max cond(J_beta)", "min cabin clearance (m)", "CSV"}, {}};
+    report::Table t{{"run", "description", "samples", "max |v_W . n_W| (m/s)", "max cond(J_beta)", "min cabin clearance (m)", "CSV",
+                     "3D"},
+                    {}};
     for (const auto& r : runner_.runs()) {
       if (!keep(r)) continue;
       double res = 0, cond = 0, clear = 1e300;
@@ -156,7 +164,8 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
         clear = std::min(clear, smp.cabin_clearance);
       }
       t.rows.push_back({{r.id}, {r.scenario.description}, {std::to_string(r.trajectory.samples.size())}, {fmt::format("{:.2e}", res)},
-                        {fmt::format("{:.3g}", cond)}, {fmt::format("{:.4f}", clear)}, {r.csv, "data/" + r.csv}});
+                        {fmt::format("{:.3g}", cond)}, {fmt::format("{:.4f}", clear)}, {r.csv, "data/" + r.csv},
+                        viewer_missing_.empty() ? report::Cell{"animate", viewer_link(r.id)} : report::Cell{"-"}});
     }
     return t;
   };
@@ -206,7 +215,10 @@ report::Document Report::document(const ReportFigures& figures) {
              {"parameters", model_options_.params_file.empty() ? "the model file's defaults" : "overridden by " + model_options_.params_file},
              {"date", utc_now()},
              {"command line", options_.command_line},
-             {"runs", options_.quick ? "--quick: a reduced set" : "all"}};
+             {"runs", options_.quick ? "--quick: a reduced set" : "all"},
+             {"3D viewer", viewer_missing_.empty() ? "viewer/viewer.html: every run animated (the \"3D\" column), the "
+                                                     "machine dragged with the closed-form IK"
+                                                   : "not included: " + viewer_missing_}};
   d.parameters.header = {"parameter", "value", "unit", "meaning"};
   const Params& p = runner_.model().params();
   for (const auto& info : gen::kParamInfo)
@@ -217,6 +229,33 @@ report::Document Report::document(const ReportFigures& figures) {
   return d;
 }
 
+void Report::write_viewer() {
+  if (!model_options_.params_file.empty()) {
+    viewer_missing_ = "the viewer draws the model's default parameters, and --params changes them";
+    return;
+  }
+  const fs::path dir = root_ / "viewer";
+  std::error_code ec;  // an earlier report's runs would stay listed in the page's index
+  fs::remove_all(dir / "runs", ec);
+  if (ec) throw OutputError((dir / "runs").string(), fmt::format("cannot remove the earlier report's ({})", ec.message()));
+  try {
+    copy_viewer_files(dir);
+  } catch (const Error& e) {  // built without emscripten: the report stands without its viewer
+    viewer_missing_ = e.what();
+    return;
+  }
+  for (const auto& r : runner_.runs()) {
+    const std::string weighting = r.scenario.weighting ? " (" + r.scenario.weighting->label() + ")" : "";
+    write_viewer_run(dir, r.scenario, r.trajectory, r.id, r.scenario.description + weighting);
+  }
+}
+
+std::string Report::viewer_link(const std::string& run_id) const {
+  std::string encoded;  // the ids' characters are A-Z a-z 0-9 . _ + -: only '+' needs encoding
+  for (char c : run_id) encoded += c == '+' ? std::string("%2B") : std::string(1, c);
+  return "viewer/viewer.html?run=" + encoded;
+}
+
 int Report::run() {
   const auto start = std::chrono::steady_clock::now();
   // An index.html from an earlier run would claim that this one is complete until it is.
@@ -225,8 +264,10 @@ int Report::run() {
   if (ec) throw OutputError((root_ / "index.html").string(), fmt::format("cannot remove the earlier report's ({})", ec.message()));
   prepare_out_dir("--out", (root_ / "data").string());
   prepare_out_dir("--out", (root_ / "fig").string());
-  total_steps_ = runner_.steps() + 2;
+  total_steps_ = runner_.steps() + 3;
   runner_.run_all((root_ / "data").string());
+  progress("the 3D viewer: the page and every run's data");
+  write_viewer();
   progress("measuring the claims and drawing the figures");
   const ReportFigures figures = make_figures(runner_, spec_, (root_ / "data").string());
   report::Document doc = document(figures);

@@ -26,7 +26,8 @@ std::string trajectory_csv_text(const Trajectory& trajectory, bool dynamics) {
   return text;
 }
 
-void write_viewer_run(const std::filesystem::path& dir, const Scenario& scenario, const Trajectory& trajectory) {
+void write_viewer_run(const std::filesystem::path& dir, const Scenario& scenario, const Trajectory& trajectory,
+                      const std::string& id, const std::string& description) {
   for (const auto& info : gen::kParamInfo)
     if (scenario.params.*info.member != Params{}.*info.member)
       throw Error("run " + scenario.id,
@@ -35,9 +36,9 @@ void write_viewer_run(const std::filesystem::path& dir, const Scenario& scenario
                               info.name, scenario.params.*info.member));
   const bool dynamics = scenario.weighting.has_value();
   ViewerRun run;
-  run.id = scenario.id;
+  run.id = id.empty() ? scenario.id : id;
   run.model = std::string(gen::kModelName);
-  run.description = scenario.description;
+  run.description = description.empty() ? scenario.description : description;
   run.trajectory_csv = trajectory_csv_text(trajectory, dynamics);
   if (!dynamics)  // the dependent pair's rates (a dynamics run plots its torques, the default)
     for (int k : scenario.pair.index) run.plot_columns.push_back(std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]) + "_dot");

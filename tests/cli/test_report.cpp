@@ -66,7 +66,7 @@ TEST_CASE("report: the full report runs, every image exists, every check passes,
   CHECK(html.find("class=\"fail\"") == std::string::npos);
   CHECK(html.find("class=\"pass\"") != std::string::npos);
   // Every referenced file exists and is not empty.
-  const std::regex ref("(src|href)=\"([^\"#]+)\"");
+  const std::regex ref("(src|href)=\"([^\"#?]+)[^\"]*\"");
   int images = 0;
   for (auto it = std::sregex_iterator(html.begin(), html.end(), ref); it != std::sregex_iterator(); ++it) {
     const fs::path file = dir / (*it)[2].str();
@@ -82,6 +82,20 @@ TEST_CASE("report: the full report runs, every image exists, every check passes,
     CHECK(text.find("nan") == std::string::npos);
     CHECK(text.find("inf") == std::string::npos);
   }
+#ifdef WLX_VIEWER_BUILT
+  // Every run links its animation in the 3D viewer, whose data file is there and names the run.
+  const std::regex animate("href=\"viewer/viewer.html\\?run=([^\"]+)\"");
+  int animated = 0;
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), animate); it != std::sregex_iterator(); ++it) {
+    const std::string id = std::regex_replace((*it)[1].str(), std::regex("%2B"), "+");
+    const std::string data = slurp(dir / "viewer" / "runs" / (id + ".js"));
+    CAPTURE(id);
+    CHECK(data.find("\"id\":\"" + id + "\"") != std::string::npos);
+    ++animated;
+  }
+  CHECK(animated >= 20);  // the 19 scenarios, inverse dynamics twice
+  CHECK(fs::file_size(dir / "viewer" / "viewer.js") > 100000);
+#endif
   const std::string log = slurp(dir.string() + ".log");
   // Progress was shown, and its last step is numbered as the last of all.
   CHECK(std::regex_search(log, std::regex(R"(\[(\d+)/\1\] rendering)")));
