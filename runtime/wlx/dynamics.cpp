@@ -43,7 +43,7 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   out.T = rate_basis(d, kCommandedSpeeds, pair);
   Coordinates bias = Coordinates::Zero();  // s'' with u' = 0
   solve_dependent_accelerations(model, d, s, out.sdot, bias, pair);
-  out.sddot = out.T * u_dot + bias;
+  out.sddot = out.T.lazyProduct(u_dot) + bias;
   gen::bodies(s, out.sdot, p,
               {.com = &d.body_com,
                .rotations = &d.body_rotations,
@@ -56,31 +56,46 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   out.b.setZero();
   out.Q_gravity.setZero();
   const Eigen::Vector3d gravity(0, 0, -(p.*gen::kGravity));
-  // Per body, over its non-zero Jacobian columns only (a compile-time list: the loops unroll with
-  // fixed indices); the dense 3 x 32 products were most of this function's time.
+  constexpr int kU = kCommandedCount;
+  // Per body, over its non-zero Jacobian columns only (a compile-time list, so every product below
+  // is fixed-size and unrolled); the dense 3 x 32 products were most of this function's time.
   for_each_body([&](auto body) {
     constexpr int i = decltype(body)::value;
     constexpr gen::BodyColumns columns = gen::kBodyColumns[static_cast<std::size_t>(i)];
+    constexpr int K = columns.count;
     const auto& Jv = d.body_Jv[static_cast<std::size_t>(i)];
     const auto& Jw = d.body_Jw[static_cast<std::size_t>(i)];
-    const double m = mass(p, i);
-    const Eigen::Matrix3d inertia = world_inertia(p, i, d.body_rotations[static_cast<std::size_t>(i)]);
-    // Partial velocities dv/du = Jv T and domega/du = Jw T; omega = Jw s'; Jv s'' and Jw s'' for u' = 0.
-    Eigen::Matrix<double, 3, kCommandedCount> A = Eigen::Matrix<double, 3, kCommandedCount>::Zero();
-    Eigen::Matrix<double, 3, kCommandedCount> B = Eigen::Matrix<double, 3, kCommandedCount>::Zero();
-    Eigen::Vector3d omega = Eigen::Vector3d::Zero(), a_bias = d.body_Jv_dot_sdot.col(i),
-                    alpha_bias = d.body_Jw_dot_sdot.col(i);
-    for (int c = 0; c < columns.count; ++c) {
+    // The body's columns of Jv over Jw, and the matching rows of T, s' and s''_bias.
+    Eigen::Matrix<double, 6, K> J;
+    Eigen::Matrix<double, K, kU> T_k;
+    Eigen::Matrix<double, K, 2> rates_k;  // s', s''_bias
+    for (int c = 0; c < K; ++c) {
       const int j = columns.index[static_cast<std::size_t>(c)];
-      A.noalias() += Jv.col(j) * out.T.row(j);
-      B.noalias() += Jw.col(j) * out.T.row(j);
-      omega.noalias() += Jw.col(j) * out.sdot(j);
-      a_bias.noalias() += Jv.col(j) * bias(j);
-      alpha_bias.noalias() += Jw.col(j) * bias(j);
+      J.col(c) << Jv.col(j), Jw.col(j);
+      T_k.row(c) = out.T.row(j);
+      rates_k(c, 0) = out.sdot(j);
+      rates_k(c, 1) = bias(j);
     }
-    out.M.noalias() += m * A.transpose().lazyProduct(A) + B.transpose().lazyProduct(inertia.lazyProduct(B));
-    out.b.noalias() += A.transpose() * (m * a_bias) + B.transpose() * (inertia * alpha_bias + omega.cross(inertia * omega));
-    out.Q_gravity.noalias() += A.transpose() * (m * gravity);
+    // Partial velocities [dv/du; domega/du] = J T, and J [s', s''_bias] = [v, a_bias; omega, alpha_bias]
+    // without the convective terms.
+    const Eigen::Matrix<double, 6, kU> partial = J.lazyProduct(T_k);
+    const Eigen::Matrix<double, 6, 2> motion = J.lazyProduct(rates_k);
+    const double m = mass(p, i);
+    const auto& A = partial.template topRows<3>();
+    const Eigen::Vector3d a_bias = d.body_Jv_dot_sdot.col(i) + motion.template block<3, 1>(0, 1);
+    // The rotational part in body axes, where the inertia is diagonal: R^T B, R^T omega, R^T alpha.
+    const Eigen::Matrix3d& R = d.body_rotations[static_cast<std::size_t>(i)];
+    const auto& info = gen::kBodyMass[static_cast<std::size_t>(i)];
+    const Eigen::Vector3d inertia(p.*info.inertia[0], p.*info.inertia[1], p.*info.inertia[2]);
+    const Eigen::Matrix<double, 3, kU> B_body = R.transpose().lazyProduct(partial.template bottomRows<3>());
+    const Eigen::Vector3d omega_body = R.transpose() * motion.template block<3, 1>(3, 0);
+    const Eigen::Vector3d alpha_body =
+        R.transpose() * (d.body_Jw_dot_sdot.col(i) + motion.template block<3, 1>(3, 1));
+    const Eigen::Vector3d spin = inertia.cwiseProduct(omega_body);
+    out.M.noalias() += m * A.transpose().lazyProduct(A) + B_body.transpose().lazyProduct(inertia.asDiagonal() * B_body);
+    out.b.noalias() += A.transpose().lazyProduct(m * a_bias) +
+                       B_body.transpose().lazyProduct(inertia.cwiseProduct(alpha_body) + omega_body.cross(spin));
+    out.Q_gravity.noalias() += A.transpose().lazyProduct(m * gravity);
   });
   out.Qstar = out.M * u_dot + out.b - out.Q_gravity;
   for (int r = 0; r < kActuatedCount; ++r) out.J_beta.row(r) = out.T.row(kActuatedJoints[static_cast<std::size_t>(r)]);
@@ -162,7 +177,7 @@ TorqueVector distribute_torques(const ActuatorJacobian& J_beta, const CommandVec
   }
   // Minimum-norm solution of A x = Q* with A = J_beta^T S (commanded x actuated): from A^T P = Q R
   // (column-pivoted, rank-revealing QR), x = Q [R^-T P^T Q*; 0].
-  const ActuatorJacobian At = S.transpose() * J_beta;
+  const ActuatorJacobian At = S.transpose().lazyProduct(J_beta);
   Eigen::ColPivHouseholderQR<ActuatorJacobian> qr;
   qr.setThreshold(1e-13);  // relative to the largest pivot: only a real rank loss, not ID-3's 1e6 conditioning
   qr.compute(At);

@@ -166,11 +166,11 @@ void solve_dependent_rates(const Model& model, Data& d, const Coordinates& s, Co
                     "{:.3g}. The wheels' sideways constraint lines coincide (collinear wheel axes, thesis "
                     "4.1.4), e.g. wheels on the same level under a level cabin. {}",
                     pair.label(), d.cond_J_beta, options.max_condition, raise_a_wheel_hint()));
-  const WheelVector phi_hat = d.C_reduced * q_rate;
+  const WheelVector phi_hat = d.C_reduced.lazyProduct(q_rate);
   const WheelVector pair_rate = -d.J_beta.partialPivLu().solve(phi_hat);
   for (int k = 0; k < kWheelCount; ++k) q_rate(pair.index[k]) = pair_rate(k);
   sdot.head<kNq>() = q_rate;
-  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>() * q_rate;
+  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>().lazyProduct(q_rate);
   solve_closure(d, closure_rhs, sdot);
 }
 
@@ -181,11 +181,12 @@ void solve_dependent_accelerations(const Model& model, Data& d, const Coordinate
   for (int k : pair.index) q_acc(k) = 0;
   // Phi_dep s''_dep = -(Phi_q q'' + conv_Phi) and C s'' + conv_C = 0 give
   // C_hat q'' = -(conv_C - Lambda^T conv_Phi).
-  const WheelVector rhs = d.C_reduced * q_acc + d.C_dot_sdot - d.wheel_adjoint.transpose() * d.dPhi_ds_dot_sdot;
+  const WheelVector rhs =
+      d.C_reduced.lazyProduct(q_acc) + d.C_dot_sdot - d.wheel_adjoint.transpose().lazyProduct(d.dPhi_ds_dot_sdot);
   const WheelVector pair_acc = -d.J_beta.partialPivLu().solve(rhs);
   for (int k = 0; k < kWheelCount; ++k) q_acc(pair.index[k]) = pair_acc(k);
   sddot.head<kNq>() = q_acc;
-  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>() * q_acc + d.dPhi_ds_dot_sdot;
+  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>().lazyProduct(q_acc) + d.dPhi_ds_dot_sdot;
   solve_closure(d, closure_rhs, sddot);
 }
 
@@ -212,7 +213,7 @@ Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> rate_basis(const Da
   for (std::size_t r = 0; r < rows.size(); ++r) {
     bool seen = false;
     for (std::size_t q = 0; q < r; ++q) seen = seen || rows[q] == rows[r];
-    if (!seen) rhs.noalias() += d.dPhi_ds.col(rows[r]) * T.row(rows[r]);
+    if (!seen) rhs.noalias() += d.dPhi_ds.col(rows[r]).lazyProduct(T.row(rows[r]));
   }
   for_each_limb([&](auto L) {
     constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(decltype(L)::value)];
