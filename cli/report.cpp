@@ -210,6 +210,7 @@ report::Document Report::document(const ReportFigures& figures) {
   report::Document d;
   d.title = spec_.title.empty() ? std::string(gen::kModelName) + ": " + std::string(gen::kModelDescription) : spec_.title;
   d.claims_source = spec_.claims.empty() ? "" : spec_.file;
+  d.sources = spec_.sources;
   d.about = {{"wlx version", options_.version},
              {"model", fmt::format("{} ({})", gen::kModelName, gen::kModelDescription)},
              {"parameters", model_options_.params_file.empty() ? "the model file's defaults" : "overridden by " + model_options_.params_file},

@@ -124,6 +124,11 @@ std::string render_html(const Document& d) {
                      d.skipped_claims ? fmt::format(" {} claims concern runs this report did not make (--quick) and are left out.",
                                                     d.skipped_claims)
                                       : "");
+    if (!d.sources.empty()) {
+      h += "<p>Sources:";
+      for (const auto& [name, what] : d.sources) h += fmt::format(" <b>{}</b>: {}.", escape(name), escape(what));
+      h += "</p>\n";
+    }
     h += claims_table(d.checks, true);
   }
   h += "<h2 id=\"inputs\">Inputs and set-up (not checks)</h2>\n<p>Values the sources report that follow from the "

@@ -6,6 +6,7 @@
 
 #include "report/gnuplot.hpp"
 
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,7 @@ struct Document {
   std::vector<std::pair<std::string, std::string>> about;  // version, model, date, command line, ...
   Table parameters;
   std::vector<ClaimRow> checks, inputs, observations;
+  std::map<std::string, std::string> sources;  // "thesis", "spec": what a row's source names
   std::string claims_source;  // where the claims come from (a file), or empty: the model has none
   int skipped_claims = 0;     // claims about runs this report did not make (--quick)
   std::vector<Section> sections;

@@ -238,7 +238,7 @@ class Parser {
     ReportSpec s;
     s.file = file_;
     if (!root || root.IsNull()) return s;
-    keys(root, "(top level)", {"title", "quick", "integrator_comparison", "sections", "reference_lines", "run_figures", "torque_figures",
+    keys(root, "(top level)", {"title", "sources", "quick", "integrator_comparison", "sections", "reference_lines", "run_figures", "torque_figures",
                                "pose", "claims"});
     s.title = optional_text(root, "title", "");
     if (const YAML::Node q = root["quick"]) {
@@ -256,6 +256,10 @@ class Parser {
         if (s.reference_step <= 0 || s.reference_step > 1e-2)
           fail(ic["reference_step"], "integrator_comparison.reference_step", "must be in (0, 0.01] s");
       }
+    }
+    if (const YAML::Node src = root["sources"]) {
+      keys(src, "sources", {"thesis", "spec"});
+      for (const auto& kv : src) s.sources[kv.first.as<std::string>()] = text(kv.second, "sources." + kv.first.as<std::string>());
     }
     if (const YAML::Node sec = root["sections"]) {
       keys(sec, "sections", {"ik", "nonholonomic", "kinematic", "dynamics"});

@@ -81,6 +81,7 @@ struct ReportSpec {
   // Keyed by the figure they go into: ik_check_error (IK sweeps), wheel_residual (wheel constraint runs).
   std::map<std::string, ReferenceLine> reference_lines;
   std::map<std::string, std::string> section_titles;  // ik, nonholonomic, kinematic, dynamics
+  std::map<std::string, std::string> sources;  // thesis, spec: what the sources are, for the reader
   std::vector<RunFigure> run_figures;
   std::vector<std::vector<std::string>> torque_panels;
   std::vector<TorqueReference> torque_references;

@@ -48,6 +48,7 @@ std::string variant(const std::string& from, const std::string& to) {
 
 TEST_CASE("report file: a valid file gives its claims, tests and layout") {
   const std::string text = std::string(R"(title: a machine
+sources: {thesis: the thesis, spec: the specification}
 quick: {sweeps: [S1], scenarios: [R1]}
 integrator_comparison: {scenarios: [R1], reference_step: 1.0e-4, coordinates: [a], note: text}
 reference_lines: {ik_check_error: {value: 1.0e-5, label: "thesis"}}
@@ -69,6 +70,7 @@ pose: {body_frame: C, outline: [p1, p2]}
 )";
   const auto spec = parse_report_spec(text, "claims.yaml");
   CHECK(spec.title == "a machine");
+  CHECK(spec.sources.at("spec") == "the specification");
   REQUIRE(spec.quick_sweeps.has_value());
   CHECK(spec.quick_sweeps->at(0) == "S1");
   CHECK(spec.integrator_coordinates.at(0) == "a");
@@ -79,7 +81,7 @@ pose: {body_frame: C, outline: [p1, p2]}
   CHECK(spec.pose_outline.at(1) == "p2");
   REQUIRE(spec.claims.size() == 2);
   CHECK(spec.claims[0].kind == ClaimKind::check);
-  CHECK(spec.claims[0].line == 12);  // after the 10 lines of layout and "claims:"
+  CHECK(spec.claims[0].line == 13);  // after the 11 lines of layout and "claims:"
   CHECK(spec.claims[0].source == "thesis Table 6-1");
   REQUIRE(spec.claims[0].tests.at(0).criterion.has_value());
   CHECK(spec.claims[0].tests[0].criterion->kind == Criterion::Kind::near);
@@ -100,6 +102,7 @@ TEST_CASE("report file: each error names the file, the line, the key and the rea
   CHECK(error_of("claims:\n  - id: [unclosed\n").find("claims.yaml:") == 0);
   // Unknown keys, with the nearest valid one.
   CHECK(error_of("titel: x\n") == "claims.yaml:1: (top level): unknown key 'titel' (did you mean 'title'?)");
+  CHECK(error_of("sources: {theses: x}\n") == "claims.yaml:1: sources: unknown key 'theses' (did you mean 'thesis'?)");
   CHECK(error_of(variant("    why:", "    wyh:")).find("claims.yaml:9: claims[0]: unknown key 'wyh' (did you mean 'why'?)") == 0);
   // Missing keys.
   CHECK(error_of(variant("    why: quoted to 0.01 kg\n", "")) == "claims.yaml:2: claims[0]: missing key 'why'");
