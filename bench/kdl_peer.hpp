@@ -39,6 +39,13 @@
 #include <string>
 #include <vector>
 
+// Debian's KDL is built for plain x86-64 (Eigen aligned to 16 bytes); with AVX (-march=native)
+// Eigen would align to 32 here and KDL's library would free our matrices with the other allocator
+// (a crash in the first Jacobian). CMakeLists.txt then defines EIGEN_MAX_ALIGN_BYTES=16.
+#if EIGEN_MAX_ALIGN_BYTES > 16
+#error "KDL needs Eigen's 16-byte alignment here: compile with -DEIGEN_MAX_ALIGN_BYTES=16"
+#endif
+
 WLX_MODEL_NAMESPACE_BEGIN
 namespace kdl_peer {
 
