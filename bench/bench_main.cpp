@@ -427,6 +427,22 @@ void BM_kdl_body_jacobians(benchmark::State& st) {
       benchmark::DoNotOptimize(J[static_cast<std::size_t>(b)].data.data());
     }
 }
+// KDL: the end frames' full Jacobians (6 x joints each), from which the closure's rows of those
+// frames are taken; wlx's generated dPhi/ds holds only those rows (BM_gen_closure).
+void BM_kdl_end_frame_jacobians(benchmark::State& st) {
+  const Model model;
+  const kdl_peer::PeerTree peer = kdl_peer::build_tree(model.params());
+  KDL::TreeJntToJacSolver solver(peer.tree);
+  const KDL::JntArray q = peer.joints(assembled_nominal(model));
+  std::vector<KDL::Jacobian> J(peer.end_frames.size(), KDL::Jacobian(peer.tree.getNrOfJoints()));
+  std::vector<std::string> names;
+  for (int f : peer.end_frames) names.push_back(kdl_peer::frame_name(f));
+  for (auto _ : st)
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      solver.JntToJac(q, J[k], names[k]);
+      benchmark::DoNotOptimize(J[k].data.data());
+    }
+}
 void BM_kdl_tree_rne(benchmark::State& st) {
   const Model model;
   const kdl_peer::PeerTree peer = kdl_peer::build_tree(model.params());
@@ -485,8 +501,9 @@ void BM_ik_newton_leg(benchmark::State& st) {
 // KDL's iterative solvers on the chain K0 -> the leg's end frame with the cabin pose and the leg's
 // own inputs frozen (the leg's dependent joints free), aimed at the end frame of wlx's closed-form
 // solution: LMA on its position (weights 1, 1, 1, 0, 0, 0), NR on the whole pose (reachable, so
-// its least squares meets it). Tolerance 1e-10 instead of KDL's defaults (1e-5, 1e-6), which
-// would stop far short of wlx's (closed form: rounding; Newton: 1e-13 on the residual).
+// its least squares meets it). Tolerance 1e-12 instead of KDL's defaults (1e-5, 1e-6, which stop
+// 1e-6 m short), near wlx's (closed form: rounding; Newton: 1e-13 on the residual): KDL's
+// solutions then agree with the closed form to about 1e-15 (LMA) and 1e-13 (NR).
 enum class KdlIk { lma, nr };
 template <KdlIk method, bool warm>
 void BM_kdl_ik_leg(benchmark::State& st) {
@@ -510,7 +527,7 @@ void BM_kdl_ik_leg(benchmark::State& st) {
   const KDL::JntArray q_solution = on_chain(solution), q_start = on_chain(leg_start(model, warm));
   KDL::Frame goal;
   fk.JntToCart(q_solution, goal);
-  constexpr double kTolerance = 1e-10;
+  constexpr double kTolerance = 1e-12;
   Eigen::Matrix<double, 6, 1> position_only;
   position_only << 1, 1, 1, 0, 0, 0;
   KDL::ChainIkSolverPos_LMA lma(chain, position_only, kTolerance);
@@ -518,15 +535,18 @@ void BM_kdl_ik_leg(benchmark::State& st) {
   KDL::ChainIkSolverPos_NR nr(chain, fk, velocity, 100, kTolerance);
   KDL::JntArray q(chain.getNrOfJoints());
   const auto solve = [&] { return method == KdlIk::lma ? lma.CartToJnt(q_start, goal, q) : nr.CartToJnt(q_start, goal, q); };
-  solve();
-  if ((q.data - q_solution.data).cwiseAbs().maxCoeff() > 1e-8) {
+  if (solve() < 0 || (q.data - q_solution.data).cwiseAbs().maxCoeff() > 1e-10) {
     st.SkipWithError("KDL's IK did not reach wlx's closed-form solution");
     return;
   }
+  long iterations = 0;
   for (auto _ : st) {
     solve();
+    iterations += lma.lastNrOfIter;  // NR does not report its count
     benchmark::DoNotOptimize(q.data.data());
   }
+  if (method == KdlIk::lma)
+    st.counters["iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
 }
 #endif
 }  // namespace
@@ -561,6 +581,7 @@ BENCHMARK(BM_gen_body_jacobians);
 BENCHMARK(BM_gen_open_tree_inverse_dynamics);
 BENCHMARK(BM_kdl_fk_chains);
 BENCHMARK(BM_kdl_body_jacobians);
+BENCHMARK(BM_kdl_end_frame_jacobians);
 BENCHMARK(BM_kdl_tree_rne);
 BENCHMARK(BM_ik_closed_form_leg);
 BENCHMARK(BM_ik_newton_leg<false>)->Name("BM_ik_newton_leg_cold");
@@ -630,6 +651,7 @@ int main(int argc, char** argv) {
       // Orocos KDL, the peer (built with KDL only): first, as the README's table shows them.
       {"KDL peer: FK of all frames (KDL: chain FK to each end frame)", "BM_gen_kinematics_all", "BM_kdl_fk_chains", ops::kinematics, true},
       {"KDL peer: bodies' CoM Jacobians Jv, Jw (KDL: tree Jacobians)", "BM_gen_body_jacobians", "BM_kdl_body_jacobians", 0, true},
+      {"KDL peer: end frames' Jacobians (wlx: their dPhi/ds rows)", "BM_gen_closure", "BM_kdl_end_frame_jacobians", ops::closure, true},
       {"KDL peer: open-tree inverse dynamics (KDL: tree RNE)", "BM_gen_open_tree_inverse_dynamics", "BM_kdl_tree_rne", 0, true},
       {"KDL peer: leg IK closed form vs KDL LMA, cold", "BM_ik_closed_form_leg", "BM_kdl_ik_lma_cold", 0, true},
       {"KDL peer: leg IK closed form vs KDL LMA, warm", "BM_ik_closed_form_leg", "BM_kdl_ik_lma_warm", 0, true},

@@ -1,7 +1,7 @@
 // An independent library as a check: Orocos KDL, on the open tree built from the generated tables
 // (bench/kdl_peer.hpp), computes the frames, the end frames' and bodies' Jacobians and the
 // open-tree inverse dynamics (recursive Newton-Euler) that the generated functions compute
-// symbolically. Compiled once per built-in model.
+// symbolically, and its FK confirms the closed-form IK's solutions. Compiled once per built-in model.
 //
 // Tolerance: 1e-12 relative to the largest entry of the compared quantity (positions, a Jacobian,
 // a torque vector). Both sides are exact formulas evaluated in double precision over at most a
@@ -13,11 +13,13 @@
 
 #include <doctest/doctest.h>
 #include <kdl/jacobian.hpp>
+#include <wlx/ik.hpp>
 #include <kdl/treefksolverpos_recursive.hpp>
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
 #include <kdl/treejnttojacsolver.hpp>
 
 #include <algorithm>
+#include <cmath>
 
 using namespace wlx;
 using namespace wlx::kdl_peer;
@@ -176,4 +178,40 @@ TEST_CASE("KDL: the comparison sees a wrong geometry and wrong masses") {
   CHECK(worst.positions > 1e-3);
   CHECK(worst.body_jacobians > 1e-3);
   CHECK(worst.torques > 1e-3);
+}
+
+TEST_CASE("KDL: the closed-form IK puts every limb where its closure rows ask, by KDL's forward kinematics") {
+  // Along the model's IK sweeps (reachable by design): each solution's end frames, computed by KDL
+  // from the solved joints, meet the limb's point and level rows. (Sum rows involve no kinematics.)
+  // Tolerance 1e-12 m or rad: the closed form is exact up to rounding, and KDL's FK adds ~1e-15.
+  const Model model;
+  const PeerTree peer = build_tree(model.params());
+  KDL::TreeFkSolverPos_recursive fk(peer.tree);
+  double worst = 0;
+  int solved = 0;
+  for (const gen::SweepInfo& sweep : gen::kIkSweeps) {
+    const int steps = static_cast<int>(std::lround(std::abs(sweep.to - sweep.from) / sweep.step));
+    const double direction = sweep.to >= sweep.from ? 1.0 : -1.0;
+    for (int k = 0; k <= steps; ++k) {
+      gen::Coordinates s = gen::Coordinates::Zero();
+      for (int i = 0; i < gen::kInputCount; ++i) s(i) = gen::kSweepStart[static_cast<std::size_t>(i)];
+      s(sweep.input) = sweep.from + direction * k * sweep.step;
+      solve_limb_closed_form(model, sweep.limb, 0, s);  // throws (fails the test) if out of reach
+      ++solved;
+      const KDL::JntArray q = peer.joints(s);
+      const LimbBlock block = limb_block(sweep.limb);
+      for (int r = 0; r < block.size; ++r) {
+        const gen::ClosureRowInfo& row = gen::kClosureRows[static_cast<std::size_t>(block.rows[static_cast<std::size_t>(r)])];
+        if (row.kind == gen::RowKind::sum) continue;
+        KDL::Frame F;
+        REQUIRE(fk.JntToCart(q, F, frame_name(row.frame)) >= 0);
+        const double residual = row.kind == gen::RowKind::point ? F.p(row.axis) - s(row.target) : F.M(2, row.axis);
+        worst = std::max(worst, std::abs(residual));
+      }
+    }
+  }
+  MESSAGE(gen::kModelName << ": " << solved << " closed-form solutions along the IK sweeps, worst closure residual by KDL's FK "
+                          << worst);
+  CHECK(solved >= 1000);
+  CHECK(worst <= 1e-12);
 }
