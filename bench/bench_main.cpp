@@ -11,6 +11,19 @@
 #include <wlx/simulation.hpp>
 
 #include <numbers>
+#include <stdexcept>
+
+#ifdef WLX_HAVE_KDL
+#include "kdl_peer.hpp"
+
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainiksolverpos_lma.hpp>
+#include <kdl/chainiksolverpos_nr.hpp>
+#include <kdl/chainiksolvervel_pinv.hpp>
+#include <kdl/jacobian.hpp>
+#include <kdl/treeidsolver_recursive_newton_euler.hpp>
+#include <kdl/treejnttojacsolver.hpp>
+#endif
 
 #include <cstring>
 #include <map>
@@ -341,6 +354,201 @@ void BM_base_newton_cold(benchmark::State& st) {
   }
 }
 
+
+#ifdef WLX_HAVE_KDL
+// ---- Orocos KDL as a peer: the model's open tree built from the generated tables ----
+// (bench/kdl_peer.hpp; tests/bench/test_kdl_peer.cpp checks that it computes the same values).
+// Both sides get their inputs prepared outside the loop, as a controller holding them would.
+
+// wlx: the bodies' CoM Jacobians Jv, Jw only (what KDL's tree Jacobian solver gives).
+void BM_gen_body_jacobians(benchmark::State& st) {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled_nominal(model), no_rates = Coordinates::Zero();  // Jv, Jw do not read s'
+  for (auto _ : st) {
+    gen::bodies(s, no_rates, model.params(), {.Jv = &d.body_Jv, .Jw = &d.body_Jw}, false);
+    benchmark::DoNotOptimize(d.body_Jv.data());
+    benchmark::DoNotOptimize(d.body_Jw.data());
+  }
+}
+// wlx: the open tree's inverse dynamics, Kane's sums over the generated body kinematics.
+void BM_gen_open_tree_inverse_dynamics(benchmark::State& st) {
+  const Model model;
+  kdl_peer::OpenTreeWorkspace w;
+  const Coordinates s = assembled_nominal(model), sdot = Coordinates::Constant(0.1), sddot = Coordinates::Constant(0.2);
+  Coordinates Q;
+  for (auto _ : st) {
+    kdl_peer::open_tree_inverse_dynamics(model.params(), s, sdot, sddot, w, Q);
+    benchmark::DoNotOptimize(Q.data());
+  }
+}
+// KDL: every frame, by one recursive FK pass over each chain from K0 to an end frame.
+void BM_kdl_fk_chains(benchmark::State& st) {
+  const Model model;
+  const kdl_peer::PeerTree peer = kdl_peer::build_tree(model.params());
+  const Coordinates s = assembled_nominal(model);
+  struct Pass {
+    KDL::Chain chain;
+    KDL::JntArray q;
+    std::vector<KDL::Frame> frames;
+  };
+  std::vector<Pass> passes;
+  for (int f : peer.end_frames) {
+    Pass pass;
+    peer.tree.getChain(kdl_peer::kRootName, kdl_peer::frame_name(f), pass.chain);
+    pass.q.resize(pass.chain.getNrOfJoints());
+    unsigned i = 0;
+    for (const KDL::Segment& seg : pass.chain.segments)
+      if (seg.getJoint().getType() != KDL::Joint::Fixed)
+        pass.q(i++) = s(static_cast<int>(std::find(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end(), seg.getJoint().getName()) -
+                                         gen::kCoordinateNames.begin()));
+    pass.frames.resize(pass.chain.getNrOfSegments());
+    passes.push_back(std::move(pass));
+  }
+  std::vector<KDL::ChainFkSolverPos_recursive> solvers;
+  for (const Pass& pass : passes) solvers.emplace_back(pass.chain);
+  for (auto _ : st)
+    for (std::size_t k = 0; k < passes.size(); ++k) {
+      solvers[k].JntToCart(passes[k].q, passes[k].frames);
+      benchmark::DoNotOptimize(passes[k].frames.data());
+    }
+}
+void BM_kdl_body_jacobians(benchmark::State& st) {
+  const Model model;
+  const kdl_peer::PeerTree peer = kdl_peer::build_tree(model.params());
+  KDL::TreeJntToJacSolver solver(peer.tree);
+  const KDL::JntArray q = peer.joints(assembled_nominal(model));
+  std::vector<KDL::Jacobian> J(gen::kBodyCount, KDL::Jacobian(peer.tree.getNrOfJoints()));
+  std::vector<std::string> names;
+  for (int b = 0; b < gen::kBodyCount; ++b) names.push_back(kdl_peer::body_com_name(b));
+  for (auto _ : st)
+    for (int b = 0; b < gen::kBodyCount; ++b) {
+      solver.JntToJac(q, J[static_cast<std::size_t>(b)], names[static_cast<std::size_t>(b)]);
+      benchmark::DoNotOptimize(J[static_cast<std::size_t>(b)].data.data());
+    }
+}
+// KDL: the end frames' full Jacobians (6 x joints each), from which the closure's rows of those
+// frames are taken; wlx's generated dPhi/ds holds only those rows (BM_gen_closure).
+void BM_kdl_end_frame_jacobians(benchmark::State& st) {
+  const Model model;
+  const kdl_peer::PeerTree peer = kdl_peer::build_tree(model.params());
+  KDL::TreeJntToJacSolver solver(peer.tree);
+  const KDL::JntArray q = peer.joints(assembled_nominal(model));
+  std::vector<KDL::Jacobian> J(peer.end_frames.size(), KDL::Jacobian(peer.tree.getNrOfJoints()));
+  std::vector<std::string> names;
+  for (int f : peer.end_frames) names.push_back(kdl_peer::frame_name(f));
+  for (auto _ : st)
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      solver.JntToJac(q, J[k], names[k]);
+      benchmark::DoNotOptimize(J[k].data.data());
+    }
+}
+void BM_kdl_tree_rne(benchmark::State& st) {
+  const Model model;
+  const kdl_peer::PeerTree peer = kdl_peer::build_tree(model.params());
+  KDL::TreeIdSolver_RNE solver(peer.tree, peer.gravity);
+  const KDL::JntArray q = peer.joints(assembled_nominal(model)), qdot = peer.joints(Coordinates::Constant(0.1)),
+                      qddot = peer.joints(Coordinates::Constant(0.2));
+  KDL::JntArray tau(peer.tree.getNrOfJoints());
+  const KDL::WrenchMap no_external_forces;
+  for (auto _ : st) {
+    solver.CartToJnt(q, qdot, qddot, no_external_forces, tau);
+    benchmark::DoNotOptimize(tau.data.data());
+  }
+}
+
+// One leg's IK (the model's first limb): from the target inputs of moved_target(), cold (the
+// nominal pose's joints) or warm (the solution 1 mm / 1 mrad of inputs away), as in the 4-limb rows.
+constexpr Limb kLeg = 0;
+Coordinates leg_start(const Model& model, bool warm) {
+  Coordinates start;
+  if (warm) {
+    start = moved_target();
+    start(gen::coord::x_Fl) -= 1e-3;
+    start(gen::coord::z_Fl) -= 1e-3;
+    solve_ik_closed_form(model, start);
+  } else {
+    start = assembled_nominal(model);
+  }
+  start.head(kInputCount) = moved_target().head(kInputCount);
+  return start;
+}
+std::vector<int> leg_joints() {
+  const LimbBlock block = limb_block(kLeg);
+  return {block.joints.begin(), block.joints.begin() + block.size};
+}
+void BM_ik_closed_form_leg(benchmark::State& st) {
+  const Model model;
+  Coordinates s = moved_target();
+  for (auto _ : st) {
+    solve_limb_closed_form(model, kLeg, 0, s);
+    benchmark::DoNotOptimize(s.data());
+  }
+}
+template <bool warm>
+void BM_ik_newton_leg(benchmark::State& st) {
+  const Model model;
+  Data d;
+  const Coordinates start = leg_start(model, warm);
+  long iterations = 0;
+  for (auto _ : st) {
+    Coordinates s = start;
+    iterations += solve_limb_newton(model, d, kLeg, s).iterations[kLeg];
+    benchmark::DoNotOptimize(s.data());
+  }
+  st.counters["iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+}
+// KDL's iterative solvers on the chain K0 -> the leg's end frame with the cabin pose and the leg's
+// own inputs frozen (the leg's dependent joints free), aimed at the end frame of wlx's closed-form
+// solution: LMA on its position (weights 1, 1, 1, 0, 0, 0), NR on the whole pose (reachable, so
+// its least squares meets it). Tolerance 1e-12 instead of KDL's defaults (1e-5, 1e-6, which stop
+// 1e-6 m short), near wlx's (closed form: rounding; Newton: 1e-13 on the residual): KDL's
+// solutions then agree with the closed form to about 1e-15 (LMA) and 1e-13 (NR).
+enum class KdlIk { lma, nr };
+template <KdlIk method, bool warm>
+void BM_kdl_ik_leg(benchmark::State& st) {
+  const Model model;
+  const kdl_peer::PeerTree peer = kdl_peer::build_tree(model.params());
+  Coordinates solution = moved_target();
+  solve_ik_closed_form(model, solution);
+  const std::vector<int> joints = leg_joints();
+  const int end = gen::kClosureRows[static_cast<std::size_t>(limb_block(kLeg).rows[0])].frame;
+  const KDL::Chain chain = kdl_peer::frozen_chain(peer, end, joints, solution);
+  KDL::ChainFkSolverPos_recursive fk(chain);
+  const auto on_chain = [&](const Coordinates& s) {
+    KDL::JntArray q(chain.getNrOfJoints());
+    unsigned i = 0;
+    for (const KDL::Segment& seg : chain.segments)
+      if (seg.getJoint().getType() != KDL::Joint::Fixed)
+        q(i++) = s(static_cast<int>(std::find(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end(), seg.getJoint().getName()) -
+                                    gen::kCoordinateNames.begin()));
+    return q;
+  };
+  const KDL::JntArray q_solution = on_chain(solution), q_start = on_chain(leg_start(model, warm));
+  KDL::Frame goal;
+  fk.JntToCart(q_solution, goal);
+  constexpr double kTolerance = 1e-12;
+  Eigen::Matrix<double, 6, 1> position_only;
+  position_only << 1, 1, 1, 0, 0, 0;
+  KDL::ChainIkSolverPos_LMA lma(chain, position_only, kTolerance);
+  KDL::ChainIkSolverVel_pinv velocity(chain);
+  KDL::ChainIkSolverPos_NR nr(chain, fk, velocity, 100, kTolerance);
+  KDL::JntArray q(chain.getNrOfJoints());
+  const auto solve = [&] { return method == KdlIk::lma ? lma.CartToJnt(q_start, goal, q) : nr.CartToJnt(q_start, goal, q); };
+  if (solve() < 0 || (q.data - q_solution.data).cwiseAbs().maxCoeff() > 1e-10) {
+    st.SkipWithError("KDL's IK did not reach wlx's closed-form solution");
+    return;
+  }
+  long iterations = 0;
+  for (auto _ : st) {
+    solve();
+    iterations += lma.lastNrOfIter;  // NR does not report its count
+    benchmark::DoNotOptimize(q.data.data());
+  }
+  if (method == KdlIk::lma)
+    st.counters["iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+}
+#endif
 }  // namespace
 
 BENCHMARK(BM_base_frames);
@@ -368,6 +576,21 @@ BENCHMARK(BM_full_kinematic_update);
 BENCHMARK(BM_ik_closed_form_4_limbs);
 BENCHMARK(BM_ik_newton_cold_4_limbs);
 BENCHMARK(BM_ik_newton_warm_4_limbs);
+#ifdef WLX_HAVE_KDL
+BENCHMARK(BM_gen_body_jacobians);
+BENCHMARK(BM_gen_open_tree_inverse_dynamics);
+BENCHMARK(BM_kdl_fk_chains);
+BENCHMARK(BM_kdl_body_jacobians);
+BENCHMARK(BM_kdl_end_frame_jacobians);
+BENCHMARK(BM_kdl_tree_rne);
+BENCHMARK(BM_ik_closed_form_leg);
+BENCHMARK(BM_ik_newton_leg<false>)->Name("BM_ik_newton_leg_cold");
+BENCHMARK(BM_ik_newton_leg<true>)->Name("BM_ik_newton_leg_warm");
+BENCHMARK(BM_kdl_ik_leg<KdlIk::lma, false>)->Name("BM_kdl_ik_lma_cold");
+BENCHMARK(BM_kdl_ik_leg<KdlIk::lma, true>)->Name("BM_kdl_ik_lma_warm");
+BENCHMARK(BM_kdl_ik_leg<KdlIk::nr, false>)->Name("BM_kdl_ik_nr_cold");
+BENCHMARK(BM_kdl_ik_leg<KdlIk::nr, true>)->Name("BM_kdl_ik_nr_warm");
+#endif
 namespace {
 
 // Collects the median of the repetitions of every benchmark, in nanoseconds.
@@ -396,6 +619,7 @@ struct Row {
   const char* generated;  // benchmark name
   const char* baseline;   // benchmark name, or nullptr
   long ops;               // operations of the generated function, or 0
+  bool peer = false;      // the baseline is Orocos KDL (a peer library), not our numeric baseline
 };
 
 }  // namespace
@@ -424,6 +648,17 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks(&collector);
   namespace ops = wlx::gen::operations;
   const Row rows[] = {
+      // Orocos KDL, the peer (built with KDL only): first, as the README's table shows them.
+      {"KDL peer: FK of all frames (KDL: chain FK to each end frame)", "BM_gen_kinematics_all", "BM_kdl_fk_chains", ops::kinematics, true},
+      {"KDL peer: bodies' CoM Jacobians Jv, Jw (KDL: tree Jacobians)", "BM_gen_body_jacobians", "BM_kdl_body_jacobians", 0, true},
+      {"KDL peer: end frames' Jacobians (wlx: their dPhi/ds rows)", "BM_gen_closure", "BM_kdl_end_frame_jacobians", ops::closure, true},
+      {"KDL peer: open-tree inverse dynamics (KDL: tree RNE)", "BM_gen_open_tree_inverse_dynamics", "BM_kdl_tree_rne", 0, true},
+      {"KDL peer: leg IK closed form vs KDL LMA, cold", "BM_ik_closed_form_leg", "BM_kdl_ik_lma_cold", 0, true},
+      {"KDL peer: leg IK closed form vs KDL LMA, warm", "BM_ik_closed_form_leg", "BM_kdl_ik_lma_warm", 0, true},
+      {"KDL peer: leg IK closed form vs KDL NR, cold", "BM_ik_closed_form_leg", "BM_kdl_ik_nr_cold", 0, true},
+      {"KDL peer: leg IK closed form vs KDL NR, warm", "BM_ik_closed_form_leg", "BM_kdl_ik_nr_warm", 0, true},
+      {"KDL peer: leg IK Newton vs KDL NR, cold", "BM_ik_newton_leg_cold", "BM_kdl_ik_nr_cold", 0, true},
+      {"KDL peer: leg IK Newton vs KDL NR, warm", "BM_ik_newton_leg_warm", "BM_kdl_ik_nr_warm", 0, true},
       {"FK of 13 frames (positions + rotations)", "BM_gen_kinematics_all", "BM_base_frames", ops::kinematics},
       {"FK positions only", "BM_gen_kinematics_positions", nullptr, 0},
       {"Phi + dPhi/ds (14 x 32)", "BM_gen_closure", "BM_base_closure_jacobian", ops::closure},
@@ -453,9 +688,10 @@ int main(int argc, char** argv) {
     bool first = true;
     for (const Row& r : rows) {
       const double g = get(r.generated), b = r.baseline ? get(r.baseline) : -1;
-      if (g < 0) continue;
+      if (g < 0 || (r.peer && b < 0)) continue;
       out += fmt::format("{}  {{\"operation\": \"{}\", \"ns\": {:.1f}", first ? "" : ",\n", r.what, g);
       if (b > 0) out += fmt::format(", \"baseline\": \"{}\", \"baseline_ns\": {:.1f}, \"speedup\": {:.2f}", r.baseline, b, b / g);
+      if (r.peer) out += ", \"peer\": \"Orocos KDL\"";
       if (r.ops > 0) out += fmt::format(", \"ops\": {}, \"ns_per_op\": {:.3f}", r.ops, g / static_cast<double>(r.ops));
       out += "}";
       first = false;
@@ -463,16 +699,17 @@ int main(int argc, char** argv) {
     fmt::print("{}\n]\n", out);
     return 0;
   }
-  fmt::print("\n{:<44} {:>11} {:>34} {:>9} {:>7} {:>7}\n", "operation", "ns/call", "baseline (ns/call)", "speedup", "ops",
+  fmt::print("\n{:<62} {:>11} {:>34} {:>9} {:>7} {:>7}\n", "operation", "ns/call", "baseline (ns/call)", "speedup", "ops",
              "ns/op");
   for (const Row& r : rows) {
     const double g = get(r.generated);
-    if (g < 0) continue;
     const double b = r.baseline ? get(r.baseline) : -1;
+    if (g < 0 || (r.peer && b < 0)) continue;
     const std::string base = b > 0 ? fmt::format("{} {:.0f}", std::string(r.baseline).substr(3), b) : "";
-    fmt::print("{:<44} {:>11.1f} {:>34} {:>9} {:>7} {:>7}\n", r.what, g, base, b > 0 ? fmt::format("{:.1f}x", b / g) : "",
+    fmt::print("{:<62} {:>11.1f} {:>34} {:>9} {:>7} {:>7}\n", r.what, g, base, b > 0 ? fmt::format("{:.1f}x", b / g) : "",
                r.ops > 0 ? std::to_string(r.ops) : "", r.ops > 0 ? fmt::format("{:.3f}", g / static_cast<double>(r.ops)) : "");
   }
-  fmt::print("\nmedians of 5 repetitions, one run; speedup = baseline / generated measured side by side\n");
+  fmt::print("\nmedians of 5 repetitions, one run; speedup = baseline (Orocos KDL in the \"KDL peer\" rows, else the numeric\n"
+             "baseline) / wlx, measured side by side\n");
   return 0;
 }
