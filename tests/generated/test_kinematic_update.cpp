@@ -46,7 +46,8 @@ namespace {
 
 // With zero_fill = false a function must write exactly its nonzero pattern: every entry it leaves
 // untouched (still the NaN sentinel) is zero in the zero-filled result, and every entry it
-// writes equals that result bit for bit.
+// writes equals that result: bit for bit in a plain build; within a few ulp where the compiler may
+// contract a * b + c into one FMA differently in the two inlined copies (-march=native builds).
 template <class Matrix>
 void check_pattern(const Matrix& filled, const Matrix& sparse, long& untouched) {
   for (Eigen::Index i = 0; i < filled.size(); ++i) {
@@ -54,7 +55,8 @@ void check_pattern(const Matrix& filled, const Matrix& sparse, long& untouched) 
       CHECK(filled.data()[i] == 0.0);
       ++untouched;
     } else {
-      CHECK(sparse.data()[i] == filled.data()[i]);
+      CHECK(std::abs(sparse.data()[i] - filled.data()[i]) <=
+            4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(filled.data()[i])));
     }
   }
 }
