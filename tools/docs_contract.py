@@ -509,24 +509,27 @@ def benchmark_rows(build):
     return json.loads(r.stdout)
 
 
-def number(x, digits=0):
-    return f"{x:,.{digits}f}" if x >= 100 or digits == 0 else f"{x:.{digits}f}"
+def duration(ns):
+    """A median in ns as the table shows it: 1 decimal below 10 ns, whole ns up to 1 ms, then ms."""
+    if ns >= 1e6:
+        return f"{ns / 1e6:.2f} ms"
+    return f"{ns:.1f}" if ns < 10 else f"{ns:,.0f}"
 
 
 def benchmark_table(rows):
     """Whatever rows wlx_bench --json reports, in its order, under a heading per "group" when the
     rows carry one (peers such as KDL can then be added to wlx_bench without touching this)."""
-    lines = ["| operation | ns/call | compared with | its ns/call | speedup | ops | ns/op |",
+    lines = ["| operation | ns/call | compared with (`base_`: the numeric baseline) | its ns/call | speedup | ops | ns/op |",
              "|---|---:|---|---:|---:|---:|---:|"]
     group = None
     for row in rows:
         if row.get("group") and row["group"] != group:
             group = row["group"]
             lines.append(f"| **{group}** | | | | | | |")
-        compared = f"`{row['baseline']}`" if row.get("baseline") else ""
+        compared = f"`{row['baseline'].removeprefix('BM_')}`" if row.get("baseline") else ""
         lines.append("| {} | {} | {} | {} | {} | {} | {} |".format(
-            row["operation"].strip(), number(row["ns"], 0 if row["ns"] >= 10 else 1), compared,
-            number(row["baseline_ns"]) if "baseline_ns" in row else "",
+            row["operation"].strip(), duration(row["ns"]), compared,
+            duration(row["baseline_ns"]) if "baseline_ns" in row else "",
             f"{row['speedup']:.1f}x" if "speedup" in row else "", row.get("ops", ""),
             f"{row['ns_per_op']:.2f}" if "ns_per_op" in row else ""))
     return "\n".join(lines) + "\n"
@@ -648,9 +651,87 @@ def cmd_figures(options):
                                 f"the generated code has {reported[name] or 'none'}")
     else:
         print("wlx_bench not built: the benchmark table's operation counts are not checked")
+    problems += precision_problems(options.build, readme)
+    problems += count_problems(options.build, readme)
     if problems:
         raise ContractError("\n".join(problems))
     print("README.md's deterministic figures agree with the code")
+
+
+def count_problems(build, readme):
+    """Counts the README states: the excavator's sweeps and report checks, dPhi/ds's structural zeros."""
+    problems = []
+    zeros, total = quoted_figure(readme, r"\(dPhi/ds: (\d+) of (\d+) entries\)")
+    banner = re.search(r"dPhi/ds, (\d+) x (\d+) \(own operations: \d+, nonzero entries: (\d+)\)",
+                       read("generated/excavator/wlx/gen/closure.hpp"))
+    rows, columns, nonzero = map(int, banner.groups())
+    if (zeros, total) != (rows * columns - nonzero, rows * columns):
+        problems.append(f"README.md: dPhi/ds has {zeros:.0f} structural zeros of {total:.0f}; generated closure.hpp: "
+                        f"{rows * columns - nonzero} of {rows * columns}")
+    sweeps, checks = quoted_figure(readme, r"For the excavator that is the thesis: (\d+) sweeps,.*?, and\s+(\d+) checks")
+    with tempfile.TemporaryDirectory(prefix=f"wlx_docs_{os.getpid()}_") as work:
+        r = run([os.path.join(build, "wlx"), "verify", "ik", "--out", work])
+    listed = re.findall(r"^(\S+)\s+\S+\s+\d+\s", r.stdout.split("\n", 1)[1], flags=re.M)
+    if r.returncode != 0 or len(listed) != sweeps:
+        problems.append(f"README.md: the excavator has {sweeps:.0f} IK sweeps; wlx verify ik ran {len(listed)} (exit {r.returncode})")
+    if not re.search(rf"the\s+excavator's\s+{sweeps:.0f}\s+of\s+docs/excavator.md", readme):
+        problems.append("README.md: `wlx verify ik` no longer states the same number of sweeps as `wlx report`")
+    claims = len(re.findall(r"^\s+kind: check\s*$", read("scenarios/excavator/report.yaml"), flags=re.M))
+    if claims != checks:
+        problems.append(f"README.md: the excavator's report has {checks:.0f} checks; scenarios/excavator/report.yaml: {claims}")
+    return problems
+
+
+def quoted_figure(readme, pattern):
+    m = re.search(pattern, readme, flags=re.S)
+    if not m:
+        raise ContractError(f"README.md no longer matches {pattern!r}: update tools/docs_contract.py with its new wording")
+    return [float(g) for g in m.groups()]
+
+
+def same_figure(quoted, measured):
+    """A figure quoted to one or two significant digits: within a factor 1.5 of the measurement
+    (rounding moves it by less; a change in the code's precision moves it by more)."""
+    return measured > 0 and quoted > 0 and 1 / 1.5 <= quoted / measured <= 1.5
+
+
+def precision_problems(build, readme):
+    """The float and dual-number error levels the README quotes, against what the tests measure."""
+    tests = os.path.join(build, "tests", "wlx_tests")
+    if not os.path.exists(tests):
+        return [f"{tests} not built: the README's precision figures cannot be checked"]
+    r = run([tests, "-tc=float*,Jet*", "-s"])
+    if r.returncode != 0:
+        return [f"wlx_tests -tc='float*,Jet*' failed:\n{r.stdout[-2000:]}"]
+    number = r"([\d.]+e[-+]\d+)"
+    scale = re.search(r"float vs double, relative to scale: (.*)", r.stdout)
+    residual = re.search(r"float IK closure residual \(in double\) " + number, r.stdout)
+    jet = re.search(r"Jet vs generated Jacobians: first derivatives " + number, r.stdout)
+    if not (scale and residual and jet):
+        return ["wlx_tests no longer prints the float/Jet measurements the README quotes"]
+    measured = {
+        "float vs double, relative to each output's scale": max(float(x) for x in re.findall(number, scale[1])),
+        "float IK closure residual (m)": float(residual[1]),
+        "dual numbers vs the generated Jacobians": float(jet[1]),
+    }
+    quoted = {
+        "float vs double, relative to each output's scale":
+            quoted_figure(readme, r"`float` agrees with `double` to ([\d.e-]+) of\s+each output's scale")[0],
+        "float IK closure residual (m)": quoted_figure(readme, r"the `float` IK meets the closure to ([\d.e-]+) m")[0],
+        "dual numbers vs the generated Jacobians":
+            quoted_figure(readme, r"reproduces\s+the generated Jacobians to ([\d.e-]+)\.")[0],
+    }
+    problems = [f"README.md quotes {quoted[k]:g} for {k}; the tests measure {measured[k]:.3g}"
+                for k in measured if not same_figure(quoted[k], measured[k])]
+    # The IK's acceptance thresholds: the generated constant for double, scaled by sqrt(eps) for float.
+    float_check, double_check = quoted_figure(readme, r"`ik_tolerance<float>\(\)`,\s+is ([\d.e-]+) m; `double`'s is ([\d.e-]+)\)")
+    tolerance = float(re.search(r"kIkTolerance = ([\d.e-]+);", read("generated/excavator/wlx/gen/ik.hpp"))[1])
+    float_tolerance = tolerance * math.sqrt(2.0 ** -23 / 2.0 ** -52)
+    if double_check != tolerance:
+        problems.append(f"README.md: double's IK check is {double_check:g}; generated/excavator ik.hpp: {tolerance:g}")
+    if not same_figure(float_check, float_tolerance):
+        problems.append(f"README.md: float's IK check is {float_check:g}; ik_tolerance<float>() is {float_tolerance:.3g}")
+    return problems
 
 
 def main():
