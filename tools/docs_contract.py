@@ -21,6 +21,8 @@ says otherwise:
   <!-- ci: setup -->               the README's first commands: .ci/run runs them itself
   <!-- ci: embedding -->           run by tools/check_package.sh
   <!-- ci: python -->              (a python block) run by tests/python/test_wlx.py
+A command of a run block must exit 0, unless its comment says `# exit N: TEXT`: then it must exit N
+and print TEXT (stdout or stderr).
 Figures. The README's generated sections lie between
   <!-- figures: NAME (...) -->  and  <!-- figures: end -->
 and only this script writes them.
@@ -47,6 +49,7 @@ SHELL_LANGUAGES = {"sh", "bash", "shell", "console"}
 MARKER = re.compile(r"^<!--\s*ci:\s*(?P<kind>[a-z]+)(?P<rest>.*?)\s*-->\s*$")
 FENCE = re.compile(r"^```(?P<lang>[\w+-]*)\s*$")
 COMMAND_TIMEOUT_S = 600
+EXPECTED_FAILURE = re.compile(r"#\s*exit (\d+): (.+)$")
 
 
 class ContractError(Exception):
@@ -167,9 +170,17 @@ class Examples:
             started = time.time()
             r = run(["bash", "-o", "pipefail", "-c", command], cwd=work)
             where = f"{block.where()}: `{command}`"
-            if r.returncode != 0:
+            # A line may say what it does instead of succeeding: `... # exit 2: the message it prints`.
+            expected = EXPECTED_FAILURE.search(command)
+            if expected:
+                code, text = int(expected[1]), expected[2].strip()
+                if r.returncode != code or text not in r.stdout + r.stderr:
+                    raise ContractError(f"{where}: the text says exit {code} with '{text}'; "
+                                        f"got exit {r.returncode}:\n{r.stdout}{r.stderr}")
+            elif r.returncode != 0:
                 raise ContractError(f"{where}: exit code {r.returncode}, expected 0\n{r.stderr}")
-            self.check_output(where, command, r.stdout, work)
+            else:
+                self.check_output(where, command, r.stdout, work)
             print(f"  ok  {time.time() - started:5.1f} s  {command}")
             ran += 1
         return ran
@@ -339,7 +350,11 @@ def cmd_examples(options):
                 if block.note not in ("", "when viewer"):
                     raise ContractError(f"{block.where()}: unknown 'ci: run' condition {block.note!r}")
                 with tempfile.TemporaryDirectory(prefix=f"wlx_docs_{os.getpid()}_") as work:
+                    # The build, and the source folders examples read (models/, scenarios/); nothing
+                    # else of the tree, so that an example cannot write into it unnoticed.
                     os.symlink(os.path.abspath(options.build), os.path.join(work, "build"))
+                    for folder in ("models", "scenarios"):
+                        os.symlink(os.path.join(ROOT, folder), os.path.join(work, folder))
                     ran_commands += examples.check_block(block, work)
                 ran_blocks += 1
             else:
@@ -444,9 +459,52 @@ def cmd_help(options):
         _, positionals = help_options(text)
         if len(positionals) != len(documented_positionals):
             problems.append(f"wlx-gen: positionals {sorted(positionals)} in --help, {sorted(documented_positionals)} in README.md")
+    problems += key_problems(wlx, readme)
+    layout = re.search(r"^cli/\s+the wlx command: (.*)$", readme, flags=re.M)
+    listed = [n.strip() for n in layout[1].split(",")] if layout else []
+    if sorted(listed) != sorted(subcommands):
+        problems.append(f"README.md's layout lists the subcommands {listed}; wlx --help lists {subcommands}")
     if problems:
         raise ContractError("\n".join(problems))
-    print(f"--help of wlx ({len(paths)} subcommands), wlx_bench and wlx-gen agree with README.md")
+    print(f"--help of wlx ({len(paths)} subcommands), wlx_bench and wlx-gen, and the JSON keys of wlx ik and "
+          "scenario files agree with README.md and scenarios/README.md")
+
+
+def accepted_keys(source, anchor):
+    """The key list a reject_unknown_keys call in cli/ spells out (the code's own list of names)."""
+    m = re.search(re.escape(anchor) + r"\s*\{([^}]*)\}", read(source))
+    if not m:
+        raise ContractError(f"{source}: no `{anchor} {{...}}` key list any more: update tools/docs_contract.py")
+    return re.findall(r'"([^"]+)"', m[1])
+
+
+def key_problems(wlx, readme):
+    """The JSON keys `wlx ik` and scenario files take, against the keys their documentation lists:
+    a documented key must be accepted (asked of the binary), an accepted one documented."""
+    problems = []
+    said = paragraph_after(readme, "Input keys:", "Output keys:")
+    documented = [k for k in backticked_names(said) if re.fullmatch(r"\w+", k)]
+    for key in accepted_keys("cli/input.cpp", "for (const char* k :"):
+        if key not in documented:
+            problems.append(f"wlx ik takes the key `{key}`; README.md's 'Input keys:' does not list it")
+    for key in documented:
+        r = run([wlx, "ik"], stdin_text=json.dumps({key: None}))
+        if "unknown key" in r.stderr:
+            problems.append(f"README.md documents the wlx ik key `{key}`; wlx ik rejects it: {r.stderr.strip()}")
+    table = read("scenarios/README.md").split("## Report files")[0]
+    documented = [k for row in re.findall(r"^\| ([^|]+) \|", table, flags=re.M) for k in re.findall(r"`(\w+)`", row)]
+    for key in accepted_keys("cli/scenario_io.cpp", "reject_unknown_keys(j,"):
+        if key not in documented:
+            problems.append(f"scenario files take the key `{key}`; scenarios/README.md's table does not list it")
+    with tempfile.TemporaryDirectory(prefix=f"wlx_docs_{os.getpid()}_") as work:
+        for key in documented:
+            path = os.path.join(work, "s.json")
+            with open(path, "w") as f:
+                json.dump({"dependent": ["y_C", "yaw"], "duration": 1, key: None}, f)
+            r = run([wlx, "simulate", path, "--out", os.path.join(work, "out")])
+            if "unknown key" in r.stderr:
+                problems.append(f"scenarios/README.md documents `{key}`; a scenario file with it is rejected: {r.stderr.strip()}")
+    return problems
 
 
 # ---------------------------------------------------------------- figures
@@ -612,7 +670,7 @@ def cmd_figures(options):
         stated = (f"Measured {today} on {machine()} by `tools/readme_figures.sh` (medians of 5 repetitions, "
                   f"`./build/wlx_bench --json`; compare ratios, not absolute times, across machines).")
         if generated:
-            stated += f" Generating everything (`wlx_bench_generator`, {generated[0]}) takes {generated[1]:.0f} ms."
+            stated += f" Generating everything (`wlx_bench_generator`, `{generated[0]}`) takes {generated[1]:.0f} ms."
         readme = readme_with(readme, "benchmarks", stated + "\n\n" + benchmark_table(rows))
         controller = controller_figures(options.build)
         if controller:
