@@ -46,8 +46,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCUMENTS = ["README.md", "scenarios/README.md"] + sorted(
     os.path.join("docs", f) for f in os.listdir(os.path.join(ROOT, "docs")) if f.endswith(".md"))
 SHELL_LANGUAGES = {"sh", "bash", "shell", "console"}
-MARKER = re.compile(r"^<!--\s*ci:\s*(?P<kind>[a-z]+)(?P<rest>.*?)\s*-->\s*$")
-FENCE = re.compile(r"^```(?P<lang>[\w+-]*)\s*$")
+MARKER = re.compile(r"^\s*<!--\s*ci:\s*(?P<kind>[a-z]+)(?P<rest>.*?)\s*-->\s*$")
+FENCE = re.compile(r"^(?P<indent>\s*)```(?P<lang>[\w+-]*)\s*$")  # indented inside a list item too
 COMMAND_TIMEOUT_S = 600
 EXPECTED_FAILURE = re.compile(r"#\s*exit (\d+): (.+)$")
 
@@ -81,10 +81,10 @@ def fenced_blocks(document):
                 raise ContractError(f"{document}:{marker[2]}: two ci markers in a row; a block takes one")
             marker = (m["kind"], m["rest"].strip(), i + 1)
         elif FENCE.match(line):
-            start, body = i + 1, []
+            start, body, indent = i + 1, [], FENCE.match(line)["indent"]
             i += 1
-            while i < len(lines) and not lines[i].startswith("```"):
-                body.append(lines[i])
+            while i < len(lines) and not lines[i].strip().startswith("```"):
+                body.append(lines[i][len(indent):] if lines[i].startswith(indent) else lines[i])
                 i += 1
             if i == len(lines):
                 raise ContractError(f"{document}:{start}: fenced block never closed")
