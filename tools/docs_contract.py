@@ -433,6 +433,9 @@ def cmd_help(options):
             m = re.match(r"^\s+(--[\w-]+)\s+(TEXT|FLOAT|INT|UINT|ENUM)(=\S+)?(.*)", line)
             if m and m[1] not in global_options and not m[3] and "default" not in m[4]:
                 problems.append(f"wlx {path} {m[1]}: --help does not say its default")
+            # A number option says its unit (or what it is relative to).
+            if m and m[2] == "FLOAT" and not re.search(r"\b(seconds|m|rad|m/s|rad/s|relative)\b", m[4]):
+                problems.append(f"wlx {path} {m[1]}: --help does not say its unit")
     for path in synopses:
         if path not in paths:
             problems.append(f"README.md documents `wlx {path}`, which wlx --help does not list")
@@ -460,6 +463,7 @@ def cmd_help(options):
         if len(positionals) != len(documented_positionals):
             problems.append(f"wlx-gen: positionals {sorted(positionals)} in --help, {sorted(documented_positionals)} in README.md")
     problems += key_problems(wlx, readme)
+    problems += python_problems(options.build, readme)
     layout = re.search(r"^cli/\s+the wlx command: (.*)$", readme, flags=re.M)
     listed = [n.strip() for n in layout[1].split(",")] if layout else []
     if sorted(listed) != sorted(subcommands):
@@ -468,6 +472,47 @@ def cmd_help(options):
         raise ContractError("\n".join(problems))
     print(f"--help of wlx ({len(paths)} subcommands), wlx_bench and wlx-gen, and the JSON keys of wlx ik and "
           "scenario files agree with README.md and scenarios/README.md")
+
+
+def python_problems(build, readme):
+    """The README's table of the Python package against the package: every public name documented,
+    every documented call with its exact signature, the dicts fk and inverse_dynamics return."""
+    package = os.path.join(build, "python")
+    if not os.path.isdir(os.path.join(package, "wlx")):
+        print("the Python package was not built: its README table is not checked")
+        return []
+    sys.path.insert(0, package)
+    try:
+        import inspect
+        import wlx
+    except ImportError as e:  # e.g. an interpreter without NumPy: ctest runs the build's Python
+        return [f"{package}: import wlx failed with {sys.executable}: {e}"]
+    section = paragraph_after(readme, "## Python", "A design study")
+    problems = []
+    model = wlx.model()
+    calls = re.findall(r"`((wlx|m)\.(\w+)(\([^`]*\)))`", section)
+    for text, owner, name, signature in calls:
+        obj = getattr(wlx if owner == "wlx" else model, name, None)
+        if obj is None:
+            problems.append(f"README.md documents `{text}`; the package has no {owner}.{name}")
+            continue
+        actual = str(inspect.signature(obj))
+        if actual != signature:
+            problems.append(f"README.md documents `{owner}.{name}{signature}`; the package's is {owner}.{name}{actual}")
+    documented = {name for _, _, name, _ in calls} | set(re.findall(r"`(?:wlx|m)?\.(\w+)`", section)) | \
+        set(re.findall(r"`wlx\.(\w+)`", section))
+    for owner, obj in (("wlx", wlx), ("model", model)):
+        for name in dir(obj):
+            if not name.startswith("_") and name not in documented:
+                problems.append(f"the Python {owner} has `{name}`, which README.md's table does not document")
+    rows = {m[1]: m[2] for m in re.finditer(r"^\| `m\.(\w+)\([^|]*\| (.*) \|$", section, flags=re.M)}
+    s = model.ik({})["s"]
+    returned = {"fk": model.fk(s), "inverse_dynamics": model.inverse_dynamics(s, [0.0] * 4)}
+    for name, answer in returned.items():
+        said = {k for k in backticked_names(rows.get(name, "")) if re.fullmatch(r"\w+", k)}
+        if said != set(answer):
+            problems.append(f"README.md: m.{name} returns {sorted(said)}; the package returns {sorted(answer)}")
+    return problems
 
 
 def accepted_keys(source, anchor):
@@ -558,6 +603,14 @@ def integrator_figures(build):
              "|---|---:|---:|---:|"]
     lines += [f"| {label} | {steps:,} | {evaluations:,} | {deviation} |" for label, steps, evaluations, deviation in rows]
     return "\n".join(lines) + "\n"
+
+
+def bench_repetitions(build):
+    """How many repetitions wlx_bench takes the median of, as its --help says."""
+    m = re.search(r"\((\d+) repetitions each\)", run([os.path.join(build, "wlx_bench"), "--help"]).stdout)
+    if not m:
+        raise ContractError("wlx_bench --help no longer says '(N repetitions each)'")
+    return int(m[1])
 
 
 def benchmark_rows(build):
@@ -667,7 +720,7 @@ def cmd_figures(options):
         print("wlx_bench --json (a few minutes) ...")
         rows = benchmark_rows(options.build)
         generated = generator_time(options.build)
-        stated = (f"Measured {today} on {machine()} by `tools/readme_figures.sh` (medians of 5 repetitions, "
+        stated = (f"Measured {today} on {machine()} by `tools/readme_figures.sh` (medians of {bench_repetitions(options.build)} repetitions, "
                   f"`./build/wlx_bench --json`; compare ratios, not absolute times, across machines).")
         if generated:
             stated += f" Generating everything (`wlx_bench_generator`, `{generated[0]}`) takes {generated[1]:.0f} ms."
@@ -694,6 +747,10 @@ def cmd_figures(options):
     if "benchmarks" not in sections:
         problems.append("README.md: no <!-- figures: benchmarks --> section")
     elif os.path.exists(os.path.join(options.build, "wlx_bench")):
+        repetitions = bench_repetitions(options.build)
+        for quoted_repetitions in re.findall(r"(\d+)\s+repetitions", readme):
+            if int(quoted_repetitions) != repetitions:
+                problems.append(f"README.md says {quoted_repetitions} repetitions; wlx_bench --help says {repetitions}")
         table = readme_table(sections["benchmarks"])
         header, body = table[0], [r for r in table[1:] if not r[0].startswith("**")]
         column = header.index("ops")
