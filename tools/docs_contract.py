@@ -768,9 +768,10 @@ def cmd_figures(options):
         print("wlx_bench not built: the benchmark table's operation counts are not checked")
     problems += precision_problems(options.build, readme)
     problems += count_problems(options.build, readme)
+    problems += excavator_doc_problems(options.build)
     if problems:
         raise ContractError("\n".join(problems))
-    print("README.md's deterministic figures agree with the code")
+    print("the deterministic figures of README.md and docs/excavator.md agree with the code")
 
 
 def count_problems(build, readme):
@@ -794,6 +795,45 @@ def count_problems(build, readme):
     claims = len(re.findall(r"^\s+kind: check\s*$", read("scenarios/excavator/report.yaml"), flags=re.M))
     if claims != checks:
         problems.append(f"README.md: the excavator's report has {checks:.0f} checks; scenarios/excavator/report.yaml: {claims}")
+    return problems
+
+
+def excavator_doc_problems(build):
+    """docs/excavator.md's figures of wlx's own runs: the total mass, the peak condition numbers of
+    the singular runs and the inverse-dynamics end states, to the digits it quotes."""
+    text = read("docs/excavator.md")
+    wlx = os.path.join(build, "wlx")
+    problems = []
+    fk = run([wlx, "fk"], stdin_text="{}")
+    mass = re.search(r"total mass ([\d.]+) kg", fk.stdout)
+    quoted = re.search(r"Total ([\d.]+) kg", text)
+    if not (mass and quoted) or mass[1] != quoted[1]:
+        problems.append(f"docs/excavator.md: total mass {quoted and quoted[1]} kg; wlx fk: {mass and mass[1]} kg")
+    conditions = re.search(r"(\S+), (\S+) and (\S+) pass through singular points \(condition numbers up to ([\d.e+]+), "
+                           r"([\d.e+]+) and\s+([\d.e+]+)", text)
+    ends = re.search(r"end states x_C = ([\d.-]+) m, roll = ([\d.-]+) deg, z_C = ([\d.-]+) m", text)
+    if not (conditions and ends):
+        return problems + ["docs/excavator.md: the singular runs' or the end states' sentence changed: update tools/docs_contract.py"]
+    runs = dict(zip(conditions.groups()[:3], conditions.groups()[3:]))
+    with tempfile.TemporaryDirectory(prefix=f"wlx_docs_{os.getpid()}_") as work:
+        def trajectory(run_id):
+            out = os.path.join(work, run_id)
+            r = run([wlx, "simulate", run_id, "--out", out])
+            if r.returncode != 0:
+                raise ContractError(f"wlx simulate {run_id}: exit {r.returncode}\n{r.stderr}")
+            with open(os.path.join(out, "trajectory.csv"), newline="") as f:
+                rows = list(csv.DictReader(f))
+            return rows
+        for run_id, quoted_condition in runs.items():
+            peak = max(float(row["cond_J_beta"]) for row in trajectory(run_id))
+            if float(f"{peak:.1e}") != float(quoted_condition):
+                problems.append(f"docs/excavator.md: {run_id}'s peak cond(J_beta) {quoted_condition}; wlx: {peak:.3g}")
+        for (run_id, column, scale), quoted_end in zip((("ID-1", "x_C", 1), ("ID-2", "roll", 180 / math.pi),
+                                                      ("ID-3", "z_C", 1)), ends.groups()):
+            value = float(trajectory(run_id)[-1][column]) * scale
+            decimals = len(quoted_end.split(".")[1]) if "." in quoted_end else 0
+            if f"{value:.{decimals}f}" != quoted_end:
+                problems.append(f"docs/excavator.md: {run_id} ends at {column} = {quoted_end}; wlx: {value:.{decimals + 2}f}")
     return problems
 
 
