@@ -30,7 +30,6 @@ and only this script writes them.
 import argparse
 import csv
 import datetime
-import io
 import json
 import math
 import os
@@ -213,7 +212,7 @@ class Examples:
             for req, answer in zip(requests, lines):
                 self.check_ik_answer(where, model, req, answer)
         elif sub == "simulate":
-            out = args[args.index("--out") + 1] if "--out" in args else "out"
+            out = args[args.index("--out") + 1] if "--out" in args else "out/simulate"  # --help's default
             scenario = next(a for a in args if not a.startswith("-") and a not in (out,) and not re.fullmatch(r"[\d.e+-]+", a)
                             and a not in ("rk4", "euler", "dopri5"))
             self.check_trajectory(where, model, scenario, os.path.join(work, out, "trajectory.csv"))
@@ -586,6 +585,7 @@ def integrator_figures(build):
             ("`--integrator dopri5` (output every 1 ms)", ["--integrator", "dopri5"]),
             ("`--integrator dopri5 --dt 0.1`", ["--integrator", "dopri5", "--dt", "0.1"])]
     rows, reference = [], None
+    coordinates = set(Examples(build, False).coordinates("excavator"))
     with tempfile.TemporaryDirectory(prefix=f"wlx_figures_{os.getpid()}_") as work:
         for k, (label, args) in enumerate(runs):
             out = os.path.join(work, str(k))
@@ -594,10 +594,9 @@ def integrator_figures(build):
                 raise ContractError(f"wlx simulate NH-4 {' '.join(args)}: exit {r.returncode}\n{r.stderr}")
             m = re.search(r"integration: (\d+) steps.*?, (\d+) evaluations", r.stdout)
             end = trajectory_end(os.path.join(out, "trajectory.csv"))
-            coordinates = [c for c in end if c in Examples(build, False).coordinates("excavator")]
             if reference is None:
                 reference = end
-            deviation = max(abs(end[c] - reference[c]) for c in coordinates)
+            deviation = max(abs(end[c] - reference[c]) for c in end if c in coordinates)
             rows.append((label, int(m[1]), int(m[2]), "" if k == 0 else f"{deviation:.1e}"))
     lines = ["| NH-4 (2 s), `wlx simulate NH-4 ...` | steps | right-hand-side evaluations | largest deviation at 2 s from RK4 at 0.1 ms (m or rad) |",
              "|---|---:|---:|---:|"]
