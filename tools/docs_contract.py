@@ -452,7 +452,7 @@ def cmd_help(options):
             problems.append(f"wlx_bench {option}: README.md passes it to Google Benchmark, whose --help does not list it")
     generator = os.path.join(options.build, "wlx-gen")
     if os.path.exists(generator):
-        text = run([generator, "--help"]).stdout + run([generator, "--help"]).stderr
+        text = run([generator, "--help"]).stdout  # (stderr may hold a sanitizer's report)
         listed = set(re.findall(r"^\s+(--[\w-]+)", text, flags=re.M)) - {"--help", "--version"}
         m = re.search(r"`wlx-gen ([^`]*)`", readme)
         documented, documented_positionals = synopsis_options(m[1]) if m else (set(), set())
