@@ -16,7 +16,7 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
     a->add_option("--model", inv.model_name, "the built-in model (" + names + "; wlx models lists them)")
         ->capture_default_str();
     a->add_option("--params", inv.model_options.params_file,
-                  "JSON file {\"name\": value, ...} overriding the model's parameters (SI units)");
+                  "JSON file {\"name\": value, ...} overriding the model's parameters (SI units; default: the model file's values)");
   };
   add_model_options(&app);
   inv.list_models = app.add_subcommand("models", "list the built-in models");
@@ -30,7 +30,7 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
   verify->require_subcommand(1);
   inv.verify_ik = verify->add_subcommand("ik", "the model's IK sweeps (its file's ik_sweeps), closed form and Newton");
   inv.verify_ik->add_option("--out", inv.ik_out, "folder for one CSV per sweep")->capture_default_str();
-  inv.verify_ik->add_option("--sweep", inv.sweep_ids, "only these sweeps (ids as wlx verify ik lists them)");
+  inv.verify_ik->add_option("--sweep", inv.sweep_ids, "only these sweeps (ids as wlx verify ik lists them; default: all)");
 
   inv.verify_nh = verify->add_subcommand("nonholonomic", "the model's scenarios marked \"verify\": \"nonholonomic\": the wheels' sideways-velocity residual");
   inv.verify_nh->add_option("--out", inv.nh_out, "folder for one trajectory CSV per run")->capture_default_str();
@@ -42,14 +42,14 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
                        "rk4, euler or dopri5 (adaptive Dormand-Prince 5(4)); default: the scenario's");
   inv.simulate->add_option("--dt", inv.sim.dt, "step in seconds, or with dopri5 the output interval (default: the scenario's)");
   inv.simulate->add_option("--tolerance", inv.sim.tolerance, "dopri5's local error bound per step, relative to 1 + |q| (default 1e-10)");
-  inv.simulate->add_option("--weighting", inv.sim.weighting, "torque weighting 1 (the model file's weights) or 2 (by contribution), for inverse dynamics");
+  inv.simulate->add_option("--weighting", inv.sim.weighting, "torque weighting 1 (the model file's weights) or 2 (by contribution), for inverse dynamics (default: the scenario's)");
   inv.simulate->add_flag("--list", inv.sim.list, "list the built-in scenarios");
 
   inv.report = app.add_subcommand("report", "run the model's verifications and scenarios, check the claims of its report file, and write an HTML report with figures");
   inv.report->add_option("--out", inv.report_options.out_dir, "output folder (index.html, fig/, data/, plots/)")->capture_default_str();
   inv.report->add_flag("--quick", inv.report_options.quick, "a reduced set of runs, for a fast look");
   inv.report->add_option("--claims", inv.report_options.claims_file,
-                         "a report file (claims and figure layout, format of scenarios/<model>/report.yaml) instead of the model's own");
+                         "a report file (claims and figure layout, format of scenarios/<model>/report.yaml; default: the model's own)");
 
   inv.viewer = app.add_subcommand("viewer", "the 3D viewer (viewer.html, drag-and-drop IK in WebAssembly) written to a folder, with runs to play");
   inv.viewer->add_option("RUN", inv.viewer_options.runs, "scenario files or ids to simulate and show (wlx simulate --list shows the ids)");

@@ -61,7 +61,7 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
   for (int k = 0; k < kCoordinateCount; ++k) {
     const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
     if (!j.contains(name)) continue;
-    s(k) = si_value(j.at(name), name, is_angle(k));  // one grammar with ik and scenarios: SI or {"deg": x}
+    s(k) = si_value(j.at(name), name, quantity_of(is_angle(k)));  // one grammar with ik and scenarios: SI or {"deg": x}
     dependents_given += k >= kInputCount;
   }
   if (dependents_given == 0) solve_ik_closed_form(model, s, {});
@@ -85,10 +85,14 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
     std::cout << out.dump(2) << "\n";
     return 0;
   }
-  fmt::print("{} pose, dependent joints{} (angles in degrees):\n", gen::kModelName,
-             dependents_given ? " as given" : " by the closed-form IK");
-  for (int k = kInputCount; k < kCoordinateCount; ++k)
-    fmt::print("  {:<12} {:>10.4f} deg\n", gen::kCoordinateNames[k], tidy(s(k)) * 180 / std::numbers::pi);
+  // SI like every other input and output (rad); degrees beside them only for reading.
+  fmt::print("{} pose, dependent joints{}:\n", gen::kModelName, dependents_given ? " as given" : " by the closed-form IK");
+  for (int k = kInputCount; k < kCoordinateCount; ++k) {
+    const std::string_view unit = gen::kCoordinateUnits[static_cast<std::size_t>(k)];
+    fmt::print("  {:<12} {:>10.6f} {:<3}", gen::kCoordinateNames[k], tidy(s(k)), unit);
+    if (is_angle(k)) fmt::print(" {:>10.4f} deg", tidy(s(k)) * 180 / std::numbers::pi);
+    fmt::print("\n");
+  }
   fmt::print("\nForward kinematics, frame origins in K0 (m):\n  {:<12} {:>9} {:>9} {:>9}\n", "frame", "x", "y", "z");
   for (int f = 0; f < gen::kFrameCount; ++f)
     fmt::print("  {:<12} {:>9.4f} {:>9.4f} {:>9.4f}\n", gen::kFrameNames[f], tidy(data.frame_positions(0, f)),

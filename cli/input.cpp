@@ -24,6 +24,12 @@ std::vector<std::string> dependent_names() {
 
 std::string type_name(const nlohmann::json& v) { return v.type_name(); }
 
+bool is_angle_param(const std::string& name) {
+  for (const auto& info : gen::kParamInfo)
+    if (info.name == name) return info.kind == gen::ParamKind::angle;
+  return false;
+}
+
 }  // namespace
 
 Params parse_params(const nlohmann::json& object, Params params) {
@@ -31,7 +37,9 @@ Params parse_params(const nlohmann::json& object, Params params) {
   std::vector<std::string> names;
   for (const auto& info : gen::kParamInfo) names.emplace_back(info.name);
   reject_unknown_keys(object, names, "params.");
-  for (const auto& [key, value] : object.items()) *find_param(params, key) = finite_number(value, "params." + key);
+  // The scenario files' grammar here too: an angle parameter may be {"deg": x}, anything else is SI.
+  for (const auto& [key, value] : object.items())
+    *find_param(params, key) = si_value(value, "params." + key, quantity_of(is_angle_param(key)));
   check_param_bounds(params, "params.");
   try {
     Model check(params);
@@ -52,7 +60,7 @@ IkRequest parse_ik_request(const nlohmann::json& j, const Params& base) {
   for (int k = 0; k < kInputCount; ++k) {
     const std::string name(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
     if (j.contains(name)) {
-      r.s(k) = si_value(j.at(name), name, is_angle(k));  // the scenario files' grammar: SI or {"deg": x}
+      r.s(k) = si_value(j.at(name), name, quantity_of(is_angle(k)));  // the scenario files' grammar: SI or {"deg": x}
       check_input_bound(k, r.s(k), name);
     }
   }
@@ -91,7 +99,7 @@ IkRequest parse_ik_request(const nlohmann::json& j, const Params& base) {
     reject_unknown_keys(st, dependent_names(), "start.");
     for (const auto& [key, value] : st.items()) {
       const int k = coordinate_index(key);
-      r.start.emplace_back(k, si_value(value, "start." + key, is_angle(k)));
+      r.start.emplace_back(k, si_value(value, "start." + key, quantity_of(is_angle(k))));
     }
     if (r.method != IkMethod::newton)
       throw Error("start", "is Newton's starting guess: it needs \"method\": \"newton\" (the closed form takes no start)");

@@ -50,13 +50,19 @@ nlohmann::json read_scenario_json(const std::string& arg) {
   return parse_json_bounded(text, arg);
 }
 
-double si_value(const nlohmann::json& v, const std::string& key, bool angle) {
+Quantity quantity_of(bool angle, bool rate) {
+  if (!angle) return Quantity::other;
+  return rate ? Quantity::angular_rate : Quantity::angle;
+}
+
+double si_value(const nlohmann::json& v, const std::string& key, Quantity quantity) {
   if (v.is_object()) {
-    if (!angle) throw Error(key, "only angles may be given in degrees; give this value in SI units");
-    if (v.size() != 1 || !(v.contains("deg") || v.contains("deg/s")))
-      throw Error(key, fmt::format("expected a number or {{\"deg\": x}} / {{\"deg/s\": x}}, got {}", excerpt(v)));
-    // v.items() is a proxy: iterate it in place (a reference into a dereferenced temporary dangles).
-    for (const auto& item : v.items()) return finite_number(item.value(), key + "." + item.key()) * std::numbers::pi / 180;
+    if (quantity == Quantity::other) throw Error(key, "only angles may be given in degrees; give this value in SI units");
+    // One unit per quantity: {"deg/s": x} for an angle (or {"deg": x} for a rate) is a mistake, not a synonym.
+    const char* unit = quantity == Quantity::angle ? "deg" : "deg/s";
+    if (v.size() != 1 || !v.contains(unit))
+      throw Error(key, fmt::format("expected a number or {{\"{}\": x}}, got {}", unit, excerpt(v)));
+    return finite_number(v.at(unit), key + "." + unit) * std::numbers::pi / 180;
   }
   return finite_number(v, key);
 }
@@ -122,7 +128,7 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base) {
     reject_unknown_keys(obj, input_names(), std::string(group) + ".");
     for (const auto& [key, value] : obj.items()) {
       const int k = coordinate_index(key);
-      const double v = si_value(value, std::string(group) + "." + key, is_angle(k));
+      const double v = si_value(value, std::string(group) + "." + key, quantity_of(is_angle(k), std::string(group) == "rates"));
       if (std::string(group) == "initial") check_input_bound(k, v, std::string(group) + "." + key);
       else check_rate_bound(k, v, std::string(group) + "." + key);
       if (std::string(group) == "initial") sc.initial(k) = v;

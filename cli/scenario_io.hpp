@@ -23,7 +23,12 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base = {});
 // 1, 2, {"diag": [...]} or {"matrix": [[...]]}.
 Weighting parse_weighting(const nlohmann::json& v, const std::string& key);
 
-// A number in SI units, or {"deg": x} / {"deg/s": x} for angle coordinates.
-double si_value(const nlohmann::json& v, const std::string& key, bool is_angle);
+// What a JSON value measures, which decides the one non-SI form it may take: an angle may be
+// {"deg": x}, an angular rate {"deg/s": x}; anything else is a plain number in SI units.
+enum class Quantity { other, angle, angular_rate };
+// `angle`: the value is an angle coordinate (or angle parameter); `rate`: it is that coordinate's rate.
+Quantity quantity_of(bool angle, bool rate = false);
+// A number in SI units, or the degree form its quantity allows ({"deg": x}, {"deg/s": x}).
+double si_value(const nlohmann::json& v, const std::string& key, Quantity quantity);
 
 WLX_COMMANDS_END

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 #include <wlx/gen/kinematics.hpp>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -58,6 +59,30 @@ TEST_CASE("cli: wlx ik solves the nominal state; the numbers put back into the F
   CHECK(j.at("x_Wr").get<double>() == doctest::Approx(pos(0, wlx::gen::frame::W_r)).epsilon(1e-15));
 }
 
+TEST_CASE("cli: wlx fk's table gives the joints in SI units (rad) like its JSON, degrees only beside them") {
+  const Run table = run_wlx("fk", "{}");
+  const Run json = run_wlx("fk --json", "{}");
+  REQUIRE(table.code == 0);
+  REQUIRE(json.code == 0);
+  const auto coordinates = nlohmann::json::parse(json.out).at("coordinates");
+  std::istringstream lines(table.out);
+  int joints = 0;
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string name, unit, deg;
+    double value = 0;
+    if (!(words >> name >> value >> unit) || !coordinates.contains(name)) continue;
+    ++joints;
+    CHECK(unit == "rad");  // every dependent joint of the excavator is an angle
+    CHECK(std::abs(value - coordinates.at(name).get<double>()) <= 5e-7);  // printed to 6 decimals
+    double in_degrees = 0;
+    REQUIRE((words >> in_degrees >> deg));
+    CHECK(deg == "deg");
+    CHECK(std::abs(in_degrees - coordinates.at(name).get<double>() * 180 / 3.14159265358979) <= 5e-5);
+  }
+  CHECK(joints == 14);
+}
+
 TEST_CASE("cli: Newton agrees with the closed form and reports its iterations") {
   const Run cf = run_wlx("ik", R"({"z_C": 1.7, "roll": 0.05, "theta_l5": 0.2})");
   const Run nt = run_wlx("ik", R"({"z_C": 1.7, "roll": 0.05, "theta_l5": 0.2, "method": "newton"})");
@@ -107,6 +132,9 @@ TEST_CASE("cli: wlx ik reads the scenario files' value grammar: {\"deg\": x} for
   r = run_wlx("ik", R"({"roll": {"rad": 3}})");
   CHECK(r.code == 2);
   CHECK(r.err.find("roll: expected a number or {\"deg\": x}") != std::string::npos);
+  r = run_wlx("ik", R"({"roll": {"deg/s": 3}})");  // a rate's unit for an angle: a mistake, not a synonym
+  CHECK(r.code == 2);
+  CHECK(r.err == "wlx: error: roll: expected a number or {\"deg\": x}, got {\"deg/s\":3}\n");
   r = run_wlx("ik", R"({"start": {"psi_l2": 0.1}})");
   CHECK(r.code == 2);
   CHECK(r.err == "wlx: error: start: is Newton's starting guess: it needs \"method\": \"newton\" (the closed form takes no start)\n");

@@ -93,6 +93,18 @@ TEST_CASE("scenarios: ST-B: with the straddle angles dependent, roll, yaw and y_
   }
 }
 
+TEST_CASE("scenarios: {\"deg\": x} for an initial angle and {\"deg/s\": x} for an angular rate are x * pi / 180 in SI") {
+  const auto parse = [](const std::string& initial_roll, const std::string& roll_rate) {
+    return commands::parse_scenario(nlohmann::json::parse(R"({"dependent": ["y_C", "yaw"], "duration": 1, "initial": {"roll": )" +
+                                                          initial_roll + R"(}, "rates": {"roll": )" + roll_rate + "}}"));
+  };
+  const auto in_degrees = parse(R"({"deg": 3})", R"({"deg/s": -5})");
+  const auto in_si = parse("0.05235987755982988", "-0.08726646259971647");  // 3 deg, -5 deg/s
+  const int roll = c::roll;
+  CHECK(in_degrees.initial(roll) == in_si.initial(roll));
+  CHECK(in_degrees.rates(roll) == in_si.rates(roll));
+}
+
 TEST_CASE("scenarios: bad scenario files get messages naming the field") {
   const auto message = [](const std::string& text) {
     try {
@@ -106,6 +118,11 @@ TEST_CASE("scenarios: bad scenario files get messages naming the field") {
         "rates.rol: unknown key; did you mean 'roll'?");
   CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "rates": {"x_C": {"deg/s": 3}}})") ==
         "rates.x_C: only angles may be given in degrees; give this value in SI units");
+  // One degree form per quantity: an angle in "deg", an angular rate in "deg/s"; the other is a mistake.
+  CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "initial": {"roll": {"deg/s": 3}}})") ==
+        "initial.roll: expected a number or {\"deg\": x}, got {\"deg/s\":3}");
+  CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "rates": {"roll": {"deg": 3}}})") ==
+        "rates.roll: expected a number or {\"deg/s\": x}, got {\"deg\":3}");
   CHECK(message(R"({"dependent": ["y_C"], "duration": 1})") == "dependent: must be an array of 2 names, got [\"y_C\"]");
   CHECK(message(R"({"dependent": ["y_C", "yaw"]})") == "duration: missing: the run's length in seconds");
   CHECK(message(R"({"dependent": ["y_C", "yaw"], "duration": 1, "integrator": "rk45"})") ==
