@@ -10,6 +10,7 @@
 #include <wlx/error.hpp>
 
 #include <filesystem>
+#include <vector>
 
 WLX_COMMANDS_BEGIN
 
@@ -52,12 +53,15 @@ int run_viewer(const ModelOptions& model_options, const ViewerOptions& options) 
                             "from them): leave --params out");
   if (options.out_dir.empty()) throw Error("--out", "must name a folder");
   const std::filesystem::path dir(options.out_dir);
+  // Every run named is read first: a bad id is a bad input (exit 2, "did you mean"), whether or
+  // not this wlx has the viewer, and nothing is written for a request that cannot be met.
+  std::vector<Scenario> scenarios;
+  for (const auto& id : options.runs) scenarios.push_back(parse_scenario(read_scenario_json(id)));
   copy_viewer_files(dir);
   const std::string module = fmt::format("wasm/wlx_{}.js", gen::kModelName);
   if (!std::filesystem::is_regular_file(dir / module))
     throw Error("--model", fmt::format("the viewer was built without model '{}' ({} is missing)", gen::kModelName, module));
-  for (const auto& id : options.runs) {
-    const Scenario scenario = parse_scenario(read_scenario_json(id));
+  for (const Scenario& scenario : scenarios) {
     const Trajectory trajectory = simulate(scenario);
     if (!trajectory.complete) fmt::print(stderr, "wlx viewer: run {} stopped early ({}); its samples up to then are shown\n", scenario.id, trajectory.error);
     write_viewer_run(dir, scenario, trajectory);
