@@ -191,6 +191,28 @@ FunctionSpec derive_kinematic_update(const Model& m) {
   return fn;
 }
 
+FunctionSpec derive_dynamics_update(const Model& m) {
+  FunctionSpec fn{"dynamics_update", "dynamics_update.hpp",
+                  "The position-level part of an inverse-dynamics step in one pass: dPhi/ds, the non-holonomic "
+                  "rows C(s) and the bodies' CoM, orientation and Jacobians (the outputs of closure, "
+                  "nonholonomic and bodies that need s only, sharing their common subexpressions).",
+                  false, {}};
+  const FunctionSpec c = derive_closure(m), n = derive_nonholonomic(m), b = derive_bodies(m);
+  fn.outputs = {c.outputs[1], n.outputs[0], b.outputs[0], b.outputs[1], b.outputs[2], b.outputs[3]};
+  return fn;
+}
+
+FunctionSpec derive_dynamics_convective(const Model& m) {
+  FunctionSpec fn{"dynamics_convective", "dynamics_convective.hpp",
+                  "The velocity-level part of an inverse-dynamics step in one pass: the convective terms of the "
+                  "closure and of the non-holonomic rows, and the bodies' Jdot s' (the outputs of convective and "
+                  "bodies that need s', sharing their common subexpressions).",
+                  true, {}};
+  const FunctionSpec c = derive_convective(m), b = derive_bodies(m);
+  fn.outputs = {c.outputs[0], c.outputs[1], b.outputs[4], b.outputs[5]};
+  return fn;
+}
+
 FunctionSpec derive_clearance(const Model& m) {
   FunctionSpec fn{"clearance", "clearance.hpp",
                   "Ground clearance: the height above z = 0 of the lowest corner of the box attached to frame " +
@@ -212,7 +234,9 @@ std::vector<Derivation> derivations(const Model& m) {
                               {"nonholonomic", derive_nonholonomic},
                               {"convective", derive_convective},
                               {"bodies", derive_bodies},
-                              {"kinematic_update", derive_kinematic_update}};
+                              {"kinematic_update", derive_kinematic_update},
+                              {"dynamics_update", derive_dynamics_update},
+                              {"dynamics_convective", derive_dynamics_convective}};
   if (m.clearance) all.push_back({"clearance", derive_clearance});
   return all;
 }

@@ -38,6 +38,10 @@ FunctionSpec derive_bodies(const Model& m);
 // Kinematics, closure and non-holonomic rows fused into one function, so that their common
 // subexpressions (the frames' rotations and positions) are computed once per update.
 FunctionSpec derive_kinematic_update(const Model& m);
+// An inverse-dynamics step's two passes, fused the same way: at s, dPhi/ds, C(s) and the bodies'
+// Jacobians; at s and s', the convective terms of both.
+FunctionSpec derive_dynamics_update(const Model& m);
+FunctionSpec derive_dynamics_convective(const Model& m);
 
 // The height of the lowest corner of the model's clearance box above the ground (z = 0 of K0).
 FunctionSpec derive_clearance(const Model& m);

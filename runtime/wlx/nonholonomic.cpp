@@ -152,6 +152,11 @@ void solve_dependent_rates(const Model& model, Data& d, const Coordinates& s, Co
                            const DependentPair& pair, const NonholonomicOptions& options) {
   // dPhi/ds and C(s) from the fused generated function: they share most subexpressions.
   gen::kinematic_update(s, model.params(), {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
+  solve_dependent_rates_prepared(d, sdot, pair, options);
+}
+
+void solve_dependent_rates_prepared(Data& d, Coordinates& sdot, const DependentPair& pair,
+                                    const NonholonomicOptions& options) {
   reduce(d);
   Eigen::Matrix<double, kNq, 1> q_rate = sdot.head<kNq>();
   for (int k = 0; k < kWheelCount; ++k) {
@@ -177,6 +182,10 @@ void solve_dependent_rates(const Model& model, Data& d, const Coordinates& s, Co
 void solve_dependent_accelerations(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot,
                                    Coordinates& sddot, const DependentPair& pair) {
   gen::convective(s, sdot, model.params(), {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot});
+  solve_dependent_accelerations_prepared(d, sddot, pair);
+}
+
+void solve_dependent_accelerations_prepared(Data& d, Coordinates& sddot, const DependentPair& pair) {
   Eigen::Matrix<double, kNq, 1> q_acc = sddot.head<kNq>();
   for (int k : pair.index) q_acc(k) = 0;
   // Phi_dep s''_dep = -(Phi_q q'' + conv_Phi) and C s'' + conv_C = 0 give

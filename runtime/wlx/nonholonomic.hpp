@@ -57,6 +57,13 @@ void solve_dependent_rates(const Model& model, Data& data, const Coordinates& s,
 void solve_dependent_accelerations(const Model& model, Data& data, const Coordinates& s, const Coordinates& sdot,
                                    Coordinates& sddot, const DependentPair& pair);
 
+// The same two solves when data's dPhi/ds and C(s) (velocity level), and its dPhi/ds' s' and
+// C' s' (acceleration level), are current already: the inverse-dynamics step computes them in its
+// fused generated passes together with the bodies' Jacobians.
+void solve_dependent_rates_prepared(Data& data, Coordinates& sdot, const DependentPair& pair,
+                                    const NonholonomicOptions& options = {});
+void solve_dependent_accelerations_prepared(Data& data, Coordinates& sddot, const DependentPair& pair);
+
 // After solve_dependent_rates at s (same pair): the full rates s' caused by a unit rate of each
 // input in `commanded` (one column each), every other commanded rate zero. Linear in the rates,
 // so s' = T u for u the rates of `commanded`.

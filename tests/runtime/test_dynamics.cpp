@@ -7,6 +7,8 @@
 #include <wlx/ik.hpp>
 #include <wlx/simulation.hpp>
 
+#include <Eigen/QR>
+
 #include <cmath>
 #include <numbers>
 
@@ -82,6 +84,37 @@ TEST_CASE("dynamics: J_beta^T tau = Q* and the power balance tau . beta' = Q* . 
   MESSAGE("relative errors: J_beta^T tau - Q* " << worst_force << ", power " << worst_power);
   CHECK(worst_force <= 1e-12);
   CHECK(worst_power <= 1e-12);
+}
+
+TEST_CASE("dynamics: the torques are the weighted least-norm solution to rounding, up to a condition of 1e11") {
+  // J_beta = U diag(sigma) V^T with sigma from 1 down to 10^-k: the fast unpivoted path serves up
+  // to a condition of 1e12, the pivoted QR beyond. The reference is the same solution in long
+  // double (complete orthogonal decomposition, 11 more bits): the double result must be within
+  // its backward-stability bound, cond * eps * a small factor (here 64).
+  using LongJacobian = Eigen::Matrix<long double, 8, 4>;
+  std::mt19937_64 rng(63);
+  for (int k = 0; k <= 11; ++k) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const Eigen::Matrix<double, 8, 8> U = Eigen::Matrix<double, 8, 8>::Random().householderQr().householderQ();
+      const Eigen::Matrix4d V = Eigen::Matrix4d::Random().householderQr().householderQ();
+      Eigen::Vector4d sigma(1, std::pow(10.0, -k / 3.0), std::pow(10.0, -2 * k / 3.0), std::pow(10.0, -k));
+      ActuatorJacobian J = U.leftCols<4>() * sigma.asDiagonal() * V.transpose();
+      const CommandVector Qstar = random4(rng, 1.0);
+      for (const Weighting& w : {Weighting::strong_weak(), Weighting::contribution()}) {
+        const TorqueVector tau = distribute_torques(J, Qstar, w);
+        // S S^T = W^-1 as distribute_torques defines it for these two diagonal weightings.
+        TorqueVector S = w.kind == Weighting::Kind::strong_weak ? kStrongWeakDiagonal.cwiseInverse().cwiseSqrt().eval()
+                                                                : J.rowwise().norm().cwiseSqrt().eval();
+        const LongJacobian A = (S.asDiagonal() * J).cast<long double>();
+        // tau = S x, x the minimum-norm solution of A^T x = Q*.
+        const Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<long double, 4, 8>> cod(A.transpose());
+        const Eigen::Matrix<long double, 8, 1> x = cod.solve(Qstar.cast<long double>());
+        const TorqueVector reference = (S.cast<long double>().asDiagonal() * x).cast<double>();
+        const double condition = std::pow(10.0, k) * S.maxCoeff() / S.minCoeff();
+        CHECK((tau - reference).norm() <= 64 * condition * 2.2e-16 * reference.norm());
+      }
+    }
+  }
 }
 
 TEST_CASE("dynamics: the weighted least norm is the optimum (no other solution has a smaller tau^T W tau)") {

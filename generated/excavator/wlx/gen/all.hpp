@@ -13,8 +13,10 @@
 //   convective               353         62310          1867
 //   bodies                   315         58902          2163
 //   kinematic_update           194         48373          1304
+//   dynamics_update           218         59522          1874
+//   dynamics_convective           389         98996          2274
 //   clearance                  0            19            20
-//   total                               230259          7501
+//   total                               388777         11649
 #pragma once
 
 #include "ik.hpp"
@@ -27,4 +29,6 @@
 #include "convective.hpp"
 #include "bodies.hpp"
 #include "kinematic_update.hpp"
+#include "dynamics_update.hpp"
+#include "dynamics_convective.hpp"
 #include "clearance.hpp"

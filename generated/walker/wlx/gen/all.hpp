@@ -13,8 +13,10 @@
 //   convective               409         68496          1721
 //   bodies                   388         63427          2538
 //   kinematic_update           234         60493          1338
+//   dynamics_update           298         73148          2095
+//   dynamics_convective           483        106473          2253
 //   clearance                  0            19            20
-//   total                               271028          7881
+//   total                               450649         12229
 #pragma once
 
 #include "ik.hpp"
@@ -27,4 +29,6 @@
 #include "convective.hpp"
 #include "bodies.hpp"
 #include "kinematic_update.hpp"
+#include "dynamics_update.hpp"
+#include "dynamics_convective.hpp"
 #include "clearance.hpp"
