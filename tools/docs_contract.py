@@ -4,11 +4,13 @@
   docs_contract.py examples --build DIR   run every shell example of the documentation and check
                                           the outputs against what the text around it promises
   docs_contract.py help --build DIR       every option in --help (wlx and each subcommand,
-                                          wlx_bench, wlx-gen) is in the README's synopses, and back
+                                          wlx_bench, wlx-gen, tools/header_compile_times.py) is in
+                                          the README's synopses, and back
   docs_contract.py figures --build DIR --check
                                           the README's deterministic figures (integrator steps,
                                           evaluations and errors; the benchmark table's operation
-                                          counts) equal what the code produces now
+                                          counts; the generation table's models and headers) equal
+                                          what the code produces now
   docs_contract.py figures --build DIR --write
                                           regenerate every figure section of README.md, timings
                                           included (tools/readme_figures.sh)
@@ -40,6 +42,8 @@ import subprocess
 import sys
 import tempfile
 import time
+
+import header_compile_times
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCUMENTS = ["README.md", "scenarios/README.md"] + sorted(
@@ -461,6 +465,13 @@ def cmd_help(options):
         _, positionals = help_options(text)
         if len(positionals) != len(documented_positionals):
             problems.append(f"wlx-gen: positionals {sorted(positionals)} in --help, {sorted(documented_positionals)} in README.md")
+    # tools/header_compile_times.py: argparse's --help lists each option at the start of a line.
+    text = run([sys.executable, os.path.join(ROOT, "tools", "header_compile_times.py"), "--help"]).stdout
+    listed = set(re.findall(r"^\s+(--[\w-]+)", text, flags=re.M)) - {"--help"}
+    m = re.search(r"`tools/header_compile_times\.py ([^`]*)`", readme)
+    documented, _ = synopsis_options(m[1]) if m else (set(), set())
+    for option in sorted(listed ^ documented):
+        problems.append(f"tools/header_compile_times.py {option}: in only one of --help and README.md's synopsis")
     problems += key_problems(wlx, readme)
     problems += python_problems(options.build, readme)
     layout = re.search(r"^cli/\s+the wlx command: (.*)$", readme, flags=re.M)
@@ -469,8 +480,8 @@ def cmd_help(options):
         problems.append(f"README.md's layout lists the subcommands {listed}; wlx --help lists {subcommands}")
     if problems:
         raise ContractError("\n".join(problems))
-    print(f"--help of wlx ({len(paths)} subcommands), wlx_bench and wlx-gen, and the JSON keys of wlx ik and "
-          "scenario files agree with README.md and scenarios/README.md")
+    print(f"--help of wlx ({len(paths)} subcommands), wlx_bench, wlx-gen and tools/header_compile_times.py, and "
+          "the JSON keys of wlx ik and scenario files agree with README.md and scenarios/README.md")
 
 
 def python_problems(build, readme):
@@ -645,17 +656,92 @@ def benchmark_table(rows):
     return "\n".join(lines) + "\n"
 
 
-def generator_time(build):
+GENERATION_REPETITIONS = 5
+GENERATION_BENCHMARK = "BM_generate_everything/"
+
+
+def generator_bench(build, *arguments, timeout=COMMAND_TIMEOUT_S):
+    """wlx_bench_generator's BM_generate_everything/<model> benchmarks, one per built-in model."""
     path = os.path.join(build, "wlx_bench_generator")
-    r = run([path, "--benchmark_format=json", "--benchmark_filter=everything|all|full"], timeout=1800)
+    r = run([path, f"--benchmark_filter=^{GENERATION_BENCHMARK}", *arguments], timeout=timeout)
     if r.returncode != 0:
-        return None
-    benchmarks = json.loads(r.stdout).get("benchmarks", [])
-    if not benchmarks:
-        return None
-    b = benchmarks[-1]
-    scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b.get("time_unit", "ns")]
-    return b["name"], b["real_time"] * scale
+        raise ContractError(f"{path}: exit {r.returncode}\n{r.stderr}")
+    return r.stdout
+
+
+def generated_models(build):
+    """The models wlx_bench_generator times, in its order."""
+    names = generator_bench(build, "--benchmark_list_tests").split()
+    return [name.removeprefix(GENERATION_BENCHMARK) for name in names]
+
+
+def generation_times(build):
+    """Per model, the median time of BM_generate_everything/<model> in ms."""
+    out = generator_bench(build, "--benchmark_format=json", f"--benchmark_repetitions={GENERATION_REPETITIONS}",
+                          "--benchmark_report_aggregates_only=true", timeout=1800)
+    scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
+    return {b["run_name"].removeprefix(GENERATION_BENCHMARK): b["real_time"] * scale[b["time_unit"]]
+            for b in json.loads(out)["benchmarks"] if b.get("aggregate_name") == "median"}
+
+
+def compiled_headers(models):
+    """Per model, the headers tools/header_compile_times.py compiles (its function headers and
+    all.hpp), for the table's rows; the models must be those of generated/."""
+    generated = os.path.join(ROOT, "generated")
+    if sorted(models) != header_compile_times.models(generated):
+        raise ContractError(f"wlx_bench_generator times the models {models}; generated/ holds "
+                            f"{header_compile_times.models(generated)}")
+    return {m: list(header_compile_times.function_headers(os.path.join(generated, m, "wlx", "gen"))) + ["all.hpp"]
+            for m in models}
+
+
+def generation_figures(build, today):
+    """Per model: the generation time and each generated header's -O2 compile time."""
+    models = generated_models(build)
+    headers = compiled_headers(models)
+    times = generation_times(build)
+    compiled = header_compile_times.measure(header_compile_times.parse([a for m in models for a in ("--model", m)]))
+    stated = (f"Measured {today} on {machine()} by `tools/readme_figures.sh`: generating is the median of "
+              f"{GENERATION_REPETITIONS} runs of `./build/wlx_bench_generator`'s `{GENERATION_BENCHMARK}<model>`; "
+              f"compiling is `tools/header_compile_times.py` ({compiled['compiler']}, "
+              f"`{' '.join(compiled['flags'])}`, median of {compiled['repeat']} compiles) of a file that includes the "
+              "header and has the compiler emit each of its functions for `double`; in parentheses, minus the "
+              "baseline.")
+    lines = ["| | " + " | ".join(models) + " |", "|---|" + "---:|" * len(models),
+             f"| generating every header (`{GENERATION_BENCHMARK}<model>`), ms | " +
+             " | ".join(f"{times[m]:.0f}" for m in models) + " |",
+             "| compiling a file with only `Eigen/Core` (the baseline), s | " +
+             " | ".join(f"{compiled['baseline_seconds']:.2f}" for _ in models) + " |"]
+    for header in dict.fromkeys(h for m in models for h in headers[m]):
+        cells = []
+        for m in models:
+            row = next((r for r in compiled["models"][m] if r["header"] == header), None)
+            cells.append(f"{row['seconds']:.2f} ({row['own_seconds']:.2f})" if row else "")
+        what = " (every function)" if header == "all.hpp" else ""
+        lines.append(f"| compiling `{header}`{what}, s | " + " | ".join(cells) + " |")
+    return stated + "\n\n" + "\n".join(lines) + "\n"
+
+
+def generation_problems(build, body):
+    """The generation table's columns are the models wlx_bench_generator times and generated/
+    holds, its rows their compiled headers (its timings are not checked)."""
+    if not os.path.exists(os.path.join(build, "wlx_bench_generator")):
+        print("wlx_bench_generator not built: the generation table's models are not checked")
+        return []
+    table = readme_table(body)
+    if not table:
+        return ["README.md's generation section has no table (tools/readme_figures.sh writes it)"]
+    models = generated_models(build)
+    problems = []
+    if table[0][1:] != models:
+        problems.append(f"README.md's generation table has the models {table[0][1:]}; wlx_bench_generator times "
+                        f"{models} (tools/readme_figures.sh rewrites the table)")
+    quoted = [m[1] for row in table[1:] for m in [re.search(r"`([\w.]+\.hpp)`", row[0])] if m]
+    expected = list(dict.fromkeys(h for hs in compiled_headers(models).values() for h in hs))
+    if sorted(quoted) != sorted(expected):
+        problems.append(f"README.md's generation table compiles the headers {quoted}; generated/ has {expected} "
+                        "(tools/readme_figures.sh rewrites the table)")
+    return problems
 
 
 def controller_figures(build):
@@ -718,12 +804,11 @@ def cmd_figures(options):
         readme = readme_with(readme, "integrators", integrator_figures(options.build))
         print("wlx_bench --json (a few minutes) ...")
         rows = benchmark_rows(options.build)
-        generated = generator_time(options.build)
         stated = (f"Measured {today} on {machine()} by `tools/readme_figures.sh` (medians of {bench_repetitions(options.build)} repetitions, "
                   f"`./build/wlx_bench --json`; compare ratios, not absolute times, across machines).")
-        if generated:
-            stated += f" Generating everything (`wlx_bench_generator`, `{generated[0]}`) takes {generated[1]:.0f} ms."
         readme = readme_with(readme, "benchmarks", stated + "\n\n" + benchmark_table(rows))
+        print("wlx_bench_generator and tools/header_compile_times.py (a minute or two) ...")
+        readme = readme_with(readme, "generation", generation_figures(options.build, today))
         controller = controller_figures(options.build)
         if controller:
             readme = readme_with(readme, "controller", controller)
@@ -765,6 +850,10 @@ def cmd_figures(options):
                                 f"the generated code has {reported[name] or 'none'}")
     else:
         print("wlx_bench not built: the benchmark table's operation counts are not checked")
+    if "generation" not in sections:
+        problems.append("README.md: no <!-- figures: generation --> section")
+    else:
+        problems += generation_problems(options.build, sections["generation"])
     problems += precision_problems(options.build, readme)
     problems += count_problems(options.build, readme)
     problems += excavator_doc_problems(options.build)

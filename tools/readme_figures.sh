@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Regenerates every figure README.md quotes, in its "<!-- figures: NAME -->" sections: the
 # integrator table (NH-4: steps, evaluations, errors), the benchmark table (every row
-# `wlx_bench --json` reports, with the machine and the date) and the controller's step times.
+# `wlx_bench --json` reports, with the machine and the date), the generation table (per model,
+# wlx_bench_generator's BM_generate_everything/<model> and tools/header_compile_times.py's -O2
+# compile time of each generated header) and the controller's step times.
 # The deterministic figures are checked by the test docs_figures; timings only change here.
 # Run it on a quiet machine after a change that moves the numbers, then commit README.md.
 set -euo pipefail
