@@ -279,6 +279,58 @@ void BM_inverse_dynamics_step(benchmark::State& st) {
     benchmark::DoNotOptimize(tau.data());
   }
 }
+// The generated passes of one inverse-dynamics step: fused (what the step calls), and the same
+// outputs from the separate functions; then the step's generated code alone, IK included, run back
+// to back as the step runs it (its floor: the rest of the step is the runtime's linear algebra).
+void BM_gen_dynamics_passes_fused(benchmark::State& st) {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled_nominal(model);
+  const Coordinates sdot = Coordinates::Constant(0.1);
+  for (auto _ : st) {
+    gen::dynamics_update(s, model.params(),
+                         {.dPhi_ds = &d.dPhi_ds, .C = &d.C, .com = &d.body_com, .rotations = &d.body_rotations,
+                          .Jv = &d.body_Jv, .Jw = &d.body_Jw},
+                         false);
+    gen::dynamics_convective(s, sdot, model.params(),
+                             {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot,
+                              .Jv_dot_sdot = &d.body_Jv_dot_sdot, .Jw_dot_sdot = &d.body_Jw_dot_sdot});
+    benchmark::DoNotOptimize(d.body_Jw_dot_sdot.data());
+  }
+}
+void BM_gen_dynamics_passes_separate(benchmark::State& st) {
+  const Model model;
+  Data d;
+  const Coordinates s = assembled_nominal(model);
+  const Coordinates sdot = Coordinates::Constant(0.1);
+  for (auto _ : st) {
+    gen::kinematic_update(s, model.params(), {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
+    gen::convective(s, sdot, model.params(), {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot});
+    gen::bodies(s, sdot, model.params(),
+                {.com = &d.body_com, .rotations = &d.body_rotations, .Jv = &d.body_Jv, .Jw = &d.body_Jw,
+                 .Jv_dot_sdot = &d.body_Jv_dot_sdot, .Jw_dot_sdot = &d.body_Jw_dot_sdot},
+                false);
+    benchmark::DoNotOptimize(d.body_Jw_dot_sdot.data());
+  }
+}
+void BM_inverse_dynamics_generated_only(benchmark::State& st) {
+  const Model model;
+  Data d;
+  Coordinates s = nominal_inputs();
+  s(gen::coord::x_C) = 0.3;
+  const Coordinates sdot = Coordinates::Constant(0.1);
+  for (auto _ : st) {
+    solve_ik_closed_form(model, s);
+    gen::dynamics_update(s, model.params(),
+                         {.dPhi_ds = &d.dPhi_ds, .C = &d.C, .com = &d.body_com, .rotations = &d.body_rotations,
+                          .Jv = &d.body_Jv, .Jw = &d.body_Jw},
+                         false);
+    gen::dynamics_convective(s, sdot, model.params(),
+                             {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot,
+                              .Jv_dot_sdot = &d.body_Jv_dot_sdot, .Jw_dot_sdot = &d.body_Jw_dot_sdot});
+    benchmark::DoNotOptimize(d.body_Jw_dot_sdot.data());
+  }
+}
 // The whole ID-1 run (495 samples, RK4) with weighting 1.
 void BM_run_ID1(benchmark::State& st) {
   Scenario sc;
@@ -558,6 +610,9 @@ BENCHMARK(BM_base_convective);
 BENCHMARK(BM_base_body_jacobians);
 BENCHMARK(BM_base_newton_cold);
 BENCHMARK(BM_inverse_dynamics_step);
+BENCHMARK(BM_inverse_dynamics_generated_only);
+BENCHMARK(BM_gen_dynamics_passes_fused);
+BENCHMARK(BM_gen_dynamics_passes_separate);
 BENCHMARK(BM_run_ID1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_dependent_rates);
 BENCHMARK(BM_dependent_accelerations);
@@ -676,6 +731,9 @@ int main(int argc, char** argv) {
       {"dependent rates (velocity level)", "BM_dependent_rates", nullptr, 0},
       {"dependent accelerations", "BM_dependent_accelerations", nullptr, 0},
       {"inverse-dynamics step", "BM_inverse_dynamics_step", nullptr, 0},
+      {"  its generated code alone: 4-limb IK + the two passes", "BM_inverse_dynamics_generated_only", nullptr, 0},
+      {"  the two passes, fused (vs kinematic_update + convective + bodies)", "BM_gen_dynamics_passes_fused",
+       "BM_gen_dynamics_passes_separate", ops::dynamics_update + ops::dynamics_convective},
       {"NH-1 run (2001 samples, RK4)", "BM_run_NH1", nullptr, 0},
       {"ID-1 run (495 samples, RK4, torques)", "BM_run_ID1", nullptr, 0},
   };

@@ -137,22 +137,27 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
       partial.col(k).template tail<3>() += Jw.col(j);
     }
     const double m = mass(p, i);
-    const auto A = partial.template topRows<3>();
-    const Eigen::Vector3d a_bias = d.body_Jv_dot_sdot.col(i) + bias_motion.template head<3>();
-    // The rotational part in body axes, where the inertia is diagonal: R^T B, R^T omega, R^T alpha,
-    // with omega = B u (s' = T u).
+    // The rotational rows in body axes, where the inertia is diagonal: R^T B, R^T alpha, and
+    // omega = B u (s' = T u). P = [A; R^T B] and D = diag(m, m, m, I): M += P^T D P in one product.
     const Eigen::Matrix3d& R = d.body_rotations[static_cast<std::size_t>(i)];
     const auto& info = gen::kBodyMass[static_cast<std::size_t>(i)];
-    const Eigen::Vector3d inertia(p.*info.inertia[0], p.*info.inertia[1], p.*info.inertia[2]);
-    const Eigen::Matrix<double, 3, kU> B_body = R.transpose().lazyProduct(partial.template bottomRows<3>());
-    const Eigen::Vector3d omega_body = B_body.lazyProduct(u);
-    const Eigen::Vector3d alpha_body = R.transpose() * (d.body_Jw_dot_sdot.col(i) + bias_motion.template tail<3>());
-    const Eigen::Vector3d spin = inertia.cwiseProduct(omega_body);
-    const Eigen::Matrix<double, 3, kU> IB = inertia.asDiagonal() * B_body;
-    out.M.noalias() += (m * A.transpose()).lazyProduct(A) + B_body.transpose().lazyProduct(IB);
-    out.b.noalias() += A.transpose().lazyProduct(m * a_bias) +
-                       B_body.transpose().lazyProduct(inertia.cwiseProduct(alpha_body) + omega_body.cross(spin));
-    out.Q_gravity.noalias() += A.transpose().lazyProduct(m * gravity);
+    Eigen::Matrix<double, 6, 1> D;
+    D << m, m, m, p.*info.inertia[0], p.*info.inertia[1], p.*info.inertia[2];
+    Eigen::Matrix<double, 6, kU> P;
+    P.template topRows<3>() = partial.template topRows<3>();
+    P.template bottomRows<3>().noalias() = R.transpose().lazyProduct(partial.template bottomRows<3>());
+    const Eigen::Matrix<double, 6, kU> DP = D.asDiagonal() * P;
+    out.M.noalias() += P.transpose().lazyProduct(DP);
+    // Generalized inertia forces of the bias motion: P^T [m a_bias; I alpha + omega x I omega].
+    const Eigen::Vector3d omega_body = P.template bottomRows<3>().lazyProduct(u);
+    const Eigen::Vector3d spin = D.template tail<3>().cwiseProduct(omega_body);
+    Eigen::Matrix<double, 6, 1> force;
+    force.template head<3>() = m * (d.body_Jv_dot_sdot.col(i) + bias_motion.template head<3>());
+    force.template tail<3>() =
+        D.template tail<3>().cwiseProduct(R.transpose() * (d.body_Jw_dot_sdot.col(i) + bias_motion.template tail<3>())) +
+        omega_body.cross(spin);
+    out.b.noalias() += P.transpose().lazyProduct(force);
+    out.Q_gravity.noalias() += P.template topRows<3>().transpose().lazyProduct(m * gravity);
   });
   out.Qstar = out.M * u_dot + out.b - out.Q_gravity;
   for (int r = 0; r < kActuatedCount; ++r) out.J_beta.row(r) = out.T.row(kActuatedJoints[static_cast<std::size_t>(r)]);
