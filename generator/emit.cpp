@@ -120,7 +120,23 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
   const int nw = static_cast<int>(m.wheels.size());
 
   std::string t = banner(m, opt, "Model sizes, names and fixed-size types.");
-  t += "#pragma once\n\n#include <Eigen/Core>\n\n#include <array>\n#include <string_view>\n\n" + namespace_open(opt);
+  // The double functions are also compiled for AVX2 + FMA and picked at run time, so that the
+  // committed headers stay portable (SSE2 at worst) and a machine that has the instructions uses
+  // them: the generated code is long chains of scalar multiply-adds, which FMA shortens. Only GCC
+  // and clang on x86-64 (the target and flatten attributes, __builtin_cpu_supports); not when the
+  // build targets AVX2 + FMA already. FMA rounds a*b+c once, so results differ in the last bits.
+  t += "#pragma once\n\n#include <Eigen/Core>\n\n#include <array>\n#include <string_view>\n\n"
+       "// The double functions have an AVX2 + FMA version, picked at run time when the CPU has both\n"
+       "// (x86-64 with GCC or clang, unless the build targets them anyway). Its results can differ from\n"
+       "// the portable version's in the last bits (a fused multiply-add rounds once). Define\n"
+       "// WLX_GEN_NO_MULTIVERSION to compile only the portable version.\n"
+       "#if !defined(WLX_GEN_NO_MULTIVERSION) && defined(__x86_64__) && defined(__GNUC__) && \\\n"
+       "    !(defined(__AVX2__) && defined(__FMA__)) && defined(__has_attribute)\n"
+       "#if __has_attribute(target) && __has_attribute(flatten)\n"
+       "#define WLX_GEN_MULTIVERSION 1\n"
+       "#endif\n"
+       "#endif\n\n" +
+       namespace_open(opt);
   t += fmt::format("\ninline constexpr std::string_view kModelName = {};\n"
                    "inline constexpr std::string_view kModelDescription = {};\n",
                    quoted(m.name), quoted(m.description));
@@ -164,6 +180,13 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
       "// output pointer may be nullptr (std::type_identity_t, which C++17 lacks).\n"
       "template <typename T> struct NonDeducedType {{ using type = T; }};\n"
       "template <typename T> using NonDeduced = typename NonDeducedType<T>::type;\n"
+      "#if defined(WLX_GEN_MULTIVERSION)\n"
+      "// Whether this CPU (and its operating system) runs AVX2 and FMA instructions; asked once.\n"
+      "inline bool has_avx2_fma() noexcept {{\n"
+      "  static const bool yes = (__builtin_cpu_init(), __builtin_cpu_supports(\"avx2\") && __builtin_cpu_supports(\"fma\"));\n"
+      "  return yes;\n"
+      "}}\n"
+      "#endif\n"
       "}}  // namespace detail\n\n",
       n, nf, nc, nw, nb);
   t += "// Index of each coordinate in s (the model file's order: inputs, then dependent joints).\nnamespace coord {\n";
@@ -333,12 +356,12 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
          "// zero already (a workspace zeroed once at setup): this function never writes them.\n";
     parameters.push_back({"bool", "bool", "zero_fill"});
   }
-  std::vector<std::string> templated, plain, arguments;
+  std::vector<std::string> templated;
+  std::vector<std::pair<std::string, std::string>> plain;  // declaration, default value
   for (const auto& par : parameters) {
     const std::string default_value = par.name == "zero_fill" ? " = true" : "";
     templated.push_back(par.templated + " " + par.name + default_value);
-    plain.push_back(par.plain + " " + par.name + default_value);
-    arguments.push_back(par.name);
+    plain.emplace_back(par.plain + " " + par.name, default_value);
   }
   t += fmt::format(
       "// Where {}() writes: set the outputs you want; a null pointer skips that output and the\n"
@@ -358,14 +381,44 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   for (const auto& o : fn.outputs) t += fmt::format("  const auto {0} = out.{0};\n", o.name);
   if (fn.needs_rates) t += "  static_cast<void>(sdot);\n";
   t += using_declarations(pr.calls()) + aliases + body + "}\n\n";
-  t += fmt::format("// {0}() in double, for any Eigen expression of the coordinates.\ninline void {0}({1}) noexcept {{\n  {0}<double>({2});\n}}\n\n",
-                   fn.name, fmt::join(plain, ", "), fmt::join(arguments, ", "));
+  t += double_overload(fn.name, "void", plain, "for any Eigen expression of the coordinates");
   t += fmt::format("namespace operations {{\n// Operations {}() evaluates with every output requested (adds, muls, divs, calls).\n"
                    "inline constexpr long {} = {};\n}}  // namespace operations\n\n",
                    fn.name, fn.name, total.total());
   t += namespace_close(opt);
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return {"wlx/gen/" + fn.header, t};
+}
+
+std::string double_overload(const std::string& name, const std::string& result,
+                            const std::vector<std::pair<std::string, std::string>>& parameters, const std::string& why) {
+  std::vector<std::string> with_defaults, without, arguments;
+  for (const auto& [declaration, default_value] : parameters) {
+    with_defaults.push_back(declaration + default_value);
+    without.push_back(declaration);
+    arguments.push_back(declaration.substr(declaration.rfind(' ') + 1));
+  }
+  const std::string call = fmt::format("{}<double>({})", name, fmt::join(arguments, ", "));
+  // The AVX2 + FMA version: flatten inlines the template's body (sincos and atan2 too) into it, so
+  // all of it is compiled for those instructions; a call to a separate function would run the
+  // portable code.
+  return fmt::format(
+      "#if defined(WLX_GEN_MULTIVERSION)\n"
+      "namespace detail {{\n"
+      "// {0}<double>() compiled for AVX2 and FMA (types.hpp).\n"
+      "__attribute__((target(\"avx2,fma\"), flatten)) inline {1} {0}_avx2_fma({2}) noexcept {{\n"
+      "  return {3};\n"
+      "}}\n"
+      "}}  // namespace detail\n"
+      "#endif\n\n"
+      "// {0}() in double, {4}; its AVX2 + FMA version on a CPU that has them (types.hpp).\n"
+      "inline {1} {0}({5}) noexcept {{\n"
+      "#if defined(WLX_GEN_MULTIVERSION)\n"
+      "  if (detail::has_avx2_fma()) return detail::{0}_avx2_fma({6});\n"
+      "#endif\n"
+      "  return {3};\n"
+      "}}\n\n",
+      name, result, fmt::join(without, ", "), call, why, fmt::join(with_defaults, ", "), fmt::join(arguments, ", "));
 }
 
 EmittedFile emit_umbrella(const Model& m, const std::vector<FunctionSpec>& fns, const std::vector<FunctionStats>& stats,

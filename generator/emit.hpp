@@ -6,6 +6,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace wlx::codegen {
@@ -53,6 +54,11 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt);
 // patterns (emit_ik.cpp documents them), with all its branches; `report` receives one line per
 // limb: the pattern used, or why none applies (that limb is then left to Newton's method).
 EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<std::string>& report);
+// The double overload of the function template `name` (parameters: declaration and default value,
+// each): it calls name<double>(), or on x86-64 with GCC or clang its AVX2 + FMA build when the CPU
+// has those (types.hpp: WLX_GEN_MULTIVERSION). `why`: what the overload is for, in its comment.
+std::string double_overload(const std::string& name, const std::string& result,
+                            const std::vector<std::pair<std::string, std::string>>& parameters, const std::string& why);
 // One header per derived function; `stats` receives the numbers written into its banner.
 EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOptions& opt, FunctionStats& stats);
 // The umbrella header including everything, with the operation-count table.

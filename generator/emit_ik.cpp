@@ -851,6 +851,14 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
         "  static_cast<void>(p);\n",
         m.limbs.size(), ops.total(), ops.adds, ops.muls, ops.divs, ops.calls);
     t += prologue + body + "}\n\n";
+    t += double_overload("ik_all", "IkStatus",
+                         {{"const Coordinates& s", ""},
+                          {"const Params& p", ""},
+                          {fmt::format("const std::array<int, {}>& branches", m.limbs.size()), ""},
+                          {"Coordinates& out", ""},
+                          {"int& failed", ""},
+                          {"IkDiagnostics& why", ""}},
+                         "what the runtime calls");
     report.push_back(fmt::format("all limbs fused: {} operations", ops.total()));
   }
   t += namespace_close(opt);

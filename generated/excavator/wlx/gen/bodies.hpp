@@ -807,9 +807,21 @@ inline void bodies(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<Coor
   }
 }
 
-// bodies() in double, for any Eigen expression of the coordinates.
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// bodies<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline void bodies_avx2_fma(const Coordinates& s, const Coordinates& sdot, const Params& p, const BodiesOutputs& out, bool zero_fill) noexcept {
+  return bodies<double>(s, sdot, p, out, zero_fill);
+}
+}  // namespace detail
+#endif
+
+// bodies() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
 inline void bodies(const Coordinates& s, const Coordinates& sdot, const Params& p, const BodiesOutputs& out, bool zero_fill = true) noexcept {
-  bodies<double>(s, sdot, p, out, zero_fill);
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::bodies_avx2_fma(s, sdot, p, out, zero_fill);
+#endif
+  return bodies<double>(s, sdot, p, out, zero_fill);
 }
 
 namespace operations {

@@ -61,9 +61,21 @@ inline void clearance(const CoordinatesOf<Scalar>& s, const Params& p, const det
   }
 }
 
-// clearance() in double, for any Eigen expression of the coordinates.
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// clearance<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline void clearance_avx2_fma(const Coordinates& s, const Params& p, const ClearanceOutputs& out) noexcept {
+  return clearance<double>(s, p, out);
+}
+}  // namespace detail
+#endif
+
+// clearance() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
 inline void clearance(const Coordinates& s, const Params& p, const ClearanceOutputs& out) noexcept {
-  clearance<double>(s, p, out);
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::clearance_avx2_fma(s, p, out);
+#endif
+  return clearance<double>(s, p, out);
 }
 
 namespace operations {

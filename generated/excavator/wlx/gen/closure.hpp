@@ -395,9 +395,21 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
   }
 }
 
-// closure() in double, for any Eigen expression of the coordinates.
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// closure<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline void closure_avx2_fma(const Coordinates& s, const Params& p, const ClosureOutputs& out, bool zero_fill) noexcept {
+  return closure<double>(s, p, out, zero_fill);
+}
+}  // namespace detail
+#endif
+
+// closure() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
 inline void closure(const Coordinates& s, const Params& p, const ClosureOutputs& out, bool zero_fill = true) noexcept {
-  closure<double>(s, p, out, zero_fill);
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::closure_avx2_fma(s, p, out, zero_fill);
+#endif
+  return closure<double>(s, p, out, zero_fill);
 }
 
 namespace operations {

@@ -517,9 +517,21 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
   }
 }
 
-// convective() in double, for any Eigen expression of the coordinates.
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// convective<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline void convective_avx2_fma(const Coordinates& s, const Coordinates& sdot, const Params& p, const ConvectiveOutputs& out) noexcept {
+  return convective<double>(s, sdot, p, out);
+}
+}  // namespace detail
+#endif
+
+// convective() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
 inline void convective(const Coordinates& s, const Coordinates& sdot, const Params& p, const ConvectiveOutputs& out) noexcept {
-  convective<double>(s, sdot, p, out);
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::convective_avx2_fma(s, sdot, p, out);
+#endif
+  return convective<double>(s, sdot, p, out);
 }
 
 namespace operations {

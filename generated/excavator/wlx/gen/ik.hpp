@@ -850,6 +850,23 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   return IkStatus::ok;
 }
 
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// ik_all<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline IkStatus ik_all_avx2_fma(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out, int& failed, IkDiagnostics& why) noexcept {
+  return ik_all<double>(s, p, branches, out, failed, why);
+}
+}  // namespace detail
+#endif
+
+// ik_all() in double, what the runtime calls; its AVX2 + FMA version on a CPU that has them (types.hpp).
+inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out, int& failed, IkDiagnostics& why) noexcept {
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::ik_all_avx2_fma(s, p, branches, out, failed, why);
+#endif
+  return ik_all<double>(s, p, branches, out, failed, why);
+}
+
 }  // namespace gen
 }  // namespace excavator
 }  // namespace wlx

@@ -635,9 +635,21 @@ inline void kinematic_update(const CoordinatesOf<Scalar>& s, const Params& p, co
   }
 }
 
-// kinematic_update() in double, for any Eigen expression of the coordinates.
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// kinematic_update<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline void kinematic_update_avx2_fma(const Coordinates& s, const Params& p, const KinematicUpdateOutputs& out, bool zero_fill) noexcept {
+  return kinematic_update<double>(s, p, out, zero_fill);
+}
+}  // namespace detail
+#endif
+
+// kinematic_update() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
 inline void kinematic_update(const Coordinates& s, const Params& p, const KinematicUpdateOutputs& out, bool zero_fill = true) noexcept {
-  kinematic_update<double>(s, p, out, zero_fill);
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::kinematic_update_avx2_fma(s, p, out, zero_fill);
+#endif
+  return kinematic_update<double>(s, p, out, zero_fill);
 }
 
 namespace operations {

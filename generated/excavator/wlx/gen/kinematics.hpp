@@ -408,9 +408,21 @@ inline void kinematics(const CoordinatesOf<Scalar>& s, const Params& p, const de
   }
 }
 
-// kinematics() in double, for any Eigen expression of the coordinates.
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// kinematics<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline void kinematics_avx2_fma(const Coordinates& s, const Params& p, const KinematicsOutputs& out) noexcept {
+  return kinematics<double>(s, p, out);
+}
+}  // namespace detail
+#endif
+
+// kinematics() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
 inline void kinematics(const Coordinates& s, const Params& p, const KinematicsOutputs& out) noexcept {
-  kinematics<double>(s, p, out);
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::kinematics_avx2_fma(s, p, out);
+#endif
+  return kinematics<double>(s, p, out);
 }
 
 namespace operations {

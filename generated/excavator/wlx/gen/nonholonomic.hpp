@@ -247,9 +247,21 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   }
 }
 
-// nonholonomic() in double, for any Eigen expression of the coordinates.
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// nonholonomic<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline void nonholonomic_avx2_fma(const Coordinates& s, const Params& p, const NonholonomicOutputs& out, bool zero_fill) noexcept {
+  return nonholonomic<double>(s, p, out, zero_fill);
+}
+}  // namespace detail
+#endif
+
+// nonholonomic() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
 inline void nonholonomic(const Coordinates& s, const Params& p, const NonholonomicOutputs& out, bool zero_fill = true) noexcept {
-  nonholonomic<double>(s, p, out, zero_fill);
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::nonholonomic_avx2_fma(s, p, out, zero_fill);
+#endif
+  return nonholonomic<double>(s, p, out, zero_fill);
 }
 
 namespace operations {

@@ -10,7 +10,7 @@
 // rounded values for |x| <= 1e6; larger, infinite or NaN angles go to std::sin / std::cos.
 // Method: x = n pi/2 + r with |r| <= pi/4 (Cody-Waite reduction with pi/2 split in three parts),
 // Taylor polynomials of sin r and cos r, the quadrant n mod 4 picked by bit masks, so the whole
-// pass is branch-free and runs on SIMD registers (2 lanes with SSE2, 4 with AVX).
+// pass is branch-free and runs on SIMD registers (4 lanes: one AVX or two SSE2 registers).
 // Compilers without GCC vector extensions, and -ffast-math builds (whose reassociation would undo
 // the rounding trick), get the std:: functions.
 #pragma once
@@ -43,56 +43,51 @@ inline constexpr double kPiHead = 3.141592653589793, kPiTail = 1.224646799147353
 
 #if (defined(__GNUC__) || defined(__clang__)) && !defined(__FAST_MATH__)
 #define WLX_GEN_SIMD_SINCOS 1
-#if defined(__AVX__)
+// 4 lanes whatever the build targets: one AVX register, so that the AVX2 version of the generated
+// functions (types.hpp) gets them, or two SSE2 registers, two independent chains (as fast as one
+// 2-lane vector at a time). Vectors are passed by reference only: by value, a 32-byte vector's
+// calling convention would depend on whether the translation unit targets AVX.
+// reinterpret_cast between vector types of the same size gives the same bits (GCC and clang).
 inline constexpr std::size_t kLanes = 4;
 typedef double Doubles __attribute__((vector_size(32)));
 typedef std::uint64_t Bits __attribute__((vector_size(32)));
-#else
-inline constexpr std::size_t kLanes = 2;
-typedef double Doubles __attribute__((vector_size(16)));
-typedef std::uint64_t Bits __attribute__((vector_size(16)));
-#endif
 
-// The bits of a vector as another vector type of the same size (memcpy: no C-style vector cast,
-// and no aliasing; compilers turn it into nothing).
-template <typename To, typename From>
-inline To bit_cast(From from) noexcept {
-  static_assert(sizeof(To) == sizeof(From), "same size");
-  To to;
-  std::memcpy(&to, &from, sizeof to);
-  return to;
-}
-
-inline void sincos_lanes(Doubles x, Doubles& sin_x, Doubles& cos_x) noexcept {
+inline void sincos_lanes(const Doubles& x, Doubles& sin_x, Doubles& cos_x) noexcept {
   const Doubles shifted = x * kTwoOverPi + kRoundToInteger;
   const Doubles n = shifted - kRoundToInteger;          // nearest integer to x / (pi/2)
-  const Bits quadrant = bit_cast<Bits>(shifted);  // its low bits: n mod 4
+  const Bits quadrant = reinterpret_cast<Bits>(shifted);  // its low bits: n mod 4
   const Doubles r = ((x - n * kHalfPiHi) - n * kHalfPiMid) - n * kHalfPiLo;
   const Doubles r2 = r * r;
   const Doubles s = r * (1.0 + r2 * (-0.16666666666666666 + r2 * (0.008333333333333333 + r2 * (-0.0001984126984126984 + r2 * (2.7557319223985893e-06 + r2 * (-2.505210838544172e-08 + r2 * (1.6059043836821613e-10 + r2 * (-7.647163731819816e-13))))))));
   const Doubles c = 1.0 - 0.5 * r2 + r2 * r2 * (0.041666666666666664 + r2 * (-0.001388888888888889 + r2 * (2.48015873015873e-05 + r2 * (-2.755731922398589e-07 + r2 * (2.08767569878681e-09 + r2 * (-1.1470745597729725e-11 + r2 * (4.779477332387385e-14)))))));
-  const Bits s_bits = bit_cast<Bits>(s), c_bits = bit_cast<Bits>(c);
+  const Bits s_bits = reinterpret_cast<Bits>(s), c_bits = reinterpret_cast<Bits>(c);
   const Bits swap = Bits{} - (quadrant & 1);  // odd quadrants exchange sin and cos
   const Bits sin_bits = ((c_bits & swap) | (s_bits & ~swap)) ^ ((quadrant & 2) << 62);  // quadrants 2, 3: -
   const Bits cos_bits = ((s_bits & swap) | (c_bits & ~swap)) ^ (((quadrant + 1) & 2) << 62);  // 1, 2: -
-  sin_x = bit_cast<Doubles>(sin_bits);
-  cos_x = bit_cast<Doubles>(cos_bits);
+  sin_x = reinterpret_cast<Doubles>(sin_bits);
+  cos_x = reinterpret_cast<Doubles>(cos_bits);
 }
 
 // Picks a where the mask is all ones, b where it is zero.
-inline Doubles select(Bits mask, Doubles a, Doubles b) noexcept { return bit_cast<Doubles>((mask & bit_cast<Bits>(a)) | (~mask & bit_cast<Bits>(b))); }
+inline void select(const Bits& mask, const Doubles& a, const Doubles& b, Doubles& out) noexcept {
+  out = reinterpret_cast<Doubles>((mask & reinterpret_cast<Bits>(a)) | (~mask & reinterpret_cast<Bits>(b)));
+}
 
-inline Doubles atan2_lanes(Doubles y, Doubles x) noexcept {
+inline void atan2_lanes(const Doubles& y, const Doubles& x, Doubles& angle) noexcept {
   const Bits sign = Bits{} + 0x8000000000000000u;
-  const Doubles ax = bit_cast<Doubles>(bit_cast<Bits>(x) & ~sign), ay = bit_cast<Doubles>(bit_cast<Bits>(y) & ~sign);
-  const Bits swap = bit_cast<Bits>(ay > ax);  // above the diagonal: atan2 = pi/2 - atan(|x| / |y|)
-  const Doubles num = select(swap, ax, ay), den = select(swap, ay, ax);
-  const Doubles t = num / (den + select(bit_cast<Bits>(den == 0.0), Doubles{} + 1.0, Doubles{}));  // in [0, 1]; 0 / 1 at the origin
+  const Doubles ax = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(x) & ~sign), ay = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(y) & ~sign);
+  const Bits swap = reinterpret_cast<Bits>(ay > ax);  // above the diagonal: atan2 = pi/2 - atan(|x| / |y|)
+  Doubles num, den, origin;
+  select(swap, ax, ay, num);
+  select(swap, ay, ax, den);
+  select(reinterpret_cast<Bits>(den == 0.0), Doubles{} + 1.0, Doubles{}, origin);
+  const Doubles t = num / (den + origin);  // in [0, 1]; 0 / 1 at the origin
   const Doubles shifted = t * 8.0 + kRoundToInteger;
   // The nearest eighth k/8, but 0 below 1/8: atan(1/8) + atan u with u near -1/16 would cancel.
-  const Bits small = bit_cast<Bits>(t < 0.125);
-  const Doubles centre = select(small, Doubles{}, (shifted - kRoundToInteger) * 0.125);
-  const Bits k = bit_cast<Bits>(shifted) & 15 & ~small;
+  const Bits small = reinterpret_cast<Bits>(t < 0.125);
+  Doubles centre;
+  select(small, Doubles{}, (shifted - kRoundToInteger) * 0.125, centre);
+  const Bits k = reinterpret_cast<Bits>(shifted) & 15 & ~small;
   // atan t = atan(k/8) + atan u; t - k/8 is exact (Sterbenz), |u| <= 1/8.
   const Doubles u = (t - centre) / (1.0 + t * centre);
   const Doubles u2 = u * u;
@@ -103,9 +98,9 @@ inline Doubles atan2_lanes(Doubles y, Doubles x) noexcept {
     tail[lane] = kAtanEighthLo[k[lane]];
   }
   Doubles a = head + (tail + atan_u);  // atan t, in [0, pi/4]
-  a = select(swap, (kHalfPiHead - a) + kHalfPiTail, a);
-  a = select(Bits{} - (bit_cast<Bits>(x) >> 63), (kPiHead - a) + kPiTail, a);  // x < 0 (and x = -0): pi - a
-  return bit_cast<Doubles>(bit_cast<Bits>(a) ^ (bit_cast<Bits>(y < 0.0) & sign));  // y < 0: -a; y = -0 counts as +0
+  select(swap, (kHalfPiHead - a) + kHalfPiTail, a, a);
+  select(Bits{} - (reinterpret_cast<Bits>(x) >> 63), (kPiHead - a) + kPiTail, a, a);  // x < 0 (and x = -0): pi - a
+  angle = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(a) ^ (reinterpret_cast<Bits>(y < 0.0) & sign));  // y < 0: -a; y = -0 counts as +0
 }
 #endif
 
@@ -172,14 +167,16 @@ inline void atan2(const std::array<double, N>& y, const std::array<double, N>& x
     Doubles yv, xv;
     std::memcpy(&yv, &y[i], sizeof yv);
     std::memcpy(&xv, &x[i], sizeof xv);
-    const Doubles av = trig_detail::atan2_lanes(yv, xv);
+    Doubles av;
+    trig_detail::atan2_lanes(yv, xv, av);
     std::memcpy(&angle[i], &av, sizeof av);
   }
   if constexpr (full < N) {  // the last, partly filled vector
     Doubles yv{}, xv{};
     std::memcpy(&yv, &y[full], (N - full) * sizeof(double));
     std::memcpy(&xv, &x[full], (N - full) * sizeof(double));
-    const Doubles av = trig_detail::atan2_lanes(yv, xv);
+    Doubles av;
+    trig_detail::atan2_lanes(yv, xv, av);
     std::memcpy(&angle[full], &av, (N - full) * sizeof(double));
   }
   for (std::size_t i = 0; i < N; ++i)

@@ -11,6 +11,17 @@
 #include <array>
 #include <string_view>
 
+// The double functions have an AVX2 + FMA version, picked at run time when the CPU has both
+// (x86-64 with GCC or clang, unless the build targets them anyway). Its results can differ from
+// the portable version's in the last bits (a fused multiply-add rounds once). Define
+// WLX_GEN_NO_MULTIVERSION to compile only the portable version.
+#if !defined(WLX_GEN_NO_MULTIVERSION) && defined(__x86_64__) && defined(__GNUC__) && \
+    !(defined(__AVX2__) && defined(__FMA__)) && defined(__has_attribute)
+#if __has_attribute(target) && __has_attribute(flatten)
+#define WLX_GEN_MULTIVERSION 1
+#endif
+#endif
+
 namespace wlx {
 inline namespace walker {
 namespace gen {
@@ -55,6 +66,13 @@ namespace detail {
 // output pointer may be nullptr (std::type_identity_t, which C++17 lacks).
 template <typename T> struct NonDeducedType { using type = T; };
 template <typename T> using NonDeduced = typename NonDeducedType<T>::type;
+#if defined(WLX_GEN_MULTIVERSION)
+// Whether this CPU (and its operating system) runs AVX2 and FMA instructions; asked once.
+inline bool has_avx2_fma() noexcept {
+  static const bool yes = (__builtin_cpu_init(), __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"));
+  return yes;
+}
+#endif
 }  // namespace detail
 
 // Index of each coordinate in s (the model file's order: inputs, then dependent joints).
