@@ -279,6 +279,20 @@ void BM_inverse_dynamics_step(benchmark::State& st) {
     benchmark::DoNotOptimize(tau.data());
   }
 }
+// The weighted least-norm torque split of that step alone (weighting 1).
+void BM_distribute_torques(benchmark::State& st) {
+  const Model model;
+  Data d;
+  DynamicsTerms terms;
+  Coordinates s = nominal_inputs();
+  s(gen::coord::x_C) = 0.3;
+  solve_ik_closed_form(model, s);
+  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
+  for (auto _ : st) {
+    const TorqueVector tau = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
+    benchmark::DoNotOptimize(tau.data());
+  }
+}
 // The generated passes of one inverse-dynamics step: fused (what the step calls), and the same
 // outputs from the separate functions; then the step's generated code alone, IK included, run back
 // to back as the step runs it (its floor: the rest of the step is the runtime's linear algebra).
@@ -611,6 +625,7 @@ BENCHMARK(BM_base_body_jacobians);
 BENCHMARK(BM_base_newton_cold);
 BENCHMARK(BM_inverse_dynamics_step);
 BENCHMARK(BM_inverse_dynamics_generated_only);
+BENCHMARK(BM_distribute_torques);
 BENCHMARK(BM_gen_dynamics_passes_fused);
 BENCHMARK(BM_gen_dynamics_passes_separate);
 BENCHMARK(BM_run_ID1)->Unit(benchmark::kMillisecond);
@@ -731,6 +746,7 @@ int main(int argc, char** argv) {
       {"dependent rates (velocity level)", "BM_dependent_rates", nullptr, 0},
       {"dependent accelerations", "BM_dependent_accelerations", nullptr, 0},
       {"inverse-dynamics step", "BM_inverse_dynamics_step", nullptr, 0},
+      {"  its torque split alone (weighted least norm, QR)", "BM_distribute_torques", nullptr, 0},
       {"  its generated code alone: 4-limb IK + the two passes", "BM_inverse_dynamics_generated_only", nullptr, 0},
       {"  the two passes, fused (vs kinematic_update + convective + bodies)", "BM_gen_dynamics_passes_fused",
        "BM_gen_dynamics_passes_separate", ops::dynamics_update + ops::dynamics_convective},

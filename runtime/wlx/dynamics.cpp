@@ -236,7 +236,7 @@ bool householder_step(ActuatorJacobian& qr, Tail<k>& v, double& tau) {
   const double alpha = column(0), norm = column.norm();
   if (!(norm > 0)) return false;  // a zero column (or NaN): the pivoted QR says what is wrong
   const double beta = alpha >= 0 ? -norm : norm;
-  v = column / (alpha - beta);
+  v = column * (1 / (alpha - beta));  // one division, not one per entry
   v(0) = 1;
   tau = (beta - alpha) / beta;
   qr(k, k) = beta;
@@ -265,13 +265,14 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
     if (!(householder_step<k>(qr, std::get<k>(v), tau(k)) && ...)) return false;
     // R^-1 by back substitution, column by column: for the condition number.
     const CommandMatrix R = qr.template topRows<kU>().template triangularView<Eigen::Upper>();
+    const CommandVector reciprocal = R.diagonal().cwiseInverse();
     CommandMatrix R_inverse = CommandMatrix::Zero();
     for (int j = 0; j < kU; ++j) {
-      R_inverse(j, j) = 1 / R(j, j);
+      R_inverse(j, j) = reciprocal(j);
       for (int i = j - 1; i >= 0; --i) {
         double sum = 0;
         for (int l = i + 1; l <= j; ++l) sum += R(i, l) * R_inverse(l, j);
-        R_inverse(i, j) = -sum / R(i, i);
+        R_inverse(i, j) = -sum * reciprocal(i);
       }
     }
     const double condition = R.cwiseAbs().colwise().sum().maxCoeff() * R_inverse.cwiseAbs().colwise().sum().maxCoeff();
@@ -281,7 +282,7 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
     for (int i = 0; i < kU; ++i) {
       double sum = Qstar(i);
       for (int l = 0; l < i; ++l) sum -= R(l, i) * x(l);
-      x(i) = sum / R(i, i);
+      x(i) = sum * reciprocal(i);
     }
     ((x.template tail<kActuatedCount - (kU - 1 - k)>() -=
       (tau(kU - 1 - k) * std::get<kU - 1 - k>(v).dot(x.template tail<kActuatedCount - (kU - 1 - k)>())) *
@@ -291,8 +292,9 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
   }(std::make_integer_sequence<int, kU>{});
 }
 
-// The same with column pivoting and a rank test: for poses where the fast path declines.
-TorqueVector min_norm_solve_pivoted(const ActuatorJacobian& At, const CommandVector& Qstar, const Weighting& weighting) {
+// The same with column pivoting and a rank test: for poses where the fast path declines. Kept out
+// of line: inlined, its dynamic-size blocks cost the fast path a 2 KB stack frame.
+[[gnu::noinline, gnu::cold]] TorqueVector min_norm_solve_pivoted(const ActuatorJacobian& At, const CommandVector& Qstar, const Weighting& weighting) {
   constexpr int kU = kCommandedCount;
   // From A^T P = Q R (column-pivoted, rank-revealing QR), x = Q [R^-T P^T Q*; 0].
   Eigen::ColPivHouseholderQR<ActuatorJacobian> qr;
@@ -313,36 +315,42 @@ TorqueVector min_norm_solve_pivoted(const ActuatorJacobian& At, const CommandVec
   return x;
 }
 
+// A full weight matrix: S = L^-T from W = L L^T (scaled to a largest entry of 1, as above).
+[[gnu::noinline]] TorqueVector distribute_torques_weight_matrix(const ActuatorJacobian& J_beta, const CommandVector& Qstar,
+                                                                const Weighting& weighting) {
+  const TorqueMatrix L = (weighting.matrix / weighting.matrix.cwiseAbs().maxCoeff()).llt().matrixL();
+  const TorqueMatrix S = L.transpose().triangularView<Eigen::Upper>().solve(TorqueMatrix::Identity());
+  const ActuatorJacobian At = S.transpose().lazyProduct(J_beta);
+  TorqueVector x;
+  if (!min_norm_solve_fast(At, Qstar, x)) x = min_norm_solve_pivoted(At, Qstar, weighting);
+  return S.lazyProduct(x);
+}
+
 }  // namespace
 
 TorqueVector distribute_torques(const ActuatorJacobian& J_beta, const CommandVector& Qstar,
                                 const Weighting& weighting) {
   // S with S S^T = W^-1: tau = S x and |x| = sqrt(tau^T W tau). Diagonal for every kind but a full
-  // weight matrix, and kept as its diagonal there: an 8 x 8 product costs more than the QR.
-  TorqueVector S_diagonal;
-  TorqueMatrix S;
+  // weight matrix (out of line below: its 8 x 8 products cost more than the QR).
+  if (weighting.kind == Weighting::Kind::matrix) return distribute_torques_weight_matrix(J_beta, Qstar, weighting);
+  TorqueVector S;
   switch (weighting.kind) {
-    case Weighting::Kind::strong_weak: S_diagonal = kStrongWeakDiagonal.cwiseInverse().cwiseSqrt(); break;
+    case Weighting::Kind::strong_weak: {
+      static const TorqueVector scale = kStrongWeakDiagonal.cwiseInverse().cwiseSqrt();  // constant: once
+      S = scale;
+      break;
+    }
     case Weighting::Kind::contribution:  // W_ii^-1 = |row i| directly: a zero row gets zero torque
-      for (int i = 0; i < kActuatedCount; ++i) S_diagonal(i) = std::sqrt(J_beta.row(i).norm());
+      for (int i = 0; i < kActuatedCount; ++i) S(i) = std::sqrt(J_beta.row(i).norm());
       break;
     // A uniform scale of W does not change the minimum-norm torques: divide it out (largest weight
     // 1) so weights of 1e308 or 1e-307 neither overflow nor fall below the rank threshold.
-    case Weighting::Kind::diagonal:
-      S_diagonal = (weighting.diagonal / weighting.diagonal.maxCoeff()).cwiseInverse().cwiseSqrt();
-      break;
-    case Weighting::Kind::matrix: {
-      const TorqueMatrix L = (weighting.matrix / weighting.matrix.cwiseAbs().maxCoeff()).llt().matrixL();
-      S = L.transpose().triangularView<Eigen::Upper>().solve(TorqueMatrix::Identity());
-      break;
-    }
+    default: S = (weighting.diagonal / weighting.diagonal.maxCoeff()).cwiseInverse().cwiseSqrt(); break;
   }
-  const bool full = weighting.kind == Weighting::Kind::matrix;
-  const ActuatorJacobian At = full ? ActuatorJacobian(S.transpose().lazyProduct(J_beta))
-                                   : ActuatorJacobian(S_diagonal.asDiagonal() * J_beta);
+  const ActuatorJacobian At = S.asDiagonal() * J_beta;
   TorqueVector x;
   if (!min_norm_solve_fast(At, Qstar, x)) x = min_norm_solve_pivoted(At, Qstar, weighting);
-  return full ? TorqueVector(S.lazyProduct(x)) : TorqueVector(S_diagonal.cwiseProduct(x));
+  return S.cwiseProduct(x);
 }
 
 WLX_MODEL_NAMESPACE_END

@@ -605,9 +605,21 @@ inline void dynamics_convective(const CoordinatesOf<Scalar>& s, const detail::No
   }
 }
 
-// dynamics_convective() in double, for any Eigen expression of the coordinates.
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// dynamics_convective<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline void dynamics_convective_avx2_fma(const Coordinates& s, const Coordinates& sdot, const Params& p, const DynamicsConvectiveOutputs& out) noexcept {
+  return dynamics_convective<double>(s, sdot, p, out);
+}
+}  // namespace detail
+#endif
+
+// dynamics_convective() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
 inline void dynamics_convective(const Coordinates& s, const Coordinates& sdot, const Params& p, const DynamicsConvectiveOutputs& out) noexcept {
-  dynamics_convective<double>(s, sdot, p, out);
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::dynamics_convective_avx2_fma(s, sdot, p, out);
+#endif
+  return dynamics_convective<double>(s, sdot, p, out);
 }
 
 namespace operations {

@@ -791,9 +791,21 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   }
 }
 
-// dynamics_update() in double, for any Eigen expression of the coordinates.
+#if defined(WLX_GEN_MULTIVERSION)
+namespace detail {
+// dynamics_update<double>() compiled for AVX2 and FMA (types.hpp).
+__attribute__((target("avx2,fma"), flatten)) inline void dynamics_update_avx2_fma(const Coordinates& s, const Params& p, const DynamicsUpdateOutputs& out, bool zero_fill) noexcept {
+  return dynamics_update<double>(s, p, out, zero_fill);
+}
+}  // namespace detail
+#endif
+
+// dynamics_update() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
 inline void dynamics_update(const Coordinates& s, const Params& p, const DynamicsUpdateOutputs& out, bool zero_fill = true) noexcept {
-  dynamics_update<double>(s, p, out, zero_fill);
+#if defined(WLX_GEN_MULTIVERSION)
+  if (detail::has_avx2_fma()) return detail::dynamics_update_avx2_fma(s, p, out, zero_fill);
+#endif
+  return dynamics_update<double>(s, p, out, zero_fill);
 }
 
 namespace operations {
