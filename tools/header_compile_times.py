@@ -5,8 +5,8 @@ after every regeneration, so that time is part of the generator's cost.
 For every function header of generated/<model>/wlx/gen/ (those defining a function template on
 Scalar that takes the coordinates: kinematics(), closure(), ik_<limb>(), ...) and for all.hpp, a
 translation unit is written to a temporary folder that includes the header and takes the address
-of each function's double specialization in a global: the compiler must then emit and optimize
-every body, as a user's call would make it. Each is compiled N times with
+of each function's double specialization in a global, and of its AVX2 + FMA version where the
+header has one: the compiler must then emit and optimize every body, as a user's call would make it. Each is compiled N times with
 `CXX -std=c++17 -O2 -c` and the median wall time reported, beside the median of a baseline unit
 that includes only Eigen/Core (the header's own cost is the difference).
 
@@ -72,12 +72,20 @@ def function_headers(gen_dir):
     return found
 
 
-def probe_source(header, functions):
+def probe_source(header, functions, texts):
     """A unit that includes wlx/gen/<header> and makes the compiler emit each function for double."""
     lines = [f"// tools/header_compile_times.py: {header}'s functions, compiled for double.",
              f"#include <wlx/gen/{header}>", "",
              "// Addresses in globals with external linkage: each body must be emitted and optimized."]
     lines += [f"decltype(&{name}<double>) wlx_probe_{k} = &{name}<double>;" for k, name in enumerate(functions)]
+    # A call with double also compiles the AVX2 + FMA version the header selects at run time
+    # (detail::NAME_avx2_fma, where the header has one and the target allows it).
+    lines += ["#if defined(WLX_GEN_MULTIVERSION)"]
+    lines += [f"auto wlx_probe_avx2_{k} = &{scope}::detail::{leaf}_avx2_fma;"
+              for k, (scope, leaf) in enumerate(name.rsplit("::", 1) for name in functions)
+              if f"{leaf}_avx2_fma" in texts.get(header, "") or (header == "all.hpp" and
+                                                                  any(f"{leaf}_avx2_fma" in t for t in texts.values()))]
+    lines += ["#endif"]
     return "\n".join(lines) + "\n"
 
 
@@ -118,13 +126,17 @@ def measure(options):
             headers = function_headers(gen_dir)
             if not headers:
                 raise Failure(f"{gen_dir}: no function header (a template on Scalar taking the coordinates)")
+            texts = {}
+            for header in headers:
+                with open(os.path.join(gen_dir, header), encoding="utf-8") as f:
+                    texts[header] = f.read()
             units = list(headers.items())
             if os.path.isfile(os.path.join(gen_dir, "all.hpp")):
                 units.append(("all.hpp", [name for names in headers.values() for name in names]))
             rows = []
             for header, functions in units:
                 seconds = compile_seconds(options.cxx, eigen_include + ["-I", os.path.join(options.generated, model)],
-                                          probe_source(header, functions), work, options.repeat,
+                                          probe_source(header, functions, texts), work, options.repeat,
                                           os.path.join(gen_dir, header))
                 rows.append({"header": header, "functions": [f.rsplit("::", 1)[1] for f in functions],
                              "seconds": seconds, "own_seconds": seconds - result["baseline_seconds"]})

@@ -27,10 +27,13 @@ def test_a_namespace_closed_before_a_function_is_not_its_namespace():
 
 
 def test_the_unit_includes_the_header_and_exports_each_double_instance():
-    source = hct.probe_source("ik.hpp", ["w::gen::ik_a", "w::gen::ik_b"])
+    source = hct.probe_source("ik.hpp", ["w::gen::ik_a", "w::gen::ik_b"], {"ik.hpp": "ik_b_avx2_fma"})
     assert "#include <wlx/gen/ik.hpp>" in source
     assert "decltype(&w::gen::ik_a<double>) wlx_probe_0 = &w::gen::ik_a<double>;" in source
     assert "wlx_probe_1 = &w::gen::ik_b<double>;" in source
+    # The AVX2 + FMA version too, where the header has one (ik_b), under the header's own switch.
+    assert "&w::gen::detail::ik_b_avx2_fma;" in source and "ik_a_avx2_fma" not in source
+    assert source.index("#if defined(WLX_GEN_MULTIVERSION)") < source.index("ik_b_avx2_fma")
 
 
 def test_the_table_has_a_row_per_header_and_a_column_per_model():
