@@ -75,8 +75,6 @@ inline constexpr auto kBodyColumnClasses = [] {
 void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const CommandVector& u,
                       const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options) {
   const Params& p = model.params();
-  out.sdot.setZero();
-  for (int k = 0; k < kCommandedCount; ++k) out.sdot(kCommandedSpeeds[static_cast<std::size_t>(k)]) = u(k);
   const DependentPair pair = dynamics_pair();
   // Two fused generated passes instead of four: dPhi/ds, C(s) and the bodies' Jacobians at s, then
   // every convective term at (s, s'); they share their subexpressions (the frames' rotations).
@@ -88,8 +86,9 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
                         .Jv = &d.body_Jv,
                         .Jw = &d.body_Jw},
                        false);
-  solve_dependent_rates_prepared(d, out.sdot, pair, options);
+  factorize_dependent_rates(d, pair, options);
   out.T = rate_basis(d, kCommandedSpeeds, pair);
+  out.sdot.noalias() = out.T.lazyProduct(u);  // the velocity level's solve, once T is known
   gen::dynamics_convective(s, out.sdot, p,
                            {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot,
                             .C_dot_sdot = &d.C_dot_sdot,

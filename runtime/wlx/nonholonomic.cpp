@@ -157,12 +157,20 @@ void solve_dependent_rates(const Model& model, Data& d, const Coordinates& s, Co
 
 void solve_dependent_rates_prepared(Data& d, Coordinates& sdot, const DependentPair& pair,
                                     const NonholonomicOptions& options) {
-  reduce(d);
+  factorize_dependent_rates(d, pair, options);
   Eigen::Matrix<double, kNq, 1> q_rate = sdot.head<kNq>();
-  for (int k = 0; k < kWheelCount; ++k) {
-    q_rate(pair.index[k]) = 0;
-    d.J_beta.col(k) = d.C_reduced.col(pair.index[k]);
-  }
+  for (int k = 0; k < kWheelCount; ++k) q_rate(pair.index[k]) = 0;
+  const WheelVector phi_hat = d.C_reduced.lazyProduct(q_rate);
+  const WheelVector pair_rate = -d.J_beta.partialPivLu().solve(phi_hat);
+  for (int k = 0; k < kWheelCount; ++k) q_rate(pair.index[k]) = pair_rate(k);
+  sdot.head<kNq>() = q_rate;
+  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>().lazyProduct(q_rate);
+  solve_closure(d, closure_rhs, sdot);
+}
+
+void factorize_dependent_rates(Data& d, const DependentPair& pair, const NonholonomicOptions& options) {
+  reduce(d);
+  for (int k = 0; k < kWheelCount; ++k) d.J_beta.col(k) = d.C_reduced.col(pair.index[k]);
   d.cond_J_beta = condition_number(d.J_beta);
   if (!(d.cond_J_beta <= options.max_condition))
     throw Error(
@@ -171,12 +179,6 @@ void solve_dependent_rates_prepared(Data& d, Coordinates& sdot, const DependentP
                     "{:.3g}. The wheels' sideways constraint lines coincide (collinear wheel axes, thesis "
                     "4.1.4), e.g. wheels on the same level under a level cabin. {}",
                     pair.label(), d.cond_J_beta, options.max_condition, raise_a_wheel_hint()));
-  const WheelVector phi_hat = d.C_reduced.lazyProduct(q_rate);
-  const WheelVector pair_rate = -d.J_beta.partialPivLu().solve(phi_hat);
-  for (int k = 0; k < kWheelCount; ++k) q_rate(pair.index[k]) = pair_rate(k);
-  sdot.head<kNq>() = q_rate;
-  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>().lazyProduct(q_rate);
-  solve_closure(d, closure_rhs, sdot);
 }
 
 void solve_dependent_accelerations(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot,

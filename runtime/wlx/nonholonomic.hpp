@@ -62,6 +62,9 @@ void solve_dependent_accelerations(const Model& model, Data& data, const Coordin
 // fused generated passes together with the bodies' Jacobians.
 void solve_dependent_rates_prepared(Data& data, Coordinates& sdot, const DependentPair& pair,
                                     const NonholonomicOptions& options = {});
+// Its first half: the limb blocks' factorizations, J_beta and its condition (data), no rates. Then
+// rate_basis() gives s' = T u for any commanded rates u without another solve.
+void factorize_dependent_rates(Data& data, const DependentPair& pair, const NonholonomicOptions& options = {});
 void solve_dependent_accelerations_prepared(Data& data, Coordinates& sddot, const DependentPair& pair);
 
 // After solve_dependent_rates at s (same pair): the full rates s' caused by a unit rate of each

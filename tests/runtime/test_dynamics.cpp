@@ -74,6 +74,14 @@ TEST_CASE("dynamics: J_beta^T tau = Q* and the power balance tau . beta' = Q* . 
     const TorqueVector beta_dot = t.J_beta * u;
     // beta' really is the actuated joints' rate of the solved motion.
     for (int r = 0; r < 8; ++r) CHECK(beta_dot(r) == doctest::Approx(t.sdot(kActuatedJoints[r])).epsilon(1e-12).scale(1));
+    // And that motion satisfies the model: the closure and the wheels' sideways constraints hold
+    // (dPhi/ds s' = 0, C s' = 0), and it carries the commanded speeds.
+    gen::ClosureJacobian J;
+    gen::WheelRows C;
+    gen::kinematic_update(s, model.params(), {.dPhi_ds = &J, .C = &C});
+    CHECK((J * t.sdot).cwiseAbs().maxCoeff() <= 1e-12 * t.sdot.norm());
+    CHECK((C * t.sdot).cwiseAbs().maxCoeff() <= 1e-12 * t.sdot.norm());
+    for (int k = 0; k < kCommandedCount; ++k) CHECK(t.sdot(kCommandedSpeeds[static_cast<std::size_t>(k)]) == u(k));
     for (const Weighting& w : weightings) {
       const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, w);
       const double scale = t.Qstar.cwiseAbs().maxCoeff();
