@@ -296,19 +296,22 @@ void BM_distribute_torques(benchmark::State& st) {
 // The generated passes of one inverse-dynamics step: fused (what the step calls), and the same
 // outputs from the separate functions; then the step's generated code alone, IK included, run back
 // to back as the step runs it (its floor: the rest of the step is the runtime's linear algebra).
+void dynamics_passes(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot) {
+  gen::dynamics_update(s, model.params(),
+                       {.dPhi_ds = &d.dPhi_ds, .C = &d.C, .com = &d.body_com, .rotations = &d.body_rotations,
+                        .Jv = &d.body_Jv, .Jw = &d.body_Jw},
+                       false);
+  gen::dynamics_convective(s, sdot, model.params(),
+                           {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot,
+                            .Jv_dot_sdot = &d.body_Jv_dot_sdot, .Jw_dot_sdot = &d.body_Jw_dot_sdot});
+}
 void BM_gen_dynamics_passes_fused(benchmark::State& st) {
   const Model model;
   Data d;
   const Coordinates s = assembled_nominal(model);
   const Coordinates sdot = Coordinates::Constant(0.1);
   for (auto _ : st) {
-    gen::dynamics_update(s, model.params(),
-                         {.dPhi_ds = &d.dPhi_ds, .C = &d.C, .com = &d.body_com, .rotations = &d.body_rotations,
-                          .Jv = &d.body_Jv, .Jw = &d.body_Jw},
-                         false);
-    gen::dynamics_convective(s, sdot, model.params(),
-                             {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot,
-                              .Jv_dot_sdot = &d.body_Jv_dot_sdot, .Jw_dot_sdot = &d.body_Jw_dot_sdot});
+    dynamics_passes(model, d, s, sdot);
     benchmark::DoNotOptimize(d.body_Jw_dot_sdot.data());
   }
 }
@@ -335,13 +338,7 @@ void BM_inverse_dynamics_generated_only(benchmark::State& st) {
   const Coordinates sdot = Coordinates::Constant(0.1);
   for (auto _ : st) {
     solve_ik_closed_form(model, s);
-    gen::dynamics_update(s, model.params(),
-                         {.dPhi_ds = &d.dPhi_ds, .C = &d.C, .com = &d.body_com, .rotations = &d.body_rotations,
-                          .Jv = &d.body_Jv, .Jw = &d.body_Jw},
-                         false);
-    gen::dynamics_convective(s, sdot, model.params(),
-                             {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot,
-                              .Jv_dot_sdot = &d.body_Jv_dot_sdot, .Jw_dot_sdot = &d.body_Jw_dot_sdot});
+    dynamics_passes(model, d, s, sdot);
     benchmark::DoNotOptimize(d.body_Jw_dot_sdot.data());
   }
 }

@@ -57,9 +57,9 @@ def enclosing_namespace(text, position):
     return "::".join(stack)
 
 
-def function_headers(gen_dir):
+def function_headers(gen_dir, texts=None):
     """{header: [qualified function names]} for the headers of one wlx/gen/ folder that define a
-    function template on Scalar, in file-name order."""
+    function template on Scalar, in file-name order; each such header's text into `texts`."""
     found = {}
     for header in sorted(os.listdir(gen_dir)):
         if not header.endswith(".hpp") or header == "all.hpp":
@@ -69,11 +69,15 @@ def function_headers(gen_dir):
         names = [f"{enclosing_namespace(text, m.start())}::{m[1]}" for m in FUNCTION.finditer(text)]
         if names:
             found[header] = names
+            if texts is not None:
+                texts[header] = text
     return found
 
 
-def probe_source(header, functions, texts):
-    """A unit that includes wlx/gen/<header> and makes the compiler emit each function for double."""
+def probe_source(header, functions, text):
+    """A unit that includes wlx/gen/<header> and makes the compiler emit each function for double.
+    `text`: the source defining the functions (for all.hpp, every header's), to find which have an
+    AVX2 + FMA version."""
     lines = [f"// tools/header_compile_times.py: {header}'s functions, compiled for double.",
              f"#include <wlx/gen/{header}>", "",
              "// Addresses in globals with external linkage: each body must be emitted and optimized."]
@@ -83,8 +87,7 @@ def probe_source(header, functions, texts):
     lines += ["#if defined(WLX_GEN_MULTIVERSION)"]
     lines += [f"auto wlx_probe_avx2_{k} = &{scope}::detail::{leaf}_avx2_fma;"
               for k, (scope, leaf) in enumerate(name.rsplit("::", 1) for name in functions)
-              if f"{leaf}_avx2_fma" in texts.get(header, "") or (header == "all.hpp" and
-                                                                  any(f"{leaf}_avx2_fma" in t for t in texts.values()))]
+              if f"{leaf}_avx2_fma" in text]
     lines += ["#endif"]
     return "\n".join(lines) + "\n"
 
@@ -123,20 +126,18 @@ def measure(options):
         progress(f"baseline (Eigen/Core only): {result['baseline_seconds']:.2f} s")
         for model in options.model:
             gen_dir = os.path.join(options.generated, model, "wlx", "gen")
-            headers = function_headers(gen_dir)
+            texts = {}
+            headers = function_headers(gen_dir, texts)
             if not headers:
                 raise Failure(f"{gen_dir}: no function header (a template on Scalar taking the coordinates)")
-            texts = {}
-            for header in headers:
-                with open(os.path.join(gen_dir, header), encoding="utf-8") as f:
-                    texts[header] = f.read()
+            texts["all.hpp"] = "".join(texts.values())
             units = list(headers.items())
             if os.path.isfile(os.path.join(gen_dir, "all.hpp")):
                 units.append(("all.hpp", [name for names in headers.values() for name in names]))
             rows = []
             for header, functions in units:
                 seconds = compile_seconds(options.cxx, eigen_include + ["-I", os.path.join(options.generated, model)],
-                                          probe_source(header, functions, texts), work, options.repeat,
+                                          probe_source(header, functions, texts[header]), work, options.repeat,
                                           os.path.join(gen_dir, header))
                 rows.append({"header": header, "functions": [f.rsplit("::", 1)[1] for f in functions],
                              "seconds": seconds, "own_seconds": seconds - result["baseline_seconds"]})

@@ -217,12 +217,6 @@ Weighting Weighting::matrix_of(const TorqueMatrix& W) {
 
 namespace {
 
-// The minimum-norm x with A^T x = Q*, A actuated x commanded with full column rank: from A = Q R
-// (Householder), x = Q [R^-T Q*; 0]. Unpivoted, fixed-size and unrolled: about a tenth of Eigen's
-// column-pivoted QR, whose inner loops run on dynamic-size blocks. Returns false, leaving the
-// answer to the pivoted QR, unless R's 1-norm condition number is at most 1e12: then
-// sigma_min / sigma_max >= 1 / (n 1e12) > 1e-13 (cond_2 <= n cond_1; n <= 9 commanded speeds), so the
-// pivoted QR's rank test would pass too, and both are backward stable: the same torques to rounding.
 template <int k>
 using Tail = Eigen::Matrix<double, kActuatedCount - k, 1>;
 
@@ -314,15 +308,19 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
   return x;
 }
 
+// The minimum-norm x with A^T x = Q*: the fast path, else the pivoted QR (which throws on a rank loss).
+TorqueVector min_norm_solve(const ActuatorJacobian& At, const CommandVector& Qstar, const Weighting& weighting) {
+  TorqueVector x;
+  if (!min_norm_solve_fast(At, Qstar, x)) x = min_norm_solve_pivoted(At, Qstar, weighting);
+  return x;
+}
+
 // A full weight matrix: S = L^-T from W = L L^T (scaled to a largest entry of 1, as above).
 [[gnu::noinline]] TorqueVector distribute_torques_weight_matrix(const ActuatorJacobian& J_beta, const CommandVector& Qstar,
                                                                 const Weighting& weighting) {
   const TorqueMatrix L = (weighting.matrix / weighting.matrix.cwiseAbs().maxCoeff()).llt().matrixL();
   const TorqueMatrix S = L.transpose().triangularView<Eigen::Upper>().solve(TorqueMatrix::Identity());
-  const ActuatorJacobian At = S.transpose().lazyProduct(J_beta);
-  TorqueVector x;
-  if (!min_norm_solve_fast(At, Qstar, x)) x = min_norm_solve_pivoted(At, Qstar, weighting);
-  return S.lazyProduct(x);
+  return S.lazyProduct(min_norm_solve(S.transpose().lazyProduct(J_beta), Qstar, weighting));
 }
 
 }  // namespace
@@ -346,10 +344,7 @@ TorqueVector distribute_torques(const ActuatorJacobian& J_beta, const CommandVec
     // 1) so weights of 1e308 or 1e-307 neither overflow nor fall below the rank threshold.
     default: S = (weighting.diagonal / weighting.diagonal.maxCoeff()).cwiseInverse().cwiseSqrt(); break;
   }
-  const ActuatorJacobian At = S.asDiagonal() * J_beta;
-  TorqueVector x;
-  if (!min_norm_solve_fast(At, Qstar, x)) x = min_norm_solve_pivoted(At, Qstar, weighting);
-  return S.cwiseProduct(x);
+  return S.cwiseProduct(min_norm_solve(S.asDiagonal() * J_beta, Qstar, weighting));
 }
 
 WLX_MODEL_NAMESPACE_END

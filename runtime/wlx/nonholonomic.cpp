@@ -152,11 +152,6 @@ void solve_dependent_rates(const Model& model, Data& d, const Coordinates& s, Co
                            const DependentPair& pair, const NonholonomicOptions& options) {
   // dPhi/ds and C(s) from the fused generated function: they share most subexpressions.
   gen::kinematic_update(s, model.params(), {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
-  solve_dependent_rates_prepared(d, sdot, pair, options);
-}
-
-void solve_dependent_rates_prepared(Data& d, Coordinates& sdot, const DependentPair& pair,
-                                    const NonholonomicOptions& options) {
   factorize_dependent_rates(d, pair, options);
   Eigen::Matrix<double, kNq, 1> q_rate = sdot.head<kNq>();
   for (int k = 0; k < kWheelCount; ++k) q_rate(pair.index[k]) = 0;

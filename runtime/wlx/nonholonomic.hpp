@@ -57,13 +57,11 @@ void solve_dependent_rates(const Model& model, Data& data, const Coordinates& s,
 void solve_dependent_accelerations(const Model& model, Data& data, const Coordinates& s, const Coordinates& sdot,
                                    Coordinates& sddot, const DependentPair& pair);
 
-// The same two solves when data's dPhi/ds and C(s) (velocity level), and its dPhi/ds' s' and
-// C' s' (acceleration level), are current already: the inverse-dynamics step computes them in its
-// fused generated passes together with the bodies' Jacobians.
-void solve_dependent_rates_prepared(Data& data, Coordinates& sdot, const DependentPair& pair,
-                                    const NonholonomicOptions& options = {});
-// Its first half: the limb blocks' factorizations, J_beta and its condition (data), no rates. Then
-// rate_basis() gives s' = T u for any commanded rates u without another solve.
+// The same two levels when data's dPhi/ds and C(s), and its dPhi/ds' s' and C' s', are current
+// already (the inverse-dynamics step computes them in its fused generated passes together with the
+// bodies' Jacobians). factorize_dependent_rates is the velocity level's first half: the limb
+// blocks' factorizations, J_beta and its condition (throws if singular), no rates; rate_basis()
+// then gives s' = T u for any commanded rates u without another solve.
 void factorize_dependent_rates(Data& data, const DependentPair& pair, const NonholonomicOptions& options = {});
 void solve_dependent_accelerations_prepared(Data& data, Coordinates& sddot, const DependentPair& pair);
 
