@@ -293,53 +293,44 @@ void BM_distribute_torques(benchmark::State& st) {
     benchmark::DoNotOptimize(tau.data());
   }
 }
-// The generated passes of one inverse-dynamics step: fused (what the step calls), and the same
-// outputs from the separate functions; then the step's generated code alone, IK included, run back
-// to back as the step runs it (its floor: the rest of the step is the runtime's linear algebra).
-void dynamics_passes(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot) {
-  gen::dynamics_update(s, model.params(),
-                       {.dPhi_ds = &d.dPhi_ds, .C = &d.C, .com = &d.body_com, .rotations = &d.body_rotations,
-                        .Jv = &d.body_Jv, .Jw = &d.body_Jw},
-                       false);
-  gen::dynamics_convective(s, sdot, model.params(),
-                           {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot,
-                            .Jv_dot_sdot = &d.body_Jv_dot_sdot, .Jw_dot_sdot = &d.body_Jw_dot_sdot});
+// The generated passes of one inverse-dynamics step, then the step's generated code alone, IK
+// included, run back to back as the step runs it (its floor: the rest of the step is the runtime's
+// linear algebra). T is the rate basis at s, computed once.
+void dynamics_passes(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot, const gen::RateBasis& T,
+                     DynamicsTerms& terms) {
+  gen::dynamics_update(s, model.params(), {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
+  CommandVector b_velocity;
+  gen::reduced_dynamics(s, sdot, T, model.params(),
+                        {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot, .M = &terms.M,
+                         .b_velocity = &b_velocity, .B_bias = &terms.B_bias, .Q_gravity = &terms.Q_gravity},
+                        false);
+  benchmark::DoNotOptimize(b_velocity.data());
 }
-void BM_gen_dynamics_passes_fused(benchmark::State& st) {
+void BM_gen_dynamics_passes(benchmark::State& st) {
   const Model model;
   Data d;
-  const Coordinates s = assembled_nominal(model);
-  const Coordinates sdot = Coordinates::Constant(0.1);
+  DynamicsTerms terms;
+  Coordinates s = nominal_inputs();
+  s(gen::coord::x_C) = 0.3;
+  solve_ik_closed_form(model, s);
+  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
   for (auto _ : st) {
-    dynamics_passes(model, d, s, sdot);
-    benchmark::DoNotOptimize(d.body_Jw_dot_sdot.data());
-  }
-}
-void BM_gen_dynamics_passes_separate(benchmark::State& st) {
-  const Model model;
-  Data d;
-  const Coordinates s = assembled_nominal(model);
-  const Coordinates sdot = Coordinates::Constant(0.1);
-  for (auto _ : st) {
-    gen::kinematic_update(s, model.params(), {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
-    gen::convective(s, sdot, model.params(), {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot});
-    gen::bodies(s, sdot, model.params(),
-                {.com = &d.body_com, .rotations = &d.body_rotations, .Jv = &d.body_Jv, .Jw = &d.body_Jw,
-                 .Jv_dot_sdot = &d.body_Jv_dot_sdot, .Jw_dot_sdot = &d.body_Jw_dot_sdot},
-                false);
-    benchmark::DoNotOptimize(d.body_Jw_dot_sdot.data());
+    dynamics_passes(model, d, s, terms.sdot, terms.T, terms);
+    benchmark::DoNotOptimize(terms.M.data());
   }
 }
 void BM_inverse_dynamics_generated_only(benchmark::State& st) {
   const Model model;
   Data d;
+  DynamicsTerms terms;
   Coordinates s = nominal_inputs();
   s(gen::coord::x_C) = 0.3;
-  const Coordinates sdot = Coordinates::Constant(0.1);
+  solve_ik_closed_form(model, s);
+  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
   for (auto _ : st) {
     solve_ik_closed_form(model, s);
-    dynamics_passes(model, d, s, sdot);
-    benchmark::DoNotOptimize(d.body_Jw_dot_sdot.data());
+    dynamics_passes(model, d, s, terms.sdot, terms.T, terms);
+    benchmark::DoNotOptimize(terms.M.data());
   }
 }
 // The whole ID-1 run (495 samples, RK4) with weighting 1.
@@ -623,8 +614,7 @@ BENCHMARK(BM_base_newton_cold);
 BENCHMARK(BM_inverse_dynamics_step);
 BENCHMARK(BM_inverse_dynamics_generated_only);
 BENCHMARK(BM_distribute_torques);
-BENCHMARK(BM_gen_dynamics_passes_fused);
-BENCHMARK(BM_gen_dynamics_passes_separate);
+BENCHMARK(BM_gen_dynamics_passes);
 BENCHMARK(BM_run_ID1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_dependent_rates);
 BENCHMARK(BM_dependent_accelerations);
@@ -745,8 +735,8 @@ int main(int argc, char** argv) {
       {"inverse-dynamics step", "BM_inverse_dynamics_step", nullptr, 0},
       {"  its torque split alone (weighted least norm, QR)", "BM_distribute_torques", nullptr, 0},
       {"  its generated code alone: 4-limb IK + the two passes", "BM_inverse_dynamics_generated_only", nullptr, 0},
-      {"  the two passes, fused (vs kinematic_update + convective + bodies)", "BM_gen_dynamics_passes_fused",
-       "BM_gen_dynamics_passes_separate", ops::dynamics_update + ops::dynamics_convective},
+      {"  the two passes: dynamics_update, reduced_dynamics (Kane's sums generated)", "BM_gen_dynamics_passes", nullptr,
+       ops::dynamics_update + ops::reduced_dynamics},
       {"NH-1 run (2001 samples, RK4)", "BM_run_NH1", nullptr, 0},
       {"ID-1 run (495 samples, RK4, torques)", "BM_run_ID1", nullptr, 0},
   };

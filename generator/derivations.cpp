@@ -2,6 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
+#include <set>
+#include <stdexcept>
+
 namespace wlx::codegen {
 
 namespace {
@@ -193,23 +198,368 @@ FunctionSpec derive_kinematic_update(const Model& m) {
 
 FunctionSpec derive_dynamics_update(const Model& m) {
   FunctionSpec fn{"dynamics_update", "dynamics_update.hpp",
-                  "The position-level part of an inverse-dynamics step in one pass: dPhi/ds, the non-holonomic "
-                  "rows C(s) and the bodies' CoM, orientation and Jacobians (the outputs of closure, "
-                  "nonholonomic and bodies that need s only, sharing their common subexpressions).",
+                  "The position-level part of an inverse-dynamics step in one pass: dPhi/ds and the "
+                  "non-holonomic rows C(s), which give the rate basis T (the outputs of closure and "
+                  "nonholonomic that an inverse-dynamics step needs, sharing their common subexpressions).",
                   false, {}};
-  const FunctionSpec c = derive_closure(m), n = derive_nonholonomic(m), b = derive_bodies(m);
-  fn.outputs = {c.outputs[1], n.outputs[0], b.outputs[0], b.outputs[1], b.outputs[2], b.outputs[3]};
+  const FunctionSpec c = derive_closure(m), n = derive_nonholonomic(m);
+  fn.outputs = {c.outputs[1], n.outputs[0]};
   return fn;
 }
 
-FunctionSpec derive_dynamics_convective(const Model& m) {
-  FunctionSpec fn{"dynamics_convective", "dynamics_convective.hpp",
-                  "The velocity-level part of an inverse-dynamics step in one pass: the convective terms of the "
-                  "closure and of the non-holonomic rows, and the bodies' Jdot s' (the outputs of convective and "
-                  "bodies that need s', sharing their common subexpressions).",
+namespace {
+
+// Whether `text` mentions the identifier `name` (as a whole word).
+bool mentions(const std::string& text, const std::string& name) {
+  const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  for (std::size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1))
+    if ((at == 0 || !word(text[at - 1])) && (at + name.size() == text.size() || !word(text[at + name.size()]))) return true;
+  return false;
+}
+
+// Writes reduced_dynamics' lane code: statements on rows of nu scalars (detail::Lanes), one lane
+// per commanded speed, and counts their operations scalar by scalar, per output (`charge_to`).
+// A row is named by its variable, or "" when it is structurally zero (nothing is written for it).
+class LaneWriter {
+ public:
+  explicit LaneWriter(int lanes) : lanes_(lanes) {}
+  int charge_to = 0;  // the output the next statements' operations count for
+  // A new row "name = base + sum_i factor_i * row_i" (zero terms, "" rows, dropped); returns the
+  // name, or base itself when no term remains (no code).
+  std::string define(const std::string& name, const std::string& base,
+                     const std::vector<std::pair<std::string, std::string>>& terms) {
+    OpCount ops;
+    const std::string rhs = sum(base, terms, ops);
+    if (rhs == base) return base;
+    add(name, fmt::format("    const L {} = {};\n", name, rhs), ops);
+    return name;
+  }
+  // A new row, the sum of `rows` (at least two).
+  std::string define_sum(const std::string& name, const std::vector<std::string>& rows) {
+    add(name, fmt::format("    const L {} = {};\n", name, fmt::join(rows, " + ")),
+        OpCount{static_cast<long>(rows.size() - 1) * lanes_, 0, 0, 0});
+    return name;
+  }
+  // "accumulator += sum_i factor_i * row_i".
+  void accumulate(const std::string& accumulator, const std::vector<std::pair<std::string, std::string>>& terms) {
+    OpCount ops;
+    const std::string rhs = sum("", terms, ops);
+    if (rhs.empty()) return;
+    ops.adds += lanes_;
+    add("", fmt::format("    {} += {};\n", accumulator, rhs), ops);
+  }
+  // A new row equal to `base` (or zero) plus `value` in lane k only: a unit row of T.
+  std::string plus_lane(const std::string& name, const std::string& base, int k, const std::string& value) {
+    add(name, fmt::format("    L {} = {};\n    {}.v[{}] += {};\n", name, base.empty() ? zero() : base, name, k, value),
+        OpCount{1, 0, 0, 0});
+    return name;
+  }
+  void comment(const std::string& text) { add("", "    // " + text + "\n", {}); }
+  std::string zero() const { return fmt::format("detail::zero_lanes<Scalar, {}>()", lanes_); }
+  // The code, without the rows nothing reads (a dense joint's wrench sums feed only the
+  // components its twist has), and each output's operations.
+  std::string finish(std::vector<OpCount>& ops) const {
+    std::vector<bool> keep(statements_.size(), true);
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (std::size_t i = 0; i < statements_.size(); ++i) {
+        if (!keep[i] || statements_[i].name.empty()) continue;
+        bool read = false;
+        for (std::size_t k = 0; k < statements_.size() && !read; ++k)
+          read = k != i && keep[k] && mentions(statements_[k].text, statements_[i].name);
+        if (!read) {
+          keep[i] = false;
+          changed = true;
+        }
+      }
+    }
+    std::string code;
+    for (std::size_t i = 0; i < statements_.size(); ++i) {
+      if (!keep[i]) continue;
+      code += statements_[i].text;
+      ops[static_cast<std::size_t>(statements_[i].output)] += statements_[i].ops;
+    }
+    return code;
+  }
+
+ private:
+  struct Statement {
+    std::string name, text;
+    OpCount ops;
+    int output = 0;
+  };
+  void add(const std::string& name, const std::string& text, const OpCount& ops) {
+    statements_.push_back({name, text, ops, charge_to});
+  }
+  std::string sum(const std::string& base, const std::vector<std::pair<std::string, std::string>>& terms, OpCount& ops) const {
+    std::string rhs = base;
+    for (const auto& [factor, row] : terms) {
+      if (factor.empty() || row.empty()) continue;
+      if (!rhs.empty()) {
+        rhs += " + ";
+        ops.adds += lanes_;
+      }
+      rhs += factor + " * " + row;
+      ops.muls += lanes_;
+    }
+    return rhs;
+  }
+  int lanes_;
+  std::vector<Statement> statements_;
+};
+
+// A joint of the bodies' chains as a node of their common tree (chains that share a prefix share
+// its nodes), with the partial twists of the chain up to it on lanes.
+struct TwistNode {
+  const JointRecord* joint = nullptr;
+  int parent = -1;
+  std::vector<int> children, bodies;
+  std::array<std::string, 6> twist;  // lanes of (omega; velocity of the point at K0's origin)
+  std::array<std::string, 6> wrench;  // lanes of the sum over the bodies beyond: (force; moment about K0's origin)
+};
+
+bool same_joint(const JointRecord& a, const JointRecord& b) {
+  if (a.coordinate != b.coordinate || a.revolute != b.revolute) return false;
+  for (int c = 0; c < 3; ++c)
+    if (!a.axis[c].is_equal(b.axis[c]) || !a.origin[c].is_equal(b.origin[c])) return false;
+  return true;
+}
+
+}  // namespace
+
+FunctionSpec derive_reduced_dynamics(const Model& m) {
+  const Dynamics& dyn = *m.dynamics;
+  const int n = coordinate_count(m);
+  const int nu = static_cast<int>(dyn.commanded.size());
+  const auto pair = m.pair(dyn.pair).coordinates;
+  FunctionSpec fn{"reduced_dynamics", "reduced_dynamics.hpp",
+                  "Kane's equations on the commanded speeds u, in one pass with the convective terms: with "
+                  "s' = T u and s'' = T u' + s''_bias, the generalized inertia, velocity and gravity forces on u "
+                  "are M u' + b_velocity + B_bias s''_bias and Q_gravity. Per body, P = [dv/du; R^T domega/du] "
+                  "(the CoM velocity in K0, the angular velocity in body axes) and D = diag(m, m, m, I) give "
+                  "M = sum P^T D P, b_velocity = sum P^T [m Jv_dot s'; I R^T Jw_dot s' + omega x I omega] and "
+                  "B_bias = sum P^T D [Jv; R^T Jw]. P comes from the joints' twists summed along the chains (one "
+                  "lane per speed), B_bias from the bodies' wrenches summed back along them.",
                   true, {}};
-  const FunctionSpec c = derive_convective(m), b = derive_bodies(m);
-  fn.outputs = {c.outputs[0], c.outputs[1], b.outputs[4], b.outputs[5]};
+  for (const auto& c : m.coordinates)
+    if (c.name.rfind("kane_", 0) == 0) throw std::runtime_error("coordinate name " + c.name + ": names starting with kane_ are reserved");
+  for (const auto& par : m.parameters)
+    if (par.name.rfind("kane_", 0) == 0) throw std::runtime_error("parameter name " + par.name + ": names starting with kane_ are reserved");
+  // T's structure is fixed by the model file: the commanded speeds' rows are unit rows, the rows of
+  // the dependent pair and of the dependent joints are dense, the rows of the other inputs (held
+  // constant) zero. So only the joints of those two kinds move the bodies.
+  std::vector<int> speed_of(static_cast<std::size_t>(n), -1);
+  for (int k = 0; k < nu; ++k) speed_of[static_cast<std::size_t>(dyn.commanded[static_cast<std::size_t>(k)])] = k;
+  const auto dense = [&](int j) { return j >= m.input_count || j == pair[0] || j == pair[1]; };
+  const auto moves = [&](int j) { return dense(j) || speed_of[static_cast<std::size_t>(j)] >= 0; };
+  fn.inputs = {{"T", "RateBasis",
+                "s' = T u, the rates caused by unit commanded speeds (rate_basis at s); only the rows of the dependent "
+                "pair and of the dependent joints are read, the others are fixed by the model file",
+                {}}};
+  const auto scalar = [&](const std::string& name, const ex& value) {
+    if (value.is_zero()) return std::string();
+    fn.lane_scalars.emplace_back(name, value);
+    return name;
+  };
+
+  // The tree of the bodies' chains, moving joints only (the others add nothing to a twist).
+  std::vector<TwistNode> nodes;
+  std::vector<int> body_node(m.bodies.size(), -1);
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    int at = -1;
+    for (const JointRecord& joint : m.bodies[i].com_frame.joints) {
+      if (!moves(joint.coordinate)) continue;
+      const auto& siblings = at < 0 ? std::vector<int>{} : nodes[static_cast<std::size_t>(at)].children;
+      int next = -1;
+      if (at < 0) {
+        for (std::size_t k = 0; k < nodes.size(); ++k)
+          if (nodes[k].parent < 0 && same_joint(*nodes[k].joint, joint)) next = static_cast<int>(k);
+      } else {
+        for (int c : siblings)
+          if (same_joint(*nodes[static_cast<std::size_t>(c)].joint, joint)) next = c;
+      }
+      if (next < 0) {
+        next = static_cast<int>(nodes.size());
+        nodes.push_back({&joint, at, {}, {}, {}, {}});
+        if (at >= 0) nodes[static_cast<std::size_t>(at)].children.push_back(next);
+      }
+      at = next;
+    }
+    body_node[i] = at;
+    if (at >= 0) nodes[static_cast<std::size_t>(at)].bodies.push_back(static_cast<int>(i));
+  }
+  // Which nodes need the wrench sums: the dense joints' (B_bias) and all beyond them.
+  std::vector<bool> needs_wrench(nodes.size(), false);
+  for (std::size_t k = 0; k < nodes.size(); ++k)
+    needs_wrench[k] = dense(nodes[k].joint->coordinate) || (nodes[k].parent >= 0 && needs_wrench[static_cast<std::size_t>(nodes[k].parent)]);
+
+  LaneWriter w(nu);
+  // Each output's share of the lane code's operations (the twists and D P count with M).
+  enum { kM, kB_velocity, kB_bias, kQ_gravity };
+  std::set<int> rows_used;
+  w.charge_to = kM;
+  // Forward: a joint's twist per unit rate is (a, o x a) for a revolute joint (axis a through o),
+  // (0, a) for a prismatic one; times T's row of its coordinate, added to its parent's.
+  std::vector<std::array<std::string, 6>> joint_twist(nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    TwistNode& node = nodes[k];
+    const JointRecord& joint = *node.joint;
+    const Vec3 zero;
+    const Vec3 angular = joint.revolute ? joint.axis : zero;
+    const Vec3 linear = joint.revolute ? cross(joint.origin, joint.axis) : joint.axis;
+    for (int c = 0; c < 3; ++c) {
+      joint_twist[k][static_cast<std::size_t>(c)] = scalar(fmt::format("kane_twist_{}_{}", k, c), angular[c]);
+      joint_twist[k][static_cast<std::size_t>(c + 3)] = scalar(fmt::format("kane_twist_{}_{}", k, c + 3), linear[c]);
+    }
+    const int j = joint.coordinate;
+    const std::array<std::string, 6> base =
+        node.parent < 0 ? std::array<std::string, 6>{} : nodes[static_cast<std::size_t>(node.parent)].twist;
+    for (std::size_t c = 0; c < 6; ++c) {
+      const std::string name = fmt::format("twist{}_{}", k, c);
+      const std::string& x = joint_twist[k][c];
+      if (x.empty()) {
+        node.twist[c] = base[c];
+      } else if (dense(j)) {
+        rows_used.insert(j);
+        node.twist[c] = w.define(name, base[c], {{x, fmt::format("kane_T_{}", j)}});
+      } else {
+        node.twist[c] = w.plus_lane(name, base[c], speed_of[static_cast<std::size_t>(j)], x);
+      }
+    }
+  }
+
+  // Per body: P from the twist at its CoM, D P, and its terms of M, b_velocity and Q_gravity.
+  const ex g = m.parameter(dyn.gravity).symbol;
+  const std::string minus_g = scalar("kane_minus_g", -g);
+  std::vector<std::array<std::string, 6>> body_wrench(m.bodies.size());
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    if (body_node[i] < 0) continue;  // moved by no joint of T: no part in u's dynamics
+    const Body& body = m.bodies[i];
+    const Frame& f = body.com_frame;
+    const auto& tw = nodes[static_cast<std::size_t>(body_node[i])].twist;
+    const auto name = [&](const char* what, int a) { return fmt::format("kane_{}_{}_{}", what, i, a); };
+    w.charge_to = kM;
+    w.comment(fmt::format("body {}: {}", body.name, body.meaning));
+    std::array<std::string, 3> p, minus_p, pv, pb, dv, db;
+    for (int c = 0; c < 3; ++c) {
+      p[static_cast<std::size_t>(c)] = scalar(name("p", c), f.r[c]);
+      minus_p[static_cast<std::size_t>(c)] = scalar(name("minus_p", c), -f.r[c]);
+    }
+    const auto at = [](const auto& a, int c) -> const std::string& { return a[static_cast<std::size_t>(c)]; };
+    // v = v_0 + omega x p.
+    for (int c = 0; c < 3; ++c) {
+      const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+      pv[static_cast<std::size_t>(c)] = w.define(fmt::format("pv{}_{}", i, c), at(tw, c + 3),
+                                                 {{at(p, c2), at(tw, c1)}, {at(minus_p, c1), at(tw, c2)}});
+    }
+    std::array<std::string, 9> R;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) R[static_cast<std::size_t>(3 * a + b)] = scalar(fmt::format("kane_R_{}_{}_{}", i, a, b), f.R(a, b));
+    const auto Rab = [&](int a, int b) -> const std::string& { return R[static_cast<std::size_t>(3 * a + b)]; };
+    for (int a = 0; a < 3; ++a)
+      pb[static_cast<std::size_t>(a)] = w.define(fmt::format("pb{}_{}", i, a), "", {{Rab(0, a), at(tw, 0)}, {Rab(1, a), at(tw, 1)}, {Rab(2, a), at(tw, 2)}});
+    const std::string mass = scalar(name("mass", 0), m.parameter(body.mass).symbol);
+    Vec3 I;
+    for (int a = 0; a < 3; ++a) I[a] = m.parameter(body.inertia[static_cast<std::size_t>(a)]).symbol;
+    for (int c = 0; c < 3; ++c) dv[static_cast<std::size_t>(c)] = w.define(fmt::format("dv{}_{}", i, c), "", {{mass, at(pv, c)}});
+    for (int a = 0; a < 3; ++a)
+      db[static_cast<std::size_t>(a)] = w.define(fmt::format("db{}_{}", i, a), "", {{scalar(name("inertia", a), I[a]), at(pb, a)}});
+    // M += P^T D P, row by row (lane l of row k: M(k, l)).
+    for (int k = 0; k < nu; ++k) {
+      std::vector<std::pair<std::string, std::string>> terms;
+      for (int c = 0; c < 3; ++c)
+        if (!at(pv, c).empty()) terms.emplace_back(fmt::format("{}.v[{}]", at(pv, c), k), at(dv, c));
+      for (int a = 0; a < 3; ++a)
+        if (!at(pb, a).empty()) terms.emplace_back(fmt::format("{}.v[{}]", at(pb, a), k), at(db, a));
+      w.accumulate(fmt::format("kane_M_{}", k), terms);
+    }
+    // b_velocity += P^T [m a; I alpha_b + omega_b x I omega_b] (body axes); Q_gravity += Pv^T m g.
+    const auto to_body = [&](const Vec3& v) {
+      Vec3 out;
+      for (int a = 0; a < 3; ++a) out[a] = f.R(0, a) * v[0] + f.R(1, a) * v[1] + f.R(2, a) * v[2];
+      return out;
+    };
+    const auto inertia_times = [&](const Vec3& v) { return Vec3(I[0] * v[0], I[1] * v[1], I[2] * v[2]); };
+    const Vec3 omega = to_body(f.omega);
+    const Vec3 torque = inertia_times(to_body(f.alpha_bias)) + cross(omega, inertia_times(omega));
+    std::vector<std::pair<std::string, std::string>> force;
+    for (int c = 0; c < 3; ++c) force.emplace_back(scalar(name("acc", c), f.a_bias[c]), at(dv, c));
+    for (int a = 0; a < 3; ++a) force.emplace_back(scalar(name("torque", a), torque[a]), at(pb, a));
+    w.charge_to = kB_velocity;
+    w.accumulate("kane_b", force);
+    w.charge_to = kQ_gravity;
+    w.accumulate("kane_Q", {{minus_g, at(dv, 2)}});
+    w.charge_to = kB_bias;
+    // Its wrench per unit speed for B_bias: force D P_v and moment p x force + R (I P_b), in K0.
+    if (!needs_wrench[static_cast<std::size_t>(body_node[i])]) continue;
+    auto& wr = body_wrench[i];
+    for (int c = 0; c < 3; ++c) wr[static_cast<std::size_t>(c)] = at(dv, c);
+    for (int c = 0; c < 3; ++c) {
+      const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+      wr[static_cast<std::size_t>(c + 3)] = w.define(
+          fmt::format("moment{}_{}", i, c), "",
+          {{Rab(c, 0), at(db, 0)}, {Rab(c, 1), at(db, 1)}, {Rab(c, 2), at(db, 2)}, {at(p, c1), at(dv, c2)}, {at(minus_p, c2), at(dv, c1)}});
+    }
+  }
+
+  // Backward: the wrench sums beyond each node, and B_bias's column of a dense joint: its twist
+  // dotted with them (the generalized force of that joint).
+  std::set<int> bias_columns;
+  for (std::size_t k = nodes.size(); k-- > 0;) {
+    if (!needs_wrench[k]) continue;
+    TwistNode& node = nodes[k];
+    for (std::size_t c = 0; c < 6; ++c) {
+      std::vector<std::string> parts;
+      for (int i : node.bodies)
+        if (!body_wrench[static_cast<std::size_t>(i)][c].empty()) parts.push_back(body_wrench[static_cast<std::size_t>(i)][c]);
+      for (int child : node.children)
+        if (!nodes[static_cast<std::size_t>(child)].wrench[c].empty()) parts.push_back(nodes[static_cast<std::size_t>(child)].wrench[c]);
+      if (parts.size() == 1) node.wrench[c] = parts[0];
+      else if (!parts.empty()) node.wrench[c] = w.define_sum(fmt::format("wrench{}_{}", k, c), parts);
+    }
+    const int j = node.joint->coordinate;
+    if (!dense(j)) continue;
+    std::vector<std::pair<std::string, std::string>> terms;
+    // generalized force = omega_j . moment + v_j . force
+    for (std::size_t c = 0; c < 3; ++c) terms.emplace_back(joint_twist[k][c], node.wrench[c + 3]);
+    for (std::size_t c = 0; c < 3; ++c) terms.emplace_back(joint_twist[k][c + 3], node.wrench[c]);
+    bias_columns.insert(j);
+    w.accumulate(fmt::format("kane_B_{}", j), terms);
+  }
+  std::vector<OpCount> lane_ops(4);
+  const std::string body_code = w.finish(lane_ops);
+  std::erase_if(fn.lane_scalars, [&](const auto& named) { return !mentions(body_code, named.first); });
+
+  // Around the bodies: T's rows, the accumulators, then the outputs.
+  std::string code = fmt::format("    using L = detail::Lanes<Scalar, {}>;\n", nu);
+  for (int j : rows_used) code += fmt::format("    const L kane_T_{0} = detail::lanes_of_row<Scalar, {1}>(T, {0});\n", j, nu);
+  code += fmt::format("    L kane_M_0 = {}", w.zero());
+  for (int k = 1; k < nu; ++k) code += fmt::format(", kane_M_{} = kane_M_0", k);
+  code += ", kane_b = kane_M_0, kane_Q = kane_M_0";
+  for (int j : bias_columns) code += fmt::format(", kane_B_{} = kane_M_0", j);
+  code += ";\n" + body_code;
+  code += "    if (M != nullptr) {  // the upper triangle, mirrored: M is symmetric to the last bit\n";
+  code += "      const L* row[] = {";
+  for (int k = 0; k < nu; ++k) code += fmt::format("{}&kane_M_{}", k ? ", " : "", k);
+  code += fmt::format("}};\n      for (int k = 0; k < {0}; ++k)\n        for (int l = k; l < {0}; ++l) (*M)(k, l) = (*M)(l, k) = row[k]->v[l];\n    }}\n", nu);
+  code += fmt::format("    if (b_velocity != nullptr)\n      for (int k = 0; k < {}; ++k) (*b_velocity)(k) = kane_b.v[k];\n", nu);
+  code += fmt::format("    if (Q_gravity != nullptr)\n      for (int k = 0; k < {}; ++k) (*Q_gravity)(k) = kane_Q.v[k];\n", nu);
+  code += "    if (B_bias != nullptr) {\n      if (zero_fill) B_bias->setZero();\n";
+  for (int j : bias_columns) code += fmt::format("      for (int k = 0; k < {}; ++k) (*B_bias)(k, {}) = kane_B_{}.v[k];\n", nu, j, j);
+  code += "    }\n";
+  fn.lane_code = code;
+
+  const FunctionSpec c = derive_convective(m);
+  OutputSpec Mo{"M", "CommandMatrix", "generalized mass matrix on u (symmetric)", "", {}};
+  OutputSpec bo{"b_velocity", "CommandVector", "velocity-dependent forces on u, s''_bias excluded", "", {}};
+  OutputSpec Bo{"B_bias", "CommandRows", "forces on u per unit s''_bias: b = b_velocity + B_bias s''_bias", kZeroMatrix, {}};
+  OutputSpec Qo{"Q_gravity", "CommandVector", "generalized gravity force on u (gravity along -z of K0)", "", {}};
+  for (OutputSpec* o : {&Mo, &bo, &Bo, &Qo}) o->from_lanes = true;
+  Mo.lane_ops = lane_ops[kM];
+  bo.lane_ops = lane_ops[kB_velocity];
+  Bo.lane_ops = lane_ops[kB_bias];
+  Qo.lane_ops = lane_ops[kQ_gravity];
+  fn.outputs = {c.outputs[0], c.outputs[1], Mo, bo, Bo, Qo};
   return fn;
 }
 
@@ -235,8 +585,8 @@ std::vector<Derivation> derivations(const Model& m) {
                               {"convective", derive_convective},
                               {"bodies", derive_bodies},
                               {"kinematic_update", derive_kinematic_update},
-                              {"dynamics_update", derive_dynamics_update},
-                              {"dynamics_convective", derive_dynamics_convective}};
+                              {"dynamics_update", derive_dynamics_update}};
+  if (m.dynamics) all.push_back({"reduced_dynamics", derive_reduced_dynamics});
   if (m.clearance) all.push_back({"clearance", derive_clearance});
   return all;
 }

@@ -3,6 +3,7 @@
 // dynamics (6.2-6.3). Each returns the symbolic outputs of one emitted function.
 #pragma once
 
+#include "expr_graph.hpp"
 #include "model.hpp"
 
 #include <string>
@@ -17,6 +18,19 @@ struct OutputSpec {
   std::string doc;
   std::string prologue;  // statement run before the elements are written (zeroing), or empty
   std::vector<std::pair<std::string, ex>> elements;  // lvalue (with `{}` for the name) -> value
+  // Written by the function's lane code (FunctionSpec::lane_code), not element by element; then
+  // `elements` is empty and lane_ops counts its share of that code's operations.
+  bool from_lanes = false;
+  OpCount lane_ops = {};
+};
+
+// One input argument besides s, sdot and p: a matrix of the scalar type, whose entries the
+// expressions use as symbols.
+struct InputSpec {
+  std::string name;
+  std::string type;  // a types.hpp name with an ...Of<Scalar> template
+  std::string doc;
+  std::vector<std::pair<std::string, std::string>> bindings;  // symbol name -> element, e.g. "T(3, 1)"
 };
 
 struct FunctionSpec {
@@ -25,6 +39,11 @@ struct FunctionSpec {
   std::string doc;
   bool needs_rates = false;  // takes sdot
   std::vector<OutputSpec> outputs;
+  std::vector<InputSpec> inputs = {};
+  // Code on rows of scalars (detail::Lanes, types.hpp) that writes the from_lanes outputs, run when
+  // any of them is requested, after the scalars it reads (lane_scalars: name -> value) are computed.
+  std::vector<std::pair<std::string, ex>> lane_scalars = {};
+  std::string lane_code = {};
 };
 
 // The value Phi_i(s) of one closure condition, in the model's symbols.
@@ -38,10 +57,11 @@ FunctionSpec derive_bodies(const Model& m);
 // Kinematics, closure and non-holonomic rows fused into one function, so that their common
 // subexpressions (the frames' rotations and positions) are computed once per update.
 FunctionSpec derive_kinematic_update(const Model& m);
-// An inverse-dynamics step's two passes, fused the same way: at s, dPhi/ds, C(s) and the bodies'
-// Jacobians; at s and s', the convective terms of both.
+// An inverse-dynamics step's two passes, fused the same way: at s, dPhi/ds and C(s); at s, s' and
+// the rate basis T, the convective terms and Kane's equations projected onto the commanded speeds
+// (only for a model with a dynamics section).
 FunctionSpec derive_dynamics_update(const Model& m);
-FunctionSpec derive_dynamics_convective(const Model& m);
+FunctionSpec derive_reduced_dynamics(const Model& m);
 
 // The height of the lowest corner of the model's clearance box above the ground (z = 0 of K0).
 FunctionSpec derive_clearance(const Model& m);

@@ -119,6 +119,23 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
   const int nc = static_cast<int>(m.closure.size());
   const int nw = static_cast<int>(m.wheels.size());
 
+  // The inverse dynamics' types, on the commanded speeds u (reduced_dynamics' arguments).
+  std::string dynamics_types;
+  if (m.dynamics) {
+    const std::size_t nu = m.dynamics->commanded.size();
+    dynamics_types = fmt::format(
+        "// The inverse dynamics on the {1} commanded speeds u (reduced_dynamics).\n"
+        "inline constexpr int kCommandedCount = {1};\n"
+        "template <typename Scalar> using CommandVectorOf = Eigen::Matrix<Scalar, {1}, 1>;\n"
+        "template <typename Scalar> using CommandMatrixOf = Eigen::Matrix<Scalar, {1}, {1}>;\n"
+        "template <typename Scalar> using RateBasisOf = Eigen::Matrix<Scalar, {0}, {1}>;  // s' = T u\n"
+        "template <typename Scalar> using CommandRowsOf = Eigen::Matrix<Scalar, {1}, {0}>;\n"
+        "using CommandVector = CommandVectorOf<double>;\n"
+        "using CommandMatrix = CommandMatrixOf<double>;\n"
+        "using RateBasis = RateBasisOf<double>;\n"
+        "using CommandRows = CommandRowsOf<double>;\n\n",
+        n, nu);
+  }
   std::string t = banner(m, opt, "Model sizes, names and fixed-size types.");
   // The double functions are also compiled for AVX2 + FMA and picked at run time, so that the
   // committed headers stay portable (SSE2 at worst) and a machine that has the instructions uses
@@ -175,11 +192,59 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
       "using BodyVectors = BodyVectorsOf<double>;\n"
       "using BodyRotations = BodyRotationsOf<double>;\n"
       "using BodyJacobians = BodyJacobiansOf<double>;\n\n"
+      "{5}"
       "namespace detail {{\n"
       "// T, but not deduced: the scalar type of a generated function comes from its coordinates, so an\n"
       "// output pointer may be nullptr (std::type_identity_t, which C++17 lacks).\n"
       "template <typename T> struct NonDeducedType {{ using type = T; }};\n"
       "template <typename T> using NonDeduced = typename NonDeducedType<T>::type;\n"
+      "// N scalars side by side, for code that does the same to N columns at once (reduced_dynamics:\n"
+      "// Kane's sums, one lane per commanded speed). Loops over a fixed N, which compilers vectorize.\n"
+      "template <typename Scalar, int N>\n"
+      "struct Lanes {{\n"
+      "  Scalar v[N];\n"
+      "  Lanes& operator+=(const Lanes& o) noexcept {{\n"
+      "    for (int i = 0; i < N; ++i) v[i] += o.v[i];\n"
+      "    return *this;\n"
+      "  }}\n"
+      "  friend Lanes operator+(Lanes a, const Lanes& b) noexcept {{ return a += b; }}\n"
+      "  friend Lanes operator*(const Scalar& s, const Lanes& a) noexcept {{\n"
+      "    Lanes out;\n"
+      "    for (int i = 0; i < N; ++i) out.v[i] = s * a.v[i];\n"
+      "    return out;\n"
+      "  }}\n"
+      "}};\n"
+      "#if defined(__GNUC__) && !defined(WLX_GEN_NO_VECTOR_LANES)\n"
+      "#define WLX_GEN_LANES_INLINE inline __attribute__((always_inline))\n"
+      "// double on 4 lanes: one GCC / clang vector (an AVX register, or two SSE2 ones), so that the\n"
+      "// rows stay in registers. Always inlined: a 32-byte vector is never passed to or returned from\n"
+      "// a call, whose convention would depend on whether the caller targets AVX.\n"
+      "template <>\n"
+      "struct Lanes<double, 4> {{\n"
+      "  typedef double Vector __attribute__((vector_size(32)));\n"
+      "  Vector v;\n"
+      "  __attribute__((always_inline)) Lanes& operator+=(const Lanes& o) noexcept {{\n"
+      "    v += o.v;\n"
+      "    return *this;\n"
+      "  }}\n"
+      "  __attribute__((always_inline)) friend Lanes operator+(const Lanes& a, const Lanes& b) noexcept {{ return {{a.v + b.v}}; }}\n"
+      "  __attribute__((always_inline)) friend Lanes operator*(const double& s, const Lanes& a) noexcept {{ return {{s * a.v}}; }}\n"
+      "}};\n"
+      "#else\n"
+      "#define WLX_GEN_LANES_INLINE inline\n"
+      "#endif\n"
+      "template <typename Scalar, int N>\n"
+      "WLX_GEN_LANES_INLINE Lanes<Scalar, N> zero_lanes() noexcept {{\n"
+      "  Lanes<Scalar, N> out;\n"
+      "  for (int i = 0; i < N; ++i) out.v[i] = Scalar(0);\n"
+      "  return out;\n"
+      "}}\n"
+      "template <typename Scalar, int N, class Matrix>\n"
+      "WLX_GEN_LANES_INLINE Lanes<Scalar, N> lanes_of_row(const Matrix& m, int row) noexcept {{\n"
+      "  Lanes<Scalar, N> out;\n"
+      "  for (int i = 0; i < N; ++i) out.v[i] = m(row, i);\n"
+      "  return out;\n"
+      "}}\n"
       "#if defined(WLX_GEN_MULTIVERSION)\n"
       "// Whether this CPU (and its operating system) runs AVX2 and FMA instructions; asked once.\n"
       "inline bool has_avx2_fma() noexcept {{\n"
@@ -188,7 +253,7 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
       "}}\n"
       "#endif\n"
       "}}  // namespace detail\n\n",
-      n, nf, nc, nw, nb);
+      n, nf, nc, nw, nb, dynamics_types);
   t += "// Index of each coordinate in s (the model file's order: inputs, then dependent joints).\nnamespace coord {\n";
   for (const auto& c : m.coordinates) t += fmt::format("inline constexpr int {} = {};  // {}, {}\n", c.name, c.index, c.unit, c.meaning);
   t += "}  // namespace coord\n\n";
@@ -262,6 +327,17 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
     }
     outs.push_back(std::move(els));
   }
+  // The lane code's scalars: one more block, after the outputs', named by lane_scalars.
+  const std::size_t lanes = outs.size();
+  if (!fn.lane_code.empty()) {
+    std::vector<Element> els;
+    for (const auto& [name, e] : fn.lane_scalars) {
+      const int id = g.add(e);
+      els.push_back({name, id});
+      roots.push_back(id);
+    }
+    outs.push_back(std::move(els));
+  }
   const CsePlan plan = eliminate_common_subexpressions(g, roots);
   const TrigBatch trig = batch_trig(m, g, roots);
 
@@ -292,7 +368,20 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
     body += fmt::format("  const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], shared_ops));
   }
   for (std::size_t o = 0; o < outs.size(); ++o) {
+    if (o == lanes) {
+      std::vector<std::string> requested;
+      for (const auto& spec : fn.outputs)
+        if (spec.from_lanes) requested.push_back(spec.name + " != nullptr");
+      body += fmt::format("  if ({}) {{\n", fmt::join(requested, " || "));
+      for (std::size_t k = 0; k < plan.temporaries.size(); ++k)
+        if (users[k].size() == 1 && *users[k].begin() == static_cast<int>(o) && !batched(k))
+          body += fmt::format("    const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], output_ops[o]));
+      for (const auto& el : outs[o]) body += fmt::format("    const Scalar {} = {};\n", el.lvalue, pr.value(el.id, output_ops[o]));
+      body += fn.lane_code + "  }\n";
+      continue;
+    }
     const auto& spec = fn.outputs[o];
+    if (spec.from_lanes) continue;
     body += fmt::format("  if ({} != nullptr) {{\n", spec.name);
     if (!spec.prologue.empty())
       body += "    if (zero_fill) " + fmt::format(fmt::runtime(spec.prologue), spec.name) + "\n";
@@ -305,6 +394,8 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
     body += "  }\n";
   }
 
+  // The lane code's operations, scalar-equivalent, are their outputs' own.
+  for (std::size_t o = 0; o < fn.outputs.size(); ++o) output_ops[o] += fn.outputs[o].lane_ops;
   OpCount total = shared_ops, before;
   for (const auto& c : output_ops) total += c;
   for (int r : roots) before += g.tree_ops(r);
@@ -314,7 +405,10 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   stats.before_cse = before;
   stats.after_cse = total;
 
-  const std::string aliases = coordinate_aliases(m, symbols) + parameter_aliases(m, symbols, opt);
+  std::string aliases = coordinate_aliases(m, symbols) + parameter_aliases(m, symbols, opt);
+  for (const auto& in : fn.inputs)
+    for (const auto& [symbol, element] : in.bindings)
+      if (symbols.count(symbol)) aliases += fmt::format("  const Scalar {} = {};\n", symbol, element);
 
   std::string t = banner(m, opt, fmt::format("{}: {}", fn.name, fn.doc));
   t += "#pragma once\n\n#include <array>\n#include <cmath>\n\n#include \"params.hpp\"\n";
@@ -326,9 +420,18 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
       "// Outputs, members of {}Of<Scalar> ({} for double), each computed only when its\n"
       "// pointer is set (C++20: {}(..., {{.{} = &x}})):\n",
       outputs_type, outputs_type, fn.name, fn.outputs.front().name);
-  for (std::size_t o = 0; o < outs.size(); ++o)
-    t += fmt::format("//   {:<18} {} (own operations: {}, nonzero entries: {})\n", fn.outputs[o].name, fn.outputs[o].doc,
-                     output_ops[o].total(), outs[o].size());
+  for (std::size_t o = 0; o < fn.outputs.size(); ++o) {
+    if (fn.outputs[o].from_lanes)
+      t += fmt::format("//   {:<18} {} (own operations: {}, on rows of {} lanes)\n", fn.outputs[o].name, fn.outputs[o].doc,
+                       output_ops[o].total(), m.dynamics ? m.dynamics->commanded.size() : 0);
+    else
+      t += fmt::format("//   {:<18} {} (own operations: {}, nonzero entries: {})\n", fn.outputs[o].name, fn.outputs[o].doc,
+                       output_ops[o].total(), outs[o].size());
+  }
+  if (!fn.lane_code.empty())
+    t += fmt::format("// The scalars those rows are built from ({} of them, the bodies' Jacobian entries among them):\n"
+                     "// {} operations, computed only when one of them is requested.\n",
+                     fn.lane_scalars.size(), output_ops[lanes].total());
   t += fmt::format("// Intermediate terms: {}; shared by several outputs: {} operations (sin and cos of all angles\n"
                    "// included: they are computed up front, whichever outputs are requested).\n",
                    stats.intermediates, shared_ops.total());
@@ -344,6 +447,10 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   };
   std::vector<Parameter> parameters{{"const CoordinatesOf<Scalar>&", "const Coordinates&", "s"}};
   if (fn.needs_rates) parameters.push_back({"const detail::NonDeduced<CoordinatesOf<Scalar>>&", "const Coordinates&", "sdot"});
+  for (const auto& in : fn.inputs) {
+    parameters.push_back({fmt::format("const detail::NonDeduced<{}Of<Scalar>>&", in.type), fmt::format("const {}&", in.type), in.name});
+    t += fmt::format("// Input {} ({}): {}\n", in.name, in.type, in.doc);
+  }
   parameters.push_back({"const Params&", "const Params&", "p"});
   // The outputs by name in one struct, not as positional pointers of look-alike types.
   parameters.push_back({fmt::format("const detail::NonDeduced<{}Of<Scalar>>&", outputs_type),
@@ -380,6 +487,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   t += "  static_cast<void>(s);\n  static_cast<void>(p);\n";
   for (const auto& o : fn.outputs) t += fmt::format("  const auto {0} = out.{0};\n", o.name);
   if (fn.needs_rates) t += "  static_cast<void>(sdot);\n";
+  for (const auto& in : fn.inputs) t += fmt::format("  static_cast<void>({});\n", in.name);
   t += using_declarations(pr.calls()) + aliases + body + "}\n\n";
   t += double_overload(fn.name, "void", plain, "for any Eigen expression of the coordinates");
   t += fmt::format("namespace operations {{\n// Operations {}() evaluates with every output requested (adds, muls, divs, calls).\n"

@@ -23,141 +23,32 @@ Eigen::Matrix3d world_inertia(const Params& p, int body, const Eigen::Matrix3d& 
 
 double mass(const Params& p, int body) { return p.*gen::kBodyMass[static_cast<std::size_t>(body)].mass; }
 
-// Calls f(std::integral_constant<int, i>) for every body i, so that its column list is a
-// compile-time constant.
-template <class F>
-void for_each_body(F&& f) {
-  [&]<std::size_t... I>(std::index_sequence<I...>) {
-    (f(std::integral_constant<int, static_cast<int>(I)>{}), ...);
-  }(std::make_index_sequence<static_cast<std::size_t>(gen::kBodyCount)>{});
-}
-
-// What T = ds'/du holds in the row of each of a body's Jacobian columns. T's structure is fixed by
-// the model file: the commanded speeds' rows are unit rows, the dynamics pair's and the dependent
-// joints' rows are dense, and the rows of the other inputs (held constant) are zero. Sorting the
-// columns by it at compile time leaves the dense ones for the products: 26 of the excavator's 60.
-struct BodyColumnClasses {
-  int dense_count = 0;  // columns whose T row is dense
-  std::array<int, gen::kMaxBodyColumns> dense{};
-  int commanded_count = 0;  // columns of a commanded speed: their T row is the unit row of speed k
-  std::array<int, gen::kMaxBodyColumns> commanded_column{}, commanded_speed{};
-};
-
-constexpr BodyColumnClasses classify_columns(int body) {
-  const gen::BodyColumns columns = gen::kBodyColumns[static_cast<std::size_t>(body)];
-  const auto pair = gen::kPairs[gen::kDynamicsPair].coordinates;
-  BodyColumnClasses out;
-  for (int c = 0; c < columns.count; ++c) {
-    const int j = columns.index[static_cast<std::size_t>(c)];
-    int speed = -1;
-    for (int k = 0; k < kCommandedCount; ++k)
-      if (kCommandedSpeeds[static_cast<std::size_t>(k)] == j) speed = k;
-    bool in_pair = false;
-    for (int w : pair) in_pair = in_pair || w == j;
-    if (speed >= 0) {
-      out.commanded_column[static_cast<std::size_t>(out.commanded_count)] = j;
-      out.commanded_speed[static_cast<std::size_t>(out.commanded_count++)] = speed;
-    } else if (j >= kInputCount || in_pair) {
-      out.dense[static_cast<std::size_t>(out.dense_count++)] = j;
-    }
-  }
-  return out;
-}
-
-inline constexpr auto kBodyColumnClasses = [] {
-  std::array<BodyColumnClasses, static_cast<std::size_t>(gen::kBodyCount)> out{};
-  for (int i = 0; i < gen::kBodyCount; ++i) out[static_cast<std::size_t>(i)] = classify_columns(i);
-  return out;
-}();
-
 }  // namespace
 
 void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const CommandVector& u,
                       const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options) {
   const Params& p = model.params();
   const DependentPair pair = dynamics_pair();
-  // Two fused generated passes instead of four: dPhi/ds, C(s) and the bodies' Jacobians at s, then
-  // every convective term at (s, s'); they share their subexpressions (the frames' rotations).
-  gen::dynamics_update(s, p,
-                       {.dPhi_ds = &d.dPhi_ds,
-                        .C = &d.C,
-                        .com = &d.body_com,
-                        .rotations = &d.body_rotations,
-                        .Jv = &d.body_Jv,
-                        .Jw = &d.body_Jw},
-                       false);
+  // Two generated passes: dPhi/ds and C(s), which give the rate basis T; then at (s, s' = T u, T)
+  // the convective terms and Kane's sums over the bodies (M, the velocity and gravity forces and
+  // their gain on s''_bias), sharing their subexpressions.
+  gen::dynamics_update(s, p, {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
   factorize_dependent_rates(d, pair, options);
   out.T = rate_basis(d, kCommandedSpeeds, pair);
   out.sdot.noalias() = out.T.lazyProduct(u);  // the velocity level's solve, once T is known
-  gen::dynamics_convective(s, out.sdot, p,
-                           {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot,
-                            .C_dot_sdot = &d.C_dot_sdot,
-                            .Jv_dot_sdot = &d.body_Jv_dot_sdot,
-                            .Jw_dot_sdot = &d.body_Jw_dot_sdot});
+  CommandVector b_velocity;
+  gen::reduced_dynamics(s, out.sdot, out.T, p,
+                        {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot,
+                         .C_dot_sdot = &d.C_dot_sdot,
+                         .M = &out.M,
+                         .b_velocity = &b_velocity,
+                         .B_bias = &out.B_bias,
+                         .Q_gravity = &out.Q_gravity},
+                        false);  // B_bias's structural zeros: set once, by DynamicsTerms
   Coordinates bias = Coordinates::Zero();  // s'' with u' = 0
   solve_dependent_accelerations_prepared(d, bias, pair);
   out.sddot = out.T.lazyProduct(u_dot) + bias;
-  out.M.setZero();
-  out.b.setZero();
-  out.Q_gravity.setZero();
-  const Eigen::Vector3d gravity(0, 0, -(p.*gen::kGravity));
-  constexpr int kU = kCommandedCount;
-  // Per body, over its Jacobian columns with a dense row of T only (a compile-time list, so every
-  // product below is fixed-size and unrolled); the columns of the commanded speeds are added, the
-  // others are skipped (their rows of T, s' and s''_bias are zero).
-  for_each_body([&](auto body) {
-    constexpr int i = decltype(body)::value;
-    constexpr BodyColumnClasses columns = kBodyColumnClasses[static_cast<std::size_t>(i)];
-    constexpr int K = columns.dense_count;
-    const auto& Jv = d.body_Jv[static_cast<std::size_t>(i)];
-    const auto& Jw = d.body_Jw[static_cast<std::size_t>(i)];
-    // Partial velocities P = [dv/du; domega/du] = J T, and J s''_bias (without the convective terms).
-    Eigen::Matrix<double, 6, kU> partial;
-    Eigen::Matrix<double, 6, 1> bias_motion = Eigen::Matrix<double, 6, 1>::Zero();
-    if constexpr (K > 0) {
-      Eigen::Matrix<double, 6, K> J;
-      Eigen::Matrix<double, K, kU> T_k;
-      Eigen::Matrix<double, K, 1> bias_k;
-      for (int c = 0; c < K; ++c) {
-        const int j = columns.dense[static_cast<std::size_t>(c)];
-        J.col(c) << Jv.col(j), Jw.col(j);
-        T_k.row(c) = out.T.row(j);
-        bias_k(c) = bias(j);
-      }
-      partial.noalias() = J.lazyProduct(T_k);
-      bias_motion.noalias() = J.lazyProduct(bias_k);
-    } else {
-      partial.setZero();
-    }
-    for (int c = 0; c < columns.commanded_count; ++c) {
-      const int j = columns.commanded_column[static_cast<std::size_t>(c)];
-      const int k = columns.commanded_speed[static_cast<std::size_t>(c)];
-      partial.col(k).template head<3>() += Jv.col(j);
-      partial.col(k).template tail<3>() += Jw.col(j);
-    }
-    const double m = mass(p, i);
-    // The rotational rows in body axes, where the inertia is diagonal: R^T B, R^T alpha, and
-    // omega = B u (s' = T u). P = [A; R^T B] and D = diag(m, m, m, I): M += P^T D P in one product.
-    const Eigen::Matrix3d& R = d.body_rotations[static_cast<std::size_t>(i)];
-    const auto& info = gen::kBodyMass[static_cast<std::size_t>(i)];
-    Eigen::Matrix<double, 6, 1> D;
-    D << m, m, m, p.*info.inertia[0], p.*info.inertia[1], p.*info.inertia[2];
-    Eigen::Matrix<double, 6, kU> P;
-    P.template topRows<3>() = partial.template topRows<3>();
-    P.template bottomRows<3>().noalias() = R.transpose().lazyProduct(partial.template bottomRows<3>());
-    const Eigen::Matrix<double, 6, kU> DP = D.asDiagonal() * P;
-    out.M.noalias() += P.transpose().lazyProduct(DP);
-    // Generalized inertia forces of the bias motion: P^T [m a_bias; I alpha + omega x I omega].
-    const Eigen::Vector3d omega_body = P.template bottomRows<3>().lazyProduct(u);
-    const Eigen::Vector3d spin = D.template tail<3>().cwiseProduct(omega_body);
-    Eigen::Matrix<double, 6, 1> force;
-    force.template head<3>() = m * (d.body_Jv_dot_sdot.col(i) + bias_motion.template head<3>());
-    force.template tail<3>() =
-        D.template tail<3>().cwiseProduct(R.transpose() * (d.body_Jw_dot_sdot.col(i) + bias_motion.template tail<3>())) +
-        omega_body.cross(spin);
-    out.b.noalias() += P.transpose().lazyProduct(force);
-    out.Q_gravity.noalias() += P.template topRows<3>().transpose().lazyProduct(m * gravity);
-  });
+  out.b = b_velocity + out.B_bias.lazyProduct(bias);
   out.Qstar = out.M * u_dot + out.b - out.Q_gravity;
   for (int r = 0; r < kActuatedCount; ++r) out.J_beta.row(r) = out.T.row(kActuatedJoints[static_cast<std::size_t>(r)]);
 }

@@ -41,6 +41,9 @@ struct DynamicsTerms {
   CommandVector Q_gravity;                                     // generalized gravity force
   CommandVector Qstar;                                         // M u' + b - Q_gravity
   ActuatorJacobian J_beta;                                     // beta' = J_beta u
+  // b = b_velocity + B_bias s''_bias (reduced_dynamics): the forces on u per unit bias
+  // acceleration. Its structural zeros are written here, once; inverse_dynamics never writes them.
+  gen::CommandRows B_bias = gen::CommandRows::Zero();
 };
 
 // Q* and its parts at s (closure satisfied) for speeds u and accelerations u_dot. Uses and

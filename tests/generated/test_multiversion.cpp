@@ -31,6 +31,11 @@ struct Comparison {
     worst = std::max(worst, (a - b).cwiseAbs().maxCoeff());
     differs = differs || !(a.array() == b.array()).all();
   }
+  // Relative to the largest entry (at least 1): for the dynamics' terms, whose size is the masses'.
+  template <class A, class B>
+  void add_scaled(const A& a, const B& b) {
+    add(a / std::max(1.0, a.cwiseAbs().maxCoeff()), b / std::max(1.0, a.cwiseAbs().maxCoeff()));
+  }
 };
 
 }  // namespace
@@ -44,20 +49,34 @@ TEST_CASE("multiversion: the AVX2 + FMA build of every generated function agrees
   gen::WheelVector C_conv_a, C_conv_b;
   gen::BodyJacobians Jv_a, Jv_b;
   gen::BodyVectors com_a, com_b, a_a, a_b;
+  gen::CommandMatrix M_a, M_b;
+  gen::CommandVector b_a, b_b, Q_a, Q_b;
+  gen::CommandRows B_a, B_b;
   Comparison c;
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng), sdot = test::random_rates(rng);
-    gen::dynamics_update(s, p, {.dPhi_ds = &J_a, .C = &C_a, .com = &com_a, .Jv = &Jv_a});
-    gen::dynamics_update<double>(s, p, {.dPhi_ds = &J_b, .C = &C_b, .com = &com_b, .Jv = &Jv_b});
+    gen::dynamics_update(s, p, {.dPhi_ds = &J_a, .C = &C_a});
+    gen::dynamics_update<double>(s, p, {.dPhi_ds = &J_b, .C = &C_b});
     c.add(J_a, J_b);
     c.add(C_a, C_b);
+    gen::bodies(s, sdot, p, {.com = &com_a, .Jv = &Jv_a, .Jv_dot_sdot = &a_a});
+    gen::bodies<double>(s, sdot, p, {.com = &com_b, .Jv = &Jv_b, .Jv_dot_sdot = &a_b});
     c.add(com_a, com_b);
+    c.add(a_a, a_b);
     for (int i = 0; i < gen::kBodyCount; ++i) c.add(Jv_a[static_cast<std::size_t>(i)], Jv_b[static_cast<std::size_t>(i)]);
-    gen::dynamics_convective(s, sdot, p, {.dPhi_ds_dot_sdot = &conv_a, .C_dot_sdot = &C_conv_a, .Jv_dot_sdot = &a_a});
-    gen::dynamics_convective<double>(s, sdot, p, {.dPhi_ds_dot_sdot = &conv_b, .C_dot_sdot = &C_conv_b, .Jv_dot_sdot = &a_b});
+    const gen::RateBasis T = gen::RateBasis::Random();
+    gen::reduced_dynamics(s, sdot, T, p,
+                          {.dPhi_ds_dot_sdot = &conv_a, .C_dot_sdot = &C_conv_a, .M = &M_a, .b_velocity = &b_a,
+                           .B_bias = &B_a, .Q_gravity = &Q_a});
+    gen::reduced_dynamics<double>(s, sdot, T, p,
+                                  {.dPhi_ds_dot_sdot = &conv_b, .C_dot_sdot = &C_conv_b, .M = &M_b,
+                                   .b_velocity = &b_b, .B_bias = &B_b, .Q_gravity = &Q_b});
     c.add(conv_a, conv_b);
     c.add(C_conv_a, C_conv_b);
-    c.add(a_a, a_b);
+    c.add_scaled(M_a, M_b);
+    c.add_scaled(b_a, b_b);
+    c.add_scaled(B_a, B_b);
+    c.add_scaled(Q_a, Q_b);
     gen::kinematic_update(s, p, {.dPhi_ds = &J_a, .C = &C_a});
     gen::kinematic_update<double>(s, p, {.dPhi_ds = &J_b, .C = &C_b});
     c.add(J_a, J_b);
@@ -67,7 +86,8 @@ TEST_CASE("multiversion: the AVX2 + FMA build of every generated function agrees
     c.add(conv_a, conv_b);
   }
   // Coordinates within +-pi rad and +-5 m, rates +-2: entries up to about 1e2 (convective terms), so
-  // 1e-12 is a few ulp of the largest; a wrong expression would be off by far more.
+  // 1e-12 is a few ulp of the largest; a wrong expression would be off by far more. The dynamics'
+  // terms (masses of tonnes) are compared relative to their largest entry.
   MESSAGE("AVX2 + FMA build in use: " << accelerated() << "; largest difference " << c.worst);
   CHECK(c.worst <= 1e-12);
   CHECK(c.differs == accelerated());

@@ -58,3 +58,20 @@ TEST_CASE("wlx-gen: a baked parameter's field in params.hpp holds the baked valu
   CHECK(params.find("double legD = 1.75;  // m: knee-to-foot length of a leg (baked:") != std::string::npos);
   CHECK(params.find("double legD = 1.5;") == std::string::npos);
 }
+
+TEST_CASE("wlx-gen: a header an earlier wlx-gen wrote and this one no longer produces is removed; others stay") {
+  const std::filesystem::path out = wlx_test::work_dir() / "stale";
+  std::filesystem::remove_all(out);
+  REQUIRE(wlx_test::run({WLX_MODEL_FILE, "--out", out.string(), "--quiet"}).code == 0);
+  const std::filesystem::path dir = out / "wlx" / "gen";
+  const std::string kinematics = wlx_test::slurp(dir / "kinematics.hpp");
+  // A dropped function's header: the banner of a real one under another name.
+  wlx_test::write(dir / "dropped_function.hpp", kinematics);
+  wlx_test::write(dir / "users_own.hpp", "// mine\n//\n// not generated\n");
+  const auto r = wlx_test::run({WLX_MODEL_FILE, "--out", out.string()});
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("1 stale removed") != std::string::npos);
+  CHECK(!std::filesystem::exists(dir / "dropped_function.hpp"));
+  CHECK(std::filesystem::exists(dir / "users_own.hpp"));
+  CHECK(wlx_test::slurp(dir / "kinematics.hpp") == kinematics);
+}

@@ -13,10 +13,10 @@
 //   convective               353         62310          1867
 //   bodies                   315         58902          2163
 //   kinematic_update           194         48373          1304
-//   dynamics_update           218         59522          1874
-//   dynamics_convective           389         98996          2274
+//   dynamics_update           150         37306          1043
+//   reduced_dynamics           484        145199          7305
 //   clearance                  0            19            20
-//   total                               388777         11649
+//   total                               412764         15849
 #pragma once
 
 #include "ik.hpp"
@@ -30,5 +30,5 @@
 #include "bodies.hpp"
 #include "kinematic_update.hpp"
 #include "dynamics_update.hpp"
-#include "dynamics_convective.hpp"
+#include "reduced_dynamics.hpp"
 #include "clearance.hpp"

@@ -61,11 +61,69 @@ using BodyVectors = BodyVectorsOf<double>;
 using BodyRotations = BodyRotationsOf<double>;
 using BodyJacobians = BodyJacobiansOf<double>;
 
+// The inverse dynamics on the 4 commanded speeds u (reduced_dynamics).
+inline constexpr int kCommandedCount = 4;
+template <typename Scalar> using CommandVectorOf = Eigen::Matrix<Scalar, 4, 1>;
+template <typename Scalar> using CommandMatrixOf = Eigen::Matrix<Scalar, 4, 4>;
+template <typename Scalar> using RateBasisOf = Eigen::Matrix<Scalar, 32, 4>;  // s' = T u
+template <typename Scalar> using CommandRowsOf = Eigen::Matrix<Scalar, 4, 32>;
+using CommandVector = CommandVectorOf<double>;
+using CommandMatrix = CommandMatrixOf<double>;
+using RateBasis = RateBasisOf<double>;
+using CommandRows = CommandRowsOf<double>;
+
 namespace detail {
 // T, but not deduced: the scalar type of a generated function comes from its coordinates, so an
 // output pointer may be nullptr (std::type_identity_t, which C++17 lacks).
 template <typename T> struct NonDeducedType { using type = T; };
 template <typename T> using NonDeduced = typename NonDeducedType<T>::type;
+// N scalars side by side, for code that does the same to N columns at once (reduced_dynamics:
+// Kane's sums, one lane per commanded speed). Loops over a fixed N, which compilers vectorize.
+template <typename Scalar, int N>
+struct Lanes {
+  Scalar v[N];
+  Lanes& operator+=(const Lanes& o) noexcept {
+    for (int i = 0; i < N; ++i) v[i] += o.v[i];
+    return *this;
+  }
+  friend Lanes operator+(Lanes a, const Lanes& b) noexcept { return a += b; }
+  friend Lanes operator*(const Scalar& s, const Lanes& a) noexcept {
+    Lanes out;
+    for (int i = 0; i < N; ++i) out.v[i] = s * a.v[i];
+    return out;
+  }
+};
+#if defined(__GNUC__) && !defined(WLX_GEN_NO_VECTOR_LANES)
+#define WLX_GEN_LANES_INLINE inline __attribute__((always_inline))
+// double on 4 lanes: one GCC / clang vector (an AVX register, or two SSE2 ones), so that the
+// rows stay in registers. Always inlined: a 32-byte vector is never passed to or returned from
+// a call, whose convention would depend on whether the caller targets AVX.
+template <>
+struct Lanes<double, 4> {
+  typedef double Vector __attribute__((vector_size(32)));
+  Vector v;
+  __attribute__((always_inline)) Lanes& operator+=(const Lanes& o) noexcept {
+    v += o.v;
+    return *this;
+  }
+  __attribute__((always_inline)) friend Lanes operator+(const Lanes& a, const Lanes& b) noexcept { return {a.v + b.v}; }
+  __attribute__((always_inline)) friend Lanes operator*(const double& s, const Lanes& a) noexcept { return {s * a.v}; }
+};
+#else
+#define WLX_GEN_LANES_INLINE inline
+#endif
+template <typename Scalar, int N>
+WLX_GEN_LANES_INLINE Lanes<Scalar, N> zero_lanes() noexcept {
+  Lanes<Scalar, N> out;
+  for (int i = 0; i < N; ++i) out.v[i] = Scalar(0);
+  return out;
+}
+template <typename Scalar, int N, class Matrix>
+WLX_GEN_LANES_INLINE Lanes<Scalar, N> lanes_of_row(const Matrix& m, int row) noexcept {
+  Lanes<Scalar, N> out;
+  for (int i = 0; i < N; ++i) out.v[i] = m(row, i);
+  return out;
+}
 #if defined(WLX_GEN_MULTIVERSION)
 // Whether this CPU (and its operating system) runs AVX2 and FMA instructions; asked once.
 inline bool has_avx2_fma() noexcept {

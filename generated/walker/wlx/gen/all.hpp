@@ -13,10 +13,10 @@
 //   convective               409         68496          1721
 //   bodies                   388         63427          2538
 //   kinematic_update           234         60493          1338
-//   dynamics_update           298         73148          2095
-//   dynamics_convective           483        106473          2253
+//   dynamics_update           183         47698           988
+//   reduced_dynamics           601        151284          7282
 //   clearance                  0            19            20
-//   total                               450649         12229
+//   total                               470010         16151
 #pragma once
 
 #include "ik.hpp"
@@ -30,5 +30,5 @@
 #include "bodies.hpp"
 #include "kinematic_update.hpp"
 #include "dynamics_update.hpp"
-#include "dynamics_convective.hpp"
+#include "reduced_dynamics.hpp"
 #include "clearance.hpp"
