@@ -45,8 +45,8 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
                          .B_bias = &out.B_bias,
                          .Q_gravity = &out.Q_gravity},
                         false);  // B_bias's structural zeros: set once, by DynamicsTerms
-  Coordinates bias = Coordinates::Zero();  // s'' with u' = 0
-  solve_dependent_accelerations_prepared(d, bias, pair);
+  Coordinates bias;  // s'' with u' = 0
+  solve_bias_accelerations(d, bias, pair);
   out.sddot = out.T.lazyProduct(u_dot) + bias;
   out.b = b_velocity + out.B_bias.lazyProduct(bias);
   out.Qstar = out.M * u_dot + out.b - out.Q_gravity;

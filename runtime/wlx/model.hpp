@@ -67,11 +67,10 @@ struct Data {
 
   // Non-holonomic solve (nonholonomic.hpp): the inverses of the closure's per-limb blocks (smaller
   // limbs padded to the largest with a unit diagonal; at these sizes products beat factorizations),
-  // the adjoint Lambda = Phi_dep^-T C_dep^T, the wheel rows reduced to the inputs
-  // C_hat = C_q - Lambda^T Phi_q, and J_beta (one row and column per wheel).
+  // the adjoint Lambda = Phi_dep^-T C_dep^T, and J_beta (one row and column per wheel): the pair's
+  // columns of the wheel rows reduced to the inputs, C_hat = C_q - Lambda^T Phi_q.
   std::array<Eigen::Matrix<double, gen::kMaxLimbSize, gen::kMaxLimbSize>, gen::kLimbCount> limb_inverse;
   Eigen::Matrix<double, gen::kDependentCount, gen::kWheelCount> wheel_adjoint;
-  Eigen::Matrix<double, gen::kWheelCount, gen::kInputCount> C_reduced;
   Eigen::Matrix<double, gen::kWheelCount, gen::kWheelCount> J_beta;
   double cond_J_beta = 0;
 };

@@ -37,8 +37,9 @@ void for_each_limb(F&& f) {
   }(std::make_index_sequence<static_cast<std::size_t>(kLimbCount)>{});
 }
 
-// Factorizes each limb's block of dPhi/ds, solves the adjoint Phi_dep^T Lambda = C_dep^T and forms
-// C_hat = C_q - Lambda^T Phi_q: one right-hand side per wheel instead of one per input (Phi_dep^-1 Phi_q).
+// Factorizes each limb's block of dPhi/ds and solves the adjoint Phi_dep^T Lambda = C_dep^T: one
+// right-hand side per wheel instead of one per input (Phi_dep^-1 Phi_q). The wheel rows reduced to
+// the inputs, C_hat = C_q - Lambda^T Phi_q, are then formed only where needed (reduced_column).
 void reduce(Data& d) {
   for_each_limb([&](auto L) {
     constexpr Limb limb = decltype(L)::value;
@@ -64,7 +65,6 @@ void reduce(Data& d) {
     const Eigen::Matrix<double, kLimbMax, kWheelCount> lambda = inverse.transpose().lazyProduct(rhs);
     for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.rows[static_cast<std::size_t>(i)]) = lambda.row(i);
   });
-  d.C_reduced = d.C.leftCols<kNq>() - d.wheel_adjoint.transpose().lazyProduct(d.dPhi_ds.leftCols<kNq>());
 }
 
 // The dependent joints' part of s'' or s' for a closure right-hand side: Phi_dep x = -v.
@@ -76,6 +76,32 @@ void solve_closure(const Data& d, const gen::ClosureVector& v, Coordinates& out)
     const LimbVector x = d.limb_inverse[static_cast<std::size_t>(decltype(L)::value)] * rhs;
     for (int j = 0; j < b.size; ++j) out(b.joints[static_cast<std::size_t>(j)]) = x(j);
   });
+}
+
+// Column k of C_hat = C_q - Lambda^T Phi_q.
+WheelVector reduced_column(const Data& d, int k) { return d.C.col(k) - d.wheel_adjoint.transpose().lazyProduct(d.dPhi_ds.col(k)); }
+
+// The wheels' rows and the closure for input rates (or accelerations) `q` whose pair entries are
+// zero, plus the convective terms: the pair's rates from J_beta pair' = -(C_q q + conv_C - Lambda^T
+// (Phi_q q + conv_Phi)), then the dependent joints from Phi_dep x = -(Phi_q q' + conv_Phi) with q'
+// = q and the pair's rates. Phi_q q is formed once; not at all when the input rates are all zero
+// (kInputsZero: the bias accelerations of the inverse dynamics).
+template <bool kInputsZero>
+void solve_pair_and_closure(const Data& d, const DependentPair& pair, const gen::ClosureVector& conv_Phi,
+                            const WheelVector& conv_C, Coordinates& out) {
+  gen::ClosureVector closure = conv_Phi;
+  WheelVector wheels = conv_C;
+  if constexpr (!kInputsZero) {
+    closure.noalias() += d.dPhi_ds.leftCols<kNq>().lazyProduct(out.head<kNq>());
+    wheels.noalias() += d.C.leftCols<kNq>().lazyProduct(out.head<kNq>());
+  }
+  const WheelVector pair_rate = -d.J_beta.partialPivLu().solve(wheels - d.wheel_adjoint.transpose().lazyProduct(closure));
+  for (int w = 0; w < kWheelCount; ++w) {
+    const int k = pair.index[static_cast<std::size_t>(w)];
+    out(k) = pair_rate(w);
+    closure.noalias() += d.dPhi_ds.col(k) * pair_rate(w);
+  }
+  solve_closure(d, closure, out);
 }
 
 }  // namespace
@@ -153,19 +179,13 @@ void solve_dependent_rates(const Model& model, Data& d, const Coordinates& s, Co
   // dPhi/ds and C(s) from the fused generated function: they share most subexpressions.
   gen::kinematic_update(s, model.params(), {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
   factorize_dependent_rates(d, pair, options);
-  Eigen::Matrix<double, kNq, 1> q_rate = sdot.head<kNq>();
-  for (int k = 0; k < kWheelCount; ++k) q_rate(pair.index[k]) = 0;
-  const WheelVector phi_hat = d.C_reduced.lazyProduct(q_rate);
-  const WheelVector pair_rate = -d.J_beta.partialPivLu().solve(phi_hat);
-  for (int k = 0; k < kWheelCount; ++k) q_rate(pair.index[k]) = pair_rate(k);
-  sdot.head<kNq>() = q_rate;
-  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>().lazyProduct(q_rate);
-  solve_closure(d, closure_rhs, sdot);
+  for (int k = 0; k < kWheelCount; ++k) sdot(pair.index[k]) = 0;
+  solve_pair_and_closure<false>(d, pair, gen::ClosureVector::Zero(), WheelVector::Zero(), sdot);
 }
 
 void factorize_dependent_rates(Data& d, const DependentPair& pair, const NonholonomicOptions& options) {
   reduce(d);
-  for (int k = 0; k < kWheelCount; ++k) d.J_beta.col(k) = d.C_reduced.col(pair.index[k]);
+  for (int k = 0; k < kWheelCount; ++k) d.J_beta.col(k) = reduced_column(d, pair.index[k]);
   d.cond_J_beta = condition_number(d.J_beta);
   if (!(d.cond_J_beta <= options.max_condition))
     throw Error(
@@ -183,17 +203,13 @@ void solve_dependent_accelerations(const Model& model, Data& d, const Coordinate
 }
 
 void solve_dependent_accelerations_prepared(Data& d, Coordinates& sddot, const DependentPair& pair) {
-  Eigen::Matrix<double, kNq, 1> q_acc = sddot.head<kNq>();
-  for (int k : pair.index) q_acc(k) = 0;
-  // Phi_dep s''_dep = -(Phi_q q'' + conv_Phi) and C s'' + conv_C = 0 give
-  // C_hat q'' = -(conv_C - Lambda^T conv_Phi).
-  const WheelVector rhs =
-      d.C_reduced.lazyProduct(q_acc) + d.C_dot_sdot - d.wheel_adjoint.transpose().lazyProduct(d.dPhi_ds_dot_sdot);
-  const WheelVector pair_acc = -d.J_beta.partialPivLu().solve(rhs);
-  for (int k = 0; k < kWheelCount; ++k) q_acc(pair.index[k]) = pair_acc(k);
-  sddot.head<kNq>() = q_acc;
-  const gen::ClosureVector closure_rhs = d.dPhi_ds.leftCols<kNq>().lazyProduct(q_acc) + d.dPhi_ds_dot_sdot;
-  solve_closure(d, closure_rhs, sddot);
+  for (int k : pair.index) sddot(k) = 0;
+  solve_pair_and_closure<false>(d, pair, d.dPhi_ds_dot_sdot, d.C_dot_sdot, sddot);
+}
+
+void solve_bias_accelerations(Data& d, Coordinates& sddot, const DependentPair& pair) {
+  sddot.setZero();
+  solve_pair_and_closure<true>(d, pair, d.dPhi_ds_dot_sdot, d.C_dot_sdot, sddot);
 }
 
 template <std::size_t N>
@@ -203,8 +219,11 @@ Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> rate_basis(const Da
   constexpr int kU = static_cast<int>(N);
   // Input-rate columns: a unit commanded rate, and the pair's answer to it.
   Eigen::Matrix<double, kWheelCount, kU> ch;
-  for (int k = 0; k < kU; ++k) ch.col(k) = d.C_reduced.col(commanded[static_cast<std::size_t>(k)]);
-  const Eigen::Matrix<double, kWheelCount, kU> pair_rates = -d.J_beta.partialPivLu().solve(ch);
+  for (int k = 0; k < kU; ++k) ch.col(k) = reduced_column(d, commanded[static_cast<std::size_t>(k)]);
+  // Column by column: a matrix right-hand side sends Eigen's triangular solve through its GEMM kernel.
+  const Eigen::PartialPivLU<WheelMatrix> lu(d.J_beta);
+  Eigen::Matrix<double, kWheelCount, kU> pair_rates;
+  for (int k = 0; k < kU; ++k) pair_rates.col(k) = -lu.solve(ch.col(k));
   Eigen::Matrix<double, kCoordinateCount, kU> T = Eigen::Matrix<double, kCoordinateCount, kU>::Zero();
   for (int k = 0; k < kU; ++k) {
     T(commanded[static_cast<std::size_t>(k)], k) = 1;

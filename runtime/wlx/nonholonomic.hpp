@@ -64,6 +64,8 @@ void solve_dependent_accelerations(const Model& model, Data& data, const Coordin
 // then gives s' = T u for any commanded rates u without another solve.
 void factorize_dependent_rates(Data& data, const DependentPair& pair, const NonholonomicOptions& options = {});
 void solve_dependent_accelerations_prepared(Data& data, Coordinates& sddot, const DependentPair& pair);
+// The same with every input acceleration zero (s''_bias of the inverse dynamics): overwrites sddot.
+void solve_bias_accelerations(Data& data, Coordinates& sddot, const DependentPair& pair);
 
 // After solve_dependent_rates at s (same pair): the full rates s' caused by a unit rate of each
 // input in `commanded` (one column each), every other commanded rate zero. Linear in the rates,
