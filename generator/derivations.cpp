@@ -248,6 +248,10 @@ class LaneWriter {
     ops.adds += lanes_;
     add("", fmt::format("    {} += {};\n", accumulator, rhs), ops);
   }
+  // "accumulator += row".
+  void add_row(const std::string& accumulator, const std::string& row) {
+    add("", fmt::format("    {} += {};\n", accumulator, row), OpCount{lanes_, 0, 0, 0});
+  }
   // A new row equal to `base` (or zero) plus `value` in lane k only: a unit row of T.
   std::string plus_lane(const std::string& name, const std::string& base, int k, const std::string& value) {
     add(name, fmt::format("    L {} = {};\n    {}.v[{}] += {};\n", name, base.empty() ? zero() : base, name, k, value),
@@ -388,10 +392,6 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
     body_node[i] = at;
     if (at >= 0) nodes[static_cast<std::size_t>(at)].bodies.push_back(static_cast<int>(i));
   }
-  // Which nodes need the wrench sums: the dense joints' (B_bias) and all beyond them.
-  std::vector<bool> needs_wrench(nodes.size(), false);
-  for (std::size_t k = 0; k < nodes.size(); ++k)
-    needs_wrench[k] = dense(nodes[k].joint->coordinate) || (nodes[k].parent >= 0 && needs_wrench[static_cast<std::size_t>(nodes[k].parent)]);
 
   LaneWriter w(nu);
   // Each output's share of the lane code's operations (the twists and D P count with M).
@@ -464,15 +464,6 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
     for (int c = 0; c < 3; ++c) dv[static_cast<std::size_t>(c)] = w.define(fmt::format("dv{}_{}", i, c), "", {{mass, at(pv, c)}});
     for (int a = 0; a < 3; ++a)
       db[static_cast<std::size_t>(a)] = w.define(fmt::format("db{}_{}", i, a), "", {{scalar(name("inertia", a), I[a]), at(pb, a)}});
-    // M += P^T D P, row by row (lane l of row k: M(k, l)).
-    for (int k = 0; k < nu; ++k) {
-      std::vector<std::pair<std::string, std::string>> terms;
-      for (int c = 0; c < 3; ++c)
-        if (!at(pv, c).empty()) terms.emplace_back(fmt::format("{}.v[{}]", at(pv, c), k), at(dv, c));
-      for (int a = 0; a < 3; ++a)
-        if (!at(pb, a).empty()) terms.emplace_back(fmt::format("{}.v[{}]", at(pb, a), k), at(db, a));
-      w.accumulate(fmt::format("kane_M_{}", k), terms);
-    }
     // b_velocity += P^T [m a; I alpha_b + omega_b x I omega_b] (body axes); Q_gravity += Pv^T m g.
     const auto to_body = [&](const Vec3& v) {
       Vec3 out;
@@ -489,9 +480,8 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
     w.accumulate("kane_b", force);
     w.charge_to = kQ_gravity;
     w.accumulate("kane_Q", {{minus_g, at(dv, 2)}});
-    w.charge_to = kB_bias;
-    // Its wrench per unit speed for B_bias: force D P_v and moment p x force + R (I P_b), in K0.
-    if (!needs_wrench[static_cast<std::size_t>(body_node[i])]) continue;
+    w.charge_to = kM;
+    // Its wrench per unit speed: force D P_v and moment p x force + R (I P_b), in K0.
     auto& wr = body_wrench[i];
     for (int c = 0; c < 3; ++c) wr[static_cast<std::size_t>(c)] = at(dv, c);
     for (int c = 0; c < 3; ++c) {
@@ -502,11 +492,12 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
     }
   }
 
-  // Backward: the wrench sums beyond each node, and B_bias's column of a dense joint: its twist
-  // dotted with them (the generalized force of that joint).
+  // Backward: the wrench sums beyond each node, and its joint's generalized force tau_j = omega_j .
+  // moment + v_j . force (lane l: for a unit speed l). A dense joint's is B_bias's column j; and
+  // M = P^T D P summed over the bodies = sum over the joints of T(j, :)^T tau_j: a commanded speed's
+  // joint adds its tau to row k, a dense joint T(j, k) tau_j to every row k.
   std::set<int> bias_columns;
   for (std::size_t k = nodes.size(); k-- > 0;) {
-    if (!needs_wrench[k]) continue;
     TwistNode& node = nodes[k];
     for (std::size_t c = 0; c < 6; ++c) {
       std::vector<std::string> parts;
@@ -518,13 +509,21 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
       else if (!parts.empty()) node.wrench[c] = w.define_sum(fmt::format("wrench{}_{}", k, c), parts);
     }
     const int j = node.joint->coordinate;
-    if (!dense(j)) continue;
     std::vector<std::pair<std::string, std::string>> terms;
-    // generalized force = omega_j . moment + v_j . force
     for (std::size_t c = 0; c < 3; ++c) terms.emplace_back(joint_twist[k][c], node.wrench[c + 3]);
     for (std::size_t c = 0; c < 3; ++c) terms.emplace_back(joint_twist[k][c + 3], node.wrench[c]);
-    bias_columns.insert(j);
-    w.accumulate(fmt::format("kane_B_{}", j), terms);
+    w.charge_to = dense(j) ? kB_bias : kM;
+    const std::string tau = w.define(fmt::format("tau{}", k), "", terms);
+    if (tau.empty()) continue;
+    if (dense(j)) {
+      bias_columns.insert(j);
+      w.add_row(fmt::format("kane_B_{}", j), tau);
+      w.charge_to = kM;
+      for (int l = 0; l < nu; ++l) w.accumulate(fmt::format("kane_M_{}", l), {{fmt::format("T({}, {})", j, l), tau}});
+    } else {
+      w.charge_to = kM;
+      w.add_row(fmt::format("kane_M_{}", speed_of[static_cast<std::size_t>(j)]), tau);
+    }
   }
   std::vector<OpCount> lane_ops(4);
   const std::string body_code = w.finish(lane_ops);

@@ -34,7 +34,7 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   // their gain on s''_bias), sharing their subexpressions.
   gen::dynamics_update(s, p, {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
   factorize_dependent_rates(d, pair, options);
-  out.T = rate_basis(d, kCommandedSpeeds, pair);
+  rate_basis(d, kCommandedSpeeds, pair, out.T);
   out.sdot.noalias() = out.T.lazyProduct(u);  // the velocity level's solve, once T is known
   CommandVector b_velocity;
   gen::reduced_dynamics(s, out.sdot, out.T, p,

@@ -213,10 +213,12 @@ void solve_bias_accelerations(Data& d, Coordinates& sddot, const DependentPair& 
 }
 
 template <std::size_t N>
-Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> rate_basis(const Data& d,
-                                                                        const std::array<int, N>& commanded,
-                                                                        const DependentPair& pair) {
+void rate_basis(const Data& d, const std::array<int, N>& commanded, const DependentPair& pair,
+                Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)>& T) {
   constexpr int kU = static_cast<int>(N);
+  for (int c : commanded)
+    for (int k : pair.index)
+      if (c == k) throw Error("commanded", fmt::format("{}' is a commanded rate and one of the dependent pair", name_of(c)));
   // Input-rate columns: a unit commanded rate, and the pair's answer to it.
   Eigen::Matrix<double, kWheelCount, kU> ch;
   for (int k = 0; k < kU; ++k) ch.col(k) = reduced_column(d, commanded[static_cast<std::size_t>(k)]);
@@ -224,22 +226,18 @@ Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> rate_basis(const Da
   const Eigen::PartialPivLU<WheelMatrix> lu(d.J_beta);
   Eigen::Matrix<double, kWheelCount, kU> pair_rates;
   for (int k = 0; k < kU; ++k) pair_rates.col(k) = -lu.solve(ch.col(k));
-  Eigen::Matrix<double, kCoordinateCount, kU> T = Eigen::Matrix<double, kCoordinateCount, kU>::Zero();
+  T.setZero();
   for (int k = 0; k < kU; ++k) {
     T(commanded[static_cast<std::size_t>(k)], k) = 1;
     for (int w = 0; w < kWheelCount; ++w) T(pair.index[static_cast<std::size_t>(w)], k) = pair_rates(w, k);
   }
   // Dependent joints: Phi_dep T_dep = -Phi_q T_q, all columns per limb block at once. T's input
-  // rows are zero except the commanded and the pair's: those columns of dPhi/ds, not all inputs.
-  Eigen::Matrix<double, gen::kClosureCount, kU> rhs = Eigen::Matrix<double, gen::kClosureCount, kU>::Zero();
-  std::array<int, N + kWheelCount> rows{};
-  for (std::size_t k = 0; k < N; ++k) rows[k] = commanded[k];
-  for (std::size_t w = 0; w < static_cast<std::size_t>(kWheelCount); ++w) rows[N + w] = pair.index[w];
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    bool seen = false;
-    for (std::size_t q = 0; q < r; ++q) seen = seen || rows[q] == rows[r];
-    if (!seen) rhs.noalias() += d.dPhi_ds.col(rows[r]).lazyProduct(T.row(rows[r]));
-  }
+  // rows are zero except the commanded (unit rows) and the pair's: rhs = those columns of dPhi/ds
+  // times them.
+  Eigen::Matrix<double, gen::kClosureCount, kU> rhs;
+  for (int k = 0; k < kU; ++k) rhs.col(k) = d.dPhi_ds.col(commanded[static_cast<std::size_t>(k)]);
+  for (int w = 0; w < kWheelCount; ++w)
+    rhs.noalias() += d.dPhi_ds.col(pair.index[static_cast<std::size_t>(w)]).lazyProduct(pair_rates.row(w));
   for_each_limb([&](auto L) {
     constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(decltype(L)::value)];
     Eigen::Matrix<double, kLimbMax, kU> block_rhs = Eigen::Matrix<double, kLimbMax, kU>::Zero();
@@ -248,12 +246,21 @@ Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> rate_basis(const Da
         d.limb_inverse[static_cast<std::size_t>(decltype(L)::value)].lazyProduct(block_rhs);
     for (int j = 0; j < b.size; ++j) T.row(b.joints[static_cast<std::size_t>(j)]) = x.row(j);
   });
+}
+
+template <std::size_t N>
+Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> rate_basis(const Data& d, const std::array<int, N>& commanded,
+                                                                        const DependentPair& pair) {
+  Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> T;
+  rate_basis(d, commanded, pair, T);
   return T;
 }
 
 // The dynamics' commanded speeds are the one set the runtime asks a basis for.
 template Eigen::Matrix<double, kCoordinateCount, static_cast<int>(gen::kCommanded.size())> rate_basis(
     const Data&, const std::array<int, gen::kCommanded.size()>&, const DependentPair&);
+template void rate_basis(const Data&, const std::array<int, gen::kCommanded.size()>&, const DependentPair&,
+                         Eigen::Matrix<double, kCoordinateCount, static_cast<int>(gen::kCommanded.size())>&);
 
 Eigen::Matrix<double, 3, kWheelCount> contact_velocities(const Model& model, Data& d, const Coordinates& s,
                                                          const Coordinates& sdot) {

@@ -70,10 +70,15 @@ void solve_bias_accelerations(Data& data, Coordinates& sddot, const DependentPai
 // After solve_dependent_rates at s (same pair): the full rates s' caused by a unit rate of each
 // input in `commanded` (one column each), every other commanded rate zero. Linear in the rates,
 // so s' = T u for u the rates of `commanded`.
+// `commanded` must not include the pair (wlx::Error otherwise).
 template <std::size_t N>
 Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> rate_basis(const Data& data,
                                                                         const std::array<int, N>& commanded,
                                                                         const DependentPair& pair);
+// The same into T (no copy of the result).
+template <std::size_t N>
+void rate_basis(const Data& data, const std::array<int, N>& commanded, const DependentPair& pair,
+                Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)>& T);
 
 // Velocity in K0 of each wheel's contact point (one column per wheel, in gen::kWheels' order) for the full sdot, from
 // the generated rows: along the contact frame's x axis w * spin rate, along its lateral axis n_W the sideways velocity

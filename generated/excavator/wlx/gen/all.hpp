@@ -14,9 +14,9 @@
 //   bodies                   315         58902          2163
 //   kinematic_update           194         48373          1304
 //   dynamics_update           150         37306          1043
-//   reduced_dynamics           484        145199          7305
+//   reduced_dynamics           484        145199          6505
 //   clearance                  0            19            20
-//   total                               412764         15849
+//   total                               412764         15049
 #pragma once
 
 #include "ik.hpp"

@@ -14,9 +14,9 @@
 //   bodies                   388         63427          2538
 //   kinematic_update           234         60493          1338
 //   dynamics_update           183         47698           988
-//   reduced_dynamics           601        151284          7282
+//   reduced_dynamics           601        151284          6482
 //   clearance                  0            19            20
-//   total                               470010         16151
+//   total                               470010         15351
 #pragma once
 
 #include "ik.hpp"

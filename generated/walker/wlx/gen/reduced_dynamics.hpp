@@ -23,15 +23,15 @@ namespace gen {
 // pointer is set (C++20: reduced_dynamics(..., {.dPhi_ds_dot_sdot = &x})):
 //   dPhi_ds_dot_sdot   (d/dt dPhi/ds) s' (own operations: 199, nonzero entries: 14)
 //   C_dot_sdot         (d/dt C) s', one per wheel (l, r) (own operations: 184, nonzero entries: 2)
-//   M                  generalized mass matrix on u (symmetric) (own operations: 2689, on rows of 4 lanes)
+//   M                  generalized mass matrix on u (symmetric) (own operations: 2669, on rows of 4 lanes)
 //   b_velocity         velocity-dependent forces on u, s''_bias excluded (own operations: 336, on rows of 4 lanes)
-//   B_bias             forces on u per unit s''_bias: b = b_velocity + B_bias s''_bias (own operations: 1196, on rows of 4 lanes)
+//   B_bias             forces on u per unit s''_bias: b = b_velocity + B_bias s''_bias (own operations: 416, on rows of 4 lanes)
 //   Q_gravity          generalized gravity force on u (gravity along -z of K0) (own operations: 56, on rows of 4 lanes)
 // The scalars those rows are built from (241 of them, the bodies' Jacobian entries among them):
 // 1248 operations, computed only when one of them is requested.
 // Intermediate terms: 601; shared by several outputs: 1374 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).
-// Operations with every output requested: 7282 (adds 3464, muls 3776, divs 0, calls 42).
+// Operations with every output requested: 6482 (adds 3084, muls 3356, divs 0, calls 42).
 // The same outputs as expression trees, before CSE: 151284 (adds 23474, muls 57237, divs 0, calls 70573).
 // Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by
 // argument-dependent lookup; deduced from s. The parameters stay double.
@@ -1165,12 +1165,10 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L db0_0 = kane_inertia_0_0 * pb0_0;
     const L db0_1 = kane_inertia_0_1 * pb0_1;
     const L db0_2 = kane_inertia_0_2 * pb0_2;
-    kane_M_0 += pv0_0.v[0] * dv0_0 + pv0_1.v[0] * dv0_1 + pv0_2.v[0] * dv0_2 + pb0_0.v[0] * db0_0 + pb0_1.v[0] * db0_1 + pb0_2.v[0] * db0_2;
-    kane_M_1 += pv0_0.v[1] * dv0_0 + pv0_1.v[1] * dv0_1 + pv0_2.v[1] * dv0_2 + pb0_0.v[1] * db0_0 + pb0_1.v[1] * db0_1 + pb0_2.v[1] * db0_2;
-    kane_M_2 += pv0_0.v[2] * dv0_0 + pv0_1.v[2] * dv0_1 + pv0_2.v[2] * dv0_2 + pb0_0.v[2] * db0_0 + pb0_1.v[2] * db0_1 + pb0_2.v[2] * db0_2;
-    kane_M_3 += pv0_0.v[3] * dv0_0 + pv0_1.v[3] * dv0_1 + pv0_2.v[3] * dv0_2 + pb0_0.v[3] * db0_0 + pb0_1.v[3] * db0_1 + pb0_2.v[3] * db0_2;
     kane_b += kane_acc_0_0 * dv0_0 + kane_acc_0_1 * dv0_1 + kane_acc_0_2 * dv0_2 + kane_torque_0_0 * pb0_0 + kane_torque_0_1 * pb0_1 + kane_torque_0_2 * pb0_2;
     kane_Q += kane_minus_g * dv0_2;
+    const L moment0_0 = kane_R_0_0_0 * db0_0 + kane_R_0_0_1 * db0_1 + kane_R_0_0_2 * db0_2 + kane_p_0_1 * dv0_2 + kane_minus_p_0_2 * dv0_1;
+    const L moment0_1 = kane_R_0_1_0 * db0_0 + kane_R_0_1_1 * db0_1 + kane_R_0_1_2 * db0_2 + kane_p_0_2 * dv0_0 + kane_minus_p_0_0 * dv0_2;
     const L moment0_2 = kane_R_0_2_0 * db0_0 + kane_R_0_2_1 * db0_1 + kane_R_0_2_2 * db0_2 + kane_p_0_0 * dv0_1 + kane_minus_p_0_1 * dv0_0;
     // body thigh_l: left thigh
     const L pv1_0 = twist7_3 + kane_p_1_2 * twist7_1 + kane_minus_p_1_1 * twist7_2;
@@ -1185,10 +1183,6 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L db1_0 = kane_inertia_1_0 * pb1_0;
     const L db1_1 = kane_inertia_1_1 * pb1_1;
     const L db1_2 = kane_inertia_1_2 * pb1_2;
-    kane_M_0 += pv1_0.v[0] * dv1_0 + pv1_1.v[0] * dv1_1 + pv1_2.v[0] * dv1_2 + pb1_0.v[0] * db1_0 + pb1_1.v[0] * db1_1 + pb1_2.v[0] * db1_2;
-    kane_M_1 += pv1_0.v[1] * dv1_0 + pv1_1.v[1] * dv1_1 + pv1_2.v[1] * dv1_2 + pb1_0.v[1] * db1_0 + pb1_1.v[1] * db1_1 + pb1_2.v[1] * db1_2;
-    kane_M_2 += pv1_0.v[2] * dv1_0 + pv1_1.v[2] * dv1_1 + pv1_2.v[2] * dv1_2 + pb1_0.v[2] * db1_0 + pb1_1.v[2] * db1_1 + pb1_2.v[2] * db1_2;
-    kane_M_3 += pv1_0.v[3] * dv1_0 + pv1_1.v[3] * dv1_1 + pv1_2.v[3] * dv1_2 + pb1_0.v[3] * db1_0 + pb1_1.v[3] * db1_1 + pb1_2.v[3] * db1_2;
     kane_b += kane_acc_1_0 * dv1_0 + kane_acc_1_1 * dv1_1 + kane_acc_1_2 * dv1_2 + kane_torque_1_0 * pb1_0 + kane_torque_1_1 * pb1_1 + kane_torque_1_2 * pb1_2;
     kane_Q += kane_minus_g * dv1_2;
     const L moment1_0 = kane_R_1_0_0 * db1_0 + kane_R_1_0_1 * db1_1 + kane_R_1_0_2 * db1_2 + kane_p_1_1 * dv1_2 + kane_minus_p_1_2 * dv1_1;
@@ -1207,10 +1201,6 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L db2_0 = kane_inertia_2_0 * pb2_0;
     const L db2_1 = kane_inertia_2_1 * pb2_1;
     const L db2_2 = kane_inertia_2_2 * pb2_2;
-    kane_M_0 += pv2_0.v[0] * dv2_0 + pv2_1.v[0] * dv2_1 + pv2_2.v[0] * dv2_2 + pb2_0.v[0] * db2_0 + pb2_1.v[0] * db2_1 + pb2_2.v[0] * db2_2;
-    kane_M_1 += pv2_0.v[1] * dv2_0 + pv2_1.v[1] * dv2_1 + pv2_2.v[1] * dv2_2 + pb2_0.v[1] * db2_0 + pb2_1.v[1] * db2_1 + pb2_2.v[1] * db2_2;
-    kane_M_2 += pv2_0.v[2] * dv2_0 + pv2_1.v[2] * dv2_1 + pv2_2.v[2] * dv2_2 + pb2_0.v[2] * db2_0 + pb2_1.v[2] * db2_1 + pb2_2.v[2] * db2_2;
-    kane_M_3 += pv2_0.v[3] * dv2_0 + pv2_1.v[3] * dv2_1 + pv2_2.v[3] * dv2_2 + pb2_0.v[3] * db2_0 + pb2_1.v[3] * db2_1 + pb2_2.v[3] * db2_2;
     kane_b += kane_acc_2_0 * dv2_0 + kane_acc_2_1 * dv2_1 + kane_acc_2_2 * dv2_2 + kane_torque_2_0 * pb2_0 + kane_torque_2_1 * pb2_1 + kane_torque_2_2 * pb2_2;
     kane_Q += kane_minus_g * dv2_2;
     const L moment2_0 = kane_R_2_0_0 * db2_0 + kane_R_2_0_1 * db2_1 + kane_R_2_0_2 * db2_2 + kane_p_2_1 * dv2_2 + kane_minus_p_2_2 * dv2_1;
@@ -1229,10 +1219,6 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L db3_0 = kane_inertia_3_0 * pb3_0;
     const L db3_1 = kane_inertia_3_1 * pb3_1;
     const L db3_2 = kane_inertia_3_2 * pb3_2;
-    kane_M_0 += pv3_0.v[0] * dv3_0 + pv3_1.v[0] * dv3_1 + pv3_2.v[0] * dv3_2 + pb3_0.v[0] * db3_0 + pb3_1.v[0] * db3_1 + pb3_2.v[0] * db3_2;
-    kane_M_1 += pv3_0.v[1] * dv3_0 + pv3_1.v[1] * dv3_1 + pv3_2.v[1] * dv3_2 + pb3_0.v[1] * db3_0 + pb3_1.v[1] * db3_1 + pb3_2.v[1] * db3_2;
-    kane_M_2 += pv3_0.v[2] * dv3_0 + pv3_1.v[2] * dv3_1 + pv3_2.v[2] * dv3_2 + pb3_0.v[2] * db3_0 + pb3_1.v[2] * db3_1 + pb3_2.v[2] * db3_2;
-    kane_M_3 += pv3_0.v[3] * dv3_0 + pv3_1.v[3] * dv3_1 + pv3_2.v[3] * dv3_2 + pb3_0.v[3] * db3_0 + pb3_1.v[3] * db3_1 + pb3_2.v[3] * db3_2;
     kane_b += kane_acc_3_0 * dv3_0 + kane_acc_3_1 * dv3_1 + kane_acc_3_2 * dv3_2 + kane_torque_3_0 * pb3_0 + kane_torque_3_1 * pb3_1 + kane_torque_3_2 * pb3_2;
     kane_Q += kane_minus_g * dv3_2;
     const L moment3_0 = kane_R_3_0_0 * db3_0 + kane_R_3_0_1 * db3_1 + kane_R_3_0_2 * db3_2 + kane_p_3_1 * dv3_2 + kane_minus_p_3_2 * dv3_1;
@@ -1251,10 +1237,6 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L db4_0 = kane_inertia_4_0 * pb4_0;
     const L db4_1 = kane_inertia_4_1 * pb4_1;
     const L db4_2 = kane_inertia_4_2 * pb4_2;
-    kane_M_0 += pv4_0.v[0] * dv4_0 + pv4_1.v[0] * dv4_1 + pv4_2.v[0] * dv4_2 + pb4_0.v[0] * db4_0 + pb4_1.v[0] * db4_1 + pb4_2.v[0] * db4_2;
-    kane_M_1 += pv4_0.v[1] * dv4_0 + pv4_1.v[1] * dv4_1 + pv4_2.v[1] * dv4_2 + pb4_0.v[1] * db4_0 + pb4_1.v[1] * db4_1 + pb4_2.v[1] * db4_2;
-    kane_M_2 += pv4_0.v[2] * dv4_0 + pv4_1.v[2] * dv4_1 + pv4_2.v[2] * dv4_2 + pb4_0.v[2] * db4_0 + pb4_1.v[2] * db4_1 + pb4_2.v[2] * db4_2;
-    kane_M_3 += pv4_0.v[3] * dv4_0 + pv4_1.v[3] * dv4_1 + pv4_2.v[3] * dv4_2 + pb4_0.v[3] * db4_0 + pb4_1.v[3] * db4_1 + pb4_2.v[3] * db4_2;
     kane_b += kane_acc_4_0 * dv4_0 + kane_acc_4_1 * dv4_1 + kane_acc_4_2 * dv4_2 + kane_torque_4_0 * pb4_0 + kane_torque_4_1 * pb4_1 + kane_torque_4_2 * pb4_2;
     kane_Q += kane_minus_g * dv4_2;
     const L moment4_0 = kane_R_4_0_0 * db4_0 + kane_R_4_0_1 * db4_1 + kane_R_4_0_2 * db4_2 + kane_p_4_1 * dv4_2 + kane_minus_p_4_2 * dv4_1;
@@ -1273,10 +1255,6 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L db5_0 = kane_inertia_5_0 * pb5_0;
     const L db5_1 = kane_inertia_5_1 * pb5_1;
     const L db5_2 = kane_inertia_5_2 * pb5_2;
-    kane_M_0 += pv5_0.v[0] * dv5_0 + pv5_1.v[0] * dv5_1 + pv5_2.v[0] * dv5_2 + pb5_0.v[0] * db5_0 + pb5_1.v[0] * db5_1 + pb5_2.v[0] * db5_2;
-    kane_M_1 += pv5_0.v[1] * dv5_0 + pv5_1.v[1] * dv5_1 + pv5_2.v[1] * dv5_2 + pb5_0.v[1] * db5_0 + pb5_1.v[1] * db5_1 + pb5_2.v[1] * db5_2;
-    kane_M_2 += pv5_0.v[2] * dv5_0 + pv5_1.v[2] * dv5_1 + pv5_2.v[2] * dv5_2 + pb5_0.v[2] * db5_0 + pb5_1.v[2] * db5_1 + pb5_2.v[2] * db5_2;
-    kane_M_3 += pv5_0.v[3] * dv5_0 + pv5_1.v[3] * dv5_1 + pv5_2.v[3] * dv5_2 + pb5_0.v[3] * db5_0 + pb5_1.v[3] * db5_1 + pb5_2.v[3] * db5_2;
     kane_b += kane_acc_5_0 * dv5_0 + kane_acc_5_1 * dv5_1 + kane_acc_5_2 * dv5_2 + kane_torque_5_0 * pb5_0 + kane_torque_5_1 * pb5_1 + kane_torque_5_2 * pb5_2;
     kane_Q += kane_minus_g * dv5_2;
     const L moment5_0 = kane_R_5_0_0 * db5_0 + kane_R_5_0_1 * db5_1 + kane_R_5_0_2 * db5_2 + kane_p_5_1 * dv5_2 + kane_minus_p_5_2 * dv5_1;
@@ -1295,40 +1273,97 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L db6_0 = kane_inertia_6_0 * pb6_0;
     const L db6_1 = kane_inertia_6_1 * pb6_1;
     const L db6_2 = kane_inertia_6_2 * pb6_2;
-    kane_M_0 += pv6_0.v[0] * dv6_0 + pv6_1.v[0] * dv6_1 + pv6_2.v[0] * dv6_2 + pb6_0.v[0] * db6_0 + pb6_1.v[0] * db6_1 + pb6_2.v[0] * db6_2;
-    kane_M_1 += pv6_0.v[1] * dv6_0 + pv6_1.v[1] * dv6_1 + pv6_2.v[1] * dv6_2 + pb6_0.v[1] * db6_0 + pb6_1.v[1] * db6_1 + pb6_2.v[1] * db6_2;
-    kane_M_2 += pv6_0.v[2] * dv6_0 + pv6_1.v[2] * dv6_1 + pv6_2.v[2] * dv6_2 + pb6_0.v[2] * db6_0 + pb6_1.v[2] * db6_1 + pb6_2.v[2] * db6_2;
-    kane_M_3 += pv6_0.v[3] * dv6_0 + pv6_1.v[3] * dv6_1 + pv6_2.v[3] * dv6_2 + pb6_0.v[3] * db6_0 + pb6_1.v[3] * db6_1 + pb6_2.v[3] * db6_2;
     kane_b += kane_acc_6_0 * dv6_0 + kane_acc_6_1 * dv6_1 + kane_acc_6_2 * dv6_2 + kane_torque_6_0 * pb6_0 + kane_torque_6_1 * pb6_1 + kane_torque_6_2 * pb6_2;
     kane_Q += kane_minus_g * dv6_2;
     const L moment6_0 = kane_R_6_0_0 * db6_0 + kane_R_6_0_1 * db6_1 + kane_R_6_0_2 * db6_2 + kane_p_6_1 * dv6_2 + kane_minus_p_6_2 * dv6_1;
     const L moment6_1 = kane_R_6_1_0 * db6_0 + kane_R_6_1_1 * db6_1 + kane_R_6_1_2 * db6_2 + kane_p_6_2 * dv6_0 + kane_minus_p_6_0 * dv6_2;
     const L moment6_2 = kane_R_6_2_0 * db6_0 + kane_R_6_2_1 * db6_1 + kane_R_6_2_2 * db6_2 + kane_p_6_0 * dv6_1 + kane_minus_p_6_1 * dv6_0;
-    kane_B_31 += kane_twist_13_0 * moment6_0 + kane_twist_13_1 * moment6_1 + kane_twist_13_2 * moment6_2 + kane_twist_13_3 * dv6_0 + kane_twist_13_4 * dv6_1 + kane_twist_13_5 * dv6_2;
-    kane_B_23 += kane_twist_12_0 * moment5_0 + kane_twist_12_1 * moment5_1 + kane_twist_12_2 * moment5_2 + kane_twist_12_3 * dv5_0 + kane_twist_12_4 * dv5_1 + kane_twist_12_5 * dv5_2;
+    const L tau13 = kane_twist_13_0 * moment6_0 + kane_twist_13_1 * moment6_1 + kane_twist_13_2 * moment6_2 + kane_twist_13_3 * dv6_0 + kane_twist_13_4 * dv6_1 + kane_twist_13_5 * dv6_2;
+    kane_B_31 += tau13;
+    kane_M_0 += T(31, 0) * tau13;
+    kane_M_1 += T(31, 1) * tau13;
+    kane_M_2 += T(31, 2) * tau13;
+    kane_M_3 += T(31, 3) * tau13;
+    const L tau12 = kane_twist_12_0 * moment5_0 + kane_twist_12_1 * moment5_1 + kane_twist_12_2 * moment5_2 + kane_twist_12_3 * dv5_0 + kane_twist_12_4 * dv5_1 + kane_twist_12_5 * dv5_2;
+    kane_B_23 += tau12;
+    kane_M_0 += T(23, 0) * tau12;
+    kane_M_1 += T(23, 1) * tau12;
+    kane_M_2 += T(23, 2) * tau12;
+    kane_M_3 += T(23, 3) * tau12;
     const L wrench11_0 = dv4_0 + dv5_0;
     const L wrench11_1 = dv4_1 + dv5_1;
     const L wrench11_2 = dv4_2 + dv5_2;
     const L wrench11_3 = moment4_0 + moment5_0;
     const L wrench11_4 = moment4_1 + moment5_1;
     const L wrench11_5 = moment4_2 + moment5_2;
-    kane_B_22 += kane_twist_11_0 * wrench11_3 + kane_twist_11_1 * wrench11_4 + kane_twist_11_2 * wrench11_5 + kane_twist_11_3 * wrench11_0 + kane_twist_11_4 * wrench11_1 + kane_twist_11_5 * wrench11_2;
-    kane_B_21 += kane_twist_10_0 * wrench11_3 + kane_twist_10_1 * wrench11_4 + kane_twist_10_2 * wrench11_5 + kane_twist_10_3 * wrench11_0 + kane_twist_10_4 * wrench11_1 + kane_twist_10_5 * wrench11_2;
-    kane_B_27 += kane_twist_9_0 * moment3_0 + kane_twist_9_1 * moment3_1 + kane_twist_9_2 * moment3_2 + kane_twist_9_3 * dv3_0 + kane_twist_9_4 * dv3_1 + kane_twist_9_5 * dv3_2;
-    kane_B_20 += kane_twist_8_0 * moment2_0 + kane_twist_8_1 * moment2_1 + kane_twist_8_2 * moment2_2 + kane_twist_8_3 * dv2_0 + kane_twist_8_4 * dv2_1 + kane_twist_8_5 * dv2_2;
+    const L tau11 = kane_twist_11_0 * wrench11_3 + kane_twist_11_1 * wrench11_4 + kane_twist_11_2 * wrench11_5 + kane_twist_11_3 * wrench11_0 + kane_twist_11_4 * wrench11_1 + kane_twist_11_5 * wrench11_2;
+    kane_B_22 += tau11;
+    kane_M_0 += T(22, 0) * tau11;
+    kane_M_1 += T(22, 1) * tau11;
+    kane_M_2 += T(22, 2) * tau11;
+    kane_M_3 += T(22, 3) * tau11;
+    const L tau10 = kane_twist_10_0 * wrench11_3 + kane_twist_10_1 * wrench11_4 + kane_twist_10_2 * wrench11_5 + kane_twist_10_3 * wrench11_0 + kane_twist_10_4 * wrench11_1 + kane_twist_10_5 * wrench11_2;
+    kane_B_21 += tau10;
+    kane_M_0 += T(21, 0) * tau10;
+    kane_M_1 += T(21, 1) * tau10;
+    kane_M_2 += T(21, 2) * tau10;
+    kane_M_3 += T(21, 3) * tau10;
+    const L tau9 = kane_twist_9_0 * moment3_0 + kane_twist_9_1 * moment3_1 + kane_twist_9_2 * moment3_2 + kane_twist_9_3 * dv3_0 + kane_twist_9_4 * dv3_1 + kane_twist_9_5 * dv3_2;
+    kane_B_27 += tau9;
+    kane_M_0 += T(27, 0) * tau9;
+    kane_M_1 += T(27, 1) * tau9;
+    kane_M_2 += T(27, 2) * tau9;
+    kane_M_3 += T(27, 3) * tau9;
+    const L tau8 = kane_twist_8_0 * moment2_0 + kane_twist_8_1 * moment2_1 + kane_twist_8_2 * moment2_2 + kane_twist_8_3 * dv2_0 + kane_twist_8_4 * dv2_1 + kane_twist_8_5 * dv2_2;
+    kane_B_20 += tau8;
+    kane_M_0 += T(20, 0) * tau8;
+    kane_M_1 += T(20, 1) * tau8;
+    kane_M_2 += T(20, 2) * tau8;
+    kane_M_3 += T(20, 3) * tau8;
     const L wrench7_0 = dv1_0 + dv2_0;
     const L wrench7_1 = dv1_1 + dv2_1;
     const L wrench7_2 = dv1_2 + dv2_2;
     const L wrench7_3 = moment1_0 + moment2_0;
     const L wrench7_4 = moment1_1 + moment2_1;
     const L wrench7_5 = moment1_2 + moment2_2;
-    kane_B_19 += kane_twist_7_0 * wrench7_3 + kane_twist_7_1 * wrench7_4 + kane_twist_7_2 * wrench7_5 + kane_twist_7_3 * wrench7_0 + kane_twist_7_4 * wrench7_1 + kane_twist_7_5 * wrench7_2;
-    kane_B_18 += kane_twist_6_0 * wrench7_3 + kane_twist_6_1 * wrench7_4 + kane_twist_6_2 * wrench7_5 + kane_twist_6_3 * wrench7_0 + kane_twist_6_4 * wrench7_1 + kane_twist_6_5 * wrench7_2;
+    const L tau7 = kane_twist_7_0 * wrench7_3 + kane_twist_7_1 * wrench7_4 + kane_twist_7_2 * wrench7_5 + kane_twist_7_3 * wrench7_0 + kane_twist_7_4 * wrench7_1 + kane_twist_7_5 * wrench7_2;
+    kane_B_19 += tau7;
+    kane_M_0 += T(19, 0) * tau7;
+    kane_M_1 += T(19, 1) * tau7;
+    kane_M_2 += T(19, 2) * tau7;
+    kane_M_3 += T(19, 3) * tau7;
+    const L tau6 = kane_twist_6_0 * wrench7_3 + kane_twist_6_1 * wrench7_4 + kane_twist_6_2 * wrench7_5 + kane_twist_6_3 * wrench7_0 + kane_twist_6_4 * wrench7_1 + kane_twist_6_5 * wrench7_2;
+    kane_B_18 += tau6;
+    kane_M_0 += T(18, 0) * tau6;
+    kane_M_1 += T(18, 1) * tau6;
+    kane_M_2 += T(18, 2) * tau6;
+    kane_M_3 += T(18, 3) * tau6;
     const L wrench5_0 = dv0_0 + wrench7_0 + dv3_0 + wrench11_0 + dv6_0;
     const L wrench5_1 = dv0_1 + wrench7_1 + dv3_1 + wrench11_1 + dv6_1;
+    const L wrench5_2 = dv0_2 + wrench7_2 + dv3_2 + wrench11_2 + dv6_2;
+    const L wrench5_3 = moment0_0 + wrench7_3 + moment3_0 + wrench11_3 + moment6_0;
+    const L wrench5_4 = moment0_1 + wrench7_4 + moment3_1 + wrench11_4 + moment6_1;
     const L wrench5_5 = moment0_2 + wrench7_5 + moment3_2 + wrench11_5 + moment6_2;
-    kane_B_3 += kane_twist_3_2 * wrench5_5 + kane_twist_3_3 * wrench5_0 + kane_twist_3_4 * wrench5_1;
-    kane_B_1 += kane_twist_1_4 * wrench5_1;
+    const L tau5 = kane_twist_5_0 * wrench5_3 + kane_twist_5_1 * wrench5_4 + kane_twist_5_2 * wrench5_5 + kane_twist_5_3 * wrench5_0 + kane_twist_5_4 * wrench5_1 + kane_twist_5_5 * wrench5_2;
+    kane_M_2 += tau5;
+    const L tau4 = kane_twist_4_0 * wrench5_3 + kane_twist_4_1 * wrench5_4 + kane_twist_4_3 * wrench5_0 + kane_twist_4_4 * wrench5_1 + kane_twist_4_5 * wrench5_2;
+    kane_M_3 += tau4;
+    const L tau3 = kane_twist_3_2 * wrench5_5 + kane_twist_3_3 * wrench5_0 + kane_twist_3_4 * wrench5_1;
+    kane_B_3 += tau3;
+    kane_M_0 += T(3, 0) * tau3;
+    kane_M_1 += T(3, 1) * tau3;
+    kane_M_2 += T(3, 2) * tau3;
+    kane_M_3 += T(3, 3) * tau3;
+    const L tau2 = kane_twist_2_5 * wrench5_2;
+    kane_M_0 += tau2;
+    const L tau1 = kane_twist_1_4 * wrench5_1;
+    kane_B_1 += tau1;
+    kane_M_0 += T(1, 0) * tau1;
+    kane_M_1 += T(1, 1) * tau1;
+    kane_M_2 += T(1, 2) * tau1;
+    kane_M_3 += T(1, 3) * tau1;
+    const L tau0 = kane_twist_0_3 * wrench5_0;
+    kane_M_1 += tau0;
     if (M != nullptr) {  // the upper triangle, mirrored: M is symmetric to the last bit
       const L* row[] = {&kane_M_0, &kane_M_1, &kane_M_2, &kane_M_3};
       for (int k = 0; k < 4; ++k)
@@ -1373,7 +1408,7 @@ inline void reduced_dynamics(const Coordinates& s, const Coordinates& sdot, cons
 
 namespace operations {
 // Operations reduced_dynamics() evaluates with every output requested (adds, muls, divs, calls).
-inline constexpr long reduced_dynamics = 7282;
+inline constexpr long reduced_dynamics = 6482;
 }  // namespace operations
 
 }  // namespace gen
