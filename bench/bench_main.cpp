@@ -1,6 +1,7 @@
 // Benchmarks (Google Benchmark): generated functions per call, and closed-form vs Newton IK.
 // Compare numbers from one run only (ratios): these machines are noisy.
 #include "numeric_baseline.hpp"
+#include "../tests/support/kane_over_bodies.hpp"
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
@@ -10,6 +11,7 @@
 #include <wlx/nonholonomic.hpp>
 #include <wlx/simulation.hpp>
 
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 
@@ -319,6 +321,39 @@ void BM_gen_dynamics_passes(benchmark::State& st) {
     benchmark::DoNotOptimize(terms.M.data());
   }
 }
+// Kane's sums alone: reduced_dynamics' (twists and wrenches on lanes) against the same sums over
+// bodies()' full Jacobians with dense Eigen products (what a user of the body Jacobians writes;
+// the step's before: the runtime summed them over the bodies' columns).
+void BM_gen_kane_sums(benchmark::State& st) {
+  const Model model;
+  Data d;
+  DynamicsTerms terms;
+  Coordinates s = nominal_inputs();
+  s(gen::coord::x_C) = 0.3;
+  solve_ik_closed_form(model, s);
+  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
+  CommandVector b_velocity;
+  for (auto _ : st) {
+    gen::reduced_dynamics(s, terms.sdot, terms.T, model.params(),
+                          {.M = &terms.M, .b_velocity = &b_velocity, .B_bias = &terms.B_bias, .Q_gravity = &terms.Q_gravity},
+                          false);
+    benchmark::DoNotOptimize(terms.M.data());
+  }
+}
+void BM_kane_sums_over_body_jacobians(benchmark::State& st) {
+  const Model model;
+  Data d;
+  DynamicsTerms terms;
+  Coordinates s = nominal_inputs();
+  s(gen::coord::x_C) = 0.3;
+  solve_ik_closed_form(model, s);
+  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
+  auto sums = std::make_unique<test::KaneSums>();
+  for (auto _ : st) {
+    test::kane_over_bodies(model.params(), s, terms.sdot, terms.T, *sums);
+    benchmark::DoNotOptimize(sums->M.data());
+  }
+}
 void BM_inverse_dynamics_generated_only(benchmark::State& st) {
   const Model model;
   Data d;
@@ -615,6 +650,8 @@ BENCHMARK(BM_inverse_dynamics_step);
 BENCHMARK(BM_inverse_dynamics_generated_only);
 BENCHMARK(BM_distribute_torques);
 BENCHMARK(BM_gen_dynamics_passes);
+BENCHMARK(BM_gen_kane_sums);
+BENCHMARK(BM_kane_sums_over_body_jacobians);
 BENCHMARK(BM_run_ID1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_dependent_rates);
 BENCHMARK(BM_dependent_accelerations);
@@ -737,6 +774,7 @@ int main(int argc, char** argv) {
       {"  its generated code alone: 4-limb IK + the two passes", "BM_inverse_dynamics_generated_only", nullptr, 0},
       {"  the two passes: dynamics_update, reduced_dynamics (Kane's sums generated)", "BM_gen_dynamics_passes", nullptr,
        ops::dynamics_update + ops::reduced_dynamics},
+      {"  Kane's sums: reduced_dynamics (vs over bodies()' Jacobians)", "BM_gen_kane_sums", "BM_kane_sums_over_body_jacobians", 0},
       {"NH-1 run (2001 samples, RK4)", "BM_run_NH1", nullptr, 0},
       {"ID-1 run (495 samples, RK4, torques)", "BM_run_ID1", nullptr, 0},
   };

@@ -1,10 +1,10 @@
 // reduced_dynamics (Kane's sums on the commanded speeds, generated on lanes from the joints'
 // twists and the bodies' wrenches) against the same sums written out over the bodies' full
 // Jacobians from bodies() (itself checked against exact derivatives in test_bodies.cpp).
+#include "../support/kane_over_bodies.hpp"
 #include "../support/random.hpp"
 
 #include <doctest/doctest.h>
-#include <Eigen/Geometry>
 #include <wlx/gen/all.hpp>
 
 #include <algorithm>
@@ -40,57 +40,32 @@ double relative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& reference) {
 TEST_CASE("reduced_dynamics: M, b_velocity, B_bias and Q_gravity equal Kane's sums over the bodies' Jacobians") {
   std::mt19937_64 rng(81);
   const gen::Params p;
-  gen::BodyVectors com, Jv_dot, Jw_dot;
-  gen::BodyRotations R;
-  gen::BodyJacobians Jv, Jw;
   gen::CommandMatrix M;
   gen::CommandVector b, Q;
   gen::CommandRows B;
   gen::ClosureVector conv, conv_ref;
   gen::WheelVector C_conv, C_conv_ref;
+  test::KaneSums ref;
   double worst_M = 0, worst_b = 0, worst_B = 0, worst_Q = 0, worst_conv = 0, asymmetry = 0, outside = 0;
-  constexpr int kU = gen::kCommandedCount;
   for (int trial = 0; trial < 1000; ++trial) {
     const gen::Coordinates s = test::random_coordinates(rng), sdot = test::random_rates(rng);
     std::vector<bool> dense;
     const gen::RateBasis T = structured_basis(rng, dense);
     gen::reduced_dynamics(s, sdot, T, p,
                           {.dPhi_ds_dot_sdot = &conv, .C_dot_sdot = &C_conv, .M = &M, .b_velocity = &b, .B_bias = &B, .Q_gravity = &Q});
-    gen::bodies(s, sdot, p, {.com = &com, .rotations = &R, .Jv = &Jv, .Jw = &Jw, .Jv_dot_sdot = &Jv_dot, .Jw_dot_sdot = &Jw_dot});
+    test::kane_over_bodies(p, s, sdot, T, ref);
     gen::convective(s, sdot, p, {.dPhi_ds_dot_sdot = &conv_ref, .C_dot_sdot = &C_conv_ref});
-    Eigen::Matrix<double, kU, kU> M_ref = Eigen::Matrix<double, kU, kU>::Zero();
-    Eigen::Matrix<double, kU, 1> b_ref = Eigen::Matrix<double, kU, 1>::Zero(), Q_ref = b_ref;
-    Eigen::Matrix<double, kU, gen::kCoordinateCount> B_ref = Eigen::Matrix<double, kU, gen::kCoordinateCount>::Zero();
-    for (int i = 0; i < gen::kBodyCount; ++i) {
-      const auto& info = gen::kBodyMass[static_cast<std::size_t>(i)];
-      const double m = p.*info.mass;
-      const Eigen::Vector3d I(p.*info.inertia[0], p.*info.inertia[1], p.*info.inertia[2]);
-      const Eigen::Matrix3d& Ri = R[static_cast<std::size_t>(i)];
-      // J = [Jv; R^T Jw] (angular rows in body axes), P = J T, D = diag(m, m, m, I).
-      Eigen::Matrix<double, 6, gen::kCoordinateCount> J;
-      J << Jv[static_cast<std::size_t>(i)], Ri.transpose() * Jw[static_cast<std::size_t>(i)];
-      const Eigen::Matrix<double, 6, kU> P = J * T;
-      Eigen::Matrix<double, 6, 1> D;
-      D << m, m, m, I;
-      M_ref += P.transpose() * D.asDiagonal() * P;
-      B_ref += P.transpose() * D.asDiagonal() * J;
-      const Eigen::Vector3d omega = Ri.transpose() * (Jw[static_cast<std::size_t>(i)] * sdot);
-      Eigen::Matrix<double, 6, 1> force;
-      force << m * Jv_dot.col(i), I.cwiseProduct(Ri.transpose() * Jw_dot.col(i)) + omega.cross(I.cwiseProduct(omega));
-      b_ref += P.transpose() * force;
-      Q_ref += P.topRows<3>().transpose() * (m * Eigen::Vector3d(0, 0, -(p.*gen::kGravity)));
-    }
     // B_bias holds the dense columns only (s''_bias is zero elsewhere); the others must be zero.
-    Eigen::Matrix<double, kU, gen::kCoordinateCount> B_dense = B_ref;
+    gen::CommandRows B_dense = ref.B;
     for (int j = 0; j < gen::kCoordinateCount; ++j)
       if (!dense[static_cast<std::size_t>(j)]) {
         B_dense.col(j).setZero();
         outside = std::max(outside, B.col(j).cwiseAbs().maxCoeff());
       }
-    worst_M = std::max(worst_M, relative(M, M_ref));
-    worst_b = std::max(worst_b, relative(b, b_ref));
+    worst_M = std::max(worst_M, relative(M, ref.M));
+    worst_b = std::max(worst_b, relative(b, ref.b_velocity));
     worst_B = std::max(worst_B, relative(B, B_dense));
-    worst_Q = std::max(worst_Q, relative(Q, Q_ref));
+    worst_Q = std::max(worst_Q, relative(Q, ref.Q_gravity));
     worst_conv = std::max({worst_conv, relative(conv, conv_ref), relative(C_conv, C_conv_ref)});
     asymmetry = std::max(asymmetry, (M - M.transpose()).cwiseAbs().maxCoeff());
   }
