@@ -8,6 +8,8 @@
 #include <chrono>
 #include <functional>
 #include <set>
+#include <sstream>
+#include <stdexcept>
 #include <unordered_set>
 
 namespace wlx::codegen {
@@ -373,11 +375,56 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
       for (const auto& spec : fn.outputs)
         if (spec.from_lanes) requested.push_back(spec.name + " != nullptr");
       body += fmt::format("  if ({}) {{\n", fmt::join(requested, " || "));
-      for (std::size_t k = 0; k < plan.temporaries.size(); ++k)
-        if (users[k].size() == 1 && *users[k].begin() == static_cast<int>(o) && !batched(k))
-          body += fmt::format("    const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], output_ops[o]));
-      for (const auto& el : outs[o]) body += fmt::format("    const Scalar {} = {};\n", el.lvalue, pr.value(el.id, output_ops[o]));
-      body += fn.lane_code + "  }\n";
+      // Each scalar right before the first line of lane code that reads it, after the block's own
+      // temporaries it needs: computed where used, not all up front, so that fewer values wait in
+      // registers or on the stack while the lanes run (the code gets shorter).
+      std::vector<bool> emitted(plan.temporaries.size(), false);
+      const auto local = [&](std::size_t k) { return users[k].size() == 1 && *users[k].begin() == static_cast<int>(o) && !batched(k); };
+      std::function<void(int)> emit_needs = [&](int id) {
+        for (int a : g.node(id).args) {
+          if (auto it = plan.temp_index.find(a); it != plan.temp_index.end()) {
+            const auto k = static_cast<std::size_t>(it->second);
+            if (!local(k) || emitted[k]) continue;
+            emitted[k] = true;
+            emit_needs(plan.temporaries[k]);
+            body += fmt::format("    const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], output_ops[o]));
+          } else {
+            emit_needs(a);
+          }
+        }
+      };
+      std::map<std::string, int> pending;  // lane scalar -> node
+      for (const auto& el : outs[o]) pending.emplace(el.lvalue, el.id);
+      const auto define_scalar = [&](const std::string& name) {
+        const auto it = pending.find(name);
+        if (it == pending.end()) return;
+        const int id = it->second;
+        pending.erase(it);
+        if (auto t = plan.temp_index.find(id); t != plan.temp_index.end()) {
+          const auto k = static_cast<std::size_t>(t->second);
+          if (local(k) && !emitted[k]) {
+            emitted[k] = true;
+            emit_needs(id);
+            body += fmt::format("    const Scalar t{} = {};\n", k, pr.define(id, output_ops[o]));
+          }
+        } else {
+          emit_needs(id);
+        }
+        body += fmt::format("    const Scalar {} = {};\n", name, pr.value(id, output_ops[o]));
+      };
+      std::istringstream lines(fn.lane_code);
+      for (std::string line; std::getline(lines, line);) {
+        for (std::size_t at = 0; (at = line.find("kane_", at)) != std::string::npos;) {
+          std::size_t end = at;
+          while (end < line.size() && (std::isalnum(static_cast<unsigned char>(line[end])) || line[end] == '_')) ++end;
+          if (at == 0 || !(std::isalnum(static_cast<unsigned char>(line[at - 1])) || line[at - 1] == '_'))
+            define_scalar(line.substr(at, end - at));
+          at = end;
+        }
+        body += line + "\n";
+      }
+      if (!pending.empty()) throw std::logic_error("lane scalar " + pending.begin()->first + " is never read");
+      body += "  }\n";
       continue;
     }
     const auto& spec = fn.outputs[o];
