@@ -564,14 +564,21 @@ std::string double_overload(const std::string& name, const std::string& result,
       "__attribute__((target(\"avx2,fma\"), flatten)) inline {1} {0}_avx2_fma({2}) noexcept {{\n"
       "  return {3};\n"
       "}}\n"
+      "// The portable version out of line, so that it does not swell every caller (and the instruction\n"
+      "// cache) where the AVX2 version is the one that runs.\n"
+      "__attribute__((noinline)) inline {1} {0}_portable({2}) noexcept {{\n"
+      "  return {3};\n"
+      "}}\n"
       "}}  // namespace detail\n"
       "#endif\n\n"
       "// {0}() in double, {4}; its AVX2 + FMA version on a CPU that has them (types.hpp).\n"
       "inline {1} {0}({5}) noexcept {{\n"
       "#if defined(WLX_GEN_MULTIVERSION)\n"
       "  if (detail::has_avx2_fma()) return detail::{0}_avx2_fma({6});\n"
-      "#endif\n"
+      "  return detail::{0}_portable({6});\n"
+      "#else\n"
       "  return {3};\n"
+      "#endif\n"
       "}}\n\n",
       name, result, fmt::join(without, ", "), call, why, fmt::join(with_defaults, ", "), fmt::join(arguments, ", "));
 }

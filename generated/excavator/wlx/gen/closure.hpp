@@ -401,6 +401,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline void closure_avx2_fma(const Coordinates& s, const Params& p, const ClosureOutputs& out, bool zero_fill) noexcept {
   return closure<double>(s, p, out, zero_fill);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline void closure_portable(const Coordinates& s, const Params& p, const ClosureOutputs& out, bool zero_fill) noexcept {
+  return closure<double>(s, p, out, zero_fill);
+}
 }  // namespace detail
 #endif
 
@@ -408,8 +413,10 @@ __attribute__((target("avx2,fma"), flatten)) inline void closure_avx2_fma(const 
 inline void closure(const Coordinates& s, const Params& p, const ClosureOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::closure_avx2_fma(s, p, out, zero_fill);
-#endif
+  return detail::closure_portable(s, p, out, zero_fill);
+#else
   return closure<double>(s, p, out, zero_fill);
+#endif
 }
 
 namespace operations {

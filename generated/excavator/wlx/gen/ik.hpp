@@ -856,6 +856,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline IkStatus ik_all_avx2_fma(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out, int& failed, IkDiagnostics& why) noexcept {
   return ik_all<double>(s, p, branches, out, failed, why);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline IkStatus ik_all_portable(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out, int& failed, IkDiagnostics& why) noexcept {
+  return ik_all<double>(s, p, branches, out, failed, why);
+}
 }  // namespace detail
 #endif
 
@@ -863,8 +868,10 @@ __attribute__((target("avx2,fma"), flatten)) inline IkStatus ik_all_avx2_fma(con
 inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out, int& failed, IkDiagnostics& why) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::ik_all_avx2_fma(s, p, branches, out, failed, why);
-#endif
+  return detail::ik_all_portable(s, p, branches, out, failed, why);
+#else
   return ik_all<double>(s, p, branches, out, failed, why);
+#endif
 }
 
 }  // namespace gen

@@ -641,6 +641,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline void kinematic_update_avx2_fma(const Coordinates& s, const Params& p, const KinematicUpdateOutputs& out, bool zero_fill) noexcept {
   return kinematic_update<double>(s, p, out, zero_fill);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline void kinematic_update_portable(const Coordinates& s, const Params& p, const KinematicUpdateOutputs& out, bool zero_fill) noexcept {
+  return kinematic_update<double>(s, p, out, zero_fill);
+}
 }  // namespace detail
 #endif
 
@@ -648,8 +653,10 @@ __attribute__((target("avx2,fma"), flatten)) inline void kinematic_update_avx2_f
 inline void kinematic_update(const Coordinates& s, const Params& p, const KinematicUpdateOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::kinematic_update_avx2_fma(s, p, out, zero_fill);
-#endif
+  return detail::kinematic_update_portable(s, p, out, zero_fill);
+#else
   return kinematic_update<double>(s, p, out, zero_fill);
+#endif
 }
 
 namespace operations {

@@ -253,6 +253,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline void nonholonomic_avx2_fma(const Coordinates& s, const Params& p, const NonholonomicOutputs& out, bool zero_fill) noexcept {
   return nonholonomic<double>(s, p, out, zero_fill);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline void nonholonomic_portable(const Coordinates& s, const Params& p, const NonholonomicOutputs& out, bool zero_fill) noexcept {
+  return nonholonomic<double>(s, p, out, zero_fill);
+}
 }  // namespace detail
 #endif
 
@@ -260,8 +265,10 @@ __attribute__((target("avx2,fma"), flatten)) inline void nonholonomic_avx2_fma(c
 inline void nonholonomic(const Coordinates& s, const Params& p, const NonholonomicOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::nonholonomic_avx2_fma(s, p, out, zero_fill);
-#endif
+  return detail::nonholonomic_portable(s, p, out, zero_fill);
+#else
   return nonholonomic<double>(s, p, out, zero_fill);
+#endif
 }
 
 namespace operations {

@@ -1268,6 +1268,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline void reduced_dynamics_avx2_fma(const Coordinates& s, const Coordinates& sdot, const RateBasis& T, const Params& p, const ReducedDynamicsOutputs& out, bool zero_fill) noexcept {
   return reduced_dynamics<double>(s, sdot, T, p, out, zero_fill);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline void reduced_dynamics_portable(const Coordinates& s, const Coordinates& sdot, const RateBasis& T, const Params& p, const ReducedDynamicsOutputs& out, bool zero_fill) noexcept {
+  return reduced_dynamics<double>(s, sdot, T, p, out, zero_fill);
+}
 }  // namespace detail
 #endif
 
@@ -1275,8 +1280,10 @@ __attribute__((target("avx2,fma"), flatten)) inline void reduced_dynamics_avx2_f
 inline void reduced_dynamics(const Coordinates& s, const Coordinates& sdot, const RateBasis& T, const Params& p, const ReducedDynamicsOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::reduced_dynamics_avx2_fma(s, sdot, T, p, out, zero_fill);
-#endif
+  return detail::reduced_dynamics_portable(s, sdot, T, p, out, zero_fill);
+#else
   return reduced_dynamics<double>(s, sdot, T, p, out, zero_fill);
+#endif
 }
 
 namespace operations {

@@ -899,6 +899,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline void bodies_avx2_fma(const Coordinates& s, const Coordinates& sdot, const Params& p, const BodiesOutputs& out, bool zero_fill) noexcept {
   return bodies<double>(s, sdot, p, out, zero_fill);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline void bodies_portable(const Coordinates& s, const Coordinates& sdot, const Params& p, const BodiesOutputs& out, bool zero_fill) noexcept {
+  return bodies<double>(s, sdot, p, out, zero_fill);
+}
 }  // namespace detail
 #endif
 
@@ -906,8 +911,10 @@ __attribute__((target("avx2,fma"), flatten)) inline void bodies_avx2_fma(const C
 inline void bodies(const Coordinates& s, const Coordinates& sdot, const Params& p, const BodiesOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::bodies_avx2_fma(s, sdot, p, out, zero_fill);
-#endif
+  return detail::bodies_portable(s, sdot, p, out, zero_fill);
+#else
   return bodies<double>(s, sdot, p, out, zero_fill);
+#endif
 }
 
 namespace operations {

@@ -67,6 +67,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline void clearance_avx2_fma(const Coordinates& s, const Params& p, const ClearanceOutputs& out) noexcept {
   return clearance<double>(s, p, out);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline void clearance_portable(const Coordinates& s, const Params& p, const ClearanceOutputs& out) noexcept {
+  return clearance<double>(s, p, out);
+}
 }  // namespace detail
 #endif
 
@@ -74,8 +79,10 @@ __attribute__((target("avx2,fma"), flatten)) inline void clearance_avx2_fma(cons
 inline void clearance(const Coordinates& s, const Params& p, const ClearanceOutputs& out) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::clearance_avx2_fma(s, p, out);
-#endif
+  return detail::clearance_portable(s, p, out);
+#else
   return clearance<double>(s, p, out);
+#endif
 }
 
 namespace operations {

@@ -586,6 +586,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline void convective_avx2_fma(const Coordinates& s, const Coordinates& sdot, const Params& p, const ConvectiveOutputs& out) noexcept {
   return convective<double>(s, sdot, p, out);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline void convective_portable(const Coordinates& s, const Coordinates& sdot, const Params& p, const ConvectiveOutputs& out) noexcept {
+  return convective<double>(s, sdot, p, out);
+}
 }  // namespace detail
 #endif
 
@@ -593,8 +598,10 @@ __attribute__((target("avx2,fma"), flatten)) inline void convective_avx2_fma(con
 inline void convective(const Coordinates& s, const Coordinates& sdot, const Params& p, const ConvectiveOutputs& out) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::convective_avx2_fma(s, sdot, p, out);
-#endif
+  return detail::convective_portable(s, sdot, p, out);
+#else
   return convective<double>(s, sdot, p, out);
+#endif
 }
 
 namespace operations {

@@ -441,6 +441,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline void dynamics_update_avx2_fma(const Coordinates& s, const Params& p, const DynamicsUpdateOutputs& out, bool zero_fill) noexcept {
   return dynamics_update<double>(s, p, out, zero_fill);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline void dynamics_update_portable(const Coordinates& s, const Params& p, const DynamicsUpdateOutputs& out, bool zero_fill) noexcept {
+  return dynamics_update<double>(s, p, out, zero_fill);
+}
 }  // namespace detail
 #endif
 
@@ -448,8 +453,10 @@ __attribute__((target("avx2,fma"), flatten)) inline void dynamics_update_avx2_fm
 inline void dynamics_update(const Coordinates& s, const Params& p, const DynamicsUpdateOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::dynamics_update_avx2_fma(s, p, out, zero_fill);
-#endif
+  return detail::dynamics_update_portable(s, p, out, zero_fill);
+#else
   return dynamics_update<double>(s, p, out, zero_fill);
+#endif
 }
 
 namespace operations {

@@ -452,6 +452,11 @@ namespace detail {
 __attribute__((target("avx2,fma"), flatten)) inline void kinematics_avx2_fma(const Coordinates& s, const Params& p, const KinematicsOutputs& out) noexcept {
   return kinematics<double>(s, p, out);
 }
+// The portable version out of line, so that it does not swell every caller (and the instruction
+// cache) where the AVX2 version is the one that runs.
+__attribute__((noinline)) inline void kinematics_portable(const Coordinates& s, const Params& p, const KinematicsOutputs& out) noexcept {
+  return kinematics<double>(s, p, out);
+}
 }  // namespace detail
 #endif
 
@@ -459,8 +464,10 @@ __attribute__((target("avx2,fma"), flatten)) inline void kinematics_avx2_fma(con
 inline void kinematics(const Coordinates& s, const Params& p, const KinematicsOutputs& out) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::kinematics_avx2_fma(s, p, out);
-#endif
+  return detail::kinematics_portable(s, p, out);
+#else
   return kinematics<double>(s, p, out);
+#endif
 }
 
 namespace operations {
