@@ -400,6 +400,8 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   w.charge_to = kM;
   // Forward: a joint's twist per unit rate is (a, o x a) for a revolute joint (axis a through o),
   // (0, a) for a prismatic one; times T's row of its coordinate, added to its parent's.
+  w.comment("The joints' partial twists (omega; velocity of the point at K0's origin), one lane per commanded");
+  w.comment("speed, summed along the bodies' chains from K0 (chains share their common joints).");
   std::vector<std::array<std::string, 6>> joint_twist(nodes.size());
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     TwistNode& node = nodes[k];
@@ -497,6 +499,9 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   // M = P^T D P summed over the bodies = sum over the joints of T(j, :)^T tau_j: a commanded speed's
   // joint adds its tau to row k, a dense joint T(j, k) tau_j to every row k.
   std::set<int> bias_columns;
+  w.charge_to = kM;
+  w.comment("Back along the chains: the bodies' wrenches summed beyond each joint, the joint's generalized");
+  w.comment("force tau (a dependent joint's is B_bias's column), and M = sum over the joints of T(j, :)^T tau.");
   for (std::size_t k = nodes.size(); k-- > 0;) {
     TwistNode& node = nodes[k];
     for (std::size_t c = 0; c < 6; ++c) {
@@ -531,6 +536,7 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
 
   // Around the bodies: T's rows, the accumulators, then the outputs.
   std::string code = fmt::format("    using L = detail::Lanes<Scalar, {}>;\n", nu);
+  code += "    // T's dense rows; the accumulators of M's rows, b_velocity, Q_gravity and B_bias's columns.\n";
   for (int j : rows_used) code += fmt::format("    const L kane_T_{0} = detail::lanes_of_row<Scalar, {1}>(T, {0});\n", j, nu);
   code += fmt::format("    L kane_M_0 = {}", w.zero());
   for (int k = 1; k < nu; ++k) code += fmt::format(", kane_M_{} = kane_M_0", k);

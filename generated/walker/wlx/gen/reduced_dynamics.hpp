@@ -718,6 +718,7 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   }
   if (M != nullptr || b_velocity != nullptr || B_bias != nullptr || Q_gravity != nullptr) {
     using L = detail::Lanes<Scalar, 4>;
+    // T's dense rows; the accumulators of M's rows, b_velocity, Q_gravity and B_bias's columns.
     const L kane_T_1 = detail::lanes_of_row<Scalar, 4>(T, 1);
     const L kane_T_3 = detail::lanes_of_row<Scalar, 4>(T, 3);
     const L kane_T_18 = detail::lanes_of_row<Scalar, 4>(T, 18);
@@ -729,6 +730,8 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L kane_T_27 = detail::lanes_of_row<Scalar, 4>(T, 27);
     const L kane_T_31 = detail::lanes_of_row<Scalar, 4>(T, 31);
     L kane_M_0 = detail::zero_lanes<Scalar, 4>(), kane_M_1 = kane_M_0, kane_M_2 = kane_M_0, kane_M_3 = kane_M_0, kane_b = kane_M_0, kane_Q = kane_M_0, kane_B_1 = kane_M_0, kane_B_3 = kane_M_0, kane_B_18 = kane_M_0, kane_B_19 = kane_M_0, kane_B_20 = kane_M_0, kane_B_21 = kane_M_0, kane_B_22 = kane_M_0, kane_B_23 = kane_M_0, kane_B_27 = kane_M_0, kane_B_31 = kane_M_0;
+    // The joints' partial twists (omega; velocity of the point at K0's origin), one lane per commanded
+    // speed, summed along the bodies' chains from K0 (chains share their common joints).
     L twist0_3 = detail::zero_lanes<Scalar, 4>();
     const Scalar kane_twist_0_3 = Scalar(1.0);
     twist0_3.v[1] += kane_twist_0_3;
@@ -1278,6 +1281,8 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L moment6_0 = kane_R_6_0_0 * db6_0 + kane_R_6_0_1 * db6_1 + kane_R_6_0_2 * db6_2 + kane_p_6_1 * dv6_2 + kane_minus_p_6_2 * dv6_1;
     const L moment6_1 = kane_R_6_1_0 * db6_0 + kane_R_6_1_1 * db6_1 + kane_R_6_1_2 * db6_2 + kane_p_6_2 * dv6_0 + kane_minus_p_6_0 * dv6_2;
     const L moment6_2 = kane_R_6_2_0 * db6_0 + kane_R_6_2_1 * db6_1 + kane_R_6_2_2 * db6_2 + kane_p_6_0 * dv6_1 + kane_minus_p_6_1 * dv6_0;
+    // Back along the chains: the bodies' wrenches summed beyond each joint, the joint's generalized
+    // force tau (a dependent joint's is B_bias's column), and M = sum over the joints of T(j, :)^T tau.
     const L tau13 = kane_twist_13_0 * moment6_0 + kane_twist_13_1 * moment6_1 + kane_twist_13_2 * moment6_2 + kane_twist_13_3 * dv6_0 + kane_twist_13_4 * dv6_1 + kane_twist_13_5 * dv6_2;
     kane_B_31 += tau13;
     kane_M_0 += T(31, 0) * tau13;
