@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <map>
 #include <set>
 #include <stdexcept>
 
@@ -196,6 +197,22 @@ FunctionSpec derive_kinematic_update(const Model& m) {
   return fn;
 }
 
+std::vector<std::string> identifiers(const std::string& code) {
+  const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  std::vector<std::string> out;
+  for (std::size_t at = 0; at < code.size();) {
+    if (!word(code[at])) {
+      ++at;
+      continue;
+    }
+    std::size_t end = at;
+    while (end < code.size() && word(code[end])) ++end;
+    out.push_back(code.substr(at, end - at));
+    at = end;
+  }
+  return out;
+}
+
 FunctionSpec derive_dynamics_update(const Model& m) {
   FunctionSpec fn{"dynamics_update", "dynamics_update.hpp",
                   "The position-level part of an inverse-dynamics step in one pass: dPhi/ds and the "
@@ -208,14 +225,6 @@ FunctionSpec derive_dynamics_update(const Model& m) {
 }
 
 namespace {
-
-// Whether `text` mentions the identifier `name` (as a whole word).
-bool mentions(const std::string& text, const std::string& name) {
-  const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
-  for (std::size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1))
-    if ((at == 0 || !word(text[at - 1])) && (at + name.size() == text.size() || !word(text[at + name.size()]))) return true;
-  return false;
-}
 
 // Writes reduced_dynamics' lane code: statements on rows of nu scalars (detail::Lanes), one lane
 // per commanded speed, and counts their operations scalar by scalar, per output (`charge_to`).
@@ -263,18 +272,23 @@ class LaneWriter {
   // The code, without the rows nothing reads (a dense joint's wrench sums feed only the
   // components its twist has), and each output's operations.
   std::string finish(std::vector<OpCount>& ops) const {
+    // How many kept statements read each named row; dropping a row that none reads can leave its
+    // own inputs unread, so this runs until nothing changes.
+    std::map<std::string, int> readers;
+    std::vector<std::set<std::string>> reads(statements_.size());
+    for (std::size_t i = 0; i < statements_.size(); ++i) {
+      for (const auto& word : identifiers(statements_[i].text))
+        if (word != statements_[i].name) reads[i].insert(word);
+      for (const auto& word : reads[i]) ++readers[word];
+    }
     std::vector<bool> keep(statements_.size(), true);
     for (bool changed = true; changed;) {
       changed = false;
       for (std::size_t i = 0; i < statements_.size(); ++i) {
-        if (!keep[i] || statements_[i].name.empty()) continue;
-        bool read = false;
-        for (std::size_t k = 0; k < statements_.size() && !read; ++k)
-          read = k != i && keep[k] && mentions(statements_[k].text, statements_[i].name);
-        if (!read) {
-          keep[i] = false;
-          changed = true;
-        }
+        if (!keep[i] || statements_[i].name.empty() || readers[statements_[i].name] > 0) continue;
+        keep[i] = false;
+        changed = true;
+        for (const auto& word : reads[i]) --readers[word];
       }
     }
     std::string code;
@@ -345,10 +359,11 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
                   "B_bias = sum P^T D [Jv; R^T Jw]. P comes from the joints' twists summed along the chains (one "
                   "lane per speed), B_bias from the bodies' wrenches summed back along them.",
                   true, {}};
-  for (const auto& c : m.coordinates)
-    if (c.name.rfind("kane_", 0) == 0) throw std::runtime_error("coordinate name " + c.name + ": names starting with kane_ are reserved");
-  for (const auto& par : m.parameters)
-    if (par.name.rfind("kane_", 0) == 0) throw std::runtime_error("parameter name " + par.name + ": names starting with kane_ are reserved");
+  const auto reserved = [](const char* what, const std::string& name) {
+    if (name.rfind("kane_", 0) == 0) throw std::runtime_error(std::string(what) + " name " + name + ": names starting with kane_ are reserved");
+  };
+  for (const auto& c : m.coordinates) reserved("coordinate", c.name);
+  for (const auto& par : m.parameters) reserved("parameter", par.name);
   // T's structure is fixed by the model file: the commanded speeds' rows are unit rows, the rows of
   // the dependent pair and of the dependent joints are dense, the rows of the other inputs (held
   // constant) zero. So only the joints of those two kinds move the bodies.
@@ -358,8 +373,7 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   const auto moves = [&](int j) { return dense(j) || speed_of[static_cast<std::size_t>(j)] >= 0; };
   fn.inputs = {{"T", "RateBasis",
                 "s' = T u, the rates caused by unit commanded speeds (rate_basis at s); only the rows of the dependent "
-                "pair and of the dependent joints are read, the others are fixed by the model file",
-                {}}};
+                "pair and of the dependent joints are read, the others are fixed by the model file"}};
   const auto scalar = [&](const std::string& name, const ex& value) {
     if (value.is_zero()) return std::string();
     fn.lane_scalars.emplace_back(name, value);
@@ -368,24 +382,20 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
 
   // The tree of the bodies' chains, moving joints only (the others add nothing to a twist).
   std::vector<TwistNode> nodes;
+  std::vector<int> roots;  // the nodes next to K0
   std::vector<int> body_node(m.bodies.size(), -1);
   for (std::size_t i = 0; i < m.bodies.size(); ++i) {
     int at = -1;
     for (const JointRecord& joint : m.bodies[i].com_frame.joints) {
       if (!moves(joint.coordinate)) continue;
-      const auto& siblings = at < 0 ? std::vector<int>{} : nodes[static_cast<std::size_t>(at)].children;
+      std::vector<int>& siblings = at < 0 ? roots : nodes[static_cast<std::size_t>(at)].children;
       int next = -1;
-      if (at < 0) {
-        for (std::size_t k = 0; k < nodes.size(); ++k)
-          if (nodes[k].parent < 0 && same_joint(*nodes[k].joint, joint)) next = static_cast<int>(k);
-      } else {
-        for (int c : siblings)
-          if (same_joint(*nodes[static_cast<std::size_t>(c)].joint, joint)) next = c;
-      }
+      for (int c : siblings)
+        if (same_joint(*nodes[static_cast<std::size_t>(c)].joint, joint)) next = c;
       if (next < 0) {
         next = static_cast<int>(nodes.size());
+        siblings.push_back(next);  // before nodes grows: `siblings` may live in it
         nodes.push_back({&joint, at, {}, {}, {}, {}});
-        if (at >= 0) nodes[static_cast<std::size_t>(at)].children.push_back(next);
       }
       at = next;
     }
@@ -532,7 +542,9 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   }
   std::vector<OpCount> lane_ops(4);
   const std::string body_code = w.finish(lane_ops);
-  std::erase_if(fn.lane_scalars, [&](const auto& named) { return !mentions(body_code, named.first); });
+  const auto body_words = identifiers(body_code);
+  const std::set<std::string> read(body_words.begin(), body_words.end());
+  std::erase_if(fn.lane_scalars, [&](const auto& named) { return !read.count(named.first); });
 
   // Around the bodies: T's rows, the accumulators, then the outputs.
   std::string code = fmt::format("    using L = detail::Lanes<Scalar, {}>;\n", nu);

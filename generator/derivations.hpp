@@ -24,14 +24,15 @@ struct OutputSpec {
   OpCount lane_ops = {};
 };
 
-// One input argument besides s, sdot and p: a matrix of the scalar type, whose entries the
-// expressions use as symbols.
+// One input argument besides s, sdot and p: a matrix of the scalar type, read by the lane code.
 struct InputSpec {
   std::string name;
   std::string type;  // a types.hpp name with an ...Of<Scalar> template
   std::string doc;
-  std::vector<std::pair<std::string, std::string>> bindings;  // symbol name -> element, e.g. "T(3, 1)"
 };
+
+// The identifiers (and other words of letters, digits and '_') in a piece of emitted code, in order.
+std::vector<std::string> identifiers(const std::string& code);
 
 struct FunctionSpec {
   std::string name;

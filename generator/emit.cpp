@@ -414,13 +414,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
       };
       std::istringstream lines(fn.lane_code);
       for (std::string line; std::getline(lines, line);) {
-        for (std::size_t at = 0; (at = line.find("kane_", at)) != std::string::npos;) {
-          std::size_t end = at;
-          while (end < line.size() && (std::isalnum(static_cast<unsigned char>(line[end])) || line[end] == '_')) ++end;
-          if (at == 0 || !(std::isalnum(static_cast<unsigned char>(line[at - 1])) || line[at - 1] == '_'))
-            define_scalar(line.substr(at, end - at));
-          at = end;
-        }
+        for (const auto& word : identifiers(line)) define_scalar(word);
         body += line + "\n";
       }
       if (!pending.empty()) throw std::logic_error("lane scalar " + pending.begin()->first + " is never read");
@@ -452,10 +446,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   stats.before_cse = before;
   stats.after_cse = total;
 
-  std::string aliases = coordinate_aliases(m, symbols) + parameter_aliases(m, symbols, opt);
-  for (const auto& in : fn.inputs)
-    for (const auto& [symbol, element] : in.bindings)
-      if (symbols.count(symbol)) aliases += fmt::format("  const Scalar {} = {};\n", symbol, element);
+  const std::string aliases = coordinate_aliases(m, symbols) + parameter_aliases(m, symbols, opt);
 
   std::string t = banner(m, opt, fmt::format("{}: {}", fn.name, fn.doc));
   t += "#pragma once\n\n#include <array>\n#include <cmath>\n\n#include \"params.hpp\"\n";
