@@ -265,107 +265,86 @@ void BM_run_NH1(benchmark::State& st) {
   }
 }
 
-// One inverse-dynamics step: closed-form IK, dependent rates and accelerations, body kinematics,
-// Kane's sums, J_beta, and the weighted torque distribution.
-void BM_inverse_dynamics_step(benchmark::State& st) {
+// The inverse-dynamics step's pose (the cabin 0.3 m forward, x_C' = 3 m/s), solved once: where the
+// benchmarks of the step and of its parts start from.
+struct SolvedStep {
   const Model model;
   Data d;
   DynamicsTerms terms;
   Coordinates s = nominal_inputs();
-  s(gen::coord::x_C) = 0.3;
-  const CommandVector u(0, 3, 0, 0);
-  for (auto _ : st) {
+  const CommandVector u = CommandVector(0, 3, 0, 0);
+  SolvedStep() {
+    s(gen::coord::x_C) = 0.3;
     solve_ik_closed_form(model, s);
     inverse_dynamics(model, d, s, u, CommandVector::Zero(), terms);
-    const TorqueVector tau = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
+  }
+};
+
+// One inverse-dynamics step: closed-form IK, dependent rates and accelerations, body kinematics,
+// Kane's sums, J_beta, and the weighted torque distribution.
+void BM_inverse_dynamics_step(benchmark::State& st) {
+  SolvedStep x;
+  for (auto _ : st) {
+    solve_ik_closed_form(x.model, x.s);
+    inverse_dynamics(x.model, x.d, x.s, x.u, CommandVector::Zero(), x.terms);
+    const TorqueVector tau = distribute_torques(x.terms.J_beta, x.terms.Qstar, Weighting::strong_weak());
     benchmark::DoNotOptimize(tau.data());
   }
 }
 // The weighted least-norm torque split of that step alone (weighting 1).
 void BM_distribute_torques(benchmark::State& st) {
-  const Model model;
-  Data d;
-  DynamicsTerms terms;
-  Coordinates s = nominal_inputs();
-  s(gen::coord::x_C) = 0.3;
-  solve_ik_closed_form(model, s);
-  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
+  SolvedStep x;
   for (auto _ : st) {
-    const TorqueVector tau = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
+    const TorqueVector tau = distribute_torques(x.terms.J_beta, x.terms.Qstar, Weighting::strong_weak());
     benchmark::DoNotOptimize(tau.data());
   }
 }
 // The generated passes of one inverse-dynamics step, then the step's generated code alone, IK
 // included, run back to back as the step runs it (its floor: the rest of the step is the runtime's
 // linear algebra). T is the rate basis at s, computed once.
-void dynamics_passes(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot, const gen::RateBasis& T,
-                     DynamicsTerms& terms) {
-  gen::dynamics_update(s, model.params(), {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
+void dynamics_passes(SolvedStep& x) {
+  gen::dynamics_update(x.s, x.model.params(), {.dPhi_ds = &x.d.dPhi_ds, .C = &x.d.C}, false);
   CommandVector b_velocity;
-  gen::reduced_dynamics(s, sdot, T, model.params(),
-                        {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot, .M = &terms.M,
-                         .b_velocity = &b_velocity, .B_bias = &terms.B_bias, .Q_gravity = &terms.Q_gravity},
+  gen::reduced_dynamics(x.s, x.terms.sdot, x.terms.T, x.model.params(),
+                        {.dPhi_ds_dot_sdot = &x.d.dPhi_ds_dot_sdot, .C_dot_sdot = &x.d.C_dot_sdot, .M = &x.terms.M,
+                         .b_velocity = &b_velocity, .B_bias = &x.terms.B_bias, .Q_gravity = &x.terms.Q_gravity},
                         false);
   benchmark::DoNotOptimize(b_velocity.data());
 }
 void BM_gen_dynamics_passes(benchmark::State& st) {
-  const Model model;
-  Data d;
-  DynamicsTerms terms;
-  Coordinates s = nominal_inputs();
-  s(gen::coord::x_C) = 0.3;
-  solve_ik_closed_form(model, s);
-  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
+  SolvedStep x;
   for (auto _ : st) {
-    dynamics_passes(model, d, s, terms.sdot, terms.T, terms);
-    benchmark::DoNotOptimize(terms.M.data());
+    dynamics_passes(x);
+    benchmark::DoNotOptimize(x.terms.M.data());
   }
 }
 // Kane's sums alone: reduced_dynamics' (twists and wrenches on lanes) against the same sums over
 // bodies()' full Jacobians with dense Eigen products (what a user of the body Jacobians writes;
 // the step's before: the runtime summed them over the bodies' columns).
 void BM_gen_kane_sums(benchmark::State& st) {
-  const Model model;
-  Data d;
-  DynamicsTerms terms;
-  Coordinates s = nominal_inputs();
-  s(gen::coord::x_C) = 0.3;
-  solve_ik_closed_form(model, s);
-  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
+  SolvedStep x;
   CommandVector b_velocity;
   for (auto _ : st) {
-    gen::reduced_dynamics(s, terms.sdot, terms.T, model.params(),
-                          {.M = &terms.M, .b_velocity = &b_velocity, .B_bias = &terms.B_bias, .Q_gravity = &terms.Q_gravity},
+    gen::reduced_dynamics(x.s, x.terms.sdot, x.terms.T, x.model.params(),
+                          {.M = &x.terms.M, .b_velocity = &b_velocity, .B_bias = &x.terms.B_bias, .Q_gravity = &x.terms.Q_gravity},
                           false);
-    benchmark::DoNotOptimize(terms.M.data());
+    benchmark::DoNotOptimize(x.terms.M.data());
   }
 }
 void BM_kane_sums_over_body_jacobians(benchmark::State& st) {
-  const Model model;
-  Data d;
-  DynamicsTerms terms;
-  Coordinates s = nominal_inputs();
-  s(gen::coord::x_C) = 0.3;
-  solve_ik_closed_form(model, s);
-  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
+  SolvedStep x;
   auto sums = std::make_unique<test::KaneSums>();
   for (auto _ : st) {
-    test::kane_over_bodies(model.params(), s, terms.sdot, terms.T, *sums);
+    test::kane_over_bodies(x.model.params(), x.s, x.terms.sdot, x.terms.T, *sums);
     benchmark::DoNotOptimize(sums->M.data());
   }
 }
 void BM_inverse_dynamics_generated_only(benchmark::State& st) {
-  const Model model;
-  Data d;
-  DynamicsTerms terms;
-  Coordinates s = nominal_inputs();
-  s(gen::coord::x_C) = 0.3;
-  solve_ik_closed_form(model, s);
-  inverse_dynamics(model, d, s, CommandVector(0, 3, 0, 0), CommandVector::Zero(), terms);
+  SolvedStep x;
   for (auto _ : st) {
-    solve_ik_closed_form(model, s);
-    dynamics_passes(model, d, s, terms.sdot, terms.T, terms);
-    benchmark::DoNotOptimize(terms.M.data());
+    solve_ik_closed_form(x.model, x.s);
+    dynamics_passes(x);
+    benchmark::DoNotOptimize(x.terms.M.data());
   }
 }
 // The whole ID-1 run (495 samples, RK4) with weighting 1.
