@@ -14,7 +14,7 @@ WLX_COMMANDS_BEGIN
 void write_ik_sweep_csv(const std::string& path, const IkSweepResult& result);
 
 // t, the coordinates, per wheel x_/y_<contact> (x_Wl, y_Wl, ...), nh_residual_<wheel>, spin_rate_<wheel>,
-// the input rates (<name>_dot), cond_J_beta, cabin_clearance, the contact velocities vx_/vy_/vz_<contact>, and for
+// the input rates (<name>_dot), cond_J_beta, clearance, the contact velocities vx_/vy_/vz_<contact>, and for
 // dynamics runs tau_<joint> and Qstar_<speed>.
 std::vector<std::string> trajectory_header(bool dynamics);
 std::vector<double> trajectory_row(const Sample& sample, bool dynamics);

@@ -152,7 +152,7 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
     out.push_back({"ik", title("ik", "Inverse kinematics sweeps"), "", {t}, figures.ik, {}});
   }
   const auto runs_table = [&](auto keep) {
-    report::Table t{{"run", "description", "samples", "max |v_W . n_W| (m/s)", "max cond(J_beta)", "min cabin clearance (m)", "CSV",
+    report::Table t{{"run", "description", "samples", "max |v_W . n_W| (m/s)", "max cond(J_beta)", "min clearance (m)", "CSV",
                      "3D"},
                     {}};
     for (const auto& r : runner_.runs()) {
@@ -161,7 +161,7 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
       for (const auto& smp : r.trajectory.samples) {
         res = std::max(res, smp.nh_residual.cwiseAbs().maxCoeff());
         cond = std::max(cond, smp.cond_J_beta);
-        clear = std::min(clear, smp.cabin_clearance);
+        clear = std::min(clear, smp.clearance);
       }
       t.rows.push_back({{r.id}, {r.scenario.description}, {std::to_string(r.trajectory.samples.size())}, {fmt::format("{:.2e}", res)},
                         {fmt::format("{:.3g}", cond)}, {fmt::format("{:.4f}", clear)}, {r.csv, "data/" + r.csv},

@@ -25,7 +25,7 @@ std::vector<std::string> trajectory_header(bool dynamics) {
     for (const gen::WheelInfo& wheel : gen::kWheels) h.push_back(quantity + std::string(wheel.name));
   for (int k = 0; k < kInputCount; ++k) h.push_back(name(k) + "_dot");
   h.emplace_back("cond_J_beta");
-  h.emplace_back("cabin_clearance");
+  h.emplace_back("clearance");
   for (int w = 0; w < kWheelCount; ++w)
     for (const char* axis : {"vx_", "vy_", "vz_"}) h.push_back(axis + contact_column_stem(w));
   if (dynamics) {
@@ -43,7 +43,7 @@ std::vector<double> trajectory_row(const Sample& smp, bool dynamics) {
   for (int w = 0; w < kWheelCount; ++w) row.push_back(smp.spin_rate(w));
   for (int k = 0; k < kInputCount; ++k) row.push_back(smp.sdot(k));
   row.push_back(smp.cond_J_beta);
-  row.push_back(smp.cabin_clearance);
+  row.push_back(smp.clearance);
   for (int w = 0; w < kWheelCount; ++w)
     for (int i = 0; i < 3; ++i) row.push_back(smp.contact_velocity(i, w));
   if (dynamics) {

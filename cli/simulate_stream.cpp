@@ -34,11 +34,11 @@ struct Summary {
   void add(const Sample& smp) {
     const double residual = smp.nh_residual.cwiseAbs().maxCoeff(), tau = smp.tau.cwiseAbs().maxCoeff();
     if (samples == 0) {
-      worst_residual = residual, worst_cond = smp.cond_J_beta, min_clearance = smp.cabin_clearance, peak_tau = tau;
+      worst_residual = residual, worst_cond = smp.cond_J_beta, min_clearance = smp.clearance, peak_tau = tau;
     } else {
       worst_residual = std::max(worst_residual, residual);
       worst_cond = std::max(worst_cond, smp.cond_J_beta);
-      min_clearance = std::min(min_clearance, smp.cabin_clearance);
+      min_clearance = std::min(min_clearance, smp.clearance);
       peak_tau = std::max(peak_tau, tau);
     }
     last_t = smp.t;
@@ -86,7 +86,7 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
   if (summary.samples == 0) {
     fmt::print("no sample was computed\n");
   } else {
-    fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, min cabin clearance = {:.4f} m\n",
+    fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, min clearance = {:.4f} m\n",
                summary.worst_residual, summary.worst_cond, summary.min_clearance);
     if (dynamics) fmt::print("inverse dynamics with {}: largest |tau| = {:.4g} N m\n", sc.weighting->label(), summary.peak_tau);
   }

@@ -349,7 +349,7 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   const Dynamics& dyn = *m.dynamics;
   const int n = coordinate_count(m);
   const int nu = static_cast<int>(dyn.commanded.size());
-  const auto pair = m.pair(dyn.pair).coordinates;
+  const std::vector<int> pair = m.wheels.empty() ? std::vector<int>{} : m.pair(dyn.pair).coordinates;
   FunctionSpec fn{"reduced_dynamics", "reduced_dynamics.hpp",
                   "Kane's equations on the commanded speeds u, in one pass with the convective terms: with "
                   "s' = T u and s'' = T u' + s''_bias, the generalized inertia, velocity and gravity forces on u "
@@ -369,7 +369,7 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   // constant) zero. So only the joints of those two kinds move the bodies.
   std::vector<int> speed_of(static_cast<std::size_t>(n), -1);
   for (int k = 0; k < nu; ++k) speed_of[static_cast<std::size_t>(dyn.commanded[static_cast<std::size_t>(k)])] = k;
-  const auto dense = [&](int j) { return j >= m.input_count || j == pair[0] || j == pair[1]; };
+  const auto dense = [&](int j) { return j >= m.input_count || std::count(pair.begin(), pair.end(), j) > 0; };
   const auto moves = [&](int j) { return dense(j) || speed_of[static_cast<std::size_t>(j)] >= 0; };
   fn.inputs = {{"T", "RateBasis",
                 "s' = T u, the rates caused by unit commanded speeds (rate_basis at s); only the rows of the dependent "

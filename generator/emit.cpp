@@ -123,8 +123,8 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
 
   // The inverse dynamics' types, on the commanded speeds u (reduced_dynamics' arguments).
   std::string dynamics_types;
-  if (m.dynamics) {
-    const std::size_t nu = m.dynamics->commanded.size();
+  {  // without a dynamics section: no commanded speeds, and the types stay defined (of size zero)
+    const std::size_t nu = m.dynamics ? m.dynamics->commanded.size() : 0;
     dynamics_types = fmt::format(
         "// The inverse dynamics on the {1} commanded speeds u (reduced_dynamics).\n"
         "inline constexpr int kCommandedCount = {1};\n"
@@ -622,8 +622,16 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
   // Frames: parents, so that a drawing can connect them.
   t += "// Parent of each frame of interest (-1: the ground frame K0), in frame:: order.\n";
   std::vector<int> parents;
-  for (const auto& f : m.frames) parents.push_back(f.parent == "K0" ? -1 : m.frame_index(f.parent));
-  t += fmt::format("inline constexpr std::array<int, {}> kFrameParent{{{{{}}}}};\n\n", parents.size(), int_list(parents));
+  std::vector<std::string> derived;
+  for (const auto& f : m.frames) {
+    parents.push_back(f.parent == "K0" ? -1 : m.frame_index(f.parent));
+    derived.push_back(f.derived_from_wheel >= 0 ? "true" : "false");
+  }
+  t += fmt::format("inline constexpr std::array<int, {}> kFrameParent{{{{{}}}}};\n", parents.size(), int_list(parents));
+  t += fmt::format("// Whether the frame is one wlx-gen derived (a wheel's contact point, which slides round the rim as\n"
+                   "// the hub tilts), not one fixed in the mechanism's chain.\n"
+                   "inline constexpr std::array<bool, {}> kFrameDerived{{{{{}}}}};\n\n",
+                   derived.size(), fmt::join(derived, ", "));
 
   // Limbs.
   std::size_t max_size = 1, max_inputs = 1;
@@ -673,40 +681,46 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
 
   // Wheels.
   t += "// Wheels rolling without sliding sideways: contact frame, the input holding the ground level\n"
-       "// under the wheel, and the rolling radius.\n"
+       "// under the wheel, and the rolling radius; for a wheel on a hub (its contact frame derived) the\n"
+       "// hub frame and the axle (-1 where the model file builds the contact frame itself).\n"
        "struct WheelInfo {\n  std::string_view name;\n  int contact_frame;\n  int ground;\n  double Params::*radius;\n"
-       "  int forward_axis;  // of the contact frame: 0 x, 1 y, 2 z\n  int lateral_axis;\n};\n";
+       "  int forward_axis;  // of the contact frame: 0 x, 1 y, 2 z\n  int lateral_axis;\n"
+       "  int hub_frame;\n  int axle_axis;  // of the hub frame\n};\n";
   t += fmt::format("inline constexpr std::array<WheelInfo, {}> kWheels{{{{\n", m.wheels.size());
   for (const auto& w : m.wheels)
-    t += fmt::format("    {{\"{}\", {}, {}, &Params::{}, {}, {}}},  // contact {}, ground {}\n", w.name, m.frame_index(w.contact),
-                     w.ground, w.radius, static_cast<int>(w.forward), static_cast<int>(w.lateral), w.contact, name_of(w.ground));
+    t += fmt::format("    {{\"{}\", {}, {}, &Params::{}, {}, {}, {}, {}}},  // contact {}, ground {}\n", w.name,
+                     m.frame_index(w.contact), w.ground, w.radius, static_cast<int>(w.forward), static_cast<int>(w.lateral),
+                     w.hub.empty() ? -1 : m.frame_index(w.hub), w.hub.empty() ? -1 : static_cast<int>(w.axle), w.contact,
+                     name_of(w.ground));
   t += "}};\n\n";
 
-  // Dependent pairs.
-  if (!m.wheels.empty()) {
-    t += fmt::format(
-        "// The input rates that may be chosen as the dependent rates of the wheel constraints, and the\n"
-        "// named choices.\n"
-        "inline constexpr std::array<int, {}> kPairCandidates{{{{{}}}}};\n"
-        "struct PairInfo {{\n  std::string_view name;\n  std::array<int, {}> coordinates;\n}};\n",
-        m.pair_candidates.size(), int_list(m.pair_candidates), m.wheels.size());
-    t += fmt::format("inline constexpr std::array<PairInfo, {}> kPairs{{{{\n", m.pairs.size());
-    int default_pair = 0;
-    for (std::size_t k = 0; k < m.pairs.size(); ++k) {
-      const auto& p = m.pairs[k];
-      if (p.name == m.default_pair) default_pair = static_cast<int>(k);
-      t += fmt::format("    {{\"{}\", {{{{{}, {}}}}}}},  // ({}', {}')\n", p.name, p.coordinates[0], p.coordinates[1],
-                       name_of(p.coordinates[0]), name_of(p.coordinates[1]));
-    }
-    t += fmt::format("}}}};\ninline constexpr int kDefaultPair = {};  // {}\n\n", default_pair, m.default_pair);
+  // Dependent pairs: a model without wheels has one, of no rates.
+  const std::vector<DependentPair> pairs = m.wheels.empty() ? std::vector<DependentPair>{{"none", {}}} : m.pairs;
+  t += fmt::format(
+      "// The input rates that may be chosen as the dependent rates of the wheel constraints (one per\n"
+      "// wheel), and the named choices.\n"
+      "inline constexpr std::array<int, {}> kPairCandidates{{{{{}}}}};\n"
+      "struct PairInfo {{\n  std::string_view name;\n  std::array<int, {}> coordinates;\n}};\n",
+      m.pair_candidates.size(), int_list(m.pair_candidates), m.wheels.size());
+  t += fmt::format("inline constexpr std::array<PairInfo, {}> kPairs{{{{\n", pairs.size());
+  int default_pair = 0;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const auto& p = pairs[k];
+    if (p.name == m.default_pair) default_pair = static_cast<int>(k);
+    std::vector<std::string> rates;
+    for (int c : p.coordinates) rates.push_back(name_of(c) + "'");
+    t += fmt::format("    {{\"{}\", {{{{{}}}}}}},  // ({})\n", p.name, int_list(p.coordinates), fmt::join(rates, ", "));
   }
+  t += fmt::format("}}}};\ninline constexpr int kDefaultPair = {};  // {}\n\n", default_pair,
+                   m.wheels.empty() ? "none" : m.default_pair);
 
-  // Inverse dynamics.
-  if (m.dynamics) {
-    const Dynamics& d = *m.dynamics;
+  // Inverse dynamics (empty sets without a dynamics section: the runtime's types stay defined).
+  {
+    const Dynamics none{};
+    const Dynamics& d = m.dynamics ? *m.dynamics : none;
     int pair = 0;
-    for (std::size_t k = 0; k < m.pairs.size(); ++k)
-      if (m.pairs[k].name == d.pair) pair = static_cast<int>(k);
+    for (std::size_t k = 0; k < pairs.size(); ++k)
+      if (pairs[k].name == d.pair) pair = static_cast<int>(k);
     std::string commanded, actuated, weights;
     for (int k : d.commanded) commanded += (commanded.empty() ? "" : ", ") + name_of(k);
     for (int k : d.actuated) actuated += (actuated.empty() ? "" : ", ") + name_of(k);
@@ -714,16 +728,15 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
     t += fmt::format(
         "// Inverse dynamics: the commanded speeds u ({}), the dependent pair, the actuated joints\n"
         "// ({}), their default weights, and gravity (along -z of K0).\n"
-        "inline constexpr bool kHasDynamics = true;\n"
+        "inline constexpr bool kHasDynamics = {};\n"
         "inline constexpr std::array<int, {}> kCommanded{{{{{}}}}};\n"
         "inline constexpr int kDynamicsPair = {};  // {}\n"
         "inline constexpr std::array<int, {}> kActuated{{{{{}}}}};\n"
         "inline constexpr std::array<double, {}> kDefaultWeights{{{{{}}}}};\n"
-        "inline constexpr double Params::*kGravity = &Params::{};\n\n",
-        commanded, actuated, d.commanded.size(), int_list(d.commanded), pair, d.pair, d.actuated.size(),
-        int_list(d.actuated), d.weights.size(), weights, d.gravity);
-  } else {
-    t += "inline constexpr bool kHasDynamics = false;\n\n";
+        "inline constexpr double Params::*kGravity = {};\n\n",
+        m.dynamics ? commanded : "none: the model file has no dynamics section", actuated, m.dynamics ? "true" : "false",
+        d.commanded.size(), int_list(d.commanded), pair, m.dynamics ? d.pair : "none", d.actuated.size(),
+        int_list(d.actuated), d.weights.size(), weights, m.dynamics ? "&Params::" + d.gravity : "nullptr");
   }
 
   // Body Jacobian columns.
@@ -784,11 +797,18 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
   t += "}};\n\n";
 
   // Nominal state.
-  std::string nominal;
-  for (double v : m.nominal) nominal += (nominal.empty() ? "" : ", ") + literal(v);
+  std::string nominal, dependent_start;
+  for (int k = 0; k < static_cast<int>(m.nominal.size()); ++k) {
+    std::string& list = k < m.input_count ? nominal : dependent_start;
+    list += fmt::format("{}{}", list.empty() ? "" : ", ", literal(m.nominal[static_cast<std::size_t>(k)]));
+  }
   t += fmt::format("// The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).\n"
-                   "inline constexpr std::array<double, {}> kNominalInputs{{{{{}}}}};\n\n",
-                   m.nominal.size(), nominal);
+                   "inline constexpr std::array<double, {}> kNominalInputs{{{{{}}}}};\n"
+                   "// Where Newton's method starts for the dependent joints when no earlier solution is at hand (the\n"
+                   "// model file's `nominal` and the limbs' `start`; 0 where neither gives one), in coord:: order from\n"
+                   "// the first dependent joint.\n"
+                   "inline constexpr std::array<double, {}> kDependentStart{{{{{}}}}};\n\n",
+                   m.input_count, nominal, m.nominal.size() - static_cast<std::size_t>(m.input_count), dependent_start);
   t += fmt::format("inline constexpr bool kHasClearance = {};\n\n", m.clearance ? "true" : "false");
   t += namespace_close(opt);
   return {"wlx/gen/structure.hpp", t};

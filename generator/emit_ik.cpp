@@ -62,14 +62,25 @@ std::vector<ChainStep> full_chain(const Model& m, const std::string& frame) {
 Frame apply(const Model& m, const Frame& f, const ChainStep& st) {
   switch (st.kind) {
     case ChainStep::Kind::Translate: return f.translated(st.offset);
-    case ChainStep::Kind::Rotate: return f.rotated(st.axis, m.coordinates[static_cast<std::size_t>(st.coordinate)]);
-    case ChainStep::Kind::Slide: return f.slid(st.axis, m.coordinates[static_cast<std::size_t>(st.coordinate)]);
+    case ChainStep::Kind::Rotate: return f.rotated(st.axis, m.coordinates[static_cast<std::size_t>(st.coordinate)], st.sign);
+    case ChainStep::Kind::Slide: return f.slid(st.axis, m.coordinates[static_cast<std::size_t>(st.coordinate)], st.sign);
     case ChainStep::Kind::Turn: return f.turned(st.axis, st.angle);
   }
   return f;
 }
 
 bool driven(const ChainStep& st) { return st.kind == ChainStep::Kind::Rotate || st.kind == ChainStep::Kind::Slide; }
+
+// The patterns below read joint steps as turns about +x, +y or +z; a chain with a negated joint
+// (`ry: -q`) or a wheel's derived contact frame is not theirs.
+void require_plain_chain(const Model& m, const std::string& frame, const std::vector<ChainStep>& chain, const char* pattern) {
+  if (m.frames[static_cast<std::size_t>(m.frame_index(frame))].derived_from_wheel >= 0)
+    throw Unsolvable{std::string(pattern) + ": " + frame + " is a wheel's derived contact point"};
+  for (const ChainStep& st : chain)
+    if (driven(st) && st.sign < 0)
+      throw Unsolvable{std::string(pattern) + ": " + m.coordinates[static_cast<std::size_t>(st.coordinate)].name +
+                       " turns about a negative axis"};
+}
 
 // A rotation whose angle is an expression, for reducing orientation chains.
 struct Rot {
@@ -187,7 +198,9 @@ Solve plan_point3(const Model& m, const Limb& limb) {
     if (t >= 0) throw Unsolvable{"point3: two rows fix the same component"};
     t = c.target;
   }
+  require_plain_chain(m, frame, {}, "point3");
   const std::vector<ChainStep> chain = full_chain(m, frame);
+  require_plain_chain(m, frame, chain, "point3");
   std::vector<std::size_t> at;
   for (std::size_t i = 0; i < chain.size(); ++i)
     if (driven(chain[i]) && chain[i].coordinate >= m.input_count) {
@@ -319,7 +332,9 @@ Solve plan_lever(const Model& m, const Limb& limb) {
   if (remaining.size() != 3) throw Unsolvable{"leveled lever: three joints must remain after the couplings"};
   const Axis vertical = static_cast<Axis>(3 - static_cast<int>(level[0]->axis) - static_cast<int>(level[1]->axis));
 
+  require_plain_chain(m, frame, {}, "leveled lever");
   const std::vector<ChainStep> chain = full_chain(m, frame);
+  require_plain_chain(m, frame, chain, "leveled lever");
   std::size_t first = chain.size();
   for (std::size_t i = 0; i < chain.size(); ++i)
     if (driven(chain[i]) && chain[i].coordinate >= m.input_count) {
@@ -812,44 +827,53 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
   t += fmt::format("// Per limb, in the order of kLimbs.\ninline constexpr std::array<ClosedFormInfo, {}> kClosedForm{{{{\n{}\n}}}};\n\n",
                    m.limbs.size(), fmt::join(entries, "\n"));
 
-  // Every limb in one function: one pass of sines and cosines for all input angles, and the
-  // subexpressions the limbs share (the cabin's pose) computed once.
-  const bool all = !m.limbs.empty() && solved.size() == m.limbs.size();
-  t += fmt::format("inline constexpr bool kHasFusedIk = {};\n\n", all ? "true" : "false");
-  if (all) {
+  // Every limb with a closed form in one function: one pass of sines and cosines for all input
+  // angles, and the subexpressions the limbs share (the body's pose) computed once. Emitted for
+  // every model, so that the runtime compiles for any mix: the limbs without a closed form are left
+  // to Newton's method (their joints in out are not written).
+  const bool all = solved.size() == m.limbs.size();
+  t += fmt::format("// Whether every limb has a closed form (ik_all then solves them all).\ninline constexpr bool kHasFusedIk = {};\n\n",
+                   all ? "true" : "false");
+  {
     // Every limb's solver stages, one atan2 pass for all their joints, then every limb's check.
     std::vector<Stage> stages, checks;
     std::vector<SolvedJoint> joints;
     std::vector<std::pair<int, std::string>> outputs;
-    std::string prologue;
+    std::string prologue, newton;
     for (std::size_t k = 0; k < solved.size(); ++k) {
       const auto& [limb, solve] = solved[k];
-      for (Stage& st : fused_stages(m, solve.stages, limb->name, static_cast<int>(k))) stages.push_back(std::move(st));
-      for (Stage& st : fused_stages(m, {check_stage(m, *limb, solve)}, limb->name, static_cast<int>(k))) checks.push_back(std::move(st));
+      const int index = static_cast<int>(limb - m.limbs.data());
+      for (Stage& st : fused_stages(m, solve.stages, limb->name, index)) stages.push_back(std::move(st));
+      for (Stage& st : fused_stages(m, {check_stage(m, *limb, solve)}, limb->name, index)) checks.push_back(std::move(st));
       joints.insert(joints.end(), solve.joints.begin(), solve.joints.end());
       for (const auto& o : solve_outputs(m, solve)) outputs.push_back(o);
       prologue += fmt::format("  const int ik_{0}_branch = branches[{1}];\n"
                               "  if (ik_{0}_branch < 0 || ik_{0}_branch >= {2}) {{\n    failed = {1};\n    return IkStatus::bad_branch;\n  }}\n",
-                              limb->name, k, solve.branches);
+                              limb->name, index, solve.branches);
     }
-    stages.push_back(angle_stage(stages, joints));
+    for (const Limb& limb : m.limbs)
+      if (std::none_of(solved.begin(), solved.end(), [&](const auto& sv) { return sv.first == &limb; }))
+        newton += (newton.empty() ? "" : ", ") + limb.name;
+    if (!joints.empty()) stages.push_back(angle_stage(stages, joints));
     stages.insert(stages.end(), checks.begin(), checks.end());
     OpCount ops;
     const std::string body = emit_body(m, stages, outputs, opt, ops);
     t += fmt::format(
-        "// The closed forms of all {0} limbs in one pass: what ik_<limb>() computes for each, with the sines and\n"
-        "// cosines of every input angle and the subexpressions the limbs share computed once. branches[k] is\n"
-        "// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed\n"
-        "// (every limb's reach is tested before any limb's residual check), `failed` its index and `why`\n"
+        "// The closed forms of the {0} limbs that have one{6} in one pass: what ik_<limb>() computes for each,\n"
+        "// with the sines and cosines of every input angle and the subexpressions the limbs share computed once.\n"
+        "// branches[k] is limb k's branch (kLimbs order). On failure returns the status of the first limb that\n"
+        "// failed (every limb's reach is tested before any limb's residual check), `failed` its index and `why`\n"
         "// its numbers; out is written only when every limb succeeded.\n"
         "// Operations: {1} (adds {2}, muls {3}, divs {4}, calls {5}), plus the solver calls.\n"
         "// Scalar: float or double.\n"
         "template <typename Scalar>\n"
-        "inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const std::array<int, {0}>& branches,\n"
+        "inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const std::array<int, {7}>& branches,\n"
         "                       detail::NonDeduced<CoordinatesOf<Scalar>>& out, int& failed, IkDiagnostics& why) noexcept {{\n"
         "  static_assert(std::is_floating_point_v<Scalar>, \"the closed-form IK is for float and double\");\n"
-        "  static_cast<void>(p);\n",
-        m.limbs.size(), ops.total(), ops.adds, ops.muls, ops.divs, ops.calls);
+        "  static_cast<void>(s);\n  static_cast<void>(p);\n  static_cast<void>(branches);\n  static_cast<void>(out);\n"
+        "  static_cast<void>(failed);\n  static_cast<void>(why);\n",
+        solved.size(), ops.total(), ops.adds, ops.muls, ops.divs, ops.calls,
+        newton.empty() ? "" : " (not " + newton + ": Newton's method at run time)", m.limbs.size());
     t += prologue + body + "}\n\n";
     t += double_overload("ik_all", "IkStatus",
                          {{"const Coordinates& s", ""},

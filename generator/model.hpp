@@ -25,6 +25,7 @@ struct ChainStep {
   Axis axis = Axis::X;
   Vec3 offset;          // Translate
   int coordinate = -1;  // Rotate, Slide
+  int sign = 1;         // Rotate, Slide: -1 for a step written `rz: -q` (about, along the negative axis)
   ex angle;             // Turn
 };
 
@@ -34,6 +35,9 @@ struct NamedFrame {
   std::string parent;  // "K0" for the ground
   std::vector<ChainStep> chain;
   Frame frame;
+  // >= 0: the contact frame wlx-gen derives for wheel `derived_from_wheel` (a wheel on a hub): no
+  // chain, its parent is the hub frame, its origin the rim point nearest the ground.
+  int derived_from_wheel = -1;
 };
 
 // A rigid body: its centre-of-mass frame (orientation of the body, origin at the CoM) and the
@@ -63,13 +67,17 @@ struct ClosureCondition {
 };
 
 // A wheel that may not slide sideways: v_W . n_W = 0 with n_W the contact frame's lateral axis.
+// Either the file gives the contact frame (with virtual joints and level rows that keep it on the
+// rim's lowest point), or the wheel sits on a hub frame and wlx-gen derives the contact frame.
 struct NonholonomicWheel {
   std::string name;
-  std::string contact;  // frame name
+  std::string contact;  // frame name (derived for a wheel on a hub)
   Axis lateral = Axis::Y;
   Axis forward = Axis::X;
   std::string radius;  // parameter name of the rolling radius
   int ground = -1;     // the input holding the ground level under the wheel
+  std::string hub;     // the hub frame (wheel centre, not spinning), or empty
+  Axis axle = Axis::Y;  // the hub frame's axis the wheel turns about
 };
 
 // Closure rows and the dependent joints they determine: a square diagonal block of dPhi/ds.
@@ -80,9 +88,10 @@ struct Limb {
   std::vector<int> joints;
 };
 
+// The input rates, one per wheel, that the wheels' rolling rows determine.
 struct DependentPair {
   std::string name;
-  std::array<int, 2> coordinates{-1, -1};
+  std::vector<int> coordinates;
 };
 
 struct Dynamics {
@@ -127,7 +136,8 @@ struct Model {
   std::string default_pair;
   std::optional<Dynamics> dynamics;
   std::optional<ClearanceBox> clearance;
-  std::vector<double> nominal;  // one value per input
+  std::vector<double> nominal;  // one value per coordinate: the inputs' nominal values, the dependent
+                                // joints' start values for Newton's method (0 where none is given)
   std::vector<double> sweep_start;  // the IK sweeps' initial inputs (nominal with overrides)
   std::vector<IkSweep> sweeps;
 

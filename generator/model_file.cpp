@@ -261,9 +261,10 @@ class Parser {
     coordinates(f["coordinates"]);
     frames(f["frames"]);
     if (auto b = f.optional("bodies")) bodies(*b);
+    // Wheels before the closure: a wheel on a hub adds its contact frame, which closure rows place.
+    if (auto w = f.optional("wheels")) wheels(*w);
     if (auto c = f.optional("closure")) closure(*c);
     limbs(f.optional("limbs"), top);
-    if (auto w = f.optional("wheels")) wheels(*w);
     nonholonomic(f.optional("nonholonomic"), top);
     if (auto d = f.optional("dynamics")) dynamics(*d);
     if (auto c = f.optional("clearance")) clearance(*c);
@@ -576,8 +577,13 @@ class Parser {
           cs.axis = static_cast<Axis>(op[1] - 'x');
           const ex e = expression(arg, true);
           const bool rotation = op[0] == 'r';
-          if (GiNaC::is_a<GiNaC::symbol>(e) && coordinates_.count(GiNaC::ex_to<GiNaC::symbol>(e).get_name())) {
-            const Coordinate& c = m_.coordinate(GiNaC::ex_to<GiNaC::symbol>(e).get_name());
+          // `rz: q` is a joint; so is `rz: -q`, about (along) the negative axis (URDF's axis 0 0 -1).
+          const auto joint_symbol = [&](const ex& x) {
+            return GiNaC::is_a<GiNaC::symbol>(x) && coordinates_.count(GiNaC::ex_to<GiNaC::symbol>(x).get_name());
+          };
+          const int sign = joint_symbol(e) ? 1 : joint_symbol(-e) ? -1 : 0;
+          if (sign != 0) {
+            const Coordinate& c = m_.coordinate(GiNaC::ex_to<GiNaC::symbol>(sign > 0 ? e : -e).get_name());
             if (rotation && c.unit != "rad") arg.fail(fmt::format("'{}' turns a revolute joint, so its unit must be rad, not {}", c.name, c.unit));
             if (!rotation && c.unit != "m") arg.fail(fmt::format("'{}' drives a prismatic joint, so its unit must be m, not {}", c.name, c.unit));
             for (const auto& [user, at] : joint_users_)
@@ -585,11 +591,12 @@ class Parser {
             joint_users_.emplace_back(c.index, arg.path());
             cs.kind = rotation ? ChainStep::Kind::Rotate : ChainStep::Kind::Slide;
             cs.coordinate = c.index;
-            frame = rotation ? frame.rotated(cs.axis, c) : frame.slid(cs.axis, c);
+            cs.sign = sign;
+            frame = rotation ? frame.rotated(cs.axis, c, sign) : frame.slid(cs.axis, c, sign);
           } else {
             for (const auto& kv : coordinates_)
               if (e.has(kv.second))
-                arg.fail(fmt::format("a joint is driven by one coordinate alone; '{}' mixes coordinate '{}' with other terms",
+                arg.fail(fmt::format("a joint is driven by one coordinate alone (or its negative); '{}' mixes coordinate '{}' with other terms",
                                      excerpt(arg.text()), kv.first));
             if (rotation) {
               cs.kind = ChainStep::Kind::Turn;
@@ -621,7 +628,7 @@ class Parser {
   void bodies(const Item& list) {
     std::set<std::string> seen;
     each(list, [&](const Item& it) {
-      const Fields f(it, {"name", "meaning", "frame", "com", "mass", "inertia"});
+      const Fields f(it, {"name", "meaning", "frame", "com", "rotation", "mass", "inertia"});
       Body b;
       b.name = f["name"].name();
       if (!seen.insert(b.name).second) f["name"].fail(fmt::format("body '{}' is defined twice", b.name));
@@ -629,6 +636,15 @@ class Parser {
       const int frame = frame_index(f["frame"]);
       b.frame = m_.frames[static_cast<std::size_t>(frame)].name;
       b.com_frame = m_.frames[static_cast<std::size_t>(frame)].frame.translated(vector3(f["com"]));
+      // The principal axes, turned from the frame's (a URDF inertial's rpy, or the axes that
+      // diagonalise its tensor): fixed turns of parameter expressions, applied in order.
+      if (auto rotation = f.optional("rotation"))
+        for (const Item& step : rotation->list()) {
+          const std::string op = step.is_map() && step.size() == 1 ? step.node().begin()->first.Scalar() : "";
+          if (op != "rx" && op != "ry" && op != "rz")
+            step.fail("a rotation step is rx, ry or rz: <expression of parameters> (a fixed turn about the axes turned so far)");
+          b.com_frame = b.com_frame.turned(static_cast<Axis>(op[1] - 'x'), expression(step.child(op), false));
+        }
       b.mass = parameter(f["mass"], ParameterKind::mass).name;
       const Item inertia = f["inertia"];
       if (!inertia.is_sequence() || inertia.size() != 3)
@@ -659,7 +675,12 @@ class Parser {
         const Fields f(it, {"name", "type", "frame", "axis"});
         c.name = f["name"].name();
         c.kind = K::AttachedDirectionLevel;
-        c.frame = m_.frames[static_cast<std::size_t>(frame_index(f["frame"]))].name;
+        const NamedFrame& frame = m_.frames[static_cast<std::size_t>(frame_index(f["frame"]))];
+        if (frame.derived_from_wheel >= 0)
+          f["frame"].fail(fmt::format("'{}' is the contact frame of wheel '{}', level by construction: a level row on it "
+                                      "would fix nothing",
+                                      frame.name, m_.wheels[static_cast<std::size_t>(frame.derived_from_wheel)].name));
+        c.frame = frame.name;
         c.axis = axis_of(f["axis"]);
       } else if (type == "sum") {
         const Fields f(it, {"name", "type", "coordinates"});
@@ -706,7 +727,7 @@ class Parser {
     }
     std::map<int, std::string> row_owner, joint_owner;
     each(*list, [&](const Item& it) {
-      const Fields f(it, {"name", "title", "closure", "joints"});
+      const Fields f(it, {"name", "title", "closure", "joints", "start"});
       Limb limb;
       limb.name = f["name"].name();
       for (const auto& l : m_.limbs)
@@ -732,6 +753,17 @@ class Parser {
         joint_owner[k] = limb.name;
         limb.joints.push_back(k);
       }
+      // Where Newton's method starts for this limb's joints (a bent knee, not a straight leg).
+      if (auto start = f.optional("start")) {
+        if (!start->is_map()) start->fail("must map the limb's joints to start values");
+        for (const auto& kv : start->node()) {
+          const Item key(src_, kv.first, start->path(), start->env());  // keys may name <variables> too
+          const int k = coordinate_index(key, false, true);
+          if (std::find(limb.joints.begin(), limb.joints.end(), k) == limb.joints.end())
+            key.fail(fmt::format("'{}' is not one of limb '{}''s joints", m_.coordinates[static_cast<std::size_t>(k)].name, limb.name));
+          limb_start_[k] = start->child(kv.first.Scalar()).number();
+        }
+      }
       if (limb.rows.size() != limb.joints.size() || limb.rows.empty())
         it.fail(fmt::format("limb '{}' has {} closure conditions and {} joints: a limb's block of dPhi/ds must be square and "
                             "non-empty",
@@ -752,19 +784,47 @@ class Parser {
       if (!joint_owner.count(k)) list->fail(fmt::format("dependent joint '{}' belongs to no limb", m_.coordinates[static_cast<std::size_t>(k)].name));
   }
 
+  // Two forms: a wheel on a hub (`hub`, `axle`: wlx-gen derives the contact frame `contact`,
+  // default contact_<name>), or a contact frame the file builds itself (`contact`, `forward`,
+  // `lateral`: virtual joints and level rows keep it on the rim's lowest point).
   void wheels(const Item& list) {
     each(list, [&](const Item& it) {
-      const Fields f(it, {"name", "contact", "forward", "lateral", "radius", "ground"});
+      const bool on_hub = it.is_map() && it.has("hub");
+      const Fields f(it, on_hub ? std::vector<std::string>{"name", "hub", "axle", "radius", "ground", "contact"}
+                                : std::vector<std::string>{"name", "contact", "forward", "lateral", "radius", "ground"});
       NonholonomicWheel w;
       w.name = f["name"].name();
       for (const auto& other : m_.wheels)
         if (other.name == w.name) f["name"].fail(fmt::format("wheel '{}' is defined twice", w.name));
-      w.contact = m_.frames[static_cast<std::size_t>(frame_index(f["contact"]))].name;
-      w.forward = axis_of(f["forward"]);
-      w.lateral = axis_of(f["lateral"]);
-      if (w.forward == w.lateral) f["lateral"].fail("the lateral axis must differ from the forward axis");
       w.radius = parameter(f["radius"], ParameterKind::length).name;
       w.ground = coordinate_index(f["ground"], true);
+      if (m_.coordinates[static_cast<std::size_t>(w.ground)].unit != "m")
+        f["ground"].fail(fmt::format("'{}' is an angle; the ground level is a height (m)", m_.coordinates[static_cast<std::size_t>(w.ground)].name));
+      if (!on_hub) {
+        w.contact = m_.frames[static_cast<std::size_t>(frame_index(f["contact"]))].name;
+        w.forward = axis_of(f["forward"]);
+        w.lateral = axis_of(f["lateral"]);
+        if (w.forward == w.lateral) f["lateral"].fail("the lateral axis must differ from the forward axis");
+        m_.wheels.push_back(std::move(w));
+        return;
+      }
+      const NamedFrame& hub = m_.frames[static_cast<std::size_t>(frame_index(f["hub"]))];
+      if (hub.derived_from_wheel >= 0) f["hub"].fail(fmt::format("'{}' is a wheel's contact frame, not a hub", hub.name));
+      w.hub = hub.name;
+      w.axle = axis_of(f["axle"]);
+      w.contact = f.optional("contact") ? f["contact"].name() : "contact_" + w.name;
+      const Item& where = f.optional("contact") ? f["contact"] : f["name"];
+      if (w.contact == "K0" || m_.frame_index(w.contact) >= 0)
+        where.fail(fmt::format("the contact frame '{}' that wlx-gen derives for this wheel is already a frame: name it "
+                               "with `contact:`",
+                               w.contact));
+      NamedFrame contact;
+      contact.name = w.contact;
+      contact.meaning = fmt::format("contact point of wheel {} (derived: the rim point nearest the ground)", w.name);
+      contact.parent = hub.name;
+      contact.frame = wheel_contact_frame(hub.frame, w.axle, m_.parameter(w.radius).symbol, m_.coordinates);
+      contact.derived_from_wheel = static_cast<int>(m_.wheels.size());
+      m_.frames.push_back(std::move(contact));
       m_.wheels.push_back(std::move(w));
     });
   }
@@ -776,6 +836,9 @@ class Parser {
     }
     if (!section) top.fail("missing field 'nonholonomic': a model with wheels names the candidate dependent rates and pairs");
     const Fields f(*section, {"pair_candidates", "pairs", "default_pair"});
+    if (f["pair_candidates"].list().size() < m_.wheels.size())
+      f["pair_candidates"].fail(fmt::format("{} wheels need at least {} candidate dependent rates, one per wheel", m_.wheels.size(),
+                                            m_.wheels.size()));
     for (const Item& c : f["pair_candidates"].list()) {
       const int k = coordinate_index(c, true);
       if (std::count(m_.pair_candidates.begin(), m_.pair_candidates.end(), k)) c.fail("listed twice");
@@ -790,13 +853,14 @@ class Parser {
       if (!is_identifier(p.name)) list.fail(fmt::format("'{}' is not a name", excerpt(p.name)));
       if (!list.is_sequence() || list.size() != m_.wheels.size())
         list.fail(fmt::format("a dependent pair lists {} rates, one per wheel", m_.wheels.size()));
-      if (m_.wheels.size() != 2) list.fail("the runtime solves for two wheels; models with another number of wheels are not supported yet");
-      for (std::size_t k = 0; k < 2; ++k) {
-        p.coordinates[k] = coordinate_index(list.element(k), true);
-        if (!std::count(m_.pair_candidates.begin(), m_.pair_candidates.end(), p.coordinates[k]))
-          list.element(k).fail(fmt::format("'{}' is not one of pair_candidates", m_.coordinates[static_cast<std::size_t>(p.coordinates[k])].name));
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const int c = coordinate_index(list.element(k), true);
+        if (!std::count(m_.pair_candidates.begin(), m_.pair_candidates.end(), c))
+          list.element(k).fail(fmt::format("'{}' is not one of pair_candidates", m_.coordinates[static_cast<std::size_t>(c)].name));
+        if (std::count(p.coordinates.begin(), p.coordinates.end(), c))
+          list.element(k).fail(fmt::format("'{}' is listed twice: the dependent rates must differ", m_.coordinates[static_cast<std::size_t>(c)].name));
+        p.coordinates.push_back(c);
       }
-      if (p.coordinates[0] == p.coordinates[1]) list.fail("the two dependent rates must differ");
       m_.pairs.push_back(p);
     }
     const Item def = f["default_pair"];
@@ -808,28 +872,38 @@ class Parser {
 
   void dynamics(const Item& section) {
     if (m_.bodies.empty()) section.fail("inverse dynamics needs bodies");
-    if (m_.wheels.empty()) section.fail("the inverse dynamics of wlx is that of wheeled machines: it needs wheels and a dependent pair");
     const Fields f(section, {"gravity", "commanded", "pair", "actuated", "weights"});
     Dynamics d;
     d.gravity = parameter(f["gravity"], ParameterKind::gravity).name;
-    d.pair = f["pair"].name();
-    const DependentPair* pair = nullptr;
-    for (const auto& p : m_.pairs)
-      if (p.name == d.pair) pair = &p;
-    if (pair == nullptr) f["pair"].fail(fmt::format("no pair '{}' under nonholonomic.pairs", d.pair));
+    // The wheels' dependent rates: a named pair (any model with wheels), none without wheels.
+    static const DependentPair no_pair{"none", {}};
+    const DependentPair* pair = &no_pair;
+    if (m_.wheels.empty()) {
+      if (auto p = f.optional("pair")) p->fail("the model has no wheels, so no dependent rates: leave `pair` out");
+      d.pair = no_pair.name;
+    } else {
+      d.pair = f["pair"].name();
+      pair = nullptr;
+      for (const auto& p : m_.pairs)
+        if (p.name == d.pair) pair = &p;
+      if (pair == nullptr) f["pair"].fail(fmt::format("no pair '{}' under nonholonomic.pairs", d.pair));
+    }
     for (const Item& c : f["commanded"].list()) {
       const int k = coordinate_index(c, true);
       if (std::count(d.commanded.begin(), d.commanded.end(), k)) c.fail("listed twice");
-      if (k == pair->coordinates[0] || k == pair->coordinates[1]) c.fail("a commanded rate cannot be one of the dependent pair");
+      if (std::count(pair->coordinates.begin(), pair->coordinates.end(), k)) c.fail("a commanded rate cannot be one of the dependent pair");
       d.commanded.push_back(k);
     }
-    if (d.commanded.size() != 4) f["commanded"].fail("the runtime's inverse dynamics takes 4 commanded speeds (a fixed-size solve); other counts are not supported yet");
+    if (d.commanded.empty()) f["commanded"].fail("name at least one commanded speed");
     for (const Item& c : f["actuated"].list()) {
       const int k = coordinate_index(c);
       if (std::count(d.actuated.begin(), d.actuated.end(), k)) c.fail("listed twice");
       d.actuated.push_back(k);
     }
-    if (d.actuated.size() != 8) f["actuated"].fail("the runtime's torque split takes 8 actuated joints (a fixed-size solve); other counts are not supported yet");
+    if (d.actuated.size() < d.commanded.size())
+      f["actuated"].fail(fmt::format("{} actuated joints for {} commanded speeds: the actuators cannot produce every generalized "
+                                     "force on the commanded speeds (give at least as many actuated joints as commanded speeds)",
+                                     d.actuated.size(), d.commanded.size()));
     if (auto w = f.optional("weights")) {
       for (const Item& x : w->list()) {
         const double v = x.number();
@@ -852,19 +926,26 @@ class Parser {
     m_.clearance = std::move(box);
   }
 
+  // The inputs' nominal values, and for dependent joints the start of Newton's method (a limb's
+  // own `start` takes precedence).
   void nominal(const std::optional<Item>& section) {
-    m_.nominal.assign(static_cast<std::size_t>(m_.input_count), 0.0);
-    if (!section) return;
-    if (!section->is_map()) section->fail("must map input names to values");
-    for (const auto& kv : section->node()) {
-      const Item key(src_, kv.first, section->path(), {});
-      const int k = coordinate_index(key, true);
-      m_.nominal[static_cast<std::size_t>(k)] = section->child(kv.first.Scalar()).number();
+    m_.nominal.assign(m_.coordinates.size(), 0.0);
+    if (section) {
+      if (!section->is_map()) section->fail("must map coordinate names to values");
+      for (const auto& kv : section->node()) {
+        const Item key(src_, kv.first, section->path(), {});
+        const int k = coordinate_index(key);
+        if (limb_start_.count(k))
+          key.fail(fmt::format("'{}' has a start value in its limb's `start` already: give it once",
+                               m_.coordinates[static_cast<std::size_t>(k)].name));
+        m_.nominal[static_cast<std::size_t>(k)] = section->child(kv.first.Scalar()).number();
+      }
     }
+    for (const auto& [k, value] : limb_start_) m_.nominal[static_cast<std::size_t>(k)] = value;
   }
 
   void sweeps(const std::optional<Item>& section) {
-    m_.sweep_start = m_.nominal;
+    m_.sweep_start.assign(m_.nominal.begin(), m_.nominal.begin() + m_.input_count);
     if (!section) return;
     const Fields f(*section, {"start", "sweeps"});
     if (auto start = f.optional("start")) {
@@ -912,6 +993,7 @@ class Parser {
   std::map<std::string, std::string> symbol_kind_;
   std::map<std::string, std::vector<Env>> repeat_;
   std::vector<std::pair<int, std::string>> joint_users_;
+  std::map<int, double> limb_start_;  // the limbs' `start` values, by coordinate
   std::optional<Item> rows_item_;
 };
 

@@ -182,6 +182,18 @@ class Printer {
       calls_.insert("sqrt");
       return fmt::format("Scalar(1)/sqrt({})", base);
     }
+    // x^(k + 1/2) = x^k sqrt(x) (a derived contact point's second derivatives have x^(-3/2)):
+    // a multiply and a square root instead of pow, which number types need not have.
+    if (integer_exponent(2 * n.value)) {
+      const long k = static_cast<long>(std::abs(n.value));  // |v| = k + 1/2
+      calls_.insert("sqrt");
+      std::string s = fmt::format("sqrt({})", base);
+      for (long i = 0; i < k; ++i) s = base + "*" + s;
+      ops.muls += k;
+      if (n.value > 0) return s;
+      ++ops.divs;
+      return "Scalar(1)/(" + s + ")";
+    }
     calls_.insert("pow");
     return fmt::format("pow({}, {})", base, scalar_literal(n.value));
   }
@@ -203,12 +215,15 @@ struct TrigBatch {
 
 inline TrigBatch batch_trig(const Model& m, const ExprGraph& g, const std::vector<int>& roots) {
   std::map<std::string, std::map<std::string, int>> by_angle;  // angle -> {"sin"/"cos" -> node}
+  std::set<std::string> coordinates;
+  for (const auto& c : m.coordinates) coordinates.insert(c.name);
   std::unordered_set<int> seen;
   std::function<void(int)> visit = [&](int id) {
     if (!seen.insert(id).second) return;
     const Node& n = g.node(id);
+    // Coordinates only: the sine of a fixed angle (a parameter) is computed once per call anyway.
     if (n.kind == NodeKind::Call && (n.text == "sin" || n.text == "cos") && n.args.size() == 1 &&
-        g.node(n.args[0]).kind == NodeKind::Symbol)
+        g.node(n.args[0]).kind == NodeKind::Symbol && coordinates.count(g.node(n.args[0]).text))
       by_angle[g.node(n.args[0]).text][n.text] = id;
     for (int a : n.args) visit(a);
   };

@@ -55,19 +55,19 @@ Frame Frame::translated(const Vec3& local_offset) const {
   return f;
 }
 
-Frame Frame::rotated(Axis axis, const Coordinate& c) const {
+Frame Frame::rotated(Axis axis, const Coordinate& c, int sign) const {
   Frame f = *this;
-  const Vec3 a = R.col(static_cast<int>(axis));  // the joint axis does not move with its own joint
-  f.R = R * rot(axis, c.q);
+  const Vec3 a = ex(sign) * R.col(static_cast<int>(axis));  // the joint axis does not move with its own joint
+  f.R = R * rot(axis, sign * c.q);
   f.omega = omega + ex(c.qdot) * a;
   f.alpha_bias = alpha_bias + ex(c.qdot) * cross(omega, a);  // the axis turns with the frame before
   f.joints.push_back({c.index, true, a, r});
   return f;
 }
 
-Frame Frame::slid(Axis axis, const Coordinate& c) const {
+Frame Frame::slid(Axis axis, const Coordinate& c, int sign) const {
   Frame f = *this;
-  const Vec3 a = R.col(static_cast<int>(axis));
+  const Vec3 a = ex(sign) * R.col(static_cast<int>(axis));
   const Vec3 d = ex(c.q) * a;
   f.r = r + d;
   f.v = v + cross(omega, d) + ex(c.qdot) * a;
@@ -83,7 +83,87 @@ Frame Frame::turned(Axis axis, const ex& angle) const {
   return f;
 }
 
+namespace {
+
+// A quantity along the motion: its value, its rate (linear in the coordinate rates) with that
+// rate's coefficients, one per coordinate (the Jacobian columns), and its second derivative with
+// every coordinate acceleration zero (the "bias", quadratic in the rates). Velocities, Jacobians
+// and convective terms of a derived point then follow by the chain rule, without differentiating
+// any expression.
+struct Moving {
+  ex value, rate, bias;
+  std::vector<ex> columns;  // d(value)/d(coordinate k), so rate = sum_k columns[k] * rate of k
+};
+std::vector<ex> combine(const std::vector<ex>& a, const ex& fa, const std::vector<ex>& b, const ex& fb) {
+  std::vector<ex> out(a.size(), 0);
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (!a[k].is_zero() || !b[k].is_zero()) out[k] = a[k] * fa + b[k] * fb;
+  return out;
+}
+Moving operator+(const Moving& a, const Moving& b) {
+  return {a.value + b.value, a.rate + b.rate, a.bias + b.bias, combine(a.columns, 1, b.columns, 1)};
+}
+Moving operator-(const Moving& a) { return {-a.value, -a.rate, -a.bias, combine(a.columns, -1, a.columns, 0)}; }
+Moving operator*(const Moving& a, const Moving& b) {
+  return {a.value * b.value, a.rate * b.value + a.value * b.rate, a.bias * b.value + 2 * a.rate * b.rate + a.value * b.bias,
+          combine(a.columns, b.value, b.columns, a.value)};
+}
+Moving reciprocal(const Moving& a) {
+  const ex inv = 1 / a.value;
+  return {inv, -a.rate * inv * inv, (2 * a.rate * a.rate * inv - a.bias) * inv * inv, combine(a.columns, -inv * inv, a.columns, 0)};
+}
+Moving root(const Moving& a) {
+  const ex r = GiNaC::sqrt(a.value);
+  return {r, a.rate / (2 * r), a.bias / (2 * r) - a.rate * a.rate / (4 * r * a.value), combine(a.columns, 1 / (2 * r), a.columns, 0)};
+}
+
+}  // namespace
+
+Frame wheel_contact_frame(const Frame& hub, Axis axle, const ex& radius, const std::vector<Coordinate>& coordinates) {
+  const std::size_t n = coordinates.size();
+  // The axle a is fixed in the hub: a' = omega x a (column k: axis_k x a for a revolute joint k),
+  // a''_bias = alpha_bias x a + omega x (omega x a).
+  const Vec3 a = hub.R.col(static_cast<int>(axle));
+  const Vec3 a_rate = cross(hub.omega, a);
+  const Vec3 a_bias = cross(hub.alpha_bias, a) + cross(hub.omega, cross(hub.omega, a));
+  const std::vector<Vec3> hub_columns = linear_jacobian(hub, static_cast<int>(n));
+  std::array<Moving, 3> A;
+  for (int i = 0; i < 3; ++i) {
+    Moving& Ai = A[static_cast<std::size_t>(i)];
+    Ai = {a[i], a_rate[i], a_bias[i], std::vector<ex>(n, 0)};
+    for (const JointRecord& j : hub.joints)
+      if (j.revolute) Ai.columns[static_cast<std::size_t>(j.coordinate)] = cross(j.axis, a)[i];
+  }
+  // sigma = |a x e_z| = sqrt(a_x^2 + a_y^2) (not sqrt(1 - a_z^2), which loses digits near an upright
+  // wheel); n = (a_x, a_y, 0) / sigma is the lateral direction, t = (n_y, -n_x, 0) the forward one.
+  const Moving sigma = root(A[0] * A[0] + A[1] * A[1]);
+  const Moving inv = reciprocal(sigma);
+  const Moving nx = A[0] * inv, ny = A[1] * inv;
+  // c = h - r u with u = (-a_z n_x, -a_z n_y, sigma).
+  const Moving r{radius, 0, 0, std::vector<ex>(n, 0)};
+  const std::array<Moving, 3> offset = {r * A[2] * nx, r * A[2] * ny, -(r * sigma)};
+  Frame f;
+  f.joints = hub.joints;  // the coordinates that move it
+  f.linear_columns.assign(n, Vec3());
+  for (int i = 0; i < 3; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    f.r[i] = hub.r[i] + offset[k].value;
+    f.v[i] = hub.v[i] + offset[k].rate;
+    f.a_bias[i] = hub.a_bias[i] + offset[k].bias;
+    for (std::size_t c = 0; c < n; ++c) f.linear_columns[c][i] = hub_columns[c][i] + offset[k].columns[c];
+  }
+  f.R(0, 0) = ny.value, f.R(1, 0) = -nx.value, f.R(2, 0) = 0;  // forward t
+  f.R(0, 1) = nx.value, f.R(1, 1) = ny.value, f.R(2, 1) = 0;   // lateral n
+  f.R(0, 2) = 0, f.R(1, 2) = 0, f.R(2, 2) = 1;                  // up
+  // The heading psi of t turns about e_z: psi' = t_x t_y' - t_y t_x' = n_x n_y' - n_y n_x', and its
+  // bias acceleration n_x n_y'' - n_y n_x'' (the rates' products cancel).
+  f.omega = Vec3(0, 0, nx.value * ny.rate - ny.value * nx.rate);
+  f.alpha_bias = Vec3(0, 0, nx.value * ny.bias - ny.value * nx.bias);
+  return f;
+}
+
 std::vector<Vec3> linear_jacobian(const Frame& f, int n) {
+  if (!f.linear_columns.empty()) return f.linear_columns;
   std::vector<Vec3> cols(static_cast<std::size_t>(n));
   for (const auto& j : f.joints)
     cols[static_cast<std::size_t>(j.coordinate)] = j.revolute ? cross(j.axis, f.r - j.origin) : j.axis;

@@ -84,17 +84,30 @@ class Frame {
   Vec3 alpha_bias;            // angular acceleration with all coordinate accelerations zero
   Vec3 a_bias;                // origin acceleration with all coordinate accelerations zero
   std::vector<JointRecord> joints;  // every joint between K0 and this frame
+  // The origin's velocity Jacobian, one column per coordinate, for a point that is not fixed in the
+  // chain (a wheel's contact point slides round the rim); empty for a rigidly attached frame, whose
+  // columns follow from `joints`.
+  std::vector<Vec3> linear_columns;
 
   static Frame ground() { return {}; }
   // A rigid offset, given in this frame's coordinates.
   Frame translated(const Vec3& local_offset) const;
-  // A revolute joint about this frame's `axis`, angle = coordinate.
-  Frame rotated(Axis axis, const Coordinate& c) const;
-  // A prismatic joint along this frame's `axis`, displacement = coordinate.
-  Frame slid(Axis axis, const Coordinate& c) const;
+  // A revolute joint about this frame's `axis` (its negative for sign -1), angle = coordinate.
+  Frame rotated(Axis axis, const Coordinate& c, int sign = 1) const;
+  // A prismatic joint along this frame's `axis` (its negative for sign -1), displacement = coordinate.
+  Frame slid(Axis axis, const Coordinate& c, int sign = 1) const;
   // A fixed rotation about this frame's `axis` by an angle that depends on parameters only.
   Frame turned(Axis axis, const ex& angle) const;
 };
+
+// The contact frame of a wheel of radius `radius` on `hub` (the wheel's centre, not spinning) that
+// turns about the hub's `axle`: origin at the rim point nearest the ground, c = h - r u with a the
+// axle in K0 and u = (e_z - a_z a) / |e_z - a_z a| the upward direction in the wheel's plane; axes
+// x = forward t = (a x e_z) / |a x e_z|, y = lateral n = e_z x t, z = e_z (level by construction).
+// The point slides round the rim as the hub tilts, so its velocity Jacobian (one column per
+// coordinate of `coordinates`) is carried explicitly; omega is the heading's rate about e_z.
+// Undefined (division by zero) when the axle is vertical.
+Frame wheel_contact_frame(const Frame& hub, Axis axle, const ex& radius, const std::vector<Coordinate>& coordinates);
 
 // Jacobian columns of the frame origin's velocity, one per coordinate (n in all).
 std::vector<Vec3> linear_jacobian(const Frame& f, int n);

@@ -322,8 +322,8 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
     if (samples.size() < 2) return Measured{NAN, "s"};
     const Sample& a = samples[samples.size() - 2];
     const Sample& b = samples.back();
-    const double rate = (b.cabin_clearance - a.cabin_clearance) / (b.t - a.t);  // negative while the cabin sinks
-    return Measured{rate < 0 ? b.t - b.cabin_clearance / rate : NAN, "s"};
+    const double rate = (b.clearance - a.clearance) / (b.t - a.t);  // negative while the body sinks
+    return Measured{rate < 0 ? b.t - b.clearance / rate : NAN, "s"};
   }
   throw Error(report::where(spec_, m.line, "quantity"), "not measured by this build: " + q);
 }

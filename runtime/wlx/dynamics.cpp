@@ -27,6 +27,15 @@ double mass(const Params& p, int body) { return p.*gen::kBodyMass[static_cast<st
 
 void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const CommandVector& u,
                       const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options) {
+// wlx-gen writes reduced_dynamics.hpp only for a model file with a dynamics section (and removes a
+// stale one), so that the runtime compiles for every model.
+#if !__has_include(<wlx/gen/reduced_dynamics.hpp>)
+  static_cast<void>(model), static_cast<void>(d), static_cast<void>(s), static_cast<void>(u), static_cast<void>(u_dot);
+  static_cast<void>(out), static_cast<void>(options);
+  throw Error("dynamics", fmt::format("model {} has no dynamics section: name its commanded speeds, actuated joints and "
+                                      "gravity in the model file (docs/model-format.md, Dynamics)",
+                                      gen::kModelName));
+#else
   const Params& p = model.params();
   const DependentPair pair = dynamics_pair();
   // Two generated passes: dPhi/ds and C(s), which give the rate basis T; then at (s, s' = T u, T)
@@ -51,10 +60,12 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   out.b = b_velocity + out.B_bias.lazyProduct(bias);
   out.Qstar = out.M * u_dot + out.b - out.Q_gravity;
   for (int r = 0; r < kActuatedCount; ++r) out.J_beta.row(r) = out.T.row(kActuatedJoints[static_cast<std::size_t>(r)]);
+#endif
 }
 
 double potential_energy(const Model& model, Data& d, const Coordinates& s) {
   const Params& p = model.params();
+  if (gen::kGravity == nullptr) throw Error("dynamics", "the model file has no dynamics section, so no gravity parameter");
   gen::bodies(s, Coordinates::Zero(), p, {.com = &d.body_com}, false);
   double V = 0;
   for (int i = 0; i < gen::kBodyCount; ++i) V += mass(p, i) * (p.*gen::kGravity) * d.body_com(2, i);
@@ -98,14 +109,19 @@ Weighting Weighting::matrix_of(const TorqueMatrix& W) {
   if ((W - W.transpose()).cwiseAbs().maxCoeff() > 1e-12 * W.cwiseAbs().maxCoeff())
     throw Error("weighting", "the weight matrix must be symmetric");
   // Scaled to a largest entry of 1 first: entries near 1e308 would overflow in the factorization.
+#if __has_include(<wlx/gen/reduced_dynamics.hpp>)  // (no actuated joints without: nothing to factorize)
   if ((W / W.cwiseAbs().maxCoeff()).llt().info() != Eigen::Success)
     throw Error("weighting", "the weight matrix must be positive definite");
+#endif
   Weighting out;
   out.kind = Kind::matrix;
   out.matrix = W;
   return out;
 }
 
+// The torque split, for a model with commanded speeds (a dynamics section: wlx-gen writes
+// reduced_dynamics.hpp then); fixed-size blocks of empty matrices would not compile.
+#if __has_include(<wlx/gen/reduced_dynamics.hpp>)
 namespace {
 
 template <int k>
@@ -141,7 +157,9 @@ bool householder_step(ActuatorJacobian& qr, Tail<k>& v, double& tau) {
 // rounding (tests/runtime/test_dynamics.cpp checks both paths against a long-double solution).
 bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
   constexpr int kU = kCommandedCount;
-  static_assert(kU <= 9, "the condition bound above assumes at most 9 commanded speeds");
+  // The 1-norm bound that keeps n cond_1 below the pivoted QR's 1e13: 1e12 up to 9 speeds (as it
+  // always was), 0.9e13 / n beyond.
+  constexpr double kConditionLimit = kU <= 9 ? 1e12 : 0.9e13 / kU;
   ActuatorJacobian qr = A;
   CommandVector tau;
   return [&]<int... k>(std::integer_sequence<int, k...>) {
@@ -160,7 +178,7 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
       }
     }
     const double condition = R.cwiseAbs().colwise().sum().maxCoeff() * R_inverse.cwiseAbs().colwise().sum().maxCoeff();
-    if (!(condition <= 1e12)) return false;
+    if (!(condition <= kConditionLimit)) return false;
     // R^T y = Q* by forward substitution, then x = H_0 ... H_{n-1} [y; 0].
     x.setZero();
     for (int i = 0; i < kU; ++i) {
@@ -237,5 +255,14 @@ TorqueVector distribute_torques(const ActuatorJacobian& J_beta, const CommandVec
   }
   return S.cwiseProduct(min_norm_solve(S.asDiagonal() * J_beta, Qstar, weighting));
 }
+
+#else
+
+TorqueVector distribute_torques(const ActuatorJacobian&, const CommandVector&, const Weighting&) {
+  throw Error("dynamics", fmt::format("model {} has no dynamics section: it has no actuated joints to share torques",
+                                      gen::kModelName));
+}
+
+#endif
 
 WLX_MODEL_NAMESPACE_END

@@ -15,10 +15,9 @@
 
 WLX_MODEL_NAMESPACE_BEGIN
 
-static_assert(gen::kHasDynamics, "the model file has no dynamics section");
-static_assert(gen::kHasClearance, "the model file has no clearance box");
 // The commanded speeds u, the actuated joints and the pair the wheels make dependent: the model
-// file's dynamics section. Sizes are compile-time, so every matrix below is fixed-size.
+// file's dynamics section (all empty without one: inverse_dynamics then throws). Sizes are
+// compile-time, so every matrix below is fixed-size.
 inline constexpr auto kCommandedSpeeds = gen::kCommanded;
 inline constexpr auto kActuatedJoints = gen::kActuated;
 inline constexpr int kCommandedCount = static_cast<int>(kCommandedSpeeds.size());
@@ -47,7 +46,8 @@ struct DynamicsTerms {
 };
 
 // Q* and its parts at s (closure satisfied) for speeds u and accelerations u_dot. Uses and
-// overwrites data's kinematic buffers; allocates nothing.
+// overwrites data's kinematic buffers; allocates nothing. Throws wlx::Error for a model file
+// without a dynamics section (gen::kHasDynamics false).
 void inverse_dynamics(const Model& model, Data& data, const Coordinates& s, const CommandVector& u,
                       const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options = {});
 

@@ -4,8 +4,7 @@
 
 #include "wlx/kinematics.hpp"
 
-#include <Eigen/Cholesky>
-#include <Eigen/LU>
+#include <Eigen/QR>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -103,8 +102,10 @@ void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinat
   check_inputs_and_branch(limb, branch, s);
   const gen::ClosedFormInfo& cf = gen::kClosedForm[static_cast<std::size_t>(limb)];
   if (cf.solve == nullptr) {  // wlx-gen found no closed form for this limb
+    std::array<bool, kLimbCount> newton{};
+    newton[static_cast<std::size_t>(limb)] = true;
     Data data;
-    solve_limb_newton(model, data, limb, s);
+    solve_newton_limbs(model, data, newton, s, {});
     return;
   }
   gen::IkDiagnostics why;
@@ -113,19 +114,23 @@ void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinat
 }
 
 void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches) {
-  if constexpr (gen::kHasFusedIk) {
-    // All limbs in one generated pass (the cabin pose and the sines and cosines computed once).
-    if (s.head<kInputCount>().allFinite()) {  // the usual case: only the branches to check
-      for (Limb limb : kLimbs) check_branch(limb, branches.limb[static_cast<std::size_t>(limb)]);
-    } else {
-      for (Limb limb : kLimbs) check_inputs_and_branch(limb, branches.limb[static_cast<std::size_t>(limb)], s);
-    }
-    int failed = 0;
-    gen::IkDiagnostics why;
-    const gen::IkStatus status = gen::ik_all(s, model.params(), branches.limb, s, failed, why);
-    if (status != gen::IkStatus::ok) throw_failure(failed, branches.limb[static_cast<std::size_t>(failed)], status, why);
+  // Every limb with a closed form in one generated pass (the body's pose and the sines and cosines
+  // computed once); the limbs without one (gen::kHasFusedIk false) then by Newton's method from
+  // the dependent joints in s.
+  if (s.head<kInputCount>().allFinite()) {  // the usual case: only the branches to check
+    for (Limb limb : kLimbs) check_branch(limb, branches.limb[static_cast<std::size_t>(limb)]);
   } else {
-    for (Limb limb : kLimbs) solve_limb_closed_form(model, limb, branches.limb[static_cast<std::size_t>(limb)], s);
+    for (Limb limb : kLimbs) check_inputs_and_branch(limb, branches.limb[static_cast<std::size_t>(limb)], s);
+  }
+  int failed = 0;
+  gen::IkDiagnostics why;
+  const gen::IkStatus status = gen::ik_all(s, model.params(), branches.limb, s, failed, why);
+  if (status != gen::IkStatus::ok) throw_failure(failed, branches.limb[static_cast<std::size_t>(failed)], status, why);
+  if constexpr (!gen::kHasFusedIk) {
+    std::array<bool, kLimbCount> newton{};
+    for (Limb limb : kLimbs) newton[static_cast<std::size_t>(limb)] = gen::kClosedForm[static_cast<std::size_t>(limb)].solve == nullptr;
+    Data data;
+    solve_newton_limbs(model, data, newton, s, {});
   }
 }
 
@@ -152,90 +157,106 @@ int classify_branch(const Model& model, Limb limb, const Coordinates& s) {
 
 namespace {
 
+// Damped Newton (Levenberg-Marquardt) on the closure, limb by limb (the limbs decouple: each limb's
+// rows involve only its own joints), from the dependent joints in s. A limb's step solves
+// (J^T J + mu I) dx = -J^T r: with mu small it is Newton's step (quadratic convergence near a
+// regular solution), with mu large a short gradient step, so the method also descends from a far
+// or singular start (a straight leg). mu follows the gain ratio of each step (Nielsen's rule), one
+// generated closure evaluation serving the trial steps of every limb at once.
 NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coordinates& s, Data& data,
                     const NewtonOptions& options) {
   for (int k = 0; k < kCoordinateCount; ++k) require_finite(s, k);
   NewtonReport report;
-  std::array<bool, kLimbCount> done{}, stalled{};  // stalled: the last damped step could not descend
-  for (Limb limb : kLimbs) done[static_cast<std::size_t>(limb)] = !active[static_cast<std::size_t>(limb)];
+  std::array<bool, kLimbCount> done{}, stalled{};
+  std::array<double, kLimbCount> mu{}, nu{};
+  for (Limb limb : kLimbs) {
+    done[static_cast<std::size_t>(limb)] = !active[static_cast<std::size_t>(limb)];
+    nu[static_cast<std::size_t>(limb)] = 2;
+  }
   const auto limb_residual = [&](const gen::ClosureVector& Phi, const LimbIndices& idx) {
     double r = 0;
     for (int i = 0; i < idx.count; ++i) r = std::max(r, std::abs(Phi(idx.rows[static_cast<std::size_t>(i)])));
     return r;
   };
-  for (int iteration = 0;; ++iteration) {
-    closure(model, data, s, true);
-    if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
+  const auto half_square = [&](const gen::ClosureVector& Phi, const LimbIndices& idx) {
+    double f = 0;
+    for (int i = 0; i < idx.count; ++i) f += 0.5 * Phi(idx.rows[static_cast<std::size_t>(i)]) * Phi(idx.rows[static_cast<std::size_t>(i)]);
+    return f;
+  };
+  closure(model, data, s, true);
+  if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
+  std::array<LimbVector, kLimbCount> step, gradient;
+  std::array<double, kLimbCount> before{};
+  for (int round = 0;; ++round) {
     bool all_done = true;
-    std::array<LimbVector, kLimbCount> step;
-    std::array<double, kLimbCount> before{};
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
-      if (!active[l]) continue;
-      const auto idx = indices(limb);
-      if (done[l]) continue;  // a converged limb stays converged: the limbs do not couple
-      before[l] = limb_residual(data.Phi, idx);
-      done[l] = before[l] <= options.tolerance || (stalled[l] && before[l] <= options.floor_tolerance);
       if (done[l]) continue;
-      all_done = false;
-      if (report.iterations[l] >= options.max_iterations)
+      const auto idx = indices(limb);
+      const double residual = limb_residual(data.Phi, idx);
+      done[l] = residual <= options.tolerance || (stalled[l] && residual <= options.floor_tolerance);
+      if (done[l]) continue;
+      if (stalled[l] || report.iterations[l] >= options.max_iterations)
         throw Error(std::string(limb_name(limb)),
-                    fmt::format("Newton did not converge in {} iterations (residual {:.3e}, tolerance {:.1e}); the "
-                                "target may be unreachable or the start too far: warm-start from a nearby solution or "
-                                "use the closed form",
-                                options.max_iterations, before[l], options.tolerance));
-      // The limb's block of dPhi/ds: its rows against its own dependent joints.
-      LimbMatrix J = LimbMatrix::Identity();  // a smaller limb padded with a unit diagonal
+                    fmt::format("Newton's method did not converge{} (residual {:.3e} after {} iterations, tolerance "
+                                "{:.1e}): the target may be out of reach or the start too far from a solution; try a target "
+                                "nearer the limb's workspace, approach it in smaller steps from a solved pose, or give the "
+                                "limb a start nearer a solution (`start:` in the model file's limb)",
+                                stalled[l] ? ": no step lowers the residual any more" : "", residual, report.iterations[l],
+                                options.tolerance));
+      all_done = false;
+      // The limb's block of dPhi/ds (a smaller limb padded with a unit diagonal and zero residual).
+      LimbMatrix J = LimbMatrix::Identity();
       LimbVector r = LimbVector::Zero();
       for (int i = 0; i < idx.count; ++i) {
         const int row = idx.rows[static_cast<std::size_t>(i)];
         r(i) = data.Phi(row);
         for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
       }
-      const Eigen::FullPivLU<LimbMatrix> lu(J);
-      if (lu.rcond() > 1e-12) {
-        step[l] = -lu.solve(r);
-      } else {  // at a singular pose (straight leg, lever at 90 deg): Levenberg-Marquardt step
-        const double mu = 1e-8 * std::max(1.0, J.squaredNorm());
-        step[l] = -(J.transpose() * J + mu * LimbMatrix::Identity()).ldlt().solve(J.transpose() * r);
-      }
+      gradient[l] = J.transpose() * r;
+      if (mu[l] == 0) mu[l] = 1e-9 * std::max(1.0, J.colwise().squaredNorm().maxCoeff());  // nearly Newton's step first
+      // As the least-squares problem [J; sqrt(mu) I] dx = [-r; 0], by QR: the normal equations would
+      // square J's condition number (1e6 at the thesis' worst poses).
+      Eigen::Matrix<double, 2 * gen::kMaxLimbSize, gen::kMaxLimbSize> stacked;
+      stacked << J, std::sqrt(mu[l]) * LimbMatrix::Identity();
+      Eigen::Matrix<double, 2 * gen::kMaxLimbSize, 1> rhs;
+      rhs << -r, LimbVector::Zero();
+      step[l] = stacked.householderQr().solve(rhs);
+      before[l] = half_square(data.Phi, idx);
       ++report.iterations[l];
     }
     if (all_done) break;
-    // Damping: halve a limb's step until its residual decreases.
-    std::array<double, kLimbCount> lambda;
-    lambda.fill(1.0);
-    std::array<bool, kLimbCount> accepted = done;
     const Coordinates start = s;
-    for (int halving = 0; halving < 40; ++halving) {
-      for (Limb limb : kLimbs) {
-        const auto l = static_cast<std::size_t>(limb);
-        if (accepted[l]) continue;
-        const auto idx = indices(limb);
-        for (int j = 0; j < idx.count; ++j)
-          s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]) + lambda[l] * step[l](j);
-      }
-      if (!options.damped) break;
-      closure(model, data, s, false);
-      bool all_accepted = true;
-      for (Limb limb : kLimbs) {
-        const auto l = static_cast<std::size_t>(limb);
-        if (accepted[l]) continue;
-        const double after = limb_residual(data.Phi, indices(limb));
-        if (after < before[l] || !std::isfinite(before[l])) accepted[l] = true;
-        else lambda[l] *= 0.5;
-        all_accepted = all_accepted && accepted[l];
-      }
-      if (all_accepted) break;
-    }
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
-      stalled[l] = !done[l] && !accepted[l];
-      if (!stalled[l]) continue;
-      // No step length lowered the residual: stay where the residual was lowest.
+      if (done[l]) continue;
       const auto idx = indices(limb);
-      for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]);
+      for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) += step[l](j);
     }
+    closure(model, data, s, true);
+    bool restore = false;
+    for (Limb limb : kLimbs) {
+      const auto l = static_cast<std::size_t>(limb);
+      if (done[l]) continue;
+      const auto idx = indices(limb);
+      const double after = half_square(data.Phi, idx);
+      // The decrease the linear model predicts: dx^T (mu dx - g) / 2 > 0.
+      const double predicted = 0.5 * step[l].dot(mu[l] * step[l] - gradient[l]);
+      const double gain = predicted > 0 ? (before[l] - after) / predicted : -1;
+      if (std::isfinite(after) && after < before[l] && gain > 0) {
+        mu[l] *= std::max(1.0 / 3, 1 - std::pow(2 * gain - 1, 3));
+        nu[l] = 2;
+      } else {
+        for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]);
+        restore = true;
+        mu[l] *= nu[l];
+        nu[l] *= 2;
+        // No damping helps any more: the residual is at its floor (or a local minimum).
+        stalled[l] = nu[l] > 1e6 || !std::isfinite(mu[l]);  // twenty rejected steps in a row
+      }
+    }
+    if (restore) closure(model, data, s, true);  // Phi and dPhi/ds where every limb now stands
+    if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
   }
   // Angles into (-pi, pi], but only where that keeps the closure: a row such as theta_4 + theta_5 = 0
   // holds for theta_4 = -pi, not for its wrapped +pi, when the input theta_5 is pi.
@@ -246,7 +267,9 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
   for (Limb limb : kLimbs) {
     if (!active[static_cast<std::size_t>(limb)]) continue;
     const auto idx = indices(limb);
-    for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = wrap(s(idx.dep[static_cast<std::size_t>(j)]));
+    for (int j = 0; j < idx.count; ++j)
+      if (gen::kCoordinateUnits[static_cast<std::size_t>(idx.dep[static_cast<std::size_t>(j)])] == "rad")
+        s(idx.dep[static_cast<std::size_t>(j)]) = wrap(s(idx.dep[static_cast<std::size_t>(j)]));
   }
   closure(model, data, s, false);
   bool reverted = false;
@@ -273,6 +296,40 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
 }
 
 }  // namespace
+
+Coordinates dependent_start(Coordinates s) {
+  for (int k = kInputCount; k < kCoordinateCount; ++k) s(k) = gen::kDependentStart[static_cast<std::size_t>(k - kInputCount)];
+  return s;
+}
+
+NewtonReport solve_newton_limbs(const Model& model, Data& data, const std::array<bool, kLimbCount>& limbs, Coordinates& s,
+                                const NewtonOptions& options) {
+  // From the joints in s (the previous solution along a sweep or a run: continuation), else, when
+  // that fails or s holds no usable guess, from the model file's start values.
+  bool usable = true;
+  for (Limb limb : kLimbs)
+    if (limbs[static_cast<std::size_t>(limb)]) {
+      const auto idx = indices(limb);
+      for (int j = 0; j < idx.count; ++j) usable = usable && std::isfinite(s(idx.dep[static_cast<std::size_t>(j)]));
+    }
+  if (usable) {
+    Coordinates warm = s;
+    try {
+      const NewtonReport report = newton(model, limbs, warm, data, options);
+      s = warm;
+      return report;
+    } catch (const Error&) {
+      // fall through to the model's start values, whose error is the one reported
+    }
+  }
+  const Coordinates fresh = dependent_start(s);
+  for (Limb limb : kLimbs)
+    if (limbs[static_cast<std::size_t>(limb)]) {
+      const auto idx = indices(limb);
+      for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = fresh(idx.dep[static_cast<std::size_t>(j)]);
+    }
+  return newton(model, limbs, s, data, options);
+}
 
 NewtonReport solve_ik_newton(const Model& model, Data& data, Coordinates& s, const NewtonOptions& options) {
   std::array<bool, kLimbCount> all;

@@ -57,8 +57,7 @@ struct NewtonOptions {
   // A limb whose residual no damped step can lower any more has reached its rounding floor; it
   // counts as converged if that floor is below this (ill-conditioned poses amplify rounding).
   double floor_tolerance = 1e-10;
-  int max_iterations = 50;
-  bool damped = true;  // backtracking on |Phi| when a full step does not decrease it
+  int max_iterations = 100;  // steps tried per limb (accepted or not)
 };
 
 struct NewtonReport {
@@ -67,10 +66,17 @@ struct NewtonReport {
   bool converged = false;
 };
 
-// Newton's method on Phi with the generated dPhi/ds, limb by limb (the limbs decouple), starting
-// from the dependent joints already in s (warm start). Throws wlx::Error if a limb does not
-// converge within max_iterations (naming the limb, its residual and the iterations).
+// Newton's method on Phi with the generated dPhi/ds, limb by limb (the limbs decouple), damped
+// (Levenberg-Marquardt) so that it also descends from a far or singular start, starting from the
+// dependent joints already in s (warm start). Throws wlx::Error if a limb does not converge within
+// max_iterations (naming the limb, its residual and what to try).
 NewtonReport solve_ik_newton(const Model& model, Data& data, Coordinates& s, const NewtonOptions& options = {});
+// The same for the limbs marked in `limbs`, first from the joints in s (continuation along a sweep
+// or a run), then, if that fails, from the model file's start values (gen::kDependentStart).
+NewtonReport solve_newton_limbs(const Model& model, Data& data, const std::array<bool, kLimbCount>& limbs, Coordinates& s,
+                                const NewtonOptions& options = {});
+// s with its dependent joints at the model file's start values for Newton's method.
+Coordinates dependent_start(Coordinates s);
 // The same for one limb only; the other limbs' joints are left as they are.
 NewtonReport solve_limb_newton(const Model& model, Data& data, Limb limb, Coordinates& s,
                                const NewtonOptions& options = {});

@@ -43,7 +43,7 @@ const IkSweep* find_ik_sweep(const std::string& id) {
 }
 
 Coordinates ik_sweep_inputs() {
-  Coordinates s = Coordinates::Zero();
+  Coordinates s = nominal_inputs();  // the dependent joints at Newton's start values
   for (int k = 0; k < kInputCount; ++k) s(k) = gen::kSweepStart[static_cast<std::size_t>(k)];
   return s;
 }
@@ -72,19 +72,22 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
   const auto joints = limb_joints(sweep.limb);
   Coordinates start = ik_sweep_inputs();
   solve_ik_closed_form(model, start);  // the assembled start pose, as in MOBILE
-  Coordinates warm = start;
+  Coordinates warm = start, previous = start;
   long iterations = 0;
   int previous_branch = 0;
   for (int k = 0; k < sweep.points(); ++k) {
     IkSweepPoint pt;
     pt.value = sweep.value(k);
-    Coordinates s = ik_sweep_inputs();
+    // The closed form reads only the inputs; a limb without one starts Newton from the previous
+    // point's solution (continuation).
+    Coordinates s = previous;
     s(input) = pt.value;
     solve_ik_closed_form(model, s);
+    previous = s;
     pt.closed_form = s;
     pt.check_closed_form = analytic_check(model, data, sweep.limb, s);
-    for (int w = 0; w < kWheelCount; ++w)
-      pt.contacts.segment<2>(2 * w) = data.frame_positions.col(gen::kWheels[static_cast<std::size_t>(w)].contact_frame).head<2>();
+    for (int w = 0; w < kWheelCount; ++w)  // element by element: compiles for no wheels too
+      for (int i = 0; i < 2; ++i) pt.contacts(2 * w + i) = data.frame_positions(i, gen::kWheels[static_cast<std::size_t>(w)].contact_frame);
 
     Coordinates n = warm;  // continuation: start from the previous point's Newton solution
     n(input) = pt.value;

@@ -72,8 +72,9 @@ double* find_param(Params& params, std::string_view name) noexcept {
 }
 
 Coordinates nominal_inputs() {
-  Coordinates s = Coordinates::Zero();
+  Coordinates s;
   for (int k = 0; k < kInputCount; ++k) s(k) = gen::kNominalInputs[static_cast<std::size_t>(k)];
+  for (int k = kInputCount; k < kCoordinateCount; ++k) s(k) = gen::kDependentStart[static_cast<std::size_t>(k - kInputCount)];
   return s;
 }
 

@@ -82,7 +82,8 @@ int frame_index(std::string_view name) noexcept;
 // A pointer to the parameter of that name, or nullptr.
 double* find_param(Params& params, std::string_view name) noexcept;
 
-// The model's nominal inputs (its file's `nominal`), dependent joints zero (solve them with the IK).
+// The model's nominal inputs (its file's `nominal`), and the dependent joints at the start values of
+// Newton's method (the file's `nominal` and limbs' `start`, else 0): solve them with the IK.
 Coordinates nominal_inputs();
 
 WLX_MODEL_NAMESPACE_END

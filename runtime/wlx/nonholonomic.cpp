@@ -95,11 +95,13 @@ void solve_pair_and_closure(const Data& d, const DependentPair& pair, const gen:
     closure.noalias() += d.dPhi_ds.leftCols<kNq>().lazyProduct(out.head<kNq>());
     wheels.noalias() += d.C.leftCols<kNq>().lazyProduct(out.head<kNq>());
   }
-  const WheelVector pair_rate = -d.J_beta.partialPivLu().solve(wheels - d.wheel_adjoint.transpose().lazyProduct(closure));
-  for (int w = 0; w < kWheelCount; ++w) {
-    const int k = pair.index[static_cast<std::size_t>(w)];
-    out(k) = pair_rate(w);
-    closure.noalias() += d.dPhi_ds.col(k) * pair_rate(w);
+  if constexpr (kWheelCount > 0) {
+    const WheelVector pair_rate = -d.J_beta.partialPivLu().solve(wheels - d.wheel_adjoint.transpose().lazyProduct(closure));
+    for (int w = 0; w < kWheelCount; ++w) {
+      const int k = pair.index[static_cast<std::size_t>(w)];
+      out(k) = pair_rate(w);
+      closure.noalias() += d.dPhi_ds.col(k) * pair_rate(w);
+    }
   }
   solve_closure(d, closure, out);
 }
@@ -112,7 +114,12 @@ void solve_pair_and_closure(const Data& d, const DependentPair& pair, const gen:
 // sqrt(E^2 - 4 det^2) loses half the digits), and sigma_max sigma_min = |det|.
 double condition_number(const WheelMatrix& J) {
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  if constexpr (kWheelCount == 2) {
+  if constexpr (kWheelCount == 0) {
+    static_cast<void>(J);
+    return 1;  // no wheels, no rates to solve for: nothing is ill-conditioned
+  } else if constexpr (kWheelCount == 1) {
+    return std::isfinite(J(0, 0)) && J(0, 0) != 0 ? 1 : kInfinity;
+  } else if constexpr (kWheelCount == 2) {
     const double a = J(0, 0), b = J(0, 1), c = J(1, 0), d = J(1, 1);
     const double p = (a + d) * (a + d) + (b - c) * (b - c), q = (a - d) * (a - d) + (b + c) * (b + c);
     const double D = std::abs(a * d - b * c);
@@ -192,7 +199,7 @@ void factorize_dependent_rates(Data& d, const DependentPair& pair, const Nonholo
         "dependent",
         fmt::format("J_beta for the dependent pair {} is singular: condition number {:.3g} exceeds the threshold "
                     "{:.3g}. The wheels' sideways constraint lines coincide (collinear wheel axes, thesis "
-                    "4.1.4), e.g. wheels on the same level under a level cabin. {}",
+                    "4.1.4), e.g. wheels on the same level under a level body. {}",
                     pair.label(), d.cond_J_beta, options.max_condition, raise_a_wheel_hint()));
 }
 
@@ -223,9 +230,11 @@ void rate_basis(const Data& d, const std::array<int, N>& commanded, const Depend
   Eigen::Matrix<double, kWheelCount, kU> ch;
   for (int k = 0; k < kU; ++k) ch.col(k) = reduced_column(d, commanded[static_cast<std::size_t>(k)]);
   // Column by column: a matrix right-hand side sends Eigen's triangular solve through its GEMM kernel.
-  const Eigen::PartialPivLU<WheelMatrix> lu(d.J_beta);
   Eigen::Matrix<double, kWheelCount, kU> pair_rates;
-  for (int k = 0; k < kU; ++k) pair_rates.col(k) = -lu.solve(ch.col(k));
+  if constexpr (kWheelCount > 0) {
+    const Eigen::PartialPivLU<WheelMatrix> lu(d.J_beta);
+    for (int k = 0; k < kU; ++k) pair_rates.col(k) = -lu.solve(ch.col(k));
+  }
   T.setZero();
   for (int k = 0; k < kU; ++k) {
     T(commanded[static_cast<std::size_t>(k)], k) = 1;
@@ -236,8 +245,9 @@ void rate_basis(const Data& d, const std::array<int, N>& commanded, const Depend
   // times them.
   Eigen::Matrix<double, gen::kClosureCount, kU> rhs;
   for (int k = 0; k < kU; ++k) rhs.col(k) = d.dPhi_ds.col(commanded[static_cast<std::size_t>(k)]);
-  for (int w = 0; w < kWheelCount; ++w)
-    rhs.noalias() += d.dPhi_ds.col(pair.index[static_cast<std::size_t>(w)]).lazyProduct(pair_rates.row(w));
+  if constexpr (kWheelCount > 0)  // (fixed-size blocks of a matrix without rows do not compile)
+    for (int w = 0; w < kWheelCount; ++w)
+      rhs.noalias() += d.dPhi_ds.col(pair.index[static_cast<std::size_t>(w)]).lazyProduct(pair_rates.row(w));
   for_each_limb([&](auto L) {
     constexpr gen::LimbInfo b = gen::kLimbs[static_cast<std::size_t>(decltype(L)::value)];
     Eigen::Matrix<double, kLimbMax, kU> block_rhs = Eigen::Matrix<double, kLimbMax, kU>::Zero();
@@ -256,11 +266,14 @@ Eigen::Matrix<double, kCoordinateCount, static_cast<int>(N)> rate_basis(const Da
   return T;
 }
 
-// The dynamics' commanded speeds are the one set the runtime asks a basis for.
+// The dynamics' commanded speeds are the one set the runtime asks a basis for (none without a
+// dynamics section: wlx-gen then writes no reduced_dynamics.hpp).
+#if __has_include(<wlx/gen/reduced_dynamics.hpp>)
 template Eigen::Matrix<double, kCoordinateCount, static_cast<int>(gen::kCommanded.size())> rate_basis(
     const Data&, const std::array<int, gen::kCommanded.size()>&, const DependentPair&);
 template void rate_basis(const Data&, const std::array<int, gen::kCommanded.size()>&, const DependentPair&,
                          Eigen::Matrix<double, kCoordinateCount, static_cast<int>(gen::kCommanded.size())>&);
+#endif
 
 Eigen::Matrix<double, 3, kWheelCount> contact_velocities(const Model& model, Data& d, const Coordinates& s,
                                                          const Coordinates& sdot) {
@@ -271,8 +284,9 @@ Eigen::Matrix<double, 3, kWheelCount> contact_velocities(const Model& model, Dat
   for (int w = 0; w < kWheelCount; ++w) {
     const gen::WheelInfo& wheel = gen::kWheels[static_cast<std::size_t>(w)];
     const Eigen::Matrix3d& R = d.frame_rotations[static_cast<std::size_t>(wheel.contact_frame)];
-    v.col(w) = R.col(wheel.forward_axis) * (model.params().*wheel.radius * spin(w)) +
-               R.col(wheel.lateral_axis) * sideways(w) + Eigen::Vector3d::UnitZ() * sdot(wheel.ground);
+    const Eigen::Vector3d vw = R.col(wheel.forward_axis) * (model.params().*wheel.radius * spin(w)) +
+                               R.col(wheel.lateral_axis) * sideways(w) + Eigen::Vector3d::UnitZ() * sdot(wheel.ground);
+    for (int i = 0; i < 3; ++i) v(i, w) = vw(i);  // element by element: compiles for no wheels too
   }
   return v;
 }

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 WLX_MODEL_NAMESPACE_BEGIN
@@ -143,7 +144,7 @@ void check_finite(const Sample& smp, const Scenario& sc) {
     if (!std::isfinite(smp.spin_rate(w))) fail(fmt::format("spin_rate_{}", wheel), smp.spin_rate(w));
   }
   if (!std::isfinite(smp.cond_J_beta)) fail("cond_J_beta", smp.cond_J_beta);
-  if (!std::isfinite(smp.cabin_clearance)) fail("cabin_clearance", smp.cabin_clearance);
+  if (std::isnan(smp.clearance) || smp.clearance == -std::numeric_limits<double>::infinity()) fail("clearance", smp.clearance);
   for (int k = 0; k < kActuatedCount; ++k)
     if (!std::isfinite(smp.tau(k))) fail("tau_" + name(kActuatedJoints[static_cast<std::size_t>(k)]), smp.tau(k));
   for (int k = 0; k < kCommandedCount; ++k)
@@ -206,10 +207,17 @@ void Scenario::validate() const {
   }
 }
 
-double cabin_clearance(const Params& p, const Coordinates& s) {
+double lowest_clearance(const Params& p, const Coordinates& s) {
+// wlx-gen writes clearance.hpp only for a model file with a clearance box (and removes a stale one).
+#if __has_include(<wlx/gen/clearance.hpp>)
   double lowest = 0;
   gen::clearance(s, p, {.lowest = &lowest});
   return lowest;
+#else
+  static_cast<void>(p);
+  static_cast<void>(s);
+  return std::numeric_limits<double>::infinity();
+#endif
 }
 
 Trajectory simulate(const Scenario& sc, const Progress& progress) {
@@ -246,12 +254,12 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       forward_kinematics(model, data, f.s);
       for (int w = 0; w < kWheelCount; ++w) {
         const int f = gen::kWheels[static_cast<std::size_t>(w)].contact_frame;
-        smp.contacts.segment<2>(2 * w) = data.frame_positions.col(f).head<2>();
+        for (int i = 0; i < 2; ++i) smp.contacts(2 * w + i) = data.frame_positions(i, f);  // compiles for no wheels
       }
       smp.contact_velocity = contact_velocities(model, data, f.s, f.sdot);  // also fills data.C, data.spin
       smp.nh_residual = data.C * f.sdot;
       smp.spin_rate = data.spin * f.sdot;
-      smp.cabin_clearance = cabin_clearance(model.params(), f.s);
+      smp.clearance = lowest_clearance(model.params(), f.s);
       if (sc.weighting) {
         inverse_dynamics(model, data, f.s, u, CommandVector::Zero(), terms, sc.nonholonomic);
         smp.Qstar = terms.Qstar;

@@ -1,5 +1,5 @@
 // Time integration of a scenario (thesis 4.2, 5; docs/excavator.md sections 5 and 8): the commanded input
-// rates and the dependent pair are integrated; the 14 holonomic dependents are re-solved by the
+// rates and the dependent pair are integrated; the holonomic dependents are re-solved by the
 // closed-form IK at every evaluation, so the loop closure cannot drift.
 #pragma once
 
@@ -56,7 +56,7 @@ struct Sample {
   WheelVector nh_residual;                                 // v_W . n_W per wheel (should be 0)
   WheelVector spin_rate;                                   // wheel spin rates, rad/s
   double cond_J_beta = 0;
-  double cabin_clearance = 0;  // lowest cabin corner above z = 0, m
+  double clearance = 0;  // the clearance box's lowest corner above z = 0, m (+infinity without a box)
   // Inverse-dynamics runs only:
   TorqueVector tau = TorqueVector::Zero();      // actuator torques, order of kActuatedJoints
   CommandVector Qstar = CommandVector::Zero();  // generalized forces on u
@@ -67,7 +67,7 @@ struct Trajectory {
   bool complete = true;
   std::string error;  // why the run stopped early (with its time), when !complete
   // Integration work: accepted steps, rejected steps (dopri5 only), right-hand-side evaluations
-  // (each one a closed-form IK of the 4 limbs plus a dependent-rate solve).
+  // (each one an IK of every limb plus a dependent-rate solve).
   long steps = 0, rejected_steps = 0, evaluations = 0;
 };
 
@@ -81,7 +81,8 @@ Trajectory simulate(const Scenario& scenario, const Progress& progress = {});
 Trajectory simulate_each(const Scenario& scenario, const std::function<void(const Sample&)>& on_sample,
                          const Progress& progress = {});
 
-// Lowest corner of the cabin block (cxd x cyd x cabin_height, centred on K_C) above the ground.
-double cabin_clearance(const Params& p, const Coordinates& s);
+// The height above the ground (z = 0 of K0) of the lowest corner of the model file's clearance box;
+// +infinity for a model without one.
+double lowest_clearance(const Params& p, const Coordinates& s);
 
 WLX_MODEL_NAMESPACE_END

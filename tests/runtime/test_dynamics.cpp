@@ -265,7 +265,7 @@ TEST_CASE("dynamics: ID-1..3 reach the thesis' end states with torques of order 
       for (const auto& smp : tr.samples) peak = std::max(peak, smp.tau.cwiseAbs().maxCoeff());
       CHECK(peak > 1e4);
       CHECK(peak < 1e5);
-      CHECK(tr.samples.back().cabin_clearance > 0);
+      CHECK(tr.samples.back().clearance > 0);
     }
   }
 }
@@ -276,7 +276,7 @@ TEST_CASE("dynamics: ID-3 ends 7 mm above the ground: the cabin would touch it a
   sc.duration = 0.581;
   sc.weighting = Weighting::strong_weak();
   const Trajectory tr = simulate(sc);
-  const double clearance = tr.samples.back().cabin_clearance;
+  const double clearance = tr.samples.back().clearance;
   CHECK(clearance == doctest::Approx(0.007).epsilon(0.05));
   CHECK(0.581 + clearance / 3.0 == doctest::Approx(0.583).epsilon(1e-3));
 }

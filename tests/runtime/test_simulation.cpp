@@ -111,9 +111,9 @@ TEST_CASE("simulation: scenario validation names the field") {
 TEST_CASE("simulation: cabin clearance of the 3 x 3 x 0.5 m block") {
   const Params p;
   Coordinates s = nominal_inputs();
-  CHECK(cabin_clearance(p, s) == doctest::Approx(2.0 - 0.25));
+  CHECK(lowest_clearance(p, s) == doctest::Approx(2.0 - 0.25));
   s(c::roll) = 0.1;
-  CHECK(cabin_clearance(p, s) == doctest::Approx(2.0 - (std::sin(0.1) * 1.5 + std::cos(0.1) * 0.25)));
+  CHECK(lowest_clearance(p, s) == doctest::Approx(2.0 - (std::sin(0.1) * 1.5 + std::cos(0.1) * 0.25)));
 }
 
 TEST_CASE("simulation: a run that meets a singular J_beta midway stops there with the reason") {

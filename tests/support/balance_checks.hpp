@@ -22,7 +22,8 @@ inline double energy_balance_error(const Model& model, const Coordinates& initia
   Scenario sc;
   sc.params = model.params();
   sc.initial = initial;
-  for (int k = 0; k < 4; ++k) sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]) = u(k);
+  sc.pair = dynamics_pair();
+  for (int k = 0; k < kCommandedCount; ++k) sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]) = u(k);
   sc.duration = 0.002;
   sc.dt = 1e-5;
   const Trajectory tr = simulate(sc);

@@ -540,12 +540,13 @@ inline constexpr std::array<ClosedFormInfo, 4> kClosedForm{{
     {&ik_wheel_r<double>, 8, "leveled-lever", {{"bit 0: the other root of theta_r6 (branch 0: the root nearest zero)", "bit 1: the other root of theta_r2 (branch 0: |theta_r2| <= 90 deg)", "bit 2: the other root of theta_r6 + theta_r3 (branch 0: nearest zero)"}}, {{"z_Wr = {value:.4f} m is out of reach: with x_C, y_C, z_C, yaw, pitch, roll, theta_r5 as given, the z of W_r reaches [{low:.4f}, {high:.4f}] m"}}},
 }};
 
+// Whether every limb has a closed form (ik_all then solves them all).
 inline constexpr bool kHasFusedIk = true;
 
-// The closed forms of all 4 limbs in one pass: what ik_<limb>() computes for each, with the sines and
-// cosines of every input angle and the subexpressions the limbs share computed once. branches[k] is
-// limb k's branch (kLimbs order). On failure returns the status of the first limb that failed
-// (every limb's reach is tested before any limb's residual check), `failed` its index and `why`
+// The closed forms of the 4 limbs that have one in one pass: what ik_<limb>() computes for each,
+// with the sines and cosines of every input angle and the subexpressions the limbs share computed once.
+// branches[k] is limb k's branch (kLimbs order). On failure returns the status of the first limb that
+// failed (every limb's reach is tested before any limb's residual check), `failed` its index and `why`
 // its numbers; out is written only when every limb succeeded.
 // Operations: 476 (adds 170, muls 292, divs 0, calls 14), plus the solver calls.
 // Scalar: float or double.
@@ -553,7 +554,12 @@ template <typename Scalar>
 inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const std::array<int, 4>& branches,
                        detail::NonDeduced<CoordinatesOf<Scalar>>& out, int& failed, IkDiagnostics& why) noexcept {
   static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
+  static_cast<void>(s);
   static_cast<void>(p);
+  static_cast<void>(branches);
+  static_cast<void>(out);
+  static_cast<void>(failed);
+  static_cast<void>(why);
   const int ik_leg_l_branch = branches[0];
   if (ik_leg_l_branch < 0 || ik_leg_l_branch >= 4) {
     failed = 0;

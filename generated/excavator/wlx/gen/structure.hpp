@@ -22,6 +22,9 @@ namespace gen {
 
 // Parent of each frame of interest (-1: the ground frame K0), in frame:: order.
 inline constexpr std::array<int, 13> kFrameParent{{-1, 0, 1, 2, 0, 4, 5, 0, 7, 8, 0, 10, 11}};
+// Whether the frame is one wlx-gen derived (a wheel's contact point, which slides round the rim as
+// the hub tilts), not one fixed in the mechanism's chain.
+inline constexpr std::array<bool, 13> kFrameDerived{{false, false, false, false, false, false, false, false, false, false, false, false, false}};
 
 // Limbs: closure rows and the dependent joints they determine (a square diagonal block of dPhi/ds;
 // the rows of one limb involve no other limb's joints), and the inputs those rows read.
@@ -51,7 +54,8 @@ inline constexpr int wheel_r = 3;
 }  // namespace limb
 
 // Wheels rolling without sliding sideways: contact frame, the input holding the ground level
-// under the wheel, and the rolling radius.
+// under the wheel, and the rolling radius; for a wheel on a hub (its contact frame derived) the
+// hub frame and the axle (-1 where the model file builds the contact frame itself).
 struct WheelInfo {
   std::string_view name;
   int contact_frame;
@@ -59,14 +63,16 @@ struct WheelInfo {
   double Params::*radius;
   int forward_axis;  // of the contact frame: 0 x, 1 y, 2 z
   int lateral_axis;
+  int hub_frame;
+  int axle_axis;  // of the hub frame
 };
 inline constexpr std::array<WheelInfo, 2> kWheels{{
-    {"l", 9, 12, &Params::w, 0, 1},  // contact W_l, ground z_Wl
-    {"r", 12, 13, &Params::w, 0, 1},  // contact W_r, ground z_Wr
+    {"l", 9, 12, &Params::w, 0, 1, -1, -1},  // contact W_l, ground z_Wl
+    {"r", 12, 13, &Params::w, 0, 1, -1, -1},  // contact W_r, ground z_Wr
 }};
 
-// The input rates that may be chosen as the dependent rates of the wheel constraints, and the
-// named choices.
+// The input rates that may be chosen as the dependent rates of the wheel constraints (one per
+// wheel), and the named choices.
 inline constexpr std::array<int, 8> kPairCandidates{{0, 1, 2, 3, 4, 5, 16, 17}};
 struct PairInfo {
   std::string_view name;
@@ -157,6 +163,10 @@ inline constexpr std::array<SweepInfo, 12> kIkSweeps{{
 
 // The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).
 inline constexpr std::array<double, 18> kNominalInputs{{0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 3.5, 1.5, 0.0, 3.5, -1.5, 0.0, 0.0, 0.05, 0.0, 0.0, 0.0, 0.0}};
+// Where Newton's method starts for the dependent joints when no earlier solution is at hand (the
+// model file's `nominal` and the limbs' `start`; 0 where neither gives one), in coord:: order from
+// the first dependent joint.
+inline constexpr std::array<double, 14> kDependentStart{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
 
 inline constexpr bool kHasClearance = true;
 

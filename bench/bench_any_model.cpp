@@ -1,0 +1,66 @@
+// The same benchmarks for every model it is compiled for (CMakeLists.txt: once per model in
+// WLX_BENCH_MODELS, linked into wlx_bench), registered as <model>/<row>, so that models of other
+// sizes are compared side by side in one run: the IK of every limb, the dependent rates, and one
+// inverse-dynamics step (IK, rates, Kane's sums, the torque split), from the model's tables alone.
+#include <benchmark/benchmark.h>
+#include <wlx/dynamics.hpp>
+#include <wlx/error.hpp>
+#include <wlx/ik.hpp>
+#include <wlx/nonholonomic.hpp>
+
+#include <memory>
+#include <string>
+
+namespace {
+
+using namespace wlx;
+
+// The nominal pose, solved, with every commanded speed at 0.2 (m/s or rad/s).
+struct Pose {
+  const Model model;
+  Data d;
+  DynamicsTerms terms;
+  Coordinates s = nominal_inputs();
+  CommandVector u = CommandVector::Constant(0.2);
+  Pose() { solve_ik_closed_form(model, s); }
+};
+
+void ik(benchmark::State& st) {
+  auto x = std::make_unique<Pose>();
+  for (auto _ : st) {
+    solve_ik_closed_form(x->model, x->s);
+    benchmark::DoNotOptimize(x->s.data());
+  }
+}
+
+void dependent_rates(benchmark::State& st) {
+  auto x = std::make_unique<Pose>();
+  Coordinates sdot = Coordinates::Zero();
+  for (int k = 0; k < kCommandedCount; ++k) sdot(kCommandedSpeeds[static_cast<std::size_t>(k)]) = x->u(k);
+  for (auto _ : st) {
+    solve_dependent_rates(x->model, x->d, x->s, sdot, dynamics_pair());
+    benchmark::DoNotOptimize(sdot.data());
+  }
+}
+
+void inverse_dynamics_step(benchmark::State& st) {
+  auto x = std::make_unique<Pose>();
+  for (auto _ : st) {
+    solve_ik_closed_form(x->model, x->s);
+    inverse_dynamics(x->model, x->d, x->s, x->u, CommandVector::Zero(), x->terms);
+    const TorqueVector tau = distribute_torques(x->terms.J_beta, x->terms.Qstar, Weighting::strong_weak());
+    benchmark::DoNotOptimize(tau.data());
+  }
+}
+
+const bool registered = [] {
+  const std::string model(gen::kModelName);
+  benchmark::RegisterBenchmark((model + "/ik_all_limbs").c_str(), ik);
+  if (gen::kHasDynamics) {
+    benchmark::RegisterBenchmark((model + "/dependent_rates").c_str(), dependent_rates);
+    benchmark::RegisterBenchmark((model + "/inverse_dynamics_step").c_str(), inverse_dynamics_step);
+  }
+  return true;
+}();
+
+}  // namespace

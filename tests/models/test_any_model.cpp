@@ -1,0 +1,271 @@
+// Checks that hold for every model, written from the generated tables alone, so that one source
+// serves every model the tests build (tests/CMakeLists.txt compiles it once per model): the models
+// made for the paths the built-in ones never take (wheels on hubs, four wheels, no wheels, limbs
+// that only Newton's method solves, open trees, no clearance box, no dynamics section).
+//
+// Every generated Jacobian and convective term against exact derivatives (jets through the
+// generated functions themselves: the derivative code is not what is evaluated), the IK against
+// the model's own closure and Newton's method, the dependent rates against the rolling rows and
+// finite differences of a run, and the inverse dynamics against power and energy balances.
+#include "../support/balance_checks.hpp"
+#include "../support/chain_algebra.hpp"
+#include "../support/jet_eigen.hpp"
+
+#include <doctest/doctest.h>
+#include <wlx/dynamics.hpp>
+#include <wlx/error.hpp>
+#include <wlx/ik.hpp>
+#include <wlx/ik_verification.hpp>
+#include <wlx/kinematics.hpp>
+#include <wlx/nonholonomic.hpp>
+#include <wlx/simulation.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <optional>
+#include <random>
+#include <string>
+
+using namespace wlx;
+using test::Jet;
+
+namespace {
+
+const std::string kName(gen::kModelName);
+
+// "<model>: <what>", kept alive for doctest, which keeps the pointer.
+const char* titled(const char* what) {
+  static std::deque<std::string> titles;
+  return titles.emplace_back(kName + ": " + what).c_str();
+}
+
+gen::CoordinatesOf<Jet> along(const Coordinates& s, const Coordinates& u) {
+  gen::CoordinatesOf<Jet> out;
+  for (int i = 0; i < kCoordinateCount; ++i) out(i) = Jet(s(i), u(i), 0);
+  return out;
+}
+
+bool is_angle(int k) { return gen::kCoordinateUnits[static_cast<std::size_t>(k)] == "rad"; }
+
+// A state near the nominal one: every input moved by up to `reach` (m or rad), the dependent
+// joints solved (closed form, Newton's method from the model's start values for the others).
+// Unreachable draws are drawn again.
+Coordinates random_state(std::mt19937_64& rng, const Model& model, double reach) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int attempt = 0; attempt < 1000; ++attempt) {
+    Coordinates s = nominal_inputs();
+    for (int k = 0; k < kInputCount; ++k) s(k) += reach * u(rng);
+    try {
+      solve_ik_closed_form(model, s);
+      return s;
+    } catch (const Error&) {
+    }
+  }
+  FAIL("no reachable state near the nominal one in 1000 draws");
+  return {};
+}
+
+// Input rates of up to 0.5 (m/s or rad/s), zero for the pair's and the dependent joints'.
+Coordinates random_input_rates(std::mt19937_64& rng, const DependentPair& pair) {
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  Coordinates sdot = Coordinates::Zero();
+  for (int k = 0; k < kInputCount; ++k) sdot(k) = u(rng);
+  for (int k : pair.index) sdot(k) = 0;
+  return sdot;
+}
+
+}  // namespace
+
+TEST_CASE(titled("Phi, dPhi/ds, the wheel rows, the bodies and their convective terms match exact derivatives")) {
+  // Along s + t u: the jet's first part is the directional derivative (J u), the second u^T H u,
+  // which is the convective term (d/dt J) u. At states on the closure, with full rates.
+  std::mt19937_64 rng(201);
+  std::uniform_real_distribution<double> rate(-1, 1);
+  const Model model;
+  const gen::Params& p = model.params();
+  double worst_J = 0, worst_conv = 0, worst_C = 0, worst_spin = 0, worst_C_conv = 0, worst_body = 0, worst_body_conv = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Coordinates s = random_state(rng, model, 0.05);
+    Coordinates u;
+    for (int k = 0; k < kCoordinateCount; ++k) u(k) = rate(rng);
+    const gen::CoordinatesOf<Jet> x = along(s, u);
+
+    gen::ClosureVector conv;
+    gen::ClosureJacobian J;
+    gen::closure(s, p, {.dPhi_ds = &J});
+    gen::ClosureVectorOf<Jet> Phi_jet;
+    gen::closure(x, p, {.Phi = &Phi_jet});
+    gen::WheelRows C, spin;
+    gen::WheelVector C_conv;
+    gen::nonholonomic(s, p, {.C = &C, .spin = &spin});
+    gen::convective(s, u, p, {.dPhi_ds_dot_sdot = &conv, .C_dot_sdot = &C_conv});
+    const gen::ClosureVector Ju = J * u;
+    for (int i = 0; i < gen::kClosureCount; ++i) {
+      worst_J = std::max(worst_J, std::abs(Ju(i) - Phi_jet(i).d));
+      worst_conv = std::max(worst_conv, std::abs(conv(i) - Phi_jet(i).dd));
+    }
+    // The contact point's velocity along its lateral axis (C s'), its forward one over the radius
+    // (spin s') and d/dt (n . v) = n' . v + n . a at zero accelerations.
+    gen::FramePositionsOf<Jet> pos;
+    gen::FrameRotationsOf<Jet> R;
+    gen::kinematics(x, p, {.positions = &pos, .rotations = &R});
+    for (int w = 0; w < kWheelCount; ++w) {
+      const gen::WheelInfo& wheel = gen::kWheels[static_cast<std::size_t>(w)];
+      const auto& Rc = R[static_cast<std::size_t>(wheel.contact_frame)];
+      Jet lateral = 0;
+      double forward = 0;
+      for (int i = 0; i < 3; ++i) {
+        const Jet velocity(pos(i, wheel.contact_frame).d, pos(i, wheel.contact_frame).dd, 0);
+        lateral += Rc(i, wheel.lateral_axis) * velocity;
+        forward += Rc(i, wheel.forward_axis).v * velocity.v;
+      }
+      worst_C = std::max(worst_C, std::abs((C.row(w) * u)(0) - lateral.v));
+      worst_spin = std::max(worst_spin, std::abs((spin.row(w) * u)(0) - forward / (p.*wheel.radius)));
+      worst_C_conv = std::max(worst_C_conv, std::abs(C_conv(w) - lateral.d));
+    }
+    gen::BodyVectors com, Jv_dot, Jw_dot;
+    gen::BodyJacobians Jv, Jw;
+    gen::bodies(s, u, p, {.com = &com, .Jv = &Jv, .Jw = &Jw, .Jv_dot_sdot = &Jv_dot, .Jw_dot_sdot = &Jw_dot});
+    gen::BodyVectorsOf<Jet> com_jet;
+    gen::BodyRotationsOf<Jet> R_jet;
+    gen::bodies(x, gen::CoordinatesOf<Jet>::Zero(), p, {.com = &com_jet, .rotations = &R_jet});
+    for (int b = 0; b < gen::kBodyCount; ++b) {
+      test::M3<Jet> Rb;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) Rb[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] = R_jet[static_cast<std::size_t>(b)](i, j);
+      const auto [omega, alpha] = test::angular_rates(Rb);
+      const Eigen::Vector3d v = Jv[static_cast<std::size_t>(b)] * u, w = Jw[static_cast<std::size_t>(b)] * u;
+      for (int i = 0; i < 3; ++i) {
+        worst_body = std::max({worst_body, std::abs(com(i, b) - com_jet(i, b).v), std::abs(v(i) - com_jet(i, b).d),
+                               std::abs(w(i) - omega[static_cast<std::size_t>(i)])});
+        worst_body_conv = std::max({worst_body_conv, std::abs(Jv_dot(i, b) - com_jet(i, b).dd),
+                                    std::abs(Jw_dot(i, b) - alpha[static_cast<std::size_t>(i)])});
+      }
+    }
+  }
+  MESSAGE(kName << ": max errors: dPhi/ds " << worst_J << ", convective " << worst_conv << ", C s' " << worst_C << ", spin s' "
+                << worst_spin << ", (d/dt C) s' " << worst_C_conv << ", bodies " << worst_body << ", their convective "
+                << worst_body_conv);
+  // Rounding of sums of a few dozen products of unit vectors, lengths of metres and rates <= 1:
+  // 1e-13; second derivatives carry one more product (and 1/sigma for a hub wheel's contact).
+  CHECK(worst_J <= 1e-12);
+  CHECK(worst_conv <= 1e-11);
+  CHECK(worst_C <= 1e-12);
+  CHECK(worst_spin <= 1e-12);
+  CHECK(worst_C_conv <= 1e-11);
+  CHECK(worst_body <= 1e-12);
+  CHECK(worst_body_conv <= 1e-11);
+}
+
+TEST_CASE(titled("the IK from the nominal state, and the model's sweeps: closure to 1e-12, closed form = Newton")) {
+  const Model model;
+  Data data;
+  Coordinates s = nominal_inputs();
+  REQUIRE_NOTHROW(solve_ik_closed_form(model, s));
+  closure(model, data, s, false);
+  CHECK(data.Phi.cwiseAbs().maxCoeff() <= 1e-12);
+  // Newton's method from the model file's start values (a straight leg would be singular).
+  Coordinates n = dependent_start(nominal_inputs());
+  REQUIRE_NOTHROW(solve_ik_newton(model, data, n));
+  for (Limb limb : kLimbs) {
+    const LimbBlock b = limb_block(limb);
+    for (int j = 0; j < b.size; ++j) {
+      const int k = b.joints[static_cast<std::size_t>(j)];
+      const double difference = is_angle(k) ? std::remainder(n(k) - s(k), 2 * std::numbers::pi) : n(k) - s(k);
+      // Newton lands on the closed form's default branch from the model's start values, or the
+      // model's start values pick another branch: then the closed form of that branch agrees.
+      Coordinates same = s;
+      solve_limb_closed_form(model, limb, classify_branch(model, limb, n), same);
+      const double to_branch = is_angle(k) ? std::remainder(n(k) - same(k), 2 * std::numbers::pi) : n(k) - same(k);
+      CHECK(std::min(std::abs(difference), std::abs(to_branch)) <= 1e-9);
+    }
+  }
+  for (const IkSweep& sweep : model_ik_sweeps()) {
+    CAPTURE(sweep.id);
+    const IkSweepResult r = run_ik_sweep(model, data, sweep);
+    MESSAGE(kName << " " << sweep.id << ": " << r.points.size() << " points, check " << r.max_check_closed_form
+                  << " m, |closed form - Newton| " << r.max_newton_difference);
+    CHECK(r.max_check_closed_form <= 1e-12);
+    CHECK(r.max_check_newton <= 1e-12);
+    CHECK(r.max_level_error <= 1e-12);
+    CHECK(r.max_newton_difference <= 1e-9);  // Newton's own stop, |Phi| <= 1e-13, over the limb's conditioning
+  }
+}
+
+TEST_CASE(titled("dependent rates and accelerations keep the wheels rolling and the closure, as a run's differences")) {
+  std::mt19937_64 rng(202);
+  const Model model;
+  Data d;
+  const DependentPair pair = default_pair();
+  double worst_side = 0, worst_closure = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const Coordinates s = random_state(rng, model, 0.05);
+    Coordinates sdot = random_input_rates(rng, pair);
+    REQUIRE_NOTHROW(solve_dependent_rates(model, d, s, sdot, pair));
+    const double scale = d.cond_J_beta * std::max(1.0, sdot.cwiseAbs().maxCoeff());
+    gen::WheelRows C;
+    gen::nonholonomic(s, model.params(), {.C = &C});
+    if (kWheelCount > 0) worst_side = std::max(worst_side, (C * sdot).cwiseAbs().maxCoeff() / scale);
+    closure(model, d, s, true);
+    if (gen::kClosureCount > 0) worst_closure = std::max(worst_closure, (d.dPhi_ds * sdot).cwiseAbs().maxCoeff() / scale);
+  }
+  MESSAGE(kName << ": max |v_W . n_W| / (cond |s'|) " << worst_side << ", max |dPhi/ds s'| / (cond |s'|) " << worst_closure);
+  CHECK(worst_side <= 1e-14);  // ~1e-16 per operation, sums of ~30 terms with lever arms of metres
+  CHECK(worst_closure <= 1e-14);
+
+  // A short run with small random commanded rates: central differences of the samples against
+  // the solved rates and accelerations (error ~dt^2 |s'''|, far below the bounds).
+  Scenario sc;
+  sc.rates = random_input_rates(rng, pair).head<kInputCount>() * 0.2;
+  sc.duration = 0.002;
+  sc.dt = 1e-5;
+  const Trajectory tr = simulate(sc);
+  REQUIRE_MESSAGE(tr.complete, tr.error);
+  double worst_v = 0, scale_v = 0, worst_a = 0, scale_a = 0, worst_rolling = 0;
+  for (std::size_t k = 1; k + 1 < tr.samples.size(); ++k) {
+    const Coordinates fd_v = (tr.samples[k + 1].s - tr.samples[k - 1].s) / (2 * sc.dt);
+    const Coordinates fd_a = (tr.samples[k + 1].sdot - tr.samples[k - 1].sdot) / (2 * sc.dt);
+    Coordinates sdot = tr.samples[k].sdot, sddot = Coordinates::Zero();
+    solve_dependent_rates(model, d, tr.samples[k].s, sdot, sc.pair);
+    solve_dependent_accelerations(model, d, tr.samples[k].s, sdot, sddot, sc.pair);
+    worst_v = std::max(worst_v, (fd_v - sdot).cwiseAbs().maxCoeff());
+    worst_a = std::max(worst_a, (fd_a - sddot).cwiseAbs().maxCoeff());
+    scale_v = std::max(scale_v, sdot.cwiseAbs().maxCoeff());
+    scale_a = std::max(scale_a, sddot.cwiseAbs().maxCoeff());
+    if (kWheelCount > 0) worst_rolling = std::max(worst_rolling, tr.samples[k].nh_residual.cwiseAbs().maxCoeff());
+  }
+  MESSAGE(kName << ": run: rolling rows " << worst_rolling << " m/s; differences: rates " << worst_v << " (scale " << scale_v
+                << "), accelerations " << worst_a << " (scale " << scale_a << ")");
+  CHECK(worst_rolling <= 1e-12);
+  CHECK(worst_v <= 1e-7 * std::max(scale_v, 1e-3));
+  CHECK(worst_a <= 1e-6 * std::max(scale_a, 1e-3));
+}
+
+TEST_CASE(titled("inverse dynamics: J_beta^T tau = Q*, power and energy balances")) {
+  const Model model;
+  Data d;
+  DynamicsTerms t;
+  if constexpr (!gen::kHasDynamics) {
+    CHECK_THROWS_WITH_AS(inverse_dynamics(model, d, nominal_inputs(), CommandVector::Zero(), CommandVector::Zero(), t),
+                         doctest::Contains("no dynamics section"), Error);
+    return;
+  }
+  std::mt19937_64 rng(203);
+  std::uniform_real_distribution<double> half(-0.5, 0.5);
+  double worst_balance = 0, worst_power = 0, worst_energy = 0;
+  for (int trial = 0; trial < 5; ++trial) {
+    const Coordinates s = random_state(rng, model, 0.03);
+    CommandVector u, u_dot;
+    for (int k = 0; k < kCommandedCount; ++k) u(k) = half(rng), u_dot(k) = half(rng);
+    inverse_dynamics(model, d, s, u, u_dot, t);
+    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+    worst_balance = std::max(worst_balance, (t.J_beta.transpose() * tau - t.Qstar).norm() / t.Qstar.norm());
+    worst_power = std::max(worst_power, std::abs(tau.dot(t.J_beta * u) - t.Qstar.dot(u)) / (t.Qstar.norm() * u.norm()));
+    worst_energy = std::max(worst_energy, test::energy_balance_error(model, s, u));
+  }
+  MESSAGE(kName << ": J^T tau = Q*: " << worst_balance << ", power: " << worst_power << ", energy: " << worst_energy);
+  CHECK(worst_balance <= 1e-9);  // least-norm solve with cond(J_beta) up to ~1e4
+  CHECK(worst_power <= 1e-9);
+  CHECK(worst_energy <= 1e-6);  // five-point stencil at dt = 1e-5 on a motion with |s'| <= 1
+}
