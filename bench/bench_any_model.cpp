@@ -1,10 +1,12 @@
 // The same benchmarks for every model it is compiled for (CMakeLists.txt: once per model in
 // WLX_BENCH_MODELS, linked into wlx_bench), registered as <model>/<row>, so that models of other
 // sizes are compared side by side in one run: the IK of every limb, the dependent rates, and one
-// inverse-dynamics step (IK, rates, Kane's sums, the torque split), from the model's tables alone.
+// inverse-dynamics step (IK, rates, Kane's sums, the torque split) and one forward-dynamics step,
+// from the model's tables alone.
 #include <benchmark/benchmark.h>
 #include <wlx/dynamics.hpp>
 #include <wlx/error.hpp>
+#include <wlx/forward_dynamics.hpp>
 #include <wlx/ik.hpp>
 #include <wlx/nonholonomic.hpp>
 
@@ -48,8 +50,22 @@ void inverse_dynamics_step(benchmark::State& st) {
   for (auto _ : st) {
     solve_ik_closed_form(x->model, x->s);
     inverse_dynamics(x->model, x->d, x->s, x->u, CommandVector::Zero(), x->terms);
-    const TorqueVector tau = distribute_torques(x->terms.J_beta, x->terms.Qstar, Weighting::strong_weak());
+    const TorqueVector tau = distribute_torques(x->terms.J_beta, x->terms.Qstar, Weighting::model_weights());
     benchmark::DoNotOptimize(tau.data());
+  }
+}
+
+// The converse step, side by side with the one above: IK, then the accelerations under the
+// torques that hold the nominal pose (one inverse-dynamics evaluation and a Cholesky of M).
+void forward_dynamics_step(benchmark::State& st) {
+  auto x = std::make_unique<Pose>();
+  inverse_dynamics(x->model, x->d, x->s, x->u, CommandVector::Zero(), x->terms);
+  const TorqueVector tau = distribute_torques(x->terms.J_beta, x->terms.Qstar, Weighting::model_weights());
+  CommandVector u_dot;
+  for (auto _ : st) {
+    solve_ik_closed_form(x->model, x->s);
+    forward_dynamics(x->model, x->d, x->s, x->u, tau, u_dot, x->terms);
+    benchmark::DoNotOptimize(u_dot.data());
   }
 }
 
@@ -59,6 +75,7 @@ const bool registered = [] {
   if (gen::kHasDynamics) {
     benchmark::RegisterBenchmark((model + "/dependent_rates").c_str(), dependent_rates);
     benchmark::RegisterBenchmark((model + "/inverse_dynamics_step").c_str(), inverse_dynamics_step);
+    benchmark::RegisterBenchmark((model + "/forward_dynamics_step").c_str(), forward_dynamics_step);
   }
   return true;
 }();

@@ -287,7 +287,7 @@ void BM_inverse_dynamics_step(benchmark::State& st) {
   for (auto _ : st) {
     solve_ik_closed_form(x.model, x.s);
     inverse_dynamics(x.model, x.d, x.s, x.u, CommandVector::Zero(), x.terms);
-    const TorqueVector tau = distribute_torques(x.terms.J_beta, x.terms.Qstar, Weighting::strong_weak());
+    const TorqueVector tau = distribute_torques(x.terms.J_beta, x.terms.Qstar, Weighting::model_weights());
     benchmark::DoNotOptimize(tau.data());
   }
 }
@@ -295,7 +295,7 @@ void BM_inverse_dynamics_step(benchmark::State& st) {
 void BM_distribute_torques(benchmark::State& st) {
   SolvedStep x;
   for (auto _ : st) {
-    const TorqueVector tau = distribute_torques(x.terms.J_beta, x.terms.Qstar, Weighting::strong_weak());
+    const TorqueVector tau = distribute_torques(x.terms.J_beta, x.terms.Qstar, Weighting::model_weights());
     benchmark::DoNotOptimize(tau.data());
   }
 }
@@ -352,7 +352,7 @@ void BM_run_ID1(benchmark::State& st) {
   Scenario sc;
   sc.rates(gen::coord::x_C) = 3.0;
   sc.duration = 0.494;
-  sc.weighting = Weighting::strong_weak();
+  sc.weighting = Weighting::model_weights();
   for (auto _ : st) {
     const Trajectory tr = simulate(sc);
     benchmark::DoNotOptimize(tr.samples.data());

@@ -68,7 +68,7 @@ double si_value(const nlohmann::json& v, const std::string& key, Quantity quanti
 }
 
 Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
-  if (v.is_number_integer() && (v == 1 || v == 2)) return v == 1 ? Weighting::strong_weak() : Weighting::contribution();
+  if (v.is_number_integer() && (v == 1 || v == 2)) return v == 1 ? Weighting::model_weights() : Weighting::contribution();
   if (v.is_object() && v.size() == 1 && v.contains("diag")) {
     const auto& d = v.at("diag");
     if (!d.is_array() || d.size() != 8) throw Error(key + ".diag", fmt::format("must be an array of 8 weights, got {}", excerpt(d)));

@@ -83,7 +83,7 @@ int run_simulate(const ModelOptions& model_options, const SimulateOptions& o) {
   }
   if (!o.weighting.empty()) {
     if (o.weighting != "1" && o.weighting != "2") throw Error("--weighting", fmt::format("must be 1 or 2, got '{}'", o.weighting));
-    sc.weighting = o.weighting == "1" ? Weighting::strong_weak() : Weighting::contribution();
+    sc.weighting = o.weighting == "1" ? Weighting::model_weights() : Weighting::contribution();
   }
   sc.validate();
   prepare_out_dir("--out", o.out_dir);

@@ -149,7 +149,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
     const bool verify = json.value("verify", "") == "nonholonomic";
     std::vector<std::pair<std::string, std::optional<Weighting>>> variants;
     if (json.contains("weighting")) {
-      variants.emplace_back(scenario_id + "-w1", Weighting::strong_weak());
+      variants.emplace_back(scenario_id + "-w1", Weighting::model_weights());
       variants.emplace_back(scenario_id + "-w2", Weighting::contribution());
     } else {
       variants.emplace_back(scenario_id, std::nullopt);
@@ -285,7 +285,7 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
     solve_ik_closed_form(model_, s);
     DynamicsTerms t;
     inverse_dynamics(model_, data_, s, CommandVector::Zero(), CommandVector::Zero(), t);
-    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, m.weighting == 1 ? Weighting::strong_weak() : Weighting::contribution());
+    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, m.weighting == 1 ? Weighting::model_weights() : Weighting::contribution());
     double worst = 0;
     for (const auto& name : m.joints) {
       const auto at = std::find(kActuatedJoints.begin(), kActuatedJoints.end(), coordinate_index(name)) - kActuatedJoints.begin();

@@ -175,7 +175,7 @@ class Parser {
     if (n["times_total_mass"]) m.times_total_mass = flag(n["times_total_mass"], path + ".times_total_mass");
     if (n["weighting"]) {
       const double w = number(n["weighting"], path + ".weighting");
-      if (w != 1 && w != 2) fail(n["weighting"], path + ".weighting", "must be 1 (strong/weak) or 2 (by contribution)");
+      if (w != 1 && w != 2) fail(n["weighting"], path + ".weighting", "must be 1 (the model file's weights) or 2 (by contribution)");
       m.weighting = static_cast<int>(w);
     }
     return m;

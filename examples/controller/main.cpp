@@ -104,7 +104,7 @@ int main() {
   // Everything the loop touches is allocated here, before it.
   wlx::Data data;
   wlx::DynamicsTerms terms;
-  const wlx::Weighting weighting = wlx::Weighting::strong_weak();  // the model file's weights
+  const wlx::Weighting weighting = wlx::Weighting::model_weights();  // the model file's weights
   wlx::Coordinates s = wlx::nominal_inputs();
   Eigen::Matrix<double, wlx::kInputCount, 1> q = s.head<wlx::kInputCount>();
   std::vector<double> step_seconds;

@@ -86,7 +86,7 @@ double kinetic_energy(const Model& model, Data& d, const Coordinates& s, const C
 
 std::string Weighting::label() const {
   switch (kind) {
-    case Kind::strong_weak: return "weighting 1 (strong/weak)";
+    case Kind::model_weights: return "weighting 1 (the model file's weights)";
     case Kind::contribution: return "weighting 2 (contribution)";
     case Kind::diagonal: return "diagonal weights";
     case Kind::matrix: return "weight matrix";
@@ -241,8 +241,8 @@ TorqueVector distribute_torques(const ActuatorJacobian& J_beta, const CommandVec
   if (weighting.kind == Weighting::Kind::matrix) return distribute_torques_weight_matrix(J_beta, Qstar, weighting);
   TorqueVector S;
   switch (weighting.kind) {
-    case Weighting::Kind::strong_weak: {
-      static const TorqueVector scale = kStrongWeakDiagonal.cwiseInverse().cwiseSqrt();  // constant: once
+    case Weighting::Kind::model_weights: {
+      static const TorqueVector scale = kModelWeightDiagonal.cwiseInverse().cwiseSqrt();  // constant: once
       S = scale;
       break;
     }

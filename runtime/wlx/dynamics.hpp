@@ -56,14 +56,14 @@ double potential_energy(const Model& model, Data& data, const Coordinates& s);
 double kinetic_energy(const Model& model, Data& data, const Coordinates& s, const Coordinates& sdot);
 
 struct Weighting {
-  enum class Kind { strong_weak, contribution, diagonal, matrix };
-  Kind kind = Kind::strong_weak;
+  enum class Kind { model_weights, contribution, diagonal, matrix };
+  Kind kind = Kind::model_weights;
   TorqueVector diagonal = TorqueVector::Ones();    // W for Kind::diagonal
   TorqueMatrix matrix = TorqueMatrix::Identity();  // W for Kind::matrix
   std::string label() const;
 
-  // The model file's default weights (the excavator: thesis 6.3.3 weighting 1, strong/weak).
-  static Weighting strong_weak() { return {}; }
+  // The model file's default weights (dynamics.weights; the excavator's are the thesis' weighting 1).
+  static Weighting model_weights() { return {}; }
   // Thesis 6.3.3 weighting 2: W_ii = 1 / |row i of J_beta|, recomputed at every step.
   static Weighting contribution() { return {Kind::contribution, TorqueVector::Ones(), TorqueMatrix::Identity()}; }
   // Throws wlx::Error (field "weighting") unless every entry is positive and finite.
@@ -73,7 +73,7 @@ struct Weighting {
 };
 
 // The model file's default weights (for the excavator, thesis 6.3.3 weighting 1).
-inline const TorqueVector kStrongWeakDiagonal = Eigen::Map<const TorqueVector>(gen::kDefaultWeights.data());
+inline const TorqueVector kModelWeightDiagonal = Eigen::Map<const TorqueVector>(gen::kDefaultWeights.data());
 
 // tau = W^-1 J_beta (J_beta^T W^-1 J_beta)^-1 Q*, computed as the minimum-norm solution of the
 // row-scaled system J_beta^T S x = Q*, tau = S x with S S^T = W^-1, which stays accurate where

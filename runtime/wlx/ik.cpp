@@ -214,6 +214,12 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
         for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
       }
       gradient[l] = J.transpose() * r;
+      before[l] = half_square(data.Phi, idx);
+      ++report.iterations[l];
+      if (!options.damped) {
+        step[l] = J.colPivHouseholderQr().solve(-r);
+        continue;
+      }
       if (mu[l] == 0) mu[l] = 1e-9 * std::max(1.0, J.colwise().squaredNorm().maxCoeff());  // nearly Newton's step first
       // As the least-squares problem [J; sqrt(mu) I] dx = [-r; 0], by QR: the normal equations would
       // square J's condition number (1e6 at the thesis' worst poses).
@@ -222,8 +228,6 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       Eigen::Matrix<double, 2 * gen::kMaxLimbSize, 1> rhs;
       rhs << -r, LimbVector::Zero();
       step[l] = stacked.householderQr().solve(rhs);
-      before[l] = half_square(data.Phi, idx);
-      ++report.iterations[l];
     }
     if (all_done) break;
     const Coordinates start = s;
@@ -240,6 +244,12 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       if (done[l]) continue;
       const auto idx = indices(limb);
       const double after = half_square(data.Phi, idx);
+      if (!options.damped) {
+        // Plain Newton takes every step; a step that does not lower the residual past its floor
+        // ends the iteration at max_iterations, as the thesis' method would.
+        stalled[l] = !std::isfinite(after);
+        continue;
+      }
       // The decrease the linear model predicts: dx^T (mu dx - g) / 2 > 0.
       const double predicted = 0.5 * step[l].dot(mu[l] * step[l] - gradient[l]);
       const double gain = predicted > 0 ? (before[l] - after) / predicted : -1;

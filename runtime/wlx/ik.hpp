@@ -58,6 +58,9 @@ struct NewtonOptions {
   // counts as converged if that floor is below this (ill-conditioned poses amplify rounding).
   double floor_tolerance = 1e-10;
   int max_iterations = 100;  // steps tried per limb (accepted or not)
+  // false: the undamped Newton step J dx = -r, every step taken, as in the thesis' verification
+  // (whose cold starts flip the knee: the damped method's descent would not show that).
+  bool damped = true;
 };
 
 struct NewtonReport {

@@ -103,7 +103,9 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
     Coordinates cold = start;  // the thesis' way: every point from the same start pose
     cold(input) = pt.value;
     try {
-      solve_ik_newton(model, data, cold);
+      NewtonOptions thesis;  // the thesis' undamped Newton, whose basins the cold starts show
+      thesis.damped = false;
+      solve_ik_newton(model, data, cold, thesis);
       pt.cold_newton_branch = classify_branch(model, sweep.limb, cold);
     } catch (const Error&) {
       pt.cold_newton_branch = -1;

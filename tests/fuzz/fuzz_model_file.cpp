@@ -2,6 +2,7 @@
 // ModelFileError; no other exception, crash, hang or sanitizer finding.
 #include "../../generator/model_file.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -10,7 +11,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
   const std::string text(reinterpret_cast<const char*>(bytes), size);
   try {
     const wlx::codegen::Model m = wlx::codegen::parse_model(text, "fuzz.yaml");
-    if (m.nominal.size() != static_cast<std::size_t>(m.input_count)) std::abort();
+    // One nominal value per coordinate (the dependents' Newton start values included), each finite.
+    if (m.nominal.size() != m.coordinates.size()) std::abort();
+    for (double v : m.nominal)
+      if (!std::isfinite(v)) std::abort();
   } catch (const wlx::codegen::ModelFileError&) {
   }
   return 0;

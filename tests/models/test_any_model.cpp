@@ -259,7 +259,7 @@ TEST_CASE(titled("inverse dynamics: J_beta^T tau = Q*, power and energy balances
     CommandVector u, u_dot;
     for (int k = 0; k < kCommandedCount; ++k) u(k) = half(rng), u_dot(k) = half(rng);
     inverse_dynamics(model, d, s, u, u_dot, t);
-    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
     worst_balance = std::max(worst_balance, (t.J_beta.transpose() * tau - t.Qstar).norm() / t.Qstar.norm());
     worst_power = std::max(worst_power, std::abs(tau.dot(t.J_beta * u) - t.Qstar.dot(u)) / (t.Qstar.norm() * u.norm()));
     worst_energy = std::max(worst_energy, test::energy_balance_error(model, s, u));
@@ -268,4 +268,77 @@ TEST_CASE(titled("inverse dynamics: J_beta^T tau = Q*, power and energy balances
   CHECK(worst_balance <= 1e-9);  // least-norm solve with cond(J_beta) up to ~1e4
   CHECK(worst_power <= 1e-9);
   CHECK(worst_energy <= 1e-6);  // five-point stencil at dt = 1e-5 on a motion with |s'| <= 1
+}
+
+TEST_CASE(titled("forward dynamics: inverts the inverse dynamics; no torque and no gravity keep the kinetic energy; power = d(T + V)/dt")) {
+  if constexpr (!gen::kHasDynamics) {
+    const Model model;
+    Data d;
+    DynamicsTerms t;
+    CommandVector u_dot;
+    CHECK_THROWS_WITH_AS(forward_dynamics(model, d, nominal_inputs(), CommandVector::Zero(), TorqueVector::Zero(), u_dot, t),
+                         doctest::Contains("no dynamics section"), Error);
+    return;
+  } else {
+    const Model model;
+    Data d;
+    DynamicsTerms t;
+    std::mt19937_64 rng(281);
+    std::uniform_real_distribution<double> half(-0.5, 0.5);
+    // 1. The torques distributed for the Q* of a u' give that u' back, whatever internal forces
+    //    (torques J_beta^T does not see) they hold.
+    double worst_round_trip = 0;
+    for (int trial = 0; trial < 5; ++trial) {
+      const Coordinates s = random_state(rng, model, 0.03);
+      CommandVector u, u_dot, back;
+      for (int k = 0; k < kCommandedCount; ++k) u(k) = half(rng), u_dot(k) = half(rng);
+      inverse_dynamics(model, d, s, u, u_dot, t);
+      // Two weightings share Q* differently: their difference is an internal force J_beta^T does not see.
+      const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::contribution());
+      const TorqueVector other = distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
+      if (kActuatedCount > kCommandedCount)  // redundant: else the split is unique
+        CHECK((tau - other).norm() > 1e-6 * tau.norm());  // else the second solve below checks nothing new
+      const Coordinates sddot = t.sddot;
+      for (const TorqueVector& torques : {tau, other}) {
+        forward_dynamics(model, d, s, u, torques, back, t);
+        worst_round_trip = std::max(worst_round_trip, (back - u_dot).norm() / u_dot.norm());
+        CHECK((t.sddot - sddot).cwiseAbs().maxCoeff() <= 1e-9 * std::max(1.0, sddot.cwiseAbs().maxCoeff()));
+      }
+    }
+    MESSAGE(kName << ": forward(inverse(u')) - u', relative: " << worst_round_trip);
+    CHECK(worst_round_trip <= 1e-9);  // cond(M) and cond(J_beta) up to ~1e4 each, on 1e-16 rounding
+
+    // 2. No torque, no gravity: the closure and the rolling constraints do no work.
+    gen::Params p = model.params();
+    p.*gen::kGravity = 0;
+    const Model weightless(p);
+    const Coordinates s0 = random_state(rng, model, 0.03);
+    CommandVector u0;
+    for (int k = 0; k < kCommandedCount; ++k) u0(k) = 0.2 * half(rng);
+    const test::ForwardRun free = test::integrate_forward(weightless, s0, u0, TorqueVector::Zero(), 0.2, 1e-3);
+    REQUIRE(free.complete);
+    double drift = 0;
+    for (double T : free.kinetic) drift = std::max(drift, std::abs(T - free.kinetic.front()));
+    MESSAGE(kName << ": kinetic energy " << free.kinetic.front() << " J, drift over 0.2 s without torque or gravity: "
+                  << drift / free.kinetic.front() << " relative");
+    CHECK(drift <= 1e-9 * free.kinetic.front());  // RK4 at dt = 1e-3 s: truncation ~dt^4 per unit time
+
+    // 3. Gravity and constant torques (those holding the start pose, plus 20 %): the actuators'
+    //    power is d(T + V)/dt, by a five-point stencil on the run's energies.
+    inverse_dynamics(model, d, s0, CommandVector::Zero(), CommandVector::Zero(), t);
+    const TorqueVector hold = 1.2 * distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
+    const double dt = 1e-4;
+    const test::ForwardRun driven = test::integrate_forward(model, s0, u0, hold, 0.01, dt);
+    REQUIRE(driven.complete);
+    double worst_power = 0, scale = 0;
+    for (std::size_t k = 2; k + 2 < driven.kinetic.size(); ++k) {
+      const auto E = [&](std::size_t j) { return driven.kinetic[j] + driven.potential[j]; };
+      const double dEdt = (E(k - 2) - 8 * E(k - 1) + 8 * E(k + 1) - E(k + 2)) / (12 * dt);
+      worst_power = std::max(worst_power, std::abs(driven.power[k] - dEdt));
+      scale = std::max(scale, std::abs(driven.power[k]));
+    }
+    MESSAGE(kName << ": |tau . J_beta u - d(T + V)/dt| = " << worst_power << " W (power up to " << scale << " W)");
+    // Stencil truncation ~dt^4 and rounding ~1e-16 |E| / dt (|E| of order 1e5 J for a few tonnes).
+    CHECK(worst_power <= 1e-6 * std::max(1.0, scale) + 1e-9 * std::abs(driven.potential.front()) / dt);
+  }
 }

@@ -325,7 +325,7 @@ TEST_CASE("walker: inverse dynamics: J_beta^T tau = Q*, power and energy balance
     sc.initial = random_state(rng, model);
     CommandVector u(d4(rng), d4(rng), d4(rng), d4(rng)), u_dot(d4(rng), d4(rng), d4(rng), d4(rng));
     inverse_dynamics(model, d, sc.initial, u, u_dot, t);
-    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
     worst_balance = std::max(worst_balance, (t.J_beta.transpose() * tau - t.Qstar).norm() / t.Qstar.norm());
     worst_power = std::max(worst_power, std::abs(tau.dot(t.J_beta * u) - t.Qstar.dot(u)) / (t.Qstar.norm() * u.norm()));
     worst_energy = std::max(worst_energy, test::energy_balance_error(model, sc.initial, u));

@@ -66,7 +66,7 @@ TEST_CASE("allocations: kinematic update, dependent rates and accelerations, inv
     solve_dependent_rates(model, *data, s, sdot, named_pair("A"));
     solve_dependent_accelerations(model, *data, s, sdot, sddot, named_pair("A"));
     inverse_dynamics(model, *data, s, CommandVector(0, 3, 0.1, 0), CommandVector::Zero(), terms);
-    const TorqueVector tau1 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::strong_weak());
+    const TorqueVector tau1 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::model_weights());
     const TorqueVector tau2 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::contribution());
     CHECK(tau1.allFinite());
     CHECK(tau2.allFinite());

@@ -63,7 +63,7 @@ TEST_CASE("dynamics: J_beta^T tau = Q* and the power balance tau . beta' = Q* . 
   Data d;
   DynamicsTerms t;
   Eigen::Matrix<double, 8, 8> G = Eigen::Matrix<double, 8, 8>::Random();
-  const Weighting weightings[] = {Weighting::strong_weak(), Weighting::contribution(),
+  const Weighting weightings[] = {Weighting::model_weights(), Weighting::contribution(),
                                   Weighting::diagonal_of((TorqueVector() << 1, 2, 3, 4, 5, 6, 7, 8).finished()),
                                   Weighting::matrix_of(G * G.transpose() + Eigen::Matrix<double, 8, 8>::Identity())};
   double worst_force = 0, worst_power = 0;
@@ -108,10 +108,10 @@ TEST_CASE("dynamics: the torques are the weighted least-norm solution to roundin
       Eigen::Vector4d sigma(1, std::pow(10.0, -k / 3.0), std::pow(10.0, -2 * k / 3.0), std::pow(10.0, -k));
       ActuatorJacobian J = U.leftCols<4>() * sigma.asDiagonal() * V.transpose();
       const CommandVector Qstar = random4(rng, 1.0);
-      for (const Weighting& w : {Weighting::strong_weak(), Weighting::contribution()}) {
+      for (const Weighting& w : {Weighting::model_weights(), Weighting::contribution()}) {
         const TorqueVector tau = distribute_torques(J, Qstar, w);
         // S S^T = W^-1 as distribute_torques defines it for these two diagonal weightings.
-        TorqueVector S = w.kind == Weighting::Kind::strong_weak ? kStrongWeakDiagonal.cwiseInverse().cwiseSqrt().eval()
+        TorqueVector S = w.kind == Weighting::Kind::model_weights ? kModelWeightDiagonal.cwiseInverse().cwiseSqrt().eval()
                                                                 : J.rowwise().norm().cwiseSqrt().eval();
         const LongJacobian A = (S.asDiagonal() * J).cast<long double>();
         // tau = S x, x the minimum-norm solution of A^T x = Q*.
@@ -132,8 +132,8 @@ TEST_CASE("dynamics: the weighted least norm is the optimum (no other solution h
   DynamicsTerms t;
   const Coordinates s = random_state(rng, model);
   inverse_dynamics(model, d, s, CommandVector(0.1, 0.5, 0.05, 0.0), CommandVector::Zero(), t);
-  const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
-  const auto cost = [](const TorqueVector& x) { return x.dot(kStrongWeakDiagonal.asDiagonal() * x); };
+  const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
+  const auto cost = [](const TorqueVector& x) { return x.dot(kModelWeightDiagonal.asDiagonal() * x); };
   // Add null-space directions of J_beta^T: the constraint still holds, the cost only grows.
   const Eigen::FullPivLU<Eigen::Matrix<double, 4, 8>> lu(t.J_beta.transpose());
   const Eigen::MatrixXd null = lu.kernel();
@@ -235,7 +235,7 @@ TEST_CASE("dynamics: the thesis' magnitudes: static torques ~2.8e4 N m (2D estim
   Coordinates s = nominal_inputs();
   solve_ik_closed_form(model, s);
   inverse_dynamics(model, d, s, CommandVector::Zero(), CommandVector::Zero(), t);
-  const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::strong_weak());
+  const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
   const double estimate = model.params().cxd / 2 * model.total_mass() * model.params().g / 2;  // thesis eq. 6.34
   CHECK(estimate == doctest::Approx(4.53e4).epsilon(1e-3));
   for (int k : {0, 3, 6, 7}) {  // psi_l2, psi_r2, theta_l6, theta_r6
@@ -253,7 +253,7 @@ TEST_CASE("dynamics: ID-1..3 reach the thesis' end states with torques of order 
   struct Run { int coordinate; double rate, duration, end; };
   for (const Run& r : {Run{c::x_C, 3.0, 0.494, 1.482}, Run{c::roll, -10 * kDeg, 0.541, -5.41 * kDeg},
                        Run{c::z_C, -3.0, 0.581, 0.257}}) {
-    for (const Weighting& w : {Weighting::strong_weak(), Weighting::contribution()}) {
+    for (const Weighting& w : {Weighting::model_weights(), Weighting::contribution()}) {
       Scenario sc;
       sc.rates(r.coordinate) = r.rate;
       sc.duration = r.duration;
@@ -274,7 +274,7 @@ TEST_CASE("dynamics: ID-3 ends 7 mm above the ground: the cabin would touch it a
   Scenario sc;
   sc.rates(c::z_C) = -3.0;
   sc.duration = 0.581;
-  sc.weighting = Weighting::strong_weak();
+  sc.weighting = Weighting::model_weights();
   const Trajectory tr = simulate(sc);
   const double clearance = tr.samples.back().clearance;
   CHECK(clearance == doctest::Approx(0.007).epsilon(0.05));
@@ -284,8 +284,8 @@ TEST_CASE("dynamics: ID-3 ends 7 mm above the ground: the cabin would touch it a
 TEST_CASE("dynamics: a rank-deficient J_beta and bad weights are clear errors; zero rows get zero torque") {
   ActuatorJacobian J = ActuatorJacobian::Zero();
   J(0, 0) = J(1, 1) = J(2, 2) = 1;  // nothing acts on pitch
-  CHECK_THROWS_WITH_AS(distribute_torques(J, CommandVector(1, 2, 3, 4), Weighting::strong_weak()),
-                       "J_beta: the actuator Jacobian has rank 3 < 4 with weighting 1 (strong/weak): the 8 actuators "
+  CHECK_THROWS_WITH_AS(distribute_torques(J, CommandVector(1, 2, 3, 4), Weighting::model_weights()),
+                       "J_beta: the actuator Jacobian has rank 3 < 4 with weighting 1 (the model file's weights): the 8 actuators "
                        "cannot produce every generalized force on u = [z_C', x_C', roll', pitch'] in this pose",
                        Error);
   J(3, 3) = 2;

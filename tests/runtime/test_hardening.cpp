@@ -53,7 +53,7 @@ TEST_CASE("hardening: a sample quantity that is not finite is named where it ari
   Scenario sc;
   sc.params.m_M1 = 1e308;
   sc.params.Ixx_M1 = sc.params.Iyy_M1 = sc.params.Izz_M1 = 1e308;
-  sc.weighting = Weighting::strong_weak();
+  sc.weighting = Weighting::model_weights();
   sc.rates(c::z_C) = 0.01;
   sc.duration = 0.01;
   Trajectory tr;

@@ -1,9 +1,9 @@
 // The wlx viewer: draws a model from its generated forward kinematics, plays the runs written by
-// `wlx viewer` / `wlx report` (runs/<id>.js), and lets the user drag the cabin, the foot targets
+// `wlx viewer` / `wlx report` (runs/<id>.js), and lets the user drag the base, the foot targets
 // and the wheels' ground levels while the limbs follow by wlx's closed-form IK (the WebAssembly
 // module built from the generated headers and the runtime's sources, wasm/wlx_<model>.js).
 //
-// Nothing about a robot is written here: names, the frame tree, limbs, wheels, the cabin box and
+// Nothing about a robot is written here: names, the frame tree, limbs, wheels, the clearance box and
 // the nominal pose come from the module (wlx_model_info_json). Loading is by <script> tags only,
 // so the page works from file:// with no server.
 import * as THREE from 'three';
@@ -107,13 +107,13 @@ const axes = new THREE.AxesHelper(1.0);  // K0: x red, y green, z blue
 scene.add(axes);
 
 const materials = {
-  cabin: new THREE.MeshStandardMaterial({ color: 0xf2b33d, roughness: 0.6, transparent: true, opacity: 0.9 }),
+  base: new THREE.MeshStandardMaterial({ color: 0xf2b33d, roughness: 0.6, transparent: true, opacity: 0.9 }),
   link: new THREE.MeshStandardMaterial({ color: 0x3b4a63, roughness: 0.5 }),
   joint: new THREE.MeshStandardMaterial({ color: 0x6d7f9c }),
   wheel: new THREE.MeshStandardMaterial({ color: 0x222222, roughness: 0.9 }),
   foot: new THREE.MeshStandardMaterial({ color: 0x2a7f62 }),
   com: new THREE.MeshStandardMaterial({ color: 0xd0306a }),
-  // Handles are drawn over everything (depthTest off): the cabin's sits inside the cabin box.
+  // Handles are drawn over everything (depthTest off): the base's sits inside the clearance box.
   handle: new THREE.MeshStandardMaterial({ color: 0xff7a1a, transparent: true, opacity: 0.85, depthTest: false }),
   handleSelected: new THREE.MeshStandardMaterial({ color: 0xff2a00, transparent: true, opacity: 0.95, depthTest: false }),
   ground: new THREE.MeshStandardMaterial({ color: 0x8a6d3b, transparent: true, opacity: 0.45, side: THREE.DoubleSide }),
@@ -179,13 +179,13 @@ function buildMachine(info) {
     machine.add(mesh);
     return mesh;
   });
-  let cabin = null;
-  if (info.cabinBox) {
-    const [hx, hy, hz] = info.cabinBox.halfExtents;
-    cabin = new THREE.Mesh(new THREE.BoxGeometry(2 * hx, 2 * hy, 2 * hz), materials.cabin);
-    cabin.matrixAutoUpdate = false;
-    cabin.add(new THREE.AxesHelper(0.6));
-    machine.add(cabin);
+  let base = null;
+  if (info.clearanceBox) {
+    const [hx, hy, hz] = info.clearanceBox.halfExtents;
+    base = new THREE.Mesh(new THREE.BoxGeometry(2 * hx, 2 * hy, 2 * hz), materials.base);
+    base.matrixAutoUpdate = false;
+    base.add(new THREE.AxesHelper(0.6));
+    machine.add(base);
   }
   const wheels = info.wheels.map((w) => {
     const disc = new THREE.Mesh(new THREE.CylinderGeometry(w.radius, w.radius, 0.18, 40), materials.wheel);
@@ -205,7 +205,7 @@ function buildMachine(info) {
     comGroup.add(mesh);
     return mesh;
   });
-  parts = { links, joints, cabin, wheels, feet, grounds, coms };
+  parts = { links, joints, base, wheels, feet, grounds, coms };
 }
 
 const _m = new THREE.Matrix4(), _a = new THREE.Vector3(), _b = new THREE.Vector3(), _y = new THREE.Vector3(0, 1, 0);
@@ -226,7 +226,7 @@ function placeMachine() {
     link.mesh.scale.set(0.055, length, 0.055);
   }
   parts.joints.forEach((mesh, f) => mesh.position.copy(origin(f)));
-  if (parts.cabin) frameMatrix(positions, rotations, info.cabinBox.frame, parts.cabin.matrix);
+  if (parts.base) frameMatrix(positions, rotations, info.clearanceBox.frame, parts.base.matrix);
   for (const w of parts.wheels) {
     // A disc in the contact frame: its axle along the lateral axis, its centre a radius above
     // the contact point along the frame's remaining (normal) axis.
@@ -247,7 +247,7 @@ function placeMachine() {
   updatePanel();
 }
 
-// --- handles: cabin, foot targets, ground levels ------------------------------------------------
+// --- handles: base, foot targets, ground levels ------------------------------------------------
 const gizmo = new TransformControls(camera, renderer.domElement);
 gizmo.setSize(0.8);
 scene.add(gizmo.getHelper());
@@ -258,10 +258,10 @@ function makeHandles(info) {
   for (const h of app.handles) scene.remove(h.object);
   app.handles = [];
   const names = info.coordinates.map((c) => c.name);
-  if (info.cabinPoseInputs) {
+  if (info.basePoseInputs) {
     const object = new THREE.Mesh(new THREE.OctahedronGeometry(0.22), materials.handle);
-    app.handles.push({ id: 'cabin-move', label: `cabin: move (${names.slice(0, 3).join(', ')})`, kind: 'cabin', mode: 'translate', object });
-    app.handles.push({ id: 'cabin-turn', label: `cabin: turn (${names.slice(3, 6).join(', ')})`, kind: 'cabin', mode: 'rotate', object });
+    app.handles.push({ id: 'base-move', label: `base: move (${names.slice(0, 3).join(', ')})`, kind: 'base', mode: 'translate', object });
+    app.handles.push({ id: 'base-turn', label: `base: turn (${names.slice(3, 6).join(', ')})`, kind: 'base', mode: 'rotate', object });
   }
   const { points, grounds } = targetsFromClosureRows(info);
   for (const p of points) {
@@ -301,7 +301,7 @@ function placeHandles(positions, rotations) {
   const q = app.inputs;
   for (const h of app.handles) {
     if (app.selected === h && gizmo.dragging) continue;  // the pointer moves it
-    if (h.kind === 'cabin') {
+    if (h.kind === 'base') {
       h.object.position.set(q[0], q[1], q[2]);
       h.object.rotation.set(q[5], q[4], q[3], 'ZYX');  // R = Rz(yaw) Ry(pitch) Rx(roll), checked by the module
     } else if (h.kind === 'point') {
@@ -329,7 +329,7 @@ function selectHandle(id) {
 // The inputs a handle's pose asks for.
 function inputsForHandle(h, object) {
   const q = Float64Array.from(app.inputs);
-  if (h.kind === 'cabin') {
+  if (h.kind === 'base') {
     q[0] = object.position.x; q[1] = object.position.y; q[2] = object.position.z;
     const e = new THREE.Euler().setFromQuaternion(object.quaternion, 'ZYX');
     q[3] = e.z; q[4] = e.y; q[5] = e.x;
@@ -382,7 +382,7 @@ renderer.domElement.addEventListener('pointerdown', (event) => {
   const hit = raycaster.intersectObjects(app.handles.map((h) => h.object), false)[0];
   if (!hit) return;
   const candidates = app.handles.filter((h) => h.object === hit.object);
-  // A second click on the cabin handle switches between moving and turning.
+  // A second click on the base handle switches between moving and turning.
   const next = candidates.length > 1 && candidates.includes(app.selected)
     ? candidates[(candidates.indexOf(app.selected) + 1) % candidates.length] : candidates[0];
   selectHandle(next.id);
@@ -597,7 +597,7 @@ viewer.api = {
   inputs: () => Array.from(app.inputs),
   residual: () => app.residual,
   message: () => app.message,
-  // Moves a handle by (dx, dy, dz) in K0 (and, for the cabin, by (dyaw, dpitch, droll)) in
+  // Moves a handle by (dx, dy, dz) in K0 (and, for the base, by (dyaw, dpitch, droll)) in
   // `steps` equal steps, each going through the same path as a mouse drag of the gizmo.
   drag(id, delta, steps = 10) {
     const h = app.handles.find((x) => x.id === id);

@@ -75,11 +75,11 @@ function cliIk(inputs) {
     check((await api(page, () => wlxViewer.api.message())) === '', 'no message after loading NH-1');
     const pixels = await api(page, () => wlxViewer.api.paintedPixels());
     check(pixels.painted > 0.03 * pixels.total, 'the 3D view is not blank', `${pixels.painted} of ${pixels.total} pixels drawn`);
-    // The cabin box, found by the module from the generated clearance function: models/excavator.yaml's
+    // The clearance box, found by the module from the generated clearance function: models/excavator.yaml's
     // clearance is frame C (frame 0) of size cxd x cyd x cabin_height = 3 x 3 x 0.5 m.
-    const box = (await api(page, () => wlxViewer.api.info())).cabinBox;
+    const box = (await api(page, () => wlxViewer.api.info())).clearanceBox;
     check(box && box.frame === 0 && box.halfExtents.every((h, i) => Math.abs(h - [1.5, 1.5, 0.25][i]) < 1e-9),
-          'the cabin box is the clearance box of the model file', JSON.stringify(box));
+          'the clearance box is the clearance box of the model file', JSON.stringify(box));
     const run = await api(page, () => wlxViewer.api.runInfo());
     check(run && run.samples > 100 && run.plot.columns.length === 2, 'NH-1 loaded with its dependent rates plotted', JSON.stringify(run));
     // The wheels' tracks run through their contact points from the first sample to the last, as
@@ -118,8 +118,8 @@ function cliIk(inputs) {
 
     // --- dragging: the WebAssembly IK follows, the closure holds ----------------------------------
     const drags = [
-      ['cabin-move', { z: -0.3, x: 0.2 }],
-      ['cabin-turn', { yaw: 0.1, pitch: 0.05, roll: -0.04 }],
+      ['base-move', { z: -0.3, x: 0.2 }],
+      ['base-turn', { yaw: 0.1, pitch: 0.05, roll: -0.04 }],
       ['target-F_l', { x: 0.3, z: 0.4 }],
       ['target-F_r', { y: -0.3 }],
       ['ground-W_l', { z: 0.15 }],
@@ -224,8 +224,8 @@ function cliIk(inputs) {
     const walkerHandles = await api(walker, () => wlxViewer.api.handles());
     const walkerCoordinates = Object.keys(await api(walker, () => wlxViewer.api.coordinates()));
     check(walkerCoordinates.includes('hub_l') && !walkerCoordinates.includes('psi_l2'), 'the walker page shows the walker\'s coordinates');
-    const cabinDrag = await api(walker, () => wlxViewer.api.drag('cabin-move', { z: -0.2 }, 5));
-    check(cabinDrag.ok && (await api(walker, () => wlxViewer.api.residual())) < 1e-9, 'dragging the walker\'s body keeps its closure',
+    const baseDrag = await api(walker, () => wlxViewer.api.drag('base-move', { z: -0.2 }, 5));
+    check(baseDrag.ok && (await api(walker, () => wlxViewer.api.residual())) < 1e-9, 'dragging the walker\'s body keeps its closure',
           walkerHandles.map((h) => h.id).join(' '));
     await walker.screenshot({ path: path.join(outDir, 'walker.png') });
   } finally {

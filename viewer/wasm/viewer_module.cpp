@@ -2,7 +2,7 @@
 // sources (forward kinematics, the closed-form IK, the closure), compiled with emscripten exactly
 // as the native runtime is compiled per model (WLX_MODEL=<name>, generated/<name> on the include
 // path). The page (viewer/src/) calls the C functions below through the module's heap; it restates
-// nothing about a robot: names, the frame tree, limbs, wheels, the cabin box and the nominal pose
+// nothing about a robot: names, the frame tree, limbs, wheels, the clearance box and the nominal pose
 // all come from wlx_model_info_json().
 //
 // Calls are single-threaded and reuse one Model and one Data (no allocation per call).
@@ -79,7 +79,7 @@ std::string integer(int v) { return std::to_string(v); }
 // The box of the generated clearance function (the model file's `clearance`: a frame and a size):
 // clearance(s) = z_f - sum_i h_i |R_f(2, i)| for the box's frame f and half extents h. The tables
 // do not name the frame, so it is found here: for each frame, h is fitted to the clearance at a few
-// poses of the cabin (each solved by the IK) and checked against all of them; the first frame the
+// poses of the base (each solved by the IK) and checked against all of them; the first frame the
 // formula fits to 1e-9 m is the box's. The model file's parameter names never appear here.
 struct ClearanceBox {
   int frame = -1;
@@ -121,9 +121,9 @@ ClearanceBox clearance_box() {
 }
 
 // Whether the first six inputs are the pose of frame 0 as position and Rz(yaw) Ry(pitch) Rx(roll)
-// (the convention the page's cabin handles use): checked on the model's own forward kinematics at
-// an arbitrary pose, so a model built otherwise gets no cabin handles rather than wrong ones.
-bool cabin_pose_is_first_six_inputs() {
+// (the convention the page's base handles use): checked on the model's own forward kinematics at
+// an arbitrary pose, so a model built otherwise gets no base handles rather than wrong ones.
+bool base_pose_is_first_six_inputs() {
   Coordinates s = nominal_inputs();
   s.head<6>() << 0.3, -0.2, 1.7, 0.4, -0.25, 0.15;
   forward_kinematics(model(), data(), s);
@@ -177,10 +177,10 @@ std::string build_info_json() {
   if (gen::kHasClearance) {
     const ClearanceBox box = clearance_box();
     if (box.frame >= 0)
-      j += ",\"cabinBox\":{\"frame\":" + integer(box.frame) + ",\"halfExtents\":" +
+      j += ",\"clearanceBox\":{\"frame\":" + integer(box.frame) + ",\"halfExtents\":" +
            array(std::array<double, 3>{box.half_extents(0), box.half_extents(1), box.half_extents(2)}, number) + "}";
   }
-  j += ",\"cabinPoseInputs\":" + std::string(cabin_pose_is_first_six_inputs() ? "true" : "false");
+  j += ",\"basePoseInputs\":" + std::string(base_pose_is_first_six_inputs() ? "true" : "false");
   j += ",\"ikTolerance\":" + number(gen::kIkTolerance);
   return j + "}";
 }

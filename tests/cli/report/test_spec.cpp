@@ -136,7 +136,7 @@ TEST_CASE("report file: each error names the file, the line, the key and the rea
   CHECK(error_of(variant("quantity: total_mass", "quantity: total_mass, run: R1")) ==
         "claims.yaml:7: claims[0].measure.run: does not apply to quantity 'total_mass'");
   CHECK(error_of(variant("quantity: total_mass", "quantity: static_torque, joints: [a], weighting: 3")) ==
-        "claims.yaml:7: claims[0].measure.weighting: must be 1 (strong/weak) or 2 (by contribution)");
+        "claims.yaml:7: claims[0].measure.weighting: must be 1 (the model file's weights) or 2 (by contribution)");
   CHECK(error_of(variant("quantity: total_mass", "quantity: peak_torque, runs: []")) ==
         "claims.yaml:7: claims[0].measure.runs: must be a non-empty list of names");
   // Two claims with one id.

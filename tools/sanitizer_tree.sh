@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# One clang tree with AddressSanitizer + UndefinedBehaviorSanitizer (and libFuzzer's coverage
+# instrumentation) that serves both the whole test suite and the fuzzers, so the sanitized
+# objects are compiled once (.ci/run; issue "CI within 30 minutes").
+#   tools/sanitizer_tree.sh test          configure, build the tests, run them (ctest)
+#   tools/sanitizer_tree.sh fuzz SECONDS  configure, build the libFuzzer targets, fuzz each for SECONDS
+# Not sanitized: the benchmarks, the viewer (emscripten's WebAssembly) and the Python module, which
+# take no untrusted input beyond what the tests run through the command line.
+# The tree is ${WLX_SANITIZER_DIR:-build-sanitize}.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+what=${1:?usage: tools/sanitizer_tree.sh test | fuzz SECONDS}
+tree=${WLX_SANITIZER_DIR:-build-sanitize}
+missing=()
+for p in clang-14 libclang-rt-14-dev; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  apt_get=(apt-get); [ "$(id -u)" -eq 0 ] || apt_get=(sudo apt-get)
+  "${apt_get[@]}" update -qq && DEBIAN_FRONTEND=noninteractive "${apt_get[@]}" install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+if [ ! -f "$tree/CMakeCache.txt" ]; then
+  # -O1 with line tables only: the sanitizers' reports keep file:line, and the big straight-line
+  # generated functions compile in a fraction of the time full debug information takes.
+  cmake -S . -B "$tree" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_COMPILER=clang++-14 \
+        -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -gline-tables-only -DNDEBUG" \
+        -DWLX_SANITIZE=ON -DWLX_FUZZ=ON -DWLX_BUILD_BENCHMARKS=OFF -DWLX_BUILD_PYTHON=OFF -DWLX_BUILD_VIEWER=OFF \
+        -DWLX_INSTALL=OFF > /dev/null
+fi
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+# CLN (GiNaC's numbers) keeps static memory until exit.
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tools/lsan.supp}
+fuzz_targets=(ik_numbers json_input model_file command_line)
+
+case "$what" in
+  test)
+    cmake --build "$tree" --parallel "$(nproc)"
+    ctest --test-dir "$tree" --output-on-failure --parallel "$(nproc)"
+    ;;
+  fuzz)
+    seconds=${2:-60}
+    cmake --build "$tree" --parallel "$(nproc)" --target "${fuzz_targets[@]/#/fuzz_}"
+    # Crashers stop the run and are copied to tests/fuzz/regressions/<target>/ (commit them:
+    # every test run replays that folder); new interesting inputs stay in the tree.
+    status=0
+    for target in "${fuzz_targets[@]}"; do
+      work=$tree/corpus-$target artifacts=$tree/artifacts-$target
+      mkdir -p "$work" "$artifacts" "tests/fuzz/regressions/$target"
+      echo "fuzz_$target: ${seconds} s"
+      seeds=("tests/fuzz/corpus/$target" "tests/fuzz/regressions/$target")
+      [ "$target" = model_file ] && seeds+=(models)
+      if ! ASAN_OPTIONS=detect_leaks=1 "$tree/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -max_len=4096 \
+          -timeout=10 -artifact_prefix="$artifacts/" "$work" "${seeds[@]}" > "$tree/fuzz-$target.log" 2>&1; then
+        status=1
+        cp "$artifacts"/* "tests/fuzz/regressions/$target/" 2>/dev/null || true
+        tail -40 "$tree/fuzz-$target.log"
+      fi
+      grep -E "^#[0-9]+.*DONE|Done [0-9]+ runs" "$tree/fuzz-$target.log" | tail -1 || true
+    done
+    exit $status
+    ;;
+  *) echo "usage: tools/sanitizer_tree.sh test | fuzz SECONDS" >&2; exit 2 ;;
+esac
