@@ -104,6 +104,14 @@ int main(int argc, char** argv) {
       if (!std::regex_match(opt.name_space, qualified))
         throw ModelFileError(fmt::format("--namespace: '{}' is not a C++ qualified name such as wlx::mine",
                                          opt.name_space.substr(0, 60)));
+      // Each part is pasted in as a name: no keyword, macro, std or Eigen (the model file's rule).
+      for (std::size_t begin = 0; begin <= opt.name_space.size();) {
+        const std::size_t end = std::min(opt.name_space.find("::", begin), opt.name_space.size());
+        const std::string part = opt.name_space.substr(begin, end - begin);
+        if (const std::string why = cpp_name_problem(part); !why.empty())
+          throw ModelFileError(fmt::format("--namespace: '{}' cannot be used: {}", part, why));
+        begin = end + 2;
+      }
     }
     const Model model = load_model_file(model_path);
     opt.model_name = model.name;
