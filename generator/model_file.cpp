@@ -153,8 +153,11 @@ struct Source {
 
   [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path, const std::string& reason) const {
     const std::string field = path.empty() ? "" : path + ": ";
-    if (mark.is_null()) throw ModelFileError(fmt::format("{}: {}{}", name, field, reason));
-    throw ModelFileError(fmt::format("{}:{}:{}: {}{}", name, mark.line + 1, mark.column + 1, field, reason));
+    // The file's name as one line: a name with a line break must not forge a message line.
+    std::string shown;
+    for (const char c : name) shown += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? fmt::format("\\x{:02x}", static_cast<unsigned char>(c)) : std::string(1, c);
+    if (mark.is_null()) throw ModelFileError(fmt::format("{}: {}{}", shown, field, reason));
+    throw ModelFileError(fmt::format("{}:{}:{}: {}{}", shown, mark.line + 1, mark.column + 1, field, reason));
   }
 };
 
