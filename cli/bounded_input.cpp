@@ -1,4 +1,5 @@
 #include "bounded_input.hpp"
+#include "interrupt.hpp"
 
 #include <fmt/format.h>
 
@@ -86,8 +87,12 @@ nlohmann::json parse_json_bounded(std::string_view text, const std::string& wher
 LineRead read_line_capped(std::istream& in, std::string& line, std::size_t limit) {
   line.clear();
   bool any = false, too_long = false;
+  std::size_t bytes = 0;
   for (int c; (c = in.get()) != std::char_traits<char>::eof();) {
     any = true;
+    // A line that never ends (data arriving without a '\n') never blocks, so no read is cut short
+    // by a signal: the signal is asked for every 64 KiB instead.
+    if ((++bytes & 0xFFFF) == 0) throw_if_interrupted();
     if (c == '\n') return too_long ? LineRead::too_long : LineRead::line;
     if (too_long) continue;
     if (line.size() == limit) {

@@ -465,12 +465,13 @@ bool has_temporary(const fs::path& dir) {
 
 }  // namespace
 
-TEST_CASE("faults: SIGINT and SIGTERM during simulate: the samples so far kept, said partial, exit 130 / 143") {
+TEST_CASE("faults: SIGINT, SIGTERM and SIGHUP during simulate: the samples so far kept, said partial, exit 130 / 143 / 129") {
   // 10^6 steps (about 10 s): long enough to be interrupted midway.
   const fs::path dir = work_dir() / "signals";
   fs::create_directories(dir);
   write(dir / "long.json", R"({"rates": {"roll": 0.0872664626}, "dependent": ["y_C", "yaw"], "duration": 1, "dt": 1e-6})");
-  for (const auto& [signal, code, name] : {std::tuple{SIGINT, 130, "SIGINT"}, std::tuple{SIGTERM, 143, "SIGTERM"}}) {
+  for (const auto& [signal, code, name] :
+       {std::tuple{SIGINT, 130, "SIGINT"}, std::tuple{SIGTERM, 143, "SIGTERM"}, std::tuple{SIGHUP, 129, "SIGHUP"}}) {
     CAPTURE(name);
     const fs::path out = dir / name;
     const Spawned s = start({"simulate", (dir / "long.json").string(), "--out", out.string()});
@@ -671,4 +672,50 @@ TEST_CASE("faults: a scenario's id or description with a line break or a control
   };
   int index = 900;
   for (const Case& c : cases) check_case(c, index++);
+}
+
+TEST_CASE("faults: ik --batch on a line that never ends (/dev/zero) stops at SIGTERM, SIGINT and SIGHUP within a second") {
+  // No '\n' ever comes and no read ever blocks: the signal must be asked for while reading.
+  for (const auto& [signal, code] : {std::pair{SIGTERM, 143}, std::pair{SIGINT, 130}, std::pair{SIGHUP, 129}}) {
+    CAPTURE(signal);
+    const Spawned s = start({"ik", "--batch"}, {.stdin_path = "/dev/zero"});
+    REQUIRE(wait_for([&] { return catches(s.pid, signal); }));
+    std::this_thread::sleep_for(200ms);  // well into the endless line
+    const auto t0 = std::chrono::steady_clock::now();
+    ::kill(s.pid, signal);
+    const Result r = finish(s);
+    CAPTURE(r.err);
+    CHECK(r.signal == 0);
+    CHECK(r.code == code);
+    CHECK(std::chrono::steady_clock::now() - t0 < 1s);
+  }
+}
+
+TEST_CASE("faults: SIGTERM and SIGHUP during wlx viewer's simulation: exit 143 / 129, no run file, no temporary") {
+  // A stand-in for the built viewer (its files are copied, not run): WLX_VIEWER_DIR points at it.
+  const fs::path dir = work_dir() / "viewer-signal", fake = dir / "built";
+  fs::create_directories(fake / "wasm");
+  write(fake / "viewer.html", "<!DOCTYPE html>");
+  write(fake / "viewer.js", "// viewer");
+  write(fake / "wasm" / "wlx_excavator.js", "// module");
+  write(dir / "long.json", R"({"id": "long", "rates": {"roll": 0.0872664626}, "dependent": ["y_C", "yaw"], "duration": 1, "dt": 1e-6})");
+  ::setenv("WLX_VIEWER_DIR", fake.c_str(), 1);
+  for (const auto& [signal, code] : {std::pair{SIGTERM, 143}, std::pair{SIGHUP, 129}}) {
+    CAPTURE(signal);
+    const fs::path out = dir / ("out-" + std::to_string(signal));
+    const Spawned s = start({"viewer", (dir / "long.json").string(), "--out", out.string()});
+    // The viewer's files are in place once the simulation runs.
+    REQUIRE(wait_for([&] { return fs::exists(out / "runs" / "index.js") && catches(s.pid, signal); }));
+    std::this_thread::sleep_for(300ms);
+    const auto t0 = std::chrono::steady_clock::now();
+    ::kill(s.pid, signal);
+    const Result r = finish(s);
+    CAPTURE(r.err);
+    CHECK(r.signal == 0);
+    CHECK(r.code == code);
+    CHECK(std::chrono::steady_clock::now() - t0 < 1s);
+    CHECK(!fs::exists(out / "runs" / "long.js"));
+    CHECK(incomplete_files(out).empty());
+  }
+  ::unsetenv("WLX_VIEWER_DIR");
 }
