@@ -6,7 +6,13 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <sys/mount.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
+
+#include <cerrno>
+#include <cstring>
+#include <map>
 
 namespace {
 
@@ -199,4 +205,65 @@ TEST_CASE("wlx-gen: a model file that never ends or is not a file exits 2 at onc
   CHECK(r.signal == 0);
   CHECK(r.code == 2);
   CHECK(r.err.find("more than the limit of 1048576 bytes") != std::string::npos);
+}
+
+// ---- wlx-gen's writes (issue 26) ----
+
+namespace {
+
+// The files under `dir` (relative path -> content).
+std::map<std::string, std::string> tree(const std::filesystem::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+    if (e.is_regular_file() || e.is_symlink()) files[std::filesystem::relative(e.path(), dir).string()] = wlx_test::slurp(e.path());
+  return files;
+}
+
+}  // namespace
+
+TEST_CASE("wlx-gen: a planted symlink is never written through; a link under a header's name is replaced, its target untouched") {
+  const std::filesystem::path dir = wlx_test::work_dir() / "symlinks", out = dir / "out", gen = out / "wlx" / "gen";
+  std::filesystem::create_directories(gen);
+  wlx_test::write(dir / "victim", "precious");
+  wlx_test::write(dir / "victim2", "precious too");
+  // The fixed temporary name an earlier wlx-gen used, and a header's own name.
+  std::filesystem::create_symlink(dir / "victim", gen / "types.hpp.tmp");
+  std::filesystem::create_symlink(dir / "victim2", gen / "params.hpp");
+  const auto r = wlx_test::run({WLX_ARM_MODEL_FILE, "--out", out.string(), "--quiet"});
+  CAPTURE(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(wlx_test::slurp(dir / "victim") == "precious");
+  CHECK(wlx_test::slurp(dir / "victim2") == "precious too");
+  CHECK(!std::filesystem::is_symlink(gen / "params.hpp"));
+  CHECK(wlx_test::slurp(gen / "params.hpp").find("struct Params") != std::string::npos);
+  for (const auto& e : std::filesystem::directory_iterator(gen))
+    if (e.path().filename() != "types.hpp.tmp") CHECK(e.path().extension() == ".hpp");  // no temporary of this run left
+}
+
+TEST_CASE("wlx-gen: a full disk exits 74 naming the header; the previous header set stays whole, no temporary left") {
+  const std::filesystem::path disk = wlx_test::work_dir() / "small-disk";
+  std::filesystem::create_directories(disk);
+  if (::mount("tmpfs", disk.c_str(), "tmpfs", 0, "size=512k") != 0) {
+    MESSAGE("skipped: cannot mount a tmpfs here (" << std::strerror(errno) << "): needs root or CAP_SYS_ADMIN");
+    return;
+  }
+  const std::filesystem::path out = disk / "out", model = wlx_test::work_dir() / "arm-changed.yaml";
+  REQUIRE(wlx_test::run({WLX_ARM_MODEL_FILE, "--out", out.string(), "--quiet"}).code == 0);
+  const auto before = tree(out);
+  REQUIRE(before.size() > 5);
+  // Another model text: every header changes (its banner's fingerprint). Then the disk is filled
+  // to within 32 KiB, less than the set needs.
+  wlx_test::write(model, replaced(arm_text(), "value: 0.6, unit: m", "value: 0.61, unit: m"));
+  struct statvfs fs {};
+  REQUIRE(::statvfs(disk.c_str(), &fs) == 0);
+  const std::size_t free_bytes = fs.f_bavail * fs.f_frsize;
+  REQUIRE(free_bytes > 32768);
+  wlx_test::write(disk / "filler", std::string(free_bytes - 32768, 'x'));
+  const auto r = wlx_test::run({model.string(), "--out", out.string(), "--quiet"});
+  CAPTURE(r.err);
+  CHECK(r.code == 74);
+  CHECK(r.err.find(".hpp: ") != std::string::npos);
+  CHECK(r.err.find("No space left on device") != std::string::npos);
+  CHECK(tree(out) == before);  // byte for byte the earlier set, nothing added
+  ::umount2(disk.c_str(), MNT_DETACH);
 }
