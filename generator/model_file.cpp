@@ -546,12 +546,39 @@ class Parser {
     GiNaC::symtab table = params_;
     if (allow_coordinates) table.insert(coordinates_.begin(), coordinates_.end());
     table["Pi"] = GiNaC::Pi;
+    ex e;
     try {
       GiNaC::parser reader(table, true);
-      return reader(s);
-    } catch (const std::exception& e) {
-      it.fail(fmt::format("cannot read the expression '{}': {}", excerpt(s), e.what()));
+      e = reader(s);
+    } catch (const std::exception& error) {
+      it.fail(fmt::format("cannot read the expression '{}': {}", excerpt(s), error.what()));
     }
+    check_at_defaults(it, s, e);
+    return e;
+  }
+
+  // An expression of parameters alone is evaluated at their defaults: acos(2) or sqrt(-a) would be
+  // emitted as code that yields NaN, 1/(a - b) with a = b as an Inf, so each is an error here,
+  // naming the field. (An expression with coordinates is a joint step, checked where it is used.)
+  void check_at_defaults(const Item& it, const std::string& s, const ex& e) const {
+    for (const auto& kv : coordinates_)
+      if (e.has(kv.second)) return;
+    std::string problem;
+    try {
+      const ex v = e.subs(param_defaults_).evalf();
+      if (!GiNaC::is_a<GiNaC::numeric>(v)) {
+        problem = "does not evaluate to a number";
+      } else {
+        const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(v);
+        std::ostringstream shown;
+        shown << n;
+        if (!n.is_real()) problem = fmt::format("is complex ({})", excerpt(shown.str()));
+        else if (!std::isfinite(n.to_double())) problem = fmt::format("is not finite ({})", n.to_double());
+      }
+    } catch (const std::exception& error) {  // GiNaC's pole_error: 1/0, log(0), tan(Pi/2)
+      problem = fmt::format("is singular ({})", error.what());
+    }
+    if (!problem.empty()) it.fail(fmt::format("'{}' at the default parameters {}", excerpt(s), problem));
   }
 
   Vec3 vector3(const Item& it) const {
@@ -589,6 +616,7 @@ class Parser {
       m_.parameters.push_back({n, value, unit, f.optional("meaning") ? f["meaning"].text() : "", GiNaC::realsymbol(n)});
       m_.parameter_kinds.push_back(pk);
       params_[n] = m_.parameters.back().symbol;
+      param_defaults_[m_.parameters.back().symbol] = value;
       symbol_kind_[n] = "parameter";
     });
     if (m_.parameters.empty()) list.fail("a model needs at least one parameter");
@@ -1109,6 +1137,7 @@ class Parser {
   Source src_;
   Model m_;
   GiNaC::symtab params_, coordinates_;
+  GiNaC::exmap param_defaults_;  // each parameter's symbol -> its default, for check_at_defaults
   std::map<std::string, std::string> symbol_kind_;
   std::map<std::string, std::vector<Env>> repeat_;
   std::size_t expanded_entries_ = 0;

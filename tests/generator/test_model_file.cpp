@@ -300,3 +300,20 @@ TEST_CASE("model file: only a regular file of at most 1 MiB is read") {
   CHECK_THROWS_WITH_AS(load_model_file(big), doctest::Contains("more than the limit of 1048576 bytes"), ModelFileError);
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("model file: an expression that is NaN, complex, infinite or singular at the default parameters names its field") {
+  const auto with = [](const std::string& expression) {
+    return error_of(tiny_model(fmt::format("  - {{name: base, parent: K0, chain: [rz: q, tx: {}]}}\n", expression)));
+  };
+  // acos(2) was emitted as code computing sqrt(-3): NaN in every call.
+  const std::string acos2 = with("acos(2)");
+  CAPTURE(acos2);
+  CHECK(acos2.rfind("hostile.yaml:8:", 0) == 0);
+  CHECK(acos2.find("frames[0].chain[1].tx: 'acos(2)' at the default parameters is complex") != std::string::npos);
+  CHECK(with("sqrt(-a)").find("'sqrt(-a)' at the default parameters is complex") != std::string::npos);
+  CHECK(with("1/(a - 0.5)").find("'1/(a - 0.5)' at the default parameters is singular") != std::string::npos);  // a = 0.5
+  CHECK(with("log(a - 0.5)").find("at the default parameters is singular") != std::string::npos);
+  CHECK(with("exp(a*2000)").find("at the default parameters is not finite") != std::string::npos);
+  CHECK(with("acos(a)") == "");  // a = 0.5: fine
+  CHECK(with("sqrt(a)/a") == "");
+}
