@@ -1,4 +1,5 @@
 #include "bounded_input.hpp"
+#include "interrupt.hpp"
 
 #include <fmt/format.h>
 
@@ -6,30 +7,11 @@
 #include <cctype>
 #include <cmath>
 #include <wlx/error.hpp>
+#include <wlx/text.hpp>
 
 namespace wlx::cli {
 
-namespace {
-
-// Length of the well-formed UTF-8 sequence at text[k] (RFC 3629, table 3-7 of Unicode), or 0.
-std::size_t utf8_length(std::string_view text, std::size_t k) {
-  const auto byte = [&](std::size_t i) { return k + i < text.size() ? static_cast<unsigned char>(text[k + i]) : 0u; };
-  const unsigned c = byte(0);
-  const auto in = [](unsigned v, unsigned lo, unsigned hi) { return v >= lo && v <= hi; };
-  if (c < 0x80) return 1;
-  if (in(c, 0xC2, 0xDF)) return in(byte(1), 0x80, 0xBF) ? 2 : 0;
-  if (in(c, 0xE0, 0xEF)) {
-    const unsigned lo = c == 0xE0 ? 0xA0 : 0x80, hi = c == 0xED ? 0x9F : 0xBF;
-    return in(byte(1), lo, hi) && in(byte(2), 0x80, 0xBF) ? 3 : 0;
-  }
-  if (in(c, 0xF0, 0xF4)) {
-    const unsigned lo = c == 0xF0 ? 0x90 : 0x80, hi = c == 0xF4 ? 0x8F : 0xBF;
-    return in(byte(1), lo, hi) && in(byte(2), 0x80, 0xBF) && in(byte(3), 0x80, 0xBF) ? 4 : 0;
-  }
-  return 0;
-}
-
-}  // namespace
+using text::utf8_length;
 
 std::string excerpt(std::string_view text) {
   // Valid UTF-8 out, always: messages go into JSON (ik --batch's error lines), whose writer
@@ -105,8 +87,12 @@ nlohmann::json parse_json_bounded(std::string_view text, const std::string& wher
 LineRead read_line_capped(std::istream& in, std::string& line, std::size_t limit) {
   line.clear();
   bool any = false, too_long = false;
+  std::size_t bytes = 0;
   for (int c; (c = in.get()) != std::char_traits<char>::eof();) {
     any = true;
+    // A line that never ends (data arriving without a '\n') never blocks, so no read is cut short
+    // by a signal: the signal is asked for every 64 KiB instead.
+    if ((++bytes & 0xFFFF) == 0) throw_if_interrupted();
     if (c == '\n') return too_long ? LineRead::too_long : LineRead::line;
     if (too_long) continue;
     if (line.size() == limit) {

@@ -19,6 +19,9 @@ inline constexpr int kMaxJsonDepth = 64;
 // An ik request or a scenario is a few kilobytes; a 1 MiB line or a 16 MiB file is a mistake.
 inline constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
 inline constexpr std::size_t kMaxFileBytes = std::size_t{16} << 20;
+// A report file (claims) is tens of kilobytes; the viewer's run index one line per run.
+inline constexpr std::size_t kMaxReportFileBytes = std::size_t{1} << 20;
+inline constexpr std::size_t kMaxRunIndexBytes = std::size_t{16} << 20;
 // How much of an offending value or key a message shows.
 inline constexpr std::size_t kExcerptBytes = 60;
 

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <wlx/bounded_file.hpp>
 #include <wlx/error.hpp>
 #include <wlx/ik.hpp>
 #include <wlx/kinematics.hpp>
@@ -30,11 +31,14 @@ constexpr std::size_t kMaxParamsFileBytes = std::size_t{1} << 20;
 
 Params load_params(const ModelOptions& model) {
   if (model.params_file.empty()) return {};
-  std::ifstream in(model.params_file, std::ios::binary);
-  if (!in) throw Error("--params", fmt::format("cannot open '{}' for reading", excerpt(model.params_file)));
-  const std::string text = read_all_capped(in, model.params_file, kMaxParamsFileBytes);
-  if (in.bad()) throw Error("--params", fmt::format("reading '{}' failed", excerpt(model.params_file)));
-  const nlohmann::json j = parse_json_bounded(text, model.params_file);
+  // Bounded, regular files only (wlx/bounded_file.hpp): a FIFO without a writer is an error, not a hang.
+  const BoundedRead file = read_bounded_file(model.params_file, kMaxParamsFileBytes);
+  if (!file.ok()) {
+    if (file.error.rfind("cannot open", 0) == 0)
+      throw Error("--params", fmt::format("cannot open '{}' for reading{}", excerpt(model.params_file), file.error.substr(14)));
+    throw Error("--params", fmt::format("'{}' {}", excerpt(model.params_file), file.error));
+  }
+  const nlohmann::json j = parse_json_bounded(file.text, model.params_file);
   // The file holds {"name": value, ...}, or the same under "params" (like an ik request).
   try {
     return parse_params(j.is_object() && j.contains("params") && j.size() == 1 ? j.at("params") : j);

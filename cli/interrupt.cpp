@@ -20,6 +20,7 @@ void install_interrupt_handlers() {
   action.sa_flags = 0;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGHUP, &action, nullptr);  // the terminal closed: stop like SIGTERM, temporaries removed
   struct sigaction ignore {};
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);
@@ -29,8 +30,11 @@ void install_interrupt_handlers() {
 int interrupt_signal() noexcept { return received; }
 
 Interrupted::Interrupted(int signal)
-    : signal_(signal), message_(signal == SIGINT ? "interrupted (SIGINT)" : signal == SIGTERM ? "terminated (SIGTERM)"
-                                                                                              : std::string("stopped by signal ") + std::to_string(signal)) {}
+    : signal_(signal),
+      message_(signal == SIGINT    ? "interrupted (SIGINT)"
+               : signal == SIGTERM ? "terminated (SIGTERM)"
+               : signal == SIGHUP  ? "hung up (SIGHUP)"
+                                   : std::string("stopped by signal ") + std::to_string(signal)) {}
 
 void throw_if_interrupted() {
   if (const int s = interrupt_signal()) throw Interrupted(s);

@@ -6,6 +6,7 @@
 // (report/html.hpp).
 #include "per_model.hpp"
 #include "model_commands.hpp"
+#include "bounded_input.hpp"
 #include "interrupt.hpp"
 #include "output_checks.hpp"
 #include "report/figures.hpp"
@@ -15,6 +16,7 @@
 #include "viewer_export.hpp"
 
 #include <fmt/format.h>
+#include <wlx/bounded_file.hpp>
 #include <wlx/atomic_file.hpp>
 #include <wlx/error.hpp>
 
@@ -37,11 +39,10 @@ using report::ClaimRow;
 report::ReportSpec load_spec(const std::string& claims_file) {
   if (claims_file.empty())
     return report::parse_report_spec(kEmbeddedReportFile, fmt::format("scenarios/{}/report.yaml", gen::kModelName));
-  std::ifstream in(claims_file);
-  if (!in) throw Error("--claims", fmt::format("cannot read {}", claims_file));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return report::parse_report_spec(text.str(), claims_file);
+  // Bounded, regular files only (wlx/bounded_file.hpp): /dev/zero or a FIFO is an error, not a hang.
+  const BoundedRead file = read_bounded_file(claims_file, kMaxReportFileBytes);
+  if (!file.ok()) throw Error("--claims", fmt::format("{} {}", excerpt(claims_file), file.error));
+  return report::parse_report_spec(file.text, claims_file);
 }
 
 // Small and large values to 3 significant digits, others to 6; more where a "near" criterion's

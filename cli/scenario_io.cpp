@@ -6,6 +6,7 @@
 #include "limits.hpp"
 
 #include <fmt/format.h>
+#include <wlx/text.hpp>
 #include <wlx/error.hpp>
 
 #include <algorithm>
@@ -115,7 +116,11 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base) {
   const auto text = [&](const char* key) {
     if (!j.contains(key)) return std::string();
     if (!j.at(key).is_string()) throw Error(key, fmt::format("must be a string, got {}", excerpt(j.at(key))));
-    return j.at(key).get<std::string>();
+    // Ids and descriptions reach the report's scripts and page and the viewer's files: one line of
+    // printable UTF-8 (and quoted again for each language where they are written).
+    std::string value = j.at(key).get<std::string>();
+    if (const std::string why = text::check_one_line(value); !why.empty()) throw Error(key, why);
+    return value;
   };
   sc.id = text("id");
   sc.description = text("description");

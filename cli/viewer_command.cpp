@@ -1,6 +1,7 @@
 // `wlx viewer`: the 3D viewer's page (built with emscripten, viewer/) copied into a folder, with
 // the given scenarios simulated and written as runs the page plays (cli/viewer_export.hpp).
 #include "per_model.hpp"
+#include "interrupt.hpp"
 #include "model_commands.hpp"
 #include "outputs.hpp"
 #include "scenario_io.hpp"
@@ -62,11 +63,14 @@ int run_viewer(const ModelOptions& model_options, const ViewerOptions& options) 
   if (!std::filesystem::is_regular_file(dir / module))
     throw Error("--model", fmt::format("the viewer was built without model '{}' ({} is missing)", gen::kModelName, module));
   for (const Scenario& scenario : scenarios) {
-    const Trajectory trajectory = simulate(scenario);
+    // Asked after every sample: SIGINT, SIGTERM or SIGHUP stop a long run at once (exit 128 + signal),
+    // and the run's file is not written.
+    const Trajectory trajectory = simulate(scenario, [](long, long) { throw_if_interrupted(); });
     if (!trajectory.complete) fmt::print(stderr, "wlx viewer: run {} stopped early ({}); its samples up to then are shown\n", scenario.id, trajectory.error);
     write_viewer_run(dir, scenario, trajectory);
     fmt::print("run {}: {} samples -> {}\n", scenario.id, trajectory.samples.size(), (dir / "runs" / (scenario.id + ".js")).string());
   }
+  throw_if_interrupted();
   fmt::print("wrote {} (open it in a browser; viewer.html?run=<id> for one run)\n", (dir / "viewer.html").string());
   return 0;
 }

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <wlx/bounded_file.hpp>
+#include <wlx/text.hpp>
 #include <wlx/atomic_file.hpp>
 #include <wlx/error.hpp>
 
@@ -119,12 +121,30 @@ void choose_plot(const std::vector<std::string>& header, const ViewerRun& run, s
   unit = "m/s, rad/s";
 }
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+// A file this program reads back (the run index, the built viewer's files): bounded and regular
+// (runs/index.js replaced by a link to /dev/zero is refused, not read until memory runs out).
+std::string read_text(const fs::path& path, std::size_t limit) {
+  const BoundedRead file = read_bounded_file(path.string(), limit);
+  if (!file.ok()) throw Error(excerpt(path.string()), file.error);
+  return file.text;
 }
+
+// A JSON value as JavaScript source: all ASCII, ill-formed UTF-8 replaced, and < > & escaped, the
+// same rules as wlx::text::js_string (JSON has these characters only inside strings).
+std::string js_json(const nlohmann::json& value) {
+  const std::string dumped = value.dump(-1, ' ', true, nlohmann::json::error_handler_t::replace);
+  std::string out;
+  for (const char c : dumped) {
+    if (c == '<') out += "\\u003c";
+    else if (c == '>') out += "\\u003e";
+    else if (c == '&') out += "\\u0026";
+    else out += c;
+  }
+  return out;
+}
+
+// The built viewer's largest file (the model's WebAssembly module in JavaScript) is a few MB.
+constexpr std::size_t kMaxViewerFileBytes = std::size_t{64} << 20;
 
 constexpr std::string_view kIndexOpen = "wlxViewer.registerIndex([\n";
 constexpr std::string_view kIndexClose = "]);\n";
@@ -133,7 +153,7 @@ constexpr std::string_view kIndexClose = "]);\n";
 std::vector<nlohmann::json> read_index(const fs::path& path) {
   std::vector<nlohmann::json> entries;
   if (!fs::exists(path)) return entries;
-  std::istringstream in(read_text(path));
+  std::istringstream in(read_text(path, kMaxRunIndexBytes));
   std::string line;
   while (std::getline(in, line)) {
     if (line.empty() || line.front() != '{') continue;
@@ -150,7 +170,7 @@ std::vector<nlohmann::json> read_index(const fs::path& path) {
 void write_index(const fs::path& path, const std::vector<nlohmann::json>& entries) {
   std::string text = "// The runs of this viewer folder, written by wlx (cli/viewer_export.cpp).\n";
   text += kIndexOpen;
-  for (std::size_t k = 0; k < entries.size(); ++k) text += entries[k].dump() + (k + 1 < entries.size() ? ",\n" : "\n");
+  for (std::size_t k = 0; k < entries.size(); ++k) text += js_json(entries[k]) + (k + 1 < entries.size() ? ",\n" : "\n");
   text += kIndexClose;
   write_file_atomically(path.string(), text);
 }
@@ -201,7 +221,7 @@ void write_viewer_run(const fs::path& dir, const ViewerRun& run, std::span<const
   head["description"] = run.description;
   head["samples"] = kept.size();
   head["plot"] = {{"title", title}, {"unit", unit}, {"columns", plot}};
-  std::string head_text = head.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  std::string head_text = js_json(head);
   head_text.pop_back();  // the closing brace: the columns follow
   text += head_text + ",\"columns\":{";
   bool first = true;
@@ -210,7 +230,7 @@ void write_viewer_run(const fs::path& dir, const ViewerRun& run, std::span<const
     if (std::find(written.begin(), written.end(), name) != written.end()) continue;
     written.push_back(name);
     const auto& values = columns.at(name);
-    text += fmt::format("{}\n{}:[", first ? "" : ",", nlohmann::json(name).dump());
+    text += fmt::format("{}\n{}:[", first ? "" : ",", text::js_string(name));
     first = false;
     for (std::size_t k = 0; k < kept.size(); ++k) {
       // 10 significant digits: 1e-10 relative, far below what the eye or the plot resolves.
@@ -267,7 +287,7 @@ void copy_viewer_files(const fs::path& dir, const fs::path& source) {
       throw Error("viewer", fmt::format("{} is missing: {}", (source / file).string(), how));
   create_folder(dir / "wasm");
   create_folder(dir / "runs");
-  for (const auto& file : files) write_file_atomically((dir / file).string(), read_text(source / file));
+  for (const auto& file : files) write_file_atomically((dir / file).string(), read_text(source / file, kMaxViewerFileBytes));
   if (!fs::exists(dir / "runs" / "index.js")) write_index(dir / "runs" / "index.js", {});
 }
 

@@ -1,6 +1,7 @@
 #include "derivations.hpp"
 
 #include <fmt/format.h>
+#include <wlx/text.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -267,7 +268,8 @@ class LaneWriter {
         OpCount{1, 0, 0, 0});
     return name;
   }
-  void comment(const std::string& text) { add("", "    // " + text + "\n", {}); }
+  // Quoted for a comment (wlx/text.hpp): the text may hold a body's meaning from the model file.
+  void comment(const std::string& text) { add("", "    // " + text::cpp_comment(text) + "\n", {}); }
   std::string zero() const { return fmt::format("detail::zero_lanes<Scalar, {}>()", lanes_); }
   // The code, without the rows nothing reads (a dense joint's wrench sums feed only the
   // components its twist has), and each output's operations.

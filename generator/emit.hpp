@@ -40,6 +40,8 @@ std::string namespace_open(const EmitOptions& opt);
 std::string namespace_close(const EmitOptions& opt);
 // Text as a C++ string literal, quotes included (", \ and anything outside printable ASCII escaped).
 std::string quoted(const std::string& text);
+// Text for a // or /* */ comment of a generated header (wlx::text::cpp_comment).
+std::string comment(const std::string& text);
 // A double as a C++ literal that round-trips exactly (always with a '.', 'e' or "nan"/"inf").
 std::string literal(double v);
 

@@ -652,7 +652,7 @@ EmittedSolve emit_solve(const Model& m, const Limb& limb, Solve solve, const Emi
   OpCount ops;
   const std::string body = emit_body(m, stages, solve_outputs(m, solve), opt, ops);
 
-  std::string t = fmt::format("// Closed-form inverse kinematics of limb {} ({}).\n//\n", limb.name, limb.title);
+  std::string t = fmt::format("// Closed-form inverse kinematics of limb {} ({}).\n//\n", limb.name, comment(limb.title));
   for (const auto& line : solve.doc) t += "// " + line + "\n";
   t += fmt::format("// Branches 0 to {}:\n", solve.branches - 1);
   for (const auto& b : solve.bits) t += "//   " + b + "\n";
@@ -801,7 +801,7 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
     }
     if (!solve) {
       report.push_back(fmt::format("{}: no closed form ({}); Newton's method at run time", limb.name, fmt::join(reasons, "; ")));
-      entries.push_back(fmt::format("    {{nullptr, 0, \"none\", {{}}, {{}}}},  // {}: {}", limb.name, fmt::join(reasons, "; ")));
+      entries.push_back(fmt::format("    {{nullptr, 0, \"none\", {{}}, {{}}}},  // {}: {}", limb.name, comment(fmt::format("{}", fmt::join(reasons, "; ")))));
       continue;
     }
     const EmittedSolve e = emit_solve(m, limb, *solve, opt);

@@ -4,6 +4,8 @@
 #include <fmt/ranges.h>
 #include <ginac/ginac.h>
 #include <yaml-cpp/yaml.h>
+#include <wlx/bounded_file.hpp>
+#include <wlx/text.hpp>
 
 #include <algorithm>
 #include <charconv>
@@ -63,6 +65,56 @@ bool is_identifier(const std::string& s) {
   return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
 }
 
+// Macros that the compilers (GCC and clang in their GNU modes: unix, linux) and the headers the
+// generated code includes (<cmath>, <cstdint>, <cstring>, <limits>, <algorithm>, Eigen, and
+// through them glibc's <errno.h>, <stdio.h>, <endian.h>, ...) define with names that do not look
+// like macros. A name that is one of them is replaced by the preprocessor before the compiler
+// sees it: the header fails to compile far from the cause. Upper-case names are caught by
+// looks_like_macro() below.
+const std::set<std::string>& lower_case_macros() {
+  static const std::set<std::string> names = {
+      "unix", "linux", "i386", "i686", "sun", "sparc", "mips", "vax", "errno", "assert", "offsetof", "alloca",
+      "setjmp", "va_arg", "va_start", "va_end", "va_copy", "stdin", "stdout", "stderr", "math_errhandling",
+      "signbit", "fpclassify", "isfinite", "isinf", "isnan", "isnormal", "issubnormal", "iszero", "issignaling",
+      "isgreater", "isgreaterequal", "isless", "islessequal", "islessgreater", "isunordered", "major", "minor",
+      "makedev", "htobe16", "htobe32", "htobe64", "htole16", "htole32", "htole64", "be16toh", "be32toh", "be64toh",
+      "le16toh", "le32toh", "le64toh", "strdupa", "strndupa", "sched_priority", "eigen_assert", "eigen_internal_assert",
+      "eigen_plain_assert", "L_ctermid", "L_cuserid", "L_tmpnam", "P_tmpdir", "pthread_cleanup_push", "pthread_cleanup_pop"};
+  return names;
+}
+
+// Upper-case names of three characters or more (EOF, NAN, M_PI, INT_MAX, E2BIG, EIGEN_...), and
+// the families with a lower-case suffix (M_PIf, M_El, ...): the standard headers define hundreds
+// of these, and which ones differs between C libraries, so the rule is by shape, not by list.
+bool looks_like_macro(const std::string& n) {
+  const bool upper = n.size() >= 3 && std::none_of(n.begin(), n.end(), [](char c) { return std::islower(static_cast<unsigned char>(c)); });
+  const bool math_constant = n.size() > 2 && n[0] == 'M' && n[1] == '_' && std::isupper(static_cast<unsigned char>(n[2]));
+  return upper || math_constant || n.rfind("EIGEN", 0) == 0 || n.rfind("ei_", 0) == 0 || n.rfind("vec2d_", 0) == 0 ||
+         n.rfind("vec4f_", 0) == 0 || n.rfind("vec4i_", 0) == 0;
+}
+
+// Why a name cannot appear in the generated C++ at all (any kind: model, frame, body, limb,
+// wheel, closure row, parameter, coordinate, and each part of --namespace), or "".
+std::string code_name_reason(const std::string& n) {
+  static const std::set<std::string> keywords = {
+      "alignas", "alignof", "asm", "auto", "bool", "break", "case", "catch", "char", "char8_t", "char16_t", "char32_t",
+      "class", "concept", "const", "consteval", "constexpr", "constinit", "const_cast", "continue", "co_await",
+      "co_return", "co_yield", "decltype", "default", "delete", "do", "double", "dynamic_cast", "else", "enum",
+      "explicit", "export", "extern", "false", "float", "for", "friend", "goto", "if", "import", "inline", "int",
+      "long", "module", "mutable", "namespace", "new", "noexcept", "nullptr", "operator", "private", "protected",
+      "public", "register", "reinterpret_cast", "requires", "return", "short", "signed", "sizeof", "static",
+      "static_assert", "static_cast", "struct", "switch", "template", "this", "thread_local", "throw", "true", "try",
+      "typedef", "typeid", "typename", "union", "unsigned", "using", "virtual", "void", "volatile", "wchar_t", "while",
+      "final", "override", "and", "or", "not", "xor", "bitand", "bitor", "compl", "and_eq", "or_eq", "xor_eq", "not_eq"};
+  if (keywords.count(n)) return "it is a C++ keyword";
+  if (lower_case_macros().count(n)) return "the compiler or the standard headers the generated code includes define it as a macro";
+  if (looks_like_macro(n))
+    return "upper-case names (EOF, NAN, M_PI, INT_MAX) are the standard headers' macros: use a lower-case letter in it";
+  if (n == "std" || n == "Eigen") return "it is the namespace of the standard library or of Eigen, which the generated code uses";
+  if (n[0] == '_' || n.find("__") != std::string::npos) return "C++ reserves names starting with _ or containing __";
+  return {};
+}
+
 // Names the emitted C++ cannot use for a parameter or coordinate: keywords, and the names the
 // generated functions give their own arguments and locals.
 std::string reserved_reason(const std::string& n) {
@@ -101,8 +153,11 @@ struct Source {
 
   [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path, const std::string& reason) const {
     const std::string field = path.empty() ? "" : path + ": ";
-    if (mark.is_null()) throw ModelFileError(fmt::format("{}: {}{}", name, field, reason));
-    throw ModelFileError(fmt::format("{}:{}:{}: {}{}", name, mark.line + 1, mark.column + 1, field, reason));
+    // The file's name as one line: a name with a line break must not forge a message line.
+    std::string shown;
+    for (const char c : name) shown += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? fmt::format("\\x{:02x}", static_cast<unsigned char>(c)) : std::string(1, c);
+    if (mark.is_null()) throw ModelFileError(fmt::format("{}: {}{}", shown, field, reason));
+    throw ModelFileError(fmt::format("{}:{}:{}: {}{}", shown, mark.line + 1, mark.column + 1, field, reason));
   }
 };
 
@@ -136,13 +191,6 @@ class Item {
     if (!node_.IsDefined() || node_.IsNull()) fail("missing: give a value");
     if (!node_.IsScalar()) fail("must be a single value, not a list or map");
     const std::string& s = node_.Scalar();
-    // Text reaches generated comments and string literals: one line of printable characters.
-    // A backslash would continue a // comment onto the next generated line.
-    for (char ch : s)
-      if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f || ch == '\\')
-        fail(fmt::format("'{}' contains a control character (a line break, a tab) or a backslash; text here is one "
-                         "plain line",
-                         excerpt(s)));
     std::string out;
     for (std::size_t i = 0; i < s.size();) {
       const std::size_t close = s[i] == '<' ? s.find('>', i) : std::string::npos;
@@ -161,12 +209,22 @@ class Item {
         out += s[i++];
       }
     }
+    // Text reaches generated comments and string literals (quoted there, emit.cpp): one line of
+    // printable UTF-8, checked after the repetition variables are put in (their values are text
+    // of the file too). A backslash would continue a // comment onto the next generated line.
+    if (std::string why = text::check_one_line(out); !why.empty() || out.find('\\') != std::string::npos)
+      fail(fmt::format("'{}' {}; text here is one plain line", excerpt(out), why.empty() ? "has a backslash" : why));
     return out;
   }
   std::string name() const {
     const std::string s = text();
     if (!is_identifier(s))
       fail(fmt::format("'{}' is not a name: use letters, digits and _, not starting with a digit", excerpt(s)));
+    // Every name of the file reaches the generated code (as an identifier, a namespace or a
+    // string): none may be a keyword, a macro or std/Eigen. K0, the ground, is the one name
+    // the file may refer to without defining it.
+    if (const std::string why = code_name_reason(s); !why.empty() && s != "K0")
+      fail(fmt::format("'{}' cannot be used as a name: {}", s, why));
     return s;
   }
   // A number; with `constant`, also an expression of numbers (such as <sign>*0.5).
@@ -254,6 +312,8 @@ class Parser {
     const Fields f(top, {"model", "description", "repeat", "parameters", "coordinates", "frames", "bodies", "closure",
                          "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "nominal", "ik_sweeps"});
     m_.name = f["model"].name();
+    if (const std::string why = model_name_problem(m_.name); !why.empty())
+      f["model"].fail(fmt::format("'{}' cannot be the model's name: {}", m_.name, why));
     m_.source = src_.name;
     if (auto d = f.optional("description")) m_.description = d->text();
     if (auto r = f.optional("repeat")) repeats(*r);
@@ -308,9 +368,14 @@ class Parser {
   // repetitions multiply; `items:` repeats a block of entries).
   void each(const Item& list, const std::function<void(const Item&)>& fn) {
     if (!list.defined()) return;
+    const auto counted = [&](const Item& entry) {
+      if (++expanded_entries_ > kMaxExpandedEntries)
+        entry.fail(fmt::format("the file expands to more than {} list entries in all: beyond any machine", kMaxExpandedEntries));
+      fn(entry);
+    };
     for (const Item& e : list.list()) {
       if (!(e.is_map() && e.has("for"))) {
-        fn(e);
+        counted(e);
         continue;
       }
       const Item spec = e.child("for");
@@ -325,6 +390,15 @@ class Parser {
           for (const auto& kv : repeat_) names.push_back(kv.first);
           spec.fail(fmt::format("no repetition '{}' under `repeat:`{}", t, suggestion(t, names)));
         }
+      // The product of the tables' rows, checked before any is written out: 10^9 rows from a
+      // 1.6 KB file once took the generator past 1.2 GB.
+      std::size_t product = 1;
+      for (const auto& t : tables) {
+        product *= repeat_[t].size();
+        if (product > kMaxExpandedEntries)
+          spec.fail(fmt::format("repeats its entry more than {} times (the product of the rows of {}): beyond any machine", kMaxExpandedEntries,
+                                fmt::join(tables, ", ")));
+      }
       std::vector<std::size_t> index(tables.size(), 0);
       while (true) {
         Env env = e.env();
@@ -345,7 +419,7 @@ class Parser {
           const Fields only(instance, {"items"});
           each(only["items"], fn);
         } else {
-          fn(instance);
+          counted(instance);
         }
         std::size_t k = tables.size();
         while (k > 0 && ++index[k - 1] == repeat_[tables[k - 1]].size()) index[--k] = 0;
@@ -402,6 +476,21 @@ class Parser {
   // against a strict table. Identifiers are checked first so that a typo gets a suggestion.
   ex expression(const Item& it, bool allow_coordinates) const {
     const std::string s = it.text();
+    // GiNaC's parser and every pass over the tree recurse on its depth: bounded before parsing.
+    if (s.size() > kMaxExpressionBytes)
+      it.fail(fmt::format("an expression of {} bytes; at most {} (a long formula belongs in parameters)", s.size(), kMaxExpressionBytes));
+    {
+      // Runs of signs (- - - x) nest like parentheses.
+      int depth = 0, deepest = 0, signs = 0;
+      for (const char c : s) {
+        if (c == '(') deepest = std::max(deepest, ++depth), signs = 0;
+        else if (c == ')') --depth, signs = 0;
+        else if (c == '-' || c == '+') deepest = std::max(deepest, depth + ++signs);
+        else if (c != ' ') signs = 0;
+      }
+      if (deepest > kMaxExpressionDepth)
+        it.fail(fmt::format("in '{}': parentheses and signs nest more than {} deep", excerpt(s), kMaxExpressionDepth));
+    }
     static const std::set<std::string> functions = {"sin", "cos", "tan", "asin", "acos", "atan", "sqrt", "exp", "log"};
     for (std::size_t i = 0; i < s.size();) {
       const auto c = static_cast<unsigned char>(s[i]);
@@ -457,12 +546,39 @@ class Parser {
     GiNaC::symtab table = params_;
     if (allow_coordinates) table.insert(coordinates_.begin(), coordinates_.end());
     table["Pi"] = GiNaC::Pi;
+    ex e;
     try {
       GiNaC::parser reader(table, true);
-      return reader(s);
-    } catch (const std::exception& e) {
-      it.fail(fmt::format("cannot read the expression '{}': {}", excerpt(s), e.what()));
+      e = reader(s);
+    } catch (const std::exception& error) {
+      it.fail(fmt::format("cannot read the expression '{}': {}", excerpt(s), error.what()));
     }
+    check_at_defaults(it, s, e);
+    return e;
+  }
+
+  // An expression of parameters alone is evaluated at their defaults: acos(2) or sqrt(-a) would be
+  // emitted as code that yields NaN, 1/(a - b) with a = b as an Inf, so each is an error here,
+  // naming the field. (An expression with coordinates is a joint step, checked where it is used.)
+  void check_at_defaults(const Item& it, const std::string& s, const ex& e) const {
+    for (const auto& kv : coordinates_)
+      if (e.has(kv.second)) return;
+    std::string problem;
+    try {
+      const ex v = e.subs(param_defaults_).evalf();
+      if (!GiNaC::is_a<GiNaC::numeric>(v)) {
+        problem = "does not evaluate to a number";
+      } else {
+        const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(v);
+        std::ostringstream shown;
+        shown << n;
+        if (!n.is_real()) problem = fmt::format("is complex ({})", excerpt(shown.str()));
+        else if (!std::isfinite(n.to_double())) problem = fmt::format("is not finite ({})", n.to_double());
+      }
+    } catch (const std::exception& error) {  // GiNaC's pole_error: 1/0, log(0), tan(Pi/2)
+      problem = fmt::format("is singular ({})", error.what());
+    }
+    if (!problem.empty()) it.fail(fmt::format("'{}' at the default parameters {}", excerpt(s), problem));
   }
 
   Vec3 vector3(const Item& it) const {
@@ -500,6 +616,7 @@ class Parser {
       m_.parameters.push_back({n, value, unit, f.optional("meaning") ? f["meaning"].text() : "", GiNaC::realsymbol(n)});
       m_.parameter_kinds.push_back(pk);
       params_[n] = m_.parameters.back().symbol;
+      param_defaults_[m_.parameters.back().symbol] = value;
       symbol_kind_[n] = "parameter";
     });
     if (m_.parameters.empty()) list.fail("a model needs at least one parameter");
@@ -511,6 +628,7 @@ class Parser {
     claim_symbol_name(f["name"], n);
     const std::string unit = f["unit"].text();
     if (unit != "m" && unit != "rad") f["unit"].fail(fmt::format("a coordinate is in m or rad, not '{}'", excerpt(unit)));
+    if (m_.coordinates.size() == kMaxCoordinates) it.fail(fmt::format("a model has at most {} coordinates", kMaxCoordinates));
     const int index = static_cast<int>(m_.coordinates.size());
     m_.coordinates.push_back({n, index, GiNaC::realsymbol(n), GiNaC::realsymbol(n + "_dot"), unit,
                               f.optional("meaning") ? f["meaning"].text() : ""});
@@ -531,6 +649,7 @@ class Parser {
     std::vector<Item> entries;
     each(list, [&](const Item& it) { entries.push_back(it); });
     if (entries.empty()) list.fail("a model needs at least one frame");
+    if (entries.size() > kMaxFrames) list.fail(fmt::format("has {} frames; a model has at most {}", entries.size(), kMaxFrames));
     std::map<std::string, std::size_t> by_name;
     std::vector<std::string> names;
     for (std::size_t k = 0; k < entries.size(); ++k) {
@@ -542,27 +661,19 @@ class Parser {
       names.push_back(n);
     }
     m_.frames.resize(entries.size());
-    std::vector<int> state(entries.size(), 0);  // 0 not built, 1 being built, 2 built
-    std::function<const Frame&(std::size_t, std::vector<std::string>&)> build = [&](std::size_t k, std::vector<std::string>& trail) -> const Frame& {
+    // Each frame is built after its parent. The order comes from walking up the parents without
+    // recursion, so no file decides the depth of the generator's stack (10^5 chained frames once
+    // overflowed it); the depth of a chain is bounded too (its expressions grow with it).
+    std::vector<int> state(entries.size(), 0);  // 0 not built, 1 on the walk, 2 built
+    std::vector<std::size_t> parent_of(entries.size(), entries.size());  // entries.size(): K0
+    std::vector<std::size_t> depth_of(entries.size(), 0);  // frames from K0, once built
+    const auto build_one = [&](std::size_t k) {
       NamedFrame& out = m_.frames[k];
-      if (state[k] == 2) return out.frame;
       const Item& it = entries[k];
       const Fields f(it, {"name", "meaning", "parent", "chain"});
-      if (state[k] == 1) {
-        trail.push_back(names[k]);
-        f["parent"].fail(fmt::format("the frames' parents form a cycle: {}", fmt::join(trail, " -> ")));
-      }
-      state[k] = 1;
-      trail.push_back(names[k]);
       out.name = names[k];
       out.meaning = f.optional("meaning") ? f["meaning"].text() : "";
-      out.parent = f["parent"].name();
-      Frame frame = Frame::ground();
-      if (out.parent != "K0") {
-        const auto p = by_name.find(out.parent);
-        if (p == by_name.end()) f["parent"].fail(fmt::format("no frame '{}' (K0 is the ground){}", out.parent, suggestion(out.parent, names)));
-        frame = build(p->second, trail);
-      }
+      Frame frame = parent_of[k] == entries.size() ? Frame::ground() : m_.frames[parent_of[k]].frame;
       for (const Item& step : f["chain"].list()) {
         if (!step.is_map() || step.size() != 1)
           step.fail("a chain step is one of tx, ty, tz, rx, ry, rz: <coordinate or expression>, or translate: [x, y, z]");
@@ -616,12 +727,48 @@ class Parser {
       }
       out.frame = std::move(frame);
       state[k] = 2;
-      trail.pop_back();
-      return out.frame;
     };
+    std::vector<std::size_t> walk;
     for (std::size_t k = 0; k < entries.size(); ++k) {
-      std::vector<std::string> trail;
-      build(k, trail);
+      walk.clear();
+      for (std::size_t j = k; j != entries.size() && state[j] != 2;) {
+        const Fields f(entries[j], {"name", "meaning", "parent", "chain"});
+        if (state[j] == 1) {
+          // The cycle is the walk from j's first visit; shown in full when short, else its ends.
+          const auto first = std::find(walk.begin(), walk.end(), j);
+          std::vector<std::string> cycle;
+          for (auto w = first; w != walk.end(); ++w) cycle.push_back(names[*w]);
+          cycle.push_back(names[j]);
+          const std::string shown = cycle.size() <= 12 ? fmt::format("{}", fmt::join(cycle, " -> "))
+                                                       : fmt::format("{} -> ... -> {} ({} frames)", fmt::join(cycle.begin(), cycle.begin() + 5, " -> "),
+                                                                     fmt::join(cycle.end() - 5, cycle.end(), " -> "), cycle.size() - 1);
+          f["parent"].fail(fmt::format("the frames' parents form a cycle: {}", shown));
+        }
+        state[j] = 1;
+        walk.push_back(j);
+        m_.frames[j].parent = f["parent"].name();
+        if (m_.frames[j].parent == "K0") {
+          parent_of[j] = entries.size();
+          break;
+        }
+        const auto p = by_name.find(m_.frames[j].parent);
+        if (p == by_name.end())
+          f["parent"].fail(fmt::format("no frame '{}' (K0 is the ground){}", m_.frames[j].parent, suggestion(m_.frames[j].parent, names)));
+        parent_of[j] = p->second;
+        j = p->second;
+      }
+      // The walk ends at K0 or at a built frame: every frame on it is that much further from K0.
+      const std::size_t end = walk.empty() ? entries.size() : parent_of[walk.back()];
+      const std::size_t base = end == entries.size() ? 0 : depth_of[end];
+      if (base + walk.size() > kMaxChainDepth)
+        Fields(entries[k], {"name", "meaning", "parent", "chain"})["parent"].fail(
+            fmt::format("frame '{}' is {} frames away from K0, more than {}: chains this deep are not a machine, and their "
+                        "expressions would grow without bound",
+                        names[k], base + walk.size(), kMaxChainDepth));
+      for (std::size_t w = walk.size(); w-- > 0;) {
+        depth_of[walk[w]] = base + walk.size() - w;
+        build_one(walk[w]);
+      }
     }
   }
 
@@ -990,8 +1137,10 @@ class Parser {
   Source src_;
   Model m_;
   GiNaC::symtab params_, coordinates_;
+  GiNaC::exmap param_defaults_;  // each parameter's symbol -> its default, for check_at_defaults
   std::map<std::string, std::string> symbol_kind_;
   std::map<std::string, std::vector<Env>> repeat_;
+  std::size_t expanded_entries_ = 0;
   std::vector<std::pair<int, std::string>> joint_users_;
   std::map<int, double> limb_start_;  // the limbs' `start` values, by coordinate
   std::optional<Item> rows_item_;
@@ -1005,6 +1154,15 @@ std::uint64_t fingerprint(const std::string& text) {
 }
 
 }  // namespace
+
+std::string cpp_name_problem(const std::string& name) { return is_identifier(name) ? code_name_reason(name) : "it is not an identifier"; }
+
+std::string model_name_problem(const std::string& name) {
+  // The model names namespaces: wlx::<model> (inline), next to the runtime's own.
+  static const std::set<std::string> taken = {"wlx", "gen", "detail", "cli", "commands", "report", "text", "dopri", "codegen"};
+  if (taken.count(name)) return "wlx and its runtime use that namespace name themselves";
+  return cpp_name_problem(name);
+}
 
 std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates) {
   return suggestion(name, candidates);
@@ -1035,13 +1193,14 @@ Model parse_model(const std::string& text, const std::string& source_name) {
 }
 
 Model load_model_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ModelFileError(fmt::format("{}: cannot open the model file", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ModelFileError(fmt::format("{}: cannot read the model file", path));
+  const BoundedRead file = read_bounded_file(path, kMaxModelFileBytes);
+  if (!file.ok()) {
+    const bool opening = file.error.rfind("cannot open", 0) == 0;
+    throw ModelFileError(fmt::format("{}: {}", excerpt(path), opening ? "cannot open the model file" + file.error.substr(14)
+                                                                      : "the model file " + file.error));
+  }
   const auto slash = path.find_last_of('/');
-  return parse_model(text.str(), slash == std::string::npos ? path : path.substr(slash + 1));
+  return parse_model(file.text, slash == std::string::npos ? path : path.substr(slash + 1));
 }
 
 }  // namespace wlx::codegen

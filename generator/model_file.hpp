@@ -10,6 +10,7 @@
 
 #include "model.hpp"
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -19,6 +20,25 @@ namespace wlx::codegen {
 struct ModelFileError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// The bounds of a model file (docs/model-format.md, "Limits"), each far above what a machine
+// needs (the excavator: 13 frames at most 5 from K0, 32 coordinates, 51 expanded entries, a
+// 20 KB file) and far below what exhausts the generator's memory or stack. A file beyond one is
+// an error naming the field and the bound.
+inline constexpr std::size_t kMaxModelFileBytes = std::size_t{1} << 20;  // 1 MiB
+inline constexpr std::size_t kMaxExpandedEntries = 4096;  // list entries after `for:` repetition, in all lists
+inline constexpr std::size_t kMaxFrames = 512;
+inline constexpr std::size_t kMaxChainDepth = 64;      // frames between any frame and K0
+inline constexpr std::size_t kMaxCoordinates = 512;    // coordinates (joints and inputs)
+inline constexpr std::size_t kMaxExpressionBytes = 1024;
+inline constexpr int kMaxExpressionDepth = 32;         // parentheses and unary signs nested in one expression
+
+// Why `name` cannot appear in generated C++ (a keyword, a macro of the compiler or of the
+// included headers, std, Eigen, a reserved spelling), or "" when it can. Every name a model file
+// defines passes this; so does each part of wlx-gen's --namespace.
+std::string cpp_name_problem(const std::string& name);
+// The same for the model's name, which also must not be one of wlx's own namespaces.
+std::string model_name_problem(const std::string& name);
 
 // " (did you mean 'x'?)" when one of the candidates is close to `name`, else "".
 std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates);

@@ -3,6 +3,7 @@
 // reuse the command line's parsing and solving, so the grammar, the checks and the error messages
 // are the CLI's own.
 #include "../cli/input.hpp"
+#include "../cli/limits.hpp"
 #include "../cli/outputs.hpp"
 #include "../cli/scenario_io.hpp"
 
@@ -14,6 +15,7 @@
 #include <wlx/kinematics.hpp>
 #include <wlx/nonholonomic.hpp>
 
+#include <cmath>
 #include <string>
 
 namespace py = pybind11;
@@ -30,14 +32,40 @@ nlohmann::json parse_json(const std::string& text, const char* what) {
   }
 }
 
-Params params_of(const std::string& params_json) { return parse_params(parse_json(params_json, "params")); }
+// The CLI's checks, argument by argument: finite values within the bounds of cli/limits.hpp (a
+// rate of NaN or a coordinate of 1e308 gave NaN torques before), so Python and the command line
+// refuse the same inputs with the same messages.
+Params params_of(const std::string& params_json) {
+  const Params params = parse_params(parse_json(params_json, "params"));
+  check_param_bounds(params, "params.");
+  return params;
+}
 
 Coordinates coordinates_of(const Eigen::VectorXd& s, const char* field) {
   if (s.size() != kCoordinateCount)
     throw Error(field, "has " + std::to_string(s.size()) + " entries; the model has " + std::to_string(kCoordinateCount) +
                            " coordinates");
-  if (!s.allFinite()) throw Error(field, "has an entry that is not a finite number");
+  for (int k = 0; k < kCoordinateCount; ++k) {
+    const std::string name = std::string(field) + "." + std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+    if (!std::isfinite(s(k))) throw Error(name, "is not a finite number");
+    // Inputs by their own bounds; dependent joints by the bound of their unit.
+    if (k < kInputCount) check_input_bound(k, s(k), name);
+    else if (std::abs(s(k)) > (is_angle(k) ? kMaxAngle : kMaxPosition))
+      throw Error(name, "is beyond the bound of " + std::to_string(is_angle(k) ? kMaxAngle : kMaxPosition) + (is_angle(k) ? " rad" : " m"));
+  }
   return s;
+}
+
+template <class Vector>
+void check_finite(const Vector& v, const char* field) {
+  for (Eigen::Index k = 0; k < v.size(); ++k)
+    if (!std::isfinite(v(k))) throw Error(std::string(field) + "[" + std::to_string(k) + "]", "is not a finite number");
+}
+
+// What a function returns is finite, or it is an error: never NaN torques.
+template <class Matrix>
+void check_result(const Matrix& m, const char* what) {
+  if (!m.allFinite()) throw Error(what, "is not finite at these inputs (a state the model does not compute)");
 }
 
 }  // namespace
@@ -93,10 +121,16 @@ void bind_python(py::module_& parent) {
         Data data;
         const Coordinates s = coordinates_of(s_in, "s");
         if (rates.size() != kInputCount) throw Error("rates", "needs one entry per input (" + std::to_string(kInputCount) + ")");
+        for (int k = 0; k < kInputCount; ++k) {
+          const std::string name = "rates." + std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+          if (!std::isfinite(rates(k))) throw Error(name, "is not a finite number");
+          check_rate_bound(k, rates(k), name);
+        }
         Coordinates sdot = Coordinates::Zero();
         sdot.head<kInputCount>() = rates;
         const DependentPair dependent = pair.empty() ? default_pair() : dependent_pair(pair);
         solve_dependent_rates(model, data, s, sdot, dependent);
+        check_result(sdot, "sdot");
         return py::make_tuple(Eigen::VectorXd(sdot), data.cond_J_beta);
       },
       "dependent_rates(s, input_rates, pair, params_json) -> (sdot, cond_J_beta)");
@@ -108,9 +142,13 @@ void bind_python(py::module_& parent) {
         const Model model(params_of(params_json));
         Data data;
         DynamicsTerms terms;
+        check_finite(u, "u");
+        check_finite(u_dot, "u_dot");
         inverse_dynamics(model, data, coordinates_of(s_in, "s"), u, u_dot, terms);
         const TorqueVector tau = distribute_torques(
             terms.J_beta, terms.Qstar, parse_weighting(parse_json(weighting_json, "weighting"), "weighting"));
+        check_result(tau, "tau");
+        check_result(terms.M, "M");
         py::dict out;
         out["tau"] = Eigen::VectorXd(tau);
         out["Qstar"] = Eigen::VectorXd(terms.Qstar);

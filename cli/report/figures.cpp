@@ -7,6 +7,7 @@
 #include <wlx/atomic_file.hpp>
 #include <wlx/dynamics.hpp>
 #include <wlx/kinematics.hpp>
+#include <wlx/text.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -21,6 +22,9 @@ using report::column;
 using report::data_path;
 using report::FigureSpec;
 using report::log_column;
+// Every text in a script, the report file's and the scenarios' names and labels included, goes in
+// as a gnuplot single-quoted string: nothing in it can end the string or the command.
+std::string q(std::string_view text) { return text::gnuplot_string(text); }
 
 constexpr double kDegPerRad = 180 / std::numbers::pi;
 
@@ -161,9 +165,7 @@ class Figures {
   std::string reference_line(const std::string& key) const {
     const auto it = spec_.reference_lines.find(key);
     if (it == spec_.reference_lines.end()) return "";
-    std::string label = it->second.label;
-    std::replace(label.begin(), label.end(), '\'', '"');  // inside a gnuplot '...' string
-    return fmt::format(", {:g} with lines dt 2 lw 2 lc rgb 'gray40' title '{}'", it->second.value, label);
+    return fmt::format(", {:g} with lines dt 2 lw 2 lc rgb 'gray40' title {}", it->second.value, q(it->second.label));
   }
 
   void ik(std::vector<FigureSpec>& out) {
@@ -181,16 +183,17 @@ class Figures {
       const double xs = s.sweep.degrees ? kDegPerRad : 1;
       const std::string file = data_path(s.sweep.id + ".csv");
       std::string b = "set multiplot layout 2,1\nset key outside right top\n";
-      b += fmt::format("set xlabel '{} ({})'\nset ylabel 'joint angle (deg)'\nset title '{}: dependent joints (closed form)'\nplot ",
-                       s.sweep.input, s.sweep.degrees ? "deg" : "m", s.sweep.id);
+      b += fmt::format("set xlabel {}\nset ylabel 'joint angle (deg)'\nset title {}\nplot ",
+                       q(fmt::format("{} ({})", s.sweep.input, s.sweep.degrees ? "deg" : "m")),
+                       q(s.sweep.id + ": dependent joints (closed form)"));
       for (std::size_t k = 0; k < joints.size(); ++k)
-        b += fmt::format("{}'{}' using {}:{} with lines lw 2 dt {} title '{}'", k ? ", " : "", file, column(s.sweep.input, xs),
-                         column(joints[k], kDegPerRad), dash(k), titles[k]);
+        b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(file), column(s.sweep.input, xs),
+                         column(joints[k], kDegPerRad), dash(k), q(titles[k]));
       b += "\nset logscale y\nset format y '1e%L'\nset yrange [1e-18:1e-3]\nset ylabel 'analytic check error (m)'\n";
-      b += fmt::format("set title '{}: |target - FK(solution)| (zeros drawn at 1e-18)'\n", s.sweep.id);
-      b += fmt::format("plot '{0}' using {1}:{2} with lines lw 2 title 'closed form', '{0}' using {1}:{3} with points pt 7 ps 0.4 "
+      b += fmt::format("set title {}\n", q(s.sweep.id + ": |target - FK(solution)| (zeros drawn at 1e-18)"));
+      b += fmt::format("plot {0} using {1}:{2} with lines lw 2 title 'closed form', {0} using {1}:{3} with points pt 7 ps 0.4 "
                        "title 'Newton'{4}\n",
-                       file, column(s.sweep.input, xs), log_column("check_error_closed_form"), log_column("check_error_newton"),
+                       q(file), column(s.sweep.input, xs), log_column("check_error_closed_form"), log_column("check_error_newton"),
                        reference_line("ik_check_error"));
       b += "unset multiplot\n";
       out.push_back({"ik-" + s.sweep.id, fmt::format("{}: {} swept; closed form and Newton", s.sweep.id, s.sweep.input), "1000,800", b});
@@ -207,10 +210,11 @@ class Figures {
                                 runs.size());
     for (const ReportRun* r : runs) {
       const std::string file = data_path(r->csv);
-      b += fmt::format("set title '{}: |v_W . n_W|'\nset xlabel 't (s)'\nset ylabel 'm/s'\nplot ", r->id);
+      b += fmt::format("set title {}\nset xlabel 't (s)'\nset ylabel 'm/s'\nplot ", q(r->id + ": |v_W . n_W|"));
       for (std::size_t w = 0; w < gen::kWheelNames.size(); ++w)
-        b += fmt::format("{}'{}' using {}:{} with lines lw 2 dt {} title 'wheel {}'", w ? ", " : "", file, column("t"),
-                         log_column(fmt::format("nh_residual_{}", gen::kWheelNames[w])), dash(w), gen::kWheelNames[w]);
+        b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", w ? ", " : "", q(file), column("t"),
+                         log_column(fmt::format("nh_residual_{}", gen::kWheelNames[w])), dash(w),
+                         q(fmt::format("wheel {}", gen::kWheelNames[w])));
       b += reference_line("wheel_residual") + "\n";
     }
     b += "unset multiplot\n";
@@ -227,11 +231,11 @@ class Figures {
       std::string b = fmt::format("set multiplot layout 1,{}\nset key outside right top\n", g.y.size());
       for (const auto& name : g.y) {
         const int y = coordinate_index(name);
-        b += fmt::format("set title '{}: {} over {}'\nset xlabel '{} ({})'\nset ylabel '{} ({})'\nplot ", g.id, name, g.x, g.x,
-                         display_unit(x), name, display_unit(y));
+        b += fmt::format("set title {}\nset xlabel {}\nset ylabel {}\nplot ", q(fmt::format("{}: {} over {}", g.id, name, g.x)),
+                         q(fmt::format("{} ({})", g.x, display_unit(x))), q(fmt::format("{} ({})", name, display_unit(y))));
         for (std::size_t k = 0; k < runs.size(); ++k)
-          b += fmt::format("{}'{}' using {}:{} with lines lw 2 dt {} title '{}'", k ? ", " : "", data_path(runs[k]->csv),
-                           column(g.x, display_scale(x)), column(name, display_scale(y)), dash(k), runs[k]->id);
+          b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(data_path(runs[k]->csv)),
+                           column(g.x, display_scale(x)), column(name, display_scale(y)), dash(k), q(runs[k]->id));
         b += "\n";
       }
       b += "unset multiplot\n";
@@ -254,21 +258,21 @@ class Figures {
         for (int w = 0; w < gen::kWheelCount; ++w) b.add(smp.contacts(2 * w), smp.contacts(2 * w + 1));
       arrows += heading_arrows(r->id, 0, 1, 1.0);
     }
-    std::string t = fmt::format("set title '{}: top view (K0): paths, and the machine at the start and the end; arrows: heading'\n"
+    std::string t = fmt::format("set title {}\n"
                                 "set xlabel 'x (m)'\nset ylabel 'y (m)'\nset size ratio -1\nset key outside right top\n{}{}plot ",
-                                id, b.xy(0.4), arrows);
+                                q(id + ": top view (K0): paths, and the machine at the start and the end; arrows: heading"), b.xy(0.4), arrows);
     const std::string start_pose = data_path(runs.front()->id + "-pose.dat");
-    t += fmt::format("'{}' index 0 using 1:2 with lines lw 1 lc rgb 'gray60' title 'machine at t = 0'", start_pose);
+    t += fmt::format("{} index 0 using 1:2 with lines lw 1 lc rgb 'gray60' title 'machine at t = 0'", q(start_pose));
     for (std::size_t k = 0; k < runs.size(); ++k) {
       const std::string file = data_path(runs[k]->csv);
-      t += fmt::format(", '{}' index 1 using 1:2 with lines lw 1 dt {} lc {} title '{} machine at the end'",
-                       data_path(runs[k]->id + "-pose.dat"), dash(k), k + 1, runs[k]->id);
-      t += fmt::format(", '{}' index 2 using 1:2 with lines lw 3 dt {} lc {} title '{} {} path'", data_path(runs[k]->id + "-pose.dat"),
-                       dash(k), k + 1, runs[k]->id, gen::kFrameNames[static_cast<std::size_t>(body_frame_)]);
+      t += fmt::format(", {} index 1 using 1:2 with lines lw 1 dt {} lc {} title {}", q(data_path(runs[k]->id + "-pose.dat")), dash(k),
+                       k + 1, q(runs[k]->id + " machine at the end"));
+      t += fmt::format(", {} index 2 using 1:2 with lines lw 3 dt {} lc {} title {}", q(data_path(runs[k]->id + "-pose.dat")), dash(k),
+                       k + 1, q(fmt::format("{} {} path", runs[k]->id, gen::kFrameNames[static_cast<std::size_t>(body_frame_)])));
       for (std::size_t w = 0; w < gen::kWheelNames.size(); ++w) {
         const std::string wheel(gen::kWheelNames[w]);
-        t += fmt::format(", '{}' using {}:{} with lines lw 2 dt {} lc {} title '{} wheel {} contact'", file, column("x_W" + wheel),
-                         column("y_W" + wheel), dash(k), k + 3 + 2 * static_cast<int>(w), runs[k]->id, wheel);
+        t += fmt::format(", {} using {}:{} with lines lw 2 dt {} lc {} title {}", q(file), column("x_W" + wheel), column("y_W" + wheel),
+                         dash(k), k + 3 + 2 * static_cast<int>(w), q(fmt::format("{} wheel {} contact", runs[k]->id, wheel)));
       }
     }
     t += "\n";
@@ -304,11 +308,11 @@ class Figures {
         }
         // Equal to rounding: 1e-9 of the largest torque of the run.
         const auto titles = legend_titles(names, curves, 1e-9 * std::max(scale, 1.0));
-        b += fmt::format("set title '{}, {}: torques{}'\nplot ", r.scenario_id, r.scenario.weighting->label(),
-                         reference ? " (cf. thesis " + reference->figures[p] + ")" : "");
+        b += fmt::format("set title {}\nplot ", q(fmt::format("{}, {}: torques{}", r.scenario_id, r.scenario.weighting->label(),
+                                                                reference ? " (cf. thesis " + reference->figures[p] + ")" : "")));
         for (std::size_t k = 0; k < names.size(); ++k)
-          b += fmt::format("{}'{}' using {}:{} with lines lw 2 dt {} title '{}'", k ? ", " : "", data_path(r.csv), column("t"),
-                           column(names[k]), dash(k), titles[k]);
+          b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(data_path(r.csv)), column("t"),
+                           column(names[k]), dash(k), q(titles[k]));
         b += "\n";
       }
       b += "unset multiplot\n";
@@ -326,17 +330,17 @@ class Figures {
       const std::string title = title_of(r);
       const double end = r.trajectory.samples.back().t;
       std::string b = "set multiplot layout 1,2\nset size ratio -1\nset key outside bottom center horizontal\n";
-      b += fmt::format("set title '{}: side view'\nset xlabel 'x (m)'\nset ylabel 'z (m)'\n{}{}", title, bounds.xz(0.3),
+      b += fmt::format("set title {}\nset xlabel 'x (m)'\nset ylabel 'z (m)'\n{}{}", q(title + ": side view"), bounds.xz(0.3),
                        heading_arrows(r.id, 0, 2, 1.0));
-      b += fmt::format("plot '{0}' index 0 using 1:3 with linespoints lw 2 pt 7 ps 0.6 lc rgb 'gray60' title 'start t = 0', '{0}' index 1 "
+      b += fmt::format("plot {0} index 0 using 1:3 with linespoints lw 2 pt 7 ps 0.6 lc rgb 'gray60' title 'start t = 0', {0} index 1 "
                        "using 1:3 with linespoints lw 2 pt 7 ps 0.6 lc rgb '#1f5fb4' title 'end t = {1} s', 0 with lines lc rgb 'black' "
                        "title 'ground z = 0'\n",
-                       dat, end);
-      b += fmt::format("unset arrow\nset title '{}: top view; arrows: heading'\nset xlabel 'x (m)'\nset ylabel 'y (m)'\n{}{}", title,
+                       q(dat), end);
+      b += fmt::format("unset arrow\nset title {}\nset xlabel 'x (m)'\nset ylabel 'y (m)'\n{}{}", q(title + ": top view; arrows: heading"),
                        bounds.xy(0.3), heading_arrows(r.id, 0, 1, 1.0));
-      b += fmt::format("plot '{0}' index 0 using 1:2 with linespoints lw 2 pt 7 ps 0.6 lc rgb 'gray60' title 'start', '{0}' index 1 using "
+      b += fmt::format("plot {0} index 0 using 1:2 with linespoints lw 2 pt 7 ps 0.6 lc rgb 'gray60' title 'start', {0} index 1 using "
                        "1:2 with linespoints lw 2 pt 7 ps 0.6 lc rgb '#1f5fb4' title 'end'\n",
-                       dat);
+                       q(dat));
       b += "unset multiplot\n";
       out.push_back({"pose-" + title, title + ": the machine (body outline and the frames of the generated forward kinematics, each joined "
                                               "to its parent) at the start and the end",

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <wlx/atomic_file.hpp>
 #include <wlx/error.hpp>
+#include <wlx/text.hpp>
 
 #include <atomic>
 #include <filesystem>
@@ -20,12 +21,14 @@ namespace fs = std::filesystem;
 
 std::string data_path(const std::string& file) { return "../data/" + file; }
 
+// Column names come from scenario files too: quoted like any text.
 std::string column(const std::string& name, double scale) {
-  return scale == 1 ? fmt::format("(column(\"{}\"))", name) : fmt::format("(column(\"{}\")*{})", name, scale);
+  const std::string quoted = text::gnuplot_string(name);
+  return scale == 1 ? fmt::format("(column({}))", quoted) : fmt::format("(column({})*{})", quoted, scale);
 }
 
 std::string log_column(const std::string& name) {
-  return fmt::format("(abs(column(\"{0}\")) > 1e-18 ? abs(column(\"{0}\")) : 1e-18)", name);
+  return fmt::format("(abs(column({0})) > 1e-18 ? abs(column({0})) : 1e-18)", text::gnuplot_string(name));
 }
 
 std::string script(const FigureSpec& f) {

@@ -2,22 +2,12 @@
 #include "report/html.hpp"
 
 #include <fmt/format.h>
+#include <wlx/text.hpp>
 
 namespace wlx::cli::report {
 
-std::string escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+// One quoting function for all of the page (wlx/text.hpp): element text and attribute values.
+std::string escape(const std::string& s) { return text::html(s); }
 
 namespace {
 
@@ -67,7 +57,7 @@ void section(std::string& h, const Section& s, int level) {
   for (const auto& f : s.figures)
     h += fmt::format("<figure id=\"fig-{0}\"><a href=\"fig/{0}.svg\"><img src=\"fig/{0}.png\" alt=\"{1}\" /></a>"
                      "<figcaption>{1} (<a href=\"plots/{0}.gp\">script</a>)</figcaption></figure>\n",
-                     f.name, escape(f.caption));
+                     escape(f.name), escape(f.caption));
   for (const auto& sub : s.subsections) section(h, sub, level + 1);
 }
 

@@ -2,6 +2,7 @@
 #include "report/runner.hpp"
 
 #include "bounded_input.hpp"
+#include "interrupt.hpp"
 #include "outputs.hpp"
 #include "scenario_io.hpp"
 
@@ -26,6 +27,9 @@ bool is_dynamics(const std::string& scenario_id) {
 }
 
 std::string name_of(int coordinate) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(coordinate)]); }
+
+// Asked after every sample: a signal stops a long simulation at once, not when it ends.
+void stop_on_signal(long, long) { throw_if_interrupted(); }
 
 }  // namespace
 
@@ -158,7 +162,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
       Scenario sc = parse_scenario(json, model_.params());
       if (weighting) sc.weighting = weighting;
       progress_(fmt::format("simulating {}{}: {}", id, weighting ? " (" + weighting->label() + ")" : "", sc.description));
-      ReportRun r{id, scenario_id, sc, simulate(sc), id + ".csv", verify};
+      ReportRun r{id, scenario_id, sc, simulate(sc, stop_on_signal), id + ".csv", verify};
       if (!r.trajectory.complete) throw Error(id, r.trajectory.error);
       write_trajectory(data_file(r.csv), r.trajectory, sc.weighting.has_value());
       runs_.push_back(std::move(r));
@@ -177,10 +181,10 @@ void ReportRunner::compare_integrators(const std::string& data_dir) {
     Scenario sc = parse_scenario(read_scenario_json(id), model_.params());
     Scenario ref_sc = sc;
     ref_sc.dt = step;
-    const Trajectory ref = simulate(ref_sc);
+    const Trajectory ref = simulate(ref_sc, stop_on_signal);
     if (!ref.complete) throw Error(id, ref.error);
     const auto compare = [&](const std::string& setting, const Scenario& run) {
-      const Trajectory tr = simulate(run);
+      const Trajectory tr = simulate(run, stop_on_signal);
       if (!tr.complete) throw Error(id, tr.error);
       IntegratorRow row{id, run.integrator, setting, static_cast<long>(tr.samples.size()), tr.evaluations, 0,
                         std::vector<double>(compared_.size(), 0.0)};

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <wlx/error.hpp>
+#include <wlx/text.hpp>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -67,7 +68,7 @@ class Parser {
       const std::string key = kv.first.as<std::string>();
       if (std::find(valid.begin(), valid.end(), key) != valid.end()) continue;
       const std::string near = nearest(key, valid);
-      fail(kv.first, path, fmt::format("unknown key '{}'{}", key, near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+      fail(kv.first, path, fmt::format("unknown key '{}'{}", excerpt(key), near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
     }
   }
   YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& path) const {
@@ -79,6 +80,9 @@ class Parser {
     if (!n.IsScalar()) fail(n, path, "must be a text");
     const std::string s = n.as<std::string>();
     if (s.empty()) fail(n, path, "must not be empty");
+    // Every text of a report file reaches a gnuplot script or the HTML page: one line of
+    // printable UTF-8 (and quoted for each where it is written, report/figures.cpp, html.cpp).
+    if (const std::string why = text::check_one_line(s); !why.empty()) fail(n, path, why);
     return s;
   }
   double number(const YAML::Node& n, const std::string& path) const {

@@ -35,8 +35,11 @@ class AtomicFile {
   ~AtomicFile();
 
   void write(std::string_view text);
-  // Flushes, syncs and closes the temporary (errors such as ENOSPC often surface only here), then
-  // renames it to the final path. Throws OutputError naming the final path.
+  // Flushes, syncs and closes the temporary (errors such as ENOSPC often surface only here); the
+  // file stays under its temporary name. For a set of files replacing another as a whole (wlx-gen's
+  // headers): finish() every one, then commit() each, so a full disk leaves the old set intact.
+  void finish();
+  // finish(), then renames the temporary to the final path. Throws OutputError naming the final path.
   void commit();
 
   const std::string& path() const noexcept { return path_; }
@@ -50,6 +53,7 @@ class AtomicFile {
   int fd_ = -1;
   std::string buffer_;  // writes go out in blocks: one system call per row would be slow
   bool committed_ = false;
+  bool finished_ = false;
 };
 
 // Writes `text` as the whole content of `path`, atomically.
@@ -109,7 +113,8 @@ inline void AtomicFile::flush() {
   buffer_.clear();
 }
 
-inline void AtomicFile::commit() {
+inline void AtomicFile::finish() {
+  if (finished_) return;
   if (fd_ < 0) throw OutputError(path_, "commit after the file was closed");
   flush();
   // Some file systems report a full disk only when the data reach it: sync before the rename so
@@ -118,6 +123,12 @@ inline void AtomicFile::commit() {
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0) fail("close", errno);
+  finished_ = true;
+}
+
+inline void AtomicFile::commit() {
+  finish();
+  if (committed_) throw OutputError(path_, "committed twice");
   if (::rename(temporary_.c_str(), path_.c_str()) != 0) fail("rename into place", errno);
   committed_ = true;
 }

@@ -5,6 +5,7 @@
 
 #include "wlx/atomic_file.hpp"
 #include "wlx/error.hpp"
+#include "wlx/text.hpp"
 
 #include <fmt/format.h>
 
@@ -20,7 +21,7 @@ class CsvWriter {
   CsvWriter(const std::string& path, const std::vector<std::string>& header)
       : path_(path), columns_(header.size()), file_(path) {
     std::string line;
-    for (const auto& h : header) line += (line.empty() ? "" : ",") + h;
+    for (const auto& h : header) line += (line.empty() ? "" : ",") + text::csv_field(h);
     file_.write(line + "\n");
     header_ = header;
   }
@@ -32,18 +33,15 @@ class CsvWriter {
 
   // One row; a non-finite value is an error naming its column, and nothing of the row is written.
   void row(const std::vector<double>& values) { row({}, values); }
-  // The same after leading text columns (identifiers: no commas or quotes).
+  // The same after leading text columns (quoted as CSV fields, wlx/text.hpp).
   void row(const std::vector<std::string>& labels, const std::vector<double>& values) {
     if (labels.size() + values.size() != columns_)
       throw Error(path_, fmt::format("row has {} values for {} columns", labels.size() + values.size(), columns_));
-    for (std::size_t k = 0; k < labels.size(); ++k)
-      if (labels[k].find_first_of(",\"\n") != std::string::npos)
-        throw Error(header_[k], fmt::format("text '{}' would need quoting in {}", labels[k], path_));
     for (std::size_t k = 0; k < values.size(); ++k)
       if (!std::isfinite(values[k]))
         throw Error(header_[labels.size() + k], fmt::format("non-finite value {} not written to {}", values[k], path_));
     std::string line;
-    for (const auto& l : labels) line += (line.empty() ? "" : ",") + l;
+    for (const auto& l : labels) line += (line.empty() ? "" : ",") + text::csv_field(l);
     for (std::size_t k = 0; k < values.size(); ++k)
       line += (labels.empty() && k == 0 ? "" : ",") + fmt::format("{:.17g}", values[k]);
     file_.write(line + "\n");

@@ -20,6 +20,7 @@
 #include <string>
 #include <sys/mount.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -464,12 +465,13 @@ bool has_temporary(const fs::path& dir) {
 
 }  // namespace
 
-TEST_CASE("faults: SIGINT and SIGTERM during simulate: the samples so far kept, said partial, exit 130 / 143") {
+TEST_CASE("faults: SIGINT, SIGTERM and SIGHUP during simulate: the samples so far kept, said partial, exit 130 / 143 / 129") {
   // 10^6 steps (about 10 s): long enough to be interrupted midway.
   const fs::path dir = work_dir() / "signals";
   fs::create_directories(dir);
   write(dir / "long.json", R"({"rates": {"roll": 0.0872664626}, "dependent": ["y_C", "yaw"], "duration": 1, "dt": 1e-6})");
-  for (const auto& [signal, code, name] : {std::tuple{SIGINT, 130, "SIGINT"}, std::tuple{SIGTERM, 143, "SIGTERM"}}) {
+  for (const auto& [signal, code, name] :
+       {std::tuple{SIGINT, 130, "SIGINT"}, std::tuple{SIGTERM, 143, "SIGTERM"}, std::tuple{SIGHUP, 129, "SIGHUP"}}) {
     CAPTURE(name);
     const fs::path out = dir / name;
     const Spawned s = start({"simulate", (dir / "long.json").string(), "--out", out.string()});
@@ -590,3 +592,130 @@ TEST_CASE("faults: paths with quotes, spaces, $, backquotes, newlines and non-AS
   }
 }
 
+
+// ---- hostile report files and inputs that are not files (issue 26) ----
+
+namespace {
+
+std::string report_file_with(const std::string& from, const std::string& to) {
+  std::string text = slurp(fs::path(WLX_SOURCE_DIR) / "scenarios" / "excavator" / "report.yaml");
+  const auto at = text.find(from);
+  REQUIRE_MESSAGE(at != std::string::npos, "anchor not in report.yaml: " << from);
+  return text.replace(at, from.size(), to);
+}
+
+}  // namespace
+
+TEST_CASE("faults: a --claims label with a line break and a system() call is refused; quotes, backquotes and </script> are quoted, nothing runs") {
+  const fs::path base = work_dir() / "hostile-claims";
+  fs::create_directories(base);
+  const std::string anchor = "label: \"thesis (~1e-5 m, section 3.4)\"}";
+  // Before: the label's line break ended the gnuplot command and system(...) ran a shell.
+  write(base / "newline.yaml", report_file_with(anchor, "label: \"x\\nsystem('touch PWNED')\"}"));
+  Result r = run({"report", "--quick", "--claims", (base / "newline.yaml").string(), "--out", (base / "r1").string()}, {.cwd = base});
+  CAPTURE(r.err);
+  CHECK(r.code == 2);
+  CHECK(r.err.find("newline.yaml:31: reference_lines.ik_check_error.label: has a line break at byte 1") != std::string::npos);
+  CHECK(!fs::exists(base / "r1" / "index.html"));
+  // Every other way out of a gnuplot string, and HTML in a claim: written as text.
+  std::string text = report_file_with(anchor, "label: \"x' . system('touch PWNED') . 'y `touch PWNED2` @z \\u00fc </script>\"}");
+  const std::string claim = "claim: Total mass of the default parameters";
+  REQUIRE(text.find(claim) != std::string::npos);
+  text.replace(text.find(claim), claim.size(), "claim: \"</td><script>alert(1)</script> Total mass\"");
+  write(base / "quotes.yaml", text);
+  r = run({"report", "--quick", "--claims", (base / "quotes.yaml").string(), "--out", (base / "r2").string()}, {.cwd = base});
+  CAPTURE(r.err);
+  REQUIRE(r.code == 0);
+  for (const fs::path& where : {base, base / "r2", base / "r2" / "plots"})
+    for (const char* name : {"PWNED", "PWNED2"}) CHECK(!fs::exists(where / name));
+  const std::string gp = slurp(base / "r2" / "plots" / "ik-IK-L3.gp");
+  CHECK(gp.find("title 'x'' . system(''touch PWNED'') . ''y `touch PWNED2` @z \u00fc </script>'") != std::string::npos);
+  const std::string html = slurp(base / "r2" / "index.html");
+  CHECK(html.find("<script>alert") == std::string::npos);
+  CHECK(html.find("&lt;/td&gt;&lt;script&gt;alert(1)&lt;/script&gt;") != std::string::npos);
+}
+
+TEST_CASE("faults: --claims and --params that never end or are not files (/dev/zero, a FIFO without a writer, a folder) exit 2 at once") {
+  const fs::path dir = work_dir() / "not-files";
+  fs::create_directories(dir);
+  const fs::path fifo = dir / "input.fifo";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  const std::vector<std::pair<std::string, std::string>> inputs = {
+      {"/dev/zero", "is a device, not a regular file"}, {fifo.string(), "is a pipe (FIFO)"}, {dir.string(), "is a folder"}};
+  for (const auto& [path, reason] : inputs) {
+    CAPTURE(path);
+    const auto t0 = std::chrono::steady_clock::now();
+    Result r = run({"report", "--quick", "--claims", path, "--out", (dir / "out").string()});
+    CAPTURE(r.err);
+    CHECK(r.code == 2);
+    CHECK(r.err.find("--claims: ") != std::string::npos);
+    CHECK(r.err.find(reason) != std::string::npos);
+    r = run({"fk", "--params", path}, {.input = "{}"});
+    CAPTURE(r.err);
+    CHECK(r.code == 2);
+    CHECK(r.err.find("--params: ") != std::string::npos);
+    CHECK(r.err.find(reason) != std::string::npos);
+    CHECK(std::chrono::steady_clock::now() - t0 < 10s);  // no waiting for a writer or an end
+  }
+  // A report file beyond the bound.
+  write(dir / "big.yaml", "title: big\n" + std::string(2 << 20, '#'));
+  const Result big = run({"report", "--quick", "--claims", (dir / "big.yaml").string(), "--out", (dir / "out").string()});
+  CHECK(big.code == 2);
+  CHECK(big.err.find("more than the limit of 1048576 bytes") != std::string::npos);
+}
+
+TEST_CASE("faults: a scenario's id or description with a line break or a control character is refused, naming the field") {
+  const Case cases[] = {
+      {"id with a line break", {"simulate", "{file}", "--out", "{dir}"}, "", "{\"id\": \"a\\nb\", " + kOk + "}", 2, e("id"), "line break"},
+      {"description with NUL", {"simulate", "{file}", "--out", "{dir}"}, "", "{\"description\": \"a\\u0000b\", " + kOk + "}", 2,
+       e("description"), "control character U+0000"},
+  };
+  int index = 900;
+  for (const Case& c : cases) check_case(c, index++);
+}
+
+TEST_CASE("faults: ik --batch on a line that never ends (/dev/zero) stops at SIGTERM, SIGINT and SIGHUP within a second") {
+  // No '\n' ever comes and no read ever blocks: the signal must be asked for while reading.
+  for (const auto& [signal, code] : {std::pair{SIGTERM, 143}, std::pair{SIGINT, 130}, std::pair{SIGHUP, 129}}) {
+    CAPTURE(signal);
+    const Spawned s = start({"ik", "--batch"}, {.stdin_path = "/dev/zero"});
+    REQUIRE(wait_for([&] { return catches(s.pid, signal); }));
+    std::this_thread::sleep_for(200ms);  // well into the endless line
+    const auto t0 = std::chrono::steady_clock::now();
+    ::kill(s.pid, signal);
+    const Result r = finish(s);
+    CAPTURE(r.err);
+    CHECK(r.signal == 0);
+    CHECK(r.code == code);
+    CHECK(std::chrono::steady_clock::now() - t0 < 1s);
+  }
+}
+
+TEST_CASE("faults: SIGTERM and SIGHUP during wlx viewer's simulation: exit 143 / 129, no run file, no temporary") {
+  // A stand-in for the built viewer (its files are copied, not run): WLX_VIEWER_DIR points at it.
+  const fs::path dir = work_dir() / "viewer-signal", fake = dir / "built";
+  fs::create_directories(fake / "wasm");
+  write(fake / "viewer.html", "<!DOCTYPE html>");
+  write(fake / "viewer.js", "// viewer");
+  write(fake / "wasm" / "wlx_excavator.js", "// module");
+  write(dir / "long.json", R"({"id": "long", "rates": {"roll": 0.0872664626}, "dependent": ["y_C", "yaw"], "duration": 1, "dt": 1e-6})");
+  ::setenv("WLX_VIEWER_DIR", fake.c_str(), 1);
+  for (const auto& [signal, code] : {std::pair{SIGTERM, 143}, std::pair{SIGHUP, 129}}) {
+    CAPTURE(signal);
+    const fs::path out = dir / ("out-" + std::to_string(signal));
+    const Spawned s = start({"viewer", (dir / "long.json").string(), "--out", out.string()});
+    // The viewer's files are in place once the simulation runs.
+    REQUIRE(wait_for([&] { return fs::exists(out / "runs" / "index.js") && catches(s.pid, signal); }));
+    std::this_thread::sleep_for(300ms);
+    const auto t0 = std::chrono::steady_clock::now();
+    ::kill(s.pid, signal);
+    const Result r = finish(s);
+    CAPTURE(r.err);
+    CHECK(r.signal == 0);
+    CHECK(r.code == code);
+    CHECK(std::chrono::steady_clock::now() - t0 < 1s);
+    CHECK(!fs::exists(out / "runs" / "long.js"));
+    CHECK(incomplete_files(out).empty());
+  }
+  ::unsetenv("WLX_VIEWER_DIR");
+}

@@ -165,3 +165,33 @@ TEST_CASE("wlx viewer: bad requests exit 2 naming the option or run") {
   CHECK(r.err.find("viewer.html is missing") != std::string::npos);
   CHECK(r.err.find("WLX_BUILD_VIEWER") != std::string::npos);
 }
+
+TEST_CASE("viewer run: hostile descriptions and column names stay inside their JavaScript strings") {
+  const fs::path dir = fresh("hostile");
+  ViewerRun run = run_with("t,a,b_deg,x\"y</script>\n0,1,2,3\n1,1,2,3\n");
+  run.description = "</script><script>alert(1)</script> \" \\ \n \xe2\x80\xa8 \xff";
+  run.plot_columns = {"x\"y</script>"};
+  write_viewer_run(dir, run, kNames);
+  for (const fs::path& file : {dir / "runs" / "R-1+.js", dir / "runs" / "index.js"}) {
+    const std::string text = slurp(file);
+    CAPTURE(file);
+    // Nothing a browser could take for markup or a line end inside a literal; all ASCII.
+    CHECK(text.find("</script") == std::string::npos);
+    CHECK(text.find("<script") == std::string::npos);
+    for (const char c : text) CHECK(static_cast<unsigned char>(c) < 0x80);
+  }
+  // And the data still reads back as written (the ill-formed byte as U+FFFD).
+  const nlohmann::json head = registered(dir / "runs" / "R-1+.js", "wlxViewer.registerRun(");
+  CHECK(head["description"] == "</script><script>alert(1)</script> \" \\ \n \xe2\x80\xa8 \xef\xbf\xbd");
+  CHECK(head["columns"].contains("x\"y</script>"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("viewer run: a run index that is not a regular file (a link to /dev/zero) is refused, not read without end") {
+  const fs::path dir = fresh("zero-index");
+  fs::create_directories(dir / "runs");
+  fs::create_symlink("/dev/zero", dir / "runs" / "index.js");
+  CHECK_THROWS_WITH_AS(write_viewer_run(dir, run_with("t,a,b_deg\n0,1,2\n1,1,2\n"), kNames), doctest::Contains("is a device, not a regular file"),
+                       wlx::Error);
+  fs::remove_all(dir);
+}

@@ -7,8 +7,11 @@
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <sys/stat.h>
+#include <unistd.h>
 
 using namespace wlx::codegen;
 
@@ -149,4 +152,168 @@ TEST_CASE("model file: a file that is not there or not a map") {
   CHECK_THROWS_WITH_AS(load_model_file("/nonexistent/model.yaml"), doctest::Contains("cannot open the model file"), ModelFileError);
   CHECK_THROWS_WITH_AS(parse_model("- a\n- b\n", "x.yaml"), doctest::Contains("must be a YAML map"), ModelFileError);
   CHECK_THROWS_WITH_AS(parse_model("model: m\n", "x.yaml"), doctest::Contains("missing field 'parameters'"), ModelFileError);
+}
+
+// ---- hostile files (issue 26): bounded, no recursion the file controls, names and text checked ----
+
+namespace {
+
+// The smallest model the reader takes, with `frames` and `extra` put in.
+std::string tiny_model(const std::string& frames, const std::string& extra = "", const std::string& name = "tiny") {
+  return "model: " + name +
+         "\n"
+         "parameters:\n"
+         "  - {name: a, value: 0.5, unit: m, kind: length, meaning: a length}\n"
+         "coordinates:\n"
+         "  inputs:\n"
+         "    - {name: q, unit: rad, meaning: a joint}\n" +
+         extra + "frames:\n" + frames;
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_model(text, "hostile.yaml");
+  } catch (const ModelFileError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("model file: the tiny model the hostile cases start from reads") {
+  CHECK(error_of(tiny_model("  - {name: base, parent: K0, chain: [rz: q]}\n")) == "");
+}
+
+TEST_CASE("model file: a cycle through 10^5 frames is an error, not a stack overflow") {
+  // Each frame's parent is the next; the last one's is the first. Read recursively, this
+  // overflowed the generator's stack (SIGSEGV).
+  constexpr int n = 100000;
+  std::string frames;
+  for (int k = 0; k < n; ++k) frames += fmt::format("  - {{name: f{}, parent: f{}, chain: []}}\n", k, (k + 1) % n);
+  const std::string message = error_of(tiny_model(frames));
+  CAPTURE(message);
+  CHECK(message.find("more than 4096 list entries") != std::string::npos);
+  // Within the entry bound but beyond the frame bound.
+  std::string many;
+  for (int k = 0; k < 1000; ++k) many += fmt::format("  - {{name: f{}, parent: K0, chain: []}}\n", k);
+  CHECK(error_of(tiny_model(many)).find("has 1000 frames; a model has at most 512") != std::string::npos);
+}
+
+TEST_CASE("model file: a cycle through 500 frames is named, shortened; a chain 100 deep is refused") {
+  std::string frames;
+  for (int k = 0; k < 500; ++k) frames += fmt::format("  - {{name: f{}, parent: f{}, chain: []}}\n", k, (k + 1) % 500);
+  const std::string cycle = error_of(tiny_model(frames));
+  CAPTURE(cycle);
+  CHECK(cycle.find("the frames' parents form a cycle: f0 -> f1 -> f2 -> f3 -> f4 -> ... -> f496 -> f497 -> f498 -> f499 -> f0 (500 frames)") !=
+        std::string::npos);
+  std::string chain = "  - {name: f0, parent: K0, chain: [rz: q]}\n";
+  for (int k = 1; k < 100; ++k) chain += fmt::format("  - {{name: f{}, parent: f{}, chain: [tx: a]}}\n", k, k - 1);
+  const std::string deep = error_of(tiny_model(chain));
+  CAPTURE(deep);
+  CHECK(deep.find("frame 'f64' is 65 frames away from K0, more than 64") != std::string::npos);
+  // 64 deep is a chain the reader takes (the bound is inclusive); parents listed after their
+  // children are found without recursion too.
+  std::string ok = "  - {name: f0, parent: K0, chain: [rz: q]}\n";
+  for (int k = 63; k >= 1; --k) ok += fmt::format("  - {{name: f{}, parent: f{}, chain: [tx: a]}}\n", k, k - 1);
+  CHECK(error_of(tiny_model(ok)) == "");
+}
+
+TEST_CASE("model file: a repeat product of 10^9 rows is refused before anything is expanded") {
+  // Nine tables of ten rows, crossed: 10^9 frames from a file of about 2 KB.
+  std::string repeat = "repeat:\n";
+  std::string tables, name = "f";
+  for (int t = 0; t < 9; ++t) {
+    repeat += fmt::format("  r{}:\n", t);
+    for (int row = 0; row < 10; ++row) repeat += fmt::format("    - {{v{}: {}}}\n", t, row);
+    tables += fmt::format("{}r{}", t ? ", " : "", t);
+    name += fmt::format("<v{}>", t);
+  }
+  const std::string frames = fmt::format("  - for: [{}]\n    name: {}\n    parent: K0\n    chain: []\n", tables, name);
+  const std::string message = error_of(tiny_model(frames, repeat));
+  CAPTURE(message);
+  CHECK(message.find("repeats its entry more than 4096 times") != std::string::npos);
+}
+
+TEST_CASE("model file: expressions are bounded in length and nesting") {
+  const auto with = [](const std::string& expression) {
+    return error_of(tiny_model(fmt::format("  - {{name: base, parent: K0, chain: [rz: q, tx: {}]}}\n", expression)));
+  };
+  CHECK(with(std::string(40, '(') + "a" + std::string(40, ')')).find("nest more than 32 deep") != std::string::npos);
+  CHECK(with(std::string(40, '-') + "a").find("nest more than 32 deep") != std::string::npos);
+  CHECK(with(std::string(32, '(') + "a" + std::string(32, ')')) == "");  // the bound itself is taken
+  std::string sum = "a";
+  while (sum.size() < 2000) sum += " + a";
+  CHECK(with(sum).find("bytes; at most 1024") != std::string::npos);
+}
+
+TEST_CASE("model file: a name that is a keyword, a macro of the compiler or the headers, std or Eigen is refused, for every kind of name") {
+  // Each of these compiles into the headers as an identifier (a frame's constant, a body's, the
+  // model's namespace) and breaks them: `unix` and `linux` are 1 under GNU modes, M_PI and EOF
+  // expand to numbers, errno to a function call.
+  const char* names[] = {"unix", "linux", "errno", "assert", "stdin", "M_PI", "M_PIf", "EOF", "NAN", "INT_MAX", "EIGEN_ALIGN",
+                         "std", "Eigen", "int", "and", "override", "__x", "_x", "isnan"};
+  for (const char* n : names) {
+    CAPTURE(n);
+    const std::string frame = error_of(tiny_model(fmt::format("  - {{name: {}, parent: K0, chain: [rz: q]}}\n", n)));
+    CHECK(frame.find(fmt::format("'{}' cannot be used as a name", n)) != std::string::npos);
+    const std::string model = error_of(tiny_model("  - {name: base, parent: K0, chain: [rz: q]}\n", "", n));
+    CHECK(model.find(fmt::format("'{}' cannot be", n)) != std::string::npos);
+  }
+  for (const char* n : {"wlx", "gen", "text", "detail"})
+    CHECK(error_of(tiny_model("  - {name: base, parent: K0, chain: [rz: q]}\n", "", n)).find("wlx and its runtime use that namespace name") !=
+          std::string::npos);
+  // Names like these are fine: lower case, or short upper case (frame C, body M1 of the excavator).
+  for (const char* n : {"C", "M1", "hip_l", "Fl", "unix_like", "m_pi"})
+    CHECK(error_of(tiny_model(fmt::format("  - {{name: {}, parent: K0, chain: [rz: q]}}\n", n))) == "");
+  CHECK(cpp_name_problem("M_PI") != "");
+  CHECK(cpp_name_problem("hip") == "");
+}
+
+TEST_CASE("model file: text is one line of printable UTF-8, also where a repetition variable puts it in") {
+  const auto meaning = [](const std::string& yaml_value, const std::string& extra = "") {
+    return error_of(tiny_model(fmt::format("  - {{name: base, parent: K0, chain: [rz: q], meaning: {}}}\n", yaml_value), extra));
+  };
+  CHECK(meaning("\"two\\nlines\"").find("has a line break at byte 3") != std::string::npos);
+  CHECK(meaning("\"nul\\0\"").find("control character U+0000") != std::string::npos);
+  CHECK(meaning("\"bell\\a\"").find("control character U+0007") != std::string::npos);
+  CHECK(meaning("'back\\slash'").find("has a backslash") != std::string::npos);
+  CHECK(meaning("\"next\\u2028line\"").find("control character U+2028") != std::string::npos);
+  CHECK(meaning("'quotes \" and */ and ??/ are fine: quoted where written'") == "");
+  // A repetition row's value is text of the file too: checked after it is put in.
+  const std::string repeat = "repeat:\n  side:\n    - {s: \"x\\n#define evil 1\"}\n";
+  const std::string message = error_of(tiny_model("  - {for: side, name: base, parent: K0, chain: [rz: q], meaning: side <s>}\n", repeat));
+  CAPTURE(message);
+  CHECK(message.find("has a line break") != std::string::npos);
+}
+
+TEST_CASE("model file: only a regular file of at most 1 MiB is read") {
+  CHECK_THROWS_WITH_AS(load_model_file("/dev/zero"), doctest::Contains("is a device, not a regular file"), ModelFileError);
+  CHECK_THROWS_WITH_AS(load_model_file("/"), doctest::Contains("is a folder"), ModelFileError);
+  const std::string dir = fmt::format("/tmp/wlx_model_file_{}", static_cast<long>(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string fifo = dir + "/model.fifo", big = dir + "/big.yaml";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  // No writer: the reader must not wait for one.
+  CHECK_THROWS_WITH_AS(load_model_file(fifo), doctest::Contains("is a pipe (FIFO)"), ModelFileError);
+  std::ofstream(big) << tiny_model("  - {name: base, parent: K0, chain: [rz: q]}\n") << std::string(kMaxModelFileBytes, '#');
+  CHECK_THROWS_WITH_AS(load_model_file(big), doctest::Contains("more than the limit of 1048576 bytes"), ModelFileError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("model file: an expression that is NaN, complex, infinite or singular at the default parameters names its field") {
+  const auto with = [](const std::string& expression) {
+    return error_of(tiny_model(fmt::format("  - {{name: base, parent: K0, chain: [rz: q, tx: {}]}}\n", expression)));
+  };
+  // acos(2) was emitted as code computing sqrt(-3): NaN in every call.
+  const std::string acos2 = with("acos(2)");
+  CAPTURE(acos2);
+  CHECK(acos2.rfind("hostile.yaml:8:", 0) == 0);
+  CHECK(acos2.find("frames[0].chain[1].tx: 'acos(2)' at the default parameters is complex") != std::string::npos);
+  CHECK(with("sqrt(-a)").find("'sqrt(-a)' at the default parameters is complex") != std::string::npos);
+  CHECK(with("1/(a - 0.5)").find("'1/(a - 0.5)' at the default parameters is singular") != std::string::npos);  // a = 0.5
+  CHECK(with("log(a - 0.5)").find("at the default parameters is singular") != std::string::npos);
+  CHECK(with("exp(a*2000)").find("at the default parameters is not finite") != std::string::npos);
+  CHECK(with("acos(a)") == "");  // a = 0.5: fine
+  CHECK(with("sqrt(a)/a") == "");
 }

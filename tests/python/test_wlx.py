@@ -180,3 +180,22 @@ def test_readme_python_example_runs(tmp_path):
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "legD_sweep.png").stat().st_size > 10000
     assert "legD" in done.stdout
+
+
+def test_nan_and_out_of_bound_arguments_are_errors_not_nan_results():
+    # Before: a NaN rate or u, or a coordinate of 1e308, returned NaN torques and rates.
+    robot = wlx.model("excavator")
+    s = robot.ik()["s"]
+    with pytest.raises(wlx.Error, match=r"^rates\.x_C: is not a finite number"):
+        robot.dependent_rates(s, {"x_C": float("nan")}, dependent=["y_C", "yaw"])
+    with pytest.raises(wlx.Error, match=r"^u\[1\]: is not a finite number"):
+        robot.inverse_dynamics(s, [0.0, float("nan"), 0.0, 0.0])
+    with pytest.raises(wlx.Error, match=r"^u_dot\[0\]: is not a finite number"):
+        robot.inverse_dynamics(s, [0.0, 3.0, 0.0, 0.0], u_dot=[float("inf"), 0.0, 0.0, 0.0])
+    huge = np.array(s, dtype=float)
+    huge[robot.coordinates.index("x_C")] = 1e308
+    with pytest.raises(wlx.Error, match=r"^s\.x_C: "):
+        robot.inverse_dynamics(huge, [0.0, 3.0, 0.0, 0.0])
+    # The CLI's bounds on rates apply too (100 m/s).
+    with pytest.raises(wlx.Error, match=r"^rates\.x_C: "):
+        robot.dependent_rates(s, {"x_C": 1e6}, dependent=["y_C", "yaw"])
