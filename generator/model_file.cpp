@@ -404,7 +404,10 @@ class Parser {
     };
     // Fixed turns rz, ry, rx (URDF's rpy: roll about x, pitch about y, yaw about z, fixed axes)
     // for a rotation matrix; angles below 1e-12 rad are the rounding of a quaternion, left out.
-    const auto turns = [&](YAML::Node& chain, const Matrix3Rows& R, const char* prefix) {
+    // Fixed turns rz, ry, rx (URDF's rpy: roll about x, pitch about y, yaw about z, fixed axes)
+    // for a rotation matrix; angles below 1e-12 rad are the rounding of a quaternion, left out.
+    // `argument` writes the angle (a number, or the name of a parameter it makes).
+    const auto turns = [&](YAML::Node& chain, const Matrix3Rows& R, const std::function<std::string(const char*, double)>& argument) {
       double yaw, pitch, roll;
       const double s = std::clamp(-R[6], -1.0, 1.0);
       pitch = std::asin(s);
@@ -415,8 +418,8 @@ class Parser {
         yaw = 0;
         roll = std::atan2(-R[5], R[4]);
       }
-      for (const auto& [op, angle] : {std::pair{"z", yaw}, std::pair{"y", pitch}, std::pair{"x", roll}})
-        if (std::abs(angle) > 1e-12) chain.push_back(flow(step(fmt::format("{}{}", prefix, op).c_str(), number(angle))));
+      for (const auto& [op, which, angle] : {std::tuple{"rz", "yaw", yaw}, std::tuple{"ry", "pitch", pitch}, std::tuple{"rx", "roll", roll}})
+        if (std::abs(angle) > 1e-12) chain.push_back(flow(step(op, argument(which, angle))));
     };
 
     std::map<std::string, int> link_of;  // name -> index
@@ -495,11 +498,12 @@ class Parser {
       for (const auto& e : list->node()) frames.push_back(e);
     if (auto list = f.optional("bodies"))
       for (const auto& e : list->node()) bodies.push_back(e);
-    const auto add_parameter = [&](const UrdfLink& l, const std::string& name, double value, const char* kind, const char* unit,
-                                   const std::string& meaning) {
+    // `owner` is the link or joint whose number it is ("link", "base"), for the message.
+    const auto add_parameter = [&](int line, const char* kind_of_owner, const std::string& owner, const std::string& name, double value,
+                                   const char* kind, const char* unit, const std::string& meaning) {
       if (file_parameters.count(name) || file_inputs.count(name) || generated_parameters.count(name) || robot.joint_index(name) >= 0)
-        urdf_fail(l.line, fmt::format("link '{}'", l.name),
-                  fmt::format("its parameter '{}' is already a name in the model: {}", name, rename_hint(l.name)));
+        urdf_fail(line, fmt::format("{} '{}'", kind_of_owner, owner),
+                  fmt::format("its parameter '{}' is already a name in the model: {}", name, rename_hint(owner)));
       generated_parameters.insert(name);
       YAML::Node p(YAML::NodeType::Map);
       p["name"] = name;
@@ -529,15 +533,31 @@ class Parser {
         frame["meaning"] = fmt::format("URDF link {} ({} joint {})", l.name,
                                        wheel ? "wheel hub, not spinning, of" : moving ? "after" : "fixed by", j.name);
         frame["parent"] = j.parent;
+        // The origin's numbers become parameters (kinds offset and angle), as a hand-written
+        // model names its geometry: symbols keep GiNaC from distributing numbers over sums (about
+        // 13% fewer operations), and the geometry stays adjustable at run time, or --bake-defaults.
         const auto& t = j.origin.translation;
         if (t[0] != 0 || t[1] != 0 || t[2] != 0) {
           YAML::Node v(YAML::NodeType::Sequence);
-          for (double x : t) v.push_back(number(x));
+          for (int a = 0; a < 3; ++a) {
+            if (t[a] == 0) {
+              v.push_back("0");
+              continue;
+            }
+            const std::string p = fmt::format("{}_{}", j.name, letters[a]);
+            add_parameter(j.line, "joint", j.name, p, t[a], "offset", "m",
+                          fmt::format("origin of joint {}: {} in link {}", j.name, letters[a], j.parent));
+            v.push_back(p);
+          }
           YAML::Node s(YAML::NodeType::Map);
           s["translate"] = flow(v);
           chain.push_back(flow(s));
         }
-        turns(chain, j.origin.rotation, "r");
+        turns(chain, j.origin.rotation, [&](const char* which, double angle) {
+          const std::string p = fmt::format("{}_{}", j.name, which);
+          add_parameter(j.line, "joint", j.name, p, angle, "angle", "rad", fmt::format("origin of joint {}: rpy {}", j.name, which));
+          return p;
+        });
         if (moving) {
           const char* kind = j.type == UrdfJoint::Type::Prismatic ? "t" : "r";
           int sign = 1;
@@ -632,9 +652,9 @@ class Parser {
                   fmt::format("the principal moments of inertia{} are {}, {}, {} kg*m^2: wlx's bodies need every one positive "
                               "(give a point mass a small inertia about each axis)",
                               members_text, principal_moments[0], principal_moments[1], principal_moments[2]));
-      add_parameter(root_link, "m_" + body_name, mass, "mass", "kg", fmt::format("mass of URDF link {}{}", body_name, members_text));
+      add_parameter(root_link.line, "link", root_link.name, "m_" + body_name, mass, "mass", "kg", fmt::format("mass of URDF link {}{}", body_name, members_text));
       for (int a = 0; a < 3; ++a)
-        add_parameter(root_link, fmt::format("I{}_{}", a + 1, body_name), principal_moments[a], "inertia", "kg*m^2",
+        add_parameter(root_link.line, "link", root_link.name, fmt::format("I{}_{}", a + 1, body_name), principal_moments[a], "inertia", "kg*m^2",
                       fmt::format("principal moment {} of URDF link {}{}", a + 1, body_name, members_text));
       YAML::Node b(YAML::NodeType::Map);
       b["name"] = body_name;
@@ -648,7 +668,7 @@ class Parser {
         for (int r = 0; r < 3; ++r)
           for (int cc = 0; cc < 3; ++cc) Vr[3 * r + cc] = V(r, cc);
         YAML::Node rotation(YAML::NodeType::Sequence);
-        turns(rotation, Vr, "r");
+        turns(rotation, Vr, [&](const char*, double angle) { return number(angle); });
         if (rotation.size() > 0) b["rotation"] = flow(rotation);
       }
       b["mass"] = "m_" + body_name;
