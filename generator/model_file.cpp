@@ -314,7 +314,11 @@ class Parser {
     if (!urdf_import_available())
       where.fail("URDF import is unavailable: this wlx-gen was built without liburdfdom (install Debian's liburdfdom-dev "
                  "and configure again), or write the model by hand (docs/model-format.md)");
-    if (!std::ifstream(path)) where.fail(fmt::format("cannot open the URDF file '{}'", excerpt(path)));
+    // Bounded before it is read: a regular file (not a device or a pipe) of at most 64 MB.
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(path, error) || !std::ifstream(path))
+      where.fail(fmt::format("cannot open the URDF file '{}'", excerpt(path)));
+    if (std::filesystem::file_size(path, error) > (64u << 20)) where.fail(fmt::format("'{}' is larger than 64 MB", excerpt(path)));
     UrdfRobot robot = read_urdf(path, shown);
     {
       std::ifstream in(path, std::ios::binary);
@@ -504,6 +508,9 @@ class Parser {
       if (file_parameters.count(name) || file_inputs.count(name) || generated_parameters.count(name) || robot.joint_index(name) >= 0)
         urdf_fail(line, fmt::format("{} '{}'", kind_of_owner, owner),
                   fmt::format("its parameter '{}' is already a name in the model: {}", name, rename_hint(owner)));
+      if (const std::string why = reserved_reason(name); !why.empty())
+        urdf_fail(line, fmt::format("{} '{}'", kind_of_owner, owner),
+                  fmt::format("its parameter '{}' cannot be used as a name: {}; {}", name, why, rename_hint(owner)));
       generated_parameters.insert(name);
       YAML::Node p(YAML::NodeType::Map);
       p["name"] = name;

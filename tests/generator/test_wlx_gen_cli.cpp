@@ -144,7 +144,7 @@ TEST_CASE("wlx-gen: a bad URDF or a bad URDF model file exits 2 with file:line: 
        {"axle: the URDF's joint 'wheel_joint_lf' (wheeled_quadruped.urdf:", "turns the wheel about y of 'wheel_lf', not x"}},
       {"a hub that is no wheel's", true, "hub: wheel_<leg>", "hub: shank_<leg>", "hub: shank_<leg>",
        {"wheels[0]{leg=lf}.hub: URDF link 'shank_lf' hangs on joint 'kfe_lf', which is not continuous"}},
-      {"no such URDF", true, "urdf: wheeled_quadruped.urdf", "urdf: wheeled_quadrupd.urdf", "urdf:",
+      {"no such URDF", true, "urdf: wheeled_quadruped.urdf", "urdf: wheeled_quadrupd.urdf", "urdf: wheeled_quadrupd",
        {"urdf: cannot open the URDF file"}},
       {"rename of nothing", true, "repeat:", "rename: {haa_lx: hip_lf_abduction}\nrepeat:", "rename:",
        {"the URDF has no link or joint 'haa_lx' (did you mean 'haa_lf'?)"}},
@@ -189,7 +189,7 @@ TEST_CASE("wlx-gen: robot.urdf --with robot.yaml, and --print-model") {
   CHECK(std::filesystem::exists(out / "wlx" / "gen" / "all.hpp"));
   const std::string params = wlx_test::slurp(out / "wlx" / "gen" / "params.hpp");
   CHECK(params.find("double haa_lf_x = 0.3;") != std::string::npos);
-  CHECK(params.find("double m_base = 40;") != std::string::npos);  // base_inertia, imu_link and lidar merged
+  CHECK(params.find("double m_base = 40.0;") != std::string::npos);  // base_inertia, imu_link and lidar merged
   const auto alone = wlx_test::run({WLX_SOURCE_DIR "/models/wheeled_quadruped.urdf", "--out", out.string()});
   CHECK(alone.code == 2);
   CHECK(alone.err.find("a URDF needs --with robot.yaml") != std::string::npos);
