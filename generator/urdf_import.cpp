@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -125,6 +126,36 @@ UrdfRobot read_urdf(const std::string& path, const std::string& shown_name) {
   if (text.size() > (64u << 20)) throw ModelFileError(fmt::format("{}: a URDF of more than 64 MB is not read", shown_name));
   const Checker check(shown_name);
 
+  // TinyXML parses nested elements recursively: bound the depth before it sees the text (a URDF
+  // nests five levels; comments, declarations and quoted attribute values are skipped).
+  {
+    int depth = 0, line = 1;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+      if (text[i] == '\n') ++line;
+      if (text[i] != '<') continue;
+      const auto skip_to = [&](const char* end) {
+        const std::size_t at = text.find(end, i);
+        const std::size_t stop = at == std::string::npos ? text.size() : at;
+        line += static_cast<int>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i), text.begin() + static_cast<std::ptrdiff_t>(stop), '\n'));
+        i = stop;
+      };
+      if (text.compare(i, 4, "<!--") == 0) skip_to("-->");
+      else if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) skip_to(">");
+      else if (text.compare(i, 2, "</") == 0) depth = std::max(0, depth - 1);
+      else {
+        char quote = 0;
+        std::size_t j = i + 1;
+        for (; j < text.size() && (quote || text[j] != '>'); ++j) {
+          if (text[j] == '\n') ++line;
+          if (quote && text[j] == quote) quote = 0;
+          else if (!quote && (text[j] == '"' || text[j] == '\'')) quote = text[j];
+        }
+        if (j < text.size() && text[j - 1] != '/' && ++depth > 64)
+          check.fail(line, "XML", "elements nest more than 64 levels deep");
+        i = j;
+      }
+    }
+  }
   TiXmlDocument doc;
   doc.Parse(text.c_str(), nullptr, TIXML_ENCODING_UTF8);
   if (doc.Error()) check.fail(doc.ErrorRow() > 0 ? doc.ErrorRow() : 1, "XML", doc.ErrorDesc());

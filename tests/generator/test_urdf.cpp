@@ -60,13 +60,6 @@ const Body& body(const Model& m, const std::string& name) {
   return m.bodies.front();
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 fs::path scratch() {
   const fs::path dir = fs::temp_directory_path() / fmt::format("wlx_urdf_test_{}", static_cast<long>(::getpid()));
   fs::create_directories(dir);

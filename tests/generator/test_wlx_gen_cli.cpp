@@ -175,6 +175,17 @@ TEST_CASE("wlx-gen: a bad URDF or a bad URDF model file exits 2 with file:line: 
     for (const char* m : c.message) CHECK(r.err.find(m) != std::string::npos);
     CHECK(!std::filesystem::exists(out));
   }
+  // Elements nested deeper than any URDF (TinyXML would recurse on each): refused on the line of
+  // the 65th, before TinyXML reads it.
+  std::string deep = urdf, nested;
+  for (int k = 0; k < 100; ++k) nested += "<g>\n";
+  deep.replace(deep.find("</robot>"), 8, nested + "</robot>");
+  wlx_test::write(dir / "wheeled_quadruped.urdf", deep);
+  wlx_test::write(dir / "wheeled_quadruped.yaml", yaml);
+  const auto r = wlx_test::run({(dir / "wheeled_quadruped.yaml").string(), "--out", out.string(), "--quiet"});
+  CHECK(r.code == 2);
+  const int robot_line = line_of(urdf, "</robot>");
+  CHECK(r.err == "wlx-gen: error: wheeled_quadruped.urdf:" + std::to_string(robot_line + 63) + ": XML: elements nest more than 64 levels deep\n");
 }
 
 TEST_CASE("wlx-gen: robot.urdf --with robot.yaml, and --print-model") {
