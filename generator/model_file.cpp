@@ -351,11 +351,13 @@ class Parser {
         }
       }
     }
-    const auto rename_hint = [&](const std::string& n) {
+    // `suffix` makes a name that is already an identifier (but taken or reserved) a new one.
+    const auto rename_hint = [&](const std::string& n, const std::string& suffix) {
       std::string fixed;
       for (char c : n) fixed += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
       if (fixed.empty() || std::isdigit(static_cast<unsigned char>(fixed[0])) || fixed[0] == '_') fixed = "n" + fixed;
       while (fixed.find("__") != std::string::npos) fixed.replace(fixed.find("__"), 2, "_");
+      if (fixed == n) fixed += suffix;
       return fmt::format("rename it in the URDF, or in {}: `rename: {{\"{}\": {}}}`", src_.name, excerpt(n), fixed);
     };
 
@@ -453,18 +455,18 @@ class Parser {
     for (const auto& l : robot.links) {
       if (!is_identifier(l.name) || l.name == "K0")
         urdf_fail(l.line, fmt::format("link '{}'", excerpt(l.name)),
-                  fmt::format("'{}' cannot name a frame (a C++ identifier, not K0): {}", excerpt(l.name), rename_hint(l.name)));
+                  fmt::format("'{}' cannot name a frame (a C++ identifier, not K0): {}", excerpt(l.name), rename_hint(l.name, "_link")));
     }
     for (std::size_t k = 0; k < robot.joints.size(); ++k) {
       const UrdfJoint& j = robot.joints[k];
       if (j.type == UrdfJoint::Type::Fixed || wheel_joints.count(static_cast<int>(k))) continue;
       const std::string element = fmt::format("joint '{}'", excerpt(j.name));
       if (!is_identifier(j.name))
-        urdf_fail(j.line, element, fmt::format("'{}' cannot name a coordinate (a C++ identifier): {}", excerpt(j.name), rename_hint(j.name)));
+        urdf_fail(j.line, element, fmt::format("'{}' cannot name a coordinate (a C++ identifier): {}", excerpt(j.name), rename_hint(j.name, "_joint")));
       if (const std::string why = reserved_reason(j.name); !why.empty())
-        urdf_fail(j.line, element, fmt::format("'{}' cannot name a coordinate: {}; {}", j.name, why, rename_hint(j.name)));
+        urdf_fail(j.line, element, fmt::format("'{}' cannot name a coordinate: {}; {}", j.name, why, rename_hint(j.name, "_joint")));
       if (file_parameters.count(j.name))
-        urdf_fail(j.line, element, fmt::format("'{}' is also the name of a parameter in {}: {}", j.name, src_.name, rename_hint(j.name)));
+        urdf_fail(j.line, element, fmt::format("'{}' is also the name of a parameter in {}: {}", j.name, src_.name, rename_hint(j.name, "_joint")));
     }
 
     // Rigid groups: a link and the links fixed to it (fixed joints collapse). Each moving joint's
@@ -507,10 +509,10 @@ class Parser {
                                    const char* kind, const char* unit, const std::string& meaning) {
       if (file_parameters.count(name) || file_inputs.count(name) || generated_parameters.count(name) || robot.joint_index(name) >= 0)
         urdf_fail(line, fmt::format("{} '{}'", kind_of_owner, owner),
-                  fmt::format("its parameter '{}' is already a name in the model: {}", name, rename_hint(owner)));
+                  fmt::format("its parameter '{}' is already a name in the model: {}", name, rename_hint(owner, std::string("_") + kind_of_owner)));
       if (const std::string why = reserved_reason(name); !why.empty())
         urdf_fail(line, fmt::format("{} '{}'", kind_of_owner, owner),
-                  fmt::format("its parameter '{}' cannot be used as a name: {}; {}", name, why, rename_hint(owner)));
+                  fmt::format("its parameter '{}' cannot be used as a name: {}; {}", name, why, rename_hint(owner, std::string("_") + kind_of_owner)));
       generated_parameters.insert(name);
       YAML::Node p(YAML::NodeType::Map);
       p["name"] = name;

@@ -189,24 +189,37 @@ TEST_CASE("URDF import: oblique axes, prismatic joints, chains of fixed links an
   <link name="tool">
     <inertial><origin xyz="0 0 0.03" rpy="0.5 0 0"/><mass value="0.25"/><inertia ixx="0.0002" ixy="0" ixz="0" iyy="0.0003" iyz="0" izz="0.0001"/></inertial>
   </link>
+  <joint name="spin" type="continuous">
+    <parent link="tool"/><child link="marker"/><origin xyz="0 0 0.1"/><axis xyz="0 0 -1"/>
+  </joint>
+  <link name="marker"/>
 </robot>
 )";
-  std::ofstream(dir / "arm.yaml") << R"(model: urdf_arm
+  const std::string yaml = R"(model: urdf_arm
 urdf: arm.urdf
-rename: {base-link: base_link}
+rename: {base-link: base_link@}
 parameters:
   - {name: g, value: 9.81, unit: m/s^2, kind: gravity}
 coordinates:
   inputs:
     - {name: slide, unit: m}
     - {name: tilt, unit: rad}
+    - {name: wrist, unit: rad}
 dynamics: {gravity: g, commanded: [slide, tilt], actuated: [slide, tilt]}
 )";
+  // The URDF's joint `spin` is a name the generated code uses itself: refused, with the rename.
+  std::ofstream(dir / "arm.yaml") << yaml.substr(0, yaml.find('@')) + yaml.substr(yaml.find('@') + 1);
+  CHECK_THROWS_WITH_AS(load_model_file((dir / "arm.yaml").string()),
+                       "arm.urdf:42: joint 'spin': 'spin' cannot name a coordinate: the generated functions use that name "
+                       "themselves; rename it in the URDF, or in arm.yaml: `rename: {\"spin\": spin_joint}`",
+                       ModelFileError);
+  std::ofstream(dir / "arm.yaml") << yaml.substr(0, yaml.find('@')) + ", spin: wrist" + yaml.substr(yaml.find('@') + 1);
   const Model m = load_model_file((dir / "arm.yaml").string());
-  CHECK(m.coordinates.size() == 2);
-  CHECK(m.input_count == 2);
+  CHECK(m.coordinates.size() == 3);
+  CHECK(m.input_count == 3);
   const double slide = 0.23, tilt = -0.7;
-  const Evaluator e(m, {{"slide", slide}, {"tilt", tilt}});
+  const double spin = 0.4;
+  const Evaluator e(m, {{"slide", slide}, {"tilt", tilt}, {"wrist", spin}});
   using Eigen::AngleAxisd;
   using Eigen::Vector3d;
   const auto rpy = [](double r, double p, double y) {
@@ -219,8 +232,9 @@ dynamics: {gravity: g, commanded: [slide, tilt], actuated: [slide, tilt]}
         Eigen::Isometry3d(AngleAxisd(tilt, Vector3d(0.6, 0, 0.8)));
   flange = arm * Eigen::Translation3d(0.4, 0, 0) * Eigen::Isometry3d(rpy(0, M_PI / 2, 0));
   tool = flange * Eigen::Translation3d(0, 0, 0.05);
+  const Eigen::Isometry3d marker = tool * Eigen::Translation3d(0, 0, 0.1) * Eigen::Isometry3d(AngleAxisd(spin, -Vector3d::UnitZ()));
   for (const auto& [name, pose] : std::vector<std::pair<std::string, Eigen::Isometry3d>>{
-           {"base_link", base}, {"carriage", carriage}, {"arm", arm}, {"flange", flange}, {"tool", tool}}) {
+           {"base_link", base}, {"carriage", carriage}, {"arm", arm}, {"flange", flange}, {"tool", tool}, {"marker", marker}}) {
     CAPTURE(name);
     REQUIRE(m.frame_index(name) >= 0);
     const Frame& f = m.frames[static_cast<std::size_t>(m.frame_index(name))].frame;
@@ -260,7 +274,8 @@ dynamics: {gravity: g, commanded: [slide, tilt], actuated: [slide, tilt]}
   J << 0.01, 0.001, 0, 0.001, 0.02, 0.0005, 0, 0.0005, 0.03;
   CHECK((e.inertia(c) - Rc * J * Rc.transpose()).cwiseAbs().maxCoeff() < 1e-15);
   CHECK((e.vec(c.com_frame.r) - carriage * Vector3d(0.01, 0.02, 0.03)).cwiseAbs().maxCoeff() < 1e-14);
-  // The massless world and the base fixed to it: one body, named after the group's first link.
+  // The massless world and the base fixed to it: one body, named after the group's first link;
+  // the massless marker on its own joint: none.
   CHECK(e.parameter(body(m, "world").mass) == 1);
   CHECK(m.bodies.size() == 3);
 }
