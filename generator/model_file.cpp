@@ -1510,8 +1510,9 @@ std::string print_model_file(const std::string& path, const std::string& urdf_pa
   const YAML::Node merged = parser.with_urdf(load_yaml(text, name));
   YAML::Emitter out;
   out << merged;
-  return fmt::format("# The model file {}{} describes, as wlx-gen reads it (wlx-gen --print-model).\n{}\n", name,
-                     parser.urdf_fingerprint().empty() ? "" : " with its URDF", out.c_str());
+  return fmt::format("# The model wlx-gen reads from {}{} (wlx-gen --print-model){}.\n{}\n", name,
+                     parser.urdf_fingerprint().empty() ? "" : " and its URDF",
+                     parser.urdf_fingerprint().empty() ? "" : ", written as a model file that needs no URDF", out.c_str());
 }
 
 }  // namespace wlx::codegen
