@@ -31,6 +31,17 @@ function(wlx_generate)
   endif()
   string(REGEX REPLACE "^model:[ \t]*([A-Za-z_][A-Za-z0-9_]*).*$" "\\1" model_name "${name_line}")
 
+  # A model file that reads a URDF (`urdf: robot.urdf`, relative to the file): generated again
+  # when the URDF changes too.
+  set(model_inputs "${model_file}")
+  file(STRINGS "${model_file}" urdf_line REGEX "^urdf:[ \t]*[^ \t#]+" LIMIT_COUNT 1)
+  if(urdf_line)
+    string(REGEX REPLACE "^urdf:[ \t]*([^ \t#]+).*$" "\\1" urdf_file "${urdf_line}")
+    get_filename_component(model_dir "${model_file}" DIRECTORY)
+    get_filename_component(urdf_file "${urdf_file}" ABSOLUTE BASE_DIR "${model_dir}")
+    list(APPEND model_inputs "${urdf_file}")
+  endif()
+
   set(out "${CMAKE_CURRENT_BINARY_DIR}/wlx_generated/${arg_TARGET}")
   set(stamp "${CMAKE_CURRENT_BINARY_DIR}/wlx_generated/${arg_TARGET}.stamp")
   set(options --quiet)
@@ -44,7 +55,7 @@ function(wlx_generate)
     OUTPUT "${stamp}"
     COMMAND wlx::wlx-gen "${model_file}" --out "${out}" ${options}
     COMMAND "${CMAKE_COMMAND}" -E touch "${stamp}"
-    DEPENDS "${model_file}" "$<TARGET_FILE:wlx::wlx-gen>"
+    DEPENDS ${model_inputs} "$<TARGET_FILE:wlx::wlx-gen>"
     COMMENT "wlx-gen: ${arg_MODEL} -> ${out}/wlx/gen/"
     VERBATIM)
   add_custom_target(${arg_TARGET}_wlx_gen DEPENDS "${stamp}")

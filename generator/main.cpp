@@ -79,13 +79,19 @@ int remove_stale(const fs::path& dir, const std::vector<EmittedFile>& files) {
 
 int main(int argc, char** argv) {
   CLI::App app{"wlx-gen: derive a model's kinematics and dynamics symbolically and emit C++ headers"};
-  std::string model_path, out_dir;
+  std::string model_path, out_dir, with_path;
   std::vector<std::string> bake_args;
-  bool bake_defaults = false, stats_only = false, quiet = false;
+  bool bake_defaults = false, stats_only = false, quiet = false, print_model = false;
   EmitOptions opt;
   opt.generator_version = WLX_VERSION;
-  app.add_option("MODEL", model_path, "the model file (models/*.yaml; format: docs/model-format.md)")->required();
-  app.add_option("--out", out_dir, "output root; headers go to OUT/wlx/gen/")->required();
+  app.add_option("MODEL", model_path,
+                 "the model file (models/*.yaml; format: docs/model-format.md), or a URDF (robot.urdf) with --with")
+      ->required();
+  app.add_option("--with", with_path,
+                 "for a URDF as MODEL: the YAML file that says what URDF cannot (docs/model-format.md, URDF import)");
+  app.add_option("--out", out_dir, "output root; headers go to OUT/wlx/gen/ (required unless --print-model)");
+  app.add_flag("--print-model", print_model,
+               "print the model file wlx-gen reads (for a URDF: the frames, joints and bodies it maps to) and exit");
   app.add_option("--bake", bake_args, "bake a parameter in as a constant: NAME=VALUE (repeatable)");
   app.add_flag("--bake-defaults", bake_defaults, "bake every geometry parameter (kinds length, offset, angle) in at its default");
   app.add_option("--namespace", opt.name_space,
@@ -120,7 +126,25 @@ int main(int argc, char** argv) {
         begin = end + 2;
       }
     }
-    const Model model = load_model_file(model_path);
+    // `wlx-gen robot.urdf --with robot.yaml`: the YAML file is the model, the URDF its robot.
+    std::string urdf_path;
+    const bool urdf_given = model_path.size() >= 5 && model_path.compare(model_path.size() - 5, 5, ".urdf") == 0;
+    if (urdf_given) {
+      if (with_path.empty())
+        throw ModelFileError(fmt::format("{}: a URDF needs --with robot.yaml, the file that names the base's inputs, the "
+                                         "wheels, limbs and dynamics (docs/model-format.md, URDF import)",
+                                         model_path.substr(0, 200)));
+      urdf_path = model_path;
+      model_path = with_path;
+    } else if (!with_path.empty()) {
+      throw ModelFileError("--with: only a URDF as MODEL takes --with (a model file names its URDF with `urdf:`)");
+    }
+    if (print_model) {
+      std::cout << print_model_file(model_path, urdf_path);
+      return 0;
+    }
+    if (out_dir.empty()) throw ModelFileError("--out is required (the output root; headers go to OUT/wlx/gen/)");
+    const Model model = load_model_file(model_path, urdf_path);
     opt.model_name = model.name;
     if (bake_defaults)
       for (std::size_t k = 0; k < model.parameters.size(); ++k) {

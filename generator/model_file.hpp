@@ -43,8 +43,14 @@ std::string model_name_problem(const std::string& name);
 // " (did you mean 'x'?)" when one of the candidates is close to `name`, else "".
 std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates);
 
-// `source_name` is what messages and the generated banners call the file.
-Model parse_model(const std::string& text, const std::string& source_name);
-Model load_model_file(const std::string& path);
+// `source_name` is what messages and the generated banners call the file; a `urdf:` path in it is
+// relative to `directory`. A non-empty `urdf_path` is the URDF to read (wlx-gen robot.urdf --with
+// robot.yaml), in place of the file's `urdf:`.
+Model parse_model(const std::string& text, const std::string& source_name, const std::string& directory = {},
+                  const std::string& urdf_path = {});
+Model load_model_file(const std::string& path, const std::string& urdf_path = {});
+// The model file as wlx-gen reads it: for a file with a URDF, the URDF's parameters, dependent
+// joints, frames and bodies written into it (a model file that needs no URDF); checked first.
+std::string print_model_file(const std::string& path, const std::string& urdf_path = {});
 
 }  // namespace wlx::codegen

@@ -10,9 +10,11 @@
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <map>
+#include <sstream>
 
 namespace {
 
@@ -267,3 +269,160 @@ TEST_CASE("wlx-gen: a full disk exits 74 naming the header; the previous header 
   CHECK(tree(out) == before);  // byte for byte the earlier set, nothing added
   ::umount2(disk.c_str(), MNT_DETACH);
 }
+
+#ifdef WLX_HAVE_URDF_TESTS
+namespace {
+
+// One mistake put into models/wheeled_quadruped.urdf (or its YAML file): the error must name the
+// file, the line where the test put the mistake (found in the edited text, not taken from
+// wlx-gen), the element and the reason, and wlx-gen must exit 2.
+struct UrdfMistake {
+  const char* what;
+  bool in_yaml;         // the mistake is in the YAML file
+  const char* find;     // first occurrence in the file
+  const char* replace;  // what it becomes
+  const char* line_of;  // the error's line is the first line of the edited file containing this (null: not checked)
+  std::vector<const char*> message;
+};
+
+int line_of(const std::string& text, const std::string& needle) {
+  const auto at = text.find(needle);
+  REQUIRE(at != std::string::npos);
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+
+}  // namespace
+
+TEST_CASE("wlx-gen: a bad URDF or a bad URDF model file exits 2 with file:line: element: reason") {
+  const std::string urdf = wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.urdf");
+  const std::string yaml = wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.yaml");
+  const UrdfMistake cases[] = {
+      {"mimic joint", false, "<joint name=\"kfe_lf\" type=\"revolute\">", "<joint name=\"kfe_lf\" type=\"revolute\">\n    <mimic joint=\"hfe_lf\" multiplier=\"-2\"/>",
+       "<mimic", {"joint 'kfe_lf' mimic: mimic joints are not supported"}},
+      {"floating joint", false, "<joint name=\"haa_lf\" type=\"revolute\">", "<joint name=\"haa_lf\" type=\"floating\">", "\"haa_lf\"",
+       {"joint 'haa_lf': floating joints are not read", "base: {chain:"}},
+      {"planar joint", false, "<joint name=\"haa_rf\" type=\"revolute\">", "<joint name=\"haa_rf\" type=\"planar\">", "\"haa_rf\"",
+       {"joint 'haa_rf': planar joints are not supported"}},
+      {"misspelt type", false, "<joint name=\"hfe_rh\" type=\"revolute\">", "<joint name=\"hfe_rh\" type=\"revolut\">", "\"hfe_rh\"",
+       {"joint 'hfe_rh': unknown joint type 'revolut' (did you mean 'revolute'?)"}},
+      {"child link missing", false, "<child link=\"thigh_lf\"/>", "<child link=\"thigh_lff\"/>", "<joint name=\"hfe_lf\"",
+       {"joint 'hfe_lf': no link 'thigh_lff' (did you mean 'thigh_lf'?)"}},
+      {"two numbers for xyz", false, "<origin xyz=\"0.3 0.1 0\"", "<origin xyz=\"0.3 0.1\"", "xyz=\"0.3 0.1\"",
+       {"joint 'haa_lf' origin: xyz=\"0.3 0.1\" must be 3 numbers"}},
+      {"not a number", false, "<origin xyz=\"0.06 0.08 0\"", "<origin xyz=\"0.06 O.08 0\"", "O.08",
+       {"joint 'hfe_lf' origin: xyz=\"0.06 O.08 0\": 'O.08' is not a finite number"}},
+      {"zero axis", false, "<axis xyz=\"1 0 0\"/>", "<axis xyz=\"0 0 0\"/>", "<axis xyz=\"0 0 0\"/>", {"joint 'haa_lf' axis: the axis is zero"}},
+      {"negative mass", false, "<mass value=\"2.0\"/>", "<mass value=\"-2.0\"/>", "-2.0", {"link 'hip_lf' inertial mass: a mass cannot be negative"}},
+      {"a point mass", false, "<inertia ixx=\"0.006\" ixy=\"0\" ixz=\"0\" iyy=\"0.010\" iyz=\"0\" izz=\"0.006\"/>",
+       "<inertia ixx=\"0\" ixy=\"0\" ixz=\"0\" iyy=\"0\" iyz=\"0\" izz=\"0\"/>", "<link name=\"wheel_lf\"",
+       {"link 'wheel_lf' inertial: the principal moments of inertia are 0, 0, 0", "every one positive"}},
+      {"a second root", false, "</robot>", "  <link name=\"spare_part\"/>\n</robot>", "spare_part",
+       {"link 'spare_part': a second root", "tree of 'base'"}},
+      {"a link twice", false, "</robot>", "  <link name=\"hip_lf\"/>\n</robot>", "<link name=\"hip_lf\"/>", {"link 'hip_lf': defined twice"}},
+      {"a link with two parents", false, "<child link=\"thigh_lf\"/>", "<child link=\"base_inertia\"/>", "<joint name=\"hfe_lf\"",
+       {"joint 'hfe_lf': link 'base_inertia' is already the child of joint 'base_to_base_inertia'", "closure conditions"}},
+      {"unexpanded xacro", false, "</robot>", "  <xacro:include filename=\"legs.xacro\"/>\n</robot>", "xacro:include",
+       {"<xacro:include>: this is xacro, not URDF: expand it first"}},
+      {"no limit on a revolute joint", false, "<limit lower=\"-0.72\" upper=\"0.49\" effort=\"80\" velocity=\"7.5\"/>", "", "<joint name=\"haa_lf\"",
+       {"joint 'haa_lf': URDF requires <limit"}},
+      {"a name C++ cannot use", false, "</robot>",
+       "  <joint name=\"camera_joint\" type=\"fixed\"><parent link=\"base\"/><child link=\"camera-link\"/></joint>\n"
+       "  <link name=\"camera-link\"/>\n</robot>",
+       "<link name=\"camera-link\"", {"link 'camera-link': 'camera-link' cannot name a frame", "rename: {\"camera-link\": camera_link}"}},
+      {"an oblique wheel axle", false, "<axis xyz=\"0 1 0\"/>\n    <limit effort=\"40\"", "<axis xyz=\"0 0.6 0.8\"/>\n    <limit effort=\"40\"",
+       "<joint name=\"wheel_joint_lf\"", {"joint 'wheel_joint_lf' axis: a wheel turns about an axis of its joint frame"}},
+      {"not XML", false, "</robot>", "</robt>", nullptr, {"XML: "}},
+      {"a wheel's axle not the URDF's", true, "axle: y", "axle: x", "axle: x",
+       {"axle: the URDF's joint 'wheel_joint_lf' (wheeled_quadruped.urdf:", "turns the wheel about y of 'wheel_lf', not x"}},
+      {"a hub that is no wheel's", true, "hub: wheel_<leg>", "hub: shank_<leg>", "hub: shank_<leg>",
+       {"wheels[0]{leg=lf}.hub: URDF link 'shank_lf' hangs on joint 'kfe_lf', which is not continuous"}},
+      {"no such URDF", true, "urdf: wheeled_quadruped.urdf", "urdf: wheeled_quadrupd.urdf", "urdf: wheeled_quadrupd",
+       {"urdf: cannot open the URDF file"}},
+      {"rename of nothing", true, "repeat:", "rename: {haa_lx: hip_lf_abduction}\nrepeat:", "rename:",
+       {"the URDF has no link or joint 'haa_lx' (did you mean 'haa_lf'?)"}},
+      {"dependent joints given", true, "# The floating base", "  dependent: []\n# The floating base", "dependent:",
+       {"coordinates.dependent: with a URDF the dependent joints are the URDF's moving joints"}},
+  };
+  const std::filesystem::path dir = wlx_test::work_dir() / "urdf";
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path out = wlx_test::work_dir() / "urdf_gen";
+  for (const UrdfMistake& c : cases) {
+    const std::string what = c.what;
+    CAPTURE(what);
+    std::string u = urdf, y = yaml;
+    std::string& edited = c.in_yaml ? y : u;
+    const auto at = edited.find(c.find);
+    REQUIRE(at != std::string::npos);
+    edited.replace(at, std::strlen(c.find), c.replace);
+    wlx_test::write(dir / "wheeled_quadruped.urdf", u);
+    wlx_test::write(dir / "wheeled_quadruped.yaml", y);
+    std::filesystem::remove_all(out);
+    const auto r = wlx_test::run({(dir / "wheeled_quadruped.yaml").string(), "--out", out.string(), "--quiet"});
+    CAPTURE(r.err);
+    CHECK(r.code == 2);
+    const std::string file = c.in_yaml ? "wheeled_quadruped.yaml:" : "wheeled_quadruped.urdf:";
+    CHECK(r.err.rfind("wlx-gen: error: " + file, 0) == 0);
+    if (c.line_of != nullptr) CHECK(r.err.rfind("wlx-gen: error: " + file + std::to_string(line_of(edited, c.line_of)) + ":", 0) == 0);
+    for (const char* m : c.message) CHECK(r.err.find(m) != std::string::npos);
+    CHECK(!std::filesystem::exists(out));
+  }
+  // Elements nested deeper than any URDF (TinyXML would recurse on each): refused on the line of
+  // the 65th, before TinyXML reads it.
+  std::string deep = urdf, nested;
+  for (int k = 0; k < 100; ++k) nested += "<g>\n";
+  deep.replace(deep.find("</robot>"), 8, nested + "</robot>");
+  wlx_test::write(dir / "wheeled_quadruped.urdf", deep);
+  wlx_test::write(dir / "wheeled_quadruped.yaml", yaml);
+  const auto r = wlx_test::run({(dir / "wheeled_quadruped.yaml").string(), "--out", out.string(), "--quiet"});
+  CHECK(r.code == 2);
+  const int robot_line = line_of(urdf, "</robot>");
+  CHECK(r.err == "wlx-gen: error: wheeled_quadruped.urdf:" + std::to_string(robot_line + 63) + ": XML: elements nest more than 64 levels deep\n");
+}
+
+TEST_CASE("wlx-gen: robot.urdf --with robot.yaml, and --print-model") {
+  const std::filesystem::path out = wlx_test::work_dir() / "urdf_with";
+  std::filesystem::remove_all(out);
+  // The YAML file without its `urdf:` line: the URDF comes from the command line.
+  std::string yaml = wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.yaml");
+  yaml.erase(yaml.find("urdf: wheeled_quadruped.urdf\n"), std::strlen("urdf: wheeled_quadruped.urdf\n"));
+  const std::filesystem::path with = wlx_test::work_dir() / "robot.yaml";
+  wlx_test::write(with, yaml);
+  const auto r = wlx_test::run({WLX_SOURCE_DIR "/models/wheeled_quadruped.urdf", "--with", with.string(), "--out", out.string(), "--quiet"});
+  CAPTURE(r.err);
+  CHECK(r.code == 0);
+  CHECK(std::filesystem::exists(out / "wlx" / "gen" / "all.hpp"));
+  const std::string params = wlx_test::slurp(out / "wlx" / "gen" / "params.hpp");
+  CHECK(params.find("double haa_lf_x = 0.3;") != std::string::npos);
+  CHECK(params.find("double m_base = 40.0;") != std::string::npos);  // base_inertia, imu_link and lidar merged
+  const auto alone = wlx_test::run({WLX_SOURCE_DIR "/models/wheeled_quadruped.urdf", "--out", out.string()});
+  CHECK(alone.code == 2);
+  CHECK(alone.err.find("a URDF needs --with robot.yaml") != std::string::npos);
+  const auto printed = wlx_test::run({WLX_SOURCE_DIR "/models/wheeled_quadruped.yaml", "--print-model"});
+  CHECK(printed.code == 0);
+  CHECK(printed.out.find("  - name: imu_link\n    meaning: URDF link imu_link (fixed by joint imu_joint)\n    parent: base\n") !=
+        std::string::npos);
+  CHECK(printed.out.find("rotation: [{ry: 0.05}]") != std::string::npos);  // the merged base's principal axes
+  // The printed model file generates the same headers as the URDF (banners apart: they name the files).
+  const std::filesystem::path printed_file = wlx_test::work_dir() / "printed.yaml";
+  wlx_test::write(printed_file, printed.out);
+  const std::filesystem::path out_printed = wlx_test::work_dir() / "urdf_printed";
+  std::filesystem::remove_all(out_printed);
+  REQUIRE(wlx_test::run({printed_file.string(), "--out", out_printed.string(), "--quiet"}).code == 0);
+  const auto without_banner = [](const std::string& text) {
+    std::string out, line;
+    std::istringstream in(text);
+    while (std::getline(in, line))
+      if (line.find("Generated by wlx-gen") == std::string::npos) out += line + "\n";
+    return out;
+  };
+  int compared = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(out / "wlx" / "gen")) {
+    CAPTURE(entry.path().filename().string());
+    const std::filesystem::path twin = out_printed / "wlx" / "gen" / entry.path().filename();
+    REQUIRE(std::filesystem::exists(twin));
+    CHECK(without_banner(wlx_test::slurp(entry.path())) == without_banner(wlx_test::slurp(twin)));
+    ++compared;
+  }
+  CHECK(compared >= 10);
+}
+#endif

@@ -1,0 +1,365 @@
+#include "urdf_import.hpp"
+
+#include "model_file.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#ifdef WLX_HAVE_URDF
+#include <console_bridge/console.h>
+#include <tinyxml.h>
+#include <urdf_parser/urdf_parser.h>
+#endif
+
+namespace wlx::codegen {
+
+int UrdfRobot::link_index(const std::string& n) const {
+  for (std::size_t k = 0; k < links.size(); ++k)
+    if (links[k].name == n) return static_cast<int>(k);
+  return -1;
+}
+
+int UrdfRobot::joint_index(const std::string& n) const {
+  for (std::size_t k = 0; k < joints.size(); ++k)
+    if (joints[k].name == n) return static_cast<int>(k);
+  return -1;
+}
+
+#ifndef WLX_HAVE_URDF
+
+bool urdf_import_available() { return false; }
+
+UrdfRobot read_urdf(const std::string&, const std::string& shown_name) {
+  throw ModelFileError(fmt::format("{}: URDF import is unavailable: this wlx-gen was built without liburdfdom (install "
+                                   "Debian's liburdfdom-dev and configure again), or write the model file by hand "
+                                   "(docs/model-format.md)",
+                                   shown_name));
+}
+
+#else
+
+bool urdf_import_available() { return true; }
+
+namespace {
+
+// A value shown in a message: short, control characters escaped.
+std::string shown(const std::string& s) {
+  std::string out;
+  for (char ch : s.substr(0, 60)) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (u < 0x20 || u == 0x7f) out += fmt::format("\\x{:02x}", u);
+    else out += ch;
+  }
+  return s.size() > 60 ? out + "..." : out;
+}
+
+// The first pass: TinyXML (what Debian's urdfdom parses with) keeps every element's line, which
+// urdfdom's own messages lack, so the structure and the numbers are checked here, with places;
+// urdfdom then reads what this pass accepted.
+class Checker {
+ public:
+  explicit Checker(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(int line, const std::string& element, const std::string& reason) const {
+    throw ModelFileError(fmt::format("{}:{}: {}: {}", file_, line, element, reason));
+  }
+
+  // Whitespace-separated finite numbers, exactly `count` of them.
+  std::vector<double> numbers(const TiXmlElement* e, const char* attribute, std::size_t count, const std::string& element,
+                              const std::vector<double>& fallback) const {
+    const char* text = e ? e->Attribute(attribute) : nullptr;
+    if (text == nullptr) return fallback;
+    std::istringstream in{std::string(text)};
+    std::vector<double> out;
+    std::string word;
+    while (in >> word) {
+      char* end = nullptr;
+      const double v = std::strtod(word.c_str(), &end);
+      if (end != word.c_str() + word.size() || !std::isfinite(v))
+        fail(e->Row(), element, fmt::format("{}=\"{}\": '{}' is not a finite number", attribute, shown(text), shown(word)));
+      out.push_back(v);
+    }
+    if (out.size() != count)
+      fail(e->Row(), element, fmt::format("{}=\"{}\" must be {} numbers", attribute, shown(text), count));
+    return out;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+std::string element_name(const char* kind, const std::string& name) { return fmt::format("{} '{}'", kind, shown(name)); }
+
+// urdfdom reports through console_bridge: its messages are collected and the last error is quoted.
+class Collector : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) last_error = text;
+  }
+  std::string last_error;
+};
+
+Matrix3Rows rotation_of(const urdf::Rotation& q) {
+  const double x = q.x, y = q.y, z = q.z, w = q.w;
+  return {1 - 2 * (y * y + z * z), 2 * (x * y - z * w),     2 * (x * z + y * w),
+          2 * (x * y + z * w),     1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+          2 * (x * z - y * w),     2 * (y * z + x * w),     1 - 2 * (x * x + y * y)};
+}
+
+}  // namespace
+
+UrdfRobot read_urdf(const std::string& path, const std::string& shown_name) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ModelFileError(fmt::format("{}: cannot open the URDF file", shown_name));
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  if (text.size() > (64u << 20)) throw ModelFileError(fmt::format("{}: a URDF of more than 64 MB is not read", shown_name));
+  const Checker check(shown_name);
+
+  // TinyXML parses nested elements recursively: bound the depth before it sees the text (a URDF
+  // nests five levels; comments, declarations and quoted attribute values are skipped).
+  {
+    int depth = 0, line = 1;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+      if (text[i] == '\n') ++line;
+      if (text[i] != '<') continue;
+      const auto skip_to = [&](const char* end) {
+        const std::size_t at = text.find(end, i);
+        const std::size_t stop = at == std::string::npos ? text.size() : at;
+        line += static_cast<int>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i), text.begin() + static_cast<std::ptrdiff_t>(stop), '\n'));
+        i = stop;
+      };
+      if (text.compare(i, 4, "<!--") == 0) skip_to("-->");
+      else if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) skip_to(">");
+      else if (text.compare(i, 2, "</") == 0) depth = std::max(0, depth - 1);
+      else {
+        char quote = 0;
+        std::size_t j = i + 1;
+        for (; j < text.size() && (quote || text[j] != '>'); ++j) {
+          if (text[j] == '\n') ++line;
+          if (quote && text[j] == quote) quote = 0;
+          else if (!quote && (text[j] == '"' || text[j] == '\'')) quote = text[j];
+        }
+        if (j < text.size() && text[j - 1] != '/' && ++depth > 64)
+          check.fail(line, "XML", "elements nest more than 64 levels deep");
+        i = j;
+      }
+    }
+  }
+  TiXmlDocument doc;
+  doc.Parse(text.c_str(), nullptr, TIXML_ENCODING_UTF8);
+  if (doc.Error()) check.fail(doc.ErrorRow() > 0 ? doc.ErrorRow() : 1, "XML", doc.ErrorDesc());
+  const TiXmlElement* robot = doc.RootElement();
+  if (robot == nullptr) check.fail(1, "XML", "no element: a URDF is a <robot> element");
+  if (std::string(robot->Value()) != "robot")
+    check.fail(robot->Row(), fmt::format("<{}>", shown(robot->Value())), "the root element of a URDF is <robot>");
+
+  struct LinkEntry {
+    int line;
+    const TiXmlElement* element;
+  };
+  struct JointEntry {
+    std::string name, type, parent, child;
+    int line;
+  };
+  std::map<std::string, LinkEntry> link_entries;
+  std::vector<std::string> link_order;
+  std::vector<JointEntry> joint_entries;
+  std::map<std::string, int> joint_lines;
+  for (const TiXmlElement* e = robot->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+    const std::string tag = e->Value();
+    if (tag.rfind("xacro:", 0) == 0)
+      check.fail(e->Row(), fmt::format("<{}>", shown(tag)), "this is xacro, not URDF: expand it first (xacro robot.urdf.xacro > robot.urdf)");
+    if (tag == "link") {
+      const char* name = e->Attribute("name");
+      if (name == nullptr || !*name) check.fail(e->Row(), "link", "has no name");
+      if (link_entries.count(name)) check.fail(e->Row(), element_name("link", name), fmt::format("defined twice (first at line {})", link_entries[name].line));
+      link_entries[name] = {e->Row(), e};
+      link_order.push_back(name);
+      const std::string element = element_name("link", name);
+      if (const TiXmlElement* inertial = e->FirstChildElement("inertial")) {
+        check.numbers(inertial->FirstChildElement("origin"), "xyz", 3, element + " inertial origin", {0, 0, 0});
+        check.numbers(inertial->FirstChildElement("origin"), "rpy", 3, element + " inertial origin", {0, 0, 0});
+        const TiXmlElement* mass = inertial->FirstChildElement("mass");
+        if (mass == nullptr) check.fail(inertial->Row(), element + " inertial", "has no <mass value=\"...\"/>");
+        const auto m = check.numbers(mass, "value", 1, element + " inertial mass", {});
+        if (m.empty()) check.fail(mass->Row(), element + " inertial mass", "has no value attribute");
+        if (m[0] < 0) check.fail(mass->Row(), element + " inertial mass", fmt::format("a mass cannot be negative, got {}", m[0]));
+        const TiXmlElement* inertia = inertial->FirstChildElement("inertia");
+        if (inertia == nullptr) check.fail(inertial->Row(), element + " inertial", "has no <inertia ixx=... iyy=... izz=... ixy=... ixz=... iyz=.../>");
+        for (const char* a : {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"})
+          if (check.numbers(inertia, a, 1, element + " inertial inertia", {}).empty())
+            check.fail(inertia->Row(), element + " inertial inertia", fmt::format("has no {} attribute", a));
+      }
+    } else if (tag == "joint") {
+      const char* name = e->Attribute("name");
+      if (name == nullptr || !*name) check.fail(e->Row(), "joint", "has no name");
+      const std::string element = element_name("joint", name);
+      if (joint_lines.count(name)) check.fail(e->Row(), element, fmt::format("defined twice (first at line {})", joint_lines[name]));
+      joint_lines[name] = e->Row();
+      const char* type = e->Attribute("type");
+      if (type == nullptr) check.fail(e->Row(), element, "has no type (revolute, continuous, prismatic or fixed)");
+      const std::string t = type;
+      if (t == "floating")
+        check.fail(e->Row(), element,
+                   "floating joints are not read: leave the joint out and place the URDF's root link with `base: {chain: "
+                   "[tx: x, ty: y, tz: z, rz: yaw, ry: pitch, rx: roll]}` in the YAML file");
+      if (t == "planar") check.fail(e->Row(), element, "planar joints are not supported: model the plane as two prismatic joints and a revolute one");
+      if (t != "revolute" && t != "continuous" && t != "prismatic" && t != "fixed")
+        check.fail(e->Row(), element, fmt::format("unknown joint type '{}'{}; the types read are revolute, continuous, prismatic and fixed",
+                                                  shown(t), did_you_mean(t, {"revolute", "continuous", "prismatic", "fixed"})));
+      if (const TiXmlElement* mimic = e->FirstChildElement("mimic"))
+        check.fail(mimic->Row(), element + " mimic",
+                   "mimic joints are not supported: wlx's joints are independent coordinates; drive the joint with its "
+                   "own coordinate and couple it with a closure condition in the YAML file");
+      JointEntry j{name, t, "", "", e->Row()};
+      for (const char* role : {"parent", "child"}) {
+        const TiXmlElement* r = e->FirstChildElement(role);
+        const char* link = r ? r->Attribute("link") : nullptr;
+        if (link == nullptr) check.fail(r ? r->Row() : e->Row(), element, fmt::format("has no <{} link=\"...\"/>", role));
+        (std::string(role) == "parent" ? j.parent : j.child) = link;
+      }
+      const TiXmlElement* origin = e->FirstChildElement("origin");
+      check.numbers(origin, "xyz", 3, element + " origin", {0, 0, 0});
+      check.numbers(origin, "rpy", 3, element + " origin", {0, 0, 0});
+      if (t != "fixed") {
+        const TiXmlElement* axis = e->FirstChildElement("axis");
+        const auto a = check.numbers(axis, "xyz", 3, element + " axis", {1, 0, 0});
+        if (std::hypot(a[0], a[1], a[2]) < 1e-9) check.fail(axis->Row(), element + " axis", "the axis is zero: give its direction");
+      }
+      if ((t == "revolute" || t == "prismatic") && e->FirstChildElement("limit") == nullptr)
+        check.fail(e->Row(), element, fmt::format("URDF requires <limit effort=... velocity=.../> for a {} joint (wlx does not use the limits)", t));
+      joint_entries.push_back(std::move(j));
+    }
+  }
+  if (link_entries.empty()) check.fail(robot->Row(), "robot", "has no <link>");
+
+  // The tree: every link has at most one parent joint, exactly one has none, all are reached.
+  std::map<std::string, std::size_t> parent_of;
+  for (std::size_t k = 0; k < joint_entries.size(); ++k) {
+    const JointEntry& j = joint_entries[k];
+    const std::string element = element_name("joint", j.name);
+    std::vector<std::string> names(link_order.begin(), link_order.end());
+    for (const std::string* link : {&j.parent, &j.child})
+      if (!link_entries.count(*link)) check.fail(j.line, element, fmt::format("no link '{}'{}", shown(*link), did_you_mean(*link, names)));
+    if (j.parent == j.child) check.fail(j.line, element, "its parent and child are the same link");
+    if (parent_of.count(j.child))
+      check.fail(j.line, element,
+                 fmt::format("link '{}' is already the child of joint '{}': a URDF is a tree (close loops with closure conditions in the YAML file)",
+                             j.child, joint_entries[parent_of[j.child]].name));
+    parent_of[j.child] = k;
+  }
+  std::vector<std::string> roots;
+  for (const auto& n : link_order)
+    if (!parent_of.count(n)) roots.push_back(n);
+  if (roots.size() != 1) {
+    if (roots.empty()) check.fail(robot->Row(), "robot", "every link has a parent joint: the joints form a loop");
+    check.fail(link_entries[roots[1]].line, element_name("link", roots[1]),
+               fmt::format("a second root: no joint connects it to the tree of '{}' (a URDF has one root link)", roots[0]));
+  }
+
+  // urdfdom reads the accepted file: the values come from it.
+  Collector collector;
+  console_bridge::useOutputHandler(&collector);
+  urdf::ModelInterfaceSharedPtr model;
+  try {
+    model = urdf::parseURDF(text);
+  } catch (const std::exception& e) {
+    collector.last_error = e.what();
+  }
+  console_bridge::restorePreviousOutputHandler();
+  if (!model) {
+    // Place it where the message names an element ("... joint [name] ..."), else the robot.
+    int line = robot->Row();
+    std::string element = "robot";
+    for (const auto& [n, l] : joint_lines)
+      if (collector.last_error.find("[" + n + "]") != std::string::npos) line = l, element = element_name("joint", n);
+    for (const auto& [n, entry] : link_entries)
+      if (collector.last_error.find("[" + n + "]") != std::string::npos) line = entry.line, element = element_name("link", n);
+    check.fail(line, element, fmt::format("urdfdom cannot read it: {}", shown(collector.last_error.empty() ? "no reason given" : collector.last_error)));
+  }
+
+  UrdfRobot out;
+  out.file = shown_name;
+  out.name = model->getName();
+  // Depth first from the root, children in the order of their joints in the file.
+  std::map<std::string, std::vector<std::size_t>> children;
+  for (std::size_t k = 0; k < joint_entries.size(); ++k) children[joint_entries[k].parent].push_back(k);
+  std::vector<std::pair<std::string, int>> stack{{roots[0], -1}};
+  while (!stack.empty()) {
+    const auto [name, parent_joint] = stack.back();
+    stack.pop_back();
+    UrdfLink link;
+    link.name = name;
+    link.line = link_entries[name].line;
+    link.parent_joint = parent_joint;
+    const urdf::LinkConstSharedPtr l = model->getLink(name);
+    if (l && l->inertial) {
+      UrdfInertial i;
+      i.mass = l->inertial->mass;
+      i.com = {l->inertial->origin.position.x, l->inertial->origin.position.y, l->inertial->origin.position.z};
+      // The tensor is given in the inertial frame: turned into the link's axes, R I R^T.
+      const Matrix3Rows R = rotation_of(l->inertial->origin.rotation);
+      const double J[9] = {l->inertial->ixx, l->inertial->ixy, l->inertial->ixz, l->inertial->ixy, l->inertial->iyy,
+                           l->inertial->iyz, l->inertial->ixz, l->inertial->iyz, l->inertial->izz};
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+          double sum = 0;
+          for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b) sum += R[3 * r + a] * J[3 * a + b] * R[3 * c + b];
+          i.inertia[3 * r + c] = sum;
+        }
+      link.inertial = i;
+    }
+    out.links.push_back(std::move(link));
+    const auto& mine = children[name];
+    for (auto it = mine.rbegin(); it != mine.rend(); ++it) {
+      const JointEntry& e = joint_entries[*it];
+      const urdf::JointConstSharedPtr j = model->getJoint(e.name);
+      UrdfJoint joint;
+      joint.name = e.name;
+      joint.line = e.line;
+      joint.type = e.type == "revolute"     ? UrdfJoint::Type::Revolute
+                   : e.type == "continuous" ? UrdfJoint::Type::Continuous
+                   : e.type == "prismatic"  ? UrdfJoint::Type::Prismatic
+                                            : UrdfJoint::Type::Fixed;
+      joint.parent = e.parent;
+      joint.child = e.child;
+      const auto& pose = j->parent_to_joint_origin_transform;
+      joint.origin.translation = {pose.position.x, pose.position.y, pose.position.z};
+      joint.origin.rotation = rotation_of(pose.rotation);
+      const double norm = std::hypot(j->axis.x, j->axis.y, j->axis.z);
+      if (joint.type != UrdfJoint::Type::Fixed) joint.axis = {j->axis.x / norm, j->axis.y / norm, j->axis.z / norm};
+      out.joints.push_back(std::move(joint));
+      stack.emplace_back(e.child, -1);
+    }
+    // The joints just pushed are numbered in pop order below.
+  }
+  // Number the joints in link order: link k's parent joint is the one whose child it is.
+  std::vector<UrdfJoint> ordered;
+  for (auto& link : out.links) {
+    if (link.name == roots[0]) continue;
+    for (auto& j : out.joints)
+      if (j.child == link.name) {
+        link.parent_joint = static_cast<int>(ordered.size());
+        ordered.push_back(j);
+        break;
+      }
+  }
+  out.joints = std::move(ordered);
+  return out;
+}
+
+#endif
+
+}  // namespace wlx::codegen
