@@ -2,15 +2,21 @@
 // arms, for the limb types of walking machines) and emitted as straight-line C++ with a few calls
 // of two small solvers, with every branch.
 //
-// Patterns (each checks its preconditions on the symbolic chain; a limb that matches none is
-// reported by wlx-gen and solved by Newton's method at run time):
+// Patterns (each checks its preconditions on the chain's canonical form, below, so on geometry;
+// a limb that matches none is reported by wlx-gen with what each pattern needs, and solved by
+// Newton's method at run time):
 //
 // point3 (a leg): the limb's three rows put one frame's origin at three input targets (x, y, z);
-//   three revolute joints drive it; the first two are consecutive steps about different axes (so
-//   their axes meet), and nothing input-driven follows the first. With d the target in the frame
-//   before the first joint, |d|^2 depends on the third joint alone: K + A cos q3 + B sin q3 = |d|^2
-//   (bit 0 picks the root); then R_a(q1) R_b(q2) v(q3) = d is two rotations about principal axes
-//   (bit 1 picks q2's root). Any fixed offsets and fixed turns between and after the joints.
+//   three revolute joints drive it, the axes of the first two meet, and nothing input-driven
+//   follows the first. With d the target seen from the meeting point P, |d|^2 depends on the third
+//   joint alone: K + A cos q3 + B sin q3 = |d|^2 (bit 0 picks the root); then R_a(q1) R_b(q2) v(q3)
+//   = d is two rotations about principal axes (bit 1 picks q2's root). Any fixed offsets and turns
+//   before the first joint, between the second and third and after the third.
+//
+// wheel leg / plane leg: the rows place a wheel's derived contact point (or a frame's origin);
+//   the second and third joints (and the axle) are parallel. The plane's offset along its normal
+//   fixes q1 (bit 0), the axle then the rim point nearest the ground and so the hub, whose distance
+//   from the second joint fixes q3 (bit 1), and one rotation q2.
 //
 // leveled lever (a wheel lever): one point row (a component of a frame's origin equals an input),
 //   two level rows on that frame (two of its axes horizontal) and sum rows that each fix one joint
@@ -323,11 +329,14 @@ void require_three_joints(const Model& m, const CanonicalChain& c, const std::st
 // R_axis(sign q) with sin(-q) written -sin(q) (GiNaC keeps sin(-q), which the solved sines would
 // not replace).
 Mat3 signed_rot(Axis axis, int sign, const ex& q) {
-  const Mat3 r = rot(axis, q);
-  if (sign > 0) return r;
-  Mat3 out = r;
-  for (auto& e : out.e) e = e.subs(GiNaC::sin(q) == -GiNaC::sin(q));
-  return out;
+  const ex c = GiNaC::cos(q), sn = sign * GiNaC::sin(q);
+  Mat3 r = Mat3::identity();
+  const int i = (static_cast<int>(axis) + 1) % 3, j = (static_cast<int>(axis) + 2) % 3;  // R turns i towards j
+  r(i, i) = c;
+  r(i, j) = -sn;
+  r(j, i) = sn;
+  r(j, j) = c;
+  return r;
 }
 
 // sin and cos of the joint from those of theta = sign q that a solver computed.
@@ -362,7 +371,7 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   std::vector<Rot> before_first, after_second;
   while (!between.turns.empty() && between.turns.front().axis == j1.axis) {
     const Rot t = between.turns.front();
-    between.offset = expanded(rot(t.axis, -t.angle) * between.offset);  // T(o) R = R T(R^T o)
+    between.offset = expanded(signed_rot(t.axis, -1, t.angle) * between.offset);  // T(o) R = R T(R^T o)
     before_first.push_back(t);
     between.turns.erase(between.turns.begin());
   }
@@ -609,8 +618,8 @@ Solve plan_wheel_leg(const Model& m, const Limb& limb) {
   // Stage 3: v = p2 + R2 R_3(q3) p3; the rotation about the plane's normal that takes v onto w.
   Stage st3;
   const Vec3 v = p2 + R2 * (signed_rot(j3.axis, j3.sign, q3) * p3);
-  for (int i = 0; i < 3; ++i) st3.locals.emplace_back(realsymbol(fmt::format("ik_v{}", i)), in_results(m, v[i], solve));
   const int b = static_cast<int>(j2.axis), i = (b + 1) % 3, j = (b + 2) % 3;  // R_b turns i towards j
+  for (int k : {i, j}) st3.locals.emplace_back(realsymbol(fmt::format("ik_v{}", k)), in_results(m, v[k], solve));  // v_b = w_b
   st3.code = fmt::format(
       "  const Scalar ik_x = ik_v{0} * ik_w{0} + ik_v{1} * ik_w{1}, ik_y = ik_v{0} * ik_w{1} - ik_v{1} * ik_w{0};\n"
       "  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);\n"
@@ -1109,6 +1118,32 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
 )";
 
 }  // namespace
+
+std::vector<ChainStep> canonical_ik_chain(const Model& m, const std::string& frame) {
+  const CanonicalChain c = canonical_chain(m, full_chain(m, frame));
+  std::vector<ChainStep> out;
+  const auto fixed = [&](const Rigid& r) {
+    if (!identically_zero(r.offset)) {
+      ChainStep st;
+      st.kind = ChainStep::Kind::Translate;
+      st.offset = r.offset;
+      out.push_back(st);
+    }
+    for (const Rot& t : r.turns) {
+      ChainStep st;
+      st.kind = ChainStep::Kind::Turn;
+      st.axis = t.axis;
+      st.angle = t.angle;
+      out.push_back(st);
+    }
+  };
+  for (std::size_t k = 0; k < c.joints.size(); ++k) {
+    fixed(c.fixed[k]);
+    out.push_back(c.joints[k]);
+  }
+  fixed(c.fixed.back());
+  return out;
+}
 
 EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<std::string>& report) {
   std::string t = banner(m, opt, "Closed-form inverse kinematics of the limbs, derived from the model's chains.");
