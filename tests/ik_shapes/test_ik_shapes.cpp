@@ -64,7 +64,7 @@ TEST_CASE("closed-form IK on random geometries of every limb shape: every branch
     const gen::LimbInfo& limb = gen::kLimbs[l];
     const gen::ClosedFormInfo& cf = gen::kClosedForm[l];
     CAPTURE(limb.name);
-    REQUIRE(cf.solve != nullptr);  // every shape in the file has a closed form
+    REQUIRE(static_cast<bool>(cf.solve));  // every shape in the file has a closed form
     double worst_residual = 0, worst_difference = 0;
     int solved = 0, ill_conditioned = 0, branches_ok = 0, newton_failed = 0;
     for (int g = 0; g < kGeometries; ++g) {
