@@ -40,7 +40,11 @@ std::string ik_line(const Model& m, const std::string& limb) {
 
 bool same(const ex& a, const ex& b) { return (a - b).expand().is_zero(); }
 
-void check_same_chain(const std::vector<ChainStep>& a, const std::vector<ChainStep>& b) {
+// The same chain in two models read from two files (each reading makes its own symbols: b's are
+// renamed to a's by name).
+void check_same_chain(const Model& ma, const std::vector<ChainStep>& a, const Model& mb, const std::vector<ChainStep>& b) {
+  GiNaC::exmap rename;
+  for (const Parameter& p : mb.parameters) rename[p.symbol] = ma.parameter(p.name).symbol;
   REQUIRE(a.size() == b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     CAPTURE(i);
@@ -48,8 +52,8 @@ void check_same_chain(const std::vector<ChainStep>& a, const std::vector<ChainSt
     CHECK(a[i].axis == b[i].axis);
     CHECK(a[i].coordinate == b[i].coordinate);
     CHECK(a[i].sign == b[i].sign);
-    for (int k = 0; k < 3; ++k) CHECK(same(a[i].offset[k], b[i].offset[k]));
-    CHECK(same(a[i].angle, b[i].angle));
+    for (int k = 0; k < 3; ++k) CHECK(same(a[i].offset[k], b[i].offset[k].subs(rename)));
+    CHECK(same(a[i].angle, b[i].angle.subs(rename)));
   }
 }
 
@@ -97,9 +101,12 @@ TEST_CASE("IK patterns: rewording a chain changes neither its canonical form nor
   const Model m = parse_model(reworded, "reworded.yaml");
   for (const char* hub : {"hub_lf", "hub_rh"}) {
     CAPTURE(hub);
-    check_same_chain(canonical_ik_chain(m, hub), canonical_ik_chain(base, hub));
+    check_same_chain(m, canonical_ik_chain(m, hub), base, canonical_ik_chain(base, hub));
   }
-  CHECK(ik_line(m, "leg_lf") == ik_line(base, "leg_lf"));
+  // The same pattern and solve (the operation count, after the branch count, may differ by a few:
+  // the two readings' symbols order GiNaC's sums differently, and so the common subexpressions).
+  const auto solve_of = [](const std::string& line) { return line.substr(0, line.find(" (4 branches")); };
+  CHECK(solve_of(ik_line(m, "leg_lf")) == solve_of(ik_line(base, "leg_lf")));
 }
 
 TEST_CASE("IK patterns: point3 tests whether the axes meet, whatever separates the joints in the file") {
