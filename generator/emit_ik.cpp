@@ -323,7 +323,7 @@ void require_three_joints(const Model& m, const CanonicalChain& c, const std::st
                        name(c.joints[0].coordinate) + " (put the inputs' joints first, nearer the root)"};
     if (j.kind == ChainStep::Kind::Slide) throw Unsolvable{pattern + ": " + name(j.coordinate) + " is prismatic"};
   }
-  if (c.joints.size() != 3) throw Unsolvable{fmt::format("{}: {} dependent joints drive {}, not 3", pattern, c.joints.size(), frame)};
+  if (c.joints.size() != 3) throw Unsolvable{fmt::format("{}: {} dependent joints drive {}; the pattern solves three", pattern, c.joints.size(), frame)};
 }
 
 // R_axis(sign q) with sin(-q) written -sin(q) (GiNaC keeps sin(-q), which the solved sines would
@@ -387,7 +387,8 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   if (!identically_zero(between.offset[across])) {
     const double gap = at_defaults(m, between.offset[across]);
     throw Unsolvable{fmt::format("point3: the axes of {} and {} do not meet: the offset between the joints ({}) has a {} "
-                                 "component ({:.4g} m at the defaults), across both axes; point3 needs it along the two axes",
+                                 "component ({:.4g} m at the defaults), across both axes; point3 needs it along the two axes (an offset "
+                                 "across them that belongs further down the limb goes after the second joint)",
                                  n1, n2, describe(m, c.fixed[1]), axis_name(static_cast<Axis>(across)), gap)};
   }
   // The meeting point P: on the first axis at the offset's component along it; from the second
@@ -492,7 +493,8 @@ Solve plan_wheel_leg(const Model& m, const Limb& limb) {
   const auto parallel = [](const Vec3& a, const Vec3& b) { return identically_zero(cross(a, b)); };
   if (!parallel(product(c.fixed[2].turns) * unit(j3.axis), unit(j2.axis)))
     throw Unsolvable{pattern + ": the axes of " + n2 + " and " + n3 + " are not parallel (" + describe(m, c.fixed[2]) +
-                     " between them); the pattern needs the last two joints about parallel axes (a leg's flexion and knee)"};
+                     " between them); the pattern needs the last two joints about parallel axes (a leg's flexion and knee), "
+                     "with turns between them only about that axis"};
   if (wheel && !parallel(product(c.fixed[3].turns) * unit(wheel->axle), unit(j3.axis)))
     throw Unsolvable{pattern + ": the axle of wheel " + wheel->name + " (" + axis_name(wheel->axle) + " of " + wheel->hub +
                      ") is not parallel to the axis of " + n3 + "; the pattern needs the wheel turning in the leg's plane"};
