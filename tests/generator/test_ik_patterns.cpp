@@ -118,6 +118,7 @@ TEST_CASE("IK patterns: point3 tests whether the axes meet, whatever separates t
   CHECK(apart.find("no closed form") != std::string::npos);
   CHECK(apart.find("point3: the axes of abduct and flex do not meet") != std::string::npos);
   CHECK(apart.find("translate [0, 0, -drop]") != std::string::npos);
+  CHECK(apart.find("goes after the second joint") != std::string::npos);  // what to change in the file
   CHECK(apart.find("plane leg: the axes of flex and knee are not parallel") != std::string::npos);
   // With the knee straight the leg is a plane leg (the first two axes need not meet there).
   CHECK(ik_line(parse_model(straight_knee, "plane.yaml"), "leg").rfind("leg: plane leg: ", 0) == 0);
