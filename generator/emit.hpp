@@ -56,6 +56,11 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt);
 // patterns (emit_ik.cpp documents them), with all its branches; `report` receives one line per
 // limb: the pattern used, or why none applies (that limb is then left to Newton's method).
 EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<std::string>& report);
+// The chain from K0 to `frame` from its first dependent joint on, in the canonical form the IK
+// patterns match on (emit_ik.cpp): per gap between joints one translation (if any) then the turns,
+// offsets slid along the joint axes they commute with, identities dropped. The steps before the
+// first dependent joint are left out (they stay as written).
+std::vector<ChainStep> canonical_ik_chain(const Model& m, const std::string& frame);
 // The double overload of the function template `name` (parameters: declaration and default value,
 // each): it calls name<double>(), or on x86-64 with GCC or clang its AVX2 + FMA build when the CPU
 // has those (types.hpp: WLX_GEN_MULTIVERSION). `why`: what the overload is for, in its comment.

@@ -2,15 +2,21 @@
 // arms, for the limb types of walking machines) and emitted as straight-line C++ with a few calls
 // of two small solvers, with every branch.
 //
-// Patterns (each checks its preconditions on the symbolic chain; a limb that matches none is
-// reported by wlx-gen and solved by Newton's method at run time):
+// Patterns (each checks its preconditions on the chain's canonical form, below, so on geometry;
+// a limb that matches none is reported by wlx-gen with what each pattern needs, and solved by
+// Newton's method at run time):
 //
 // point3 (a leg): the limb's three rows put one frame's origin at three input targets (x, y, z);
-//   three revolute joints drive it; the first two are consecutive steps about different axes (so
-//   their axes meet), and nothing input-driven follows the first. With d the target in the frame
-//   before the first joint, |d|^2 depends on the third joint alone: K + A cos q3 + B sin q3 = |d|^2
-//   (bit 0 picks the root); then R_a(q1) R_b(q2) v(q3) = d is two rotations about principal axes
-//   (bit 1 picks q2's root). Any fixed offsets and fixed turns between and after the joints.
+//   three revolute joints drive it, the axes of the first two meet, and nothing input-driven
+//   follows the first. With d the target seen from the meeting point P, |d|^2 depends on the third
+//   joint alone: K + A cos q3 + B sin q3 = |d|^2 (bit 0 picks the root); then R_a(q1) R_b(q2) v(q3)
+//   = d is two rotations about principal axes (bit 1 picks q2's root). Any fixed offsets and turns
+//   before the first joint, between the second and third and after the third.
+//
+// wheel leg / plane leg: the rows place a wheel's derived contact point (or a frame's origin);
+//   the second and third joints (and the axle) are parallel. The plane's offset along its normal
+//   fixes q1 (bit 0), the axle then the rim point nearest the ground and so the hub, whose distance
+//   from the second joint fixes q3 (bit 1), and one rotation q2.
 //
 // leveled lever (a wheel lever): one point row (a component of a frame's origin equals an input),
 //   two level rows on that frame (two of its axes horizontal) and sum rows that each fix one joint
@@ -29,9 +35,11 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <regex>
-#include <stdexcept>
 #include <set>
+#include <sstream>
+#include <stdexcept>
 
 namespace wlx::codegen {
 
@@ -168,6 +176,8 @@ ex in_results(const Model& m, ex e, const Solve& solve) {
     const ex q = m.coordinates[static_cast<std::size_t>(j.coordinate)].q;
     trig.append(GiNaC::sin(q) == j.s);
     trig.append(GiNaC::cos(q) == j.c);
+    trig.append(GiNaC::sin(-q) == -j.s);  // a step about a negative axis (`ry: -q`): GiNaC keeps sin(-q)
+    trig.append(GiNaC::cos(-q) == j.c);
     plain.append(q == j.q);
   }
   return e.subs(trig).subs(plain);
@@ -182,57 +192,225 @@ std::string two_axis_call(Axis a, Axis b, const std::string& v, const std::strin
       static_cast<int>(b), v, d, flip);
 }
 
-// ---- point3 -------------------------------------------------------------------------------------
+// ---- canonical chains ---------------------------------------------------------------------------
+//
+// The patterns test geometry (do two axes meet, are they parallel), not the wording of the file:
+// before matching, a chain is brought to a canonical form. From the first dependent joint on, the
+// fixed steps between consecutive joints become one rigid transform (an offset, then the turns),
+// with consecutive translations added up, consecutive turns about one axis merged and zero offsets
+// and zero turns dropped. Then every offset's component along the axis of the joint just before it
+// slides to before that joint (a translation along a joint's axis commutes with the joint), from
+// the last joint to the first, so that offsets gather as near the root as they can; and turns about
+// that joint's axis right after it (with no offset left in front of them) slide before it too.
+// `translate: [0, 0, 0]` between two joints, a translation split over two steps, a hub offset
+// written along the knee axis after the knee: all give the same canonical chain.
 
-Solve plan_point3(const Model& m, const Limb& limb) {
-  const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
-  if (limb.rows.size() != 3) throw Unsolvable{"point3 needs three point rows"};
+// A rigid transform that depends on parameters only: T(offset), then the turns in order.
+struct Rigid {
+  Vec3 offset;
+  std::vector<Rot> turns;
+};
+
+bool identically_zero(const ex& e) { return e.expand().is_zero(); }
+bool identically_zero(const Vec3& v) { return identically_zero(v[0]) && identically_zero(v[1]) && identically_zero(v[2]); }
+
+// e at the parameters' defaults (for messages and for telling "not identically" from "not at all").
+double at_defaults(const Model& m, const ex& e) {
+  GiNaC::lst values;
+  for (const Parameter& p : m.parameters) values.append(p.symbol == p.default_value);
+  const ex v = GiNaC::evalf(e.subs(values));
+  return GiNaC::is_a<GiNaC::numeric>(v) ? GiNaC::ex_to<GiNaC::numeric>(v).to_double() : std::nan("");
+}
+
+struct CanonicalChain {
+  std::vector<ChainStep> prefix;  // the steps before the first dependent joint, as written
+  std::vector<ChainStep> joints;  // every joint step from the first dependent one on
+  std::vector<Rigid> fixed;       // fixed[k] before joints[k]; fixed[joints.size()] after the last
+};
+
+Vec3 expanded(const Vec3& v) { return {v[0].expand(), v[1].expand(), v[2].expand()}; }
+
+CanonicalChain canonical_chain(const Model& m, const std::vector<ChainStep>& chain) {
+  CanonicalChain c;
+  std::size_t first = 0;
+  while (first < chain.size() && !(driven(chain[first]) && chain[first].coordinate >= m.input_count)) ++first;
+  c.prefix.assign(chain.begin(), chain.begin() + static_cast<std::ptrdiff_t>(first));
+  c.fixed.emplace_back();
+  for (std::size_t i = first; i < chain.size(); ++i) {
+    const ChainStep& st = chain[i];
+    Rigid& r = c.fixed.back();
+    if (driven(st)) {
+      c.joints.push_back(st);
+      c.fixed.emplace_back();
+    } else if (st.kind == ChainStep::Kind::Translate) {
+      r.offset = expanded(r.offset + product(r.turns) * st.offset);  // T(o) R T(v) = T(o + R v) R
+    } else {
+      r.turns.push_back({st.axis, st.angle});
+      r.turns = merge(r.turns);
+    }
+  }
+  for (std::size_t k = c.joints.size(); k-- > 0;) {
+    const ChainStep& j = c.joints[k];
+    if (j.coordinate < m.input_count) continue;  // the base's own steps stay as written
+    const int a = static_cast<int>(j.axis);
+    Rigid &before = c.fixed[k], &after = c.fixed[k + 1];
+    if (!identically_zero(after.offset[a])) {
+      before.offset = expanded(before.offset + product(before.turns) * (after.offset[a] * unit(j.axis)));
+      after.offset[a] = 0;
+    }
+    if (j.kind == ChainStep::Kind::Rotate && identically_zero(after.offset))
+      while (!after.turns.empty() && after.turns.front().axis == j.axis) {
+        before.turns.push_back(after.turns.front());
+        before.turns = merge(before.turns);
+        after.turns.erase(after.turns.begin());
+      }
+  }
+  return c;
+}
+
+Frame apply(const Frame& f, const Rigid& r) {
+  Frame out = identically_zero(r.offset) ? f : f.translated(r.offset);
+  for (const Rot& t : r.turns) out = out.turned(t.axis, t.angle);
+  return out;
+}
+
+// The frame before the first dependent joint: the prefix and the fixed transform after it.
+Frame base_frame(const Model& m, const CanonicalChain& c) {
+  Frame base = Frame::ground();
+  for (const ChainStep& st : c.prefix) base = apply(m, base, st);
+  return apply(base, c.fixed[0]);
+}
+
+std::string describe(const Model& m, const Rigid& r) {
+  std::vector<std::string> parts;
+  if (!identically_zero(r.offset)) {
+    std::ostringstream o;
+    o << "translate [" << r.offset[0] << ", " << r.offset[1] << ", " << r.offset[2] << "]";
+    parts.push_back(o.str());
+  }
+  for (const Rot& t : r.turns) {
+    std::ostringstream o;
+    o << "r" << axis_name(t.axis) << ": " << t.angle;
+    parts.push_back(o.str());
+  }
+  static_cast<void>(m);
+  return parts.empty() ? "nothing" : fmt::format("{}", fmt::join(parts, ", "));
+}
+
+// The limb's three point rows: the frame they place and the input targets of its x, y and z.
+std::pair<std::string, std::array<int, 3>> point_rows(const Model& m, const Limb& limb, const std::string& pattern) {
+  if (limb.rows.size() != 3) throw Unsolvable{pattern + " needs three point rows (x, y and z of one frame)"};
   std::string frame;
   std::array<int, 3> target{-1, -1, -1};
   for (int r : limb.rows) {
     const ClosureCondition& c = m.closure[static_cast<std::size_t>(r)];
-    if (c.kind != ClosureCondition::Kind::PointEqualsCoordinate) throw Unsolvable{"point3: row " + c.name + " is not a point row"};
-    if (!frame.empty() && c.frame != frame) throw Unsolvable{"point3: the rows place different frames"};
+    if (c.kind != ClosureCondition::Kind::PointEqualsCoordinate) throw Unsolvable{pattern + ": row " + c.name + " is not a point row"};
+    if (!frame.empty() && c.frame != frame) throw Unsolvable{pattern + ": the rows place different frames (" + frame + ", " + c.frame + ")"};
     frame = c.frame;
     auto& t = target[static_cast<std::size_t>(c.axis)];
-    if (t >= 0) throw Unsolvable{"point3: two rows fix the same component"};
+    if (t >= 0) throw Unsolvable{pattern + ": two rows fix the same component"};
     t = c.target;
   }
-  require_plain_chain(m, frame, {}, "point3");
-  const std::vector<ChainStep> chain = full_chain(m, frame);
-  require_plain_chain(m, frame, chain, "point3");
-  std::vector<std::size_t> at;
-  for (std::size_t i = 0; i < chain.size(); ++i)
-    if (driven(chain[i]) && chain[i].coordinate >= m.input_count) {
-      if (chain[i].kind == ChainStep::Kind::Slide) throw Unsolvable{"point3: " + name(chain[i].coordinate) + " is prismatic"};
-      at.push_back(i);
-    }
-  if (at.size() != 3) throw Unsolvable{fmt::format("point3: {} dependent joints drive {}, not 3", at.size(), frame)};
-  const ChainStep &j1 = chain[at[0]], &j2 = chain[at[1]], &j3 = chain[at[2]];
-  if (at[1] != at[0] + 1)
-    throw Unsolvable{"point3: " + name(j1.coordinate) + " and " + name(j2.coordinate) + " are not consecutive steps, so their axes need not meet"};
-  if (j1.axis == j2.axis) throw Unsolvable{"point3: " + name(j1.coordinate) + " and " + name(j2.coordinate) + " turn about the same axis"};
-  for (std::size_t i = at[0] + 1; i < chain.size(); ++i)
-    if (driven(chain[i]) && chain[i].coordinate < m.input_count)
-      throw Unsolvable{"point3: input " + name(chain[i].coordinate) + " moves the chain after " + name(j1.coordinate)};
+  return {frame, target};
+}
 
-  Frame base = Frame::ground(), mid = Frame::ground(), tip = Frame::ground();
-  for (std::size_t i = 0; i < at[0]; ++i) base = apply(m, base, chain[i]);
-  for (std::size_t i = at[1] + 1; i < at[2]; ++i) mid = apply(m, mid, chain[i]);
-  for (std::size_t i = at[2] + 1; i < chain.size(); ++i) tip = apply(m, tip, chain[i]);
+// The three dependent revolute joints of a canonical chain, nothing input-driven after the first.
+void require_three_joints(const Model& m, const CanonicalChain& c, const std::string& frame, const std::string& pattern) {
+  const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
+  for (const ChainStep& j : c.joints) {
+    if (j.coordinate < m.input_count)
+      throw Unsolvable{pattern + ": input " + name(j.coordinate) + " moves the chain after the first dependent joint " +
+                       name(c.joints[0].coordinate) + " (put the inputs' joints first, nearer the root)"};
+    if (j.kind == ChainStep::Kind::Slide) throw Unsolvable{pattern + ": " + name(j.coordinate) + " is prismatic"};
+  }
+  if (c.joints.size() != 3) throw Unsolvable{fmt::format("{}: {} dependent joints drive {}; the pattern solves three", pattern, c.joints.size(), frame)};
+}
+
+// R_axis(sign q) with sin(-q) written -sin(q) (GiNaC keeps sin(-q), which the solved sines would
+// not replace).
+Mat3 signed_rot(Axis axis, int sign, const ex& q) {
+  const ex c = GiNaC::cos(q), sn = sign * GiNaC::sin(q);
+  Mat3 r = Mat3::identity();
+  const int i = (static_cast<int>(axis) + 1) % 3, j = (static_cast<int>(axis) + 2) % 3;  // R turns i towards j
+  r(i, i) = c;
+  r(i, j) = -sn;
+  r(j, i) = sn;
+  r(j, j) = c;
+  return r;
+}
+
+// sin and cos of the joint from those of theta = sign q that a solver computed.
+std::string unsign(const ChainStep& j, const SolvedJoint& s) {
+  return j.sign < 0 ? fmt::format("  {0} = -{0};  // the step turns about the negative axis: q = -theta\n", s.s.get_name()) : "";
+}
+
+// |p + M R_axis(sign q) t|^2 = K + A cos q + B sin q, for p, t and M free of q.
+Sinusoid distance_squared(const Vec3& p, const Mat3& M, const ChainStep& joint, const Vec3& t) {
+  const realsymbol angle("ik_angle");
+  const Sinusoid cross = sinusoid(2 * dot(p, M * (signed_rot(joint.axis, joint.sign, angle) * t)), angle, "the distance");
+  return {cross.a, cross.b, (dot(p, p) + dot(t, t) + cross.c).expand()};
+}
+
+// ---- point3 -------------------------------------------------------------------------------------
+
+Solve plan_point3(const Model& m, const Limb& limb) {
+  const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
+  const auto [frame, target] = point_rows(m, limb, "point3");
+  if (m.frames[static_cast<std::size_t>(m.frame_index(frame))].derived_from_wheel >= 0)
+    throw Unsolvable{"point3: " + frame + " is a wheel's contact point (the wheel-leg pattern places it)"};
+  const CanonicalChain c = canonical_chain(m, full_chain(m, frame));
+  require_three_joints(m, c, frame, "point3");
+  const ChainStep &j1 = c.joints[0], &j2 = c.joints[1], &j3 = c.joints[2];
+  const std::string n1 = name(j1.coordinate), n2 = name(j2.coordinate), n3 = name(j3.coordinate);
+  if (j1.axis == j2.axis)
+    throw Unsolvable{"point3: " + n1 + " and " + n2 + " turn about parallel axes (both " + axis_name(j1.axis) + ")"};
+
+  // Between the first two joints: turns about the first joint's axis move before it, turns about
+  // the second's after it (both commute with their joint); anything else tilts the second axis.
+  Rigid between = c.fixed[1];
+  std::vector<Rot> before_first, after_second;
+  while (!between.turns.empty() && between.turns.front().axis == j1.axis) {
+    const Rot t = between.turns.front();
+    between.offset = expanded(signed_rot(t.axis, -1, t.angle) * between.offset);  // T(o) R = R T(R^T o)
+    before_first.push_back(t);
+    between.turns.erase(between.turns.begin());
+  }
+  while (!between.turns.empty() && between.turns.back().axis == j2.axis) {
+    after_second.insert(after_second.begin(), between.turns.back());
+    between.turns.pop_back();
+  }
+  if (!between.turns.empty())
+    throw Unsolvable{"point3: between " + n1 + " and " + n2 + " the chain turns (" + describe(m, between) +
+                     ") about an axis of neither, so the axis of " + n2 + " is not a principal axis of " + n1 + "'s frame"};
+  // The axes meet when the offset between the joints lies in the plane of the two axes.
+  const int a1 = static_cast<int>(j1.axis), a2 = static_cast<int>(j2.axis), across = 3 - a1 - a2;
+  if (!identically_zero(between.offset[across])) {
+    const double gap = at_defaults(m, between.offset[across]);
+    throw Unsolvable{fmt::format("point3: the axes of {} and {} do not meet: the offset between the joints ({}) has a {} "
+                                 "component ({:.4g} m at the defaults), across both axes; point3 needs it along the two axes (an offset "
+                                 "across them that belongs further down the limb goes after the second joint)",
+                                 n1, n2, describe(m, c.fixed[1]), axis_name(static_cast<Axis>(across)), gap)};
+  }
+  // The meeting point P: on the first axis at the offset's component along it; from the second
+  // joint's frame it lies back along the second axis by the offset's component along that one.
+  Frame base = base_frame(m, c);
+  for (const Rot& t : before_first) base = base.turned(t.axis, t.angle);
+  if (!identically_zero(between.offset[a1])) base = base.translated(between.offset[a1] * unit(j1.axis));
+  const Mat3 M = product(after_second) * product(c.fixed[2].turns);
+  const Vec3 p = between.offset[a2] * unit(j2.axis) + product(after_second) * c.fixed[2].offset;  // P to the third joint
+  const Vec3 t = c.fixed[3].offset;                                                                  // the third joint to the point
 
   Solve solve;
   solve.pattern = "point3";
   const SolvedJoint q1 = joint_symbols(m, j1.coordinate), q2 = joint_symbols(m, j2.coordinate), q3 = joint_symbols(m, j3.coordinate);
   solve.joints = {q1, q2, q3};
-  const std::string n1 = name(j1.coordinate), n2 = name(j2.coordinate), n3 = name(j3.coordinate);
   solve.summary = fmt::format("point3: {} at (x, y, z) = ({}, {}, {}) by {} ({}), {} ({}) with meeting axes, then {} ({})", frame,
                               name(target[0]), name(target[1]), name(target[2]), n1, axis_name(j1.axis), n2, axis_name(j2.axis), n3,
                               axis_name(j3.axis));
   solve.doc = {
       fmt::format("Pattern point3: the origin of {} at the targets ({}, {}, {}), placed by the joints {} and {}", frame,
                   name(target[0]), name(target[1]), name(target[2]), n1, n2),
-      fmt::format("(about {} and {}, consecutive: their axes meet) and {} (about {}). The distance from the", axis_name(j1.axis),
+      fmt::format("(about {} and {}, with meeting axes) and {} (about {}). The distance from the", axis_name(j1.axis),
                   axis_name(j2.axis), n3, axis_name(j3.axis)),
       fmt::format("meeting point to the target fixes {}; then {} and {} turn the limb onto it.", n3, n2, n1)};
   solve.branches = 4;
@@ -247,7 +425,7 @@ Solve plan_point3(const Model& m, const Limb& limb) {
                   "{{value:.4f}} m off it",
                   frame, n3, n1)};
 
-  // Stage 0: the target in the base frame; |d|^2 = K + A cos q3 + B sin q3.
+  // Stage 0: the target seen from the meeting point; |d|^2 = K + A cos q3 + B sin q3.
   Stage s0;
   const realsymbol d[3] = {realsymbol("ik_d0"), realsymbol("ik_d1"), realsymbol("ik_d2")};
   for (int i = 0; i < 3; ++i) {
@@ -256,14 +434,11 @@ Solve plan_point3(const Model& m, const Limb& limb) {
       di += base.R(k, i) * (m.coordinates[static_cast<std::size_t>(target[static_cast<std::size_t>(k)])].q - base.r[k]);
     s0.locals.emplace_back(d[i], di);
   }
-  const Vec3 p1 = mid.r, p2 = tip.r;
-  const ex K = dot(p1, p1) + dot(p2, p2);
-  const realsymbol angle("ik_angle");
-  const Sinusoid cross = sinusoid(2 * dot(p1, mid.R * (rot(j3.axis, angle) * p2)), angle, "the distance");
+  const Sinusoid distance = distance_squared(p, M, j3, t);
   const realsymbol K_("ik_K"), A_("ik_A"), B_("ik_B");
-  s0.locals.emplace_back(K_, K);
-  s0.locals.emplace_back(A_, cross.a);
-  s0.locals.emplace_back(B_, cross.b);
+  s0.locals.emplace_back(K_, distance.c);
+  s0.locals.emplace_back(A_, distance.a);
+  s0.locals.emplace_back(B_, distance.b);
   s0.code = fmt::format(
       "  const Scalar ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;\n"
       "  Scalar {0}, {1};\n"
@@ -276,18 +451,185 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   s0.defines = {q3.c.get_name(), q3.s.get_name()};
   solve.stages.push_back(s0);
 
-  // Stage 1: v = p1 + M R_c(q3) p2 in the frame after q2; two rotations take it onto d.
+  // Stage 1: v = p + M R_c(q3) t in the frame after q2, from P; two rotations take it onto d.
   Stage s1;
-  const Vec3 v = p1 + mid.R * (rot(j3.axis, m.coordinates[static_cast<std::size_t>(j3.coordinate)].q) * p2);
+  const Vec3 v = p + M * (signed_rot(j3.axis, j3.sign, m.coordinates[static_cast<std::size_t>(j3.coordinate)].q) * t);
   const realsymbol vs[3] = {realsymbol("ik_v0"), realsymbol("ik_v1"), realsymbol("ik_v2")};
   for (int i = 0; i < 3; ++i) s1.locals.emplace_back(vs[i], in_results(m, v[i], solve));
   s1.code = "  const Scalar ik_v[3] = {ik_v0, ik_v1, ik_v2};\n  const Scalar ik_d[3] = {ik_d0, ik_d1, ik_d2};\n" +
             two_axis_call(j1.axis, j2.axis, "ik_v", "ik_d", "(branch & 2) != 0", q1, q2) +
             fmt::format("  if (!ik_two_axis_ok) {{\n    why = {{2, ik_beside, 0.0, ik_room, double(std::atan2({}, {})) * 57.29577951308232}};\n"
                         "    return IkStatus::out_of_reach;\n  }}\n",
-                        q3.s.get_name(), q3.c.get_name());
+                        q3.s.get_name(), q3.c.get_name()) +
+            unsign(j1, q1) + unsign(j2, q2);
   s1.defines = {q1.c.get_name(), q1.s.get_name(), q2.c.get_name(), q2.s.get_name()};
   solve.stages.push_back(s1);
+  return solve;
+}
+
+// ---- wheel leg (and plane leg) ------------------------------------------------------------------
+//
+// Three revolute joints, the last two (and, for a wheel, its axle) parallel: a hip that swings the
+// leg's plane, then a planar two-link leg in it. Every point of the leg beyond the first joint,
+// the wheel's contact point included (it lies in the wheel's plane, which the axle is normal to),
+// keeps one distance Y along the leg plane's normal n from the first joint's origin, so the target
+// d fixes the first joint: (R_1(q1) n) . d = Y. The axle a then follows from q1 and the inputs
+// alone, hence the contact's offset from the hub, -r u with u = (e_z - a_z a) / |e_z - a_z a| (the
+// derived contact frame's), and the hub's place h = target + r u. The distance from the second
+// joint's origin to h fixes the third joint (K + A cos q3 + B sin q3 = |w|^2) and one rotation
+// about the plane's normal the second. Without a wheel (r = 0) the same for a point.
+
+Solve plan_wheel_leg(const Model& m, const Limb& limb) {
+  const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
+  const auto [frame, target] = point_rows(m, limb, "wheel leg");
+  const NamedFrame& placed = m.frames[static_cast<std::size_t>(m.frame_index(frame))];
+  const NonholonomicWheel* wheel = placed.derived_from_wheel >= 0 ? &m.wheels[static_cast<std::size_t>(placed.derived_from_wheel)] : nullptr;
+  const std::string pattern = wheel ? "wheel leg" : "plane leg";
+  const std::string point = wheel ? wheel->hub : frame;
+  const CanonicalChain c = canonical_chain(m, full_chain(m, point));
+  require_three_joints(m, c, point, pattern);
+  const ChainStep &j1 = c.joints[0], &j2 = c.joints[1], &j3 = c.joints[2];
+  const std::string n1 = name(j1.coordinate), n2 = name(j2.coordinate), n3 = name(j3.coordinate);
+  const auto parallel = [](const Vec3& a, const Vec3& b) { return identically_zero(cross(a, b)); };
+  if (!parallel(product(c.fixed[2].turns) * unit(j3.axis), unit(j2.axis)))
+    throw Unsolvable{pattern + ": the axes of " + n2 + " and " + n3 + " are not parallel (" + describe(m, c.fixed[2]) +
+                     " between them); the pattern needs the last two joints about parallel axes (a leg's flexion and knee), "
+                     "with turns between them only about that axis"};
+  if (wheel && !parallel(product(c.fixed[3].turns) * unit(wheel->axle), unit(j3.axis)))
+    throw Unsolvable{pattern + ": the axle of wheel " + wheel->name + " (" + axis_name(wheel->axle) + " of " + wheel->hub +
+                     ") is not parallel to the axis of " + n3 + "; the pattern needs the wheel turning in the leg's plane"};
+  const Mat3 R1 = product(c.fixed[1].turns);
+  const Vec3 normal = R1 * unit(j2.axis);  // the leg plane's normal in the frame after q1
+  if (parallel(unit(j1.axis), normal) || std::abs(at_defaults(m, cross(unit(j1.axis), normal)[0])) +
+                                                 std::abs(at_defaults(m, cross(unit(j1.axis), normal)[1])) +
+                                                 std::abs(at_defaults(m, cross(unit(j1.axis), normal)[2])) < 1e-9)
+    throw Unsolvable{pattern + ": the axis of " + n1 + " is parallel to those of " + n2 + " and " + n3 + " (a planar leg: " + n1 +
+                     " cannot move the leg's plane)"};
+  const ex& q2 = m.coordinates[static_cast<std::size_t>(j2.coordinate)].q;
+  const ex& q3 = m.coordinates[static_cast<std::size_t>(j3.coordinate)].q;
+  const Vec3 p1 = c.fixed[1].offset, p2 = c.fixed[2].offset, p3 = c.fixed[3].offset;
+  const Mat3 R2 = product(c.fixed[2].turns);
+  const Vec3 hub = p1 + R1 * (signed_rot(j2.axis, j2.sign, q2) * (p2 + R2 * (signed_rot(j3.axis, j3.sign, q3) * p3)));
+  const ex plane = dot(normal, hub).expand();
+  if (plane.has(q2) || plane.has(q3))
+    throw std::logic_error("wlx-gen: the leg plane's offset depends on the planar joints");  // parallel axes exclude it
+
+  Solve solve;
+  solve.pattern = wheel ? "wheel-leg" : "plane-leg";
+  const SolvedJoint s1 = joint_symbols(m, j1.coordinate), s2 = joint_symbols(m, j2.coordinate), s3 = joint_symbols(m, j3.coordinate);
+  solve.joints = {s1, s2, s3};
+  const std::string what = wheel ? "the contact point of wheel " + wheel->name + " (" + frame + ")" : frame;
+  solve.summary = fmt::format("{}: {} at (x, y, z) = ({}, {}, {}) by {} ({}), then {} and {} (parallel, about {}){}", pattern, what,
+                              name(target[0]), name(target[1]), name(target[2]), n1, axis_name(j1.axis), n2, n3, axis_name(j2.axis),
+                              wheel ? ", the hub " + point + " from the radius and the ground" : "");
+  solve.doc = {
+      fmt::format("Pattern {}: {} at the targets ({}, {}, {}).", pattern, what, name(target[0]), name(target[1]), name(target[2])),
+      fmt::format("{} (about {}) turns the plane of {} and {} (parallel axes) through the target;", n1, axis_name(j1.axis), n2, n3),
+      wheel ? fmt::format("the axle then fixes the rim point nearest the ground, so the hub {} sits at the target plus the", point)
+            : std::string("the distance from the axis of " + n2 + " fixes " + n3 + ", one rotation " + n2 + "."),
+  };
+  if (wheel)
+    solve.doc.push_back(fmt::format("radius along the rim's upward direction; its distance from the axis of {} fixes {}, then {}.", n2, n3, n2));
+  solve.branches = 4;
+  solve.bits = {fmt::format("bit 0: the other root of {} (branch 0: the root nearest zero; on a tie the positive one)", n1),
+                fmt::format("bit 1: the other root of {} (branch 0: the root nearest zero; on a tie the positive one)", n3)};
+  solve.failures = {
+      fmt::format("{} out of reach: the plane of {} and {} lies {{value:.4f}} m from the axis of {}, and the target only "
+                  "{{high:.4f}} m{}",
+                  frame, n2, n3, n1, wheel ? " (or the wheel's axle would be vertical: a wheel lying flat touches no single point)" : ""),
+      fmt::format("{} out of reach: it would be {{value:.4f}} m from the axis of {} (the origin of its frame), and the leg "
+                  "reaches [{{low:.4f}}, {{high:.4f}}] m from it",
+                  point, n2)};
+
+  // Stage 0: the target in the frame before q1; (R_1(q1) n) . d = Y.
+  const Frame base = base_frame(m, c);
+  Stage st0;
+  const realsymbol d[3] = {realsymbol("ik_d0"), realsymbol("ik_d1"), realsymbol("ik_d2")};
+  for (int i = 0; i < 3; ++i) {
+    ex di = 0;
+    for (int k = 0; k < 3; ++k)
+      di += base.R(k, i) * (m.coordinates[static_cast<std::size_t>(target[static_cast<std::size_t>(k)])].q - base.r[k]);
+    st0.locals.emplace_back(d[i], di);
+  }
+  const realsymbol& q1 = m.coordinates[static_cast<std::size_t>(j1.coordinate)].q;
+  const Mat3 turn1 = signed_rot(j1.axis, j1.sign, q1);
+  const Sinusoid first = sinusoid(dot(turn1 * normal, Vec3(d[0], d[1], d[2])).expand(), q1, "the leg plane's offset");
+  st0.locals.emplace_back(realsymbol("ik_alpha"), first.a);
+  st0.locals.emplace_back(realsymbol("ik_beta"), first.b);
+  st0.locals.emplace_back(realsymbol("ik_gamma"), (plane - first.c).expand());
+  st0.code = fmt::format(
+      "  Scalar {0}, {1};\n"
+      "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, {0}, {1})) {{\n"
+      "    why = {{1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0}};\n"
+      "    return IkStatus::out_of_reach;\n"
+      "  }}\n",
+      s1.c.get_name(), s1.s.get_name());
+  st0.defines = {s1.c.get_name(), s1.s.get_name()};
+  solve.stages.push_back(st0);
+
+  // Stage 1 (a wheel): the axle in K0, the rim's upward direction u, the hub at the target + r u.
+  Vec3 hub_target(d[0], d[1], d[2]);
+  if (wheel) {
+    Stage st1;
+    const Vec3 axle = base.R * (turn1 * normal);
+    const realsymbol a[3] = {realsymbol("ik_a0"), realsymbol("ik_a1"), realsymbol("ik_a2")};
+    for (int i = 0; i < 3; ++i) st1.locals.emplace_back(a[i], in_results(m, axle[i], solve));
+    st1.code =
+        "  const Scalar ik_tilt2 = (1 - ik_a2) * (1 + ik_a2);  // |e_z - a_z a|^2\n"
+        "  if (!(ik_tilt2 > std::numeric_limits<Scalar>::epsilon())) {\n"
+        "    why = {1, 0.0, 0.0, 0.0, 0.0};\n"
+        "    return IkStatus::out_of_reach;\n"
+        "  }\n"
+        "  const Scalar ik_tilt = std::sqrt(ik_tilt2);\n"
+        "  const Scalar ik_u0 = -ik_a2 * ik_a0 / ik_tilt, ik_u1 = -ik_a2 * ik_a1 / ik_tilt, ik_u2 = ik_tilt;\n";
+    st1.defines = {"ik_u0", "ik_u1", "ik_u2"};
+    solve.stages.push_back(st1);
+    const ex r = m.parameter(wheel->radius).symbol;
+    const Vec3 up(realsymbol("ik_u0"), realsymbol("ik_u1"), realsymbol("ik_u2"));
+    Vec3 up_base;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) up_base[i] += base.R(k, i) * up[k];
+    hub_target = hub_target + r * up_base;
+  }
+
+  // Stage 2: the hub (point) from the second joint's origin, in the frame before q2; its distance
+  // fixes q3: |p2 + R2 R_3(q3) p3|^2 = |w|^2.
+  Stage st2;
+  Vec3 w_expr = signed_rot(j1.axis, -j1.sign, q1) * hub_target - p1;
+  Vec3 w_local;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) w_local[i] += R1(k, i) * w_expr[k];
+  const realsymbol w[3] = {realsymbol("ik_w0"), realsymbol("ik_w1"), realsymbol("ik_w2")};
+  for (int i = 0; i < 3; ++i) st2.locals.emplace_back(w[i], in_results(m, w_local[i], solve));
+  const Sinusoid distance = distance_squared(p2, R2, j3, p3);
+  st2.locals.emplace_back(realsymbol("ik_K"), distance.c);
+  st2.locals.emplace_back(realsymbol("ik_A"), distance.a);
+  st2.locals.emplace_back(realsymbol("ik_B"), distance.b);
+  st2.code = fmt::format(
+      "  const Scalar ik_ww = ik_w0 * ik_w0 + ik_w1 * ik_w1 + ik_w2 * ik_w2;\n"
+      "  Scalar {0}, {1};\n"
+      "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_ww - ik_K, (branch & 2) != 0, {0}, {1})) {{\n"
+      "    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
+      "    why = {{2, std::sqrt(ik_ww), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
+      "    return IkStatus::out_of_reach;\n"
+      "  }}\n",
+      s3.c.get_name(), s3.s.get_name());
+  st2.defines = {s3.c.get_name(), s3.s.get_name()};
+  solve.stages.push_back(st2);
+
+  // Stage 3: v = p2 + R2 R_3(q3) p3; the rotation about the plane's normal that takes v onto w.
+  Stage st3;
+  const Vec3 v = p2 + R2 * (signed_rot(j3.axis, j3.sign, q3) * p3);
+  const int b = static_cast<int>(j2.axis), i = (b + 1) % 3, j = (b + 2) % 3;  // R_b turns i towards j
+  for (int k : {i, j}) st3.locals.emplace_back(realsymbol(fmt::format("ik_v{}", k)), in_results(m, v[k], solve));  // v_b = w_b
+  st3.code = fmt::format(
+      "  const Scalar ik_x = ik_v{0} * ik_w{0} + ik_v{1} * ik_w{1}, ik_y = ik_v{0} * ik_w{1} - ik_v{1} * ik_w{0};\n"
+      "  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);\n"
+      "  Scalar {2} = ik_r > 0 ? ik_x / ik_r : Scalar(1), {3} = ik_r > 0 ? ik_y / ik_r : Scalar(0);\n",
+      i, j, s2.c.get_name(), s2.s.get_name()) +
+      unsign(j2, s2);
+  st3.defines = {s2.c.get_name(), s2.s.get_name()};
+  solve.stages.push_back(st3);
   return solve;
 }
 
@@ -779,6 +1121,32 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
 
 }  // namespace
 
+std::vector<ChainStep> canonical_ik_chain(const Model& m, const std::string& frame) {
+  const CanonicalChain c = canonical_chain(m, full_chain(m, frame));
+  std::vector<ChainStep> out;
+  const auto fixed = [&](const Rigid& r) {
+    if (!identically_zero(r.offset)) {
+      ChainStep st;
+      st.kind = ChainStep::Kind::Translate;
+      st.offset = r.offset;
+      out.push_back(st);
+    }
+    for (const Rot& t : r.turns) {
+      ChainStep st;
+      st.kind = ChainStep::Kind::Turn;
+      st.axis = t.axis;
+      st.angle = t.angle;
+      out.push_back(st);
+    }
+  };
+  for (std::size_t k = 0; k < c.joints.size(); ++k) {
+    fixed(c.fixed[k]);
+    out.push_back(c.joints[k]);
+  }
+  fixed(c.fixed.back());
+  return out;
+}
+
 EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<std::string>& report) {
   std::string t = banner(m, opt, "Closed-form inverse kinematics of the limbs, derived from the model's chains.");
   t += "//\n// Each limb whose chain matches a solvable pattern gets a function ik_<limb>() with all its\n"
@@ -791,7 +1159,7 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
   for (const Limb& limb : m.limbs) {
     std::optional<Solve> solve;
     std::vector<std::string> reasons;
-    for (auto plan : {plan_point3, plan_lever}) {
+    for (auto plan : {plan_point3, plan_wheel_leg, plan_lever}) {
       try {
         solve = plan(m, limb);
         break;

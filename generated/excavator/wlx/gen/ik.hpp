@@ -128,7 +128,7 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
 // Closed-form inverse kinematics of limb leg_l (left leg).
 //
 // Pattern point3: the origin of F_l at the targets (x_Fl, y_Fl, z_Fl), placed by the joints psi_l2 and psi_l3
-// (about y and z, consecutive: their axes meet) and psi_l4 (about y). The distance from the
+// (about y and z, with meeting axes) and psi_l4 (about y). The distance from the
 // meeting point to the target fixes psi_l4; then psi_l3 and psi_l2 turn the limb onto it.
 // Branches 0 to 3:
 //   bit 0: the other root of psi_l4 (branch 0: the root nearest zero; on a tie the positive one)
@@ -232,7 +232,7 @@ inline IkStatus ik_leg_l(const CoordinatesOf<Scalar>& s, const Params& p, int br
 // Closed-form inverse kinematics of limb leg_r (right leg).
 //
 // Pattern point3: the origin of F_r at the targets (x_Fr, y_Fr, z_Fr), placed by the joints psi_r2 and psi_r3
-// (about y and z, consecutive: their axes meet) and psi_r4 (about y). The distance from the
+// (about y and z, with meeting axes) and psi_r4 (about y). The distance from the
 // meeting point to the target fixes psi_r4; then psi_r3 and psi_r2 turn the limb onto it.
 // Branches 0 to 3:
 //   bit 0: the other root of psi_r4 (branch 0: the root nearest zero; on a tie the positive one)

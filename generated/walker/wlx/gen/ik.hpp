@@ -128,7 +128,7 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
 // Closed-form inverse kinematics of limb leg_l (left leg).
 //
 // Pattern point3: the origin of foot_l at the targets (foot_x_l, foot_y_l, foot_z_l), placed by the joints abduct_l and lift_l
-// (about x and y, consecutive: their axes meet) and knee_l (about y). The distance from the
+// (about x and y, with meeting axes) and knee_l (about y). The distance from the
 // meeting point to the target fixes knee_l; then lift_l and abduct_l turn the limb onto it.
 // Branches 0 to 3:
 //   bit 0: the other root of knee_l (branch 0: the root nearest zero; on a tie the positive one)
@@ -241,7 +241,7 @@ inline IkStatus ik_leg_l(const CoordinatesOf<Scalar>& s, const Params& p, int br
 // Closed-form inverse kinematics of limb leg_r (right leg).
 //
 // Pattern point3: the origin of foot_r at the targets (foot_x_r, foot_y_r, foot_z_r), placed by the joints abduct_r and lift_r
-// (about x and y, consecutive: their axes meet) and knee_r (about y). The distance from the
+// (about x and y, with meeting axes) and knee_r (about y). The distance from the
 // meeting point to the target fixes knee_r; then lift_r and abduct_r turn the limb onto it.
 // Branches 0 to 3:
 //   bit 0: the other root of knee_r (branch 0: the root nearest zero; on a tie the positive one)

@@ -1,0 +1,136 @@
+// The closed-form IK's patterns match on geometry, not on how a file is written (docs/
+// architecture.md, "Canonical chains"): the canonical chain of the quadruped's leg is the one the
+// document shows, rewordings of a chain (zero offsets, split offsets, an offset moved along the
+// joint axis it commutes with) give the same canonical chain and the same pattern, and a limb that
+// matches nothing is told which precondition failed.
+#include "../../generator/emit.hpp"
+#include "../../generator/model_file.hpp"
+
+#include <doctest/doctest.h>
+
+#include <fstream>
+#include <sstream>
+
+using namespace wlx::codegen;
+
+namespace {
+
+std::string text_of(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string replaced(std::string text, const std::string& find, const std::string& by) {
+  const auto at = text.find(find);
+  REQUIRE(at != std::string::npos);
+  return text.replace(at, find.size(), by);
+}
+
+// wlx-gen's report line for the limb: "<limb>: <pattern>: ..." or "<limb>: no closed form (...)".
+std::string ik_line(const Model& m, const std::string& limb) {
+  std::vector<std::string> report;
+  emit_ik_header(m, EmitOptions{}, report);
+  for (const auto& line : report)
+    if (line.rfind(limb + ": ", 0) == 0) return line;
+  FAIL("no report line for " << limb);
+  return {};
+}
+
+bool same(const ex& a, const ex& b) { return (a - b).expand().is_zero(); }
+
+// The same chain in two models read from two files (each reading makes its own symbols: b's are
+// renamed to a's by name).
+void check_same_chain(const Model& ma, const std::vector<ChainStep>& a, const Model& mb, const std::vector<ChainStep>& b) {
+  GiNaC::exmap rename;
+  for (const Parameter& p : mb.parameters) rename[p.symbol] = ma.parameter(p.name).symbol;
+  REQUIRE(a.size() == b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    CAPTURE(i);
+    CHECK(a[i].kind == b[i].kind);
+    CHECK(a[i].axis == b[i].axis);
+    CHECK(a[i].coordinate == b[i].coordinate);
+    CHECK(a[i].sign == b[i].sign);
+    for (int k = 0; k < 3; ++k) CHECK(same(a[i].offset[k], b[i].offset[k].subs(rename)));
+    CHECK(same(a[i].angle, b[i].angle.subs(rename)));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("IK patterns: the quadruped's leg in canonical form, offsets gathered along the axes they commute with") {
+  const Model m = load_model_file(WLX_QUADRUPED_FILE);
+  const auto sym = [&](const char* n) { return ex(m.parameter(n).symbol); };
+  const std::vector<ChainStep> c = canonical_ik_chain(m, "hub_lf");
+  using K = ChainStep::Kind;
+  REQUIRE(c.size() == 7);
+  const K kinds[] = {K::Translate, K::Rotate, K::Translate, K::Rotate, K::Translate, K::Rotate, K::Translate};
+  for (std::size_t i = 0; i < 7; ++i) CHECK(c[i].kind == kinds[i]);
+  CHECK(c[1].coordinate == m.coordinate("haa_lf").index);
+  CHECK(c[1].axis == Axis::X);
+  CHECK(c[3].coordinate == m.coordinate("hfe_lf").index);
+  CHECK(c[5].coordinate == m.coordinate("kfe_lf").index);
+  const Vec3 expected[] = {{sym("flex_x"), 0, 0},
+                           {0, sym("flex_y") + sym("knee_y") + sym("hub_y"), 0},
+                           {0, 0, -sym("thigh")},
+                           {sym("hub_x"), 0, -sym("shank")}};
+  for (int g = 0; g < 4; ++g)
+    for (int k = 0; k < 3; ++k) CHECK(same(c[static_cast<std::size_t>(2 * g)].offset[k], expected[g][k]));
+  // The right legs' joints about -y keep their sign.
+  const std::vector<ChainStep> right = canonical_ik_chain(m, "hub_rf");
+  REQUIRE(right.size() == 7);
+  CHECK(right[1].sign == 1);
+  CHECK(right[3].sign == -1);
+  CHECK(right[5].sign == -1);
+  CHECK(ik_line(m, "leg_lf").rfind("leg_lf: wheel leg: ", 0) == 0);
+  CHECK(ik_line(m, "leg_rh").rfind("leg_rh: wheel leg: ", 0) == 0);
+}
+
+TEST_CASE("IK patterns: rewording a chain changes neither its canonical form nor its pattern") {
+  const std::string original = text_of(WLX_QUADRUPED_FILE);
+  const Model base = parse_model(original, "quadruped.yaml");
+  // Zero offsets and an offset split over three steps; the wheel-plane offset written before the
+  // knee instead of after it (along the knee axis: the same geometry).
+  std::string reworded = replaced(original, "chain: [translate: [<sx>*flex_x, <sy>*flex_y, 0], ry: <sy>*hfe_<leg>]",
+                                  "chain: [translate: [0, 0, 0], translate: [<sx>*flex_x, 0, 0], translate: [0, <sy>*flex_y, 0], "
+                                  "ry: <sy>*hfe_<leg>, translate: [0, 0, 0]]");
+  reworded = replaced(reworded, "chain: [translate: [0, <sy>*knee_y, -thigh], ry: <sy>*kfe_<leg>]",
+                      "chain: [translate: [0, <sy>*knee_y + <sy>*hub_y, -thigh], ry: <sy>*kfe_<leg>]");
+  reworded = replaced(reworded, "chain: [translate: [hub_x, <sy>*hub_y, -shank]]", "chain: [translate: [hub_x, 0, -shank]]");
+  const Model m = parse_model(reworded, "reworded.yaml");
+  for (const char* hub : {"hub_lf", "hub_rh"}) {
+    CAPTURE(hub);
+    check_same_chain(m, canonical_ik_chain(m, hub), base, canonical_ik_chain(base, hub));
+  }
+  // The same pattern and solve (the operation count, after the branch count, may differ by a few:
+  // the two readings' symbols order GiNaC's sums differently, and so the common subexpressions).
+  const auto solve_of = [](const std::string& line) { return line.substr(0, line.find(" (4 branches")); };
+  CHECK(solve_of(ik_line(m, "leg_lf")) == solve_of(ik_line(base, "leg_lf")));
+}
+
+TEST_CASE("IK patterns: point3 tests whether the axes meet, whatever separates the joints in the file") {
+  const std::string original = text_of(WLX_NEWTON_LEG_FILE);
+  const std::string straight_knee = replaced(original, "rz: skew, ry: knee", "ry: knee");
+  // As written, the flexion axis passes `drop` below the abduction axis: no point3, and the
+  // report says which offset and what point3 needs.
+  const std::string apart = ik_line(parse_model(original, "newton_leg.yaml"), "leg");
+  CHECK(apart.find("no closed form") != std::string::npos);
+  CHECK(apart.find("point3: the axes of abduct and flex do not meet") != std::string::npos);
+  CHECK(apart.find("translate [0, 0, -drop]") != std::string::npos);
+  CHECK(apart.find("goes after the second joint") != std::string::npos);  // what to change in the file
+  CHECK(apart.find("plane leg: the axes of flex and knee are not parallel") != std::string::npos);
+  // With the knee straight the leg is a plane leg (the first two axes need not meet there).
+  CHECK(ik_line(parse_model(straight_knee, "plane.yaml"), "leg").rfind("leg: plane leg: ", 0) == 0);
+  // `translate: [0, 0, 0]` between the first two joints, or an offset along the second joint's
+  // axis: the axes meet, point3 (which comes first) solves the leg with the skewed knee too.
+  for (const char* between : {"translate: [0, 0, 0]", "translate: [0, drop, 0]", "translate: [drop, 0, 0], translate: [0, drop, 0]"}) {
+    CAPTURE(between);
+    const std::string text = replaced(original, "chain: [translate: [0, 0, -drop], ry: flex]", std::string("chain: [") + between + ", ry: flex]");
+    CHECK(ik_line(parse_model(text, "meeting.yaml"), "leg").rfind("leg: point3: ", 0) == 0);
+  }
+  // A turn between the first two joints about an axis of neither tilts the second axis.
+  const std::string tilted = replaced(original, "chain: [translate: [0, 0, -drop], ry: flex]", "chain: [rz: skew, ry: flex]");
+  const std::string tilted_line = ik_line(parse_model(tilted, "tilted.yaml"), "leg");
+  CHECK(tilted_line.find("point3: between abduct and flex the chain turns (rz: skew)") != std::string::npos);
+}
