@@ -53,16 +53,7 @@ std::string suggestion(const std::string& name, const std::vector<std::string>& 
   return best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best);
 }
 
-// A value shown in a message: short, with control characters escaped.
-std::string excerpt(const std::string& s) {
-  std::string out;
-  for (char ch : s.substr(0, 60)) {
-    const auto u = static_cast<unsigned char>(ch);
-    if (u < 0x20 || u == 0x7f) out += fmt::format("\\x{:02x}", u);
-    else out += ch;
-  }
-  return s.size() > 60 ? out + "..." : out;
-}
+std::string excerpt(const std::string& s) { return text::excerpt(s); }
 
 bool is_identifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;

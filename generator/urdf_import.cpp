@@ -3,6 +3,7 @@
 #include "model_file.hpp"
 
 #include <fmt/format.h>
+#include <wlx/text.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -49,16 +50,7 @@ bool urdf_import_available() { return true; }
 
 namespace {
 
-// A value shown in a message: short, control characters escaped.
-std::string shown(const std::string& s) {
-  std::string out;
-  for (char ch : s.substr(0, 60)) {
-    const auto u = static_cast<unsigned char>(ch);
-    if (u < 0x20 || u == 0x7f) out += fmt::format("\\x{:02x}", u);
-    else out += ch;
-  }
-  return s.size() > 60 ? out + "..." : out;
-}
+std::string shown(const std::string& s) { return text::excerpt(s); }
 
 // The first pass: TinyXML (what Debian's urdfdom parses with) keeps every element's line, which
 // urdfdom's own messages lack, so the structure and the numbers are checked here, with places;

@@ -8,6 +8,7 @@
 #include "../cli/scenario_io.hpp"
 
 #include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <wlx/dynamics.hpp>
@@ -17,6 +18,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace py = pybind11;
 
@@ -163,21 +165,38 @@ void bind_python(py::module_& parent) {
 
   m.def(
       "simulate",
-      [](const std::string& scenario_json) {
+      [](const std::string& scenario_json, long every) {
         const nlohmann::json j = parse_json(scenario_json, "scenario");
         const Scenario sc = parse_scenario(j.is_string() ? read_scenario_json(j.get<std::string>()) : j);
+        if (every < 1) throw Error("every", "must be at least 1 (keep every k-th sample), got " + std::to_string(every));
         const bool dynamics = sc.weighting.has_value();
         const std::vector<std::string> header = trajectory_header(dynamics);
-        Eigen::MatrixXd table(sc.samples(), static_cast<Eigen::Index>(header.size()));
-        Eigen::Index rows = 0;
+        // The columns are written as the run streams its samples (no table, no copy), and bounded:
+        // a run's samples beyond kMaxSimulateBytes are an error before anything is allocated,
+        // where `wlx simulate` streams any length to a file.
+        const long kept = (sc.samples() + every - 1) / every;
+        const double bytes = static_cast<double>(kept) * static_cast<double>(header.size()) * sizeof(double);
+        constexpr double kMaxSimulateBytes = 256.0 * 1024 * 1024;
+        if (bytes > kMaxSimulateBytes)
+          throw Error("every", "the run would keep " + std::to_string(kept) + " samples of " + std::to_string(header.size()) +
+                                   " columns (" + std::to_string(static_cast<long>(bytes / (1024 * 1024))) +
+                                   " MiB, more than 256 MiB): keep every k-th sample (every=k), shorten the run, or stream it "
+                                   "to a file with `wlx simulate`");
+        std::vector<py::array_t<double>> columns_out;
+        columns_out.reserve(header.size());
+        for (std::size_t c = 0; c < header.size(); ++c) columns_out.emplace_back(kept);
+        long index = 0, rows = 0;
         const Trajectory run = simulate_each(sc, [&](const Sample& smp) {
+          if (index++ % every != 0 || rows >= kept) return;
           const std::vector<double> row = trajectory_row(smp, dynamics);
-          for (std::size_t c = 0; c < row.size(); ++c) table(rows, static_cast<Eigen::Index>(c)) = row[c];
+          for (std::size_t c = 0; c < row.size(); ++c) columns_out[c].mutable_at(rows) = row[c];
           ++rows;
         });
         py::dict columns;
-        for (std::size_t c = 0; c < header.size(); ++c)
-          columns[py::str(header[c])] = Eigen::VectorXd(table.col(static_cast<Eigen::Index>(c)).head(rows));
+        for (std::size_t c = 0; c < header.size(); ++c) {
+          columns_out[c].resize({rows}, false);  // a run that stopped early: only its samples
+          columns[py::str(header[c])] = columns_out[c];
+        }
         py::dict out;
         out["columns"] = columns;
         out["id"] = sc.id;
@@ -186,7 +205,8 @@ void bind_python(py::module_& parent) {
         out["evaluations"] = run.evaluations;
         return out;
       },
-      "simulate(scenario_json) -> dict: columns (the CSV's, as arrays), complete, stopped (why, if early)");
+      py::arg("scenario_json"), py::arg("every") = 1,
+      "simulate(scenario_json, every=1) -> dict: columns (the CSV's, as arrays; every k-th sample), complete, stopped (why, if early)");
 }
 
 WLX_COMMANDS_END

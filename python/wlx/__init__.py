@@ -102,15 +102,19 @@ class Model:
         return self._m.inverse_dynamics(_np.asarray(s, dtype=float), _np.asarray(u, dtype=float),
                                         _np.asarray(u_dot, dtype=float), _params_json(params), _to_json(weighting, "weighting"))
 
-    def simulate(self, scenario):
+    def simulate(self, scenario, every=1):
         """Runs a scenario: an embedded id ("NH-1"), a path to a JSON file, or a dict in the scenario
-        format. Returns the CSV's columns as arrays by name, plus "complete", "stopped" (why a run
-        ended early) and "evaluations"."""
+        format. Returns the CSV's columns as arrays by name (every `every`-th sample, from t = 0),
+        plus "complete", "stopped" (why a run ended early) and "evaluations". A run whose kept
+        samples would take more than 256 MiB is refused (ValueError naming `every`): keep fewer, or
+        stream it to a file with `wlx simulate`."""
         if isinstance(scenario, dict):
             text = _to_json(scenario, "scenario")
         else:
             text = _to_json(str(scenario), "scenario")
-        result = self._m.simulate(text)
+        if isinstance(every, bool) or not isinstance(every, int):
+            raise TypeError("every: must be an integer")
+        result = self._m.simulate(text, every)
         out = dict(result["columns"])
         for k in ("id", "complete", "stopped", "evaluations"):
             out[k] = result[k]

@@ -4,6 +4,7 @@
 
 #include "wlx/kinematics.hpp"
 
+#include <Eigen/LU>
 #include <Eigen/QR>
 #include <fmt/format.h>
 
@@ -169,6 +170,15 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
   NewtonReport report;
   std::array<bool, kLimbCount> done{}, stalled{};
   std::array<double, kLimbCount> mu{}, nu{};
+  const auto not_converged = [&](Limb limb, bool no_descent, double residual) {
+    return Error(std::string(limb_name(limb)),
+                 fmt::format("Newton's method did not converge{} (residual {:.3e} after {} iterations, tolerance "
+                             "{:.1e}): the target may be out of reach or the start too far from a solution; try a target "
+                             "nearer the limb's workspace, approach it in smaller steps from a solved pose, or give the "
+                             "limb a start nearer a solution (`start:` in the model file's limb)",
+                             no_descent ? ": no step lowers the residual any more" : "", residual,
+                             report.iterations[static_cast<std::size_t>(limb)], options.tolerance));
+  };
   for (Limb limb : kLimbs) {
     done[static_cast<std::size_t>(limb)] = !active[static_cast<std::size_t>(limb)];
     nu[static_cast<std::size_t>(limb)] = 2;
@@ -183,6 +193,77 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
     for (int i = 0; i < idx.count; ++i) f += 0.5 * Phi(idx.rows[static_cast<std::size_t>(i)]) * Phi(idx.rows[static_cast<std::size_t>(i)]);
     return f;
   };
+  // The thesis' method (NewtonOptions::Method::backtracking): full Newton steps, each halved
+  // until max |Phi| of its limb decreases.
+  for (int iteration = 0; options.method == NewtonOptions::Method::backtracking; ++iteration) {
+    closure(model, data, s, true);
+    if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
+    bool all_done = true;
+    std::array<LimbVector, kLimbCount> step;
+    std::array<double, kLimbCount> before{};
+    for (Limb limb : kLimbs) {
+      const auto l = static_cast<std::size_t>(limb);
+      if (!active[l]) continue;
+      const auto idx = indices(limb);
+      if (done[l]) continue;  // a converged limb stays converged: the limbs do not couple
+      before[l] = limb_residual(data.Phi, idx);
+      done[l] = before[l] <= options.tolerance || (stalled[l] && before[l] <= options.floor_tolerance);
+      if (done[l]) continue;
+      all_done = false;
+      if (report.iterations[l] >= options.max_iterations) throw not_converged(limb, false, before[l]);
+      // The limb's block of dPhi/ds: its rows against its own dependent joints.
+      LimbMatrix J = LimbMatrix::Identity();  // a smaller limb padded with a unit diagonal
+      LimbVector r = LimbVector::Zero();
+      for (int i = 0; i < idx.count; ++i) {
+        const int row = idx.rows[static_cast<std::size_t>(i)];
+        r(i) = data.Phi(row);
+        for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
+      }
+      const Eigen::FullPivLU<LimbMatrix> lu(J);
+      if (lu.rcond() > 1e-12) {
+        step[l] = -lu.solve(r);
+      } else {  // at a singular pose (straight leg, lever at 90 deg): Levenberg-Marquardt step
+        const double mu = 1e-8 * std::max(1.0, J.squaredNorm());
+        step[l] = -(J.transpose() * J + mu * LimbMatrix::Identity()).ldlt().solve(J.transpose() * r);
+      }
+      ++report.iterations[l];
+    }
+    if (all_done) break;
+    // Damping: halve a limb's step until its residual decreases.
+    std::array<double, kLimbCount> lambda;
+    lambda.fill(1.0);
+    std::array<bool, kLimbCount> accepted = done;
+    const Coordinates start = s;
+    for (int halving = 0; halving < 40; ++halving) {
+      for (Limb limb : kLimbs) {
+        const auto l = static_cast<std::size_t>(limb);
+        if (accepted[l]) continue;
+        const auto idx = indices(limb);
+        for (int j = 0; j < idx.count; ++j)
+          s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]) + lambda[l] * step[l](j);
+      }
+      closure(model, data, s, false);
+      bool all_accepted = true;
+      for (Limb limb : kLimbs) {
+        const auto l = static_cast<std::size_t>(limb);
+        if (accepted[l]) continue;
+        const double after = limb_residual(data.Phi, indices(limb));
+        if (after < before[l] || !std::isfinite(before[l])) accepted[l] = true;
+        else lambda[l] *= 0.5;
+        all_accepted = all_accepted && accepted[l];
+      }
+      if (all_accepted) break;
+    }
+    for (Limb limb : kLimbs) {
+      const auto l = static_cast<std::size_t>(limb);
+      stalled[l] = !done[l] && !accepted[l];
+      if (!stalled[l]) continue;
+      // No step length lowered the residual: stay where the residual was lowest.
+      const auto idx = indices(limb);
+      for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]);
+    }
+  }
+  if (options.method == NewtonOptions::Method::levenberg_marquardt) {
   closure(model, data, s, true);
   if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
   std::array<LimbVector, kLimbCount> step, gradient;
@@ -196,14 +277,7 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       const double residual = limb_residual(data.Phi, idx);
       done[l] = residual <= options.tolerance || (stalled[l] && residual <= options.floor_tolerance);
       if (done[l]) continue;
-      if (stalled[l] || report.iterations[l] >= options.max_iterations)
-        throw Error(std::string(limb_name(limb)),
-                    fmt::format("Newton's method did not converge{} (residual {:.3e} after {} iterations, tolerance "
-                                "{:.1e}): the target may be out of reach or the start too far from a solution; try a target "
-                                "nearer the limb's workspace, approach it in smaller steps from a solved pose, or give the "
-                                "limb a start nearer a solution (`start:` in the model file's limb)",
-                                stalled[l] ? ": no step lowers the residual any more" : "", residual, report.iterations[l],
-                                options.tolerance));
+      if (stalled[l] || report.iterations[l] >= options.max_iterations) throw not_converged(limb, stalled[l], residual);
       all_done = false;
       // The limb's block of dPhi/ds (a smaller limb padded with a unit diagonal and zero residual).
       LimbMatrix J = LimbMatrix::Identity();
@@ -214,12 +288,6 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
         for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
       }
       gradient[l] = J.transpose() * r;
-      before[l] = half_square(data.Phi, idx);
-      ++report.iterations[l];
-      if (!options.damped) {
-        step[l] = J.colPivHouseholderQr().solve(-r);
-        continue;
-      }
       if (mu[l] == 0) mu[l] = 1e-9 * std::max(1.0, J.colwise().squaredNorm().maxCoeff());  // nearly Newton's step first
       // As the least-squares problem [J; sqrt(mu) I] dx = [-r; 0], by QR: the normal equations would
       // square J's condition number (1e6 at the thesis' worst poses).
@@ -228,6 +296,8 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       Eigen::Matrix<double, 2 * gen::kMaxLimbSize, 1> rhs;
       rhs << -r, LimbVector::Zero();
       step[l] = stacked.householderQr().solve(rhs);
+      before[l] = half_square(data.Phi, idx);
+      ++report.iterations[l];
     }
     if (all_done) break;
     const Coordinates start = s;
@@ -244,12 +314,6 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       if (done[l]) continue;
       const auto idx = indices(limb);
       const double after = half_square(data.Phi, idx);
-      if (!options.damped) {
-        // Plain Newton takes every step; a step that does not lower the residual past its floor
-        // ends the iteration at max_iterations, as the thesis' method would.
-        stalled[l] = !std::isfinite(after);
-        continue;
-      }
       // The decrease the linear model predicts: dx^T (mu dx - g) / 2 > 0.
       const double predicted = 0.5 * step[l].dot(mu[l] * step[l] - gradient[l]);
       const double gain = predicted > 0 ? (before[l] - after) / predicted : -1;
@@ -267,6 +331,7 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
     }
     if (restore) closure(model, data, s, true);  // Phi and dPhi/ds where every limb now stands
     if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
+  }
   }
   // Angles into (-pi, pi], but only where that keeps the closure: a row such as theta_4 + theta_5 = 0
   // holds for theta_4 = -pi, not for its wrapped +pi, when the input theta_5 is pi.

@@ -58,9 +58,11 @@ struct NewtonOptions {
   // counts as converged if that floor is below this (ill-conditioned poses amplify rounding).
   double floor_tolerance = 1e-10;
   int max_iterations = 100;  // steps tried per limb (accepted or not)
-  // false: the undamped Newton step J dx = -r, every step taken, as in the thesis' verification
-  // (whose cold starts flip the knee: the damped method's descent would not show that).
-  bool damped = true;
+  // levenberg_marquardt: damped steps that also descend from far or singular starts (the default).
+  // backtracking: full Newton steps, each halved until the limb's max |Phi| decreases: the
+  // thesis' method, whose basins of attraction its cold starts show (docs/excavator.md section 4).
+  enum class Method { levenberg_marquardt, backtracking };
+  Method method = Method::levenberg_marquardt;
 };
 
 struct NewtonReport {

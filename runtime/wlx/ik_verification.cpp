@@ -103,8 +103,8 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
     Coordinates cold = start;  // the thesis' way: every point from the same start pose
     cold(input) = pt.value;
     try {
-      NewtonOptions thesis;  // the thesis' undamped Newton, whose basins the cold starts show
-      thesis.damped = false;
+      NewtonOptions thesis;  // the thesis' Newton with backtracking, whose basins the cold starts show
+      thesis.method = NewtonOptions::Method::backtracking;
       solve_ik_newton(model, data, cold, thesis);
       pt.cold_newton_branch = classify_branch(model, sweep.limb, cold);
     } catch (const Error&) {

@@ -210,4 +210,21 @@ inline std::string cpp_comment(std::string_view s) {
   return out;
 }
 
+// A value shown in an error message: its first 60 bytes, control characters as \xNN, "..." when
+// cut (the messages of the model-file and URDF readers).
+inline std::string excerpt(std::string_view s) {
+  std::string out;
+  for (char ch : s.substr(0, 60)) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (u < 0x20 || u == 0x7f) {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", u);
+      out += hex;
+    } else {
+      out += ch;
+    }
+  }
+  return s.size() > 60 ? out + "..." : out;
+}
+
 }  // namespace wlx::text

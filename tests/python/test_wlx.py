@@ -118,6 +118,23 @@ def test_simulate_takes_a_scenario_dict_like_a_file(tmp_path):
     assert from_dict["t"][-1] == pytest.approx(0.2, abs=1e-12)
 
 
+def test_simulate_keeps_every_kth_sample_and_refuses_a_run_beyond_its_memory_bound():
+    robot = wlx.model("excavator")
+    scenario = {"id": "mine", "rates": {"x_C": 1.0, "z_C": -0.5}, "dependent": ["y_C", "yaw"], "duration": 0.2}
+    full, thinned = robot.simulate(scenario), robot.simulate(scenario, every=7)
+    assert len(full["t"]) == 201 and len(thinned["t"]) == 29  # samples 0, 7, ..., 196
+    for column in ("t", "x_C", "yaw", "theta_l3"):
+        np.testing.assert_array_equal(thinned[column], full[column][::7], err_msg=column)
+    # 5 10^7 samples of about a hundred columns: refused before anything runs or is allocated.
+    long_run = dict(scenario, duration=5e4)
+    with pytest.raises(wlx.Error, match=r"^every: the run would keep 50000001 samples .* more than 256 MiB"):
+        robot.simulate(long_run)
+    with pytest.raises(wlx.Error, match=r"^every: must be at least 1"):
+        robot.simulate(scenario, every=0)
+    with pytest.raises(TypeError):
+        robot.simulate(scenario, every=2.5)
+
+
 def test_inverse_dynamics_and_rates_match_the_simulation():
     # ID-1 at t = 0: the pose is the nominal one, u = [z_C', x_C', roll', pitch'] = [0, 3, 0, 0], u' = 0.
     robot = wlx.model("excavator")
