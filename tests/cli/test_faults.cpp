@@ -356,7 +356,8 @@ TEST_CASE("faults: stdout that fails (/dev/full, a closed pipe) is an error with
       {{"simulate", "NH-2", "--out", (dir / "s").string()}, ""},
   };
   for (const auto& [args, input] : commands) {
-    CAPTURE(args[0] + (args.size() > 1 ? " " + args[1] : ""));
+    const auto shown = args[0] + (args.size() > 1 ? " " + args[1] : "");  // a copy: clang 14 cannot capture a structured binding
+    CAPTURE(shown);
     const Result full = run(args, {.input = input, .stdout_path = "/dev/full"});
     CHECK(full.code == 74);
     CHECK(full.err.find("stdout: writ") != std::string::npos);
@@ -470,10 +471,13 @@ TEST_CASE("faults: SIGINT, SIGTERM and SIGHUP during simulate: the samples so fa
   const fs::path dir = work_dir() / "signals";
   fs::create_directories(dir);
   write(dir / "long.json", R"({"rates": {"roll": 0.0872664626}, "dependent": ["y_C", "yaw"], "duration": 1, "dt": 1e-6})");
-  for (const auto& [signal, code, name] :
+  for (const auto& entry :
        {std::tuple{SIGINT, 130, "SIGINT"}, std::tuple{SIGTERM, 143, "SIGTERM"}, std::tuple{SIGHUP, 129, "SIGHUP"}}) {
-    CAPTURE(name);
-    const fs::path out = dir / name;
+    // Plain variables, not structured bindings: clang 14 cannot capture those in a lambda.
+    const int signal = std::get<0>(entry), code = std::get<1>(entry);
+    const char* const shown = std::get<2>(entry);
+    CAPTURE(shown);
+    const fs::path out = dir / shown;
     const Spawned s = start({"simulate", (dir / "long.json").string(), "--out", out.string()});
     REQUIRE(wait_for([&] { return has_temporary(out); }));
     ::kill(s.pid, signal);
@@ -481,7 +485,7 @@ TEST_CASE("faults: SIGINT, SIGTERM and SIGHUP during simulate: the samples so fa
     CAPTURE(r.err);
     CHECK(r.signal == 0);
     CHECK(r.code == code);
-    CHECK(r.err.find(name) != std::string::npos);
+    CHECK(r.err.find(shown) != std::string::npos);
     CHECK(r.err.find("the run is partial") != std::string::npos);
     CHECK(incomplete_files(out).empty());
     // The file holds exactly the samples the message counts, each row complete, t increasing by dt.
@@ -643,7 +647,8 @@ TEST_CASE("faults: --claims and --params that never end or are not files (/dev/z
   const std::vector<std::pair<std::string, std::string>> inputs = {
       {"/dev/zero", "is a device, not a regular file"}, {fifo.string(), "is a pipe (FIFO)"}, {dir.string(), "is a folder"}};
   for (const auto& [path, reason] : inputs) {
-    CAPTURE(path);
+    const auto shown = path;  // a copy: clang 14 cannot capture a structured binding
+    CAPTURE(shown);
     const auto t0 = std::chrono::steady_clock::now();
     Result r = run({"report", "--quick", "--claims", path, "--out", (dir / "out").string()});
     CAPTURE(r.err);
@@ -676,7 +681,8 @@ TEST_CASE("faults: a scenario's id or description with a line break or a control
 
 TEST_CASE("faults: ik --batch on a line that never ends (/dev/zero) stops at SIGTERM, SIGINT and SIGHUP within a second") {
   // No '\n' ever comes and no read ever blocks: the signal must be asked for while reading.
-  for (const auto& [signal, code] : {std::pair{SIGTERM, 143}, std::pair{SIGINT, 130}, std::pair{SIGHUP, 129}}) {
+  for (const auto& entry : {std::pair{SIGTERM, 143}, std::pair{SIGINT, 130}, std::pair{SIGHUP, 129}}) {
+    const int signal = entry.first, code = entry.second;  // not a structured binding: clang 14 cannot capture one
     CAPTURE(signal);
     const Spawned s = start({"ik", "--batch"}, {.stdin_path = "/dev/zero"});
     REQUIRE(wait_for([&] { return catches(s.pid, signal); }));
@@ -700,7 +706,8 @@ TEST_CASE("faults: SIGTERM and SIGHUP during wlx viewer's simulation: exit 143 /
   write(fake / "wasm" / "wlx_excavator.js", "// module");
   write(dir / "long.json", R"({"id": "long", "rates": {"roll": 0.0872664626}, "dependent": ["y_C", "yaw"], "duration": 1, "dt": 1e-6})");
   ::setenv("WLX_VIEWER_DIR", fake.c_str(), 1);
-  for (const auto& [signal, code] : {std::pair{SIGTERM, 143}, std::pair{SIGHUP, 129}}) {
+  for (const auto& entry : {std::pair{SIGTERM, 143}, std::pair{SIGHUP, 129}}) {
+    const int signal = entry.first, code = entry.second;  // not a structured binding: clang 14 cannot capture one
     CAPTURE(signal);
     const fs::path out = dir / ("out-" + std::to_string(signal));
     const Spawned s = start({"viewer", (dir / "long.json").string(), "--out", out.string()});

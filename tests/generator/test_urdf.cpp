@@ -233,8 +233,11 @@ dynamics: {gravity: g, commanded: [slide, tilt], actuated: [slide, tilt]}
   flange = arm * Eigen::Translation3d(0.4, 0, 0) * Eigen::Isometry3d(rpy(0, M_PI / 2, 0));
   tool = flange * Eigen::Translation3d(0, 0, 0.05);
   const Eigen::Isometry3d marker = tool * Eigen::Translation3d(0, 0, 0.1) * Eigen::Isometry3d(AngleAxisd(spin, -Vector3d::UnitZ()));
-  for (const auto& [name, pose] : std::vector<std::pair<std::string, Eigen::Isometry3d>>{
+  for (const auto& entry : std::vector<std::pair<std::string, Eigen::Isometry3d>>{
            {"base_link", base}, {"carriage", carriage}, {"arm", arm}, {"flange", flange}, {"tool", tool}, {"marker", marker}}) {
+    // Not a structured binding: clang 14 cannot capture one in CAPTURE's lambda.
+    const std::string& name = entry.first;
+    const Eigen::Isometry3d& pose = entry.second;
     CAPTURE(name);
     REQUIRE(m.frame_index(name) >= 0);
     const Frame& f = m.frames[static_cast<std::size_t>(m.frame_index(name))].frame;

@@ -162,7 +162,8 @@ TEST_CASE("wlx-gen: names that are keywords or macros of the compiler or the hea
       {"model: arm", "model: gen"},
   };
   for (const auto& [from, to] : cases) {
-    CAPTURE(to);
+    const auto shown = to;  // a copy: clang 14 cannot capture a structured binding
+    CAPTURE(shown);
     std::filesystem::remove_all(out);
     wlx_test::write(model, replaced(arm_text(), from, to));
     const auto r = wlx_test::run({model.string(), "--out", out.string(), "--quiet"});
@@ -193,7 +194,8 @@ TEST_CASE("wlx-gen: a model file that never ends or is not a file exits 2 at onc
       {dir.string(), "is a folder"},
   };
   for (const auto& [path, reason] : cases) {
-    CAPTURE(path);
+    const auto shown = path;  // a copy: clang 14 cannot capture a structured binding
+    CAPTURE(shown);
     const auto r = wlx_test::run({path, "--out", (dir / "out").string(), "--quiet"});
     CAPTURE(r.err);
     CHECK(r.code == 2);
