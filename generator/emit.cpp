@@ -37,6 +37,20 @@ std::string namespace_open(const EmitOptions& opt) {
   if (opt.name_space.empty()) return fmt::format("namespace wlx {{\ninline namespace {} {{\nnamespace gen {{\n", opt.model_name);
   return fmt::format("namespace {} {{\n", opt.name_space);
 }
+// The macro with which a library says it compiles this model's double functions: one per model,
+// so that another model's headers in the same translation unit stay inline.
+std::string compiled_macro(const EmitOptions& opt) { return "WLX_GEN_COMPILED_" + opt.model_name; }
+std::string double_linkage_note(const EmitOptions& opt) {
+  if (!opt.name_space.empty())
+    return "// The double versions of the functions are inline, compiled in every translation unit that\n"
+           "// calls them.\n";
+  return fmt::format(
+      "// The double versions of the functions are inline, compiled in every translation unit that\n"
+      "// calls them. With {0} defined they are only declared: a library compiles them once, in\n"
+      "// translation units that define WLX_GEN_DEFINE_DOUBLE and include each header once (the wlx\n"
+      "// runtime library of the model does, and defines {0} for its users).\n",
+      compiled_macro(opt));
+}
 std::string namespace_close(const EmitOptions& opt) {
   if (opt.name_space.empty())
     return fmt::format("}}  // namespace gen\n}}  // namespace {}\n}}  // namespace wlx\n", opt.model_name);
@@ -150,6 +164,12 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
        "#if __has_attribute(target) && __has_attribute(flatten)\n"
        "#define WLX_GEN_MULTIVERSION 1\n"
        "#endif\n"
+       "#endif\n\n"
+       + double_linkage_note(opt) +
+       "#if defined(WLX_GEN_DEFINE_DOUBLE)\n"
+       "#define WLX_GEN_DOUBLE_INLINE\n"
+       "#else\n"
+       "#define WLX_GEN_DOUBLE_INLINE inline\n"
        "#endif\n\n" +
        namespace_open(opt);
   t += fmt::format("\ninline constexpr std::string_view kModelName = {};\n"
@@ -523,7 +543,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   if (fn.needs_rates) t += "  static_cast<void>(sdot);\n";
   for (const auto& in : fn.inputs) t += fmt::format("  static_cast<void>({});\n", in.name);
   t += using_declarations(pr.calls()) + aliases + body + "}\n\n";
-  t += double_overload(fn.name, "void", plain, "for any Eigen expression of the coordinates");
+  t += double_overload(opt, fn.name, "void", plain, "for any Eigen expression of the coordinates");
   t += fmt::format("namespace operations {{\n// Operations {}() evaluates with every output requested (adds, muls, divs, calls).\n"
                    "inline constexpr long {} = {};\n}}  // namespace operations\n\n",
                    fn.name, fn.name, total.total());
@@ -532,7 +552,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   return {"wlx/gen/" + fn.header, t};
 }
 
-std::string double_overload(const std::string& name, const std::string& result,
+std::string double_overload(const EmitOptions& opt, const std::string& name, const std::string& result,
                             const std::vector<std::pair<std::string, std::string>>& parameters, const std::string& why) {
   std::vector<std::string> with_defaults, without, arguments;
   for (const auto& [declaration, default_value] : parameters) {
@@ -544,7 +564,18 @@ std::string double_overload(const std::string& name, const std::string& result,
   // The AVX2 + FMA version: flatten inlines the template's body (sincos and atan2 too) into it, so
   // all of it is compiled for those instructions; a call to a separate function would run the
   // portable code.
-  return fmt::format(
+  // In the model's own namespace, the runtime library of the model may compile the double version
+  // once for all its users (types.hpp); headers in another namespace are never compiled so.
+  const std::string external =
+      opt.name_space.empty()
+          ? fmt::format("#if defined({0}) && !defined(WLX_GEN_DEFINE_DOUBLE)\n"
+                        "// {1}() in double, {2}; its AVX2 + FMA version on a CPU that has them.\n"
+                        "// Compiled once, in the library that defines {0} (types.hpp).\n"
+                        "{3} {1}({4}) noexcept;\n"
+                        "#else\n",
+                        compiled_macro(opt), name, why, result, fmt::join(with_defaults, ", "))
+          : std::string();
+  return external + fmt::format(
       "#if defined(WLX_GEN_MULTIVERSION)\n"
       "namespace detail {{\n"
       "// {0}<double>() compiled for AVX2 and FMA (types.hpp).\n"
@@ -559,29 +590,34 @@ std::string double_overload(const std::string& name, const std::string& result,
       "}}  // namespace detail\n"
       "#endif\n\n"
       "// {0}() in double, {4}; its AVX2 + FMA version on a CPU that has them (types.hpp).\n"
-      "inline {1} {0}({5}) noexcept {{\n"
+      "WLX_GEN_DOUBLE_INLINE {1} {0}({5}) noexcept {{\n"
       "#if defined(WLX_GEN_MULTIVERSION)\n"
       "  if (detail::has_avx2_fma()) return detail::{0}_avx2_fma({6});\n"
       "  return detail::{0}_portable({6});\n"
       "#else\n"
       "  return {3};\n"
       "#endif\n"
-      "}}\n\n",
-      name, result, fmt::join(without, ", "), call, why, fmt::join(with_defaults, ", "), fmt::join(arguments, ", "));
+      "}}\n"
+      "{7}\n",
+      name, result, fmt::join(without, ", "), call, why, fmt::join(with_defaults, ", "), fmt::join(arguments, ", "),
+      external.empty() ? "" : "#endif\n");
 }
 
 EmittedFile emit_umbrella(const Model& m, const std::vector<FunctionSpec>& fns, const std::vector<FunctionStats>& stats,
                           const EmitOptions& opt) {
   std::string t = banner(m, opt, "All generated functions of the model.");
   t += "//\n// Operation counts (each +, -, *, /, negation and function call counts as one):\n";
-  t += fmt::format("//   {:<14} {:>13} {:>13} {:>13}\n", "function", "intermediates", "before CSE", "after CSE");
+  std::size_t width = std::string_view("function").size();
+  for (const auto& s : stats) width = std::max(width, s.name.size());
+  t += fmt::format("//   {:<{}} {:>13} {:>13} {:>13}\n", "function", width, "intermediates", "before CSE", "after CSE");
   OpCount b, a;
   for (const auto& s : stats) {
-    t += fmt::format("//   {:<14} {:>13} {:>13} {:>13}\n", s.name, s.intermediates, s.before_cse.total(), s.after_cse.total());
+    t += fmt::format("//   {:<{}} {:>13} {:>13} {:>13}\n", s.name, width, s.intermediates, s.before_cse.total(),
+                     s.after_cse.total());
     b += s.before_cse;
     a += s.after_cse;
   }
-  t += fmt::format("//   {:<14} {:>13} {:>13} {:>13}\n", "total", "", b.total(), a.total());
+  t += fmt::format("//   {:<{}} {:>13} {:>13} {:>13}\n", "total", width, "", b.total(), a.total());
   t += "#pragma once\n\n#include \"ik.hpp\"\n#include \"params.hpp\"\n#include \"structure.hpp\"\n#include \"types.hpp\"\n";
   for (const auto& f : fns) t += fmt::format("#include \"{}\"\n", f.header);
   return {"wlx/gen/all.hpp", t};

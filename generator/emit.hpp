@@ -64,7 +64,9 @@ std::vector<ChainStep> canonical_ik_chain(const Model& m, const std::string& fra
 // The double overload of the function template `name` (parameters: declaration and default value,
 // each): it calls name<double>(), or on x86-64 with GCC or clang its AVX2 + FMA build when the CPU
 // has those (types.hpp: WLX_GEN_MULTIVERSION). `why`: what the overload is for, in its comment.
-std::string double_overload(const std::string& name, const std::string& result,
+// In the model's own namespace it is only declared where WLX_GEN_COMPILED_<model> is defined (a
+// library compiles it once, types.hpp).
+std::string double_overload(const EmitOptions& opt, const std::string& name, const std::string& result,
                             const std::vector<std::pair<std::string, std::string>>& parameters, const std::string& why);
 // One header per derived function; `stats` receives the numbers written into its banner.
 EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOptions& opt, FunctionStats& stats);

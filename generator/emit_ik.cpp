@@ -1243,7 +1243,7 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
         solved.size(), ops.total(), ops.adds, ops.muls, ops.divs, ops.calls,
         newton.empty() ? "" : " (not " + newton + ": Newton's method at run time)", m.limbs.size());
     t += prologue + body + "}\n\n";
-    t += double_overload("ik_all", "IkStatus",
+    t += double_overload(opt, "ik_all", "IkStatus",
                          {{"const Coordinates& s", ""},
                           {"const Params& p", ""},
                           {fmt::format("const std::array<int, {}>& branches", m.limbs.size()), ""},

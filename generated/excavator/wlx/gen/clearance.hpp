@@ -61,6 +61,11 @@ inline void clearance(const CoordinatesOf<Scalar>& s, const Params& p, const det
   }
 }
 
+#if defined(WLX_GEN_COMPILED_excavator) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// clearance() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_excavator (types.hpp).
+void clearance(const Coordinates& s, const Params& p, const ClearanceOutputs& out) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // clearance<double>() compiled for AVX2 and FMA (types.hpp).
@@ -76,7 +81,7 @@ __attribute__((noinline)) inline void clearance_portable(const Coordinates& s, c
 #endif
 
 // clearance() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline void clearance(const Coordinates& s, const Params& p, const ClearanceOutputs& out) noexcept {
+WLX_GEN_DOUBLE_INLINE void clearance(const Coordinates& s, const Params& p, const ClearanceOutputs& out) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::clearance_avx2_fma(s, p, out);
   return detail::clearance_portable(s, p, out);
@@ -84,6 +89,7 @@ inline void clearance(const Coordinates& s, const Params& p, const ClearanceOutp
   return clearance<double>(s, p, out);
 #endif
 }
+#endif
 
 namespace operations {
 // Operations clearance() evaluates with every output requested (adds, muls, divs, calls).

@@ -517,6 +517,11 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
   }
 }
 
+#if defined(WLX_GEN_COMPILED_excavator) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// convective() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_excavator (types.hpp).
+void convective(const Coordinates& s, const Coordinates& sdot, const Params& p, const ConvectiveOutputs& out) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // convective<double>() compiled for AVX2 and FMA (types.hpp).
@@ -532,7 +537,7 @@ __attribute__((noinline)) inline void convective_portable(const Coordinates& s, 
 #endif
 
 // convective() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline void convective(const Coordinates& s, const Coordinates& sdot, const Params& p, const ConvectiveOutputs& out) noexcept {
+WLX_GEN_DOUBLE_INLINE void convective(const Coordinates& s, const Coordinates& sdot, const Params& p, const ConvectiveOutputs& out) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::convective_avx2_fma(s, sdot, p, out);
   return detail::convective_portable(s, sdot, p, out);
@@ -540,6 +545,7 @@ inline void convective(const Coordinates& s, const Coordinates& sdot, const Para
   return convective<double>(s, sdot, p, out);
 #endif
 }
+#endif
 
 namespace operations {
 // Operations convective() evaluates with every output requested (adds, muls, divs, calls).

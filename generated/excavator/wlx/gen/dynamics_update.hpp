@@ -395,6 +395,11 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   }
 }
 
+#if defined(WLX_GEN_COMPILED_excavator) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// dynamics_update() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_excavator (types.hpp).
+void dynamics_update(const Coordinates& s, const Params& p, const DynamicsUpdateOutputs& out, bool zero_fill = true) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // dynamics_update<double>() compiled for AVX2 and FMA (types.hpp).
@@ -410,7 +415,7 @@ __attribute__((noinline)) inline void dynamics_update_portable(const Coordinates
 #endif
 
 // dynamics_update() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline void dynamics_update(const Coordinates& s, const Params& p, const DynamicsUpdateOutputs& out, bool zero_fill = true) noexcept {
+WLX_GEN_DOUBLE_INLINE void dynamics_update(const Coordinates& s, const Params& p, const DynamicsUpdateOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::dynamics_update_avx2_fma(s, p, out, zero_fill);
   return detail::dynamics_update_portable(s, p, out, zero_fill);
@@ -418,6 +423,7 @@ inline void dynamics_update(const Coordinates& s, const Params& p, const Dynamic
   return dynamics_update<double>(s, p, out, zero_fill);
 #endif
 }
+#endif
 
 namespace operations {
 // Operations dynamics_update() evaluates with every output requested (adds, muls, divs, calls).

@@ -856,6 +856,11 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   return IkStatus::ok;
 }
 
+#if defined(WLX_GEN_COMPILED_excavator) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// ik_all() in double, what the runtime calls; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_excavator (types.hpp).
+IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out, int& failed, IkDiagnostics& why) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // ik_all<double>() compiled for AVX2 and FMA (types.hpp).
@@ -871,7 +876,7 @@ __attribute__((noinline)) inline IkStatus ik_all_portable(const Coordinates& s, 
 #endif
 
 // ik_all() in double, what the runtime calls; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out, int& failed, IkDiagnostics& why) noexcept {
+WLX_GEN_DOUBLE_INLINE IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<int, 4>& branches, Coordinates& out, int& failed, IkDiagnostics& why) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::ik_all_avx2_fma(s, p, branches, out, failed, why);
   return detail::ik_all_portable(s, p, branches, out, failed, why);
@@ -879,6 +884,7 @@ inline IkStatus ik_all(const Coordinates& s, const Params& p, const std::array<i
   return ik_all<double>(s, p, branches, out, failed, why);
 #endif
 }
+#endif
 
 }  // namespace gen
 }  // namespace excavator

@@ -635,6 +635,11 @@ inline void kinematic_update(const CoordinatesOf<Scalar>& s, const Params& p, co
   }
 }
 
+#if defined(WLX_GEN_COMPILED_excavator) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// kinematic_update() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_excavator (types.hpp).
+void kinematic_update(const Coordinates& s, const Params& p, const KinematicUpdateOutputs& out, bool zero_fill = true) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // kinematic_update<double>() compiled for AVX2 and FMA (types.hpp).
@@ -650,7 +655,7 @@ __attribute__((noinline)) inline void kinematic_update_portable(const Coordinate
 #endif
 
 // kinematic_update() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline void kinematic_update(const Coordinates& s, const Params& p, const KinematicUpdateOutputs& out, bool zero_fill = true) noexcept {
+WLX_GEN_DOUBLE_INLINE void kinematic_update(const Coordinates& s, const Params& p, const KinematicUpdateOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::kinematic_update_avx2_fma(s, p, out, zero_fill);
   return detail::kinematic_update_portable(s, p, out, zero_fill);
@@ -658,6 +663,7 @@ inline void kinematic_update(const Coordinates& s, const Params& p, const Kinema
   return kinematic_update<double>(s, p, out, zero_fill);
 #endif
 }
+#endif
 
 namespace operations {
 // Operations kinematic_update() evaluates with every output requested (adds, muls, divs, calls).

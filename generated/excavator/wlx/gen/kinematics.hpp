@@ -408,6 +408,11 @@ inline void kinematics(const CoordinatesOf<Scalar>& s, const Params& p, const de
   }
 }
 
+#if defined(WLX_GEN_COMPILED_excavator) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// kinematics() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_excavator (types.hpp).
+void kinematics(const Coordinates& s, const Params& p, const KinematicsOutputs& out) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // kinematics<double>() compiled for AVX2 and FMA (types.hpp).
@@ -423,7 +428,7 @@ __attribute__((noinline)) inline void kinematics_portable(const Coordinates& s, 
 #endif
 
 // kinematics() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline void kinematics(const Coordinates& s, const Params& p, const KinematicsOutputs& out) noexcept {
+WLX_GEN_DOUBLE_INLINE void kinematics(const Coordinates& s, const Params& p, const KinematicsOutputs& out) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::kinematics_avx2_fma(s, p, out);
   return detail::kinematics_portable(s, p, out);
@@ -431,6 +436,7 @@ inline void kinematics(const Coordinates& s, const Params& p, const KinematicsOu
   return kinematics<double>(s, p, out);
 #endif
 }
+#endif
 
 namespace operations {
 // Operations kinematics() evaluates with every output requested (adds, muls, divs, calls).

@@ -1267,6 +1267,11 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   }
 }
 
+#if defined(WLX_GEN_COMPILED_excavator) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// reduced_dynamics() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_excavator (types.hpp).
+void reduced_dynamics(const Coordinates& s, const Coordinates& sdot, const RateBasis& T, const Params& p, const ReducedDynamicsOutputs& out, bool zero_fill = true) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // reduced_dynamics<double>() compiled for AVX2 and FMA (types.hpp).
@@ -1282,7 +1287,7 @@ __attribute__((noinline)) inline void reduced_dynamics_portable(const Coordinate
 #endif
 
 // reduced_dynamics() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline void reduced_dynamics(const Coordinates& s, const Coordinates& sdot, const RateBasis& T, const Params& p, const ReducedDynamicsOutputs& out, bool zero_fill = true) noexcept {
+WLX_GEN_DOUBLE_INLINE void reduced_dynamics(const Coordinates& s, const Coordinates& sdot, const RateBasis& T, const Params& p, const ReducedDynamicsOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::reduced_dynamics_avx2_fma(s, sdot, T, p, out, zero_fill);
   return detail::reduced_dynamics_portable(s, sdot, T, p, out, zero_fill);
@@ -1290,6 +1295,7 @@ inline void reduced_dynamics(const Coordinates& s, const Coordinates& sdot, cons
   return reduced_dynamics<double>(s, sdot, T, p, out, zero_fill);
 #endif
 }
+#endif
 
 namespace operations {
 // Operations reduced_dynamics() evaluates with every output requested (adds, muls, divs, calls).

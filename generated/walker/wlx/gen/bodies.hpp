@@ -893,6 +893,11 @@ inline void bodies(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<Coor
   }
 }
 
+#if defined(WLX_GEN_COMPILED_walker) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// bodies() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_walker (types.hpp).
+void bodies(const Coordinates& s, const Coordinates& sdot, const Params& p, const BodiesOutputs& out, bool zero_fill = true) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // bodies<double>() compiled for AVX2 and FMA (types.hpp).
@@ -908,7 +913,7 @@ __attribute__((noinline)) inline void bodies_portable(const Coordinates& s, cons
 #endif
 
 // bodies() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline void bodies(const Coordinates& s, const Coordinates& sdot, const Params& p, const BodiesOutputs& out, bool zero_fill = true) noexcept {
+WLX_GEN_DOUBLE_INLINE void bodies(const Coordinates& s, const Coordinates& sdot, const Params& p, const BodiesOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::bodies_avx2_fma(s, sdot, p, out, zero_fill);
   return detail::bodies_portable(s, sdot, p, out, zero_fill);
@@ -916,6 +921,7 @@ inline void bodies(const Coordinates& s, const Coordinates& sdot, const Params& 
   return bodies<double>(s, sdot, p, out, zero_fill);
 #endif
 }
+#endif
 
 namespace operations {
 // Operations bodies() evaluates with every output requested (adds, muls, divs, calls).

@@ -423,6 +423,11 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
   }
 }
 
+#if defined(WLX_GEN_COMPILED_walker) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// closure() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_walker (types.hpp).
+void closure(const Coordinates& s, const Params& p, const ClosureOutputs& out, bool zero_fill = true) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // closure<double>() compiled for AVX2 and FMA (types.hpp).
@@ -438,7 +443,7 @@ __attribute__((noinline)) inline void closure_portable(const Coordinates& s, con
 #endif
 
 // closure() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline void closure(const Coordinates& s, const Params& p, const ClosureOutputs& out, bool zero_fill = true) noexcept {
+WLX_GEN_DOUBLE_INLINE void closure(const Coordinates& s, const Params& p, const ClosureOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::closure_avx2_fma(s, p, out, zero_fill);
   return detail::closure_portable(s, p, out, zero_fill);
@@ -446,6 +451,7 @@ inline void closure(const Coordinates& s, const Params& p, const ClosureOutputs&
   return closure<double>(s, p, out, zero_fill);
 #endif
 }
+#endif
 
 namespace operations {
 // Operations closure() evaluates with every output requested (adds, muls, divs, calls).

@@ -279,6 +279,11 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   }
 }
 
+#if defined(WLX_GEN_COMPILED_walker) && !defined(WLX_GEN_DEFINE_DOUBLE)
+// nonholonomic() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them.
+// Compiled once, in the library that defines WLX_GEN_COMPILED_walker (types.hpp).
+void nonholonomic(const Coordinates& s, const Params& p, const NonholonomicOutputs& out, bool zero_fill = true) noexcept;
+#else
 #if defined(WLX_GEN_MULTIVERSION)
 namespace detail {
 // nonholonomic<double>() compiled for AVX2 and FMA (types.hpp).
@@ -294,7 +299,7 @@ __attribute__((noinline)) inline void nonholonomic_portable(const Coordinates& s
 #endif
 
 // nonholonomic() in double, for any Eigen expression of the coordinates; its AVX2 + FMA version on a CPU that has them (types.hpp).
-inline void nonholonomic(const Coordinates& s, const Params& p, const NonholonomicOutputs& out, bool zero_fill = true) noexcept {
+WLX_GEN_DOUBLE_INLINE void nonholonomic(const Coordinates& s, const Params& p, const NonholonomicOutputs& out, bool zero_fill = true) noexcept {
 #if defined(WLX_GEN_MULTIVERSION)
   if (detail::has_avx2_fma()) return detail::nonholonomic_avx2_fma(s, p, out, zero_fill);
   return detail::nonholonomic_portable(s, p, out, zero_fill);
@@ -302,6 +307,7 @@ inline void nonholonomic(const Coordinates& s, const Params& p, const Nonholonom
   return nonholonomic<double>(s, p, out, zero_fill);
 #endif
 }
+#endif
 
 namespace operations {
 // Operations nonholonomic() evaluates with every output requested (adds, muls, divs, calls).

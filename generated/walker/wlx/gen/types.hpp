@@ -22,6 +22,16 @@
 #endif
 #endif
 
+// The double versions of the functions are inline, compiled in every translation unit that
+// calls them. With WLX_GEN_COMPILED_walker defined they are only declared: a library compiles them once, in
+// translation units that define WLX_GEN_DEFINE_DOUBLE and include each header once (the wlx
+// runtime library of the model does, and defines WLX_GEN_COMPILED_walker for its users).
+#if defined(WLX_GEN_DEFINE_DOUBLE)
+#define WLX_GEN_DOUBLE_INLINE
+#else
+#define WLX_GEN_DOUBLE_INLINE inline
+#endif
+
 namespace wlx {
 inline namespace walker {
 namespace gen {
