@@ -25,6 +25,12 @@ double mass(const Params& p, int body) { return p.*gen::kBodyMass[static_cast<st
 
 }  // namespace
 
+void throw_no_dynamics_section() {
+  throw Error("dynamics", fmt::format("model {} has no dynamics section: name its commanded speeds, actuated joints and "
+                                      "gravity in the model file (docs/model-format.md, Dynamics)",
+                                      gen::kModelName));
+}
+
 void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const CommandVector& u,
                       const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options) {
 // wlx-gen writes reduced_dynamics.hpp only for a model file with a dynamics section (and removes a
@@ -32,9 +38,7 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
 #if !__has_include(<wlx/gen/reduced_dynamics.hpp>)
   static_cast<void>(model), static_cast<void>(d), static_cast<void>(s), static_cast<void>(u), static_cast<void>(u_dot);
   static_cast<void>(out), static_cast<void>(options);
-  throw Error("dynamics", fmt::format("model {} has no dynamics section: name its commanded speeds, actuated joints and "
-                                      "gravity in the model file (docs/model-format.md, Dynamics)",
-                                      gen::kModelName));
+  throw_no_dynamics_section();
 #else
   const Params& p = model.params();
   const DependentPair pair = dynamics_pair();
@@ -65,7 +69,8 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
 
 double potential_energy(const Model& model, Data& d, const Coordinates& s) {
   const Params& p = model.params();
-  if (gen::kGravity == nullptr) throw Error("dynamics", "the model file has no dynamics section, so no gravity parameter");
+  // if constexpr: for a model with gravity the test is false at compile time (GCC's -Waddress).
+  if constexpr (gen::kGravity == nullptr) throw Error("dynamics", "the model file has no dynamics section, so no gravity parameter");
   gen::bodies(s, Coordinates::Zero(), p, {.com = &d.body_com}, false);
   double V = 0;
   for (int i = 0; i < gen::kBodyCount; ++i) V += mass(p, i) * (p.*gen::kGravity) * d.body_com(2, i);

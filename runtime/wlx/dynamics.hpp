@@ -51,6 +51,9 @@ struct DynamicsTerms {
 void inverse_dynamics(const Model& model, Data& data, const Coordinates& s, const CommandVector& u,
                       const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options = {});
 
+// The wlx::Error every dynamics function throws for a model file without a dynamics section.
+[[noreturn]] void throw_no_dynamics_section();
+
 // Potential and kinetic energy of the bodies (for the energy checks).
 double potential_energy(const Model& model, Data& data, const Coordinates& s);
 double kinetic_energy(const Model& model, Data& data, const Coordinates& s, const Coordinates& sdot);

@@ -12,8 +12,9 @@ WLX_MODEL_NAMESPACE_BEGIN
 void forward_dynamics(const Model& model, Data& d, const Coordinates& s, const CommandVector& u, const TorqueVector& tau,
                       CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options) {
 #if !__has_include(<wlx/gen/reduced_dynamics.hpp>)
-  static_cast<void>(tau), static_cast<void>(u_dot);
-  inverse_dynamics(model, d, s, u, u, out, options);  // throws: no dynamics section
+  static_cast<void>(model), static_cast<void>(d), static_cast<void>(s), static_cast<void>(u), static_cast<void>(tau);
+  static_cast<void>(u_dot), static_cast<void>(out), static_cast<void>(options);
+  throw_no_dynamics_section();
 #else
   for (int r = 0; r < kActuatedCount; ++r)
     if (!std::isfinite(tau(r)))

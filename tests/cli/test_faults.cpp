@@ -464,6 +464,20 @@ bool has_temporary(const fs::path& dir) {
   return false;
 }
 
+// Sends `signal` to a running `wlx report --out out` and checks what an interrupted report leaves:
+// the exit code, the signal named, no index.html, no file cut short. Returns the result for more.
+Result interrupt_report(const Spawned& s, int signal, int code, const char* name, const fs::path& out) {
+  ::kill(s.pid, signal);
+  const Result r = finish(s);
+  CAPTURE(r.err);
+  CHECK(r.code == code);
+  CHECK(r.err.find(name) != std::string::npos);
+  CHECK(r.err.find("no index.html was written") != std::string::npos);
+  CHECK(!fs::exists(out / "index.html"));
+  CHECK(incomplete_files(out).empty());
+  return r;
+}
+
 }  // namespace
 
 TEST_CASE("faults: SIGINT, SIGTERM and SIGHUP during simulate: the samples so far kept, said partial, exit 130 / 143 / 129") {
@@ -523,14 +537,8 @@ TEST_CASE("faults: SIGINT during report: exit 130, said partial, no index.html (
   const Spawned s = start({"report", "--out", out.string()});
   // Interrupted once the simulations have started: some data files are finished, most are not.
   REQUIRE(wait_for([&] { return slurp(s.out).find("simulating") != std::string::npos; }, 300s));  // sanitized builds are slow
-  ::kill(s.pid, SIGINT);
-  const Result r = finish(s);
-  CAPTURE(r.err);
-  CHECK(r.code == 130);
-  CHECK(r.err.find("SIGINT") != std::string::npos);
+  const Result r = interrupt_report(s, SIGINT, 130, "SIGINT", out);
   CHECK(r.err.find("partial: no index.html was written") != std::string::npos);
-  CHECK(!fs::exists(out / "index.html"));
-  CHECK(incomplete_files(out).empty());
 }
 
 TEST_CASE("faults: SIGTERM while gnuplot renders: exit 143, no index.html, no temporary image left") {
@@ -538,14 +546,7 @@ TEST_CASE("faults: SIGTERM while gnuplot renders: exit 143, no index.html, no te
   const Spawned s = start({"report", "--out", out.string()});
   REQUIRE(wait_for([&] { return slurp(s.out).find("rendering") != std::string::npos; }, 300s));
   std::this_thread::sleep_for(200ms);  // some figures done, some under way
-  ::kill(s.pid, SIGTERM);
-  const Result r = finish(s);
-  CAPTURE(r.err);
-  CHECK(r.code == 143);
-  CHECK(r.err.find("SIGTERM") != std::string::npos);
-  CHECK(r.err.find("no index.html was written") != std::string::npos);
-  CHECK(!fs::exists(out / "index.html"));
-  CHECK(incomplete_files(out).empty());
+  interrupt_report(s, SIGTERM, 143, "SIGTERM", out);
   fs::remove_all(out);
 }
 

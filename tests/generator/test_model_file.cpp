@@ -279,7 +279,7 @@ TEST_CASE("model file: text is one line of printable UTF-8, also where a repetit
   CHECK(meaning("\"bell\\a\"").find("control character U+0007") != std::string::npos);
   CHECK(meaning("'back\\slash'").find("has a backslash") != std::string::npos);
   CHECK(meaning("\"next\\u2028line\"").find("control character U+2028") != std::string::npos);
-  CHECK(meaning("'quotes \" and */ and ??/ are fine: quoted where written'") == "");
+  CHECK(meaning("'quotes \" and */ and ?\?/ are fine: quoted where written'") == "");
   // A repetition row's value is text of the file too: checked after it is put in.
   const std::string repeat = "repeat:\n  side:\n    - {s: \"x\\n#define evil 1\"}\n";
   const std::string message = error_of(tiny_model("  - {for: side, name: base, parent: K0, chain: [rz: q], meaning: side <s>}\n", repeat));
