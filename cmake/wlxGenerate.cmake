@@ -67,6 +67,12 @@ function(wlx_generate)
   else()
     file(GLOB runtime_sources "${WLX_RUNTIME_SOURCE_DIR}/*.cpp")
     add_library(${arg_TARGET} STATIC ${runtime_sources})
+    # The runtime's sources in one translation unit (they share their Eigen templates: half the
+    # compile time); the generated functions' files apart, each defines WLX_GEN_DEFINE_DOUBLE.
+    set_target_properties(${arg_TARGET} PROPERTIES UNITY_BUILD ON)
+    set(generated_function_sources "${runtime_sources}")
+    list(FILTER generated_function_sources INCLUDE REGEX "/generated_[a-z_]*\\.cpp$")
+    set_source_files_properties(${generated_function_sources} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
     target_include_directories(${arg_TARGET} PUBLIC "${out}")
     # The generated functions' double versions are compiled once, here (generated_*.cpp).
     target_compile_definitions(${arg_TARGET} PUBLIC WLX_MODEL=${model_name} WLX_GEN_COMPILED_${model_name})

@@ -26,10 +26,6 @@ using report::log_column;
 // as a gnuplot single-quoted string: nothing in it can end the string or the command.
 std::string q(std::string_view text) { return text::gnuplot_string(text); }
 
-constexpr double kDegPerRad = 180 / std::numbers::pi;
-
-std::string name_of(int coordinate) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(coordinate)]); }
-
 // The legend titles of curves given as sample vectors: "<name> (identical to <earlier>)" where a
 // curve equals an earlier one to `tolerance`, since the later one is drawn over it.
 std::vector<std::string> legend_titles(const std::vector<std::string>& names, const std::vector<std::vector<double>>& curves,
@@ -175,7 +171,7 @@ class Figures {
       std::vector<std::vector<double>> curves;
       for (int j = 0; j < block.size; ++j) {
         const int c = block.joints[static_cast<std::size_t>(j)];
-        joints.push_back(name_of(c));
+        joints.push_back(coordinate_name(c));
         curves.emplace_back();
         for (const auto& p : s.points) curves.back().push_back(p.closed_form(c));
       }
@@ -285,7 +281,7 @@ class Figures {
     std::vector<std::vector<std::string>> panels = spec_.torque_panels;
     if (panels.empty()) {  // no report file: the actuated joints in two halves
       panels.resize(2);
-      for (std::size_t k = 0; k < kActuatedJoints.size(); ++k) panels[k * 2 / kActuatedJoints.size()].push_back(name_of(kActuatedJoints[k]));
+      for (std::size_t k = 0; k < kActuatedJoints.size(); ++k) panels[k * 2 / kActuatedJoints.size()].push_back(coordinate_name(kActuatedJoints[k]));
     }
     for (const auto& r : runner_.runs()) {
       if (!r.scenario.weighting) continue;

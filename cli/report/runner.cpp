@@ -20,13 +20,9 @@ WLX_COMMANDS_BEGIN
 
 namespace {
 
-constexpr double kDegPerRad = 180 / std::numbers::pi;
-
 bool is_dynamics(const std::string& scenario_id) {
   return nlohmann::json::parse(embedded_scenario(scenario_id)).contains("weighting");
 }
-
-std::string name_of(int coordinate) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(coordinate)]); }
 
 // Asked after every sample: a signal stops a long simulation at once, not when it ends.
 void stop_on_signal(long, long) { throw_if_interrupted(); }
@@ -64,7 +60,7 @@ void ReportRunner::validate() const {
   std::vector<std::string> sweeps, params, joints;
   for (const auto& s : model_ik_sweeps()) sweeps.push_back(s.id);
   for (const auto& p : gen::kParamInfo) params.emplace_back(p.name);
-  for (int j : kActuatedJoints) joints.push_back(name_of(j));
+  for (int j : kActuatedJoints) joints.push_back(coordinate_name(j));
   const auto check = [&](const std::vector<std::string>& names, const std::vector<std::string>& valid, int line,
                          const std::string& path, const std::string& what) {
     for (const auto& n : names)
@@ -207,7 +203,7 @@ void ReportRunner::compare_integrators(const std::string& data_dir) {
     compare(fmt::format("tolerance {:.0e}", dopri.tolerance), dopri);
   }
   std::vector<std::string> header{"run", "integrator", "samples", "evaluations", "max_input_deviation"};
-  for (int c : compared_) header.push_back("max_" + name_of(c) + "_deviation");
+  for (int c : compared_) header.push_back("max_" + coordinate_name(c) + "_deviation");
   CsvWriter csv(data_dir + "/integrators.csv", header);
   for (const auto& r : integrators_) {
     std::vector<double> values{static_cast<double>(r.samples), static_cast<double>(r.evaluations), r.inputs};

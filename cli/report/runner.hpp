@@ -11,11 +11,19 @@
 #include <wlx/simulation.hpp>
 
 #include <functional>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
 
 WLX_COMMANDS_BEGIN
+
+// Degrees per radian: the report's tables and figures show angles in degrees.
+inline constexpr double kDegPerRad = 180 / std::numbers::pi;
+// A coordinate's name in the model file.
+inline std::string coordinate_name(int coordinate) {
+  return std::string(gen::kCoordinateNames[static_cast<std::size_t>(coordinate)]);
+}
 
 struct ReportRun {
   std::string id;           // the scenario's id, "<id>-w1"/"<id>-w2" for inverse dynamics
