@@ -1,5 +1,7 @@
 // The shipped scenario files: each runs, keeps both wheels from sliding, and shows the thesis'
 // observations (docs/excavator.md section 8).
+#include "../support/units.hpp"
+
 #include <doctest/doctest.h>
 #include <scenario_io.hpp>
 #include <wlx/error.hpp>
@@ -13,7 +15,7 @@ namespace c = gen::coord;
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180;
+using test::kDeg;
 
 const Trajectory& run(const std::string& id) {
   static std::map<std::string, Trajectory> cache;

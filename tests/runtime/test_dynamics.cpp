@@ -1,4 +1,5 @@
 // Inverse dynamics: checks independent of the Kane formula under test (energy, power, statics).
+#include "../support/units.hpp"
 #include "../support/random.hpp"
 
 #include <doctest/doctest.h>
@@ -17,7 +18,7 @@ namespace c = gen::coord;
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180;
+using test::kDeg;
 
 // A random admissible state near the thesis' workspace: cabin moved and tilted, feet and
 // levers moved, dependents by the closed form; pair A regular.

@@ -1,4 +1,6 @@
 // Dependent rates of the non-holonomic wheels at velocity and acceleration level.
+#include "../support/units.hpp"
+
 #include <doctest/doctest.h>
 #include <wlx/error.hpp>
 #include <wlx/ik.hpp>
@@ -17,7 +19,7 @@ namespace c = gen::coord;
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180;
+using test::kDeg;
 
 Coordinates assembled(Coordinates s, const Model& model = Model()) {
   solve_ik_closed_form(model, s);

@@ -1,4 +1,6 @@
 // Integration: no drift, convergence, the thesis' singular crossing, stopping cleanly.
+#include "../support/units.hpp"
+
 #include <doctest/doctest.h>
 #include <wlx/error.hpp>
 #include <wlx/kinematics.hpp>
@@ -11,7 +13,7 @@ using namespace wlx;
 namespace c = gen::coord;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180;
+using test::kDeg;
 }
 
 TEST_CASE("simulation: the closure does not drift; sample count includes t = 0") {
