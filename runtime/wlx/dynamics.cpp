@@ -3,6 +3,7 @@
 #include "wlx/error.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/QR>
 #include <fmt/format.h>
@@ -199,6 +200,30 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
   }(std::make_integer_sequence<int, kU>{});
 }
 
+// The motion no actuator acts on, for the message of a rank loss: the unit combination n of the
+// commanded speeds with A n = 0 (A's rows are the actuated joints' rates per commanded speed, up to
+// a weighting, which leaves n as it is): the eigenvector of A^T A of the smallest eigenvalue,
+// written with its largest entry +1 and entries below 1e-9 of it left out. (Wheels that roll
+// freely give one where they all point the same way: the whole machine rolls along them and no
+// actuated joint moves.)
+[[gnu::noinline, gnu::cold]] std::string unactuated_motion(const ActuatorJacobian& At) {
+  const Eigen::SelfAdjointEigenSolver<CommandMatrix> eigen(At.transpose() * At);
+  CommandVector n = eigen.eigenvectors().col(0);
+  Eigen::Index largest = 0;
+  n.cwiseAbs().maxCoeff(&largest);
+  n /= n(largest);
+  std::string combination;
+  for (int k = 0; k < kCommandedCount; ++k) {
+    if (std::abs(n(k)) < 1e-9) continue;
+    const std::string_view name = gen::kCoordinateNames[static_cast<std::size_t>(kCommandedSpeeds[static_cast<std::size_t>(k)])];
+    combination += combination.empty() ? fmt::format("{:.6g} {}'", n(k), name)
+                                       : fmt::format(" {} {:.6g} {}'", n(k) < 0 ? '-' : '+', std::abs(n(k)), name);
+  }
+  return fmt::format("the speeds {} move no actuated joint (wheels that roll freely, a joint that is not actuated): "
+                     "actuate a joint they move, or command fewer speeds",
+                     combination);
+}
+
 // The same with column pivoting and a rank test: for poses where the fast path declines. Kept out
 // of line: inlined, its dynamic-size blocks cost the fast path a 2 KB stack frame.
 [[gnu::noinline, gnu::cold]] TorqueVector min_norm_solve_pivoted(const ActuatorJacobian& At, const CommandVector& Qstar, const Weighting& weighting) {
@@ -211,8 +236,8 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
     std::string u;
     for (int k : kCommandedSpeeds) u += fmt::format("{}{}'", u.empty() ? "" : ", ", gen::kCoordinateNames[static_cast<std::size_t>(k)]);
     throw Error("J_beta", fmt::format("the actuator Jacobian has rank {} < {} with {}: the {} actuators cannot produce "
-                                      "every generalized force on u = [{}] in this pose",
-                                      qr.rank(), kU, weighting.label(), kActuatedCount, u));
+                                      "every generalized force on u = [{}] in this pose: {}",
+                                      qr.rank(), kU, weighting.label(), kActuatedCount, u, unactuated_motion(At)));
   }
   const CommandMatrix R = qr.matrixR().template topLeftCorner<kU, kU>().template triangularView<Eigen::Upper>();
   const CommandVector y = R.transpose().template triangularView<Eigen::Lower>().solve(qr.colsPermutation().transpose() * Qstar);

@@ -207,10 +207,11 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       const auto idx = indices(limb);
       if (done[l]) continue;  // a converged limb stays converged: the limbs do not couple
       before[l] = limb_residual(data.Phi, idx);
-      done[l] = before[l] <= options.tolerance || (stalled[l] && before[l] <= options.floor_tolerance);
+      const bool out_of_steps = report.iterations[l] >= options.max_iterations;
+      done[l] = before[l] <= options.tolerance || ((stalled[l] || out_of_steps) && before[l] <= options.floor_tolerance);
       if (done[l]) continue;
       all_done = false;
-      if (report.iterations[l] >= options.max_iterations) throw not_converged(limb, false, before[l]);
+      if (out_of_steps) throw not_converged(limb, false, before[l]);
       // The limb's block of dPhi/ds: its rows against its own dependent joints.
       LimbMatrix J = LimbMatrix::Identity();  // a smaller limb padded with a unit diagonal
       LimbVector r = LimbVector::Zero();
@@ -275,9 +276,10 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       if (done[l]) continue;
       const auto idx = indices(limb);
       const double residual = limb_residual(data.Phi, idx);
-      done[l] = residual <= options.tolerance || (stalled[l] && residual <= options.floor_tolerance);
+      const bool out_of_steps = report.iterations[l] >= options.max_iterations;
+      done[l] = residual <= options.tolerance || ((stalled[l] || out_of_steps) && residual <= options.floor_tolerance);
       if (done[l]) continue;
-      if (stalled[l] || report.iterations[l] >= options.max_iterations) throw not_converged(limb, stalled[l], residual);
+      if (stalled[l] || out_of_steps) throw not_converged(limb, stalled[l], residual);
       all_done = false;
       // The limb's block of dPhi/ds (a smaller limb padded with a unit diagonal and zero residual).
       LimbMatrix J = LimbMatrix::Identity();

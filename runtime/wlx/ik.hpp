@@ -55,7 +55,9 @@ int classify_branch(const Model& model, Limb limb, const Coordinates& s);
 struct NewtonOptions {
   double tolerance = 1e-13;  // on max |Phi| of the limb, in m or rad
   // A limb whose residual no damped step can lower any more has reached its rounding floor; it
-  // counts as converged if that floor is below this (ill-conditioned poses amplify rounding).
+  // counts as converged if that floor is below this (ill-conditioned poses amplify rounding). So
+  // does a limb still below it when max_iterations run out: at a singular pose (a leg stretched
+  // or folded flat) the convergence is linear, and the last digits take hundreds of steps.
   double floor_tolerance = 1e-10;
   int max_iterations = 100;  // steps tried per limb (accepted or not)
   // levenberg_marquardt: damped steps that also descend from far or singular starts (the default).

@@ -25,6 +25,7 @@
 #include <deque>
 #include <optional>
 #include <random>
+#include <sstream>
 #include <string>
 
 using namespace wlx;
@@ -270,6 +271,57 @@ TEST_CASE(titled("inverse dynamics: J_beta^T tau = Q*, power and energy balances
   CHECK(worst_energy <= 1e-6);  // five-point stencil at dt = 1e-5 on a motion with |s'| <= 1
 }
 
+TEST_CASE(titled("inverse dynamics at the nominal pose: torques that balance Q*, or a refusal naming the speeds no actuator moves")) {
+  if constexpr (!gen::kHasDynamics) return;
+  const Model model;
+  Data d;
+  DynamicsTerms t;
+  Coordinates s = nominal_inputs();
+  solve_ik_closed_form(model, s);
+  CommandVector u = CommandVector::Constant(0.1), u_dot = CommandVector::Constant(0.1);
+  inverse_dynamics(model, d, s, u, u_dot, t);
+  try {
+    const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
+    CHECK((t.J_beta.transpose() * tau - t.Qstar).norm() <= 1e-9 * t.Qstar.norm());
+  } catch (const Error& e) {
+    // The refusal's combination, read back from the message: J_beta must take it to zero.
+    const std::string message = e.what();
+    CAPTURE(message);
+    const std::size_t from = message.find("the speeds "), to = message.find(" move no actuated joint");
+    REQUIRE(from != std::string::npos);
+    REQUIRE(to != std::string::npos);
+    std::istringstream terms(message.substr(from + 11, to - from - 11));
+    CommandVector n = CommandVector::Zero();
+    std::string token;
+    double sign = 1, coefficient = 0;
+    bool have_coefficient = false;
+    while (terms >> token) {
+      if (token == "+" || token == "-") {
+        sign = token == "-" ? -1 : 1;
+      } else if (!have_coefficient) {
+        coefficient = sign * std::stod(token);
+        have_coefficient = true;
+      } else {
+        REQUIRE(token.back() == '\'');
+        token.pop_back();
+        int column = -1;
+        for (int k = 0; k < kCommandedCount; ++k)
+          if (gen::kCoordinateNames[static_cast<std::size_t>(kCommandedSpeeds[static_cast<std::size_t>(k)])] == token) column = k;
+        CAPTURE(token);
+        REQUIRE(column >= 0);
+        n(column) = coefficient;
+        have_coefficient = false;
+        sign = 1;
+      }
+    }
+    MESSAGE(kName << ": J_beta refused at the nominal pose; |J_beta n| / |J_beta| |n| = "
+                  << (t.J_beta * n).norm() / (t.J_beta.norm() * n.norm()) << " for the named n = " << n.transpose());
+    CHECK(n.norm() >= 1);  // its largest entry is written as 1
+    // The message prints 6 significant digits: each entry is off by up to 5e-7 of the largest.
+    CHECK((t.J_beta * n).norm() <= 2e-6 * t.J_beta.norm() * n.norm());
+  }
+}
+
 TEST_CASE(titled("forward dynamics: inverts the inverse dynamics; no torque and no gravity keep the kinetic energy; power = d(T + V)/dt")) {
   if constexpr (!gen::kHasDynamics) {
     const Model model;
@@ -315,30 +367,43 @@ TEST_CASE(titled("forward dynamics: inverts the inverse dynamics; no torque and 
     const Coordinates s0 = random_state(rng, model, 0.03);
     CommandVector u0;
     for (int k = 0; k < kCommandedCount; ++k) u0(k) = 0.2 * half(rng);
-    const test::ForwardRun free = test::integrate_forward(weightless, s0, u0, TorqueVector::Zero(), 0.2, 1e-3);
+    const TorqueTrajectory free = simulate_torques(
+        weightless, {.initial = s0, .speeds = u0, .duration = 0.2, .dt = 1e-3,
+                     .torques = [](double, const Coordinates&, const CommandVector&) { return TorqueVector::Zero().eval(); }});
+    CAPTURE(free.error);
     REQUIRE(free.complete);
-    double drift = 0;
-    for (double T : free.kinetic) drift = std::max(drift, std::abs(T - free.kinetic.front()));
-    MESSAGE(kName << ": kinetic energy " << free.kinetic.front() << " J, drift over 0.2 s without torque or gravity: "
-                  << drift / free.kinetic.front() << " relative");
-    CHECK(drift <= 1e-9 * free.kinetic.front());  // RK4 at dt = 1e-3 s: truncation ~dt^4 per unit time
+    REQUIRE(free.samples.size() == 201);
+    const double T0 = free.samples.front().kinetic;
+    double drift = 0, worst_closure = 0;
+    for (const TorqueSample& smp : free.samples) {
+      drift = std::max(drift, std::abs(smp.kinetic - T0));
+      closure(weightless, d, smp.s, false);
+      if constexpr (gen::kClosureCount > 0) worst_closure = std::max(worst_closure, d.Phi.cwiseAbs().maxCoeff());
+    }
+    MESSAGE(kName << ": kinetic energy " << T0 << " J, drift over 0.2 s without torque or gravity: " << drift / T0
+                  << " relative; closure residual along the run " << worst_closure << " m");
+    CHECK(drift <= 1e-9 * T0);  // RK4 at dt = 1e-3 s: truncation ~dt^4 per unit time
+    CHECK(worst_closure <= 1e-12);  // the IK at every evaluation: nothing of the closure is integrated
 
     // 3. Gravity and constant torques (those holding the start pose, plus 20 %): the actuators'
     //    power is d(T + V)/dt, by a five-point stencil on the run's energies.
     inverse_dynamics(model, d, s0, CommandVector::Zero(), CommandVector::Zero(), t);
     const TorqueVector hold = 1.2 * distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
     const double dt = 1e-4;
-    const test::ForwardRun driven = test::integrate_forward(model, s0, u0, hold, 0.01, dt);
+    const TorqueTable constant({0.0, 0.01}, {hold, hold});
+    const TorqueTrajectory driven = simulate_torques(model, {.initial = s0, .speeds = u0, .duration = 0.01, .dt = dt, .torques = constant});
+    CAPTURE(driven.error);
     REQUIRE(driven.complete);
+    const auto& smp = driven.samples;
     double worst_power = 0, scale = 0;
-    for (std::size_t k = 2; k + 2 < driven.kinetic.size(); ++k) {
-      const auto E = [&](std::size_t j) { return driven.kinetic[j] + driven.potential[j]; };
+    for (std::size_t k = 2; k + 2 < smp.size(); ++k) {
+      const auto E = [&](std::size_t j) { return smp[j].kinetic + smp[j].potential; };
       const double dEdt = (E(k - 2) - 8 * E(k - 1) + 8 * E(k + 1) - E(k + 2)) / (12 * dt);
-      worst_power = std::max(worst_power, std::abs(driven.power[k] - dEdt));
-      scale = std::max(scale, std::abs(driven.power[k]));
+      worst_power = std::max(worst_power, std::abs(smp[k].power - dEdt));
+      scale = std::max(scale, std::abs(smp[k].power));
     }
     MESSAGE(kName << ": |tau . J_beta u - d(T + V)/dt| = " << worst_power << " W (power up to " << scale << " W)");
     // Stencil truncation ~dt^4 and rounding ~1e-16 |E| / dt (|E| of order 1e5 J for a few tonnes).
-    CHECK(worst_power <= 1e-6 * std::max(1.0, scale) + 1e-9 * std::abs(driven.potential.front()) / dt);
+    CHECK(worst_power <= 1e-6 * std::max(1.0, scale) + 1e-9 * std::abs(smp.front().potential) / dt);
   }
 }

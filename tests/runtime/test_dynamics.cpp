@@ -5,13 +5,17 @@
 #include <doctest/doctest.h>
 #include <wlx/dynamics.hpp>
 #include <wlx/error.hpp>
+#include <wlx/forward_dynamics.hpp>
 #include <wlx/ik.hpp>
 #include <wlx/simulation.hpp>
 
 #include <Eigen/QR>
 
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 using namespace wlx;
 namespace c = gen::coord;
@@ -271,6 +275,72 @@ TEST_CASE("dynamics: ID-1..3 reach the thesis' end states with torques of order 
   }
 }
 
+TEST_CASE("forward dynamics: the torques of ID-1..3, fed back, reproduce their trajectories (round trip)") {
+  // The inverse-dynamics runs hold u constant. Their torques, as a table, drive simulate_torques
+  // (RK4) from the same start and speeds, which must retrace the kinematic run. With the table's
+  // rows at every time the forward run's RK4 stages ask for (the inverse run at half its step),
+  // nothing is interpolated and the two runs differ only by their integrators' truncation. With
+  // rows only at its steps the midpoints are interpolated, off by tau'' dt^2 / 8 (reported).
+  struct Run { int coordinate; double rate, duration; };
+  for (const Run& r : {Run{c::x_C, 3.0, 0.494}, Run{c::roll, -10 * kDeg, 0.541}, Run{c::z_C, -3.0, 0.581}}) {
+    CommandVector u0;
+    std::array<double, 2> worst_s{}, worst_u{};
+    for (int exact = 0; exact < 2; ++exact) {
+      const double dt = exact ? 1e-4 : 1e-3;
+      Scenario sc;
+      sc.rates(r.coordinate) = r.rate;
+      sc.duration = r.duration;
+      sc.dt = exact ? dt / 2 : dt;
+      sc.weighting = Weighting::model_weights();
+      const Trajectory id = simulate(sc);
+      REQUIRE(id.complete);
+      std::vector<double> times;
+      std::vector<TorqueVector> torques;
+      for (const Sample& smp : id.samples) times.push_back(smp.t), torques.push_back(smp.tau);
+      for (int k = 0; k < kCommandedCount; ++k) u0(k) = sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]);
+      const Model model;
+      const TorqueTrajectory fd = simulate_torques(
+          model, {.initial = id.samples.front().s, .speeds = u0, .duration = sc.duration, .dt = dt,
+                  .torques = TorqueTable(std::move(times), std::move(torques))});
+      CAPTURE(fd.error);
+      REQUIRE(fd.complete);
+      const std::size_t every = exact ? 2 : 1;  // the kinematic run's samples at the forward run's times
+      REQUIRE((fd.samples.size() - 1) * every == id.samples.size() - 1);
+      for (std::size_t k = 0; k < fd.samples.size(); ++k) {
+        worst_s[exact] = std::max(worst_s[exact], (fd.samples[k].s - id.samples[k * every].s).cwiseAbs().maxCoeff());
+        worst_u[exact] = std::max(worst_u[exact], (fd.samples[k].u - u0).cwiseAbs().maxCoeff());
+      }
+    }
+    MESSAGE(gen::kCoordinateNames[static_cast<std::size_t>(r.coordinate)] << "' = " << r.rate << ": |s_forward - s_inverse| <= "
+            << worst_s[1] << ", |u - u0| <= " << worst_u[1] << " (torques at every stage); " << worst_s[0] << ", "
+            << worst_u[0] << " (interpolated at 1 ms)");
+    // RK4 at 0.1 and 0.05 ms: x_C' and z_C' agree to 1e-12. ID-2 (roll', which steers the dependent
+    // pair y_C, yaw) to 9e-10 m only, and its difference shrinks as dt^1.6 rather than dt^4 (3.6e-8
+    // with the forward run at 1 ms): something along it is not smooth to fourth order, an open
+    // question (docs/architecture.md). The bound holds both with a factor of two.
+    CHECK(worst_s[1] <= 2e-9);
+    CHECK(worst_u[1] <= 2e-9);
+  }
+}
+
+TEST_CASE("forward dynamics: a torque table refuses bad rows and times outside it, naming the field") {
+  const TorqueVector one = TorqueVector::Ones();
+  CHECK_THROWS_WITH_AS(TorqueTable({}, {}), doctest::Contains("at least one"), Error);
+  CHECK_THROWS_WITH_AS(TorqueTable({0.0, 1.0}, {one}), doctest::Contains("2 times and 1 rows"), Error);
+  CHECK_THROWS_WITH_AS(TorqueTable({0.0, 0.0}, {one, one}), doctest::Contains("must increase: row 1"), Error);
+  CHECK_THROWS_WITH_AS(TorqueTable({0.0, NAN}, {one, one}), doctest::Contains("row 1 (t = nan) is not finite"), Error);
+  const TorqueTable table({0.0, 1.0}, {TorqueVector::Zero(), 2 * one});
+  CHECK((table.at(0.25) - 0.5 * one).cwiseAbs().maxCoeff() <= 1e-15);
+  CHECK_THROWS_WITH_AS(table.at(1.5), doctest::Contains("t = 1.5 s is outside the table's times [0, 1] s"), Error);
+  // A run with a source that stops answering ends early and says when and why.
+  const Model model;
+  const TorqueTrajectory short_table = simulate_torques(model, {.duration = 0.01, .dt = 1e-3, .torques = TorqueTable({0.0, 0.005}, {one, one})});
+  CHECK(!short_table.complete);
+  CHECK(short_table.error.find("stopped at t = 0.005000 s: torques: t = 0.0055 s is outside") != std::string::npos);
+  CHECK_THROWS_WITH_AS(simulate_torques(model, {.duration = 1, .dt = 0}), doctest::Contains("dt: must be finite and > 0"), Error);
+  CHECK_THROWS_WITH_AS(simulate_torques(model, {.duration = 1}), doctest::Contains("torques: no torque source given"), Error);
+}
+
 TEST_CASE("dynamics: ID-3 ends 7 mm above the ground: the cabin would touch it at t ~ 0.583 s") {
   Scenario sc;
   sc.rates(c::z_C) = -3.0;
@@ -287,8 +357,16 @@ TEST_CASE("dynamics: a rank-deficient J_beta and bad weights are clear errors; z
   J(0, 0) = J(1, 1) = J(2, 2) = 1;  // nothing acts on pitch
   CHECK_THROWS_WITH_AS(distribute_torques(J, CommandVector(1, 2, 3, 4), Weighting::model_weights()),
                        "J_beta: the actuator Jacobian has rank 3 < 4 with weighting 1 (the model file's weights): the 8 actuators "
-                       "cannot produce every generalized force on u = [z_C', x_C', roll', pitch'] in this pose",
+                       "cannot produce every generalized force on u = [z_C', x_C', roll', pitch'] in this pose: the speeds "
+                       "1 pitch' move no actuated joint (wheels that roll freely, a joint that is not actuated): actuate a "
+                       "joint they move, or command fewer speeds",
                        Error);
+  // A combination: two actuators see roll' and pitch' only as roll' + 2 pitch'.
+  J(2, 2) = 1, J(2, 3) = 2, J(3, 2) = 2, J(3, 3) = 4;
+  CHECK_THROWS_WITH_AS(distribute_torques(J, CommandVector(1, 2, 3, 4), Weighting::model_weights()),
+                       doctest::Contains("the speeds 1 roll' - 0.5 pitch' move no actuated joint"), Error);
+  J = ActuatorJacobian::Zero();
+  J(0, 0) = J(1, 1) = J(2, 2) = 1;
   J(3, 3) = 2;
   const TorqueVector tau = distribute_torques(J, CommandVector(1, 2, 3, 4), Weighting::contribution());
   for (int r = 4; r < 8; ++r) CHECK(tau(r) == 0.0);

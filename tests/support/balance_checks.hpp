@@ -46,49 +46,4 @@ inline double energy_balance_error(const Model& model, const Coordinates& initia
   return worst;
 }
 
-// A torque-driven motion by the forward dynamics (RK4 on the inputs and the commanded speeds u,
-// the dependents re-solved by the IK at every stage): the kinetic and potential energy at every
-// step and the actuators' power tau . J_beta u there. Independent of the run's own integrator.
-struct ForwardRun {
-  std::vector<double> kinetic, potential, power;
-  bool complete = true;
-};
-
-inline ForwardRun integrate_forward(const Model& model, const Coordinates& initial, const CommandVector& u0,
-                                    const TorqueVector& tau, double duration, double dt) {
-  using Inputs = Eigen::Matrix<double, kInputCount, 1>;
-  Data d;
-  DynamicsTerms t;
-  Coordinates s = initial;
-  const auto rhs = [&](const Inputs& q, const CommandVector& u, Inputs& dq, CommandVector& du) {
-    s.head<kInputCount>() = q;
-    solve_ik_closed_form(model, s);
-    forward_dynamics(model, d, s, u, tau, du, t);
-    dq = t.sdot.head<kInputCount>();
-  };
-  ForwardRun run;
-  Inputs q = initial.head<kInputCount>();
-  CommandVector u = u0;
-  const long steps = std::lround(duration / dt);
-  try {
-    for (long k = 0; k <= steps; ++k) {
-      Inputs k1q, k2q, k3q, k4q;
-      CommandVector k1u, k2u, k3u, k4u;
-      rhs(q, u, k1q, k1u);  // leaves s, t at the step's start
-      run.kinetic.push_back(kinetic_energy(model, d, s, t.sdot));
-      run.potential.push_back(potential_energy(model, d, s));
-      run.power.push_back(tau.dot(t.J_beta * u));
-      if (k == steps) break;
-      rhs(q + 0.5 * dt * k1q, u + 0.5 * dt * k1u, k2q, k2u);
-      rhs(q + 0.5 * dt * k2q, u + 0.5 * dt * k2u, k3q, k3u);
-      rhs(q + dt * k3q, u + dt * k3u, k4q, k4u);
-      q += dt / 6 * (k1q + 2 * k2q + 2 * k3q + k4q);
-      u += dt / 6 * (k1u + 2 * k2u + 2 * k3u + k4u);
-    }
-  } catch (const Error&) {
-    run.complete = false;
-  }
-  return run;
-}
-
 }  // namespace wlx::test
