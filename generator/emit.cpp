@@ -41,15 +41,15 @@ std::string namespace_open(const EmitOptions& opt) {
 // so that another model's headers in the same translation unit stay inline.
 std::string compiled_macro(const EmitOptions& opt) { return "WLX_GEN_COMPILED_" + opt.model_name; }
 std::string double_linkage_note(const EmitOptions& opt) {
-  if (!opt.name_space.empty())
-    return "// The double versions of the functions are inline, compiled in every translation unit that\n"
-           "// calls them.\n";
-  return fmt::format(
+  const std::string inline_everywhere =
       "// The double versions of the functions are inline, compiled in every translation unit that\n"
-      "// calls them. With {0} defined they are only declared: a library compiles them once, in\n"
-      "// translation units that define WLX_GEN_DEFINE_DOUBLE and include each header once (the wlx\n"
-      "// runtime library of the model does, and defines {0} for its users).\n",
-      compiled_macro(opt));
+      "// calls them.";
+  if (!opt.name_space.empty()) return inline_everywhere + "\n";
+  return inline_everywhere +
+         fmt::format(" With {0} defined they are only declared: a library compiles them once, in\n"
+                     "// translation units that define WLX_GEN_DEFINE_DOUBLE and include each header once (the wlx\n"
+                     "// runtime library of the model does, and defines {0} for its users).\n",
+                     compiled_macro(opt));
 }
 std::string namespace_close(const EmitOptions& opt) {
   if (opt.name_space.empty())
@@ -561,9 +561,6 @@ std::string double_overload(const EmitOptions& opt, const std::string& name, con
     arguments.push_back(declaration.substr(declaration.rfind(' ') + 1));
   }
   const std::string call = fmt::format("{}<double>({})", name, fmt::join(arguments, ", "));
-  // The AVX2 + FMA version: flatten inlines the template's body (sincos and atan2 too) into it, so
-  // all of it is compiled for those instructions; a call to a separate function would run the
-  // portable code.
   // In the model's own namespace, the runtime library of the model may compile the double version
   // once for all its users (types.hpp); headers in another namespace are never compiled so.
   const std::string external =
@@ -575,6 +572,9 @@ std::string double_overload(const EmitOptions& opt, const std::string& name, con
                         "#else\n",
                         compiled_macro(opt), name, why, result, fmt::join(with_defaults, ", "))
           : std::string();
+  // The AVX2 + FMA version: flatten inlines the template's body (sincos and atan2 too) into it, so
+  // all of it is compiled for those instructions; a call to a separate function would run the
+  // portable code.
   return external + fmt::format(
       "#if defined(WLX_GEN_MULTIVERSION)\n"
       "namespace detail {{\n"

@@ -1,6 +1,7 @@
 #include "wlx/forward_dynamics.hpp"
 
 #include "wlx/error.hpp"
+#include "wlx/simulation.hpp"
 
 #include <Eigen/Cholesky>
 #include <fmt/format.h>
@@ -61,9 +62,7 @@ TorqueVector TorqueTable::at(double t) const {
 TorqueVector TorqueTable::operator()(double t, const Coordinates&, const CommandVector&) const { return at(t); }
 
 void TorqueRun::validate() const {
-  if (!(std::isfinite(duration) && duration >= 0)) throw Error("duration", fmt::format("must be finite and >= 0, got {}", duration));
-  if (!(std::isfinite(dt) && dt > 0)) throw Error("dt", fmt::format("must be finite and > 0, got {}", dt));
-  if (duration / dt > 1e8) throw Error("dt", fmt::format("{} s in steps of {} s is more than the limit of 1e8 steps", duration, dt));
+  validate_time_grid(duration, dt);  // the kinematic runs' grid rules (wlx/simulation.hpp)
   if (!speeds.allFinite()) throw Error("speeds", "must be finite");
   if (!initial.allFinite()) throw Error("initial", "must be finite");
   if (!torques) throw Error("torques", "no torque source given");

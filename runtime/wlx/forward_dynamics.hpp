@@ -50,7 +50,8 @@ struct TorqueRun {
   Branches branches;
   NonholonomicOptions nonholonomic;
   TorqueSource torques;
-  // Throws wlx::Error naming the field for a bad duration, step, start speed or a missing source.
+  // Throws wlx::Error naming the field for a bad duration or step (validate_time_grid), start
+  // state or speed, or a missing source.
   void validate() const;
 };
 

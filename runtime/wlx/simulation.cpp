@@ -170,16 +170,20 @@ std::optional<Integrator> integrator_from_name(std::string_view name) noexcept {
 
 long Scenario::samples() const { return std::lround(duration / dt) + 1; }
 
-void Scenario::validate() const {
+void validate_time_grid(double duration, double dt) {
   if (!(std::isfinite(duration) && duration > 0))
     throw Error("duration", fmt::format("must be a positive number of seconds, got {}", duration));
   if (!(std::isfinite(dt) && dt > 0)) throw Error("dt", fmt::format("must be a positive number of seconds, got {}", dt));
-  if (integrator == Integrator::dopri5 && !(std::isfinite(tolerance) && tolerance >= 1e-14 && tolerance <= 1e-2))
-    throw Error("tolerance", fmt::format("must be between 1e-14 (rounding) and 1e-2, got {}", tolerance));
   if (duration / dt > 1e8)
     throw Error("dt", fmt::format("{} s over {} s is {:.3g} steps, more than the limit of 1e8", dt, duration, duration / dt));
   if (std::abs(duration / dt - std::round(duration / dt)) > 1e-6 * (duration / dt))
     throw Error("dt", fmt::format("the duration {} s is not a whole number of steps of {} s", duration, dt));
+}
+
+void Scenario::validate() const {
+  validate_time_grid(duration, dt);
+  if (integrator == Integrator::dopri5 && !(std::isfinite(tolerance) && tolerance >= 1e-14 && tolerance <= 1e-2))
+    throw Error("tolerance", fmt::format("must be between 1e-14 (rounding) and 1e-2, got {}", tolerance));
   for (int k : pair.index)
     if (rates(k) != 0)
       throw Error(fmt::format("rates.{}", gen::kCoordinateNames[static_cast<std::size_t>(k)]),

@@ -24,6 +24,10 @@ std::string_view integrator_name(Integrator integrator) noexcept;
 // The integrator of that name ("rk4", "euler", "dopri5"), or nothing.
 std::optional<Integrator> integrator_from_name(std::string_view name) noexcept;
 
+// Every run's time grid: throws wlx::Error naming "duration" or "dt" unless both are positive and
+// finite and the duration is a whole number of at most 1e8 steps of dt.
+void validate_time_grid(double duration, double dt);
+
 struct Scenario {
   std::string id;
   std::string description;

@@ -337,7 +337,9 @@ TEST_CASE("forward dynamics: a torque table refuses bad rows and times outside i
   const TorqueTrajectory short_table = simulate_torques(model, {.duration = 0.01, .dt = 1e-3, .torques = TorqueTable({0.0, 0.005}, {one, one})});
   CHECK(!short_table.complete);
   CHECK(short_table.error.find("stopped at t = 0.005000 s: torques: t = 0.0055 s is outside") != std::string::npos);
-  CHECK_THROWS_WITH_AS(simulate_torques(model, {.duration = 1, .dt = 0}), doctest::Contains("dt: must be finite and > 0"), Error);
+  CHECK_THROWS_WITH_AS(simulate_torques(model, {.duration = 1, .dt = 0}), doctest::Contains("dt: must be a positive number of seconds, got 0"), Error);
+  CHECK_THROWS_WITH_AS(simulate_torques(model, {.duration = 0.0105, .dt = 1e-3, .torques = TorqueTable({0.0, 1.0}, {one, one})}),
+                       doctest::Contains("dt: the duration 0.0105 s is not a whole number of steps of 0.001 s"), Error);
   CHECK_THROWS_WITH_AS(simulate_torques(model, {.duration = 1}), doctest::Contains("torques: no torque source given"), Error);
 }
 
