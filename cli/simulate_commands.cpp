@@ -29,7 +29,7 @@ std::vector<std::string> trajectory_header(bool dynamics) {
   for (int w = 0; w < kWheelCount; ++w)
     for (const char* axis : {"vx_", "vy_", "vz_"}) h.push_back(axis + contact_column_stem(w));
   if (dynamics) {
-    for (int k : kActuatedJoints) h.push_back("tau_" + name(k));
+    for (const std::string_view a : kActuatorNames) h.push_back("tau_" + std::string(a));
     for (int k : kCommandedSpeeds) h.push_back("Qstar_" + name(k));
   }
   return h;

@@ -111,7 +111,8 @@ FunctionSpec derive_closure(const Model& m) {
   FunctionSpec fn{"closure", "closure.hpp",
                   "Loop closure: Phi(s) and its Jacobian dPhi/ds.", false, {}};
   OutputSpec phi{"Phi", "ClosureVector", "closure residuals, zero on the constraint manifold", "", {}};
-  OutputSpec jac{"dPhi_ds", "ClosureJacobian", "dPhi/ds, 14 x 32", kZeroMatrix, {}};
+  OutputSpec jac{"dPhi_ds", "ClosureJacobian", fmt::format("dPhi/ds, {} x {}", m.closure.size(), coordinate_count(m)),
+                 kZeroMatrix, {}};
   for (int i = 0; i < static_cast<int>(m.closure.size()); ++i) {
     const ClosureRow row = closure_row(m, m.closure[static_cast<std::size_t>(i)]);
     phi.elements.emplace_back(at(i), row.value);
@@ -127,8 +128,8 @@ FunctionSpec derive_nonholonomic(const Model& m) {
                   "Non-holonomic wheels: rows C(s) with v_W . n_W = C(s) s', and "
                   "the rolling rows with spin rate = (v_W . e_x,W) / w = spin(s) s'.",
                   false, {}};
-  OutputSpec C{"C", "WheelRows", "cornering constraint rows, one per wheel (l, r)", kZeroMatrix, {}};
-  OutputSpec spin{"spin", "WheelRows", "wheel spin-rate rows, one per wheel (l, r)", kZeroMatrix, {}};
+  OutputSpec C{"C", "WheelRows", "cornering constraint rows, one per wheel", kZeroMatrix, {}};
+  OutputSpec spin{"spin", "WheelRows", "wheel spin-rate rows, one per wheel", kZeroMatrix, {}};
   for (int i = 0; i < static_cast<int>(m.wheels.size()); ++i) {
     const WheelRow row = wheel_row(m, m.wheels[static_cast<std::size_t>(i)]);
     for (int j = 0; j < coordinate_count(m); ++j) {
@@ -136,7 +137,29 @@ FunctionSpec derive_nonholonomic(const Model& m) {
       spin.elements.emplace_back(at(i, j), row.spin[static_cast<std::size_t>(j)]);
     }
   }
-  fn.outputs = {C, spin};
+  // A wheel's drive turns it against its hub: its rate is the spin relative to the hub. The
+  // wheel's material point at the contact has zero velocity, v_hub + (w_hub + drive a) x rho = 0
+  // with rho = -r u the rim offset; along the forward direction t (a x u = t, u x t = a) this gives
+  // drive = (v_hub . t) / r - w_hub . a. Rows only for the wheels the dynamics section drives.
+  OutputSpec drive{"drive", "WheelRows",
+                   "wheel drive-rate rows: the spin relative to the hub, drive rate = drive(s) s' (zero rows for a "
+                   "wheel without a drive)",
+                   kZeroMatrix, {}};
+  if (m.dynamics)
+    for (const Actuator& a : m.dynamics->actuated) {
+      if (a.wheel < 0) continue;
+      const NonholonomicWheel& wheel = m.wheels[static_cast<std::size_t>(a.wheel)];
+      const Frame& hub = m.frame(wheel.hub);
+      const Vec3 t = m.frame(wheel.contact).R.col(static_cast<int>(wheel.forward));
+      const Vec3 axle = hub.R.col(static_cast<int>(wheel.axle));
+      const ex radius = m.parameter(wheel.radius).symbol;
+      const auto Jv = linear_jacobian(hub, coordinate_count(m));
+      const auto Jw = angular_jacobian(hub, coordinate_count(m));
+      for (int j = 0; j < coordinate_count(m); ++j)
+        drive.elements.emplace_back(at(a.wheel, j), dot(t, Jv[static_cast<std::size_t>(j)]) / radius -
+                                                        dot(axle, Jw[static_cast<std::size_t>(j)]));
+    }
+  fn.outputs = {C, spin, drive};
   return fn;
 }
 
@@ -221,7 +244,7 @@ FunctionSpec derive_dynamics_update(const Model& m) {
                   "nonholonomic that an inverse-dynamics step needs, sharing their common subexpressions).",
                   false, {}};
   const FunctionSpec c = derive_closure(m), n = derive_nonholonomic(m);
-  fn.outputs = {c.outputs[1], n.outputs[0]};
+  fn.outputs = {c.outputs[1], n.outputs[0], n.outputs[2]};
   return fn;
 }
 

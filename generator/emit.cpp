@@ -754,21 +754,33 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
     for (std::size_t k = 0; k < pairs.size(); ++k)
       if (pairs[k].name == d.pair) pair = static_cast<int>(k);
     std::string commanded, actuated, weights;
+    std::vector<int> joints, wheels;
+    std::vector<std::string> names;
     for (int k : d.commanded) commanded += (commanded.empty() ? "" : ", ") + name_of(k);
-    for (int k : d.actuated) actuated += (actuated.empty() ? "" : ", ") + name_of(k);
+    for (const Actuator& a : d.actuated) {
+      actuated += (actuated.empty() ? "" : ", ") + a.name;
+      joints.push_back(a.coordinate);
+      wheels.push_back(a.wheel);
+      names.push_back(quoted(a.name));
+    }
     for (double w : d.weights) weights += (weights.empty() ? "" : ", ") + literal(w);
     t += fmt::format(
-        "// Inverse dynamics: the commanded speeds u ({}), the dependent pair, the actuated joints\n"
+        "// Inverse dynamics: the commanded speeds u ({}), the dependent pair, the actuators\n"
         "// ({}), their default weights, and gravity (along -z of K0).\n"
+        "// An actuator is a joint (kActuated: its coordinate) or the drive of a wheel on a hub\n"
+        "// (kActuatedWheels: the wheel, whose spin relative to the hub is the drive's rate); -1 where not.\n"
         "inline constexpr bool kHasDynamics = {};\n"
         "inline constexpr std::array<int, {}> kCommanded{{{{{}}}}};\n"
         "inline constexpr int kDynamicsPair = {};  // {}\n"
         "inline constexpr std::array<int, {}> kActuated{{{{{}}}}};\n"
+        "inline constexpr std::array<int, {}> kActuatedWheels{{{{{}}}}};\n"
+        "inline constexpr std::array<std::string_view, {}> kActuatorNames{{{{{}}}}};\n"
         "inline constexpr std::array<double, {}> kDefaultWeights{{{{{}}}}};\n"
         "inline constexpr double Params::*kGravity = {};\n\n",
         m.dynamics ? commanded : "none: the model file has no dynamics section", actuated, m.dynamics ? "true" : "false",
-        d.commanded.size(), int_list(d.commanded), pair, m.dynamics ? d.pair : "none", d.actuated.size(),
-        int_list(d.actuated), d.weights.size(), weights, m.dynamics ? "&Params::" + d.gravity : "nullptr");
+        d.commanded.size(), int_list(d.commanded), pair, m.dynamics ? d.pair : "none", joints.size(), int_list(joints),
+        wheels.size(), int_list(wheels), names.size(), fmt::join(names, ", "), d.weights.size(), weights,
+        m.dynamics ? "&Params::" + d.gravity : "nullptr");
   }
 
   // Body Jacobian columns.

@@ -94,12 +94,20 @@ struct DependentPair {
   std::vector<int> coordinates;
 };
 
+// An actuator: a joint (a coordinate), or the drive of a wheel on a hub (a motor between the hub
+// and the wheel, whose rate is the wheel's spin relative to the hub).
+struct Actuator {
+  int coordinate = -1;  // the joint's coordinate, or -1 for a wheel's drive
+  int wheel = -1;       // the wheel (index into Model::wheels), or -1 for a joint
+  std::string name;     // the joint's name, or spin_<wheel>
+};
+
 struct Dynamics {
   std::string gravity;  // parameter name; gravity acts along -z of K0
   std::vector<int> commanded;
   std::string pair;  // name of the dependent pair
-  std::vector<int> actuated;
-  std::vector<double> weights;  // default weighting, one per actuated joint
+  std::vector<Actuator> actuated;
+  std::vector<double> weights;  // default weighting, one per actuator
 };
 
 // A box attached to a frame (centred on its origin, along its axes) whose lowest corner must

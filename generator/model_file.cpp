@@ -1467,10 +1467,46 @@ class Parser {
       d.commanded.push_back(k);
     }
     if (d.commanded.empty()) f["commanded"].fail("name at least one commanded speed");
+    // An actuator is a joint (a coordinate's name) or a wheel's drive ({wheel: NAME}, or from a URDF
+    // the name of the wheel's continuous joint, which then names the drive).
+    const auto urdf_wheel_joint = [&](const Item& c) -> const NonholonomicWheel* {
+      if (c.is_map()) return nullptr;
+      const std::string name = c.text();
+      for (const auto& w : m_.wheels)
+        if (const auto u = urdf_axle_.find(w.hub); u != urdf_axle_.end() && u->second.joint == name) return &w;
+      return nullptr;
+    };
     for (const Item& c : f["actuated"].list()) {
-      const int k = coordinate_index(c);
-      if (std::count(d.actuated.begin(), d.actuated.end(), k)) c.fail("listed twice");
-      d.actuated.push_back(k);
+      Actuator a;
+      if (c.is_map() || urdf_wheel_joint(c) != nullptr) {
+        const Item at = c.is_map() ? Fields(c, {"wheel", "name"})["wheel"] : c;  // where a message points
+        const std::string wheel = c.is_map() ? at.name() : urdf_wheel_joint(c)->name;
+        const std::optional<Item> own_name = c.is_map() ? Fields(c, {"wheel", "name"}).optional("name") : std::nullopt;
+        for (std::size_t w = 0; w < m_.wheels.size(); ++w)
+          if (m_.wheels[w].name == wheel) a.wheel = static_cast<int>(w);
+        if (a.wheel < 0) {
+          std::vector<std::string> names;
+          for (const auto& w : m_.wheels) names.push_back(w.name);
+          at.fail(fmt::format("no wheel '{}' under wheels{}", wheel, suggestion(wheel, names)));
+        }
+        const NonholonomicWheel& w = m_.wheels[static_cast<std::size_t>(a.wheel)];
+        if (w.hub.empty())
+          at.fail(fmt::format("wheel '{}' has no hub (its contact frame is built by the file): its spin is a joint "
+                              "of the file's, so actuate that joint instead; a drive needs a wheel on a hub",
+                              wheel));
+        const auto u = urdf_axle_.find(w.hub);
+        a.name = own_name ? own_name->name() : u != urdf_axle_.end() ? u->second.joint : "spin_" + wheel;
+        for (const auto& q : m_.coordinates)
+          if (q.name == a.name)
+            at.fail(fmt::format("the drive of wheel '{}' is named '{}', as is a coordinate: rename the coordinate",
+                                wheel, a.name));
+      } else {
+        a.coordinate = coordinate_index(c);
+        a.name = m_.coordinates[static_cast<std::size_t>(a.coordinate)].name;
+      }
+      for (const Actuator& b : d.actuated)
+        if (b.name == a.name) c.fail("listed twice");
+      d.actuated.push_back(std::move(a));
     }
     if (d.actuated.size() < d.commanded.size())
       f["actuated"].fail(fmt::format("{} actuated joints for {} commanded speeds: the actuators cannot produce every generalized "
@@ -1657,9 +1693,27 @@ Model load_model_file(const std::string& path, const std::string& urdf_path) {
 std::string print_model_file(const std::string& path, const std::string& urdf_path) {
   const std::string text = read_text(path);
   const std::string name = shown_name(path);
-  load_model_file(path, urdf_path);  // every check a model file gets
+  const Model model = load_model_file(path, urdf_path);  // every check a model file gets
   Parser parser(name, directory_of(path), urdf_path);
-  const YAML::Node merged = parser.with_urdf(load_yaml(text, name));
+  YAML::Node merged = parser.with_urdf(load_yaml(text, name));
+  // A wheel's drive named by its URDF joint is written {wheel: NAME, name: JOINT}: without the URDF,
+  // the joint's name names nothing.
+  if (!parser.urdf_fingerprint().empty() && model.dynamics) {
+    YAML::Node actuated(YAML::NodeType::Sequence);
+    for (const Actuator& a : model.dynamics->actuated) {
+      if (a.wheel < 0) {
+        actuated.push_back(a.name);
+        continue;
+      }
+      YAML::Node drive(YAML::NodeType::Map);
+      drive.SetStyle(YAML::EmitterStyle::Flow);
+      drive["wheel"] = model.wheels[static_cast<std::size_t>(a.wheel)].name;
+      drive["name"] = a.name;
+      actuated.push_back(drive);
+    }
+    actuated.SetStyle(YAML::EmitterStyle::Flow);
+    merged["dynamics"]["actuated"] = actuated;
+  }
   YAML::Emitter out;
   out << merged;
   return fmt::format("# The model wlx-gen reads from {}{} (wlx-gen --print-model){}.\n{}\n", name,

@@ -279,9 +279,9 @@ class Figures {
 
   void dynamics(std::vector<FigureSpec>& out) {
     std::vector<std::vector<std::string>> panels = spec_.torque_panels;
-    if (panels.empty()) {  // no report file: the actuated joints in two halves
+    if (panels.empty()) {  // no report file: the actuators in two halves
       panels.resize(2);
-      for (std::size_t k = 0; k < kActuatedJoints.size(); ++k) panels[k * 2 / kActuatedJoints.size()].push_back(coordinate_name(kActuatedJoints[k]));
+      for (std::size_t k = 0; k < kActuatorNames.size(); ++k) panels[k * 2 / kActuatorNames.size()].emplace_back(kActuatorNames[k]);
     }
     for (const auto& r : runner_.runs()) {
       if (!r.scenario.weighting) continue;
@@ -297,7 +297,7 @@ class Figures {
         std::vector<std::string> names;
         std::vector<std::vector<double>> curves;
         for (const auto& joint : panels[p]) {
-          const auto at = std::find(kActuatedJoints.begin(), kActuatedJoints.end(), coordinate_index(joint)) - kActuatedJoints.begin();
+          const auto at = std::find(kActuatorNames.begin(), kActuatorNames.end(), joint) - kActuatorNames.begin();
           names.push_back("tau_" + joint);
           curves.emplace_back();
           for (const auto& smp : r.trajectory.samples) curves.back().push_back(smp.tau(at));

@@ -60,7 +60,7 @@ void ReportRunner::validate() const {
   std::vector<std::string> sweeps, params, joints;
   for (const auto& s : model_ik_sweeps()) sweeps.push_back(s.id);
   for (const auto& p : gen::kParamInfo) params.emplace_back(p.name);
-  for (int j : kActuatedJoints) joints.push_back(coordinate_name(j));
+  for (const std::string_view a : kActuatorNames) joints.emplace_back(a);
   const auto check = [&](const std::vector<std::string>& names, const std::vector<std::string>& valid, int line,
                          const std::string& path, const std::string& what) {
     for (const auto& n : names)
@@ -288,7 +288,7 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
     const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, m.weighting == 1 ? Weighting::model_weights() : Weighting::contribution());
     double worst = 0;
     for (const auto& name : m.joints) {
-      const auto at = std::find(kActuatedJoints.begin(), kActuatedJoints.end(), coordinate_index(name)) - kActuatedJoints.begin();
+      const auto at = std::find(kActuatorNames.begin(), kActuatorNames.end(), name) - kActuatorNames.begin();
       worst = std::max(worst, std::abs(tau(at)));
     }
     return Measured{worst, "N m"};

@@ -24,6 +24,13 @@ Eigen::Matrix3d world_inertia(const Params& p, int body, const Eigen::Matrix3d& 
 
 double mass(const Params& p, int body) { return p.*gen::kBodyMass[static_cast<std::size_t>(body)].mass; }
 
+// Row r of J_beta for the drive of wheel w: its drive row times T. A template, so that for a model
+// without wheels (a 0-row WheelRows, whose row Eigen refuses at compile time) nothing is compiled.
+template <typename Rows, typename Basis, typename Jacobian>
+void drive_rate_row(const Rows& drive, int w, const Basis& T, Jacobian& J_beta, int r) {
+  if constexpr (Rows::RowsAtCompileTime > 0) J_beta.row(r).noalias() = drive.row(w).lazyProduct(T);
+}
+
 }  // namespace
 
 void throw_no_dynamics_section() {
@@ -46,7 +53,7 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   // Two generated passes: dPhi/ds and C(s), which give the rate basis T; then at (s, s' = T u, T)
   // the convective terms and Kane's sums over the bodies (M, the velocity and gravity forces and
   // their gain on s''_bias), sharing their subexpressions.
-  gen::dynamics_update(s, p, {.dPhi_ds = &d.dPhi_ds, .C = &d.C}, false);
+  gen::dynamics_update(s, p, {.dPhi_ds = &d.dPhi_ds, .C = &d.C, .drive = kHasWheelDrives ? &d.drive : nullptr}, false);
   factorize_dependent_rates(d, pair, options);
   rate_basis(d, kCommandedSpeeds, pair, out.T);
   out.sdot.noalias() = out.T.lazyProduct(u);  // the velocity level's solve, once T is known
@@ -64,7 +71,14 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   out.sddot = out.T.lazyProduct(u_dot) + bias;
   out.b = b_velocity + out.B_bias.lazyProduct(bias);
   out.Qstar = out.M * u_dot + out.b - out.Q_gravity;
-  for (int r = 0; r < kActuatedCount; ++r) out.J_beta.row(r) = out.T.row(kActuatedJoints[static_cast<std::size_t>(r)]);
+  // A joint's rate is its coordinate's, T's row; a wheel drive's is its drive row times T.
+  for (int r = 0; r < kActuatedCount; ++r) {
+    const int joint = kActuatedJoints[static_cast<std::size_t>(r)];
+    if (joint >= 0)
+      out.J_beta.row(r) = out.T.row(joint);
+    else
+      drive_rate_row(d.drive, kActuatedWheels[static_cast<std::size_t>(r)], out.T, out.J_beta, r);
+  }
 #endif
 }
 
@@ -201,7 +215,7 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
 }
 
 // The motion no actuator acts on, for the message of a rank loss: the unit combination n of the
-// commanded speeds with A n = 0 (A's rows are the actuated joints' rates per commanded speed, up to
+// commanded speeds with A n = 0 (A's rows are the actuators' rates per commanded speed, up to
 // a weighting, which leaves n as it is): the eigenvector of A^T A of the smallest eigenvalue,
 // written with its largest entry +1 and entries below 1e-9 of it left out. (Wheels that roll
 // freely give one where they all point the same way: the whole machine rolls along them and no
@@ -219,8 +233,9 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
     combination += combination.empty() ? fmt::format("{:.6g} {}'", n(k), name)
                                        : fmt::format(" {} {:.6g} {}'", n(k) < 0 ? '-' : '+', std::abs(n(k)), name);
   }
-  return fmt::format("the speeds {} move no actuated joint (wheels that roll freely, a joint that is not actuated): "
-                     "actuate a joint they move, or command fewer speeds",
+  return fmt::format("the speeds {} move no actuator (wheels that roll freely, a joint that is not actuated): "
+                     "actuate a joint they move or drive the wheels ({{wheel: NAME}} under dynamics.actuated), or command "
+                     "fewer speeds",
                      combination);
 }
 
@@ -229,6 +244,8 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
 [[gnu::noinline, gnu::cold]] TorqueVector min_norm_solve_pivoted(const ActuatorJacobian& At, const CommandVector& Qstar, const Weighting& weighting) {
   constexpr int kU = kCommandedCount;
   // From A^T P = Q R (column-pivoted, rank-revealing QR), x = Q [R^-T P^T Q*; 0].
+  if (!At.allFinite())  // no rank to speak of, and no combination to name
+    throw Error("J_beta", "the actuator Jacobian has a non-finite entry: the pose or the parameters are outside the model's domain");
   Eigen::ColPivHouseholderQR<ActuatorJacobian> qr;
   qr.setThreshold(1e-13);  // relative to the largest pivot: only a real rank loss, not ID-3's 1e6 conditioning
   qr.compute(At);

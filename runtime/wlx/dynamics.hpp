@@ -1,7 +1,7 @@
 // Inverse dynamics with redundant actuation (thesis 6.3; docs/excavator.md section 7).
 //
 // The model file's dynamics section names the commanded speeds u (the excavator: z_C', x_C', roll',
-// pitch'), the dependent pair the wheels determine (y_C', yaw') and the actuated joints; every other
+// pitch'), the dependent pair the wheels determine (y_C', yaw') and the actuators; every other
 // input is constant. Kane's method on the bodies, with s' = T u + 0 and s'' = T u' + s''_bias from
 // the non-holonomic solve, gives Q* = M u' + b - Q_gravity. The actuators share Q* by weighted
 // least norm: J_beta^T tau = Q*, minimising tau^T W tau.
@@ -19,15 +19,25 @@ WLX_MODEL_NAMESPACE_BEGIN
 // file's dynamics section (all empty without one: inverse_dynamics then throws). Sizes are
 // compile-time, so every matrix below is fixed-size.
 inline constexpr auto kCommandedSpeeds = gen::kCommanded;
+// An actuator is a joint (kActuatedJoints: its coordinate) or a wheel's drive (kActuatedWheels: the
+// wheel, whose spin relative to its hub is the drive's rate); -1 where not. kActuatorNames names
+// them (the joint's coordinate, spin_<wheel> for a drive): the torques' order everywhere.
 inline constexpr auto kActuatedJoints = gen::kActuated;
+inline constexpr auto kActuatedWheels = gen::kActuatedWheels;
+inline constexpr auto kActuatorNames = gen::kActuatorNames;
 inline constexpr int kCommandedCount = static_cast<int>(kCommandedSpeeds.size());
 inline constexpr int kActuatedCount = static_cast<int>(kActuatedJoints.size());
+inline constexpr bool kHasWheelDrives = [] {
+  for (int w : kActuatedWheels)
+    if (w >= 0) return true;
+  return false;
+}();
 static_assert(kActuatedCount >= kCommandedCount, "fewer actuators than commanded speeds: Q* cannot be produced");
 inline DependentPair dynamics_pair() noexcept { return {gen::kPairs[gen::kDynamicsPair].coordinates}; }
 
 using CommandVector = Eigen::Matrix<double, kCommandedCount, 1>;  // u, u', Q*
 using CommandMatrix = Eigen::Matrix<double, kCommandedCount, kCommandedCount>;
-using TorqueVector = Eigen::Matrix<double, kActuatedCount, 1>;  // tau, in kActuatedJoints' order
+using TorqueVector = Eigen::Matrix<double, kActuatedCount, 1>;  // tau, in kActuatorNames' order
 using TorqueMatrix = Eigen::Matrix<double, kActuatedCount, kActuatedCount>;
 using ActuatorJacobian = Eigen::Matrix<double, kActuatedCount, kCommandedCount>;
 
@@ -39,7 +49,7 @@ struct DynamicsTerms {
   CommandVector b;                                             // velocity-dependent terms
   CommandVector Q_gravity;                                     // generalized gravity force
   CommandVector Qstar;                                         // M u' + b - Q_gravity
-  ActuatorJacobian J_beta;                                     // beta' = J_beta u
+  ActuatorJacobian J_beta;                                     // actuator rates beta' = J_beta u
   // b = b_velocity + B_bias s''_bias (reduced_dynamics): the forces on u per unit bias
   // acceleration. Its structural zeros are written here, once; inverse_dynamics never writes them.
   gen::CommandRows B_bias = gen::CommandRows::Zero();

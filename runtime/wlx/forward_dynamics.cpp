@@ -21,7 +21,7 @@ void forward_dynamics(const Model& model, Data& d, const Coordinates& s, const C
 #else
   for (int r = 0; r < kActuatedCount; ++r)
     if (!std::isfinite(tau(r)))
-      throw Error(fmt::format("tau.{}", gen::kCoordinateNames[static_cast<std::size_t>(kActuatedJoints[static_cast<std::size_t>(r)])]),
+      throw Error(fmt::format("tau.{}", kActuatorNames[static_cast<std::size_t>(r)]),
                   fmt::format("must be a finite number, got {}", tau(r)));
   inverse_dynamics(model, d, s, u, CommandVector::Zero(), out, options);  // M, b, Q_gravity, J_beta; s'' at u' = 0
   out.Qstar.noalias() = out.J_beta.transpose() * tau;

@@ -46,6 +46,7 @@ struct Data {
     dPhi_ds.setZero();
     C.setZero();
     spin.setZero();
+    drive.setZero();
     for (auto& J : body_Jv) J.setZero();
     for (auto& J : body_Jw) J.setZero();
   }
@@ -56,6 +57,7 @@ struct Data {
   gen::ClosureJacobian dPhi_ds;
   gen::WheelRows C;
   gen::WheelRows spin;
+  gen::WheelRows drive;  // wheel drives' rates (spin relative to the hub) = drive s'; rows of driven wheels
   gen::ClosureVector dPhi_ds_dot_sdot;
   gen::WheelVector C_dot_sdot;
   gen::BodyVectors body_com;

@@ -146,7 +146,7 @@ void check_finite(const Sample& smp, const Scenario& sc) {
   if (!std::isfinite(smp.cond_J_beta)) fail("cond_J_beta", smp.cond_J_beta);
   if (std::isnan(smp.clearance) || smp.clearance == -std::numeric_limits<double>::infinity()) fail("clearance", smp.clearance);
   for (int k = 0; k < kActuatedCount; ++k)
-    if (!std::isfinite(smp.tau(k))) fail("tau_" + name(kActuatedJoints[static_cast<std::size_t>(k)]), smp.tau(k));
+    if (!std::isfinite(smp.tau(k))) fail("tau_" + std::string(kActuatorNames[static_cast<std::size_t>(k)]), smp.tau(k));
   for (int k = 0; k < kCommandedCount; ++k)
     if (!std::isfinite(smp.Qstar(k))) fail("Qstar_" + name(kCommandedSpeeds[static_cast<std::size_t>(k)]), smp.Qstar(k));
 }

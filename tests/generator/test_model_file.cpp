@@ -123,6 +123,12 @@ TEST_CASE("model file: every kind of mistake names the place, the field and the 
       {"flow collections nested too deep", "  - {name: cxd, value: 3.0,", "  - {name: cxd, value: [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[3]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]],",
        {"nest more than 64 levels"}, false},
       {"a gravity parameter of the wrong kind", "  gravity: g", "  gravity: w", {"'w' is a parameter of kind length; one of kind gravity"}},
+      {"a drive for a wheel whose contact frame the file builds", "actuated: [psi_l2,", "actuated: [{wheel: l}, psi_l2,",
+       {"wheel 'l' has no hub", "actuate that joint instead"}},
+      {"a drive for a wheel that does not exist", "actuated: [psi_l2,", "actuated: [{wheel: ll}, psi_l2,",
+       {"no wheel 'll' under wheels", "did you mean 'l'?"}},
+      {"a drive with an unknown field", "actuated: [psi_l2,", "actuated: [{wheel: l, torque: 3}, psi_l2,",
+       {"unknown field 'torque'", "wheel, name"}},
   };
   for (const Mistake& c : cases) {
     CAPTURE(c.what);
@@ -316,4 +322,35 @@ TEST_CASE("model file: an expression that is NaN, complex, infinite or singular 
   CHECK(with("exp(a*2000)").find("at the default parameters is not finite") != std::string::npos);
   CHECK(with("acos(a)") == "");  // a = 0.5: fine
   CHECK(with("sqrt(a)/a") == "");
+}
+
+// Wheel drives on hubs (the quadruped's): their names, and the mistakes a file can make with them.
+TEST_CASE("model file: a wheel on a hub may be driven; the drive's name and its mistakes") {
+  std::ifstream in(WLX_SOURCE_DIR "/tests/models/quadruped.yaml");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  const std::string good = buffer.str();
+  const std::string anchor = "{wheel: lf}, {wheel: rf}";
+  REQUIRE(good.find(anchor) != std::string::npos);
+  const Model m = parse_model(good, "quadruped.yaml");
+  REQUIRE(m.dynamics);
+  REQUIRE(m.dynamics->actuated.size() == 16);
+  CHECK(m.dynamics->actuated[12].name == "spin_lf");
+  CHECK(m.dynamics->actuated[12].wheel == 0);
+  CHECK(m.dynamics->actuated[12].coordinate == -1);
+  CHECK(m.dynamics->actuated[0].coordinate >= 0);
+  const auto with = [&](const std::string& replacement) {
+    std::string text = good;
+    text.replace(text.find(anchor), anchor.size(), replacement);
+    try {
+      return parse_model(text, "quadruped.yaml").dynamics->actuated[12].name;
+    } catch (const ModelFileError& e) {
+      return std::string(e.what());
+    }
+  };
+  CHECK(with("{wheel: lf, name: motor_lf}, {wheel: rf}") == "motor_lf");
+  CHECK(with("{wheel: lf}, {wheel: lf}").find("dynamics.actuated[13]: listed twice") != std::string::npos);
+  CHECK(with("{wheel: lf, name: x_lf}, {wheel: rf}").find("named 'x_lf', as is a coordinate") != std::string::npos);
+  CHECK(with("{wheel: lf, name: 3x}, {wheel: rf}").find("'3x' is not a name") != std::string::npos);
+  CHECK(with("{name: motor_lf}, {wheel: rf}").find("missing field 'wheel'") != std::string::npos);
 }

@@ -83,7 +83,19 @@ TEST_CASE("URDF import: the wheeled quadruped's URDF and YAML give the hand-writ
   CHECK(urdf.input_count == hand.input_count);
   CHECK(urdf.wheels.size() == 4);
   CHECK(urdf.limbs.size() == 4);
-  CHECK(urdf.dynamics->actuated.size() == 12);
+  // The twelve leg joints and the four wheels' drives, which the URDF's continuous joints name
+  // (the hand-written file's drives are spin_<wheel>), each on its own wheel.
+  REQUIRE(urdf.dynamics->actuated.size() == 16);
+  REQUIRE(hand.dynamics->actuated.size() == 16);
+  for (std::size_t k = 0; k < 16; ++k) {
+    const Actuator &u = urdf.dynamics->actuated[k], &h = hand.dynamics->actuated[k];
+    CHECK(u.coordinate == h.coordinate);
+    CHECK(u.wheel == h.wheel);
+    if (k < 12) CHECK(u.name == h.name);
+  }
+  CHECK(urdf.dynamics->actuated[12].name == "wheel_joint_lf");
+  CHECK(hand.dynamics->actuated[12].name == "spin_lf");
+  CHECK(urdf.dynamics->actuated[15].wheel == 3);
   // Every link is a frame (the fixed sensor links too): 1 + 4 fixed + 4 x 4 leg links + 4 contacts.
   CHECK(urdf.frames.size() == 25);
   CHECK(urdf.frame_index("imu_link") >= 0);
@@ -142,6 +154,12 @@ TEST_CASE("URDF import: --print-model writes a model file that reads without the
   for (std::size_t k = 0; k < urdf.frames.size(); ++k) {
     CHECK(printed.frames[k].name == urdf.frames[k].name);
     CHECK((a.vec(printed.frames[k].frame.r) - b.vec(urdf.frames[k].frame.r)).norm() == 0);
+  }
+  // The drives keep the URDF joints' names without the URDF.
+  REQUIRE(printed.dynamics->actuated.size() == urdf.dynamics->actuated.size());
+  for (std::size_t k = 0; k < urdf.dynamics->actuated.size(); ++k) {
+    CHECK(printed.dynamics->actuated[k].name == urdf.dynamics->actuated[k].name);
+    CHECK(printed.dynamics->actuated[k].wheel == urdf.dynamics->actuated[k].wheel);
   }
 }
 

@@ -11,6 +11,7 @@
 #include "../support/chain_algebra.hpp"
 #include "../support/jet_eigen.hpp"
 
+#include <Eigen/Geometry>
 #include <doctest/doctest.h>
 #include <wlx/dynamics.hpp>
 #include <wlx/error.hpp>
@@ -243,6 +244,77 @@ TEST_CASE(titled("dependent rates and accelerations keep the wheels rolling and 
   CHECK(worst_a <= 1e-6 * std::max(scale_a, 1e-3));
 }
 
+// A wheel's drive turns it against its hub; rolling without slipping, the wheel's material point
+// at the contact does not move along the ground. Checked here from the forward kinematics alone
+// (central differences of the hub's and the contact's placement along s'), not from the generated
+// rows: with the hub's velocity v and angular velocity w, the axle a and rho = contact - hub,
+// (v + (w + drive a) x rho) . t = 0 along the wheel's forward direction t. And J_beta's row of each
+// drive is that rate per commanded speed.
+TEST_CASE(titled("a wheel's drive rate is its spin against the hub: the contact point does not slide")) {
+  if constexpr (!kHasWheelDrives) {
+    MESSAGE(kName << ": no wheel drives");
+    return;
+  }
+  std::mt19937_64 rng(207);
+  const Model model;
+  Data d, d2;
+  const DependentPair pair = default_pair();
+  double worst_slip = 0, worst_beta = 0;
+  int checked = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Coordinates s = random_state(rng, model, 0.05);
+    Coordinates sdot = random_input_rates(rng, pair);
+    REQUIRE_NOTHROW(solve_dependent_rates(model, d, s, sdot, pair));
+    gen::WheelRows D = gen::WheelRows::Zero();
+    gen::nonholonomic(s, model.params(), {.drive = &D});
+    const double h = 1e-6;  // central differences: error ~h^2 |s'|^3 ~ 1e-12, rounding ~1e-16 / h
+    forward_kinematics(model, d, s + h * sdot);
+    const gen::FramePositions p_plus = d.frame_positions;
+    const gen::FrameRotations R_plus = d.frame_rotations;
+    forward_kinematics(model, d, s - h * sdot);
+    const gen::FramePositions p_minus = d.frame_positions;
+    const gen::FrameRotations R_minus = d.frame_rotations;
+    forward_kinematics(model, d, s);
+    for (int r = 0; r < kActuatedCount; ++r) {
+      const int w = kActuatedWheels[static_cast<std::size_t>(r)];
+      if (w < 0) continue;
+      const gen::WheelInfo& wheel = gen::kWheels[static_cast<std::size_t>(w)];
+      const auto hub = static_cast<std::size_t>(wheel.hub_frame), contact = static_cast<std::size_t>(wheel.contact_frame);
+      const Eigen::Vector3d v = (p_plus.col(wheel.hub_frame) - p_minus.col(wheel.hub_frame)) / (2 * h);
+      const Eigen::Matrix3d R = d.frame_rotations[hub];
+      const Eigen::Matrix3d W = (R_plus[hub] - R_minus[hub]) / (2 * h) * R.transpose();  // skew(w)
+      const Eigen::Vector3d omega = 0.5 * Eigen::Vector3d(W(2, 1) - W(1, 2), W(0, 2) - W(2, 0), W(1, 0) - W(0, 1));
+      const Eigen::Vector3d a = R.col(wheel.axle_axis);
+      const Eigen::Vector3d t = d.frame_rotations[contact].col(wheel.forward_axis);
+      const Eigen::Vector3d rho = d.frame_positions.col(wheel.contact_frame) - d.frame_positions.col(wheel.hub_frame);
+      double drive = 0;
+      for (int j = 0; j < kCoordinateCount; ++j) drive += D(w, j) * sdot(j);
+      const Eigen::Vector3d slip = v + (omega + drive * a).cross(rho);
+      worst_slip = std::max(worst_slip, std::abs(slip.dot(t)) / std::max(1.0, sdot.norm()));
+      ++checked;
+    }
+    // J_beta's drive rows, through the inverse dynamics' own rate basis: rate = J_beta u.
+    if constexpr (gen::kHasDynamics) {
+      CommandVector u;
+      for (int k = 0; k < kCommandedCount; ++k) u(k) = std::uniform_real_distribution<double>(-0.5, 0.5)(rng);
+      DynamicsTerms terms;
+      inverse_dynamics(model, d2, s, u, CommandVector::Zero(), terms);
+      gen::nonholonomic(s, model.params(), {.drive = &D});
+      const TorqueVector rates = terms.J_beta * u;
+      for (int r = 0; r < kActuatedCount; ++r) {
+        const int w = kActuatedWheels[static_cast<std::size_t>(r)];
+        const double expected = w >= 0 ? (D.row(w) * terms.sdot)(0) : terms.sdot(kActuatedJoints[static_cast<std::size_t>(r)]);
+        worst_beta = std::max(worst_beta, std::abs(rates(r) - expected) / std::max(1.0, terms.sdot.norm()));
+      }
+    }
+  }
+  MESSAGE(kName << ": " << checked << " drive rates; the contact point's forward slip " << worst_slip
+                << " m/s per |s'|; J_beta u against the drive rows " << worst_beta);
+  CHECK(checked > 0);
+  CHECK(worst_slip <= 1e-8);  // the differences' truncation and rounding (above), times lever arms < 1 m
+  CHECK(worst_beta <= 1e-13);
+}
+
 TEST_CASE(titled("inverse dynamics: J_beta^T tau = Q*, power and energy balances")) {
   const Model model;
   Data d;
@@ -287,7 +359,7 @@ TEST_CASE(titled("inverse dynamics at the nominal pose: torques that balance Q*,
     // The refusal's combination, read back from the message: J_beta must take it to zero.
     const std::string message = e.what();
     CAPTURE(message);
-    const std::size_t from = message.find("the speeds "), to = message.find(" move no actuated joint");
+    const std::size_t from = message.find("the speeds "), to = message.find(" move no actuator");
     REQUIRE(from != std::string::npos);
     REQUIRE(to != std::string::npos);
     std::istringstream terms(message.substr(from + 11, to - from - 11));

@@ -22,7 +22,8 @@ namespace gen {
 // Outputs, members of DynamicsUpdateOutputsOf<Scalar> (DynamicsUpdateOutputs for double), each computed only when its
 // pointer is set (C++20: dynamics_update(..., {.dPhi_ds = &x})):
 //   dPhi_ds            dPhi/ds, 14 x 32 (own operations: 526, nonzero entries: 98)
-//   C                  cornering constraint rows, one per wheel (l, r) (own operations: 269, nonzero entries: 20)
+//   C                  cornering constraint rows, one per wheel (own operations: 269, nonzero entries: 20)
+//   drive              wheel drive-rate rows: the spin relative to the hub, drive rate = drive(s) s' (zero rows for a wheel without a drive) (own operations: 0, nonzero entries: 0)
 // Intermediate terms: 150; shared by several outputs: 248 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).
 // Operations with every output requested: 1043 (adds 320, muls 681, divs 0, calls 42).
@@ -36,7 +37,8 @@ namespace gen {
 template <typename Scalar>
 struct DynamicsUpdateOutputsOf {
   ClosureJacobianOf<Scalar>* dPhi_ds = nullptr;  // dPhi/ds, 14 x 32
-  WheelRowsOf<Scalar>* C = nullptr;              // cornering constraint rows, one per wheel (l, r)
+  WheelRowsOf<Scalar>* C = nullptr;              // cornering constraint rows, one per wheel
+  WheelRowsOf<Scalar>* drive = nullptr;          // wheel drive-rate rows: the spin relative to the hub, drive rate = drive(s) s' (zero rows for a wheel without a drive)
 };
 using DynamicsUpdateOutputs = DynamicsUpdateOutputsOf<double>;
 
@@ -46,6 +48,7 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   static_cast<void>(p);
   const auto dPhi_ds = out.dPhi_ds;
   const auto C = out.C;
+  const auto drive = out.drive;
   const Scalar yaw = s(3);
   const Scalar pitch = s(4);
   const Scalar roll = s(5);
@@ -392,6 +395,9 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
     (*C)(1, 29) = -(t171*(t187*w*t162 - w*t188*t149) + (t156*w*t188 + t187*w*t161)*t172 - t189*t163);
     (*C)(1, 30) = t171*(w*t186*t149 - t142*t187*w) - (t156*w*t186 - t187*w*t155)*t172 - t164*t189;
     (*C)(1, 31) = t171*(sin_roll*t159*cos_pitch + t11*t191) + t189*t165 - t172*(sin_roll*t158*cos_pitch + t41*t191);
+  }
+  if (drive != nullptr) {
+    if (zero_fill) drive->setZero();
   }
 }
 

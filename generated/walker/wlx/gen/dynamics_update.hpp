@@ -22,7 +22,8 @@ namespace gen {
 // Outputs, members of DynamicsUpdateOutputsOf<Scalar> (DynamicsUpdateOutputs for double), each computed only when its
 // pointer is set (C++20: dynamics_update(..., {.dPhi_ds = &x})):
 //   dPhi_ds            dPhi/ds, 14 x 32 (own operations: 474, nonzero entries: 98)
-//   C                  cornering constraint rows, one per wheel (l, r) (own operations: 237, nonzero entries: 20)
+//   C                  cornering constraint rows, one per wheel (own operations: 237, nonzero entries: 20)
+//   drive              wheel drive-rate rows: the spin relative to the hub, drive rate = drive(s) s' (zero rows for a wheel without a drive) (own operations: 0, nonzero entries: 0)
 // Intermediate terms: 183; shared by several outputs: 277 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).
 // Operations with every output requested: 988 (adds 364, muls 582, divs 0, calls 42).
@@ -36,7 +37,8 @@ namespace gen {
 template <typename Scalar>
 struct DynamicsUpdateOutputsOf {
   ClosureJacobianOf<Scalar>* dPhi_ds = nullptr;  // dPhi/ds, 14 x 32
-  WheelRowsOf<Scalar>* C = nullptr;              // cornering constraint rows, one per wheel (l, r)
+  WheelRowsOf<Scalar>* C = nullptr;              // cornering constraint rows, one per wheel
+  WheelRowsOf<Scalar>* drive = nullptr;          // wheel drive-rate rows: the spin relative to the hub, drive rate = drive(s) s' (zero rows for a wheel without a drive)
 };
 using DynamicsUpdateOutputs = DynamicsUpdateOutputsOf<double>;
 
@@ -46,6 +48,7 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   static_cast<void>(p);
   const auto dPhi_ds = out.dPhi_ds;
   const auto C = out.C;
+  const auto drive = out.drive;
   const Scalar yaw = s(3);
   const Scalar pitch = s(4);
   const Scalar roll = s(5);
@@ -432,6 +435,9 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
     (*C)(1, 29) = -(t217*t185 + t193*(t224*t170 - t183*t214) + t194*(t214*t184 - t224*t161));
     (*C)(1, 30) = t217*t186 + t194*(t148*t224 - t215*t184) - t193*(t224*t173 - t183*t215);
     (*C)(1, 31) = t187*t217 + t194*(t223*t45 - sin_roll*cos_pitch*t180) + t193*(sin_roll*cos_pitch*t181 - t11*t223);
+  }
+  if (drive != nullptr) {
+    if (zero_fill) drive->setZero();
   }
 }
 

@@ -25,7 +25,7 @@ namespace gen {
 //   rotations          frame orientations in K0 (columns: frame axes) (own operations: 63, nonzero entries: 117)
 //   Phi                closure residuals, zero on the constraint manifold (own operations: 65, nonzero entries: 14)
 //   dPhi_ds            dPhi/ds, 14 x 32 (own operations: 277, nonzero entries: 98)
-//   C                  cornering constraint rows, one per wheel (l, r) (own operations: 165, nonzero entries: 20)
+//   C                  cornering constraint rows, one per wheel (own operations: 165, nonzero entries: 20)
 // Intermediate terms: 234; shared by several outputs: 572 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).
 // Operations with every output requested: 1338 (adds 676, muls 620, divs 0, calls 42).
@@ -42,7 +42,7 @@ struct KinematicUpdateOutputsOf {
   FrameRotationsOf<Scalar>* rotations = nullptr;  // frame orientations in K0 (columns: frame axes)
   ClosureVectorOf<Scalar>* Phi = nullptr;         // closure residuals, zero on the constraint manifold
   ClosureJacobianOf<Scalar>* dPhi_ds = nullptr;   // dPhi/ds, 14 x 32
-  WheelRowsOf<Scalar>* C = nullptr;               // cornering constraint rows, one per wheel (l, r)
+  WheelRowsOf<Scalar>* C = nullptr;               // cornering constraint rows, one per wheel
 };
 using KinematicUpdateOutputs = KinematicUpdateOutputsOf<double>;
 

@@ -21,8 +21,9 @@ namespace gen {
 //
 // Outputs, members of NonholonomicOutputsOf<Scalar> (NonholonomicOutputs for double), each computed only when its
 // pointer is set (C++20: nonholonomic(..., {.C = &x})):
-//   C                  cornering constraint rows, one per wheel (l, r) (own operations: 95, nonzero entries: 20)
-//   spin               wheel spin-rate rows, one per wheel (l, r) (own operations: 120, nonzero entries: 20)
+//   C                  cornering constraint rows, one per wheel (own operations: 95, nonzero entries: 20)
+//   spin               wheel spin-rate rows, one per wheel (own operations: 120, nonzero entries: 20)
+//   drive              wheel drive-rate rows: the spin relative to the hub, drive rate = drive(s) s' (zero rows for a wheel without a drive) (own operations: 0, nonzero entries: 0)
 // Intermediate terms: 135; shared by several outputs: 403 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).
 // Operations with every output requested: 618 (adds 223, muls 368, divs 1, calls 26).
@@ -35,8 +36,9 @@ namespace gen {
 // work only it needs.
 template <typename Scalar>
 struct NonholonomicOutputsOf {
-  WheelRowsOf<Scalar>* C = nullptr;     // cornering constraint rows, one per wheel (l, r)
-  WheelRowsOf<Scalar>* spin = nullptr;  // wheel spin-rate rows, one per wheel (l, r)
+  WheelRowsOf<Scalar>* C = nullptr;      // cornering constraint rows, one per wheel
+  WheelRowsOf<Scalar>* spin = nullptr;   // wheel spin-rate rows, one per wheel
+  WheelRowsOf<Scalar>* drive = nullptr;  // wheel drive-rate rows: the spin relative to the hub, drive rate = drive(s) s' (zero rows for a wheel without a drive)
 };
 using NonholonomicOutputs = NonholonomicOutputsOf<double>;
 
@@ -46,6 +48,7 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   static_cast<void>(p);
   const auto C = out.C;
   const auto spin = out.spin;
+  const auto drive = out.drive;
   const Scalar yaw = s(3);
   const Scalar pitch = s(4);
   const Scalar roll = s(5);
@@ -276,6 +279,9 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
     (*spin)(1, 29) = -t154*(t144*t160 - t147*t159 - t158*t146);
     (*spin)(1, 30) = (t158*t149 + t148*t160 - t159*t150)*t154;
     (*spin)(1, 31) = -t154*(t158*t153 + t159*t152 - t151*t160);
+  }
+  if (drive != nullptr) {
+    if (zero_fill) drive->setZero();
   }
 }
 

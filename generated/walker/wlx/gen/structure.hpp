@@ -84,12 +84,16 @@ inline constexpr std::array<PairInfo, 2> kPairs{{
 }};
 inline constexpr int kDefaultPair = 0;  // A
 
-// Inverse dynamics: the commanded speeds u (z_C, x_C, roll, pitch), the dependent pair, the actuated joints
+// Inverse dynamics: the commanded speeds u (z_C, x_C, roll, pitch), the dependent pair, the actuators
 // (abduct_l, lift_l, knee_l, abduct_r, lift_r, knee_r, swing_l, swing_r), their default weights, and gravity (along -z of K0).
+// An actuator is a joint (kActuated: its coordinate) or the drive of a wheel on a hub
+// (kActuatedWheels: the wheel, whose spin relative to the hub is the drive's rate); -1 where not.
 inline constexpr bool kHasDynamics = true;
 inline constexpr std::array<int, 4> kCommanded{{2, 0, 5, 4}};
 inline constexpr int kDynamicsPair = 0;  // A
 inline constexpr std::array<int, 8> kActuated{{18, 19, 20, 21, 22, 23, 27, 31}};
+inline constexpr std::array<int, 8> kActuatedWheels{{-1, -1, -1, -1, -1, -1, -1, -1}};
+inline constexpr std::array<std::string_view, 8> kActuatorNames{{"abduct_l", "lift_l", "knee_l", "abduct_r", "lift_r", "knee_r", "swing_l", "swing_r"}};
 inline constexpr std::array<double, 8> kDefaultWeights{{1.0, 0.01, 0.1, 1.0, 0.01, 0.1, 0.01, 0.01}};
 inline constexpr double Params::*kGravity = &Params::gravity;
 
