@@ -11,6 +11,8 @@
 #include <wlx/nonholonomic.hpp>
 #include <wlx/simulation.hpp>
 
+#include <algorithm>
+#include <deque>
 #include <memory>
 #include <numbers>
 #include <stdexcept>
@@ -693,6 +695,7 @@ struct Row {
   const char* baseline;   // benchmark name, or nullptr
   long ops;               // operations of the generated function, or 0
   bool peer = false;      // the baseline is Orocos KDL (a peer library), not our numeric baseline
+  const char* group = nullptr;  // a heading for the rows from here on (JSON "group")
 };
 
 }  // namespace
@@ -720,7 +723,7 @@ int main(int argc, char** argv) {
   MedianCollector collector;
   benchmark::RunSpecifiedBenchmarks(&collector);
   namespace ops = wlx::gen::operations;
-  const Row rows[] = {
+  std::vector<Row> rows = {
       // Orocos KDL, the peer (built with KDL only): first, as the README's table shows them.
       {"KDL peer: FK of all frames (KDL: chain FK to each end frame)", "BM_gen_kinematics_all", "BM_kdl_fk_chains", ops::kinematics, true},
       {"KDL peer: bodies' CoM Jacobians Jv, Jw (KDL: tree Jacobians)", "BM_gen_body_jacobians", "BM_kdl_body_jacobians", 0, true},
@@ -757,6 +760,40 @@ int main(int argc, char** argv) {
       {"NH-1 run (2001 samples, RK4)", "BM_run_NH1", nullptr, 0},
       {"ID-1 run (495 samples, RK4, torques)", "BM_run_ID1", nullptr, 0},
   };
+  // The rows every model gets (bench/bench_any_model.cpp: <model>/<row>), side by side: each
+  // model's against the first model's (the excavator's) in the same run, so that the ratio, not
+  // the machine, is what is read.
+  std::deque<std::string> texts;  // stable storage for the rows' strings
+  {
+    std::vector<std::string> suffixes, models;
+    for (const auto& [name, ns] : collector.median_ns) {
+      const auto slash = name.find('/');
+      if (slash == std::string::npos || name.rfind("BM_", 0) == 0) continue;
+      const std::string model = name.substr(0, slash), suffix = name.substr(slash + 1);
+      if (std::find(models.begin(), models.end(), model) == models.end()) models.push_back(model);
+      if (std::find(suffixes.begin(), suffixes.end(), suffix) == suffixes.end()) suffixes.push_back(suffix);
+    }
+    // The excavator first (the reference), the others in name order.
+    std::sort(models.begin(), models.end(), [](const std::string& a, const std::string& b) {
+      return (a == "excavator") != (b == "excavator") ? a == "excavator" : a < b;
+    });
+    bool first = true;
+    for (const std::string& suffix : {std::string("ik_all_limbs"), std::string("dependent_rates"),
+                                      std::string("inverse_dynamics_step"), std::string("forward_dynamics_step")}) {
+      if (std::find(suffixes.begin(), suffixes.end(), suffix) == suffixes.end()) continue;
+      const std::string reference = models.front() + "/" + suffix;
+      for (const std::string& model : models) {
+        const std::string name = model + "/" + suffix;
+        if (!collector.median_ns.count(name)) continue;
+        const char* what = texts.emplace_back(fmt::format("{}: {}", model, suffix)).c_str();
+        const char* generated = texts.emplace_back(name).c_str();
+        const char* baseline = model == models.front() ? nullptr : texts.emplace_back(reference).c_str();
+        rows.push_back({what, generated, baseline, 0, false,
+                        first ? "every model, side by side (speedup: the first model's time over this one's)" : nullptr});
+        first = false;
+      }
+    }
+  }
   const auto get = [&](const char* name) {
     const auto it = collector.median_ns.find(name);
     return it == collector.median_ns.end() ? -1.0 : it->second;
@@ -764,10 +801,13 @@ int main(int argc, char** argv) {
   if (json) {
     std::string out = "[\n";
     bool first = true;
+    const char* group = nullptr;
     for (const Row& r : rows) {
       const double g = get(r.generated), b = r.baseline ? get(r.baseline) : -1;
       if (g < 0 || (r.peer && b < 0)) continue;
       out += fmt::format("{}  {{\"operation\": \"{}\", \"ns\": {:.1f}", first ? "" : ",\n", r.what, g);
+      if (r.group != nullptr) group = r.group;
+      if (group != nullptr) out += fmt::format(", \"group\": \"{}\"", group);
       if (b > 0) out += fmt::format(", \"baseline\": \"{}\", \"baseline_ns\": {:.1f}, \"speedup\": {:.2f}", r.baseline, b, b / g);
       if (r.peer) out += ", \"peer\": \"Orocos KDL\"";
       if (r.ops > 0) out += fmt::format(", \"ops\": {}, \"ns_per_op\": {:.3f}", r.ops, g / static_cast<double>(r.ops));
@@ -783,7 +823,10 @@ int main(int argc, char** argv) {
     const double g = get(r.generated);
     const double b = r.baseline ? get(r.baseline) : -1;
     if (g < 0 || (r.peer && b < 0)) continue;
-    const std::string base = b > 0 ? fmt::format("{} {:.0f}", std::string(r.baseline).substr(3), b) : "";
+    if (r.group != nullptr) fmt::print("{}\n", r.group);
+    std::string baseline_name = r.baseline ? r.baseline : "";
+    if (baseline_name.rfind("BM_", 0) == 0) baseline_name.erase(0, 3);
+    const std::string base = b > 0 ? fmt::format("{} {:.0f}", baseline_name, b) : "";
     fmt::print("{:<62} {:>11.1f} {:>34} {:>9} {:>7} {:>7}\n", r.what, g, base, b > 0 ? fmt::format("{:.1f}x", b / g) : "",
                r.ops > 0 ? std::to_string(r.ops) : "", r.ops > 0 ? fmt::format("{:.3f}", g / static_cast<double>(r.ops)) : "");
   }

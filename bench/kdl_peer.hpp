@@ -110,6 +110,57 @@ inline double max_difference(const Transform& a, const Transform& b) {
   return std::max((a.linear() - b.linear()).cwiseAbs().maxCoeff(), (a.translation() - b.translation()).cwiseAbs().maxCoeff());
 }
 
+// The wheel whose derived contact frame f is (a wheel on a hub: wlx-gen places it at the rim point
+// nearest the ground, level, so it is no rigid link of the tree), or -1.
+inline int wheel_of_contact(int f) {
+  for (std::size_t w = 0; w < gen::kWheels.size(); ++w)
+    if (gen::kWheels[w].hub_frame >= 0 && gen::kWheels[w].contact_frame == f) return static_cast<int>(w);
+  return -1;
+}
+
+// A derived contact frame from its hub's pose and, optionally, the hub's 6 x n Jacobian (rows
+// v, omega): written here from the definition (docs/model-format.md, "Wheels"), not from the
+// generator. With a the axle in K0, sigma = |(a_x, a_y)|, n = (a_x, a_y, 0) / sigma (lateral),
+// t = (n_y, -n_x, 0) (forward), u = (-a_z n_x, -a_z n_y, sigma): c = h - r u, axes (t, n, e_z).
+struct ContactFromHub {
+  Eigen::Vector3d position;
+  Eigen::Matrix3d rotation;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> jacobian;  // dc/dq, the columns of the hub's Jacobian
+};
+inline ContactFromHub contact_from_hub(const gen::Params& p, int w, const Eigen::Vector3d& hub_position,
+                                       const Eigen::Matrix3d& hub_rotation,
+                                       const Eigen::Matrix<double, 6, Eigen::Dynamic>* hub_jacobian = nullptr) {
+  const gen::WheelInfo& wheel = gen::kWheels[static_cast<std::size_t>(w)];
+  const double r = p.*wheel.radius;
+  const Eigen::Vector3d a = hub_rotation.col(wheel.axle_axis);
+  const auto u_of = [](const Eigen::Vector3d& axle) {
+    const double sigma = std::hypot(axle.x(), axle.y());
+    return Eigen::Vector3d(-axle.z() * axle.x() / sigma, -axle.z() * axle.y() / sigma, sigma);
+  };
+  const double sigma = std::hypot(a.x(), a.y());
+  const Eigen::Vector3d n(a.x() / sigma, a.y() / sigma, 0);
+  ContactFromHub out;
+  out.position = hub_position - r * u_of(a);
+  out.rotation.col(0) = Eigen::Vector3d(n.y(), -n.x(), 0);
+  out.rotation.col(1) = n;
+  out.rotation.col(2) = Eigen::Vector3d::UnitZ();
+  if (hub_jacobian != nullptr) {
+    const auto& J = *hub_jacobian;
+    out.jacobian.resize(3, J.cols());
+    for (Eigen::Index c = 0; c < J.cols(); ++c) {
+      // a' = omega_c x a; u' from u(a) by the chain rule, written out: with s = sigma,
+      // s' = (a_x a_x' + a_y a_y') / s and (a_z a_i / s)' = (a_z' a_i + a_z a_i') / s - a_z a_i s' / s^2.
+      const Eigen::Vector3d da = Eigen::Vector3d(J.col(c).tail<3>()).cross(a);
+      const double ds = (a.x() * da.x() + a.y() * da.y()) / sigma;
+      Eigen::Vector3d du;
+      for (int i = 0; i < 2; ++i) du(i) = -((da.z() * a(i) + a.z() * da(i)) / sigma - a.z() * a(i) * ds / (sigma * sigma));
+      du.z() = ds;
+      out.jacobian.col(c) = J.col(c).head<3>() - r * du;
+    }
+  }
+  return out;
+}
+
 // The structure recovered from the generated functions (geometry at the given parameters).
 struct DerivedStructure {
   std::array<FrameChain, gen::kFrameCount> chains;
@@ -132,6 +183,7 @@ inline DerivedStructure derive_structure(const gen::Params& p) {
     s(j) = kProbe;
     const std::vector<Transform> T = frame_poses(p, s);
     for (int f = 0; f < gen::kFrameCount; ++f) {
+      if (wheel_of_contact(f) >= 0) continue;  // derived from its hub, not a link
       const Transform rel0 = relative_pose(T0, f), rel = relative_pose(T, f);
       if (max_difference(rel, rel0) <= kMoves) continue;
       if (owner[static_cast<std::size_t>(j)] >= 0)
@@ -220,6 +272,7 @@ inline DerivedStructure derive_structure(const gen::Params& p) {
   for (int b = 0; b < gen::kBodyCount; ++b) {
     int found = -1;
     for (int f = 0; f < gen::kFrameCount && found < 0; ++f) {
+      if (wheel_of_contact(f) >= 0) continue;
       const auto in_frame = [&](std::size_t trial) {
         return Transform(frames[trial][static_cast<std::size_t>(f)].inverse() * bodies[trial][static_cast<std::size_t>(b)]);
       };
@@ -273,6 +326,10 @@ inline PeerTree build_tree(const gen::Params& p) {
     for (int f = 0; f < gen::kFrameCount; ++f) {
       const int parent = gen::kFrameParent[static_cast<std::size_t>(f)];
       if (added[static_cast<std::size_t>(f)] || (parent >= 0 && !added[static_cast<std::size_t>(parent)])) continue;
+      if (wheel_of_contact(f) >= 0) {  // computed from its hub (contact_from_hub), no segment
+        added[static_cast<std::size_t>(f)] = true;
+        continue;
+      }
       const FrameChain& chain = d.chains[static_cast<std::size_t>(f)];
       std::string hook = parent < 0 ? kRootName : frame_name(parent);
       // exp(xi q) = Trans(point) Rot(axis, q) Trans(-point): KDL's RotAxis joint is
@@ -309,7 +366,12 @@ inline PeerTree build_tree(const gen::Params& p) {
       throw std::runtime_error("kdl_peer: KDL numbered the joints in another order than they were added");
   }
   for (int f = 0; f < gen::kFrameCount; ++f)
-    if (std::find(gen::kFrameParent.begin(), gen::kFrameParent.end(), f) == gen::kFrameParent.end()) out.end_frames.push_back(f);
+    if (wheel_of_contact(f) < 0) {  // a leaf: no frame of the tree hangs from it (a hub's contact frame is not in the tree)
+      bool leaf = true;
+      for (int c = 0; c < gen::kFrameCount; ++c)
+        leaf = leaf && !(gen::kFrameParent[static_cast<std::size_t>(c)] == f && wheel_of_contact(c) < 0);
+      if (leaf) out.end_frames.push_back(f);
+    }
   out.gravity = KDL::Vector(0, 0, -(p.*gen::kGravity));
   return out;
 }

@@ -47,7 +47,9 @@ int main(int argc, char** argv) {
                                               hint.empty() ? "" : " (did you mean '" + hint + "'?)", model_names));
     }
     if (list_models->parsed()) {
-      for (const auto& m : models()) fmt::print("{:<12} {}\n", m.name, m.description);
+      std::size_t width = 0;
+      for (const auto& m : models()) width = std::max(width, std::string_view(m.name).size());
+      for (const auto& m : models()) fmt::print("{:<{}}  {}\n", m.name, width, m.description);
       return finish(0);
     }
     const auto require = [&](auto function, const char* command) {

@@ -68,13 +68,24 @@ double si_value(const nlohmann::json& v, const std::string& key, Quantity quanti
   return finite_number(v, key);
 }
 
+namespace {
+// "psi_l2, psi_l3, ...": the actuators in the order of a weighting's entries.
+std::string actuator_list() {
+  std::string out;
+  for (const std::string_view a : kActuatorNames) out += (out.empty() ? "" : ", ") + std::string(a);
+  return out;
+}
+}  // namespace
+
 Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
   if (v.is_number_integer() && (v == 1 || v == 2)) return v == 1 ? Weighting::model_weights() : Weighting::contribution();
   if (v.is_object() && v.size() == 1 && v.contains("diag")) {
     const auto& d = v.at("diag");
-    if (!d.is_array() || d.size() != 8) throw Error(key + ".diag", fmt::format("must be an array of 8 weights, got {}", excerpt(d)));
+    if (!d.is_array() || d.size() != static_cast<std::size_t>(kActuatedCount))
+      throw Error(key + ".diag", fmt::format("must be an array of {} weights (one per actuator: {}), got {}", kActuatedCount,
+                                             actuator_list(), excerpt(d)));
     TorqueVector w;
-    for (int i = 0; i < 8; ++i) w(i) = finite_number(d[static_cast<std::size_t>(i)], fmt::format("{}.diag[{}]", key, i));
+    for (int i = 0; i < kActuatedCount; ++i) w(i) = finite_number(d[static_cast<std::size_t>(i)], fmt::format("{}.diag[{}]", key, i));
     // Only ratios of weights matter (a uniform scale leaves the torques unchanged); beyond this span
     // rounding, not the weights, would decide how the torque is split.
     if (w.minCoeff() > 0 && w.maxCoeff() / w.minCoeff() > kMaxWeightRatio)
@@ -88,12 +99,14 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
   }
   if (v.is_object() && v.size() == 1 && v.contains("matrix")) {
     const auto& m = v.at("matrix");
-    if (!m.is_array() || m.size() != 8) throw Error(key + ".matrix", "must be 8 rows of 8 numbers");
-    Eigen::Matrix<double, 8, 8> W;
-    for (int r = 0; r < 8; ++r) {
+    constexpr auto n = static_cast<std::size_t>(kActuatedCount);
+    if (!m.is_array() || m.size() != n)
+      throw Error(key + ".matrix", fmt::format("must be {} rows of {} numbers (one per actuator: {})", n, n, actuator_list()));
+    TorqueMatrix W;
+    for (int r = 0; r < kActuatedCount; ++r) {
       const auto& row = m[static_cast<std::size_t>(r)];
-      if (!row.is_array() || row.size() != 8) throw Error(fmt::format("{}.matrix[{}]", key, r), "must be a row of 8 numbers");
-      for (int c = 0; c < 8; ++c) W(r, c) = finite_number(row[static_cast<std::size_t>(c)], fmt::format("{}.matrix[{}][{}]", key, r, c));
+      if (!row.is_array() || row.size() != n) throw Error(fmt::format("{}.matrix[{}]", key, r), fmt::format("must be a row of {} numbers", n));
+      for (int c = 0; c < kActuatedCount; ++c) W(r, c) = finite_number(row[static_cast<std::size_t>(c)], fmt::format("{}.matrix[{}][{}]", key, r, c));
     }
     try {
       return Weighting::matrix_of(W);
@@ -101,7 +114,8 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
       throw Error(key + ".matrix", e.reason());
     }
   }
-  throw Error(key, fmt::format("must be 1, 2, {{\"diag\": [8 weights]}} or {{\"matrix\": [[8 x 8]]}}, got {}", excerpt(v)));
+  throw Error(key, fmt::format("must be 1, 2, {{\"diag\": [{0} weights]}} or {{\"matrix\": [[{0} x {0}]]}}, got {1}",
+                               kActuatedCount, excerpt(v)));
 }
 
 Scenario parse_scenario(const nlohmann::json& j, const Params& base) {

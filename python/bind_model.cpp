@@ -43,6 +43,14 @@ Params params_of(const std::string& params_json) {
   return params;
 }
 
+// u or u' from Python: one entry per commanded speed (the model file's dynamics.commanded).
+CommandVector commands_of(const Eigen::VectorXd& u, const char* field) {
+  if (u.size() != kCommandedCount)
+    throw Error(field, "has " + std::to_string(u.size()) + " entries; the model commands " + std::to_string(kCommandedCount) +
+                           " speeds");
+  return u;
+}
+
 Coordinates coordinates_of(const Eigen::VectorXd& s, const char* field) {
   if (s.size() != kCoordinateCount)
     throw Error(field, "has " + std::to_string(s.size()) + " entries; the model has " + std::to_string(kCoordinateCount) +
@@ -84,6 +92,11 @@ void bind_python(py::module_& parent) {
   const Params p;
   for (const auto& info_p : gen::kParamInfo) defaults[py::str(std::string(info_p.name))] = p.*info_p.member;
   for (const auto& id : scenario_ids()) scenarios.append(id);
+  py::list commanded, actuators;
+  for (int k : kCommandedSpeeds) commanded.append(std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]));
+  for (const std::string_view a : kActuatorNames) actuators.append(std::string(a));
+  info["commanded"] = commanded;
+  info["actuators"] = actuators;
   info["name"] = std::string(gen::kModelName);
   info["description"] = std::string(gen::kModelDescription);
   info["coordinates"] = coordinates;
@@ -139,8 +152,9 @@ void bind_python(py::module_& parent) {
 
   m.def(
       "inverse_dynamics",
-      [](const Eigen::VectorXd& s_in, const Eigen::Vector4d& u, const Eigen::Vector4d& u_dot, const std::string& params_json,
+      [](const Eigen::VectorXd& s_in, const Eigen::VectorXd& u_in, const Eigen::VectorXd& u_dot_in, const std::string& params_json,
          const std::string& weighting_json) {
+        const CommandVector u = commands_of(u_in, "u"), u_dot = commands_of(u_dot_in, "u_dot");
         const Model model(params_of(params_json));
         Data data;
         DynamicsTerms terms;

@@ -60,6 +60,8 @@ class Model:
         self.frames = list(info["frames"])
         self.params = dict(info["params"])  # defaults, SI units
         self.scenarios = list(info["scenarios"])
+        self.commanded = list(info["commanded"])  # u: the commanded speeds, in inverse_dynamics' order
+        self.actuators = list(info["actuators"])  # tau's order: joints, and wheel drives (spin_<wheel>)
 
     def __repr__(self):
         return f"wlx.model({self.name!r})"
@@ -95,10 +97,13 @@ class Model:
         return self._m.dependent_rates(_np.asarray(s, dtype=float), _np.asarray(rates, dtype=float),
                                        list(dependent or []), _params_json(params))
 
-    def inverse_dynamics(self, s, u, u_dot=(0, 0, 0, 0), params=None, weighting=1):
-        """Q* and the actuator torques at s for the commanded speeds u and their rates u_dot (the
-        model file's dynamics section orders them); `weighting` as in scenario files (1, 2,
-        {"diag": [...]}, {"matrix": [[...]]})."""
+    def inverse_dynamics(self, s, u, u_dot=None, params=None, weighting=1):
+        """Q* and the actuator torques at s for the commanded speeds u and their rates u_dot
+        (default 0), in the order of `commanded` (the model file's dynamics section); tau is in the
+        order of `actuators`; `weighting` as in scenario files (1, 2, {"diag": [...]},
+        {"matrix": [[...]]})."""
+        if u_dot is None:
+            u_dot = _np.zeros(len(self.commanded))
         return self._m.inverse_dynamics(_np.asarray(s, dtype=float), _np.asarray(u, dtype=float),
                                         _np.asarray(u_dot, dtype=float), _params_json(params), _to_json(weighting, "weighting"))
 

@@ -79,9 +79,15 @@ Worst compare(const PeerTree& peer, const gen::Params& p, int configurations) {
     gen::FrameRotations kdl_rotations;
     for (int f = 0; f < gen::kFrameCount; ++f) {
       KDL::Frame F;
-      REQUIRE(fk.JntToCart(q, F, frame_name(f)) >= 0);
+      const int wheel = wheel_of_contact(f);  // a hub's contact frame: from the hub's KDL pose
+      REQUIRE(fk.JntToCart(q, F, frame_name(wheel < 0 ? f : gen::kWheels[static_cast<std::size_t>(wheel)].hub_frame)) >= 0);
       kdl_positions.col(f) = to_eigen(F.p);
       kdl_rotations[static_cast<std::size_t>(f)] = to_eigen(F.M);
+      if (wheel >= 0) {
+        const ContactFromHub c = contact_from_hub(p, wheel, to_eigen(F.p), to_eigen(F.M));
+        kdl_positions.col(f) = c.position;
+        kdl_rotations[static_cast<std::size_t>(f)] = c.rotation;
+      }
       worst.rotations = std::max(worst.rotations, (kdl_rotations[static_cast<std::size_t>(f)] - rotations[static_cast<std::size_t>(f)]).cwiseAbs().maxCoeff());
     }
     worst.positions = std::max(worst.positions, relative(kdl_positions, positions));
@@ -102,8 +108,14 @@ Worst compare(const PeerTree& peer, const gen::Params& p, int configurations) {
     for (int r = 0; r < gen::kClosureCount; ++r) {
       const gen::ClosureRowInfo& row = gen::kClosureRows[static_cast<std::size_t>(r)];
       if (row.kind == gen::RowKind::sum) continue;
-      REQUIRE(jacobian.JntToJac(q, J, frame_name(row.frame)) >= 0);
-      const auto Js = on_coordinates(peer, J);
+      const int wheel = wheel_of_contact(row.frame);
+      const int hub = wheel < 0 ? row.frame : gen::kWheels[static_cast<std::size_t>(wheel)].hub_frame;
+      REQUIRE(jacobian.JntToJac(q, J, frame_name(hub)) >= 0);
+      Eigen::Matrix<double, 6, gen::kCoordinateCount> Js = on_coordinates(peer, J);
+      if (wheel >= 0) {  // the contact point's columns, from the hub's pose and Jacobian
+        const Eigen::Matrix<double, 6, Eigen::Dynamic> hub_jacobian = Js;
+        Js.topRows<3>() = contact_from_hub(p, wheel, positions.col(hub), rotations[static_cast<std::size_t>(hub)], &hub_jacobian).jacobian;
+      }
       Eigen::Matrix<double, 1, gen::kCoordinateCount> expected;
       if (row.kind == gen::RowKind::point) {
         expected = Js.row(row.axis);
@@ -147,7 +159,7 @@ TEST_CASE("KDL: the open tree built from the generated tables has every frame, b
     gen::kinematics(s, p, {.positions = &moved, .rotations = &turned});
     CHECK_MESSAGE((moved == at_zero && turned == turned_at_zero), gen::kCoordinateNames[static_cast<std::size_t>(c)]);
   }
-  for (int f = 0; f < gen::kFrameCount; ++f) CHECK(peer.tree.getSegments().count(frame_name(f)) == 1);
+  for (int f = 0; f < gen::kFrameCount; ++f) CHECK(peer.tree.getSegments().count(frame_name(f)) == (wheel_of_contact(f) < 0 ? 1u : 0u));
   for (int b = 0; b < gen::kBodyCount; ++b) CHECK(peer.tree.getSegments().count(body_com_name(b)) == 1);
   MESSAGE(gen::kModelName << ": " << peer.tree.getNrOfJoints() << " KDL joints, " << peer.tree.getNrOfSegments() << " segments, "
                           << peer.end_frames.size() << " end frames");
@@ -168,12 +180,13 @@ TEST_CASE("KDL: frames, Jacobians and open-tree inverse dynamics agree with the 
 }
 
 TEST_CASE("KDL: the comparison sees a wrong geometry and wrong masses") {
-  // The tree built for lengths and masses 10% larger than the generated functions are evaluated
+  // The tree built for lengths, offsets (a URDF's origins) and masses 10% larger than the generated functions are evaluated
   // with must disagree far beyond the tolerance: the comparison is not vacuous.
   const gen::Params p;
   gen::Params changed = p;
   for (const gen::ParamInfo& info : gen::kParamInfo)
-    if (info.kind == gen::ParamKind::length || info.kind == gen::ParamKind::mass) changed.*info.member *= 1.1;
+    if (info.kind == gen::ParamKind::length || info.kind == gen::ParamKind::offset || info.kind == gen::ParamKind::mass)
+      changed.*info.member *= 1.1;
   const Worst worst = compare(build_tree(changed), p, 20);
   CHECK(worst.positions > 1e-3);
   CHECK(worst.body_jacobians > 1e-3);
@@ -204,7 +217,13 @@ TEST_CASE("KDL: the closed-form IK puts every limb where its closure rows ask, b
         const gen::ClosureRowInfo& row = gen::kClosureRows[static_cast<std::size_t>(block.rows[static_cast<std::size_t>(r)])];
         if (row.kind == gen::RowKind::sum) continue;
         KDL::Frame F;
-        REQUIRE(fk.JntToCart(q, F, frame_name(row.frame)) >= 0);
+        const int wheel = wheel_of_contact(row.frame);
+        REQUIRE(fk.JntToCart(q, F, frame_name(wheel < 0 ? row.frame : gen::kWheels[static_cast<std::size_t>(wheel)].hub_frame)) >= 0);
+        if (wheel >= 0) {
+          const ContactFromHub c = contact_from_hub(model.params(), wheel, to_eigen(F.p), to_eigen(F.M));
+          F.p = to_kdl(c.position);
+          F.M = to_kdl(c.rotation);
+        }
         const double residual = row.kind == gen::RowKind::point ? F.p(row.axis) - s(row.target) : F.M(2, row.axis);
         worst = std::max(worst, std::abs(residual));
       }
@@ -212,6 +231,9 @@ TEST_CASE("KDL: the closed-form IK puts every limb where its closure rows ask, b
   }
   MESSAGE(gen::kModelName << ": " << solved << " closed-form solutions along the IK sweeps, worst closure residual by KDL's FK "
                           << worst);
-  CHECK(solved >= 1000);
+  int points = 0;  // every point of every sweep solved (a failure throws above)
+  for (const gen::SweepInfo& sweep : gen::kIkSweeps) points += 1 + static_cast<int>(std::lround(std::abs(sweep.to - sweep.from) / sweep.step));
+  CHECK(solved == points);
+  CHECK(solved >= 100);
   CHECK(worst <= 1e-12);
 }

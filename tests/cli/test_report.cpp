@@ -193,3 +193,20 @@ TEST_CASE("report: a model without a report file still gets a report of its runs
   CHECK(html.find("<img src=\"fig/pose-") != std::string::npos);
   CHECK(html.find("<img src=\"fig/id-") != std::string::npos);
 }
+
+TEST_CASE("report: the wheeled quadruped (four wheels, sixteen actuators) gets a report of its runs that passes") {
+  const fs::path dir = temp_dir("wlx_report_wheeled_quadruped");
+  fs::remove_all(dir);
+  const int code = run(std::string(WLX_BINARY) + " --model wheeled_quadruped report --out " + dir.string(), dir.string() + ".log");
+  INFO(slurp(dir.string() + ".log"));
+  REQUIRE(code == 0);
+  const std::string html = slurp(dir / "index.html");
+  CHECK(markup_problem(html).empty());
+  CHECK(html.find("class=\"fail\"") == std::string::npos);
+  // The torque figures plot every actuator: the wheel drives by their URDF joints' names.
+  bool drives = false;
+  for (const auto& entry : fs::directory_iterator(dir / "plots"))
+    if (entry.path().extension() == ".gp" && slurp(entry.path()).find("tau_wheel_joint_rh") != std::string::npos) drives = true;
+  CHECK(drives);
+  CHECK(html.find("<img src=\"fig/id-") != std::string::npos);
+}

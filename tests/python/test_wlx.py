@@ -43,19 +43,29 @@ def test_models_and_tables(robot):
     assert all(math.isfinite(v) for v in robot.params.values())
 
 
-IK_REQUESTS = [
-    {},
-    {"z_C": 1.8, "pitch": {"deg": 3}},
-    {"params": "first parameter 2% larger"},
-    {"method": "newton", "x_C": 0.2},
-]
+def base_input(robot, axis):
+    """The model's base position input along axis ("x" or "z"): the first input named <axis>_..."""
+    return next(n for n in robot.inputs if n.startswith(axis + "_"))
 
 
-@pytest.mark.parametrize("request_", IK_REQUESTS, ids=lambda r: json.dumps(r))
-def test_ik_answers_what_wlx_ik_answers(robot, request_):
-    if request_.get("params") == "first parameter 2% larger":  # each model has its own names
-        name, value = next(iter(robot.params.items()))
-        request_ = {"params": {name: value * 1.02}}
+def nominal(robot, name):
+    return robot.ik()["s"][robot.coordinates.index(name)]
+
+
+# Each model has its own names: the base's height and position inputs, its first parameter.
+IK_REQUESTS = {
+    "nominal": lambda robot: {},
+    "base lowered 2 cm and pitched 3 deg": lambda robot: {
+        base_input(robot, "z"): nominal(robot, base_input(robot, "z")) - 0.02, "pitch": {"deg": 3}},
+    "first parameter 2% larger": lambda robot: {"params": {k: v * 1.02 for k, v in list(robot.params.items())[:1]}},
+    "newton, base moved 2 cm": lambda robot: {
+        "method": "newton", base_input(robot, "x"): nominal(robot, base_input(robot, "x")) + 0.02},
+}
+
+
+@pytest.mark.parametrize("request_name", list(IK_REQUESTS))
+def test_ik_answers_what_wlx_ik_answers(robot, request_name):
+    request_ = IK_REQUESTS[request_name](robot)
     expected = cli_json(["ik", "--model", robot.name], request_)
     got = robot.ik(request_)
     s = got.pop("s")
@@ -75,7 +85,8 @@ def test_ik_branches_give_other_solutions():
 
 
 def test_fk_gives_what_wlx_fk_gives(robot):
-    request = {"z_C": 1.9, "roll": {"deg": 2}}
+    z = base_input(robot, "z")
+    request = {z: nominal(robot, z) - 0.1, "roll": {"deg": 2}}
     expected = cli_json(["fk", "--json", "--model", robot.name], request)
     s = robot.ik(request)["s"]
     got = robot.fk(s)
@@ -92,7 +103,8 @@ def read_csv(path):
     return rows[0], np.array(rows[1:], dtype=float)
 
 
-@pytest.mark.parametrize("model_and_id", [("excavator", "NH-1"), ("excavator", "ID-1"), ("walker", None)])
+@pytest.mark.parametrize("model_and_id", [("excavator", "NH-1"), ("excavator", "ID-1"), ("walker", None),
+                                          ("wheeled_quadruped", "ID-Q2")])
 def test_simulate_gives_the_csv_of_wlx_simulate(tmp_path, model_and_id):
     name, scenario = model_and_id
     robot = wlx.model(name)
@@ -216,3 +228,28 @@ def test_nan_and_out_of_bound_arguments_are_errors_not_nan_results():
     # The CLI's bounds on rates apply too (100 m/s).
     with pytest.raises(wlx.Error, match=r"^rates\.x_C: "):
         robot.dependent_rates(s, {"x_C": 1e6}, dependent=["y_C", "yaw"])
+
+
+def test_the_wheeled_quadruped_commands_ten_speeds_with_sixteen_actuators():
+    # Sizes come from the model: u has one entry per commanded speed, tau one per actuator (the
+    # twelve joints and the four wheel drives, named by the URDF's continuous joints).
+    robot = wlx.model("wheeled_quadruped")
+    assert len(robot.commanded) == 10
+    assert robot.actuators[:3] == ["haa_lf", "hfe_lf", "kfe_lf"]
+    assert robot.actuators[12:] == ["wheel_joint_lf", "wheel_joint_rf", "wheel_joint_lh", "wheel_joint_rh"]
+    s = robot.ik()["s"]
+    u = np.zeros(10)
+    u[robot.commanded.index("x_B")] = 0.5
+    for leg in ("lf", "rf", "lh", "rh"):
+        u[robot.commanded.index("x_" + leg)] = 0.5
+    dyn = robot.inverse_dynamics(s, u)
+    assert dyn["tau"].shape == (16,)
+    # The torques produce Q* (least-norm solve of J_beta^T tau = Q*).
+    residual = np.abs(dyn["J_beta"].T @ dyn["tau"] - dyn["Qstar"]).max()
+    assert residual <= 1e-9 * np.abs(dyn["Qstar"]).max()
+    # Rolling forward at a fixed shape moves the wheel drives only: 0.5 m/s on 0.1 m wheels.
+    rates = dyn["J_beta"] @ u
+    assert np.abs(rates[:12]).max() <= 1e-12
+    assert np.allclose(rates[12:], 5.0, rtol=0, atol=1e-12)
+    with pytest.raises(wlx.Error, match=r"^u: has 4 entries; the model commands 10 speeds"):
+        robot.inverse_dynamics(s, [0.0, 3.0, 0.0, 0.0])
