@@ -174,7 +174,7 @@ function buildMachine(info) {
     links.push({ mesh, from: frame.parent, to: f });
   });
   const joints = info.frames.map((frame) => {
-    const mesh = new THREE.Mesh(new THREE.SphereGeometry(0.09, 16, 12), materials.joint);
+    const mesh = new THREE.Mesh(new THREE.SphereGeometry(0.09 * app.viewScale, 16, 12), materials.joint);
     mesh.name = `frame ${frame.name}`;
     machine.add(mesh);
     return mesh;
@@ -184,23 +184,23 @@ function buildMachine(info) {
     const [hx, hy, hz] = info.clearanceBox.halfExtents;
     base = new THREE.Mesh(new THREE.BoxGeometry(2 * hx, 2 * hy, 2 * hz), materials.base);
     base.matrixAutoUpdate = false;
-    base.add(new THREE.AxesHelper(0.6));
+    base.add(new THREE.AxesHelper(0.6 * app.viewScale));
     machine.add(base);
   }
   const wheels = info.wheels.map((w) => {
-    const disc = new THREE.Mesh(new THREE.CylinderGeometry(w.radius, w.radius, 0.18, 40), materials.wheel);
+    const disc = new THREE.Mesh(new THREE.CylinderGeometry(w.radius, w.radius, Math.min(0.18, 0.6 * w.radius), 40), materials.wheel);
     disc.name = `wheel ${w.name}`;
     machine.add(disc);
     return { info: w, disc };
   });
   const { points, grounds } = targetsFromClosureRows(info);
   const feet = points.map((p) => {
-    const mesh = new THREE.Mesh(new THREE.SphereGeometry(0.14, 20, 14), materials.foot);
+    const mesh = new THREE.Mesh(new THREE.SphereGeometry(0.14 * app.viewScale, 20, 14), materials.foot);
     machine.add(mesh);
     return { ...p, mesh };
   });
   const coms = info.bodies.map((b) => {
-    const mesh = new THREE.Mesh(new THREE.SphereGeometry(0.1, 16, 12), materials.com);
+    const mesh = new THREE.Mesh(new THREE.SphereGeometry(0.1 * app.viewScale, 16, 12), materials.com);
     mesh.name = `com ${b.name}`;
     comGroup.add(mesh);
     return mesh;
@@ -223,7 +223,7 @@ function placeMachine() {
     if (!link.mesh.visible) continue;
     link.mesh.position.copy(_a).addScaledVector(d, 0.5);
     link.mesh.quaternion.setFromUnitVectors(_y, d.normalize());
-    link.mesh.scale.set(0.055, length, 0.055);
+    link.mesh.scale.set(0.055 * app.viewScale, length, 0.055 * app.viewScale);
   }
   parts.joints.forEach((mesh, f) => mesh.position.copy(origin(f)));
   if (parts.base) frameMatrix(positions, rotations, info.clearanceBox.frame, parts.base.matrix);
@@ -259,19 +259,19 @@ function makeHandles(info) {
   app.handles = [];
   const names = info.coordinates.map((c) => c.name);
   if (info.basePoseInputs) {
-    const object = new THREE.Mesh(new THREE.OctahedronGeometry(0.22), materials.handle);
+    const object = new THREE.Mesh(new THREE.OctahedronGeometry(0.22 * app.viewScale), materials.handle);
     app.handles.push({ id: 'base-move', label: `base: move (${names.slice(0, 3).join(', ')})`, kind: 'base', mode: 'translate', object });
     app.handles.push({ id: 'base-turn', label: `base: turn (${names.slice(3, 6).join(', ')})`, kind: 'base', mode: 'rotate', object });
   }
   const { points, grounds } = targetsFromClosureRows(info);
   for (const p of points) {
-    const object = new THREE.Mesh(new THREE.SphereGeometry(0.2, 20, 14), materials.handle);
+    const object = new THREE.Mesh(new THREE.SphereGeometry(0.2 * app.viewScale, 20, 14), materials.handle);
     const frame = info.frames[p.frame].name;
     app.handles.push({ id: `target-${frame}`, label: `target of ${frame} (${p.targets.map((t) => names[t]).join(', ')})`,
                        kind: 'point', mode: 'translate', targets: p.targets, frame: p.frame, object });
   }
   for (const g of grounds) {
-    const object = new THREE.Mesh(new THREE.CylinderGeometry(0.45, 0.45, 0.02, 32), materials.ground);
+    const object = new THREE.Mesh(new THREE.CylinderGeometry(0.45 * app.viewScale, 0.45 * app.viewScale, 0.02 * app.viewScale, 32), materials.ground);
     object.quaternion.setFromUnitVectors(_y, new THREE.Vector3(0, 0, 1));
     const frame = info.frames[g.frame].name;
     app.handles.push({ id: `ground-${frame}`, label: `ground under ${frame} (${names[g.target]})`, kind: 'ground',
@@ -557,6 +557,13 @@ const ready = (async () => {
   app.model = await WasmModel.load(modelName, loadScript);
   app.info = app.model.info;
   app.branches = new Int32Array(app.info.limbs.length);
+  // The nominal pose first, so that a run that fails to load still leaves a machine on screen, and
+  // the view and the drawn parts sized to it.
+  const nominal = app.model.solve(Float64Array.from(app.info.nominalInputs), app.branches);
+  if (!nominal.ok) throw new Error(`the nominal pose: ${nominal.message}`);
+  app.inputs = Float64Array.from(app.info.nominalInputs);
+  app.s = nominal.s;
+  frameView();
   buildMachine(app.info);
   makeHandles(app.info);
   buildPanel(app.info);
@@ -569,11 +576,6 @@ const ready = (async () => {
     if (select.value) url.searchParams.set('run', select.value); else { url.searchParams.delete('run'); url.searchParams.set('model', app.info.name); }
     window.location.href = url.toString();
   };
-  // The nominal pose first, so that a run that fails to load still leaves a machine on screen.
-  const nominal = app.model.solve(Float64Array.from(app.info.nominalInputs), app.branches);
-  if (!nominal.ok) throw new Error(`the nominal pose: ${nominal.message}`);
-  app.inputs = Float64Array.from(app.info.nominalInputs);
-  app.s = nominal.s;
   placeMachine();
   if (runId) {
     app.run = prepareRun(await loadRun(runId));
@@ -587,6 +589,24 @@ const ready = (async () => {
 })();
 ready.catch((e) => showMessage(`viewer: ${e.message}`));
 requestAnimationFrame(frame);
+
+// The view scaled to the machine at its nominal pose: the default camera and the drawn joints,
+// links and handles suit a machine whose frames span some 7 m (the excavator); a 0.9 m quadruped
+// gets the same share of the screen and parts in proportion (app.viewScale).
+function frameView() {
+  const { positions } = app.model.forwardKinematics(app.s);
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let f = 0; f < positions.length / 3; ++f)
+    for (let i = 0; i < 3; ++i) lo[i] = Math.min(lo[i], positions[3 * f + i]), hi[i] = Math.max(hi[i], positions[3 * f + i]);
+  const size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  app.viewScale = Math.min(3, Math.max(0.1, size / 7));
+  const c = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, Math.max(0, (lo[2] + hi[2]) / 2)];
+  orbit.target.set(c[0], c[1], c[2]);
+  camera.position.set(c[0] + 9 * app.viewScale, c[1] - 11 * app.viewScale, c[2] + 6 * app.viewScale);
+  axes.scale.setScalar(app.viewScale);
+  orbit.update();
+  orbit.saveState();
+}
 
 // --- the page's API (for tests and scripting) -----------------------------------------------
 viewer.ready = ready;
@@ -642,7 +662,10 @@ viewer.api = {
     return (performance.now() - t0) / n;
   },
   // A view from above onto the wheels' tracks (for screenshots).
-  lookFromAbove() { camera.position.set(orbit.target.x + 0.01, orbit.target.y - 0.01, 16); orbit.update(); },
+  lookFromAbove() {
+    camera.position.set(orbit.target.x + 0.01, orbit.target.y - 0.01, 16 * (app.viewScale || 1));
+    orbit.update();
+  },
   resetView() { orbit.reset(); },
   loadMs: () => app.loadMs,
   // Pixels of the 3D view that differ from the background, for a blank-canvas check.

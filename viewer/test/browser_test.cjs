@@ -228,6 +228,22 @@ function cliIk(inputs) {
     check(baseDrag.ok && (await api(walker, () => wlxViewer.api.residual())) < 1e-9, 'dragging the walker\'s body keeps its closure',
           walkerHandles.map((h) => h.id).join(' '));
     await walker.screenshot({ path: path.join(outDir, 'walker.png') });
+
+    // --- the third: a floating base on four wheeled legs (URDF), sixteen actuators --------------------
+    const quadruped = await open('?model=wheeled_quadruped');
+    const quadrupedPixels = await api(quadruped, () => wlxViewer.api.paintedPixels());
+    check(quadrupedPixels.painted > 0.03 * quadrupedPixels.total, 'the wheeled quadruped renders', `${quadrupedPixels.painted} pixels`);
+    const quadrupedCoordinates = Object.keys(await api(quadruped, () => wlxViewer.api.coordinates()));
+    check(quadrupedCoordinates.includes('kfe_rh') && quadrupedCoordinates.includes('x_B'),
+          'the wheeled quadruped\'s page shows its coordinates', quadrupedCoordinates.join(' '));
+    const quadrupedBox = (await api(quadruped, () => wlxViewer.api.info())).clearanceBox;
+    check(quadrupedBox && Math.abs(quadrupedBox.halfExtents[0] - 0.35) < 1e-9, 'the wheeled quadruped\'s base box is found',
+          JSON.stringify(quadrupedBox));
+    const quadrupedHandles = await api(quadruped, () => wlxViewer.api.handles());
+    const lowered = await api(quadruped, () => wlxViewer.api.drag('base-move', { z: -0.1 }, 5));
+    check(lowered.ok && (await api(quadruped, () => wlxViewer.api.residual())) < 1e-9,
+          'lowering the wheeled quadruped\'s base keeps its four legs closed', quadrupedHandles.map((h) => h.id).join(' '));
+    await quadruped.screenshot({ path: path.join(outDir, 'wheeled_quadruped.png') });
   } finally {
     await browser.close();
   }

@@ -91,9 +91,13 @@ ClearanceBox clearance_box() {
                                                    {0.35, 0.2, -0.1}, {-0.15, -0.1, 0.3}, {0.05, 0.02, 0.0}}};
   std::vector<Coordinates> poses;
   std::vector<double> lowest;
+  // The turns, and a quarter of them where a smaller machine's legs cannot follow the larger ones
+  // (the wheeled quadruped's reach ends before 0.4 rad of pitch).
+  for (double scale : {1.0, 0.25})
   for (const auto& [pitch, roll, yaw] : turns) {
+    if (scale < 1 && poses.size() >= 4) break;
     Coordinates s = nominal_inputs();
-    s(3) += yaw, s(4) += pitch, s(5) += roll;
+    s(3) += scale * yaw, s(4) += scale * pitch, s(5) += scale * roll;
     try {
       solve_ik_closed_form(model(), s);
     } catch (const Error&) {
