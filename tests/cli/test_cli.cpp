@@ -232,6 +232,30 @@ TEST_CASE("cli: wlx simulate ID-1 --weighting 2 adds the torque and Q* columns")
   CHECK(run_wlx("simulate ID-1 --weighting 3 --out " + dir.string()).err == "wlx: error: --weighting: must be 1 or 2, got '3'\n");
 }
 
+TEST_CASE("cli: the wheeled quadruped's inverse dynamics has a column per actuator, drives too, and weightings of its size") {
+  const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "quadruped";
+  fs::remove_all(dir);
+  Run r = run_wlx("--model wheeled_quadruped simulate ID-Q2 --out " + dir.string());
+  REQUIRE(r.code == 0);
+  const std::string csv = slurp(dir / "trajectory.csv");
+  const std::string header = csv.substr(0, csv.find('\n'));
+  CHECK(header.find(",tau_haa_lf,tau_hfe_lf,tau_kfe_lf,") != std::string::npos);
+  CHECK(header.find(",tau_kfe_rh,tau_wheel_joint_lf,tau_wheel_joint_rf,tau_wheel_joint_lh,tau_wheel_joint_rh,Qstar_x_B,")
+        != std::string::npos);
+  CHECK(csv.find("nan") == std::string::npos);
+  // A weighting has one entry per actuator: sixteen here, not the excavator's eight.
+  const fs::path file = dir / "diag.json";
+  std::ofstream(file) << R"({"rates": {"z_B": -0.1}, "dependent": ["y_lf", "y_rf", "y_lh", "y_rh"], "duration": 0.01,
+                             "weighting": {"diag": [1, 1, 1, 1, 1, 1, 1, 1]}})";
+  r = run_wlx("--model wheeled_quadruped simulate " + file.string() + " --out " + dir.string());
+  CHECK(r.code == 2);
+  CHECK(r.err.find("wlx: error: weighting.diag: must be an array of 16 weights (one per actuator: haa_lf, ") == 0);
+  CHECK(r.err.find("wheel_joint_rh), got [1,1,1,1,1,1,1,1]") != std::string::npos);
+  std::ofstream(file) << R"({"rates": {"z_B": -0.1}, "dependent": ["y_lf", "y_rf", "y_lh", "y_rh"], "duration": 0.01,
+                             "weighting": {"diag": [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 2, 2, 2, 2]}})";
+  CHECK(run_wlx("--model wheeled_quadruped simulate " + file.string() + " --out " + dir.string()).code == 0);
+}
+
 TEST_CASE("cli: every validation rule names the field, the value and the rule, with exit code 2") {
   const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "rules";
   fs::create_directories(dir);
