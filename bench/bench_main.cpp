@@ -765,13 +765,11 @@ int main(int argc, char** argv) {
   // the machine, is what is read.
   std::deque<std::string> texts;  // stable storage for the rows' strings
   {
-    std::vector<std::string> suffixes, models;
+    std::vector<std::string> models;
     for (const auto& [name, ns] : collector.median_ns) {
       const auto slash = name.find('/');
       if (slash == std::string::npos || name.rfind("BM_", 0) == 0) continue;
-      const std::string model = name.substr(0, slash), suffix = name.substr(slash + 1);
-      if (std::find(models.begin(), models.end(), model) == models.end()) models.push_back(model);
-      if (std::find(suffixes.begin(), suffixes.end(), suffix) == suffixes.end()) suffixes.push_back(suffix);
+      if (std::find(models.begin(), models.end(), name.substr(0, slash)) == models.end()) models.push_back(name.substr(0, slash));
     }
     // The excavator first (the reference), the others in name order.
     std::sort(models.begin(), models.end(), [](const std::string& a, const std::string& b) {
@@ -780,7 +778,7 @@ int main(int argc, char** argv) {
     bool first = true;
     for (const std::string& suffix : {std::string("ik_all_limbs"), std::string("dependent_rates"),
                                       std::string("inverse_dynamics_step"), std::string("forward_dynamics_step")}) {
-      if (std::find(suffixes.begin(), suffixes.end(), suffix) == suffixes.end()) continue;
+      if (models.empty()) break;  // (a --benchmark_filter without them)
       const std::string reference = models.front() + "/" + suffix;
       for (const std::string& model : models) {
         const std::string name = model + "/" + suffix;

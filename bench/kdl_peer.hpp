@@ -133,14 +133,10 @@ inline ContactFromHub contact_from_hub(const gen::Params& p, int w, const Eigen:
   const gen::WheelInfo& wheel = gen::kWheels[static_cast<std::size_t>(w)];
   const double r = p.*wheel.radius;
   const Eigen::Vector3d a = hub_rotation.col(wheel.axle_axis);
-  const auto u_of = [](const Eigen::Vector3d& axle) {
-    const double sigma = std::hypot(axle.x(), axle.y());
-    return Eigen::Vector3d(-axle.z() * axle.x() / sigma, -axle.z() * axle.y() / sigma, sigma);
-  };
   const double sigma = std::hypot(a.x(), a.y());
   const Eigen::Vector3d n(a.x() / sigma, a.y() / sigma, 0);
   ContactFromHub out;
-  out.position = hub_position - r * u_of(a);
+  out.position = hub_position - r * Eigen::Vector3d(-a.z() * n.x(), -a.z() * n.y(), sigma);
   out.rotation.col(0) = Eigen::Vector3d(n.y(), -n.x(), 0);
   out.rotation.col(1) = n;
   out.rotation.col(2) = Eigen::Vector3d::UnitZ();

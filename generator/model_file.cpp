@@ -1469,37 +1469,45 @@ class Parser {
     if (d.commanded.empty()) f["commanded"].fail("name at least one commanded speed");
     // An actuator is a joint (a coordinate's name) or a wheel's drive ({wheel: NAME}, or from a URDF
     // the name of the wheel's continuous joint, which then names the drive).
-    const auto urdf_wheel_joint = [&](const Item& c) -> const NonholonomicWheel* {
-      if (c.is_map()) return nullptr;
-      const std::string name = c.text();
-      for (const auto& w : m_.wheels)
-        if (const auto u = urdf_axle_.find(w.hub); u != urdf_axle_.end() && u->second.joint == name) return &w;
-      return nullptr;
+    const auto wheel_of_urdf_joint = [&](const std::string& joint) {
+      for (std::size_t w = 0; w < m_.wheels.size(); ++w)
+        if (const auto u = urdf_axle_.find(m_.wheels[w].hub); u != urdf_axle_.end() && u->second.joint == joint)
+          return static_cast<int>(w);
+      return -1;
+    };
+    const auto wheel_named = [&](const Item& it) {
+      const std::string wheel = it.name();
+      std::vector<std::string> names;
+      for (std::size_t w = 0; w < m_.wheels.size(); ++w) {
+        if (m_.wheels[w].name == wheel) return static_cast<int>(w);
+        names.push_back(m_.wheels[w].name);
+      }
+      it.fail(fmt::format("no wheel '{}' under wheels{}", wheel, suggestion(wheel, names)));
+    };
+    // The drive of wheel w; `at` is where a message points, `own_name` the file's name for it.
+    const auto drive = [&](const Item& at, int w, const std::optional<Item>& own_name) {
+      const NonholonomicWheel& wheel = m_.wheels[static_cast<std::size_t>(w)];
+      if (wheel.hub.empty())
+        at.fail(fmt::format("wheel '{}' has no hub (its contact frame is built by the file): its spin is a joint "
+                            "of the file's, so actuate that joint instead; a drive needs a wheel on a hub",
+                            wheel.name));
+      const auto u = urdf_axle_.find(wheel.hub);
+      Actuator a;
+      a.wheel = w;
+      a.name = own_name ? own_name->name() : u != urdf_axle_.end() ? u->second.joint : "spin_" + wheel.name;
+      for (const auto& q : m_.coordinates)
+        if (q.name == a.name)
+          at.fail(fmt::format("the drive of wheel '{}' is named '{}', as is a coordinate: rename the coordinate",
+                              wheel.name, a.name));
+      return a;
     };
     for (const Item& c : f["actuated"].list()) {
       Actuator a;
-      if (c.is_map() || urdf_wheel_joint(c) != nullptr) {
-        const Item at = c.is_map() ? Fields(c, {"wheel", "name"})["wheel"] : c;  // where a message points
-        const std::string wheel = c.is_map() ? at.name() : urdf_wheel_joint(c)->name;
-        const std::optional<Item> own_name = c.is_map() ? Fields(c, {"wheel", "name"}).optional("name") : std::nullopt;
-        for (std::size_t w = 0; w < m_.wheels.size(); ++w)
-          if (m_.wheels[w].name == wheel) a.wheel = static_cast<int>(w);
-        if (a.wheel < 0) {
-          std::vector<std::string> names;
-          for (const auto& w : m_.wheels) names.push_back(w.name);
-          at.fail(fmt::format("no wheel '{}' under wheels{}", wheel, suggestion(wheel, names)));
-        }
-        const NonholonomicWheel& w = m_.wheels[static_cast<std::size_t>(a.wheel)];
-        if (w.hub.empty())
-          at.fail(fmt::format("wheel '{}' has no hub (its contact frame is built by the file): its spin is a joint "
-                              "of the file's, so actuate that joint instead; a drive needs a wheel on a hub",
-                              wheel));
-        const auto u = urdf_axle_.find(w.hub);
-        a.name = own_name ? own_name->name() : u != urdf_axle_.end() ? u->second.joint : "spin_" + wheel;
-        for (const auto& q : m_.coordinates)
-          if (q.name == a.name)
-            at.fail(fmt::format("the drive of wheel '{}' is named '{}', as is a coordinate: rename the coordinate",
-                                wheel, a.name));
+      if (c.is_map()) {
+        const Fields af(c, {"wheel", "name"});
+        a = drive(af["wheel"], wheel_named(af["wheel"]), af.optional("name"));
+      } else if (const int w = wheel_of_urdf_joint(c.text()); w >= 0) {
+        a = drive(c, w, std::nullopt);
       } else {
         a.coordinate = coordinate_index(c);
         a.name = m_.coordinates[static_cast<std::size_t>(a.coordinate)].name;
