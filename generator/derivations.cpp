@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <functional>
+#include <iterator>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -250,50 +252,123 @@ FunctionSpec derive_dynamics_update(const Model& m) {
 
 namespace {
 
-// Writes reduced_dynamics' lane code: statements on rows of nu scalars (detail::Lanes), one lane
-// per commanded speed, and counts their operations scalar by scalar, per output (`charge_to`).
+// Writes reduced_dynamics' lane code: statements on rows of scalars (detail::Lanes), one lane per
+// commanded speed, and counts their operations scalar by scalar, per output (`charge_to`).
 // A row is named by its variable, or "" when it is structurally zero (nothing is written for it).
+//
+// Rows are narrow or wide. A wide row (type LW) holds every commanded speed, lane k for speed k. A
+// narrow row (type L) holds only the speeds its set names, speed k in lane slot[k]: speeds that
+// never move the same body (the commanded speeds of two legs, say) share a lane, so that a
+// machine with many commanded speeds but few per limb runs its limbs' sums on short rows. A row
+// is narrow when its speeds' slots are distinct; sums whose speeds collide (the wrenches where the
+// limbs meet) are wide, their narrow parts widened first. With no sharing (slot[k] = k) every row
+// is narrow and L holds every speed.
 class LaneWriter {
  public:
-  explicit LaneWriter(int lanes) : lanes_(lanes) {}
+  using Set = std::vector<int>;  // commanded speeds, ascending
+  LaneWriter(std::vector<int> slot, int width) : slot_(std::move(slot)), width_(width), speeds_(static_cast<int>(slot_.size())) {}
   int charge_to = 0;  // the output the next statements' operations count for
+  bool shares_lanes() const { return width_ < speeds_; }
+  int width() const { return width_; }
+  // A row the caller declares (T's rows): its name and speeds, narrow.
+  void declare(const std::string& name, const Set& speeds) { rows_[name] = {speeds, false}; }
+  const Set& speeds(const std::string& row) const { return rows_.at(row).speeds; }
   // A new row "name = base + sum_i factor_i * row_i" (zero terms, "" rows, dropped); returns the
   // name, or base itself when no term remains (no code).
   std::string define(const std::string& name, const std::string& base,
                      const std::vector<std::pair<std::string, std::string>>& terms) {
+    std::vector<std::pair<std::string, std::string>> kept;
+    for (const auto& t : terms)
+      if (!t.first.empty() && !t.second.empty()) kept.push_back(t);
+    if (kept.empty()) return base;
+    std::vector<std::string> rows;
+    if (!base.empty()) rows.push_back(base);
+    for (const auto& t : kept) rows.push_back(t.second);
+    const Layout layout = unify(rows);
+    const int n = lanes(layout.wide);
+    std::string rhs = base.empty() ? "" : as(base, layout.wide);
     OpCount ops;
-    const std::string rhs = sum(base, terms, ops);
-    if (rhs == base) return base;
-    add(name, fmt::format("    const L {} = {};\n", name, rhs), ops);
+    for (const auto& [factor, row] : kept) {
+      if (!rhs.empty()) {
+        rhs += " + ";
+        ops.adds += n;
+      }
+      rhs += factor + " * " + as(row, layout.wide);
+      ops.muls += n;
+    }
+    add(name, fmt::format("    const {} {} = {};\n", type(layout.wide), name, rhs), ops);
+    rows_[name] = {layout.speeds, layout.wide};
     return name;
   }
   // A new row, the sum of `rows` (at least two).
   std::string define_sum(const std::string& name, const std::vector<std::string>& rows) {
-    add(name, fmt::format("    const L {} = {};\n", name, fmt::join(rows, " + ")),
-        OpCount{static_cast<long>(rows.size() - 1) * lanes_, 0, 0, 0});
+    const Layout layout = unify(rows);
+    std::vector<std::string> operands;
+    for (const auto& r : rows) operands.push_back(as(r, layout.wide));
+    add(name, fmt::format("    const {} {} = {};\n", type(layout.wide), name, fmt::join(operands, " + ")),
+        OpCount{static_cast<long>(rows.size() - 1) * lanes(layout.wide), 0, 0, 0});
+    rows_[name] = {layout.speeds, layout.wide};
     return name;
   }
-  // "accumulator += sum_i factor_i * row_i".
+  // "accumulator += sum_i factor_i * row_i": into one of the accumulator's parts (one whose
+  // speeds, with the terms', keep distinct lanes; else a new part).
   void accumulate(const std::string& accumulator, const std::vector<std::pair<std::string, std::string>>& terms) {
-    OpCount ops;
-    const std::string rhs = sum("", terms, ops);
-    if (rhs.empty()) return;
-    ops.adds += lanes_;
-    add("", fmt::format("    {} += {};\n", accumulator, rhs), ops);
+    std::vector<std::pair<std::string, std::string>> kept;
+    for (const auto& t : terms)
+      if (!t.first.empty() && !t.second.empty()) kept.push_back(t);
+    if (kept.empty()) return;
+    std::vector<std::string> rows;
+    for (const auto& t : kept) rows.push_back(t.second);
+    const Layout layout = unify(rows);
+    const Part& part = part_for(accumulator, layout);
+    const int n = lanes(part.wide);
+    std::string rhs;
+    OpCount ops{n, 0, 0, 0};  // the +=
+    for (const auto& [factor, row] : kept) {
+      if (!rhs.empty()) {
+        rhs += " + ";
+        ops.adds += n;
+      }
+      rhs += factor + " * " + as(row, part.wide);
+      ops.muls += n;
+    }
+    add("", fmt::format("    {} += {};\n", part.name, rhs), ops);
   }
   // "accumulator += row".
   void add_row(const std::string& accumulator, const std::string& row) {
-    add("", fmt::format("    {} += {};\n", accumulator, row), OpCount{lanes_, 0, 0, 0});
+    const Layout layout = unify({row});
+    const Part& part = part_for(accumulator, layout);
+    add("", fmt::format("    {} += {};\n", part.name, as(row, part.wide)), OpCount{lanes(part.wide), 0, 0, 0});
   }
-  // A new row equal to `base` (or zero) plus `value` in lane k only: a unit row of T.
+  // A new row equal to `base` (or zero) plus `value` for speed k only: a unit row of T.
   std::string plus_lane(const std::string& name, const std::string& base, int k, const std::string& value) {
-    add(name, fmt::format("    L {} = {};\n    {}.v[{}] += {};\n", name, base.empty() ? zero() : base, name, k, value),
+    Set speeds = base.empty() ? Set{} : rows_.at(base).speeds;
+    speeds = merged(speeds, {k});
+    const bool wide = (!base.empty() && rows_.at(base).wide) || !distinct(speeds);
+    add(name, fmt::format("    {} {} = {};\n    {}.add_to_lane({}, {});\n", type(wide), name, base.empty() ? zero(wide) : as(base, wide),
+                          name, wide ? k : slot_[static_cast<std::size_t>(k)], value),
         OpCount{1, 0, 0, 0});
+    rows_[name] = {speeds, wide};
     return name;
   }
   // Quoted for a comment (wlx/text.hpp): the text may hold a body's meaning from the model file.
   void comment(const std::string& text) { add("", "    // " + text::cpp_comment(text) + "\n", {}); }
-  std::string zero() const { return fmt::format("detail::zero_lanes<Scalar, {}>()", lanes_); }
+  std::string zero(bool wide = false) const { return fmt::format("detail::zero_lanes<Scalar, {}>()", lanes(wide)); }
+  std::string type(bool wide) const { return wide ? "LW" : "L"; }
+  // The lane of speed k in a row of the given kind.
+  int lane(int k, bool wide) const { return wide ? k : slot_[static_cast<std::size_t>(k)]; }
+
+  struct Part {
+    std::string name;
+    Set speeds;
+    bool wide = false;
+  };
+  // Every accumulator's parts, in the order they were made (the caller declares them, zero).
+  const std::map<std::string, std::vector<Part>>& accumulators() const { return accumulators_; }
+  // An accumulator nothing was added to gets one narrow part, so the caller's code can name it.
+  void ensure(const std::string& accumulator) {
+    if (!accumulators_.count(accumulator)) accumulators_[accumulator].push_back({accumulator, {}, false});
+  }
   // The code, without the rows nothing reads (a dense joint's wrench sums feed only the
   // components its twist has), and each output's operations.
   std::string finish(std::vector<OpCount>& ops) const {
@@ -326,28 +401,77 @@ class LaneWriter {
   }
 
  private:
+  struct Row {
+    Set speeds;
+    bool wide = false;
+  };
+  struct Layout {
+    Set speeds;
+    bool wide = false;
+  };
   struct Statement {
     std::string name, text;
     OpCount ops;
     int output = 0;
   };
+  static Set merged(const Set& a, const Set& b) {
+    Set out;
+    std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+    return out;
+  }
+  bool distinct(const Set& speeds) const {
+    std::set<int> used;
+    for (int k : speeds)
+      if (!used.insert(slot_[static_cast<std::size_t>(k)]).second) return false;
+    return true;
+  }
+  int lanes(bool wide) const { return wide ? speeds_ : width_; }
+  Layout unify(const std::vector<std::string>& rows) const {
+    Layout out;
+    for (const auto& r : rows) {
+      const Row& row = rows_.at(r);
+      out.speeds = merged(out.speeds, row.speeds);
+      out.wide = out.wide || row.wide;
+    }
+    out.wide = out.wide || !distinct(out.speeds);
+    return out;
+  }
+  // `row` as a row of the given kind: itself, or (narrow to wide) its lanes moved to a new wide
+  // row, once.
+  std::string as(const std::string& row, bool wide) {
+    const Row info = rows_.at(row);
+    if (info.wide == wide) return row;
+    const std::string name = row + "_all";
+    if (rows_.count(name)) return name;
+    std::string text = fmt::format("    LW {} = {};\n", name, zero(true));
+    for (int k : info.speeds) text += fmt::format("    {}.set_lane({}, {}.lane({}));\n", name, k, row, slot_[static_cast<std::size_t>(k)]);
+    add(name, text, {});
+    rows_[name] = {info.speeds, true};
+    return name;
+  }
+  const Part& part_for(const std::string& accumulator, const Layout& layout) {
+    auto& parts = accumulators_[accumulator];
+    for (Part& p : parts) {
+      if (p.wide != layout.wide) continue;
+      const Set speeds = merged(p.speeds, layout.speeds);
+      if (p.wide || distinct(speeds)) {
+        p.speeds = speeds;
+        return p;
+      }
+    }
+    const std::string name = parts.empty() ? accumulator
+                             : layout.wide ? accumulator + "_all"
+                                           : fmt::format("{}_part{}", accumulator, parts.size());
+    parts.push_back({name, layout.speeds, layout.wide});
+    return parts.back();
+  }
   void add(const std::string& name, const std::string& text, const OpCount& ops) {
     statements_.push_back({name, text, ops, charge_to});
   }
-  std::string sum(const std::string& base, const std::vector<std::pair<std::string, std::string>>& terms, OpCount& ops) const {
-    std::string rhs = base;
-    for (const auto& [factor, row] : terms) {
-      if (factor.empty() || row.empty()) continue;
-      if (!rhs.empty()) {
-        rhs += " + ";
-        ops.adds += lanes_;
-      }
-      rhs += factor + " * " + row;
-      ops.muls += lanes_;
-    }
-    return rhs;
-  }
-  int lanes_;
+  std::vector<int> slot_;
+  int width_, speeds_;
+  std::map<std::string, Row> rows_;
+  std::map<std::string, std::vector<Part>> accumulators_;
   std::vector<Statement> statements_;
 };
 
@@ -361,6 +485,77 @@ struct TwistNode {
   std::array<std::string, 6> wrench;  // lanes of the sum over the bodies beyond: (force; moment about K0's origin)
 };
 
+// The commanded speeds each coordinate's rate depends on (T's nonzero columns in its row), from the
+// structure of the equations that fix the dense rates: the closure rows and the wheels' rolling
+// rows, linear in s'. Their unknowns (the dependent pair and the dependent joints) split into
+// independent blocks, the connected parts of "row r involves unknown j" (a leg's joints and its
+// wheel's rate, say); a block's rates depend on the commanded speeds its rows involve, and on no
+// other. A commanded speed's rate is itself; a held input's is zero (no speeds).
+std::vector<std::vector<int>> rate_speeds(const Model& m, const std::vector<int>& speed_of, const std::function<bool(int)>& dense) {
+  const int n = coordinate_count(m);
+  std::vector<std::vector<ex>> rows;
+  for (const auto& c : m.closure) rows.push_back(closure_row(m, c).gradient);
+  if (m.dynamics && !m.wheels.empty())
+    for (const auto& wheel : m.wheels) rows.push_back(wheel_row(m, wheel).C);
+  // Union-find over the rows (0 .. rows-1) and the coordinates (rows + j).
+  const int count = static_cast<int>(rows.size()) + n;
+  std::vector<int> parent(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) parent[static_cast<std::size_t>(i)] = i;
+  const std::function<int(int)> root = [&](int i) {
+    while (parent[static_cast<std::size_t>(i)] != i) i = parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    return i;
+  };
+  const int R = static_cast<int>(rows.size());
+  for (int r = 0; r < R; ++r)
+    for (int j = 0; j < n; ++j)
+      if (dense(j) && !rows[static_cast<std::size_t>(r)][static_cast<std::size_t>(j)].is_zero()) parent[static_cast<std::size_t>(root(r))] = root(R + j);
+  std::map<int, std::set<int>> block_speeds;
+  std::set<int> blocks_with_rows;
+  for (int r = 0; r < R; ++r) {
+    blocks_with_rows.insert(root(r));
+    for (int j = 0; j < n; ++j)
+      if (speed_of[static_cast<std::size_t>(j)] >= 0 && !rows[static_cast<std::size_t>(r)][static_cast<std::size_t>(j)].is_zero())
+        block_speeds[root(r)].insert(speed_of[static_cast<std::size_t>(j)]);
+  }
+  const int nu = static_cast<int>(std::count_if(speed_of.begin(), speed_of.end(), [](int k) { return k >= 0; }));
+  std::vector<std::vector<int>> out(static_cast<std::size_t>(n));
+  for (int j = 0; j < n; ++j) {
+    auto& speeds = out[static_cast<std::size_t>(j)];
+    if (speed_of[static_cast<std::size_t>(j)] >= 0) {
+      speeds = {speed_of[static_cast<std::size_t>(j)]};
+    } else if (dense(j)) {
+      const int b = root(R + j);
+      if (!blocks_with_rows.count(b)) {  // no row fixes it (the solve would fail): assume every speed
+        for (int k = 0; k < nu; ++k) speeds.push_back(k);
+      } else {
+        speeds.assign(block_speeds[b].begin(), block_speeds[b].end());
+      }
+    }
+  }
+  return out;
+}
+
+// A lane for each commanded speed such that the speeds of any one set (the speeds that move one
+// joint) get distinct lanes: greedy colouring of "share a set". Speeds of different limbs that
+// never move a common joint share a lane.
+std::vector<int> shared_lanes(int nu, const std::vector<std::vector<int>>& sets) {
+  std::vector<std::set<int>> conflicts(static_cast<std::size_t>(nu));
+  for (const auto& set : sets)
+    for (int a : set)
+      for (int b : set)
+        if (a != b) conflicts[static_cast<std::size_t>(a)].insert(b);
+  std::vector<int> slot(static_cast<std::size_t>(nu), -1);
+  for (int k = 0; k < nu; ++k) {
+    std::set<int> taken;
+    for (int other : conflicts[static_cast<std::size_t>(k)])
+      if (slot[static_cast<std::size_t>(other)] >= 0) taken.insert(slot[static_cast<std::size_t>(other)]);
+    int s = 0;
+    while (taken.count(s)) ++s;
+    slot[static_cast<std::size_t>(k)] = s;
+  }
+  return slot;
+}
+
 bool same_joint(const JointRecord& a, const JointRecord& b) {
   if (a.coordinate != b.coordinate || a.revolute != b.revolute) return false;
   for (int c = 0; c < 3; ++c)
@@ -369,6 +564,16 @@ bool same_joint(const JointRecord& a, const JointRecord& b) {
 }
 
 }  // namespace
+
+std::vector<std::vector<int>> rate_basis_pattern(const Model& m) {
+  const int n = coordinate_count(m);
+  if (!m.dynamics) return std::vector<std::vector<int>>(static_cast<std::size_t>(n));
+  const Dynamics& dyn = *m.dynamics;
+  const std::vector<int> pair = m.wheels.empty() ? std::vector<int>{} : m.pair(dyn.pair).coordinates;
+  std::vector<int> speed_of(static_cast<std::size_t>(n), -1);
+  for (std::size_t k = 0; k < dyn.commanded.size(); ++k) speed_of[static_cast<std::size_t>(dyn.commanded[k])] = static_cast<int>(k);
+  return rate_speeds(m, speed_of, [&](int j) { return j >= m.input_count || std::count(pair.begin(), pair.end(), j) > 0; });
+}
 
 FunctionSpec derive_reduced_dynamics(const Model& m) {
   const Dynamics& dyn = *m.dynamics;
@@ -398,7 +603,8 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   const auto moves = [&](int j) { return dense(j) || speed_of[static_cast<std::size_t>(j)] >= 0; };
   fn.inputs = {{"T", "RateBasis",
                 "s' = T u, the rates caused by unit commanded speeds (rate_basis at s); only the rows of the dependent "
-                "pair and of the dependent joints are read, the others are fixed by the model file"}};
+                "pair and of the dependent joints are read, the others are fixed by the model file, and in them only "
+                "the entries kRateBasisPattern marks (structure.hpp; the others are zero)"}};
   const auto scalar = [&](const std::string& name, const ex& value) {
     if (value.is_zero()) return std::string();
     fn.lane_scalars.emplace_back(name, value);
@@ -428,7 +634,23 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
     if (at >= 0) nodes[static_cast<std::size_t>(at)].bodies.push_back(static_cast<int>(i));
   }
 
-  LaneWriter w(nu);
+  // Which commanded speeds each joint's rate depends on, and the lanes they take (LaneWriter).
+  const std::vector<std::vector<int>> speeds_of = rate_basis_pattern(m);
+  std::vector<std::vector<int>> node_speeds(nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const int j = nodes[k].joint->coordinate;
+    const int parent = nodes[k].parent;
+    const std::vector<int> own = dense(j) ? speeds_of[static_cast<std::size_t>(j)] : std::vector<int>{speed_of[static_cast<std::size_t>(j)]};
+    const std::vector<int> before = parent < 0 ? std::vector<int>{} : node_speeds[static_cast<std::size_t>(parent)];
+    std::set_union(before.begin(), before.end(), own.begin(), own.end(), std::back_inserter(node_speeds[k]));
+  }
+  std::vector<int> slot = shared_lanes(nu, node_speeds);
+  const int width = slot.empty() ? nu : *std::max_element(slot.begin(), slot.end()) + 1;
+  if (width >= nu)  // nothing to gain: every speed its own lane
+    for (int k = 0; k < nu; ++k) slot[static_cast<std::size_t>(k)] = k;
+  LaneWriter w(slot, std::min(width, nu));
+  for (int j = 0; j < n; ++j)
+    if (dense(j)) w.declare(fmt::format("kane_T_{}", j), speeds_of[static_cast<std::size_t>(j)]);
   // Each output's share of the lane code's operations (the twists and D P count with M).
   enum { kM, kB_velocity, kB_bias, kQ_gravity };
   std::set<int> rows_used;
@@ -559,7 +781,8 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
       bias_columns.insert(j);
       w.add_row(fmt::format("kane_B_{}", j), tau);
       w.charge_to = kM;
-      for (int l = 0; l < nu; ++l) w.accumulate(fmt::format("kane_M_{}", l), {{fmt::format("T({}, {})", j, l), tau}});
+      // T(j, l) is zero for the speeds j's rate does not depend on.
+      for (int l : speeds_of[static_cast<std::size_t>(j)]) w.accumulate(fmt::format("kane_M_{}", l), {{fmt::format("T({}, {})", j, l), tau}});
     } else {
       w.charge_to = kM;
       w.add_row(fmt::format("kane_M_{}", speed_of[static_cast<std::size_t>(j)]), tau);
@@ -572,23 +795,64 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   std::erase_if(fn.lane_scalars, [&](const auto& named) { return !read.count(named.first); });
 
   // Around the bodies: T's rows, the accumulators, then the outputs.
-  std::string code = fmt::format("    using L = detail::Lanes<Scalar, {}>;\n", nu);
+  for (int k = 0; k < nu; ++k) w.ensure(fmt::format("kane_M_{}", k));
+  w.ensure("kane_b");
+  w.ensure("kane_Q");
+  std::string code = fmt::format("    using L = detail::Lanes<Scalar, {}>;\n", w.width());
+  if (w.shares_lanes()) code += fmt::format("    using LW = detail::Lanes<Scalar, {}>;\n", nu);
   code += "    // T's dense rows; the accumulators of M's rows, b_velocity, Q_gravity and B_bias's columns.\n";
-  for (int j : rows_used) code += fmt::format("    const L kane_T_{0} = detail::lanes_of_row<Scalar, {1}>(T, {0});\n", j, nu);
-  code += fmt::format("    L kane_M_0 = {}", w.zero());
-  for (int k = 1; k < nu; ++k) code += fmt::format(", kane_M_{} = kane_M_0", k);
-  code += ", kane_b = kane_M_0, kane_Q = kane_M_0";
-  for (int j : bias_columns) code += fmt::format(", kane_B_{} = kane_M_0", j);
-  code += ";\n" + body_code;
+  for (int j : rows_used) {
+    const auto& speeds = speeds_of[static_cast<std::size_t>(j)];
+    if (!w.shares_lanes() && static_cast<int>(speeds.size()) == nu) {
+      code += fmt::format("    const L kane_T_{0} = detail::lanes_of_row<Scalar, {1}>(T, {0});\n", j, nu);
+      continue;
+    }
+    code += fmt::format("    L kane_T_{} = {};\n", j, w.zero());
+    for (int l : speeds) code += fmt::format("    kane_T_{}.set_lane({}, T({}, {}));\n", j, w.lane(l, false), j, l);
+  }
+  for (const auto& [name, parts] : w.accumulators())
+    for (const auto& part : parts) code += fmt::format("    {} {} = {};\n", w.type(part.wide), part.name, w.zero(part.wide));
+  code += body_code;
+  // An output entry: the sum of the accumulator's parts that hold speed l.
+  OpCount output_adds;
+  const auto entry = [&](const std::string& accumulator, int l) {
+    std::vector<std::string> terms;
+    for (const auto& part : w.accumulators().at(accumulator))
+      if (std::binary_search(part.speeds.begin(), part.speeds.end(), l)) terms.push_back(fmt::format("{}.lane({})", part.name, w.lane(l, part.wide)));
+    if (terms.empty()) return std::string("Scalar(0)");
+    output_adds.adds += static_cast<long>(terms.size()) - 1;
+    return fmt::format("{}", fmt::join(terms, " + "));
+  };
   code += "    if (M != nullptr) {  // the upper triangle, mirrored: M is symmetric to the last bit\n";
-  code += "      const L* row[] = {";
-  for (int k = 0; k < nu; ++k) code += fmt::format("{}&kane_M_{}", k ? ", " : "", k);
-  code += fmt::format("}};\n      for (int k = 0; k < {0}; ++k)\n        for (int l = k; l < {0}; ++l) (*M)(k, l) = (*M)(l, k) = row[k]->v[l];\n    }}\n", nu);
-  code += fmt::format("    if (b_velocity != nullptr)\n      for (int k = 0; k < {}; ++k) (*b_velocity)(k) = kane_b.v[k];\n", nu);
-  code += fmt::format("    if (Q_gravity != nullptr)\n      for (int k = 0; k < {}; ++k) (*Q_gravity)(k) = kane_Q.v[k];\n", nu);
-  code += "    if (B_bias != nullptr) {\n      if (zero_fill) B_bias->setZero();\n";
-  for (int j : bias_columns) code += fmt::format("      for (int k = 0; k < {}; ++k) (*B_bias)(k, {}) = kane_B_{}.v[k];\n", nu, j, j);
+  output_adds = {};
+  for (int k = 0; k < nu; ++k)
+    for (int l = k; l < nu; ++l) {
+      const std::string e = entry(fmt::format("kane_M_{}", k), l);
+      code += k == l ? fmt::format("      (*M)({0}, {0}) = {1};\n", k, e) : fmt::format("      (*M)({0}, {1}) = (*M)({1}, {0}) = {2};\n", k, l, e);
+    }
+  const OpCount M_adds = output_adds;
+  code += "    }\n    if (b_velocity != nullptr) {\n";
+  output_adds = {};
+  for (int k = 0; k < nu; ++k) code += fmt::format("      (*b_velocity)({}) = {};\n", k, entry("kane_b", k));
+  const OpCount b_adds = output_adds;
+  code += "    }\n    if (Q_gravity != nullptr) {\n";
+  output_adds = {};
+  for (int k = 0; k < nu; ++k) code += fmt::format("      (*Q_gravity)({}) = {};\n", k, entry("kane_Q", k));
+  const OpCount Q_adds = output_adds;
+  code += "    }\n    if (B_bias != nullptr) {\n      if (zero_fill) B_bias->setZero();\n";
+  output_adds = {};
+  for (int j : bias_columns)
+    for (int k = 0; k < nu; ++k) {
+      const std::string e = entry(fmt::format("kane_B_{}", j), k);
+      if (e != "Scalar(0)") code += fmt::format("      (*B_bias)({}, {}) = {};\n", k, j, e);
+    }
+  const OpCount B_adds = output_adds;
   code += "    }\n";
+  lane_ops[kM] += M_adds;
+  lane_ops[kB_velocity] += b_adds;
+  lane_ops[kQ_gravity] += Q_adds;
+  lane_ops[kB_bias] += B_adds;
+  fn.lane_layout = w.shares_lanes() ? fmt::format("{} lanes, {} where the limbs' sums meet", w.width(), nu) : fmt::format("{} lanes", nu);
   fn.lane_code = code;
 
   const FunctionSpec c = derive_convective(m);

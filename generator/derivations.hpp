@@ -45,6 +45,8 @@ struct FunctionSpec {
   // any of them is requested, after the scalars it reads (lane_scalars: name -> value) are computed.
   std::vector<std::pair<std::string, ex>> lane_scalars = {};
   std::string lane_code = {};
+  // How wide its rows are, for the header's documentation ("10 lanes").
+  std::string lane_layout = {};
 };
 
 // The value Phi_i(s) of one closure condition, in the model's symbols.
@@ -63,6 +65,9 @@ FunctionSpec derive_kinematic_update(const Model& m);
 // (only for a model with a dynamics section).
 FunctionSpec derive_dynamics_update(const Model& m);
 FunctionSpec derive_reduced_dynamics(const Model& m);
+// The commanded speeds each coordinate's rate depends on (the nonzero columns of its row of the rate
+// basis T, s' = T u), ascending; none for a held input or without a dynamics section.
+std::vector<std::vector<int>> rate_basis_pattern(const Model& m);
 
 // The height of the lowest corner of the model's clearance box above the ground (z = 0 of K0).
 FunctionSpec derive_clearance(const Model& m);

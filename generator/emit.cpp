@@ -217,10 +217,13 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
       "template <typename T> struct NonDeducedType {{ using type = T; }};\n"
       "template <typename T> using NonDeduced = typename NonDeducedType<T>::type;\n"
       "// N scalars side by side, for code that does the same to N columns at once (reduced_dynamics:\n"
-      "// Kane's sums, one lane per commanded speed). Loops over a fixed N, which compilers vectorize.\n"
+      "// Kane's sums, one lane per commanded speed). Loops over a fixed N, which compilers unroll.\n"
       "template <typename Scalar, int N>\n"
       "struct Lanes {{\n"
       "  Scalar v[N];\n"
+      "  Scalar lane(int i) const noexcept {{ return v[i]; }}\n"
+      "  void set_lane(int i, const Scalar& x) noexcept {{ v[i] = x; }}\n"
+      "  void add_to_lane(int i, const Scalar& x) noexcept {{ v[i] += x; }}\n"
       "  Lanes& operator+=(const Lanes& o) noexcept {{\n"
       "    for (int i = 0; i < N; ++i) v[i] += o.v[i];\n"
       "    return *this;\n"
@@ -234,33 +237,43 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
       "}};\n"
       "#if defined(__GNUC__) && !defined(WLX_GEN_NO_VECTOR_LANES)\n"
       "#define WLX_GEN_LANES_INLINE inline __attribute__((always_inline))\n"
-      "// double on 4 lanes: one GCC / clang vector (an AVX register, or two SSE2 ones), so that the\n"
-      "// rows stay in registers. Always inlined: a 32-byte vector is never passed to or returned from\n"
-      "// a call, whose convention would depend on whether the caller targets AVX.\n"
-      "template <>\n"
-      "struct Lanes<double, 4> {{\n"
+      "// double: GCC / clang vectors of 4 (an AVX register, or two SSE2 ones), as many as N needs, the\n"
+      "// last one padded with zeros, so that the rows stay in registers and every operation is one\n"
+      "// vector instruction per 4 lanes whatever N is. Always inlined: a 32-byte vector is never passed\n"
+      "// to or returned from a call, whose convention would depend on whether the caller targets AVX.\n"
+      "template <int N>\n"
+      "struct Lanes<double, N> {{\n"
       "  typedef double Vector __attribute__((vector_size(32)));\n"
-      "  Vector v;\n"
+      "  static constexpr int kVectors = (N + 3) / 4;\n"
+      "  Vector c[kVectors];\n"
+      "  __attribute__((always_inline)) double lane(int i) const noexcept {{ return c[i / 4][i % 4]; }}\n"
+      "  __attribute__((always_inline)) void set_lane(int i, double x) noexcept {{ c[i / 4][i % 4] = x; }}\n"
+      "  __attribute__((always_inline)) void add_to_lane(int i, double x) noexcept {{ c[i / 4][i % 4] += x; }}\n"
       "  __attribute__((always_inline)) Lanes& operator+=(const Lanes& o) noexcept {{\n"
-      "    v += o.v;\n"
+      "    for (int k = 0; k < kVectors; ++k) c[k] += o.c[k];\n"
       "    return *this;\n"
       "  }}\n"
-      "  __attribute__((always_inline)) friend Lanes operator+(const Lanes& a, const Lanes& b) noexcept {{ return {{a.v + b.v}}; }}\n"
-      "  __attribute__((always_inline)) friend Lanes operator*(const double& s, const Lanes& a) noexcept {{ return {{s * a.v}}; }}\n"
+      "  __attribute__((always_inline)) friend Lanes operator+(Lanes a, const Lanes& b) noexcept {{ return a += b; }}\n"
+      "  __attribute__((always_inline)) friend Lanes operator*(const double& s, const Lanes& a) noexcept {{\n"
+      "    Lanes out;\n"
+      "    for (int k = 0; k < kVectors; ++k) out.c[k] = s * a.c[k];\n"
+      "    return out;\n"
+      "  }}\n"
       "}};\n"
       "#else\n"
       "#define WLX_GEN_LANES_INLINE inline\n"
       "#endif\n"
+      "// Value-initialized first: a vector's padding lanes are zero too.\n"
       "template <typename Scalar, int N>\n"
       "WLX_GEN_LANES_INLINE Lanes<Scalar, N> zero_lanes() noexcept {{\n"
-      "  Lanes<Scalar, N> out;\n"
-      "  for (int i = 0; i < N; ++i) out.v[i] = Scalar(0);\n"
+      "  Lanes<Scalar, N> out{{}};\n"
+      "  for (int i = 0; i < N; ++i) out.set_lane(i, Scalar(0));\n"
       "  return out;\n"
       "}}\n"
       "template <typename Scalar, int N, class Matrix>\n"
       "WLX_GEN_LANES_INLINE Lanes<Scalar, N> lanes_of_row(const Matrix& m, int row) noexcept {{\n"
-      "  Lanes<Scalar, N> out;\n"
-      "  for (int i = 0; i < N; ++i) out.v[i] = m(row, i);\n"
+      "  Lanes<Scalar, N> out{{}};\n"
+      "  for (int i = 0; i < N; ++i) out.set_lane(i, m(row, i));\n"
       "  return out;\n"
       "}}\n"
       "#if defined(WLX_GEN_MULTIVERSION)\n"
@@ -476,8 +489,8 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
       outputs_type, outputs_type, fn.name, fn.outputs.front().name);
   for (std::size_t o = 0; o < fn.outputs.size(); ++o) {
     if (fn.outputs[o].from_lanes)
-      t += fmt::format("//   {:<18} {} (own operations: {}, on rows of {} lanes)\n", fn.outputs[o].name, fn.outputs[o].doc,
-                       output_ops[o].total(), m.dynamics ? m.dynamics->commanded.size() : 0);
+      t += fmt::format("//   {:<18} {} (own operations: {}, on rows of {})\n", fn.outputs[o].name, fn.outputs[o].doc,
+                       output_ops[o].total(), fn.lane_layout);
     else
       t += fmt::format("//   {:<18} {} (own operations: {}, nonzero entries: {})\n", fn.outputs[o].name, fn.outputs[o].doc,
                        output_ops[o].total(), outs[o].size());
@@ -783,8 +796,28 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
         m.dynamics ? "&Params::" + d.gravity : "nullptr");
   }
 
-  // Body Jacobian columns.
+  // The rate basis' structure.
   const int n = static_cast<int>(m.coordinates.size());
+  {
+    const auto pattern = rate_basis_pattern(m);
+    const std::size_t nu = m.dynamics ? m.dynamics->commanded.size() : 0;
+    t += fmt::format(
+        "// The rate basis T (s' = T u, one column per commanded speed): whether a coordinate's rate can\n"
+        "// depend on a commanded speed. The closure's and the wheels' rows split the dependent rates into\n"
+        "// independent blocks (a limb's joints with its wheel's rate, say), each moved only by the speeds\n"
+        "// its rows involve; every other entry of T is exactly zero, and reduced_dynamics never reads it.\n"
+        "inline constexpr std::array<std::array<bool, {}>, {}> kRateBasisPattern{{{{\n",
+        nu, n);
+    for (int j = 0; j < n; ++j) {
+      std::vector<std::string> row;
+      for (std::size_t k = 0; k < nu; ++k)
+        row.push_back(std::binary_search(pattern[static_cast<std::size_t>(j)].begin(), pattern[static_cast<std::size_t>(j)].end(), static_cast<int>(k)) ? "true" : "false");
+      t += fmt::format("    {{{{{}}}}},  // {}\n", fmt::join(row, ", "), m.coordinates[static_cast<std::size_t>(j)].name);
+    }
+    t += "}};\n\n";
+  }
+
+  // Body Jacobian columns.
   std::vector<std::vector<int>> columns;
   std::size_t max_columns = 1;
   for (const auto& b : m.bodies) {

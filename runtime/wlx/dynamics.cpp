@@ -24,11 +24,12 @@ Eigen::Matrix3d world_inertia(const Params& p, int body, const Eigen::Matrix3d& 
 
 double mass(const Params& p, int body) { return p.*gen::kBodyMass[static_cast<std::size_t>(body)].mass; }
 
-// Row r of J_beta for the drive of wheel w: its drive row times T. A template, so that for a model
-// without wheels (a 0-row WheelRows, whose row Eigen refuses at compile time) nothing is compiled.
-template <typename Rows, typename Basis, typename Jacobian>
-void drive_rate_row(const Rows& drive, int w, const Basis& T, Jacobian& J_beta, int r) {
-  if constexpr (Rows::RowsAtCompileTime > 0) J_beta.row(r).noalias() = drive.row(w).lazyProduct(T);
+// Row r of J_beta for the drive of wheel w: row w of the drives' rates per commanded speed (their
+// rows times T, one product for all of them). A template, so that for a model without wheels (a
+// 0-row matrix, whose row Eigen refuses at compile time) nothing is compiled.
+template <typename Rates, typename Jacobian>
+void drive_rate_row(const Rates& drive_rates, int w, Jacobian& J_beta, int r) {
+  if constexpr (Rates::RowsAtCompileTime > 0) J_beta.row(r) = drive_rates.row(w);
 }
 
 }  // namespace
@@ -72,12 +73,14 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   out.b = b_velocity + out.B_bias.lazyProduct(bias);
   out.Qstar = out.M * u_dot + out.b - out.Q_gravity;
   // A joint's rate is its coordinate's, T's row; a wheel drive's is its drive row times T.
+  Eigen::Matrix<double, kWheelCount, kCommandedCount> drive_rates;
+  if constexpr (kHasWheelDrives) drive_rates.noalias() = d.drive * out.T;
   for (int r = 0; r < kActuatedCount; ++r) {
     const int joint = kActuatedJoints[static_cast<std::size_t>(r)];
     if (joint >= 0)
       out.J_beta.row(r) = out.T.row(joint);
     else
-      drive_rate_row(d.drive, kActuatedWheels[static_cast<std::size_t>(r)], out.T, out.J_beta, r);
+      drive_rate_row(drive_rates, kActuatedWheels[static_cast<std::size_t>(r)], out.J_beta, r);
   }
 #endif
 }

@@ -15,17 +15,18 @@ using namespace wlx;
 namespace {
 
 // A rate basis with the structure the model file fixes (what reduced_dynamics relies on): unit rows
-// for the commanded speeds, dense rows for the dependent pair and the dependent joints, zero rows
-// for the other inputs. The dense rows are random.
+// for the commanded speeds, zero rows for the other inputs, and in the rows of the dependent pair and
+// of the dependent joints random entries where kRateBasisPattern allows one (zero elsewhere).
 gen::RateBasis structured_basis(std::mt19937_64& rng, std::vector<bool>& dense) {
   std::uniform_real_distribution<double> any(-2, 2);
   gen::RateBasis T = gen::RateBasis::Zero();
   dense.assign(gen::kCoordinateCount, false);
   const auto pair = gen::kPairs[gen::kDynamicsPair].coordinates;
   for (int j = 0; j < gen::kCoordinateCount; ++j) {
-    dense[static_cast<std::size_t>(j)] = j >= gen::kInputCount || j == pair[0] || j == pair[1];
+    dense[static_cast<std::size_t>(j)] = j >= gen::kInputCount || std::find(pair.begin(), pair.end(), j) != pair.end();
     if (dense[static_cast<std::size_t>(j)])
-      for (int k = 0; k < gen::kCommandedCount; ++k) T(j, k) = any(rng);
+      for (int k = 0; k < gen::kCommandedCount; ++k)
+        if (gen::kRateBasisPattern[static_cast<std::size_t>(j)][static_cast<std::size_t>(k)]) T(j, k) = any(rng);
   }
   for (int k = 0; k < gen::kCommandedCount; ++k) T(gen::kCommanded[static_cast<std::size_t>(k)], k) = 1;
   return T;

@@ -327,17 +327,27 @@ TEST_CASE(titled("inverse dynamics: J_beta^T tau = Q*, power and energy balances
   std::mt19937_64 rng(203);
   std::uniform_real_distribution<double> half(-0.5, 0.5);
   double worst_balance = 0, worst_power = 0, worst_energy = 0;
+  int outside_pattern = 0, inside_pattern = 0;
   for (int trial = 0; trial < 5; ++trial) {
     const Coordinates s = random_state(rng, model, 0.03);
     CommandVector u, u_dot;
     for (int k = 0; k < kCommandedCount; ++k) u(k) = half(rng), u_dot(k) = half(rng);
     inverse_dynamics(model, d, s, u, u_dot, t);
+    // reduced_dynamics reads only the entries of T the generator's pattern marks: the runtime's
+    // solve must leave every other one exactly zero (else M would silently miss a coupling).
+    for (int j = 0; j < kCoordinateCount; ++j)
+      for (int k = 0; k < kCommandedCount; ++k)
+        (gen::kRateBasisPattern[static_cast<std::size_t>(j)][static_cast<std::size_t>(k)] ? inside_pattern : outside_pattern) +=
+            t.T(j, k) != 0 ? 1 : 0;
     const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
     worst_balance = std::max(worst_balance, (t.J_beta.transpose() * tau - t.Qstar).norm() / t.Qstar.norm());
     worst_power = std::max(worst_power, std::abs(tau.dot(t.J_beta * u) - t.Qstar.dot(u)) / (t.Qstar.norm() * u.norm()));
     worst_energy = std::max(worst_energy, test::energy_balance_error(model, s, u));
   }
-  MESSAGE(kName << ": J^T tau = Q*: " << worst_balance << ", power: " << worst_power << ", energy: " << worst_energy);
+  MESSAGE(kName << ": J^T tau = Q*: " << worst_balance << ", power: " << worst_power << ", energy: " << worst_energy
+                << "; nonzero entries of T inside its pattern: " << inside_pattern << ", outside: " << outside_pattern);
+  CHECK(outside_pattern == 0);
+  CHECK(inside_pattern > 0);
   CHECK(worst_balance <= 1e-9);  // least-norm solve with cond(J_beta) up to ~1e4
   CHECK(worst_power <= 1e-9);
   CHECK(worst_energy <= 1e-6);  // five-point stencil at dt = 1e-5 on a motion with |s'| <= 1

@@ -35,7 +35,7 @@ namespace gen {
 // The same outputs as expression trees, before CSE: 145199 (adds 22365, muls 55177, divs 0, calls 67657).
 // Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by
 // argument-dependent lookup; deduced from s. The parameters stay double.
-// Input T (RateBasis): s' = T u, the rates caused by unit commanded speeds (rate_basis at s); only the rows of the dependent pair and of the dependent joints are read, the others are fixed by the model file
+// Input T (RateBasis): s' = T u, the rates caused by unit commanded speeds (rate_basis at s); only the rows of the dependent pair and of the dependent joints are read, the others are fixed by the model file, and in them only the entries kRateBasisPattern marks (structure.hpp; the others are zero)
 // zero_fill: write the structural zeros of the matrix outputs too. Pass false when they are
 // zero already (a workspace zeroed once at setup): this function never writes them.
 // Where reduced_dynamics() writes: set the outputs you want; a null pointer skips that output and the
@@ -612,17 +612,32 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L kane_T_23 = detail::lanes_of_row<Scalar, 4>(T, 23);
     const L kane_T_27 = detail::lanes_of_row<Scalar, 4>(T, 27);
     const L kane_T_31 = detail::lanes_of_row<Scalar, 4>(T, 31);
-    L kane_M_0 = detail::zero_lanes<Scalar, 4>(), kane_M_1 = kane_M_0, kane_M_2 = kane_M_0, kane_M_3 = kane_M_0, kane_b = kane_M_0, kane_Q = kane_M_0, kane_B_1 = kane_M_0, kane_B_3 = kane_M_0, kane_B_18 = kane_M_0, kane_B_19 = kane_M_0, kane_B_20 = kane_M_0, kane_B_21 = kane_M_0, kane_B_22 = kane_M_0, kane_B_23 = kane_M_0, kane_B_27 = kane_M_0, kane_B_31 = kane_M_0;
+    L kane_B_1 = detail::zero_lanes<Scalar, 4>();
+    L kane_B_18 = detail::zero_lanes<Scalar, 4>();
+    L kane_B_19 = detail::zero_lanes<Scalar, 4>();
+    L kane_B_20 = detail::zero_lanes<Scalar, 4>();
+    L kane_B_21 = detail::zero_lanes<Scalar, 4>();
+    L kane_B_22 = detail::zero_lanes<Scalar, 4>();
+    L kane_B_23 = detail::zero_lanes<Scalar, 4>();
+    L kane_B_27 = detail::zero_lanes<Scalar, 4>();
+    L kane_B_3 = detail::zero_lanes<Scalar, 4>();
+    L kane_B_31 = detail::zero_lanes<Scalar, 4>();
+    L kane_M_0 = detail::zero_lanes<Scalar, 4>();
+    L kane_M_1 = detail::zero_lanes<Scalar, 4>();
+    L kane_M_2 = detail::zero_lanes<Scalar, 4>();
+    L kane_M_3 = detail::zero_lanes<Scalar, 4>();
+    L kane_Q = detail::zero_lanes<Scalar, 4>();
+    L kane_b = detail::zero_lanes<Scalar, 4>();
     // The joints' partial twists (omega; velocity of the point at K0's origin), one lane per commanded
     // speed, summed along the bodies' chains from K0 (chains share their common joints).
     L twist0_3 = detail::zero_lanes<Scalar, 4>();
     const Scalar kane_twist_0_3 = Scalar(1.0);
-    twist0_3.v[1] += kane_twist_0_3;
+    twist0_3.add_to_lane(1, kane_twist_0_3);
     const Scalar kane_twist_1_4 = Scalar(1.0);
     const L twist1_4 = kane_twist_1_4 * kane_T_1;
     L twist2_5 = detail::zero_lanes<Scalar, 4>();
     const Scalar kane_twist_2_5 = Scalar(1.0);
-    twist2_5.v[0] += kane_twist_2_5;
+    twist2_5.add_to_lane(0, kane_twist_2_5);
     const Scalar kane_twist_3_2 = Scalar(1.0);
     const L twist3_2 = kane_twist_3_2 * kane_T_3;
     const Scalar kane_twist_3_3 = y_C;
@@ -632,40 +647,40 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L twist3_4 = twist1_4 + kane_twist_3_4 * kane_T_3;
     L twist4_0 = detail::zero_lanes<Scalar, 4>();
     const Scalar kane_twist_4_0 = -sin_yaw;
-    twist4_0.v[3] += kane_twist_4_0;
+    twist4_0.add_to_lane(3, kane_twist_4_0);
     L twist4_1 = detail::zero_lanes<Scalar, 4>();
     const Scalar kane_twist_4_1 = cos_yaw;
-    twist4_1.v[3] += kane_twist_4_1;
+    twist4_1.add_to_lane(3, kane_twist_4_1);
     L twist4_3 = twist3_3;
     const Scalar kane_twist_4_3 = -cos_yaw*z_C;
-    twist4_3.v[3] += kane_twist_4_3;
+    twist4_3.add_to_lane(3, kane_twist_4_3);
     L twist4_4 = twist3_4;
     const Scalar kane_twist_4_4 = -z_C*sin_yaw;
-    twist4_4.v[3] += kane_twist_4_4;
+    twist4_4.add_to_lane(3, kane_twist_4_4);
     L twist4_5 = twist2_5;
     const Scalar kane_twist_4_5 = cos_yaw*x_C + y_C*sin_yaw;
-    twist4_5.v[3] += kane_twist_4_5;
+    twist4_5.add_to_lane(3, kane_twist_4_5);
     L twist5_0 = twist4_0;
     const Scalar t430 = cos_yaw*cos_pitch;
     const Scalar kane_twist_5_0 = t430;
-    twist5_0.v[2] += kane_twist_5_0;
+    twist5_0.add_to_lane(2, kane_twist_5_0);
     L twist5_1 = twist4_1;
     const Scalar t431 = cos_pitch*sin_yaw;
     const Scalar kane_twist_5_1 = t431;
-    twist5_1.v[2] += kane_twist_5_1;
+    twist5_1.add_to_lane(2, kane_twist_5_1);
     L twist5_2 = twist3_2;
     const Scalar t432 = -sin_pitch;
     const Scalar kane_twist_5_2 = t432;
-    twist5_2.v[2] += kane_twist_5_2;
+    twist5_2.add_to_lane(2, kane_twist_5_2);
     L twist5_3 = twist4_3;
     const Scalar kane_twist_5_3 = -(z_C*cos_pitch*sin_yaw + sin_pitch*y_C);
-    twist5_3.v[2] += kane_twist_5_3;
+    twist5_3.add_to_lane(2, kane_twist_5_3);
     L twist5_4 = twist4_4;
     const Scalar kane_twist_5_4 = cos_yaw*z_C*cos_pitch + sin_pitch*x_C;
-    twist5_4.v[2] += kane_twist_5_4;
+    twist5_4.add_to_lane(2, kane_twist_5_4);
     L twist5_5 = twist4_5;
     const Scalar kane_twist_5_5 = -(cos_yaw*y_C*cos_pitch - x_C*cos_pitch*sin_yaw);
-    twist5_5.v[2] += kane_twist_5_5;
+    twist5_5.add_to_lane(2, kane_twist_5_5);
     const Scalar kane_twist_6_0 = t160;
     const L twist6_0 = twist5_0 + kane_twist_6_0 * kane_T_21;
     const Scalar kane_twist_6_1 = t156;
@@ -1243,26 +1258,71 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     const L tau0 = kane_twist_0_3 * wrench5_0;
     kane_M_1 += tau0;
     if (M != nullptr) {  // the upper triangle, mirrored: M is symmetric to the last bit
-      const L* row[] = {&kane_M_0, &kane_M_1, &kane_M_2, &kane_M_3};
-      for (int k = 0; k < 4; ++k)
-        for (int l = k; l < 4; ++l) (*M)(k, l) = (*M)(l, k) = row[k]->v[l];
+      (*M)(0, 0) = kane_M_0.lane(0);
+      (*M)(0, 1) = (*M)(1, 0) = kane_M_0.lane(1);
+      (*M)(0, 2) = (*M)(2, 0) = kane_M_0.lane(2);
+      (*M)(0, 3) = (*M)(3, 0) = kane_M_0.lane(3);
+      (*M)(1, 1) = kane_M_1.lane(1);
+      (*M)(1, 2) = (*M)(2, 1) = kane_M_1.lane(2);
+      (*M)(1, 3) = (*M)(3, 1) = kane_M_1.lane(3);
+      (*M)(2, 2) = kane_M_2.lane(2);
+      (*M)(2, 3) = (*M)(3, 2) = kane_M_2.lane(3);
+      (*M)(3, 3) = kane_M_3.lane(3);
     }
-    if (b_velocity != nullptr)
-      for (int k = 0; k < 4; ++k) (*b_velocity)(k) = kane_b.v[k];
-    if (Q_gravity != nullptr)
-      for (int k = 0; k < 4; ++k) (*Q_gravity)(k) = kane_Q.v[k];
+    if (b_velocity != nullptr) {
+      (*b_velocity)(0) = kane_b.lane(0);
+      (*b_velocity)(1) = kane_b.lane(1);
+      (*b_velocity)(2) = kane_b.lane(2);
+      (*b_velocity)(3) = kane_b.lane(3);
+    }
+    if (Q_gravity != nullptr) {
+      (*Q_gravity)(0) = kane_Q.lane(0);
+      (*Q_gravity)(1) = kane_Q.lane(1);
+      (*Q_gravity)(2) = kane_Q.lane(2);
+      (*Q_gravity)(3) = kane_Q.lane(3);
+    }
     if (B_bias != nullptr) {
       if (zero_fill) B_bias->setZero();
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 1) = kane_B_1.v[k];
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 3) = kane_B_3.v[k];
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 18) = kane_B_18.v[k];
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 19) = kane_B_19.v[k];
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 20) = kane_B_20.v[k];
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 21) = kane_B_21.v[k];
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 22) = kane_B_22.v[k];
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 23) = kane_B_23.v[k];
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 27) = kane_B_27.v[k];
-      for (int k = 0; k < 4; ++k) (*B_bias)(k, 31) = kane_B_31.v[k];
+      (*B_bias)(0, 1) = kane_B_1.lane(0);
+      (*B_bias)(1, 1) = kane_B_1.lane(1);
+      (*B_bias)(2, 1) = kane_B_1.lane(2);
+      (*B_bias)(3, 1) = kane_B_1.lane(3);
+      (*B_bias)(0, 3) = kane_B_3.lane(0);
+      (*B_bias)(1, 3) = kane_B_3.lane(1);
+      (*B_bias)(2, 3) = kane_B_3.lane(2);
+      (*B_bias)(3, 3) = kane_B_3.lane(3);
+      (*B_bias)(0, 18) = kane_B_18.lane(0);
+      (*B_bias)(1, 18) = kane_B_18.lane(1);
+      (*B_bias)(2, 18) = kane_B_18.lane(2);
+      (*B_bias)(3, 18) = kane_B_18.lane(3);
+      (*B_bias)(0, 19) = kane_B_19.lane(0);
+      (*B_bias)(1, 19) = kane_B_19.lane(1);
+      (*B_bias)(2, 19) = kane_B_19.lane(2);
+      (*B_bias)(3, 19) = kane_B_19.lane(3);
+      (*B_bias)(0, 20) = kane_B_20.lane(0);
+      (*B_bias)(1, 20) = kane_B_20.lane(1);
+      (*B_bias)(2, 20) = kane_B_20.lane(2);
+      (*B_bias)(3, 20) = kane_B_20.lane(3);
+      (*B_bias)(0, 21) = kane_B_21.lane(0);
+      (*B_bias)(1, 21) = kane_B_21.lane(1);
+      (*B_bias)(2, 21) = kane_B_21.lane(2);
+      (*B_bias)(3, 21) = kane_B_21.lane(3);
+      (*B_bias)(0, 22) = kane_B_22.lane(0);
+      (*B_bias)(1, 22) = kane_B_22.lane(1);
+      (*B_bias)(2, 22) = kane_B_22.lane(2);
+      (*B_bias)(3, 22) = kane_B_22.lane(3);
+      (*B_bias)(0, 23) = kane_B_23.lane(0);
+      (*B_bias)(1, 23) = kane_B_23.lane(1);
+      (*B_bias)(2, 23) = kane_B_23.lane(2);
+      (*B_bias)(3, 23) = kane_B_23.lane(3);
+      (*B_bias)(0, 27) = kane_B_27.lane(0);
+      (*B_bias)(1, 27) = kane_B_27.lane(1);
+      (*B_bias)(2, 27) = kane_B_27.lane(2);
+      (*B_bias)(3, 27) = kane_B_27.lane(3);
+      (*B_bias)(0, 31) = kane_B_31.lane(0);
+      (*B_bias)(1, 31) = kane_B_31.lane(1);
+      (*B_bias)(2, 31) = kane_B_31.lane(2);
+      (*B_bias)(3, 31) = kane_B_31.lane(3);
     }
   }
 }

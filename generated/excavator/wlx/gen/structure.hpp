@@ -97,6 +97,45 @@ inline constexpr std::array<std::string_view, 8> kActuatorNames{{"psi_l2", "psi_
 inline constexpr std::array<double, 8> kDefaultWeights{{0.01, 100.0, 1.0, 0.01, 100.0, 1.0, 0.01, 0.01}};
 inline constexpr double Params::*kGravity = &Params::g;
 
+// The rate basis T (s' = T u, one column per commanded speed): whether a coordinate's rate can
+// depend on a commanded speed. The closure's and the wheels' rows split the dependent rates into
+// independent blocks (a limb's joints with its wheel's rate, say), each moved only by the speeds
+// its rows involve; every other entry of T is exactly zero, and reduced_dynamics never reads it.
+inline constexpr std::array<std::array<bool, 4>, 32> kRateBasisPattern{{
+    {{false, true, false, false}},  // x_C
+    {{true, true, true, true}},  // y_C
+    {{true, false, false, false}},  // z_C
+    {{true, true, true, true}},  // yaw
+    {{false, false, false, true}},  // pitch
+    {{false, false, true, false}},  // roll
+    {{false, false, false, false}},  // x_Fl
+    {{false, false, false, false}},  // y_Fl
+    {{false, false, false, false}},  // z_Fl
+    {{false, false, false, false}},  // x_Fr
+    {{false, false, false, false}},  // y_Fr
+    {{false, false, false, false}},  // z_Fr
+    {{false, false, false, false}},  // z_Wl
+    {{false, false, false, false}},  // z_Wr
+    {{false, false, false, false}},  // psi_l1
+    {{false, false, false, false}},  // psi_r1
+    {{false, false, false, false}},  // theta_l5
+    {{false, false, false, false}},  // theta_r5
+    {{true, true, true, true}},  // psi_l2
+    {{true, true, true, true}},  // psi_l3
+    {{true, true, true, true}},  // psi_l4
+    {{true, true, true, true}},  // psi_r2
+    {{true, true, true, true}},  // psi_r3
+    {{true, true, true, true}},  // psi_r4
+    {{true, true, true, true}},  // theta_l2
+    {{true, true, true, true}},  // theta_l3
+    {{true, true, true, true}},  // theta_l4
+    {{true, true, true, true}},  // theta_l6
+    {{true, true, true, true}},  // theta_r2
+    {{true, true, true, true}},  // theta_r3
+    {{true, true, true, true}},  // theta_r4
+    {{true, true, true, true}},  // theta_r6
+}};
+
 // Per body, the coordinates its velocity Jacobians Jv, Jw depend on: every other column is a
 // structural zero (bodies() never writes it).
 inline constexpr int kMaxBodyColumns = 10;

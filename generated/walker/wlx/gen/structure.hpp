@@ -97,6 +97,45 @@ inline constexpr std::array<std::string_view, 8> kActuatorNames{{"abduct_l", "li
 inline constexpr std::array<double, 8> kDefaultWeights{{1.0, 0.01, 0.1, 1.0, 0.01, 0.1, 0.01, 0.01}};
 inline constexpr double Params::*kGravity = &Params::gravity;
 
+// The rate basis T (s' = T u, one column per commanded speed): whether a coordinate's rate can
+// depend on a commanded speed. The closure's and the wheels' rows split the dependent rates into
+// independent blocks (a limb's joints with its wheel's rate, say), each moved only by the speeds
+// its rows involve; every other entry of T is exactly zero, and reduced_dynamics never reads it.
+inline constexpr std::array<std::array<bool, 4>, 32> kRateBasisPattern{{
+    {{false, true, false, false}},  // x_C
+    {{true, true, true, true}},  // y_C
+    {{true, false, false, false}},  // z_C
+    {{true, true, true, true}},  // yaw
+    {{false, false, false, true}},  // pitch
+    {{false, false, true, false}},  // roll
+    {{false, false, false, false}},  // foot_x_l
+    {{false, false, false, false}},  // foot_y_l
+    {{false, false, false, false}},  // foot_z_l
+    {{false, false, false, false}},  // foot_x_r
+    {{false, false, false, false}},  // foot_y_r
+    {{false, false, false, false}},  // foot_z_r
+    {{false, false, false, false}},  // ground_l
+    {{false, false, false, false}},  // ground_r
+    {{false, false, false, false}},  // slew_l
+    {{false, false, false, false}},  // slew_r
+    {{false, false, false, false}},  // steer_l
+    {{false, false, false, false}},  // steer_r
+    {{true, true, true, true}},  // abduct_l
+    {{true, true, true, true}},  // lift_l
+    {{true, true, true, true}},  // knee_l
+    {{true, true, true, true}},  // abduct_r
+    {{true, true, true, true}},  // lift_r
+    {{true, true, true, true}},  // knee_r
+    {{true, true, true, true}},  // camber_l
+    {{true, true, true, true}},  // hub_l
+    {{true, true, true, true}},  // guide_l
+    {{true, true, true, true}},  // swing_l
+    {{true, true, true, true}},  // camber_r
+    {{true, true, true, true}},  // hub_r
+    {{true, true, true, true}},  // guide_r
+    {{true, true, true, true}},  // swing_r
+}};
+
 // Per body, the coordinates its velocity Jacobians Jv, Jw depend on: every other column is a
 // structural zero (bodies() never writes it).
 inline constexpr int kMaxBodyColumns = 10;

@@ -14,9 +14,9 @@
 //   bodies                    1022        165475          5164
 //   kinematic_update           411         98350          2249
 //   dynamics_update            355        102428          1887
-//   reduced_dynamics          1155        371844         24718
+//   reduced_dynamics          1155        371844         18784
 //   clearance                    0            19            19
-//   total                                1095022         40639
+//   total                                1095022         34705
 #pragma once
 
 #include "ik.hpp"

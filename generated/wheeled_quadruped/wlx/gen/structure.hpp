@@ -99,6 +99,43 @@ inline constexpr std::array<std::string_view, 16> kActuatorNames{{"haa_lf", "hfe
 inline constexpr std::array<double, 16> kDefaultWeights{{1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0}};
 inline constexpr double Params::*kGravity = &Params::g;
 
+// The rate basis T (s' = T u, one column per commanded speed): whether a coordinate's rate can
+// depend on a commanded speed. The closure's and the wheels' rows split the dependent rates into
+// independent blocks (a limb's joints with its wheel's rate, say), each moved only by the speeds
+// its rows involve; every other entry of T is exactly zero, and reduced_dynamics never reads it.
+inline constexpr std::array<std::array<bool, 10>, 30> kRateBasisPattern{{
+    {{true, false, false, false, false, false, false, false, false, false}},  // x_B
+    {{false, true, false, false, false, false, false, false, false, false}},  // y_B
+    {{false, false, true, false, false, false, false, false, false, false}},  // z_B
+    {{false, false, false, true, false, false, false, false, false, false}},  // yaw
+    {{false, false, false, false, true, false, false, false, false, false}},  // pitch
+    {{false, false, false, false, false, true, false, false, false, false}},  // roll
+    {{false, false, false, false, false, false, true, false, false, false}},  // x_lf
+    {{true, true, true, true, true, true, true, false, false, false}},  // y_lf
+    {{false, false, false, false, false, false, false, false, false, false}},  // ground_lf
+    {{false, false, false, false, false, false, false, true, false, false}},  // x_rf
+    {{true, true, true, true, true, true, false, true, false, false}},  // y_rf
+    {{false, false, false, false, false, false, false, false, false, false}},  // ground_rf
+    {{false, false, false, false, false, false, false, false, true, false}},  // x_lh
+    {{true, true, true, true, true, true, false, false, true, false}},  // y_lh
+    {{false, false, false, false, false, false, false, false, false, false}},  // ground_lh
+    {{false, false, false, false, false, false, false, false, false, true}},  // x_rh
+    {{true, true, true, true, true, true, false, false, false, true}},  // y_rh
+    {{false, false, false, false, false, false, false, false, false, false}},  // ground_rh
+    {{true, true, true, true, true, true, true, false, false, false}},  // haa_lf
+    {{true, true, true, true, true, true, true, false, false, false}},  // hfe_lf
+    {{true, true, true, true, true, true, true, false, false, false}},  // kfe_lf
+    {{true, true, true, true, true, true, false, true, false, false}},  // haa_rf
+    {{true, true, true, true, true, true, false, true, false, false}},  // hfe_rf
+    {{true, true, true, true, true, true, false, true, false, false}},  // kfe_rf
+    {{true, true, true, true, true, true, false, false, true, false}},  // haa_lh
+    {{true, true, true, true, true, true, false, false, true, false}},  // hfe_lh
+    {{true, true, true, true, true, true, false, false, true, false}},  // kfe_lh
+    {{true, true, true, true, true, true, false, false, false, true}},  // haa_rh
+    {{true, true, true, true, true, true, false, false, false, true}},  // hfe_rh
+    {{true, true, true, true, true, true, false, false, false, true}},  // kfe_rh
+}};
+
 // Per body, the coordinates its velocity Jacobians Jv, Jw depend on: every other column is a
 // structural zero (bodies() never writes it).
 inline constexpr int kMaxBodyColumns = 9;

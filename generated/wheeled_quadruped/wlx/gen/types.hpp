@@ -88,10 +88,13 @@ namespace detail {
 template <typename T> struct NonDeducedType { using type = T; };
 template <typename T> using NonDeduced = typename NonDeducedType<T>::type;
 // N scalars side by side, for code that does the same to N columns at once (reduced_dynamics:
-// Kane's sums, one lane per commanded speed). Loops over a fixed N, which compilers vectorize.
+// Kane's sums, one lane per commanded speed). Loops over a fixed N, which compilers unroll.
 template <typename Scalar, int N>
 struct Lanes {
   Scalar v[N];
+  Scalar lane(int i) const noexcept { return v[i]; }
+  void set_lane(int i, const Scalar& x) noexcept { v[i] = x; }
+  void add_to_lane(int i, const Scalar& x) noexcept { v[i] += x; }
   Lanes& operator+=(const Lanes& o) noexcept {
     for (int i = 0; i < N; ++i) v[i] += o.v[i];
     return *this;
@@ -105,33 +108,43 @@ struct Lanes {
 };
 #if defined(__GNUC__) && !defined(WLX_GEN_NO_VECTOR_LANES)
 #define WLX_GEN_LANES_INLINE inline __attribute__((always_inline))
-// double on 4 lanes: one GCC / clang vector (an AVX register, or two SSE2 ones), so that the
-// rows stay in registers. Always inlined: a 32-byte vector is never passed to or returned from
-// a call, whose convention would depend on whether the caller targets AVX.
-template <>
-struct Lanes<double, 4> {
+// double: GCC / clang vectors of 4 (an AVX register, or two SSE2 ones), as many as N needs, the
+// last one padded with zeros, so that the rows stay in registers and every operation is one
+// vector instruction per 4 lanes whatever N is. Always inlined: a 32-byte vector is never passed
+// to or returned from a call, whose convention would depend on whether the caller targets AVX.
+template <int N>
+struct Lanes<double, N> {
   typedef double Vector __attribute__((vector_size(32)));
-  Vector v;
+  static constexpr int kVectors = (N + 3) / 4;
+  Vector c[kVectors];
+  __attribute__((always_inline)) double lane(int i) const noexcept { return c[i / 4][i % 4]; }
+  __attribute__((always_inline)) void set_lane(int i, double x) noexcept { c[i / 4][i % 4] = x; }
+  __attribute__((always_inline)) void add_to_lane(int i, double x) noexcept { c[i / 4][i % 4] += x; }
   __attribute__((always_inline)) Lanes& operator+=(const Lanes& o) noexcept {
-    v += o.v;
+    for (int k = 0; k < kVectors; ++k) c[k] += o.c[k];
     return *this;
   }
-  __attribute__((always_inline)) friend Lanes operator+(const Lanes& a, const Lanes& b) noexcept { return {a.v + b.v}; }
-  __attribute__((always_inline)) friend Lanes operator*(const double& s, const Lanes& a) noexcept { return {s * a.v}; }
+  __attribute__((always_inline)) friend Lanes operator+(Lanes a, const Lanes& b) noexcept { return a += b; }
+  __attribute__((always_inline)) friend Lanes operator*(const double& s, const Lanes& a) noexcept {
+    Lanes out;
+    for (int k = 0; k < kVectors; ++k) out.c[k] = s * a.c[k];
+    return out;
+  }
 };
 #else
 #define WLX_GEN_LANES_INLINE inline
 #endif
+// Value-initialized first: a vector's padding lanes are zero too.
 template <typename Scalar, int N>
 WLX_GEN_LANES_INLINE Lanes<Scalar, N> zero_lanes() noexcept {
-  Lanes<Scalar, N> out;
-  for (int i = 0; i < N; ++i) out.v[i] = Scalar(0);
+  Lanes<Scalar, N> out{};
+  for (int i = 0; i < N; ++i) out.set_lane(i, Scalar(0));
   return out;
 }
 template <typename Scalar, int N, class Matrix>
 WLX_GEN_LANES_INLINE Lanes<Scalar, N> lanes_of_row(const Matrix& m, int row) noexcept {
-  Lanes<Scalar, N> out;
-  for (int i = 0; i < N; ++i) out.v[i] = m(row, i);
+  Lanes<Scalar, N> out{};
+  for (int i = 0; i < N; ++i) out.set_lane(i, m(row, i));
   return out;
 }
 #if defined(WLX_GEN_MULTIVERSION)
