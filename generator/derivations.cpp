@@ -171,7 +171,7 @@ FunctionSpec derive_convective(const Model& m) {
                   "second time derivatives of Phi and of v_W . n_W with all accelerations zero.",
                   true, {}};
   OutputSpec phi{"dPhi_ds_dot_sdot", "ClosureVector", "(d/dt dPhi/ds) s'", "", {}};
-  OutputSpec C{"C_dot_sdot", "WheelVector", "(d/dt C) s', one per wheel (l, r)", "", {}};
+  OutputSpec C{"C_dot_sdot", "WheelVector", "(d/dt C) s', one per wheel (kWheels' order)", "", {}};
   for (int i = 0; i < static_cast<int>(m.closure.size()); ++i)
     phi.elements.emplace_back(at(i), closure_row(m, m.closure[static_cast<std::size_t>(i)]).convective);
   for (int i = 0; i < static_cast<int>(m.wheels.size()); ++i)

@@ -22,7 +22,7 @@ namespace gen {
 // Outputs, members of ConvectiveOutputsOf<Scalar> (ConvectiveOutputs for double), each computed only when its
 // pointer is set (C++20: convective(..., {.dPhi_ds_dot_sdot = &x})):
 //   dPhi_ds_dot_sdot   (d/dt dPhi/ds) s' (own operations: 800, nonzero entries: 14)
-//   C_dot_sdot         (d/dt C) s', one per wheel (l, r) (own operations: 433, nonzero entries: 2)
+//   C_dot_sdot         (d/dt C) s', one per wheel (kWheels' order) (own operations: 433, nonzero entries: 2)
 // Intermediate terms: 353; shared by several outputs: 634 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).
 // Operations with every output requested: 1867 (adds 773, muls 1052, divs 0, calls 42).
@@ -34,7 +34,7 @@ namespace gen {
 template <typename Scalar>
 struct ConvectiveOutputsOf {
   ClosureVectorOf<Scalar>* dPhi_ds_dot_sdot = nullptr;  // (d/dt dPhi/ds) s'
-  WheelVectorOf<Scalar>* C_dot_sdot = nullptr;          // (d/dt C) s', one per wheel (l, r)
+  WheelVectorOf<Scalar>* C_dot_sdot = nullptr;          // (d/dt C) s', one per wheel (kWheels' order)
 };
 using ConvectiveOutputs = ConvectiveOutputsOf<double>;
 

@@ -22,7 +22,7 @@ namespace gen {
 // Outputs, members of ReducedDynamicsOutputsOf<Scalar> (ReducedDynamicsOutputs for double), each computed only when its
 // pointer is set (C++20: reduced_dynamics(..., {.dPhi_ds_dot_sdot = &x})):
 //   dPhi_ds_dot_sdot   (d/dt dPhi/ds) s' (own operations: 253, nonzero entries: 14)
-//   C_dot_sdot         (d/dt C) s', one per wheel (l, r) (own operations: 405, nonzero entries: 2)
+//   C_dot_sdot         (d/dt C) s', one per wheel (kWheels' order) (own operations: 405, nonzero entries: 2)
 //   M                  generalized mass matrix on u (symmetric) (own operations: 2669, on rows of 4 lanes)
 //   b_velocity         velocity-dependent forces on u, s''_bias excluded (own operations: 312, on rows of 4 lanes)
 //   B_bias             forces on u per unit s''_bias: b = b_velocity + B_bias s''_bias (own operations: 416, on rows of 4 lanes)
@@ -43,7 +43,7 @@ namespace gen {
 template <typename Scalar>
 struct ReducedDynamicsOutputsOf {
   ClosureVectorOf<Scalar>* dPhi_ds_dot_sdot = nullptr;  // (d/dt dPhi/ds) s'
-  WheelVectorOf<Scalar>* C_dot_sdot = nullptr;          // (d/dt C) s', one per wheel (l, r)
+  WheelVectorOf<Scalar>* C_dot_sdot = nullptr;          // (d/dt C) s', one per wheel (kWheels' order)
   CommandMatrixOf<Scalar>* M = nullptr;                 // generalized mass matrix on u (symmetric)
   CommandVectorOf<Scalar>* b_velocity = nullptr;        // velocity-dependent forces on u, s''_bias excluded
   CommandRowsOf<Scalar>* B_bias = nullptr;              // forces on u per unit s''_bias: b = b_velocity + B_bias s''_bias

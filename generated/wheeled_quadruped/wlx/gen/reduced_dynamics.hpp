@@ -22,7 +22,7 @@ namespace gen {
 // Outputs, members of ReducedDynamicsOutputsOf<Scalar> (ReducedDynamicsOutputs for double), each computed only when its
 // pointer is set (C++20: reduced_dynamics(..., {.dPhi_ds_dot_sdot = &x})):
 //   dPhi_ds_dot_sdot   (d/dt dPhi/ds) s' (own operations: 105, nonzero entries: 12)
-//   C_dot_sdot         (d/dt C) s', one per wheel (l, r) (own operations: 209, nonzero entries: 4)
+//   C_dot_sdot         (d/dt C) s', one per wheel (kWheels' order) (own operations: 209, nonzero entries: 4)
 //   M                  generalized mass matrix on u (symmetric) (own operations: 10533, on rows of 7 lanes, 10 where the limbs' sums meet)
 //   b_velocity         velocity-dependent forces on u, s''_bias excluded (own operations: 1446, on rows of 7 lanes, 10 where the limbs' sums meet)
 //   B_bias             forces on u per unit s''_bias: b = b_velocity + B_bias s''_bias (own operations: 1008, on rows of 7 lanes, 10 where the limbs' sums meet)
@@ -43,7 +43,7 @@ namespace gen {
 template <typename Scalar>
 struct ReducedDynamicsOutputsOf {
   ClosureVectorOf<Scalar>* dPhi_ds_dot_sdot = nullptr;  // (d/dt dPhi/ds) s'
-  WheelVectorOf<Scalar>* C_dot_sdot = nullptr;          // (d/dt C) s', one per wheel (l, r)
+  WheelVectorOf<Scalar>* C_dot_sdot = nullptr;          // (d/dt C) s', one per wheel (kWheels' order)
   CommandMatrixOf<Scalar>* M = nullptr;                 // generalized mass matrix on u (symmetric)
   CommandVectorOf<Scalar>* b_velocity = nullptr;        // velocity-dependent forces on u, s''_bias excluded
   CommandRowsOf<Scalar>* B_bias = nullptr;              // forces on u per unit s''_bias: b = b_velocity + B_bias s''_bias
