@@ -266,6 +266,7 @@ namespace {
 class LaneWriter {
  public:
   using Set = std::vector<int>;  // commanded speeds, ascending
+  using Terms = std::vector<std::pair<std::string, std::string>>;  // (scalar factor, row)
   LaneWriter(std::vector<int> slot, int width) : slot_(std::move(slot)), width_(width), speeds_(static_cast<int>(slot_.size())) {}
   int charge_to = 0;  // the output the next statements' operations count for
   bool shares_lanes() const { return width_ < speeds_; }
@@ -275,27 +276,14 @@ class LaneWriter {
   const Set& speeds(const std::string& row) const { return rows_.at(row).speeds; }
   // A new row "name = base + sum_i factor_i * row_i" (zero terms, "" rows, dropped); returns the
   // name, or base itself when no term remains (no code).
-  std::string define(const std::string& name, const std::string& base,
-                     const std::vector<std::pair<std::string, std::string>>& terms) {
-    std::vector<std::pair<std::string, std::string>> kept;
-    for (const auto& t : terms)
-      if (!t.first.empty() && !t.second.empty()) kept.push_back(t);
+  std::string define(const std::string& name, const std::string& base, const Terms& terms) {
+    const Terms kept = nonzero(terms);
     if (kept.empty()) return base;
-    std::vector<std::string> rows;
-    if (!base.empty()) rows.push_back(base);
-    for (const auto& t : kept) rows.push_back(t.second);
+    std::vector<std::string> rows = rows_of(kept);
+    if (!base.empty()) rows.insert(rows.begin(), base);
     const Layout layout = unify(rows);
-    const int n = lanes(layout.wide);
-    std::string rhs = base.empty() ? "" : as(base, layout.wide);
     OpCount ops;
-    for (const auto& [factor, row] : kept) {
-      if (!rhs.empty()) {
-        rhs += " + ";
-        ops.adds += n;
-      }
-      rhs += factor + " * " + as(row, layout.wide);
-      ops.muls += n;
-    }
+    const std::string rhs = products(base.empty() ? "" : as(base, layout.wide), kept, layout.wide, ops);
     add(name, fmt::format("    const {} {} = {};\n", type(layout.wide), name, rhs), ops);
     rows_[name] = {layout.speeds, layout.wide};
     return name;
@@ -312,26 +300,12 @@ class LaneWriter {
   }
   // "accumulator += sum_i factor_i * row_i": into one of the accumulator's parts (one whose
   // speeds, with the terms', keep distinct lanes; else a new part).
-  void accumulate(const std::string& accumulator, const std::vector<std::pair<std::string, std::string>>& terms) {
-    std::vector<std::pair<std::string, std::string>> kept;
-    for (const auto& t : terms)
-      if (!t.first.empty() && !t.second.empty()) kept.push_back(t);
+  void accumulate(const std::string& accumulator, const Terms& terms) {
+    const Terms kept = nonzero(terms);
     if (kept.empty()) return;
-    std::vector<std::string> rows;
-    for (const auto& t : kept) rows.push_back(t.second);
-    const Layout layout = unify(rows);
-    const Part& part = part_for(accumulator, layout);
-    const int n = lanes(part.wide);
-    std::string rhs;
-    OpCount ops{n, 0, 0, 0};  // the +=
-    for (const auto& [factor, row] : kept) {
-      if (!rhs.empty()) {
-        rhs += " + ";
-        ops.adds += n;
-      }
-      rhs += factor + " * " + as(row, part.wide);
-      ops.muls += n;
-    }
+    const Part& part = part_for(accumulator, unify(rows_of(kept)));
+    OpCount ops{lanes(part.wide), 0, 0, 0};  // the +=
+    const std::string rhs = products("", kept, part.wide, ops);
     add("", fmt::format("    {} += {};\n", part.name, rhs), ops);
   }
   // "accumulator += row".
@@ -414,6 +388,31 @@ class LaneWriter {
     OpCount ops;
     int output = 0;
   };
+  // The terms without a zero factor or row, and their rows.
+  static Terms nonzero(const Terms& terms) {
+    Terms kept;
+    for (const auto& t : terms)
+      if (!t.first.empty() && !t.second.empty()) kept.push_back(t);
+    return kept;
+  }
+  static std::vector<std::string> rows_of(const Terms& terms) {
+    std::vector<std::string> rows;
+    for (const auto& t : terms) rows.push_back(t.second);
+    return rows;
+  }
+  // "rhs + factor_i * row_i + ...", the rows as rows of the given kind; counts the operations on its lanes.
+  std::string products(std::string rhs, const Terms& terms, bool wide, OpCount& ops) {
+    const int n = lanes(wide);
+    for (const auto& [factor, row] : terms) {
+      if (!rhs.empty()) {
+        rhs += " + ";
+        ops.adds += n;
+      }
+      rhs += factor + " * " + as(row, wide);
+      ops.muls += n;
+    }
+    return rhs;
+  }
   static Set merged(const Set& a, const Set& b) {
     Set out;
     std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
