@@ -490,7 +490,25 @@ struct TwistNode {
 // independent blocks, the connected parts of "row r involves unknown j" (a leg's joints and its
 // wheel's rate, say); a block's rates depend on the commanded speeds its rows involve, and on no
 // other. A commanded speed's rate is itself; a held input's is zero (no speeds).
-std::vector<std::vector<int>> rate_speeds(const Model& m, const std::vector<int>& speed_of, const std::function<bool(int)>& dense) {
+// The coordinates' roles in s' = T u (model with a dynamics section): each commanded speed's index
+// in u (-1 for the others), and whether T's row is dense (the dependent pair and the dependent joints).
+struct RateRoles {
+  std::vector<int> speed_of;
+  std::vector<bool> dense;
+};
+RateRoles rate_roles(const Model& m) {
+  const Dynamics& dyn = *m.dynamics;
+  const int n = coordinate_count(m);
+  const std::vector<int> pair = m.wheels.empty() ? std::vector<int>{} : m.pair(dyn.pair).coordinates;
+  RateRoles roles{std::vector<int>(static_cast<std::size_t>(n), -1), std::vector<bool>(static_cast<std::size_t>(n), false)};
+  for (std::size_t k = 0; k < dyn.commanded.size(); ++k) roles.speed_of[static_cast<std::size_t>(dyn.commanded[k])] = static_cast<int>(k);
+  for (int j = 0; j < n; ++j) roles.dense[static_cast<std::size_t>(j)] = j >= m.input_count || std::count(pair.begin(), pair.end(), j) > 0;
+  return roles;
+}
+
+std::vector<std::vector<int>> rate_speeds(const Model& m, const RateRoles& roles) {
+  const std::vector<int>& speed_of = roles.speed_of;
+  const auto dense = [&](int j) { return roles.dense[static_cast<std::size_t>(j)]; };
   const int n = coordinate_count(m);
   std::vector<std::vector<ex>> rows;
   for (const auto& c : m.closure) rows.push_back(closure_row(m, c).gradient);
@@ -567,18 +585,13 @@ bool same_joint(const JointRecord& a, const JointRecord& b) {
 std::vector<std::vector<int>> rate_basis_pattern(const Model& m) {
   const int n = coordinate_count(m);
   if (!m.dynamics) return std::vector<std::vector<int>>(static_cast<std::size_t>(n));
-  const Dynamics& dyn = *m.dynamics;
-  const std::vector<int> pair = m.wheels.empty() ? std::vector<int>{} : m.pair(dyn.pair).coordinates;
-  std::vector<int> speed_of(static_cast<std::size_t>(n), -1);
-  for (std::size_t k = 0; k < dyn.commanded.size(); ++k) speed_of[static_cast<std::size_t>(dyn.commanded[k])] = static_cast<int>(k);
-  return rate_speeds(m, speed_of, [&](int j) { return j >= m.input_count || std::count(pair.begin(), pair.end(), j) > 0; });
+  return rate_speeds(m, rate_roles(m));
 }
 
 FunctionSpec derive_reduced_dynamics(const Model& m) {
   const Dynamics& dyn = *m.dynamics;
   const int n = coordinate_count(m);
   const int nu = static_cast<int>(dyn.commanded.size());
-  const std::vector<int> pair = m.wheels.empty() ? std::vector<int>{} : m.pair(dyn.pair).coordinates;
   FunctionSpec fn{"reduced_dynamics", "reduced_dynamics.hpp",
                   "Kane's equations on the commanded speeds u, in one pass with the convective terms: with "
                   "s' = T u and s'' = T u' + s''_bias, the generalized inertia, velocity and gravity forces on u "
@@ -596,9 +609,9 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   // T's structure is fixed by the model file: the commanded speeds' rows are unit rows, the rows of
   // the dependent pair and of the dependent joints are dense, the rows of the other inputs (held
   // constant) zero. So only the joints of those two kinds move the bodies.
-  std::vector<int> speed_of(static_cast<std::size_t>(n), -1);
-  for (int k = 0; k < nu; ++k) speed_of[static_cast<std::size_t>(dyn.commanded[static_cast<std::size_t>(k)])] = k;
-  const auto dense = [&](int j) { return j >= m.input_count || std::count(pair.begin(), pair.end(), j) > 0; };
+  const RateRoles roles = rate_roles(m);
+  const std::vector<int>& speed_of = roles.speed_of;
+  const auto dense = [&](int j) { return roles.dense[static_cast<std::size_t>(j)]; };
   const auto moves = [&](int j) { return dense(j) || speed_of[static_cast<std::size_t>(j)] >= 0; };
   fn.inputs = {{"T", "RateBasis",
                 "s' = T u, the rates caused by unit commanded speeds (rate_basis at s); only the rows of the dependent "
@@ -639,7 +652,7 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     const int j = nodes[k].joint->coordinate;
     const int parent = nodes[k].parent;
-    const std::vector<int> own = dense(j) ? speeds_of[static_cast<std::size_t>(j)] : std::vector<int>{speed_of[static_cast<std::size_t>(j)]};
+    const std::vector<int>& own = speeds_of[static_cast<std::size_t>(j)];  // a commanded speed's: itself
     const std::vector<int> before = parent < 0 ? std::vector<int>{} : node_speeds[static_cast<std::size_t>(parent)];
     std::set_union(before.begin(), before.end(), own.begin(), own.end(), std::back_inserter(node_speeds[k]));
   }
