@@ -1,7 +1,8 @@
 // The same benchmarks for every model it is compiled for (CMakeLists.txt: once per model in
 // WLX_BENCH_MODELS, linked into wlx_bench), registered as <model>/<row>, so that models of other
 // sizes are compared side by side in one run: the IK of every limb, the dependent rates, and one
-// inverse-dynamics step (IK, rates, Kane's sums, the torque split) and one forward-dynamics step,
+// inverse-dynamics step (IK, rates, the Newton-Euler pass, the torque split; and the same by Kane's
+// sums) and one forward-dynamics step,
 // from the model's tables alone.
 #include <benchmark/benchmark.h>
 #include <wlx/dynamics.hpp>
@@ -68,6 +69,21 @@ void inverse_dynamics_step(benchmark::State& st) {
   }
 }
 
+// The same step with Q* from Kane's equations of motion (M u' + b - Q_gravity, reduced_dynamics'
+// sums on the commanded speeds) instead of the Newton-Euler pass: what the step cost before, and
+// what it costs a user who also wants M.
+void inverse_dynamics_step_by_kane(benchmark::State& st) {
+  auto x = std::make_unique<Pose>();
+  const CommandVector u_dot = CommandVector::Zero();
+  for (auto _ : st) {
+    solve_ik_closed_form(x->model, x->s, x->branches);
+    equations_of_motion(x->model, x->d, x->s, x->u, x->terms);
+    x->terms.Qstar.noalias() = x->terms.M * u_dot + x->terms.b - x->terms.Q_gravity;
+    const TorqueVector tau = distribute_torques(x->terms.J_beta, x->terms.Qstar, Weighting::model_weights());
+    benchmark::DoNotOptimize(tau.data());
+  }
+}
+
 // The converse step, side by side with the one above: IK, then the accelerations under the
 // torques that hold the nominal pose (one inverse-dynamics evaluation and a Cholesky of M).
 void forward_dynamics_step(benchmark::State& st) {
@@ -88,6 +104,7 @@ const bool registered = [] {
   if (gen::kHasDynamics) {
     benchmark::RegisterBenchmark((model + "/dependent_rates").c_str(), dependent_rates);
     benchmark::RegisterBenchmark((model + "/inverse_dynamics_step").c_str(), inverse_dynamics_step);
+    benchmark::RegisterBenchmark((model + "/inverse_dynamics_step_by_kane").c_str(), inverse_dynamics_step_by_kane);
     benchmark::RegisterBenchmark((model + "/forward_dynamics_step").c_str(), forward_dynamics_step);
   }
   return true;

@@ -282,8 +282,8 @@ struct SolvedStep {
   }
 };
 
-// One inverse-dynamics step: closed-form IK, dependent rates and accelerations, body kinematics,
-// Kane's sums, J_beta, and the weighted torque distribution.
+// One inverse-dynamics step: closed-form IK, dependent rates and accelerations, the bodies'
+// Newton-Euler pass, J_beta, and the weighted torque distribution.
 void BM_inverse_dynamics_step(benchmark::State& st) {
   SolvedStep x;
   for (auto _ : st) {
@@ -303,21 +303,17 @@ void BM_distribute_torques(benchmark::State& st) {
 }
 // The generated passes of one inverse-dynamics step, then the step's generated code alone, IK
 // included, run back to back as the step runs it (its floor: the rest of the step is the runtime's
-// linear algebra). T is the rate basis at s, computed once.
+// linear algebra). T is the rate basis at s, computed once; s'' that step's.
 void dynamics_passes(SolvedStep& x) {
   gen::dynamics_update(x.s, x.model.params(), {.dPhi_ds = &x.d.dPhi_ds, .C = &x.d.C}, false);
-  CommandVector b_velocity;
-  gen::reduced_dynamics(x.s, x.terms.sdot, x.terms.T, x.model.params(),
-                        {.dPhi_ds_dot_sdot = &x.d.dPhi_ds_dot_sdot, .C_dot_sdot = &x.d.C_dot_sdot, .M = &x.terms.M,
-                         .b_velocity = &b_velocity, .B_bias = &x.terms.B_bias, .Q_gravity = &x.terms.Q_gravity},
-                        false);
-  benchmark::DoNotOptimize(b_velocity.data());
+  gen::convective(x.s, x.terms.sdot, x.model.params(), {.dPhi_ds_dot_sdot = &x.d.dPhi_ds_dot_sdot, .C_dot_sdot = &x.d.C_dot_sdot});
+  gen::generalized_forces(x.s, x.terms.sdot, x.terms.sddot, x.terms.T, x.model.params(), {.Qstar = &x.terms.Qstar});
 }
 void BM_gen_dynamics_passes(benchmark::State& st) {
   SolvedStep x;
   for (auto _ : st) {
     dynamics_passes(x);
-    benchmark::DoNotOptimize(x.terms.M.data());
+    benchmark::DoNotOptimize(x.terms.Qstar.data());
   }
 }
 // Kane's sums alone: reduced_dynamics' (twists and wrenches on lanes) against the same sums over
@@ -346,7 +342,7 @@ void BM_inverse_dynamics_generated_only(benchmark::State& st) {
   for (auto _ : st) {
     solve_ik_closed_form(x.model, x.s);
     dynamics_passes(x);
-    benchmark::DoNotOptimize(x.terms.M.data());
+    benchmark::DoNotOptimize(x.terms.Qstar.data());
   }
 }
 // The whole ID-1 run (495 samples, RK4) with weighting 1.
@@ -753,10 +749,11 @@ int main(int argc, char** argv) {
       {"dependent accelerations", "BM_dependent_accelerations", nullptr, 0},
       {"inverse-dynamics step", "BM_inverse_dynamics_step", nullptr, 0},
       {"  its torque split alone (weighted least norm, QR)", "BM_distribute_torques", nullptr, 0},
-      {"  its generated code alone: 4-limb IK + the two passes", "BM_inverse_dynamics_generated_only", nullptr, 0},
-      {"  the two passes: dynamics_update, reduced_dynamics (Kane's sums generated)", "BM_gen_dynamics_passes", nullptr,
-       ops::dynamics_update + ops::reduced_dynamics},
-      {"  Kane's sums: reduced_dynamics (vs over bodies()' Jacobians)", "BM_gen_kane_sums", "BM_kane_sums_over_body_jacobians", 0},
+      {"  its generated code alone: 4-limb IK + the three passes", "BM_inverse_dynamics_generated_only", nullptr, 0},
+      {"  the three passes: dynamics_update, convective, generalized_forces (Newton-Euler)", "BM_gen_dynamics_passes", nullptr,
+       ops::dynamics_update + ops::convective + ops::generalized_forces},
+      {"  Kane's sums: reduced_dynamics, M b B_bias Q_gravity (vs over bodies()' Jacobians)", "BM_gen_kane_sums",
+       "BM_kane_sums_over_body_jacobians", 0},
       {"NH-1 run (2001 samples, RK4)", "BM_run_NH1", nullptr, 0},
       {"ID-1 run (495 samples, RK4, torques)", "BM_run_ID1", nullptr, 0},
   };
@@ -777,7 +774,8 @@ int main(int argc, char** argv) {
     });
     bool first = true;
     for (const std::string& suffix : {std::string("ik_all_limbs"), std::string("dependent_rates"),
-                                      std::string("inverse_dynamics_step"), std::string("forward_dynamics_step")}) {
+                                      std::string("inverse_dynamics_step"), std::string("inverse_dynamics_step_by_kane"),
+                                      std::string("forward_dynamics_step")}) {
       if (models.empty()) break;  // (a --benchmark_filter without them)
       const std::string reference = models.front() + "/" + suffix;
       for (const std::string& model : models) {

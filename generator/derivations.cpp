@@ -580,6 +580,37 @@ bool same_joint(const JointRecord& a, const JointRecord& b) {
   return true;
 }
 
+// The tree of the bodies' chains through the joints `moves` accepts (the others add nothing to a
+// twist): chains share their common joints; nodes come parents first.
+struct TwistTree {
+  std::vector<TwistNode> nodes;
+  std::vector<int> body_node;  // each body's last node, -1 for a body no such joint moves
+};
+TwistTree twist_tree(const Model& m, const std::function<bool(int)>& moves) {
+  TwistTree tree;
+  std::vector<int> roots;  // the nodes next to K0
+  tree.body_node.assign(m.bodies.size(), -1);
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    int at = -1;
+    for (const JointRecord& joint : m.bodies[i].com_frame.joints) {
+      if (!moves(joint.coordinate)) continue;
+      std::vector<int>& siblings = at < 0 ? roots : tree.nodes[static_cast<std::size_t>(at)].children;
+      int next = -1;
+      for (int c : siblings)
+        if (same_joint(*tree.nodes[static_cast<std::size_t>(c)].joint, joint)) next = c;
+      if (next < 0) {
+        next = static_cast<int>(tree.nodes.size());
+        siblings.push_back(next);  // before nodes grows: `siblings` may live in it
+        tree.nodes.push_back({&joint, at, {}, {}, {}, {}});
+      }
+      at = next;
+    }
+    tree.body_node[i] = at;
+    if (at >= 0) tree.nodes[static_cast<std::size_t>(at)].bodies.push_back(static_cast<int>(i));
+  }
+  return tree;
+}
+
 }  // namespace
 
 std::vector<std::vector<int>> rate_basis_pattern(const Model& m) {
@@ -624,27 +655,9 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   };
 
   // The tree of the bodies' chains, moving joints only (the others add nothing to a twist).
-  std::vector<TwistNode> nodes;
-  std::vector<int> roots;  // the nodes next to K0
-  std::vector<int> body_node(m.bodies.size(), -1);
-  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
-    int at = -1;
-    for (const JointRecord& joint : m.bodies[i].com_frame.joints) {
-      if (!moves(joint.coordinate)) continue;
-      std::vector<int>& siblings = at < 0 ? roots : nodes[static_cast<std::size_t>(at)].children;
-      int next = -1;
-      for (int c : siblings)
-        if (same_joint(*nodes[static_cast<std::size_t>(c)].joint, joint)) next = c;
-      if (next < 0) {
-        next = static_cast<int>(nodes.size());
-        siblings.push_back(next);  // before nodes grows: `siblings` may live in it
-        nodes.push_back({&joint, at, {}, {}, {}, {}});
-      }
-      at = next;
-    }
-    body_node[i] = at;
-    if (at >= 0) nodes[static_cast<std::size_t>(at)].bodies.push_back(static_cast<int>(i));
-  }
+  TwistTree tree = twist_tree(m, moves);
+  std::vector<TwistNode>& nodes = tree.nodes;
+  const std::vector<int>& body_node = tree.body_node;
 
   // Which commanded speeds each joint's rate depends on, and the lanes they take (LaneWriter).
   const std::vector<std::vector<int>> speeds_of = rate_basis_pattern(m);
@@ -881,6 +894,228 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   return fn;
 }
 
+namespace {
+
+// Straight-line scalar code, one `const Scalar name = ...;` per value, for the recursive
+// Newton-Euler pass. A value is a name, or empty for an exact zero: products with a zero and zero
+// terms are dropped, a sum of one plain term is that term (no line, no operation).
+class ScalarWriter {
+ public:
+  struct Term {
+    std::string a, b;  // a * b; b == kOne: a alone; an empty factor: zero
+    bool negate = false;
+  };
+  static inline const std::string kOne = "1";
+  std::string define(const std::string& name, const std::vector<Term>& terms) {
+    std::vector<const Term*> live;
+    for (const Term& t : terms)
+      if (!t.a.empty() && !t.b.empty()) live.push_back(&t);
+    if (live.empty()) return {};
+    if (live.size() == 1 && !live[0]->negate && live[0]->b == kOne) return live[0]->a;
+    std::string line = "    const Scalar " + name + " = ";
+    for (std::size_t k = 0; k < live.size(); ++k) {
+      const Term& t = *live[k];
+      if (k > 0) line += t.negate ? " - " : " + ";
+      else if (t.negate) line += "-";
+      if (k > 0 || t.negate) ++ops.adds;
+      line += t.b == kOne ? t.a : t.a + " * " + t.b;
+      if (t.b != kOne) ++ops.muls;
+    }
+    code += line + ";\n";
+    return name;
+  }
+  std::string code;
+  OpCount ops;
+};
+using Term = ScalarWriter::Term;
+
+// (x cross y)_c as two terms.
+std::vector<Term> cross_terms(const std::array<std::string, 3>& x, const std::array<std::string, 3>& y, int c) {
+  const auto c1 = static_cast<std::size_t>((c + 1) % 3), c2 = static_cast<std::size_t>((c + 2) % 3);
+  return {{x[c1], y[c2]}, {x[c2], y[c1], true}};
+}
+
+}  // namespace
+
+FunctionSpec derive_generalized_forces(const Model& m) {
+  const Dynamics& dyn = *m.dynamics;
+  const int nu = static_cast<int>(dyn.commanded.size());
+  FunctionSpec fn{"generalized_forces", "generalized_forces.hpp",
+                  "The inverse dynamics of the bodies by the recursive Newton-Euler equations, without the mass "
+                  "matrix: from s, s' and s'' the joints' spatial velocities and accelerations out along the chains, "
+                  "each body's force m (a + g e_z) and moment I alpha + omega x I omega, their wrenches summed back "
+                  "along the chains, and each moving coordinate's generalized force tau (the bodies' inertia, "
+                  "velocity and gravity forces on s). Projected on the commanded speeds, Q* = T^T tau: with "
+                  "s' = T u and s'' = T u' + s''_bias this is M u' + b - Q_gravity (reduced_dynamics) at a cost "
+                  "linear in the number of joints.",
+                  true, {}};
+  fn.inputs = {{"sddot", "Coordinates",
+                "s'', the accelerations of the coordinates (T u' + s''_bias in a step); with s' zero on the inputs held in a "
+                "step (T's zero rows, whose joints this pass leaves out)"},
+               {"T", "RateBasis",
+                "s' = T u, as for reduced_dynamics: only the rows of the dependent pair and of the dependent joints are "
+                "read, and in them only the entries kRateBasisPattern marks"}};
+  const RateRoles roles = rate_roles(m);
+  const auto dense = [&](int j) { return roles.dense[static_cast<std::size_t>(j)]; };
+  const auto moves = [&](int j) { return dense(j) || roles.speed_of[static_cast<std::size_t>(j)] >= 0; };
+  const auto scalar = [&](const std::string& name, const ex& value) {
+    if (value.is_zero()) return std::string();
+    fn.lane_scalars.emplace_back(name, value);
+    return name;
+  };
+  using V3 = std::array<std::string, 3>;
+  using V6 = std::array<std::string, 6>;
+  const auto head = [](const V6& v) { return V3{v[0], v[1], v[2]}; };
+  const auto tail = [](const V6& v) { return V3{v[3], v[4], v[5]}; };
+  TwistTree tree = twist_tree(m, moves);
+  ScalarWriter w;
+  const std::string one = ScalarWriter::kOne;
+
+  // Out along the chains: a joint's spatial axis S = (a; o x a) (revolute, axis a through o) or
+  // (0; a) (prismatic), in K0; V = V_parent + S s'_j; A = A_parent + S s''_j + (V_parent x S) s'_j
+  // (the axis moves with the parent: d/dt S = V_parent x S, the motion cross product).
+  std::vector<V6> axis(tree.nodes.size()), velocity(tree.nodes.size()), acceleration(tree.nodes.size());
+  for (std::size_t k = 0; k < tree.nodes.size(); ++k) {
+    const TwistNode& node = tree.nodes[k];
+    const JointRecord& joint = *node.joint;
+    const Vec3 zero;
+    const Vec3 angular = joint.revolute ? joint.axis : zero;
+    const Vec3 linear = joint.revolute ? cross(joint.origin, joint.axis) : joint.axis;
+    for (int c = 0; c < 3; ++c) {
+      axis[k][static_cast<std::size_t>(c)] = scalar(fmt::format("kane_S_{}_{}", k, c), angular[c]);
+      axis[k][static_cast<std::size_t>(c + 3)] = scalar(fmt::format("kane_S_{}_{}", k, c + 3), linear[c]);
+    }
+    const std::string sd = fmt::format("sdot({})", joint.coordinate), sdd = fmt::format("sddot({})", joint.coordinate);
+    const V6 V0 = node.parent < 0 ? V6{} : velocity[static_cast<std::size_t>(node.parent)];
+    const V6 A0 = node.parent < 0 ? V6{} : acceleration[static_cast<std::size_t>(node.parent)];
+    // V_parent x S = (w x a; w x b + v x a).
+    V6 X;
+    for (int c = 0; c < 3; ++c) {
+      X[static_cast<std::size_t>(c)] = w.define(fmt::format("kane_X{}_{}", k, c), cross_terms(head(V0), head(axis[k]), c));
+      std::vector<Term> lin = cross_terms(head(V0), tail(axis[k]), c);
+      for (const Term& t : cross_terms(tail(V0), head(axis[k]), c)) lin.push_back(t);
+      X[static_cast<std::size_t>(c + 3)] = w.define(fmt::format("kane_X{}_{}", k, c + 3), lin);
+    }
+    for (std::size_t c = 0; c < 6; ++c) {
+      velocity[k][c] = w.define(fmt::format("kane_V{}_{}", k, c), {{V0[c], one}, {axis[k][c], sd}});
+      acceleration[k][c] = w.define(fmt::format("kane_A{}_{}", k, c), {{A0[c], one}, {axis[k][c], sdd}, {X[c], sd}});
+    }
+  }
+
+  // Each body: its CoM's velocity v = V_lin + omega x p and acceleration a = A_lin + alpha x p +
+  // omega x v; force F = m (a + g e_z); moment in body axes N = I alpha_b + omega_b x I omega_b;
+  // wrench about K0's origin (F; R N + p x F).
+  const std::string g = scalar("kane_g", m.parameter(dyn.gravity).symbol);
+  std::vector<V6> wrench(m.bodies.size());
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    const int at_node = tree.body_node[i];
+    if (at_node < 0) continue;
+    const Body& body = m.bodies[i];
+    const Frame& f = body.com_frame;
+    const V6& V = velocity[static_cast<std::size_t>(at_node)];
+    const V6& A = acceleration[static_cast<std::size_t>(at_node)];
+    const auto name = [&](const char* what, int c) { return fmt::format("kane_{}{}_{}", what, i, c); };
+    w.code += "    // " + text::cpp_comment(fmt::format("body {}: {}", body.name, body.meaning)) + "\n";
+    V3 p, v, a, F, wb, ab, Iw, N, M;
+    std::array<std::string, 9> R;
+    for (int c = 0; c < 3; ++c) p[static_cast<std::size_t>(c)] = scalar(fmt::format("kane_p_{}_{}", i, c), f.r[c]);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) R[static_cast<std::size_t>(3 * r + c)] = scalar(fmt::format("kane_R_{}_{}_{}", i, r, c), f.R(r, c));
+    const auto Rrc = [&](int r, int c) -> const std::string& { return R[static_cast<std::size_t>(3 * r + c)]; };
+    const std::string mass = scalar(fmt::format("kane_mass_{}", i), m.parameter(body.mass).symbol);
+    V3 I;
+    for (int c = 0; c < 3; ++c)
+      I[static_cast<std::size_t>(c)] = scalar(fmt::format("kane_inertia_{}_{}", i, c), m.parameter(body.inertia[static_cast<std::size_t>(c)]).symbol);
+    for (int c = 0; c < 3; ++c) {
+      std::vector<Term> t = cross_terms(head(V), p, c);
+      t.insert(t.begin(), {V[static_cast<std::size_t>(c + 3)], one});
+      v[static_cast<std::size_t>(c)] = w.define(name("v", c), t);
+    }
+    for (int c = 0; c < 3; ++c) {
+      std::vector<Term> t = cross_terms(head(A), p, c);
+      for (const Term& x : cross_terms(head(V), v, c)) t.push_back(x);
+      t.insert(t.begin(), {A[static_cast<std::size_t>(c + 3)], one});
+      if (c == 2) t.push_back({g, one});
+      a[static_cast<std::size_t>(c)] = w.define(name("a", c), t);
+      F[static_cast<std::size_t>(c)] = w.define(name("F", c), {{mass, a[static_cast<std::size_t>(c)]}});
+    }
+    for (int c = 0; c < 3; ++c) {
+      wb[static_cast<std::size_t>(c)] = w.define(name("wb", c), {{Rrc(0, c), V[0]}, {Rrc(1, c), V[1]}, {Rrc(2, c), V[2]}});
+      ab[static_cast<std::size_t>(c)] = w.define(name("ab", c), {{Rrc(0, c), A[0]}, {Rrc(1, c), A[1]}, {Rrc(2, c), A[2]}});
+    }
+    for (int c = 0; c < 3; ++c) Iw[static_cast<std::size_t>(c)] = w.define(name("Iw", c), {{I[static_cast<std::size_t>(c)], wb[static_cast<std::size_t>(c)]}});
+    for (int c = 0; c < 3; ++c) {
+      std::vector<Term> t = cross_terms(wb, Iw, c);
+      t.insert(t.begin(), {I[static_cast<std::size_t>(c)], ab[static_cast<std::size_t>(c)]});
+      N[static_cast<std::size_t>(c)] = w.define(name("N", c), t);
+    }
+    for (int c = 0; c < 3; ++c) {
+      std::vector<Term> t = cross_terms(p, F, c);
+      for (int k = 0; k < 3; ++k) t.push_back({Rrc(c, k), N[static_cast<std::size_t>(k)]});
+      M[static_cast<std::size_t>(c)] = w.define(name("M", c), t);
+    }
+    wrench[i] = {F[0], F[1], F[2], M[0], M[1], M[2]};
+  }
+
+  // Back along the chains: the wrenches beyond each joint, tau_j = S . (moment; force).
+  w.code += "    // Back along the chains: the wrenches beyond each joint and the joints' generalized forces.\n";
+  std::vector<V6> beyond(tree.nodes.size());
+  // A component of a joint's wrench sum is read by its tau where the axis has the matching component
+  // (force with the linear part, moment with the angular), and by the joints before it that read it.
+  std::vector<std::array<bool, 6>> read(tree.nodes.size());
+  for (std::size_t k = 0; k < tree.nodes.size(); ++k)
+    for (std::size_t c = 0; c < 6; ++c)
+      read[k][c] = !axis[k][c < 3 ? c + 3 : c - 3].empty() ||
+                   (tree.nodes[k].parent >= 0 && read[static_cast<std::size_t>(tree.nodes[k].parent)][c]);
+  std::map<int, std::vector<Term>> tau_terms;  // coordinate -> its joints' taus
+  for (std::size_t k = tree.nodes.size(); k-- > 0;) {
+    const TwistNode& node = tree.nodes[k];
+    for (std::size_t c = 0; c < 6; ++c) {
+      if (!read[k][c]) continue;
+      std::vector<Term> parts;
+      for (int i : node.bodies) parts.push_back({wrench[static_cast<std::size_t>(i)][c], one});
+      for (int child : node.children) parts.push_back({beyond[static_cast<std::size_t>(child)][c], one});
+      beyond[k][c] = w.define(fmt::format("kane_W{}_{}", k, c), parts);
+    }
+    std::vector<Term> t;
+    for (std::size_t c = 0; c < 3; ++c) t.push_back({axis[k][c], beyond[k][c + 3]});
+    for (std::size_t c = 0; c < 3; ++c) t.push_back({axis[k][c + 3], beyond[k][c]});
+    const std::string tau = w.define(fmt::format("kane_tau{}", k), t);
+    if (!tau.empty()) tau_terms[node.joint->coordinate].push_back({tau, one});
+  }
+  std::map<int, std::string> tau_of;
+  for (const auto& [j, terms] : tau_terms) {
+    const std::string t = w.define(fmt::format("kane_tau_s{}", j), terms);
+    if (!t.empty()) tau_of[j] = t;
+  }
+  // Q*_l = sum_j T(j, l) tau_j: a commanded speed's coordinate adds its tau to its row; a dense
+  // coordinate's, times T(j, l), to the rows of the speeds its rate depends on (kRateBasisPattern).
+  const std::vector<std::vector<int>> speeds_of = rate_basis_pattern(m);
+  std::vector<std::string> Q(static_cast<std::size_t>(nu));
+  w.code += "    if (Qstar != nullptr) {\n";
+  for (int l = 0; l < nu; ++l) {
+    std::vector<Term> t;
+    for (const auto& [j, tau] : tau_of) {
+      if (roles.speed_of[static_cast<std::size_t>(j)] == l) t.push_back({tau, one});
+      else if (dense(j) && std::binary_search(speeds_of[static_cast<std::size_t>(j)].begin(), speeds_of[static_cast<std::size_t>(j)].end(), l))
+        t.push_back({fmt::format("T({}, {})", j, l), tau});
+    }
+    const std::string q = w.define(fmt::format("kane_Q{}", l), t);
+    w.code += fmt::format("    (*Qstar)({}) = {};\n", l, q.empty() ? "Scalar(0)" : q);
+  }
+  w.code += "    }\n    if (tau != nullptr) {\n      tau->setZero();\n";
+  for (const auto& [j, t] : tau_of) w.code += fmt::format("      (*tau)({}) = {};\n", j, t);
+  w.code += "    }\n";
+  fn.lane_code = w.code;
+  // The pass runs for either output: its operations are Q*'s (tau adds no operation of its own).
+  OutputSpec Qo{"Qstar", "CommandVector", "M u' + b - Q_gravity for s'' = sddot: T^T tau, the forces the actuators must supply on u", "", {}};
+  OutputSpec to{"tau", "Coordinates", "the bodies' generalized inertia, velocity and gravity forces on each coordinate (0 on the held inputs; computed with Qstar)", "", {}};
+  Qo.from_lanes = to.from_lanes = true;
+  Qo.lane_ops = w.ops;
+  fn.outputs = {Qo, to};
+  return fn;
+}
+
 FunctionSpec derive_clearance(const Model& m) {
   FunctionSpec fn{"clearance", "clearance.hpp",
                   "Ground clearance: the height above z = 0 of the lowest corner of the box attached to frame " +
@@ -904,7 +1139,10 @@ std::vector<Derivation> derivations(const Model& m) {
                               {"bodies", derive_bodies},
                               {"kinematic_update", derive_kinematic_update},
                               {"dynamics_update", derive_dynamics_update}};
-  if (m.dynamics) all.push_back({"reduced_dynamics", derive_reduced_dynamics});
+  if (m.dynamics) {
+    all.push_back({"reduced_dynamics", derive_reduced_dynamics});
+    all.push_back({"generalized_forces", derive_generalized_forces});
+  }
   if (m.clearance) all.push_back({"clearance", derive_clearance});
   return all;
 }

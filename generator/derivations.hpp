@@ -65,6 +65,8 @@ FunctionSpec derive_kinematic_update(const Model& m);
 // (only for a model with a dynamics section).
 FunctionSpec derive_dynamics_update(const Model& m);
 FunctionSpec derive_reduced_dynamics(const Model& m);
+// The same equations' Q* by the recursive Newton-Euler equations at given s'' (no mass matrix).
+FunctionSpec derive_generalized_forces(const Model& m);
 // The commanded speeds each coordinate's rate depends on (the nonzero columns of its row of the rate
 // basis T, s' = T u), ascending; none for a held input or without a dynamics section.
 std::vector<std::vector<int>> rate_basis_pattern(const Model& m);

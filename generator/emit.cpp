@@ -488,7 +488,9 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
       "// pointer is set (C++20: {}(..., {{.{} = &x}})):\n",
       outputs_type, outputs_type, fn.name, fn.outputs.front().name);
   for (std::size_t o = 0; o < fn.outputs.size(); ++o) {
-    if (fn.outputs[o].from_lanes)
+    if (fn.outputs[o].from_lanes && fn.lane_layout.empty())  // scalar code
+      t += fmt::format("//   {:<18} {} (own operations: {})\n", fn.outputs[o].name, fn.outputs[o].doc, output_ops[o].total());
+    else if (fn.outputs[o].from_lanes)
       t += fmt::format("//   {:<18} {} (own operations: {}, on rows of {})\n", fn.outputs[o].name, fn.outputs[o].doc,
                        output_ops[o].total(), fn.lane_layout);
     else
@@ -496,9 +498,9 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
                        output_ops[o].total(), outs[o].size());
   }
   if (!fn.lane_code.empty())
-    t += fmt::format("// The scalars those rows are built from ({} of them, the bodies' Jacobian entries among them):\n"
+    t += fmt::format("// The scalars {} built from ({} of them, the bodies' and joints' geometry among them):\n"
                      "// {} operations, computed only when one of them is requested.\n",
-                     fn.lane_scalars.size(), output_ops[lanes].total());
+                     fn.lane_layout.empty() ? "that code is" : "those rows are", fn.lane_scalars.size(), output_ops[lanes].total());
   t += fmt::format("// Intermediate terms: {}; shared by several outputs: {} operations (sin and cos of all angles\n"
                    "// included: they are computed up front, whichever outputs are requested).\n",
                    stats.intermediates, shared_ops.total());

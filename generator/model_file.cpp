@@ -127,7 +127,7 @@ std::string reserved_reason(const std::string& n) {
   static const std::set<std::string> locals = {
       "s", "sdot", "p", "zero_fill", "angle", "sin_angle", "cos_angle", "std", "Eigen", "positions", "rotations",
       "Phi", "dPhi_ds", "C", "spin", "dPhi_ds_dot_sdot", "C_dot_sdot", "com", "Jv", "Jw", "Jv_dot_sdot",
-      "Jw_dot_sdot", "Params", "Coordinates", "Pi", "pi", "sin", "cos", "tan", "asin", "acos", "atan", "sqrt",
+      "Jw_dot_sdot", "T", "sddot", "Qstar", "tau", "out", "Params", "Coordinates", "Pi", "pi", "sin", "cos", "tan", "asin", "acos", "atan", "sqrt",
       "exp", "log", "abs"};
   if (keywords.count(n)) return "it is a C++ keyword";
   if (locals.count(n)) return "the generated functions use that name themselves";

@@ -160,7 +160,11 @@ void bind_python(py::module_& parent) {
         DynamicsTerms terms;
         check_finite(u, "u");
         check_finite(u_dot, "u_dot");
-        inverse_dynamics(model, data, coordinates_of(s_in, "s"), u, u_dot, terms);
+        const Coordinates s = coordinates_of(s_in, "s");
+        inverse_dynamics(model, data, s, u, u_dot, terms);
+        DynamicsTerms motion;  // M, b and Q_gravity, which the result returns too (Kane's sums)
+        equations_of_motion(model, data, s, u, motion);
+        terms.M = motion.M, terms.b = motion.b, terms.Q_gravity = motion.Q_gravity;
         const TorqueVector tau = distribute_torques(
             terms.J_beta, terms.Qstar, parse_weighting(parse_json(weighting_json, "weighting"), "weighting"));
         check_result(tau, "tau");

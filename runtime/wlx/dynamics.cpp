@@ -40,6 +40,32 @@ void throw_no_dynamics_section() {
                                       gen::kModelName));
 }
 
+#if __has_include(<wlx/gen/reduced_dynamics.hpp>)
+namespace {
+
+// Both formulations' velocity level: dPhi/ds and C(s) (a generated pass), the rate basis T,
+// s' = T u and J_beta.
+void velocity_level(const Params& p, Data& d, const Coordinates& s, const CommandVector& u, DynamicsTerms& out,
+                    const DependentPair& pair, const NonholonomicOptions& options) {
+  gen::dynamics_update(s, p, {.dPhi_ds = &d.dPhi_ds, .C = &d.C, .drive = kHasWheelDrives ? &d.drive : nullptr}, false);
+  factorize_dependent_rates(d, pair, options);
+  rate_basis(d, kCommandedSpeeds, pair, out.T);
+  out.sdot.noalias() = out.T.lazyProduct(u);  // the velocity level's solve, once T is known
+  // A joint's rate is its coordinate's, T's row; a wheel drive's is its drive row times T.
+  Eigen::Matrix<double, kWheelCount, kCommandedCount> drive_rates;
+  if constexpr (kHasWheelDrives) drive_rates.noalias() = d.drive.lazyProduct(out.T);  // not through the GEMM kernel
+  for (int r = 0; r < kActuatedCount; ++r) {
+    const int joint = kActuatedJoints[static_cast<std::size_t>(r)];
+    if (joint >= 0)
+      out.J_beta.row(r) = out.T.row(joint);
+    else
+      drive_rate_row(drive_rates, kActuatedWheels[static_cast<std::size_t>(r)], out.J_beta, r);
+  }
+}
+
+}  // namespace
+#endif
+
 void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const CommandVector& u,
                       const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options) {
 // wlx-gen writes reduced_dynamics.hpp only for a model file with a dynamics section (and removes a
@@ -51,13 +77,30 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
 #else
   const Params& p = model.params();
   const DependentPair pair = dynamics_pair();
-  // Two generated passes: dPhi/ds and C(s), which give the rate basis T; then at (s, s' = T u, T)
-  // the convective terms and Kane's sums over the bodies (M, the velocity and gravity forces and
-  // their gain on s''_bias), sharing their subexpressions.
-  gen::dynamics_update(s, p, {.dPhi_ds = &d.dPhi_ds, .C = &d.C, .drive = kHasWheelDrives ? &d.drive : nullptr}, false);
-  factorize_dependent_rates(d, pair, options);
-  rate_basis(d, kCommandedSpeeds, pair, out.T);
-  out.sdot.noalias() = out.T.lazyProduct(u);  // the velocity level's solve, once T is known
+  // Three generated passes: dPhi/ds and C(s), which give the rate basis T; at (s, s' = T u) the
+  // convective terms, which give s''_bias; at (s, s', s'') the bodies' Newton-Euler equations,
+  // summed back along the chains and projected on u (Q* = T^T tau), with no mass matrix.
+  velocity_level(p, d, s, u, out, pair, options);
+  gen::convective(s, out.sdot, p, {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot});
+  solve_bias_accelerations(d, out.sddot_bias, pair);
+  out.sddot = out.T.lazyProduct(u_dot) + out.sddot_bias;
+  gen::generalized_forces(s, out.sdot, out.sddot, out.T, p, {.Qstar = &out.Qstar});
+#endif
+}
+
+void equations_of_motion(const Model& model, Data& d, const Coordinates& s, const CommandVector& u, DynamicsTerms& out,
+                         const NonholonomicOptions& options) {
+#if !__has_include(<wlx/gen/reduced_dynamics.hpp>)
+  static_cast<void>(model), static_cast<void>(d), static_cast<void>(s), static_cast<void>(u), static_cast<void>(out);
+  static_cast<void>(options);
+  throw_no_dynamics_section();
+#else
+  const Params& p = model.params();
+  const DependentPair pair = dynamics_pair();
+  // Two generated passes: dPhi/ds and C(s), which give T; at (s, s' = T u, T) the convective terms
+  // and Kane's sums over the bodies (M, the velocity and gravity forces and their gain on
+  // s''_bias), sharing their subexpressions.
+  velocity_level(p, d, s, u, out, pair, options);
   CommandVector b_velocity;
   gen::reduced_dynamics(s, out.sdot, out.T, p,
                         {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot,
@@ -67,21 +110,9 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
                          .B_bias = &out.B_bias,
                          .Q_gravity = &out.Q_gravity},
                         false);  // B_bias's structural zeros: set once, by DynamicsTerms
-  Coordinates bias;  // s'' with u' = 0
-  solve_bias_accelerations(d, bias, pair);
-  out.sddot = out.T.lazyProduct(u_dot) + bias;
-  out.b = b_velocity + out.B_bias.lazyProduct(bias);
-  out.Qstar = out.M * u_dot + out.b - out.Q_gravity;
-  // A joint's rate is its coordinate's, T's row; a wheel drive's is its drive row times T.
-  Eigen::Matrix<double, kWheelCount, kCommandedCount> drive_rates;
-  if constexpr (kHasWheelDrives) drive_rates.noalias() = d.drive * out.T;
-  for (int r = 0; r < kActuatedCount; ++r) {
-    const int joint = kActuatedJoints[static_cast<std::size_t>(r)];
-    if (joint >= 0)
-      out.J_beta.row(r) = out.T.row(joint);
-    else
-      drive_rate_row(drive_rates, kActuatedWheels[static_cast<std::size_t>(r)], out.J_beta, r);
-  }
+  solve_bias_accelerations(d, out.sddot_bias, pair);
+  out.sddot = out.sddot_bias;
+  out.b = b_velocity + out.B_bias.lazyProduct(out.sddot_bias);
 #endif
 }
 

@@ -2,9 +2,10 @@
 //
 // The model file's dynamics section names the commanded speeds u (the excavator: z_C', x_C', roll',
 // pitch'), the dependent pair the wheels determine (y_C', yaw') and the actuators; every other
-// input is constant. Kane's method on the bodies, with s' = T u + 0 and s'' = T u' + s''_bias from
-// the non-holonomic solve, gives Q* = M u' + b - Q_gravity. The actuators share Q* by weighted
-// least norm: J_beta^T tau = Q*, minimising tau^T W tau.
+// input is constant. With s' = T u and s'' = T u' + s''_bias from the non-holonomic solve, the
+// bodies' equations projected on u give Q* = M u' + b - Q_gravity: inverse_dynamics by the recursive
+// Newton-Euler equations (no M), equations_of_motion by Kane's sums (M, b, Q_gravity). The
+// actuators share Q* by weighted least norm: J_beta^T tau = Q*, minimising tau^T W tau.
 #pragma once
 
 #include "wlx/model.hpp"
@@ -45,21 +46,33 @@ struct DynamicsTerms {
   Eigen::Matrix<double, kCoordinateCount, kCommandedCount> T;  // s' = T u
   Coordinates sdot;                                            // T u
   Coordinates sddot;                                           // T u' + s''_bias
-  CommandMatrix M;                                             // generalized mass matrix on u
-  CommandVector b;                                             // velocity-dependent terms
-  CommandVector Q_gravity;                                     // generalized gravity force
+  Coordinates sddot_bias;                                      // s''_bias: s'' at u' = 0
   CommandVector Qstar;                                         // M u' + b - Q_gravity
   ActuatorJacobian J_beta;                                     // actuator rates beta' = J_beta u
+  // Written by equations_of_motion() (inverse_dynamics needs none of them):
+  CommandMatrix M;          // generalized mass matrix on u
+  CommandVector b;          // velocity-dependent terms
+  CommandVector Q_gravity;  // generalized gravity force
   // b = b_velocity + B_bias s''_bias (reduced_dynamics): the forces on u per unit bias
-  // acceleration. Its structural zeros are written here, once; inverse_dynamics never writes them.
+  // acceleration. Its structural zeros are written here, once; equations_of_motion never writes them.
   gen::CommandRows B_bias = gen::CommandRows::Zero();
 };
 
-// Q* and its parts at s (closure satisfied) for speeds u and accelerations u_dot. Uses and
-// overwrites data's kinematic buffers; allocates nothing. Throws wlx::Error for a model file
-// without a dynamics section (gen::kHasDynamics false).
+// One inverse-dynamics step at s (closure satisfied) for speeds u and accelerations u_dot: T, s',
+// s'', Q* and J_beta, what the torque split needs. Q* comes from the bodies' Newton-Euler equations
+// (generalized_forces), without the mass matrix; equations_of_motion() adds M, b and Q_gravity.
+// Uses and overwrites data's kinematic buffers; allocates nothing. Throws wlx::Error for a model
+// file without a dynamics section (gen::kHasDynamics false).
 void inverse_dynamics(const Model& model, Data& data, const Coordinates& s, const CommandVector& u,
                       const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options = {});
+
+// The equations of motion on the commanded speeds at s for speeds u, M u' + b - Q_gravity = Q*, by
+// Kane's sums (reduced_dynamics, in one generated pass with the convective terms): T, s', s''_bias
+// (and s'' at u' = 0), M, b, Q_gravity and J_beta; not Q*. For forward dynamics and whoever wants
+// the mass matrix. With them, M u_dot + b - Q_gravity equals inverse_dynamics' Q* (two
+// formulations; the tests compare them). Allocates nothing; throws as inverse_dynamics does.
+void equations_of_motion(const Model& model, Data& data, const Coordinates& s, const CommandVector& u, DynamicsTerms& out,
+                         const NonholonomicOptions& options = {});
 
 // The wlx::Error every dynamics function throws for a model file without a dynamics section.
 [[noreturn]] void throw_no_dynamics_section();

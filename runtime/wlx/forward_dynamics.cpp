@@ -23,7 +23,7 @@ void forward_dynamics(const Model& model, Data& d, const Coordinates& s, const C
     if (!std::isfinite(tau(r)))
       throw Error(fmt::format("tau.{}", kActuatorNames[static_cast<std::size_t>(r)]),
                   fmt::format("must be a finite number, got {}", tau(r)));
-  inverse_dynamics(model, d, s, u, CommandVector::Zero(), out, options);  // M, b, Q_gravity, J_beta; s'' at u' = 0
+  equations_of_motion(model, d, s, u, out, options);  // M, b, Q_gravity, J_beta; s'' at u' = 0
   out.Qstar.noalias() = out.J_beta.transpose() * tau;
   const Eigen::LLT<CommandMatrix> llt(out.M);
   if (llt.info() != Eigen::Success)

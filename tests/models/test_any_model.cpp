@@ -326,13 +326,18 @@ TEST_CASE(titled("inverse dynamics: J_beta^T tau = Q*, power and energy balances
   }
   std::mt19937_64 rng(203);
   std::uniform_real_distribution<double> half(-0.5, 0.5);
-  double worst_balance = 0, worst_power = 0, worst_energy = 0;
+  double worst_balance = 0, worst_power = 0, worst_energy = 0, worst_formulations = 0;
   int outside_pattern = 0, inside_pattern = 0;
   for (int trial = 0; trial < 5; ++trial) {
     const Coordinates s = random_state(rng, model, 0.03);
     CommandVector u, u_dot;
     for (int k = 0; k < kCommandedCount; ++k) u(k) = half(rng), u_dot(k) = half(rng);
     inverse_dynamics(model, d, s, u, u_dot, t);
+    // The step's Q* (Newton-Euler, no M) against Kane's equations of motion at the same state.
+    DynamicsTerms kane;
+    equations_of_motion(model, d, s, u, kane);
+    const CommandVector from_kane = kane.M * u_dot + kane.b - kane.Q_gravity;
+    worst_formulations = std::max(worst_formulations, (t.Qstar - from_kane).cwiseAbs().maxCoeff() / from_kane.cwiseAbs().maxCoeff());
     // reduced_dynamics reads only the entries of T the generator's pattern marks: the runtime's
     // solve must leave every other one exactly zero (else M would silently miss a coupling).
     for (int j = 0; j < kCoordinateCount; ++j)
@@ -345,7 +350,9 @@ TEST_CASE(titled("inverse dynamics: J_beta^T tau = Q*, power and energy balances
     worst_energy = std::max(worst_energy, test::energy_balance_error(model, s, u));
   }
   MESSAGE(kName << ": J^T tau = Q*: " << worst_balance << ", power: " << worst_power << ", energy: " << worst_energy
-                << "; nonzero entries of T inside its pattern: " << inside_pattern << ", outside: " << outside_pattern);
+                << "; nonzero entries of T inside its pattern: " << inside_pattern << ", outside: " << outside_pattern
+                << "; Q* Newton-Euler vs Kane: " << worst_formulations);
+  CHECK(worst_formulations <= 1e-12);  // relative to the largest entry: the same sums in another order
   CHECK(outside_pattern == 0);
   CHECK(inside_pattern > 0);
   CHECK(worst_balance <= 1e-9);  // least-norm solve with cond(J_beta) up to ~1e4

@@ -156,7 +156,7 @@ TEST_CASE("dynamics: M is the Hessian of the kinetic energy: T = u^T M u / 2") {
   for (int trial = 0; trial < 100; ++trial) {
     const Coordinates s = random_state(rng, model);
     const CommandVector u = random4(rng, 1.0);
-    inverse_dynamics(model, d, s, u, CommandVector::Zero(), t);
+    equations_of_motion(model, d, s, u, t);
     const double T = kinetic_energy(model, d, s, t.sdot);
     worst = std::max(worst, std::abs(T - 0.5 * u.dot(t.M * u)) / T);
     CHECK((t.M - t.M.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * t.M.cwiseAbs().maxCoeff());

@@ -6,17 +6,18 @@
 // Depends on Eigen only.
 //
 // Operation counts (each +, -, *, /, negation and function call counts as one):
-//   function         intermediates    before CSE     after CSE
-//   kinematics                 126          9681           616
-//   closure                    146         23500           906
-//   nonholonomic               106         27474           625
-//   convective                 353         62310          1867
-//   bodies                     315         58902          2163
-//   kinematic_update           194         48373          1304
-//   dynamics_update            150         37306          1043
-//   reduced_dynamics           484        145199          6505
-//   clearance                    0            19            20
-//   total                                 412764         15049
+//   function           intermediates    before CSE     after CSE
+//   kinematics                   126          9681           616
+//   closure                      146         23500           906
+//   nonholonomic                 106         27474           625
+//   convective                   353         62310          1867
+//   bodies                       315         58902          2163
+//   kinematic_update             194         48373          1304
+//   dynamics_update              150         37306          1043
+//   reduced_dynamics             484        145199          6505
+//   generalized_forces           110          7426          2377
+//   clearance                      0            19            20
+//   total                                   420190         17426
 #pragma once
 
 #include "ik.hpp"
@@ -31,4 +32,5 @@
 #include "kinematic_update.hpp"
 #include "dynamics_update.hpp"
 #include "reduced_dynamics.hpp"
+#include "generalized_forces.hpp"
 #include "clearance.hpp"

@@ -6,17 +6,18 @@
 // Depends on Eigen only.
 //
 // Operation counts (each +, -, *, /, negation and function call counts as one):
-//   function         intermediates    before CSE     after CSE
-//   kinematics                 157         11011           740
-//   closure                    167         28482           906
-//   nonholonomic               135         39100           618
-//   convective                 409         68496          1721
-//   bodies                     388         63427          2538
-//   kinematic_update           234         60493          1338
-//   dynamics_update            183         47698           988
-//   reduced_dynamics           601        151284          6482
-//   clearance                    0            19            20
-//   total                                 470010         15351
+//   function           intermediates    before CSE     after CSE
+//   kinematics                   157         11011           740
+//   closure                      167         28482           906
+//   nonholonomic                 135         39100           618
+//   convective                   409         68496          1721
+//   bodies                       388         63427          2538
+//   kinematic_update             234         60493          1338
+//   dynamics_update              183         47698           988
+//   reduced_dynamics             601        151284          6482
+//   generalized_forces           122          7864          2412
+//   clearance                      0            19            20
+//   total                                   477874         17763
 #pragma once
 
 #include "ik.hpp"
@@ -31,4 +32,5 @@
 #include "kinematic_update.hpp"
 #include "dynamics_update.hpp"
 #include "reduced_dynamics.hpp"
+#include "generalized_forces.hpp"
 #include "clearance.hpp"

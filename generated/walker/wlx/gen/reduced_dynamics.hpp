@@ -27,7 +27,7 @@ namespace gen {
 //   b_velocity         velocity-dependent forces on u, s''_bias excluded (own operations: 336, on rows of 4 lanes)
 //   B_bias             forces on u per unit s''_bias: b = b_velocity + B_bias s''_bias (own operations: 416, on rows of 4 lanes)
 //   Q_gravity          generalized gravity force on u (gravity along -z of K0) (own operations: 56, on rows of 4 lanes)
-// The scalars those rows are built from (241 of them, the bodies' Jacobian entries among them):
+// The scalars those rows are built from (241 of them, the bodies' and joints' geometry among them):
 // 1248 operations, computed only when one of them is requested.
 // Intermediate terms: 601; shared by several outputs: 1374 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).

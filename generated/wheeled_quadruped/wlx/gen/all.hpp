@@ -6,17 +6,18 @@
 // Depends on Eigen only.
 //
 // Operation counts (each +, -, *, /, negation and function call counts as one):
-//   function         intermediates    before CSE     after CSE
-//   kinematics                 229         15634          1075
-//   closure                    294         46236          1552
-//   nonholonomic               346         96920          1859
-//   convective                 436        198116          2116
-//   bodies                    1022        165475          5164
-//   kinematic_update           411         98350          2249
-//   dynamics_update            355        102428          1887
-//   reduced_dynamics          1155        371844         18784
-//   clearance                    0            19            19
-//   total                                1095022         34705
+//   function           intermediates    before CSE     after CSE
+//   kinematics                   229         15634          1075
+//   closure                      294         46236          1552
+//   nonholonomic                 346         96920          1859
+//   convective                   436        198116          2116
+//   bodies                      1022        165475          5164
+//   kinematic_update             411         98350          2249
+//   dynamics_update              355        102428          1887
+//   reduced_dynamics            1155        371844         18784
+//   generalized_forces           243         16742          4986
+//   clearance                      0            19            19
+//   total                                  1111764         39691
 #pragma once
 
 #include "ik.hpp"
@@ -31,4 +32,5 @@
 #include "kinematic_update.hpp"
 #include "dynamics_update.hpp"
 #include "reduced_dynamics.hpp"
+#include "generalized_forces.hpp"
 #include "clearance.hpp"

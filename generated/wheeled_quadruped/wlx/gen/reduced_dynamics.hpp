@@ -27,7 +27,7 @@ namespace gen {
 //   b_velocity         velocity-dependent forces on u, s''_bias excluded (own operations: 1446, on rows of 7 lanes, 10 where the limbs' sums meet)
 //   B_bias             forces on u per unit s''_bias: b = b_velocity + B_bias s''_bias (own operations: 1008, on rows of 7 lanes, 10 where the limbs' sums meet)
 //   Q_gravity          generalized gravity force on u (gravity along -z of K0) (own operations: 256, on rows of 7 lanes, 10 where the limbs' sums meet)
-// The scalars those rows are built from (515 of them, the bodies' Jacobian entries among them):
+// The scalars those rows are built from (515 of them, the bodies' and joints' geometry among them):
 // 3340 operations, computed only when one of them is requested.
 // Intermediate terms: 1155; shared by several outputs: 1887 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).
