@@ -580,6 +580,18 @@ bool same_joint(const JointRecord& a, const JointRecord& b) {
   return true;
 }
 
+// A joint's twist per unit rate in K0, (omega; velocity of the point at K0's origin): (a; o x a)
+// for a revolute joint (axis a through o), (0; a) for a prismatic one.
+std::array<ex, 6> spatial_axis(const JointRecord& joint) {
+  const Vec3 linear = joint.revolute ? cross(joint.origin, joint.axis) : joint.axis;
+  std::array<ex, 6> S;
+  for (int c = 0; c < 3; ++c) {
+    S[static_cast<std::size_t>(c)] = joint.revolute ? joint.axis[c] : ex(0);
+    S[static_cast<std::size_t>(c + 3)] = linear[c];
+  }
+  return S;
+}
+
 // The tree of the bodies' chains through the joints `moves` accepts (the others add nothing to a
 // twist): chains share their common joints; nodes come parents first.
 struct TwistTree {
@@ -688,13 +700,8 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     TwistNode& node = nodes[k];
     const JointRecord& joint = *node.joint;
-    const Vec3 zero;
-    const Vec3 angular = joint.revolute ? joint.axis : zero;
-    const Vec3 linear = joint.revolute ? cross(joint.origin, joint.axis) : joint.axis;
-    for (int c = 0; c < 3; ++c) {
-      joint_twist[k][static_cast<std::size_t>(c)] = scalar(fmt::format("kane_twist_{}_{}", k, c), angular[c]);
-      joint_twist[k][static_cast<std::size_t>(c + 3)] = scalar(fmt::format("kane_twist_{}_{}", k, c + 3), linear[c]);
-    }
+    const std::array<ex, 6> S = spatial_axis(joint);
+    for (std::size_t c = 0; c < 6; ++c) joint_twist[k][c] = scalar(fmt::format("kane_twist_{}_{}", k, c), S[c]);
     const int j = joint.coordinate;
     const std::array<std::string, 6> base =
         node.parent < 0 ? std::array<std::string, 6>{} : nodes[static_cast<std::size_t>(node.parent)].twist;
@@ -978,13 +985,8 @@ FunctionSpec derive_generalized_forces(const Model& m) {
   for (std::size_t k = 0; k < tree.nodes.size(); ++k) {
     const TwistNode& node = tree.nodes[k];
     const JointRecord& joint = *node.joint;
-    const Vec3 zero;
-    const Vec3 angular = joint.revolute ? joint.axis : zero;
-    const Vec3 linear = joint.revolute ? cross(joint.origin, joint.axis) : joint.axis;
-    for (int c = 0; c < 3; ++c) {
-      axis[k][static_cast<std::size_t>(c)] = scalar(fmt::format("kane_S_{}_{}", k, c), angular[c]);
-      axis[k][static_cast<std::size_t>(c + 3)] = scalar(fmt::format("kane_S_{}_{}", k, c + 3), linear[c]);
-    }
+    const std::array<ex, 6> S = spatial_axis(joint);
+    for (std::size_t c = 0; c < 6; ++c) axis[k][c] = scalar(fmt::format("kane_S_{}_{}", k, c), S[c]);
     const std::string sd = fmt::format("sdot({})", joint.coordinate), sdd = fmt::format("sddot({})", joint.coordinate);
     const V6 V0 = node.parent < 0 ? V6{} : velocity[static_cast<std::size_t>(node.parent)];
     const V6 A0 = node.parent < 0 ? V6{} : acceleration[static_cast<std::size_t>(node.parent)];
