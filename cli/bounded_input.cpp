@@ -144,6 +144,9 @@ std::string nearest(const std::string& key, const std::vector<std::string>& vali
   std::string best;
   std::size_t best_d = std::max<std::size_t>(2, key.size() / 3) + 1;
   for (const auto& v : valid) {
+    // The distance is at least the difference in length: a candidate that cannot beat the best is
+    // not compared (a hostile 10 MB key against every name took 7 s, 54 s under the sanitizers).
+    if ((key.size() > v.size() ? key.size() - v.size() : v.size() - key.size()) >= best_d) continue;
     const std::size_t d = edit_distance(key, v);
     if (d < best_d) {
       best_d = d;
