@@ -2,10 +2,10 @@
 // They take the same JSON the command line reads (the Python package turns dicts into it), and
 // reuse the command line's parsing and solving, so the grammar, the checks and the error messages
 // are the CLI's own.
-#include "../cli/input.hpp"
-#include "../cli/limits.hpp"
-#include "../cli/outputs.hpp"
-#include "../cli/scenario_io.hpp"
+#include "../cli/commands/input.hpp"
+#include "../cli/commands/limits.hpp"
+#include "../cli/commands/outputs.hpp"
+#include "../cli/commands/scenario_io.hpp"
 
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
@@ -34,7 +34,7 @@ nlohmann::json parse_json(const std::string& text, const char* what) {
   }
 }
 
-// The CLI's checks, argument by argument: finite values within the bounds of cli/limits.hpp (a
+// The CLI's checks, argument by argument: finite values within the bounds of cli/commands/limits.hpp (a
 // rate of NaN or a coordinate of 1e308 gave NaN torques before), so Python and the command line
 // refuse the same inputs with the same messages.
 Params params_of(const std::string& params_json) {

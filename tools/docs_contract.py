@@ -474,8 +474,11 @@ def cmd_help(options):
         problems.append(f"tools/header_compile_times.py {option}: in only one of --help and README.md's synopsis")
     problems += key_problems(wlx, readme)
     problems += python_problems(options.build, readme)
-    layout = re.search(r"^cli/\s+the wlx command: (.*)$", readme, flags=re.M)
+    # The layout's two rooms of cli/: the commands compiled per model, and the shell's own (wlx models).
+    layout = re.search(r"^cli/commands/\s+the commands compiled per model: (.*)$", readme, flags=re.M)
+    shell = re.search(r"^cli/shell/\s+.*$", readme, flags=re.M)
     listed = [n.strip() for n in layout[1].split(",")] if layout else []
+    listed += re.findall(r"\bwlx (\w+)(?=,|$)", shell[0]) if shell else []
     if sorted(listed) != sorted(subcommands):
         problems.append(f"README.md's layout lists the subcommands {listed}; wlx --help lists {subcommands}")
     if problems:
@@ -539,7 +542,7 @@ def key_problems(wlx, readme):
     problems = []
     said = paragraph_after(readme, "Input keys:", "Output keys:")
     documented = [k for k in backticked_names(said) if re.fullmatch(r"\w+", k)]
-    for key in accepted_keys("cli/input.cpp", "for (const char* k :"):
+    for key in accepted_keys("cli/commands/input.cpp", "for (const char* k :"):
         if key not in documented:
             problems.append(f"wlx ik takes the key `{key}`; README.md's 'Input keys:' does not list it")
     for key in documented:
@@ -548,7 +551,7 @@ def key_problems(wlx, readme):
             problems.append(f"README.md documents the wlx ik key `{key}`; wlx ik rejects it: {r.stderr.strip()}")
     table = read("scenarios/README.md").split("## Report files")[0]
     documented = [k for row in re.findall(r"^\| ([^|]+) \|", table, flags=re.M) for k in re.findall(r"`(\w+)`", row)]
-    for key in accepted_keys("cli/scenario_io.cpp", "reject_unknown_keys(j,"):
+    for key in accepted_keys("cli/commands/scenario_io.cpp", "reject_unknown_keys(j,"):
         if key not in documented:
             problems.append(f"scenario files take the key `{key}`; scenarios/README.md's table does not list it")
     with tempfile.TemporaryDirectory(prefix=f"wlx_docs_{os.getpid()}_") as work:

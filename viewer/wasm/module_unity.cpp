@@ -5,5 +5,5 @@
 #include "../../runtime/wlx/model.cpp"
 #include "../../runtime/wlx/kinematics.cpp"
 #include "../../runtime/wlx/ik.cpp"
-#include "../../cli/limits.cpp"
+#include "../../cli/commands/limits.cpp"
 #include "viewer_module.cpp"

@@ -204,7 +204,7 @@ EMSCRIPTEN_KEEPALIVE const char* wlx_last_error() { return last_error().c_str();
 
 // Closed-form IK of every limb: inputs[kInputCount] and branches[kLimbCount] in, all coordinates
 // out (s_out[kCoordinateCount]). Returns 1 on success; 0 on failure, leaving s_out untouched and
-// the message in wlx_last_error(). The checks are those of `wlx ik` (cli/ik_commands.cpp,
+// the message in wlx_last_error(). The checks are those of `wlx ik` (cli/commands/ik_commands.cpp,
 // solve_ik_request): the inputs' bounds, the runtime's reach and residual errors, and the whole
 // closure's residual at most 1e-9.
 EMSCRIPTEN_KEEPALIVE int wlx_solve_ik(const double* inputs, const int* branches, double* s_out) {

@@ -168,7 +168,7 @@ std::vector<nlohmann::json> read_index(const fs::path& path) {
 }
 
 void write_index(const fs::path& path, const std::vector<nlohmann::json>& entries) {
-  std::string text = "// The runs of this viewer folder, written by wlx (cli/viewer_export.cpp).\n";
+  std::string text = "// The runs of this viewer folder, written by wlx (cli/shell/viewer_export.cpp).\n";
   text += kIndexOpen;
   for (std::size_t k = 0; k < entries.size(); ++k) text += js_json(entries[k]) + (k + 1 < entries.size() ? ",\n" : "\n");
   text += kIndexClose;

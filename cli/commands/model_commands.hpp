@@ -1,4 +1,4 @@
-// One model's command functions (compiled per model: cli/per_model.hpp).
+// One model's command functions (compiled per model: cli/commands/per_model.hpp).
 #pragma once
 
 #include "commands.hpp"

@@ -1,5 +1,5 @@
 // `wlx viewer`: the 3D viewer's page (built with emscripten, viewer/) copied into a folder, with
-// the given scenarios simulated and written as runs the page plays (cli/viewer_export.hpp).
+// the given scenarios simulated and written as runs the page plays (cli/shell/viewer_export.hpp).
 #include "per_model.hpp"
 #include "interrupt.hpp"
 #include "model_commands.hpp"

@@ -1,5 +1,5 @@
 // The CLI's subcommands: their options (model-independent) and the table of one model's command
-// functions. Each built-in model compiles its own functions (cli/model_commands.hpp); main.cpp
+// functions. Each built-in model compiles its own functions (cli/commands/model_commands.hpp); main.cpp
 // finds them by name in models() (the registry CMake writes from the list of built-in models).
 #pragma once
 
