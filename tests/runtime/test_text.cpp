@@ -233,3 +233,17 @@ TEST_CASE("cpp_string and cpp_comment: the compiler reads the literals back byte
   fs::remove_all(cpp.parent_path());
 #endif
 }
+
+TEST_CASE("text: nearest suggests the closest name within a third of the key's length, case folded on request") {
+  const std::vector<std::string> names{"duration", "dependent", "rates", "initial"};
+  CHECK(wlx::text::nearest("duraton", names, false) == "duration");
+  CHECK(wlx::text::nearest("RATES", names, true) == "rates");
+  CHECK(wlx::text::nearest("RATES", names, false).empty());  // five substitutions: too far
+  CHECK(wlx::text::nearest("xyz", names, true).empty());
+  CHECK(wlx::text::nearest("", names, true).empty());
+  // A key of a million characters is farther than its length's third from every name: none.
+  CHECK(wlx::text::nearest(std::string(1'000'000, 'd'), names, true).empty());
+  // ...and one near a long name is still found.
+  const std::vector<std::string> long_names{std::string(300, 'a') + "b"};
+  CHECK(wlx::text::nearest(std::string(300, 'a') + "c", long_names, false) == long_names[0]);
+}
