@@ -495,6 +495,9 @@ struct TwistNode {
 struct RateRoles {
   std::vector<int> speed_of;
   std::vector<bool> dense;
+  // Coordinate j's joint moves in a step: its rate is a commanded speed or a dense row of T (the
+  // other inputs are held, and add nothing to a twist).
+  bool moves(int j) const { return dense[static_cast<std::size_t>(j)] || speed_of[static_cast<std::size_t>(j)] >= 0; }
 };
 RateRoles rate_roles(const Model& m) {
   const Dynamics& dyn = *m.dynamics;
@@ -592,20 +595,28 @@ std::array<ex, 6> spatial_axis(const JointRecord& joint) {
   return S;
 }
 
-// The tree of the bodies' chains through the joints `moves` accepts (the others add nothing to a
-// twist): chains share their common joints; nodes come parents first.
+// A value the lane code reads, named and handed to CSE with the function's other expressions; ""
+// for an exact zero, which the code writers drop.
+std::string lane_scalar(FunctionSpec& fn, const std::string& name, const ex& value) {
+  if (value.is_zero()) return {};
+  fn.lane_scalars.emplace_back(name, value);
+  return name;
+}
+
+// The tree of the bodies' chains through the joints that move in a step (RateRoles::moves): chains
+// share their common joints; nodes come parents first.
 struct TwistTree {
   std::vector<TwistNode> nodes;
   std::vector<int> body_node;  // each body's last node, -1 for a body no such joint moves
 };
-TwistTree twist_tree(const Model& m, const std::function<bool(int)>& moves) {
+TwistTree twist_tree(const Model& m, const RateRoles& roles) {
   TwistTree tree;
   std::vector<int> roots;  // the nodes next to K0
   tree.body_node.assign(m.bodies.size(), -1);
   for (std::size_t i = 0; i < m.bodies.size(); ++i) {
     int at = -1;
     for (const JointRecord& joint : m.bodies[i].com_frame.joints) {
-      if (!moves(joint.coordinate)) continue;
+      if (!roles.moves(joint.coordinate)) continue;
       std::vector<int>& siblings = at < 0 ? roots : tree.nodes[static_cast<std::size_t>(at)].children;
       int next = -1;
       for (int c : siblings)
@@ -655,24 +666,19 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   const RateRoles roles = rate_roles(m);
   const std::vector<int>& speed_of = roles.speed_of;
   const auto dense = [&](int j) { return roles.dense[static_cast<std::size_t>(j)]; };
-  const auto moves = [&](int j) { return dense(j) || speed_of[static_cast<std::size_t>(j)] >= 0; };
   fn.inputs = {{"T", "RateBasis",
                 "s' = T u, the rates caused by unit commanded speeds (rate_basis at s); only the rows of the dependent "
                 "pair and of the dependent joints are read, the others are fixed by the model file, and in them only "
                 "the entries kRateBasisPattern marks (structure.hpp; the others are zero)"}};
-  const auto scalar = [&](const std::string& name, const ex& value) {
-    if (value.is_zero()) return std::string();
-    fn.lane_scalars.emplace_back(name, value);
-    return name;
-  };
+  const auto scalar = [&](const std::string& name, const ex& value) { return lane_scalar(fn, name, value); };
 
   // The tree of the bodies' chains, moving joints only (the others add nothing to a twist).
-  TwistTree tree = twist_tree(m, moves);
+  TwistTree tree = twist_tree(m, roles);
   std::vector<TwistNode>& nodes = tree.nodes;
   const std::vector<int>& body_node = tree.body_node;
 
   // Which commanded speeds each joint's rate depends on, and the lanes they take (LaneWriter).
-  const std::vector<std::vector<int>> speeds_of = rate_basis_pattern(m);
+  const std::vector<std::vector<int>> speeds_of = rate_speeds(m, roles);  // = rate_basis_pattern(m), from the roles at hand
   std::vector<std::vector<int>> node_speeds(nodes.size());
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     const int j = nodes[k].joint->coordinate;
@@ -964,17 +970,12 @@ FunctionSpec derive_generalized_forces(const Model& m) {
                 "read, and in them only the entries kRateBasisPattern marks"}};
   const RateRoles roles = rate_roles(m);
   const auto dense = [&](int j) { return roles.dense[static_cast<std::size_t>(j)]; };
-  const auto moves = [&](int j) { return dense(j) || roles.speed_of[static_cast<std::size_t>(j)] >= 0; };
-  const auto scalar = [&](const std::string& name, const ex& value) {
-    if (value.is_zero()) return std::string();
-    fn.lane_scalars.emplace_back(name, value);
-    return name;
-  };
+  const auto scalar = [&](const std::string& name, const ex& value) { return lane_scalar(fn, name, value); };
   using V3 = std::array<std::string, 3>;
   using V6 = std::array<std::string, 6>;
   const auto head = [](const V6& v) { return V3{v[0], v[1], v[2]}; };
   const auto tail = [](const V6& v) { return V3{v[3], v[4], v[5]}; };
-  TwistTree tree = twist_tree(m, moves);
+  TwistTree tree = twist_tree(m, roles);
   ScalarWriter w;
   const std::string one = ScalarWriter::kOne;
 
@@ -1092,8 +1093,7 @@ FunctionSpec derive_generalized_forces(const Model& m) {
   }
   // Q*_l = sum_j T(j, l) tau_j: a commanded speed's coordinate adds its tau to its row; a dense
   // coordinate's, times T(j, l), to the rows of the speeds its rate depends on (kRateBasisPattern).
-  const std::vector<std::vector<int>> speeds_of = rate_basis_pattern(m);
-  std::vector<std::string> Q(static_cast<std::size_t>(nu));
+  const std::vector<std::vector<int>> speeds_of = rate_speeds(m, roles);
   w.code += "    if (Qstar != nullptr) {\n";
   for (int l = 0; l < nu; ++l) {
     std::vector<Term> t;
