@@ -835,6 +835,24 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
     max_columns = std::max(max_columns, cols.size());
     columns.push_back(std::move(cols));
   }
+  // Per wheel, the coordinates its drive row can depend on: the hub's velocity Jacobians' columns
+  // (the row is t . Jv / r - a . Jw of the hub), none for a wheel without a drive.
+  std::vector<std::vector<int>> drive_columns(m.wheels.size());
+  if (m.dynamics)
+    for (const Actuator& a : m.dynamics->actuated) {
+      if (a.wheel < 0) continue;
+      const Frame& hub = m.frame(m.wheels[static_cast<std::size_t>(a.wheel)].hub);
+      const auto Hv = linear_jacobian(hub, n);
+      const auto Hw = angular_jacobian(hub, n);
+      auto& cols = drive_columns[static_cast<std::size_t>(a.wheel)];
+      for (int j = 0; j < n; ++j) {
+        bool nonzero = false;
+        for (int i = 0; i < 3; ++i)
+          nonzero = nonzero || !Hv[static_cast<std::size_t>(j)][i].is_zero() || !Hw[static_cast<std::size_t>(j)][i].is_zero();
+        if (nonzero) cols.push_back(j);
+      }
+      max_columns = std::max(max_columns, cols.size());
+    }
   t += fmt::format(
       "// Per body, the coordinates its velocity Jacobians Jv, Jw depend on: every other column is a\n"
       "// structural zero (bodies() never writes it).\n"
@@ -844,6 +862,15 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
   t += fmt::format("inline constexpr std::array<BodyColumns, {}> kBodyColumns{{{{\n", m.bodies.size());
   for (std::size_t k = 0; k < m.bodies.size(); ++k)
     t += fmt::format("    {{{}, {{{{{}}}}}}},  // {}\n", columns[k].size(), int_list(padded(columns[k], max_columns)), m.bodies[k].name);
+  t += "}};\n\n";
+  t += fmt::format(
+      "// Per wheel, the coordinates its drive row (dynamics_update's `drive`) depends on; every other\n"
+      "// entry is a structural zero. Empty for a wheel without a drive.\n"
+      "inline constexpr std::array<BodyColumns, {}> kDriveColumns{{{{\n",
+      m.wheels.size());
+  for (std::size_t w = 0; w < m.wheels.size(); ++w)
+    t += fmt::format("    {{{}, {{{{{}}}}}}},  // {}\n", drive_columns[w].size(), int_list(padded(drive_columns[w], max_columns)),
+                     m.wheels[w].name);
   t += "}};\n\n";
 
   // Closure rows, as the model file gives them (for checks that put a solution into the FK).

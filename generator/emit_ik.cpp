@@ -326,19 +326,6 @@ void require_three_joints(const Model& m, const CanonicalChain& c, const std::st
   if (c.joints.size() != 3) throw Unsolvable{fmt::format("{}: {} dependent joints drive {}; the pattern solves three", pattern, c.joints.size(), frame)};
 }
 
-// R_axis(sign q) with sin(-q) written -sin(q) (GiNaC keeps sin(-q), which the solved sines would
-// not replace).
-Mat3 signed_rot(Axis axis, int sign, const ex& q) {
-  const ex c = GiNaC::cos(q), sn = sign * GiNaC::sin(q);
-  Mat3 r = Mat3::identity();
-  const int i = (static_cast<int>(axis) + 1) % 3, j = (static_cast<int>(axis) + 2) % 3;  // R turns i towards j
-  r(i, i) = c;
-  r(i, j) = -sn;
-  r(j, i) = sn;
-  r(j, j) = c;
-  return r;
-}
-
 // sin and cos of the joint from those of theta = sign q that a solver computed.
 std::string unsign(const ChainStep& j, const SolvedJoint& s) {
   return j.sign < 0 ? fmt::format("  {0} = -{0};  // the step turns about the negative axis: q = -theta\n", s.s.get_name()) : "";

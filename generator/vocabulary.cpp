@@ -46,6 +46,17 @@ Mat3 rot(Axis axis, const ex& angle) {
   return m;
 }
 
+Mat3 signed_rot(Axis axis, int sign, const ex& q) {
+  const ex c = GiNaC::cos(q), sn = sign * GiNaC::sin(q);
+  Mat3 r = Mat3::identity();
+  const int i = (static_cast<int>(axis) + 1) % 3, j = (static_cast<int>(axis) + 2) % 3;  // R turns i towards j
+  r(i, i) = c;
+  r(i, j) = -sn;
+  r(j, i) = sn;
+  r(j, j) = c;
+  return r;
+}
+
 Frame Frame::translated(const Vec3& local_offset) const {
   Frame f = *this;
   const Vec3 rho = R * local_offset;
@@ -58,7 +69,7 @@ Frame Frame::translated(const Vec3& local_offset) const {
 Frame Frame::rotated(Axis axis, const Coordinate& c, int sign) const {
   Frame f = *this;
   const Vec3 a = ex(sign) * R.col(static_cast<int>(axis));  // the joint axis does not move with its own joint
-  f.R = R * rot(axis, sign * c.q);
+  f.R = R * signed_rot(axis, sign, c.q);
   f.omega = omega + ex(c.qdot) * a;
   f.alpha_bias = alpha_bias + ex(c.qdot) * cross(omega, a);  // the axis turns with the frame before
   f.joints.push_back({c.index, true, a, r});

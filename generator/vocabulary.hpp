@@ -48,6 +48,10 @@ enum class Axis { X = 0, Y = 1, Z = 2 };
 Vec3 unit(Axis axis);
 // Elementary rotation, right-handed: Ry(a)*(1,0,0) = (cos a, 0, -sin a).
 Mat3 rot(Axis axis, const ex& angle);
+// R_axis(sign q) written with cos(q) and sign sin(q): GiNaC keeps sin(-q) and cos(-q) as they are,
+// and a step about a negative axis would then need its own sine and cosine, outside the batched
+// pass that every generated function computes for its angles.
+Mat3 signed_rot(Axis axis, int sign, const ex& q);
 
 // One generalized coordinate of the model: a position symbol and its rate symbol.
 struct Coordinate {

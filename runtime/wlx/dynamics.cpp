@@ -8,6 +8,7 @@
 #include <Eigen/QR>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <tuple>
 #include <utility>
@@ -52,8 +53,17 @@ void velocity_level(const Params& p, Data& d, const Coordinates& s, const Comman
   rate_basis(d, kCommandedSpeeds, pair, out.T);
   out.sdot.noalias() = out.T.lazyProduct(u);  // the velocity level's solve, once T is known
   // A joint's rate is its coordinate's, T's row; a wheel drive's is its drive row times T.
+  // A drive row's structural nonzeros are its hub's coordinates (kDriveColumns): a ninth of the product.
   Eigen::Matrix<double, kWheelCount, kCommandedCount> drive_rates;
-  if constexpr (kHasWheelDrives) drive_rates.noalias() = d.drive.lazyProduct(out.T);  // not through the GEMM kernel
+  if constexpr (kHasWheelDrives)
+    for (int w = 0; w < kWheelCount; ++w) {
+      const auto& columns = gen::kDriveColumns[static_cast<std::size_t>(w)];
+      drive_rates.row(w).setZero();
+      for (int i = 0; i < columns.count; ++i) {
+        const int c = columns.index[static_cast<std::size_t>(i)];
+        drive_rates.row(w) += d.drive(w, c) * out.T.row(c);
+      }
+    }
   for (int r = 0; r < kActuatedCount; ++r) {
     const int joint = kActuatedJoints[static_cast<std::size_t>(r)];
     if (joint >= 0)
@@ -169,7 +179,7 @@ Weighting Weighting::matrix_of(const TorqueMatrix& W) {
 #endif
   Weighting out;
   out.kind = Kind::matrix;
-  out.matrix = W;
+  out.matrix = std::make_shared<const TorqueMatrix>(W);
   return out;
 }
 
@@ -177,6 +187,40 @@ Weighting Weighting::matrix_of(const TorqueMatrix& W) {
 // reduced_dynamics.hpp then); fixed-size blocks of empty matrices would not compile.
 #if __has_include(<wlx/gen/reduced_dynamics.hpp>)
 namespace {
+
+template <int k>
+using Tail = Eigen::Matrix<double, kActuatedCount - k, 1>;
+
+// An upper bound on the infinity-norm condition number of the upper triangular R: ||R||_inf times
+// ||M(R)^-1 e||_inf, M(R) R's comparison matrix (|r_ii| on the diagonal, -|r_ij| above it) and e =
+// (1, ..., 1). |R^-1| <= M(R)^-1 entrywise (Higham, Accuracy and Stability of Numerical
+// Algorithms, 2nd ed., Theorem 8.12), and M(R)^-1 e >= 0 comes from one back substitution without
+// cancellation: a tenth of forming R^-1, and an upper bound, which is what the fast paths' guarantee
+// needs (it can overstate the condition, up to 2^(n-1) for R far from diagonally dominant: then the
+// pivoted QR answers, to the same rounding).
+double condition_bound(const CommandMatrix& R) {
+  constexpr int kU = kCommandedCount;
+  CommandVector z;
+  double norm_R = 0, norm_inverse = 0;
+  for (int i = kU - 1; i >= 0; --i) {
+    double sum = 1, row = std::abs(R(i, i));
+    for (int j = i + 1; j < kU; ++j) {
+      sum += std::abs(R(i, j)) * z(j);
+      row += std::abs(R(i, j));
+    }
+    z(i) = sum / std::abs(R(i, i));
+    norm_R = std::max(norm_R, row);
+    norm_inverse = std::max(norm_inverse, z(i));
+  }
+  return norm_R * norm_inverse;
+}
+
+// The bound on condition_bound() that keeps n cond_inf below the pivoted QR's 1e13 (cond_2 <= n
+// cond_inf): 1e12 up to 9 speeds, 0.9e13 / n beyond. Then sigma_min / sigma_max > 1e-13, so the
+// pivoted QR's rank test would pass too, and both paths are backward stable: the same torques to
+// rounding (tests/runtime/test_dynamics.cpp and tests/models/test_any_model.cpp check the paths
+// against a long-double solution).
+constexpr double kConditionLimit = kCommandedCount <= 9 ? 1e12 : 0.9e13 / kCommandedCount;
 
 template <int k>
 using Tail = Eigen::Matrix<double, kActuatedCount - k, 1>;
@@ -205,40 +249,22 @@ bool householder_step(ActuatorJacobian& qr, Tail<k>& v, double& tau) {
 // The minimum-norm x with A^T x = Q*, A actuated x commanded with full column rank: from A = Q R
 // (Householder), x = Q [R^-T Q*; 0]. Unpivoted, fixed-size and unrolled: a fraction of Eigen's
 // column-pivoted QR, whose inner loops run on dynamic-size blocks. Returns false, leaving the
-// answer to the pivoted QR, unless R's 1-norm condition number is at most 1e12: then
-// sigma_min / sigma_max >= 1 / (n 1e12) > 1e-13 (cond_2 <= n cond_1; n <= 9 commanded speeds), so
-// the pivoted QR's rank test would pass too, and both are backward stable: the same torques to
-// rounding (tests/runtime/test_dynamics.cpp checks both paths against a long-double solution).
-bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
+// answer to the pivoted QR, unless condition_bound(R) <= kConditionLimit.
+bool min_norm_solve_dense(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
   constexpr int kU = kCommandedCount;
-  // The 1-norm bound that keeps n cond_1 below the pivoted QR's 1e13: 1e12 up to 9 speeds (as it
-  // always was), 0.9e13 / n beyond.
-  constexpr double kConditionLimit = kU <= 9 ? 1e12 : 0.9e13 / kU;
   ActuatorJacobian qr = A;
   CommandVector tau;
   return [&]<int... k>(std::integer_sequence<int, k...>) {
     std::tuple<Tail<k>...> v;
     if (!(householder_step<k>(qr, std::get<k>(v), tau(k)) && ...)) return false;
-    // R^-1 by back substitution, column by column: for the condition number.
     const CommandMatrix R = qr.template topRows<kU>().template triangularView<Eigen::Upper>();
-    const CommandVector reciprocal = R.diagonal().cwiseInverse();
-    CommandMatrix R_inverse = CommandMatrix::Zero();
-    for (int j = 0; j < kU; ++j) {
-      R_inverse(j, j) = reciprocal(j);
-      for (int i = j - 1; i >= 0; --i) {
-        double sum = 0;
-        for (int l = i + 1; l <= j; ++l) sum += R(i, l) * R_inverse(l, j);
-        R_inverse(i, j) = -sum * reciprocal(i);
-      }
-    }
-    const double condition = R.cwiseAbs().colwise().sum().maxCoeff() * R_inverse.cwiseAbs().colwise().sum().maxCoeff();
-    if (!(condition <= kConditionLimit)) return false;
+    if (!(condition_bound(R) <= kConditionLimit)) return false;
     // R^T y = Q* by forward substitution, then x = H_0 ... H_{n-1} [y; 0].
     x.setZero();
     for (int i = 0; i < kU; ++i) {
       double sum = Qstar(i);
       for (int l = 0; l < i; ++l) sum -= R(l, i) * x(l);
-      x(i) = sum * reciprocal(i);
+      x(i) = sum / R(i, i);
     }
     ((x.template tail<kActuatedCount - (kU - 1 - k)>() -=
       (tau(kU - 1 - k) * std::get<kU - 1 - k>(v).dot(x.template tail<kActuatedCount - (kU - 1 - k)>())) *
@@ -246,6 +272,167 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
      ...);
     return true;
   }(std::make_integer_sequence<int, kU>{});
+}
+
+// Which entries of J_beta can be nonzero, from the generated structure: a joint's row is its
+// coordinate's row of T (kRateBasisPattern), a drive's row its drive row times T (the rows of T
+// that kDriveColumns names). A machine of several legs has many structural zeros: a speed that
+// moves one foot moves only that leg's actuators.
+using ActuatorPattern = std::array<std::array<bool, kCommandedCount>, kActuatedCount>;
+constexpr ActuatorPattern actuator_pattern() {
+  ActuatorPattern p{};
+  for (int r = 0; r < kActuatedCount; ++r) {
+    const int joint = kActuatedJoints[static_cast<std::size_t>(r)];
+    if (joint >= 0) {
+      for (int k = 0; k < kCommandedCount; ++k)
+        p[static_cast<std::size_t>(r)][static_cast<std::size_t>(k)] = gen::kRateBasisPattern[static_cast<std::size_t>(joint)][static_cast<std::size_t>(k)];
+      continue;
+    }
+    const auto& columns = gen::kDriveColumns[static_cast<std::size_t>(kActuatedWheels[static_cast<std::size_t>(r)])];
+    for (int i = 0; i < columns.count; ++i)
+      for (int k = 0; k < kCommandedCount; ++k)
+        p[static_cast<std::size_t>(r)][static_cast<std::size_t>(k)] =
+            p[static_cast<std::size_t>(r)][static_cast<std::size_t>(k)] ||
+            gen::kRateBasisPattern[static_cast<std::size_t>(columns.index[static_cast<std::size_t>(i)])][static_cast<std::size_t>(k)];
+  }
+  return p;
+}
+inline constexpr ActuatorPattern kActuatorPattern = actuator_pattern();
+
+// The Householder QR of a J_beta with that structure, planned at compile time as a sparse QR
+// would be: the column with the fewest nonzero rows goes next (a foot's speed before the body's),
+// its reflector acts on those rows only, the first of them keeps R's row (the others' order does
+// not matter: a row permutation, and Householder QR is backward stable in any row order), and the
+// columns it meets fill in on those rows. For the wheeled quadruped the four feet's speeds go
+// first, on their legs' four rows each, and leave a 12 x 6 dense QR for the body's speeds.
+struct SparseQrPlan {
+  std::array<int, kCommandedCount> column{};  // the column step k reduces
+  std::array<int, kCommandedCount> count{};   // the rows its reflector acts on
+  std::array<std::array<int, kActuatedCount>, kCommandedCount> rows{};      // those rows, R's row first
+  std::array<std::array<bool, kCommandedCount>, kCommandedCount> meets{};  // step k's reflector meets column c
+  bool feasible = true;  // every step has a row left (else the structure alone loses rank)
+  long sparse_work = 0, dense_work = 0;  // multiply-adds of the reflectors' applications
+};
+
+constexpr SparseQrPlan sparse_qr_plan() {
+  constexpr int kU = kCommandedCount, kA = kActuatedCount;
+  ActuatorPattern p = kActuatorPattern;
+  SparseQrPlan plan;
+  std::array<bool, kA> retired{};
+  std::array<bool, kU> done{};
+  for (int k = 0; k < kU; ++k) {
+    int best = -1, best_count = kA + 1;
+    for (int c = 0; c < kU; ++c) {
+      if (done[static_cast<std::size_t>(c)]) continue;
+      int n = 0;
+      for (int i = 0; i < kA; ++i) n += !retired[static_cast<std::size_t>(i)] && p[static_cast<std::size_t>(i)][static_cast<std::size_t>(c)];
+      if (n < best_count) best = c, best_count = n;
+    }
+    if (best_count == 0) {
+      plan.feasible = false;
+      return plan;
+    }
+    auto& rows = plan.rows[static_cast<std::size_t>(k)];
+    int n = 0;
+    for (int i = 0; i < kA; ++i)
+      if (!retired[static_cast<std::size_t>(i)] && p[static_cast<std::size_t>(i)][static_cast<std::size_t>(best)]) rows[static_cast<std::size_t>(n++)] = i;
+    plan.column[static_cast<std::size_t>(k)] = best;
+    plan.count[static_cast<std::size_t>(k)] = n;
+    done[static_cast<std::size_t>(best)] = true;
+    for (int c = 0; c < kU; ++c) {
+      if (done[static_cast<std::size_t>(c)]) continue;
+      bool meets = false;
+      for (int i = 0; i < n; ++i) meets = meets || p[static_cast<std::size_t>(rows[static_cast<std::size_t>(i)])][static_cast<std::size_t>(c)];
+      if (!meets) continue;
+      plan.meets[static_cast<std::size_t>(k)][static_cast<std::size_t>(c)] = true;
+      for (int i = 0; i < n; ++i) p[static_cast<std::size_t>(rows[static_cast<std::size_t>(i)])][static_cast<std::size_t>(c)] = true;
+      plan.sparse_work += 2 * n;
+    }
+    plan.dense_work += 2L * (kA - k) * (kU - k - 1);
+    retired[static_cast<std::size_t>(rows[0])] = true;
+  }
+  return plan;
+}
+inline constexpr SparseQrPlan kSparseQr = sparse_qr_plan();
+// Worth it where it skips at least a third of the dense QR's work; a dense J_beta (the excavator's)
+// keeps the dense path, whose fixed-size blocks vectorize.
+inline constexpr bool kUseSparseQr = kSparseQr.feasible && 3 * kSparseQr.sparse_work <= 2 * kSparseQr.dense_work;
+
+// Whether A has a nonzero where the structure says zero: J_beta from inverse_dynamics never does,
+// a matrix a caller builds may (then the dense path answers).
+[[maybe_unused]] bool breaks_pattern(const ActuatorJacobian& A) {
+  bool broken = false;
+  for (int r = 0; r < kActuatedCount; ++r)
+    for (int c = 0; c < kCommandedCount; ++c)
+      if (!kActuatorPattern[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)]) broken = broken || A(r, c) != 0;
+  return broken;
+}
+
+// min_norm_solve_dense's answer by the plan's sparse QR: the same reflectors on a row-permuted A,
+// skipping the structural zeros, with the same condition test. Loop bounds and row indices are
+// compile-time constants (kSparseQr), so the compiler unrolls every loop.
+[[maybe_unused]] bool min_norm_solve_sparse(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
+  constexpr int kU = kCommandedCount;
+  constexpr const SparseQrPlan& plan = kSparseQr;
+  ActuatorJacobian qr = A;
+  std::array<std::array<double, kActuatedCount>, kU> v{};
+  CommandVector tau;
+  CommandMatrix R = CommandMatrix::Zero();  // in step order: R(k, j) on step j's column
+  const bool full_rank = [&]<int... k>(std::integer_sequence<int, k...>) {
+    const auto step = [&](auto K) {
+      constexpr int s = decltype(K)::value, n = plan.count[s], c = plan.column[s];
+      constexpr auto rows = plan.rows[s];
+      double norm2 = 0;
+      for (int i = 0; i < n; ++i) norm2 += qr(rows[i], c) * qr(rows[i], c);
+      const double alpha = qr(rows[0], c), norm = std::sqrt(norm2);
+      if (!(norm > 0)) return false;
+      const double beta = alpha >= 0 ? -norm : norm, scale = 1 / (alpha - beta);
+      auto& vs = v[s];
+      vs[0] = 1;
+      for (int i = 1; i < n; ++i) vs[i] = qr(rows[i], c) * scale;
+      tau(s) = (beta - alpha) / beta;
+      R(s, s) = beta;
+      for (int j = 0; j < kU; ++j) {
+        if (!plan.meets[s][j]) continue;
+        double projection = 0;
+        for (int i = 0; i < n; ++i) projection += vs[i] * qr(rows[i], j);
+        projection *= tau(s);
+        for (int i = 0; i < n; ++i) qr(rows[i], j) -= vs[i] * projection;
+      }
+      return true;
+    };
+    return (step(std::integral_constant<int, k>{}) && ...);
+  }(std::make_integer_sequence<int, kU>{});
+  if (!full_rank) return false;
+  // R's row k is step k's first row, on the columns reduced after it (retired rows no longer change).
+  for (int k = 0; k < kU; ++k)
+    for (int j = k + 1; j < kU; ++j) R(k, j) = qr(plan.rows[static_cast<std::size_t>(k)][0], plan.column[static_cast<std::size_t>(j)]);
+  if (!(condition_bound(R) <= kConditionLimit)) return false;
+  // R^T y = (Q* in step order), then x = H_0 ... H_{n-1} y placed on R's rows.
+  x.setZero();
+  for (int k = 0; k < kU; ++k) {
+    double sum = Qstar(plan.column[static_cast<std::size_t>(k)]);
+    for (int l = 0; l < k; ++l) sum -= R(l, k) * x(plan.rows[static_cast<std::size_t>(l)][0]);
+    x(plan.rows[static_cast<std::size_t>(k)][0]) = sum / R(k, k);
+  }
+  [&]<int... k>(std::integer_sequence<int, k...>) {
+    const auto reflect = [&](auto K) {
+      constexpr int s = kU - 1 - decltype(K)::value, n = plan.count[s];
+      constexpr auto rows = plan.rows[s];
+      double d = 0;
+      for (int i = 0; i < n; ++i) d += v[s][i] * x(rows[i]);
+      d *= tau(s);
+      for (int i = 0; i < n; ++i) x(rows[i]) -= v[s][i] * d;
+    };
+    (reflect(std::integral_constant<int, k>{}), ...);
+  }(std::make_integer_sequence<int, kU>{});
+  return true;
+}
+
+bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
+  if constexpr (kUseSparseQr)
+    if (!breaks_pattern(A)) return min_norm_solve_sparse(A, Qstar, x);
+  return min_norm_solve_dense(A, Qstar, x);
 }
 
 // The motion no actuator acts on, for the message of a rank loss: the unit combination n of the
@@ -308,7 +495,8 @@ TorqueVector min_norm_solve(const ActuatorJacobian& At, const CommandVector& Qst
 // A full weight matrix: S = L^-T from W = L L^T (scaled to a largest entry of 1, as above).
 [[gnu::noinline]] TorqueVector distribute_torques_weight_matrix(const ActuatorJacobian& J_beta, const CommandVector& Qstar,
                                                                 const Weighting& weighting) {
-  const TorqueMatrix L = (weighting.matrix / weighting.matrix.cwiseAbs().maxCoeff()).llt().matrixL();
+  const TorqueMatrix& W = *weighting.matrix;
+  const TorqueMatrix L = (W / W.cwiseAbs().maxCoeff()).llt().matrixL();
   const TorqueMatrix S = L.transpose().triangularView<Eigen::Upper>().solve(TorqueMatrix::Identity());
   return S.lazyProduct(min_norm_solve(S.transpose().lazyProduct(J_beta), Qstar, weighting));
 }

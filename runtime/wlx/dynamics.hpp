@@ -12,6 +12,7 @@
 #include "wlx/nonholonomic.hpp"
 
 #include <array>
+#include <memory>
 #include <string>
 
 WLX_MODEL_NAMESPACE_BEGIN
@@ -84,14 +85,16 @@ double kinetic_energy(const Model& model, Data& data, const Coordinates& s, cons
 struct Weighting {
   enum class Kind { model_weights, contribution, diagonal, matrix };
   Kind kind = Kind::model_weights;
-  TorqueVector diagonal = TorqueVector::Ones();    // W for Kind::diagonal
-  TorqueMatrix matrix = TorqueMatrix::Identity();  // W for Kind::matrix
+  TorqueVector diagonal = TorqueVector::Ones();  // W for Kind::diagonal
+  // W for Kind::matrix, else null: shared, so that a Weighting made at every step (model_weights())
+  // costs nothing, where a matrix member would write kActuatedCount^2 numbers each time.
+  std::shared_ptr<const TorqueMatrix> matrix;
   std::string label() const;
 
   // The model file's default weights (dynamics.weights; the excavator's are the thesis' weighting 1).
   static Weighting model_weights() { return {}; }
   // Thesis 6.3.3 weighting 2: W_ii = 1 / |row i of J_beta|, recomputed at every step.
-  static Weighting contribution() { return {Kind::contribution, TorqueVector::Ones(), TorqueMatrix::Identity()}; }
+  static Weighting contribution() { return {Kind::contribution, TorqueVector::Ones(), nullptr}; }
   // Throws wlx::Error (field "weighting") unless every entry is positive and finite.
   static Weighting diagonal_of(const TorqueVector& w);
   // Throws unless symmetric positive definite.

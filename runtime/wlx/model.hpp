@@ -7,9 +7,10 @@
 
 #include <wlx/gen/all.hpp>
 
-#include <Eigen/LU>  // Matrix4d::inverse
+#include <Eigen/LU>  // Matrix4d::inverse, PartialPivLU
 
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 WLX_MODEL_NAMESPACE_BEGIN
@@ -74,6 +75,10 @@ struct Data {
   std::array<Eigen::Matrix<double, gen::kMaxLimbSize, gen::kMaxLimbSize>, gen::kLimbCount> limb_inverse;
   Eigen::Matrix<double, gen::kDependentCount, gen::kWheelCount> wheel_adjoint;
   Eigen::Matrix<double, gen::kWheelCount, gen::kWheelCount> J_beta;
+  // J_beta's LU factorization (partial pivoting), once per step: every solve with J_beta uses it.
+  // (A model without wheels has nothing to factorize, and Eigen no 0 x 0 LU.)
+  std::conditional_t<(gen::kWheelCount > 0), Eigen::PartialPivLU<Eigen::Matrix<double, gen::kWheelCount, gen::kWheelCount>>, char>
+      J_beta_lu;
   double cond_J_beta = 0;
 };
 

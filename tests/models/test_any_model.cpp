@@ -12,6 +12,8 @@
 #include "../support/jet_eigen.hpp"
 
 #include <Eigen/Geometry>
+#include <Eigen/QR>
+#include <Eigen/SVD>
 #include <doctest/doctest.h>
 #include <wlx/dynamics.hpp>
 #include <wlx/error.hpp>
@@ -358,6 +360,61 @@ TEST_CASE(titled("inverse dynamics: J_beta^T tau = Q*, power and energy balances
   CHECK(worst_balance <= 1e-9);  // least-norm solve with cond(J_beta) up to ~1e4
   CHECK(worst_power <= 1e-9);
   CHECK(worst_energy <= 1e-6);  // five-point stencil at dt = 1e-5 on a motion with |s'| <= 1
+}
+
+// A template, so that a model without dynamics (0 x 0 matrices) compiles none of it.
+template <bool kDynamics = gen::kHasDynamics>
+void check_torque_split_against_long_double() {
+  if constexpr (kDynamics) {
+    // distribute_torques plans its QR on J_beta's structural zeros (a sparse QR where a foot's speed
+    // moves only its leg, the dense one otherwise) and must give, on a J_beta from inverse_dynamics
+    // and on a dense matrix that breaks the structure (which the sparse plan would get wrong), the
+    // minimum-norm solution of J^T S x = Q* (tau = S x), here against the same solution in long
+    // double (complete orthogonal decomposition): within the backward-stability bound cond * eps *
+    // 64, as tests/runtime/test_dynamics.cpp asks of the excavator's.
+    using LongJacobian = Eigen::Matrix<long double, kActuatedCount, kCommandedCount>;
+    const Model model;
+    Data d;
+    DynamicsTerms t;
+    std::mt19937_64 rng(211);
+    std::uniform_real_distribution<double> half(-0.5, 0.5);
+    double worst = 0;
+    int solved = 0;
+    const auto check = [&](const ActuatorJacobian& J, const CommandVector& Qstar) {
+      const Weighting w = Weighting::model_weights();
+      TorqueVector tau;
+      try {
+        tau = distribute_torques(J, Qstar, w);
+      } catch (const Error&) {
+        return;  // a rank loss (the nominal pose's free rolling): the refusal has its own test
+      }
+      const TorqueVector S = kModelWeightDiagonal.cwiseInverse().cwiseSqrt();
+      const LongJacobian A = (S.asDiagonal() * J).cast<long double>();
+      const Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<long double, kCommandedCount, kActuatedCount>> cod(A.transpose());
+      const TorqueVector reference = (S.cast<long double>().asDiagonal() * cod.solve(Qstar.cast<long double>())).cast<double>();
+      const Eigen::JacobiSVD<ActuatorJacobian> svd(S.asDiagonal() * J);
+      const double condition = svd.singularValues()(0) / svd.singularValues()(kCommandedCount - 1);
+      const double error = (tau - reference).norm() / (condition * 2.2e-16 * reference.norm());
+      worst = std::max(worst, error);
+      ++solved;
+    };
+    for (int trial = 0; trial < 20; ++trial) {
+      const Coordinates s = random_state(rng, model, 0.03);
+      CommandVector u, u_dot;
+      for (int k = 0; k < kCommandedCount; ++k) u(k) = half(rng), u_dot(k) = half(rng);
+      inverse_dynamics(model, d, s, u, u_dot, t);
+      check(t.J_beta, t.Qstar);
+      ActuatorJacobian dense = ActuatorJacobian::Random();  // Eigen's generator: nonzero everywhere
+      check(dense, t.Qstar);
+    }
+    MESSAGE(kName << ": torque split error over cond * eps, worst of " << solved << " solves: " << worst);
+    CHECK(solved >= 20);
+    CHECK(worst <= 64);
+  }
+}
+
+TEST_CASE(titled("the torque split is the weighted least-norm solution to rounding, on J_beta's structure and off it")) {
+  check_torque_split_against_long_double();
 }
 
 TEST_CASE(titled("inverse dynamics at the nominal pose: torques that balance Q*, or a refusal naming the speeds no actuator moves")) {

@@ -153,6 +153,13 @@ inline constexpr std::array<BodyColumns, 7> kBodyColumns{{
     {8, {{0, 1, 2, 3, 4, 5, 17, 31, -1, -1}}},  // lever_r
 }};
 
+// Per wheel, the coordinates its drive row (dynamics_update's `drive`) depends on; every other
+// entry is a structural zero. Empty for a wheel without a drive.
+inline constexpr std::array<BodyColumns, 2> kDriveColumns{{
+    {0, {{-1, -1, -1, -1, -1, -1, -1, -1, -1, -1}}},  // l
+    {0, {{-1, -1, -1, -1, -1, -1, -1, -1, -1, -1}}},  // r
+}};
+
 // Each closure row: its kind, the frame it constrains, the K0 component (point) or the frame's axis
 // (level), and the input it equals (point), else -1.
 enum class RowKind { point, level, sum };

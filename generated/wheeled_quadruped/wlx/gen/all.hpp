@@ -7,17 +7,17 @@
 //
 // Operation counts (each +, -, *, /, negation and function call counts as one):
 //   function           intermediates    before CSE     after CSE
-//   kinematics                   229         15634          1075
-//   closure                      294         46236          1552
-//   nonholonomic                 346         96920          1859
-//   convective                   436        198116          2116
-//   bodies                      1022        165475          5164
-//   kinematic_update             411         98350          2249
-//   dynamics_update              355        102428          1887
-//   reduced_dynamics            1155        371844         18784
-//   generalized_forces           243         16742          4986
+//   kinematics                   220         15634          1087
+//   closure                      300         46236          1580
+//   nonholonomic                 351         96920          1892
+//   convective                   412        198116          2120
+//   bodies                      1018        165475          5175
+//   kinematic_update             420         98350          2296
+//   dynamics_update              361        102428          1916
+//   reduced_dynamics            1130        371844         18793
+//   generalized_forces           236         16742          4979
 //   clearance                      0            19            19
-//   total                                  1111764         39691
+//   total                                  1111764         39857
 #pragma once
 
 #include "ik.hpp"

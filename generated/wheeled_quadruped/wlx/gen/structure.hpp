@@ -163,6 +163,15 @@ inline constexpr std::array<BodyColumns, 17> kBodyColumns{{
     {9, {{0, 1, 2, 3, 4, 5, 27, 28, 29}}},  // wheel_rh
 }};
 
+// Per wheel, the coordinates its drive row (dynamics_update's `drive`) depends on; every other
+// entry is a structural zero. Empty for a wheel without a drive.
+inline constexpr std::array<BodyColumns, 4> kDriveColumns{{
+    {9, {{0, 1, 2, 3, 4, 5, 18, 19, 20}}},  // lf
+    {9, {{0, 1, 2, 3, 4, 5, 21, 22, 23}}},  // rf
+    {9, {{0, 1, 2, 3, 4, 5, 24, 25, 26}}},  // lh
+    {9, {{0, 1, 2, 3, 4, 5, 27, 28, 29}}},  // rh
+}};
+
 // Each closure row: its kind, the frame it constrains, the K0 component (point) or the frame's axis
 // (level), and the input it equals (point), else -1.
 enum class RowKind { point, level, sum };
