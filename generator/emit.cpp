@@ -822,18 +822,22 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
   // Body Jacobian columns.
   std::vector<std::vector<int>> columns;
   std::size_t max_columns = 1;
-  for (const auto& b : m.bodies) {
-    const auto Lv = linear_jacobian(b.com_frame, n);
-    const auto Lw = angular_jacobian(b.com_frame, n);
+  // The coordinates a frame's velocity Jacobians have a nonzero column for.
+  const auto jacobian_columns = [n](const Frame& frame) {
+    const auto Jv = linear_jacobian(frame, n);
+    const auto Jw = angular_jacobian(frame, n);
     std::vector<int> cols;
     for (int j = 0; j < n; ++j) {
       bool nonzero = false;
       for (int i = 0; i < 3; ++i)
-        nonzero = nonzero || !Lv[static_cast<std::size_t>(j)][i].is_zero() || !Lw[static_cast<std::size_t>(j)][i].is_zero();
+        nonzero = nonzero || !Jv[static_cast<std::size_t>(j)][i].is_zero() || !Jw[static_cast<std::size_t>(j)][i].is_zero();
       if (nonzero) cols.push_back(j);
     }
-    max_columns = std::max(max_columns, cols.size());
-    columns.push_back(std::move(cols));
+    return cols;
+  };
+  for (const auto& b : m.bodies) {
+    columns.push_back(jacobian_columns(b.com_frame));
+    max_columns = std::max(max_columns, columns.back().size());
   }
   // Per wheel, the coordinates its drive row can depend on: the hub's velocity Jacobians' columns
   // (the row is t . Jv / r - a . Jw of the hub), none for a wheel without a drive.
@@ -841,16 +845,8 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
   if (m.dynamics)
     for (const Actuator& a : m.dynamics->actuated) {
       if (a.wheel < 0) continue;
-      const Frame& hub = m.frame(m.wheels[static_cast<std::size_t>(a.wheel)].hub);
-      const auto Hv = linear_jacobian(hub, n);
-      const auto Hw = angular_jacobian(hub, n);
       auto& cols = drive_columns[static_cast<std::size_t>(a.wheel)];
-      for (int j = 0; j < n; ++j) {
-        bool nonzero = false;
-        for (int i = 0; i < 3; ++i)
-          nonzero = nonzero || !Hv[static_cast<std::size_t>(j)][i].is_zero() || !Hw[static_cast<std::size_t>(j)][i].is_zero();
-        if (nonzero) cols.push_back(j);
-      }
+      cols = jacobian_columns(m.frame(m.wheels[static_cast<std::size_t>(a.wheel)].hub));
       max_columns = std::max(max_columns, cols.size());
     }
   t += fmt::format(
