@@ -12,6 +12,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <wlx/dynamics.hpp>
+#include <wlx/forward_dynamics.hpp>
 #include <wlx/error.hpp>
 #include <wlx/kinematics.hpp>
 #include <wlx/nonholonomic.hpp>
@@ -180,6 +181,34 @@ void bind_python(py::module_& parent) {
         return out;
       },
       "inverse_dynamics(s, u, u_dot, params_json, weighting_json) -> dict tau, Qstar, M, b, Q_gravity, J_beta, sdot");
+
+  m.def(
+      "forward_dynamics",
+      [](const Eigen::VectorXd& s_in, const Eigen::VectorXd& u_in, const Eigen::VectorXd& tau_in, const std::string& params_json) {
+        const CommandVector u = commands_of(u_in, "u");
+        if (tau_in.size() != kActuatedCount)
+          throw Error("tau", "has " + std::to_string(tau_in.size()) + " entries; the model has " + std::to_string(kActuatedCount) +
+                                 " actuators");
+        const TorqueVector tau = tau_in;
+        const Model model(params_of(params_json));
+        Data data;
+        DynamicsTerms terms;
+        check_finite(u, "u");
+        check_finite(tau, "tau");
+        const Coordinates s = coordinates_of(s_in, "s");
+        CommandVector u_dot;
+        forward_dynamics(model, data, s, u, tau, u_dot, terms);
+        check_result(u_dot, "u_dot");
+        check_result(terms.sddot, "sddot");
+        py::dict out;
+        out["u_dot"] = Eigen::VectorXd(u_dot);
+        out["sddot"] = Eigen::VectorXd(terms.sddot);
+        out["sdot"] = Eigen::VectorXd(terms.sdot);
+        out["Qstar"] = Eigen::VectorXd(terms.Qstar);
+        out["M"] = Eigen::MatrixXd(terms.M);
+        return out;
+      },
+      "forward_dynamics(s, u, tau, params_json) -> dict u_dot, sddot, sdot, Qstar (= J_beta^T tau), M");
 
   m.def(
       "simulate",

@@ -107,6 +107,13 @@ class Model:
         return self._m.inverse_dynamics(_np.asarray(s, dtype=float), _np.asarray(u, dtype=float),
                                         _np.asarray(u_dot, dtype=float), _params_json(params), _to_json(weighting, "weighting"))
 
+    def forward_dynamics(self, s, u, tau, params=None):
+        """The converse of inverse_dynamics: the accelerations u_dot of the commanded speeds u at s
+        under the actuator torques tau (in the order of `actuators`), the closure and the rolling
+        rows held. Returns a dict: u_dot, sddot (all coordinates), sdot, Qstar (= J_beta^T tau), M."""
+        return self._m.forward_dynamics(_np.asarray(s, dtype=float), _np.asarray(u, dtype=float),
+                                        _np.asarray(tau, dtype=float), _params_json(params))
+
     def simulate(self, scenario, every=1):
         """Runs a scenario: an embedded id ("NH-1"), a path to a JSON file, or a dict in the scenario
         format. Returns the CSV's columns as arrays by name (every `every`-th sample, from t = 0),
