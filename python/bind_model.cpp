@@ -214,10 +214,11 @@ void bind_python(py::module_& parent) {
       "simulate",
       [](const std::string& scenario_json, long every) {
         const nlohmann::json j = parse_json(scenario_json, "scenario");
-        const Scenario sc = parse_scenario(j.is_string() ? read_scenario_json(j.get<std::string>()) : j);
+        const Scenario sc = j.is_string() ? parse_scenario(read_scenario_json(j.get<std::string>()), {},
+                                                           scenario_directory(j.get<std::string>()))
+                                          : parse_scenario(j);
         if (every < 1) throw Error("every", "must be at least 1 (keep every k-th sample), got " + std::to_string(every));
-        const bool dynamics = sc.weighting.has_value();
-        const std::vector<std::string> header = trajectory_header(dynamics);
+        const std::vector<std::string> header = trajectory_header(sc);
         // The columns are written as the run streams its samples (no table, no copy), and bounded:
         // a run's samples beyond kMaxSimulateBytes are an error before anything is allocated,
         // where `wlx simulate` streams any length to a file.
@@ -235,7 +236,7 @@ void bind_python(py::module_& parent) {
         long index = 0, rows = 0;
         const Trajectory run = simulate_each(sc, [&](const Sample& smp) {
           if (index++ % every != 0 || rows >= kept) return;
-          const std::vector<double> row = trajectory_row(smp, dynamics);
+          const std::vector<double> row = trajectory_row(smp, sc);
           for (std::size_t c = 0; c < row.size(); ++c) columns_out[c].mutable_at(rows) = row[c];
           ++rows;
         });

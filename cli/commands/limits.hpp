@@ -7,6 +7,7 @@
 #include "per_model.hpp"
 #include <wlx/model.hpp>
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,8 @@ inline constexpr double kMaxAngle = 100;          // rad: |yaw|, |theta_l5|, ...
 inline constexpr double kMaxLinearRate = 100;     // m/s
 inline constexpr double kMaxAngularRate = 100;    // rad/s (about 16 turns per second)
 inline constexpr double kMaxWeightRatio = 1e12;   // largest / smallest diagonal torque weight
+inline constexpr double kMaxTorque = 1e9;         // N m (or N): any actuator, in a torque table
+inline constexpr std::size_t kMaxTorqueRows = 1'000'000;  // rows of a torque table: 1000 s at 1 ms, ~0.1 GB
 
 // Whether a coordinate is an angle (unit rad): only angles may be given as {"deg": x}.
 bool is_angle(int coordinate);

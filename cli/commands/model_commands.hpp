@@ -25,7 +25,7 @@ int run_report(const ModelOptions& model, const ReportOptions& options);
 int run_viewer(const ModelOptions& model, const ViewerOptions& options);
 
 // The text of a trajectory CSV (`wlx simulate`'s columns), for write_viewer_run (viewer_export.hpp).
-std::string trajectory_csv_text(const Trajectory& trajectory, bool dynamics);
+std::string trajectory_csv_text(const Trajectory& trajectory, const Scenario& scenario);
 // Writes DIR/runs/<scenario.id>.js for the viewer: the run's coordinates and, beside them, its
 // dependent pair's rates (or, for an inverse-dynamics run, its joint torques). Throws wlx::Error
 // for a scenario with parameters other than the model's defaults (the viewer draws those).

@@ -15,10 +15,11 @@ void write_ik_sweep_csv(const std::string& path, const IkSweepResult& result);
 
 // t, the coordinates, per wheel x_/y_<contact> (x_Wl, y_Wl, ...), nh_residual_<wheel>, spin_rate_<wheel>,
 // the input rates (<name>_dot), cond_J_beta, clearance, the contact velocities vx_/vy_/vz_<contact>, and for
-// dynamics runs tau_<joint> and Qstar_<speed>.
-std::vector<std::string> trajectory_header(bool dynamics);
-std::vector<double> trajectory_row(const Sample& sample, bool dynamics);
-void write_trajectory(const std::string& path, const Trajectory& trajectory, bool dynamics);
+// dynamics runs tau_<joint> and Qstar_<speed>, and for runs driven by torques the commanded speeds'
+// accelerations <name>_ddot, the kinetic and potential energy (J) and the actuators' power (W).
+std::vector<std::string> trajectory_header(const Scenario& scenario);
+std::vector<double> trajectory_row(const Sample& sample, const Scenario& scenario);
+void write_trajectory(const std::string& path, const Trajectory& trajectory, const Scenario& scenario);
 
 // `wlx simulate`'s run: samples streamed to <out_dir>/trajectory.csv as they are computed
 // (constant memory), the file put in place when the run ends, also when it stops early or is

@@ -2,16 +2,20 @@
 #include "scenario_io.hpp"
 
 #include "bounded_input.hpp"
+#include "csv_columns.hpp"
+#include "interrupt.hpp"
 #include "input.hpp"
 #include "limits.hpp"
 
 #include <fmt/format.h>
 #include <wlx/text.hpp>
+#include <wlx/bounded_file.hpp>
 #include <wlx/error.hpp>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numbers>
 #include <sstream>
 
@@ -118,10 +122,137 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
                                kActuatedCount, excerpt(v)));
 }
 
-Scenario parse_scenario(const nlohmann::json& j, const Params& base) {
+std::string scenario_directory(const std::string& path_or_id) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path_or_id, ec)) return {};
+  return std::filesystem::path(path_or_id).parent_path().string();
+}
+
+namespace {
+
+// The CSV columns of a torque table: t, then tau_<actuator> (as `wlx simulate` writes them).
+std::vector<std::string> torque_columns() {
+  std::vector<std::string> names{"t"};
+  for (const std::string_view a : kActuatorNames) names.push_back("tau_" + std::string(a));
+  return names;
+}
+
+// A table's rows: bounded in number and size, checked against the run it drives.
+TorqueTable torque_table(const std::map<std::string, std::vector<double>>& columns, const std::string& key,
+                         TorqueTable::Interpolation interpolation, double duration) {
+  const std::vector<double>& times = columns.at("t");
+  if (times.size() > kMaxTorqueRows)
+    throw Error(key, fmt::format("{} rows, more than the limit of {}", times.size(), kMaxTorqueRows));
+  std::vector<TorqueVector> rows(times.size());
+  for (int a = 0; a < kActuatedCount; ++a) {
+    const std::string name = "tau_" + std::string(kActuatorNames[static_cast<std::size_t>(a)]);
+    const std::vector<double>& values = columns.at(name);
+    if (values.size() != times.size())
+      throw Error(key + "." + name, fmt::format("has {} values for {} times", values.size(), times.size()));
+    for (std::size_t r = 0; r < times.size(); ++r) {
+      if (!(std::abs(values[r]) <= kMaxTorque))
+        throw Error(key + "." + name, fmt::format("row {}: |{}| N m (or N) is beyond the limit of {:g}", r, values[r], kMaxTorque));
+      rows[r](a) = values[r];
+    }
+  }
+  try {
+    TorqueTable table(times, std::move(rows), interpolation);
+    // The run asks for every time in [0, duration]: a table that ends early is a mistake now, not
+    // a run that stops half-way.
+    if (table.start() > 0 || table.end() < duration * (1 - 1e-12))
+      throw Error("torques", fmt::format("the table covers t = {} to {} s; the run needs 0 to {} s", table.start(),
+                                         table.end(), duration));
+    return table;
+  } catch (const Error& e) {
+    throw Error(key, e.reason());
+  }
+}
+
+}  // namespace
+
+TorqueSource parse_torques(const nlohmann::json& v, const Params& params, double duration, const std::string& directory) {
+  const std::string key = "torques";
+  if (!v.is_object())
+    throw Error(key, fmt::format("must be {{\"file\": CSV}}, {{\"run\": an inverse-dynamics scenario}} or {{\"t\": [...], "
+                                 "\"tau_<actuator>\": [...]}}, got {}",
+                                 excerpt(v)));
+  const std::vector<std::string> columns = torque_columns();
+  const int sources = static_cast<int>(v.contains("file")) + static_cast<int>(v.contains("run")) + static_cast<int>(v.contains("t"));
+  if (sources != 1) throw Error(key, "give exactly one of \"file\", \"run\" or the columns \"t\", \"tau_<actuator>\"");
+  std::vector<std::string> valid{"interpolation"};
+  if (v.contains("t")) valid.insert(valid.end(), columns.begin(), columns.end());
+  else valid.emplace_back(v.contains("file") ? "file" : "run");
+  reject_unknown_keys(v, valid, key + ".");
+  // A run's torques are samples of a smooth function (cubic); a table of set points means what
+  // it says between its rows (linear).
+  auto interpolation = v.contains("run") ? TorqueTable::Interpolation::cubic : TorqueTable::Interpolation::linear;
+  if (v.contains("interpolation")) {
+    const auto& i = v.at("interpolation");
+    if (i == "linear") interpolation = TorqueTable::Interpolation::linear;
+    else if (i == "cubic") interpolation = TorqueTable::Interpolation::cubic;
+    else throw Error(key + ".interpolation", fmt::format("must be \"linear\" or \"cubic\", got {}", excerpt(i)));
+  }
+  const auto text_of = [&](const char* field) {
+    const auto& value = v.at(field);
+    if (!value.is_string() || value.get<std::string>().empty())
+      throw Error(key + "." + field, fmt::format("must be a file name, got {}", excerpt(value)));
+    return value.get<std::string>();
+  };
+  if (v.contains("file")) {
+    const std::string name = text_of("file");
+    const std::filesystem::path path = std::filesystem::path(name).is_absolute() || directory.empty()
+                                           ? std::filesystem::path(name)
+                                           : std::filesystem::path(directory) / name;
+    const BoundedRead file = read_bounded_file(path.string(), kMaxFileBytes);
+    if (!file.ok()) throw Error(key + ".file", fmt::format("{}: {}", excerpt(path.string()), file.error));
+    return torque_table(read_csv_columns(file.text, key + ".file", "the torque table " + excerpt(path.string()), columns),
+                        key + ".file", interpolation, duration);
+  }
+  if (v.contains("run")) {
+    const std::string id = text_of("run");
+    // A file beside the scenario, else a file or an embedded id as `wlx simulate` takes them.
+    std::error_code ec;
+    const std::filesystem::path beside = std::filesystem::path(directory) / id;
+    const std::string source = !directory.empty() && std::filesystem::is_regular_file(beside, ec) ? beside.string() : id;
+    const nlohmann::json referenced = read_scenario_json(source);
+    if (referenced.is_object() && referenced.contains("torques"))
+      throw Error(key + ".run", fmt::format("'{}' is driven by torques itself: name an inverse-dynamics run", excerpt(id)));
+    Scenario inverse = parse_scenario(referenced, params, scenario_directory(source));
+    if (!inverse.weighting)
+      throw Error(key + ".run", fmt::format("'{}' has no weighting: it is a kinematic run, and only an inverse-dynamics run "
+                                            "computes torques",
+                                            excerpt(id)));
+    if (inverse.samples() > static_cast<long>(kMaxTorqueRows))
+      throw Error(key + ".run", fmt::format("'{}' has {} samples, more than the limit of {} rows", excerpt(id),
+                                            inverse.samples(), kMaxTorqueRows));
+    std::map<std::string, std::vector<double>> table;
+    for (const auto& name : columns) table[name].reserve(static_cast<std::size_t>(inverse.samples()));
+    const Trajectory run = simulate_each(inverse, [&](const Sample& smp) {
+      throw_if_interrupted();
+      table["t"].push_back(smp.t);
+      for (int a = 0; a < kActuatedCount; ++a) table[columns[static_cast<std::size_t>(a) + 1]].push_back(smp.tau(a));
+    });
+    if (!run.complete) throw Error(key + ".run", fmt::format("the inverse-dynamics run '{}' {}", excerpt(id), run.error));
+    return torque_table(table, key + ".run", interpolation, duration);
+  }
+  std::map<std::string, std::vector<double>> table;
+  for (const auto& name : columns) {
+    if (!v.contains(name))
+      throw Error(key, fmt::format("has \"t\" but no column \"{}\": a table gives every actuator's torque", name));
+    const auto& column = v.at(name);
+    if (!column.is_array()) throw Error(key + "." + name, fmt::format("must be an array of numbers, got {}", excerpt(column)));
+    if (column.size() > kMaxTorqueRows)
+      throw Error(key + "." + name, fmt::format("{} rows, more than the limit of {}", column.size(), kMaxTorqueRows));
+    std::vector<double>& values = table[name];
+    for (std::size_t r = 0; r < column.size(); ++r) values.push_back(finite_number(column[r], fmt::format("{}.{}[{}]", key, name, r)));
+  }
+  return torque_table(table, key, interpolation, duration);
+}
+
+Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::string& directory) {
   if (!j.is_object()) throw Error("", fmt::format("a scenario is a JSON object, got {}", j.type_name()));
   reject_unknown_keys(j, {"id", "description", "observation", "verify", "initial", "params", "rates", "dependent", "duration",
-                          "dt", "integrator", "tolerance", "branch", "max_condition", "weighting"},
+                          "dt", "integrator", "tolerance", "branch", "max_condition", "weighting", "torques"},
                       "");
   // "verify": "nonholonomic" puts the scenario into `wlx verify nonholonomic`.
   if (j.contains("verify") && j.at("verify") != "nonholonomic")
@@ -154,24 +285,27 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base) {
       else sc.rates(k) = v;
     }
   }
-  if (!j.contains("dependent")) {
+  if (!j.contains("dependent") && j.contains("torques")) {
+    sc.pair = dynamics_pair();  // the only pair a forward-dynamics run can have
+  } else if (!j.contains("dependent")) {
     std::string example;
     for (int k : default_pair().index)
       example += fmt::format("{}\"{}\"", example.empty() ? "" : ", ", gen::kCoordinateNames[static_cast<std::size_t>(k)]);
     throw Error("dependent",
                 fmt::format("missing: name the {} dependent rates (one per wheel), e.g. [{}]", kWheelCount, example));
+  } else {
+    const auto& dep = j.at("dependent");
+    if (!dep.is_array() || dep.size() != static_cast<std::size_t>(kWheelCount) ||
+        !std::all_of(dep.begin(), dep.end(), [](const auto& name) { return name.is_string(); }))
+      throw Error("dependent", fmt::format("must be an array of {} names, got {}", kWheelCount, excerpt(dep)));
+    std::vector<std::string> names;
+    for (const auto& name : dep) {  // the pair's own messages quote the names in full
+      if (excerpt(name.get<std::string>()) != name.get<std::string>())
+        throw Error("dependent", fmt::format("'{}' cannot be a dependent rate", excerpt(name.get<std::string>())));
+      names.push_back(name.get<std::string>());
+    }
+    sc.pair = dependent_pair(names);
   }
-  const auto& dep = j.at("dependent");
-  if (!dep.is_array() || dep.size() != static_cast<std::size_t>(kWheelCount) ||
-      !std::all_of(dep.begin(), dep.end(), [](const auto& name) { return name.is_string(); }))
-    throw Error("dependent", fmt::format("must be an array of {} names, got {}", kWheelCount, excerpt(dep)));
-  std::vector<std::string> names;
-  for (const auto& name : dep) {  // the pair's own messages quote the names in full
-    if (excerpt(name.get<std::string>()) != name.get<std::string>())
-      throw Error("dependent", fmt::format("'{}' cannot be a dependent rate", excerpt(name.get<std::string>())));
-    names.push_back(name.get<std::string>());
-  }
-  sc.pair = dependent_pair(names);
   if (!j.contains("duration")) throw Error("duration", "missing: the run's length in seconds");
   sc.duration = finite_number(j.at("duration"), "duration");
   if (j.contains("dt")) sc.dt = finite_number(j.at("dt"), "dt");
@@ -189,6 +323,12 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base) {
       throw Error("max_condition", fmt::format("must be above 1, got {}", sc.nonholonomic.max_condition));
   }
   if (j.contains("weighting")) sc.weighting = parse_weighting(j.at("weighting"), "weighting");
+  if (j.contains("torques")) {
+    if (sc.weighting)
+      throw Error("torques", "a run is driven by its rates (the weighting then splits their torques) or by torques, not both");
+    sc.validate();  // the time grid first: the table is checked against it
+    sc.torques = parse_torques(j.at("torques"), sc.params, sc.duration, directory);
+  }
   sc.validate();
   return sc;
 }

@@ -17,8 +17,17 @@ std::string embedded_scenario(const std::string& id);
 
 // A path to a JSON file, or the id of an embedded scenario; errors suggest the nearest id.
 nlohmann::json read_scenario_json(const std::string& path_or_id);
-// `base`: the parameters the scenario's "params" override.
-Scenario parse_scenario(const nlohmann::json& j, const Params& base = {});
+// The folder of a scenario file (where the files it names are looked for), or empty for an id.
+std::string scenario_directory(const std::string& path_or_id);
+
+// `base`: the parameters the scenario's "params" override; `directory`: where a file the scenario
+// names (a torque table) is looked for, relative names from the working directory when empty.
+Scenario parse_scenario(const nlohmann::json& j, const Params& base = {}, const std::string& directory = {});
+
+// A scenario's "torques": {"file": CSV}, {"run": an inverse-dynamics scenario, run first with
+// `params`} or the columns inline ({"t": [...], "tau_<actuator>": [...]}), with "interpolation"
+// "linear" or "cubic" (the default for a run's torques); the table must cover [0, duration].
+TorqueSource parse_torques(const nlohmann::json& value, const Params& params, double duration, const std::string& directory);
 
 // 1, 2, {"diag": [...]} or {"matrix": [[...]]}.
 Weighting parse_weighting(const nlohmann::json& v, const std::string& key);

@@ -15,7 +15,8 @@
 
 WLX_COMMANDS_BEGIN
 
-std::vector<std::string> trajectory_header(bool dynamics) {
+std::vector<std::string> trajectory_header(const Scenario& sc) {
+  const bool dynamics = sc.weighting || sc.driven_by_torques();
   const auto name = [](int k) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]); };
   std::vector<std::string> h{"t"};
   for (int k = 0; k < kCoordinateCount; ++k) h.push_back(name(k));
@@ -32,10 +33,15 @@ std::vector<std::string> trajectory_header(bool dynamics) {
     for (const std::string_view a : kActuatorNames) h.push_back("tau_" + std::string(a));
     for (int k : kCommandedSpeeds) h.push_back("Qstar_" + name(k));
   }
+  if (sc.driven_by_torques()) {
+    for (int k : kCommandedSpeeds) h.push_back(name(k) + "_ddot");
+    for (const char* energy : {"kinetic", "potential", "power"}) h.emplace_back(energy);
+  }
   return h;
 }
 
-std::vector<double> trajectory_row(const Sample& smp, bool dynamics) {
+std::vector<double> trajectory_row(const Sample& smp, const Scenario& sc) {
+  const bool dynamics = sc.weighting || sc.driven_by_torques();
   std::vector<double> row{smp.t};
   for (int k = 0; k < kCoordinateCount; ++k) row.push_back(smp.s(k));
   for (int k = 0; k < smp.contacts.size(); ++k) row.push_back(smp.contacts(k));
@@ -50,12 +56,16 @@ std::vector<double> trajectory_row(const Sample& smp, bool dynamics) {
     for (int k = 0; k < kActuatedCount; ++k) row.push_back(smp.tau(k));
     for (int k = 0; k < kCommandedCount; ++k) row.push_back(smp.Qstar(k));
   }
+  if (sc.driven_by_torques()) {
+    for (int k = 0; k < kCommandedCount; ++k) row.push_back(smp.u_dot(k));
+    row.insert(row.end(), {smp.kinetic, smp.potential, smp.power});
+  }
   return row;
 }
 
-void write_trajectory(const std::string& path, const Trajectory& tr, bool dynamics) {
-  CsvWriter csv(path, trajectory_header(dynamics));
-  for (const auto& smp : tr.samples) csv.row(trajectory_row(smp, dynamics));
+void write_trajectory(const std::string& path, const Trajectory& tr, const Scenario& sc) {
+  CsvWriter csv(path, trajectory_header(sc));
+  for (const auto& smp : tr.samples) csv.row(trajectory_row(smp, sc));
   csv.commit();
 }
 
@@ -69,7 +79,7 @@ int run_simulate(const ModelOptions& model_options, const SimulateOptions& o) {
     }
     return 0;
   }
-  Scenario sc = parse_scenario(read_scenario_json(o.scenario), load_params(model_options));
+  Scenario sc = parse_scenario(read_scenario_json(o.scenario), load_params(model_options), scenario_directory(o.scenario));
   if (!o.integrator.empty()) {
     const auto integrator = integrator_from_name(o.integrator);
     if (!integrator) throw Error("--integrator", fmt::format("must be rk4, euler or dopri5, got '{}'", o.integrator));
@@ -107,7 +117,7 @@ int run_verify_nonholonomic(const ModelOptions& model_options, const std::string
     throw_if_interrupted();
     const Scenario sc = parse_scenario(read_scenario_json(id), params);
     const Trajectory tr = simulate(sc);
-    write_trajectory((std::filesystem::path(out_dir) / (id + ".csv")).string(), tr, false);
+    write_trajectory((std::filesystem::path(out_dir) / (id + ".csv")).string(), tr, sc);
     WheelVector worst = WheelVector::Zero();
     double cond = 0;
     for (const auto& smp : tr.samples) {

@@ -30,8 +30,16 @@ struct Summary {
   long samples = 0;
   double last_t = 0;
   double worst_residual = 0, worst_cond = 0, min_clearance = 0, peak_tau = 0;
+  // Runs driven by torques: the energy at the first and the last sample, and the actuators' work
+  // in between (the trapezoid rule on the samples' power, error ~dt^2 per unit time).
+  double first_energy = 0, last_energy = 0, work = 0, last_power = 0;
 
   void add(const Sample& smp) {
+    const double energy = smp.kinetic + smp.potential;
+    if (samples == 0) first_energy = energy;
+    else work += 0.5 * (smp.t - last_t) * (smp.power + last_power);
+    last_energy = energy;
+    last_power = smp.power;
     const double residual = smp.nh_residual.cwiseAbs().maxCoeff(), tau = smp.tau.cwiseAbs().maxCoeff();
     if (samples == 0) {
       worst_residual = residual, worst_cond = smp.cond_J_beta, min_clearance = smp.clearance, peak_tau = tau;
@@ -50,8 +58,7 @@ struct Summary {
 
 int stream_simulation(const Scenario& sc, const std::string& label, const std::string& out_dir) {
   const std::string path = (std::filesystem::path(out_dir) / "trajectory.csv").string();
-  const bool dynamics = sc.weighting.has_value();
-  CsvWriter csv(path, trajectory_header(dynamics));
+  CsvWriter csv(path, trajectory_header(sc));
   Summary summary;
   std::optional<Interrupted> interrupted;
   Trajectory tr;
@@ -59,7 +66,7 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
     tr = simulate_each(sc, [&](const Sample& smp) {
       try {
         throw_if_interrupted();
-        csv.row(trajectory_row(smp, dynamics));
+        csv.row(trajectory_row(smp, sc));
       } catch (...) {
         throw StopRun{std::current_exception()};
       }
@@ -88,7 +95,12 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
   } else {
     fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, min clearance = {:.4f} m\n",
                summary.worst_residual, summary.worst_cond, summary.min_clearance);
-    if (dynamics) fmt::print("inverse dynamics with {}: largest |tau| = {:.4g} N m\n", sc.weighting->label(), summary.peak_tau);
+    if (sc.weighting) fmt::print("inverse dynamics with {}: largest |tau| = {:.4g} N m\n", sc.weighting->label(), summary.peak_tau);
+    if (sc.driven_by_torques())
+      fmt::print("driven by torques: largest |tau| = {:.4g} N m; kinetic + potential energy {:.6g} -> {:.6g} J, the "
+                 "actuators' work {:.6g} J (trapezoid on the samples): balance off by {:.2e} J\n",
+                 summary.peak_tau, summary.first_energy, summary.last_energy, summary.work,
+                 summary.last_energy - summary.first_energy - summary.work);
   }
   fmt::print("wrote {}\n", path);
   if (interrupted) {

@@ -15,13 +15,13 @@
 
 WLX_COMMANDS_BEGIN
 
-std::string trajectory_csv_text(const Trajectory& trajectory, bool dynamics) {
+std::string trajectory_csv_text(const Trajectory& trajectory, const Scenario& scenario) {
   std::string text;
-  const auto header = trajectory_header(dynamics);
+  const auto header = trajectory_header(scenario);
   for (std::size_t k = 0; k < header.size(); ++k) text += (k ? "," : "") + header[k];
   text += "\n";
   for (const auto& sample : trajectory.samples) {
-    const auto row = trajectory_row(sample, dynamics);
+    const auto row = trajectory_row(sample, scenario);
     for (std::size_t k = 0; k < row.size(); ++k) text += fmt::format("{}{:.17g}", k ? "," : "", row[k]);
     text += "\n";
   }
@@ -36,12 +36,12 @@ void write_viewer_run(const std::filesystem::path& dir, const Scenario& scenario
                   fmt::format("sets params.{} = {:g}; the viewer draws the model's default parameters (its WebAssembly "
                               "module is built from them), so it would show another machine",
                               info.name, scenario.params.*info.member));
-  const bool dynamics = scenario.weighting.has_value();
+  const bool dynamics = scenario.weighting || scenario.driven_by_torques();  // its torques are plotted
   ViewerRun run;
   run.id = id.empty() ? scenario.id : id;
   run.model = std::string(gen::kModelName);
   run.description = description.empty() ? scenario.description : description;
-  run.trajectory_csv = trajectory_csv_text(trajectory, dynamics);
+  run.trajectory_csv = trajectory_csv_text(trajectory, scenario);
   if (!dynamics)  // the dependent pair's rates (a dynamics run plots its torques, the default)
     for (int k : scenario.pair.index) run.plot_columns.push_back(std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]) + "_dot");
   if (!dynamics) run.plot_title = "dependent rates " + scenario.pair.label();
@@ -57,7 +57,7 @@ int run_viewer(const ModelOptions& model_options, const ViewerOptions& options) 
   // Every run named is read first: a bad id is a bad input (exit 2, "did you mean"), whether or
   // not this wlx has the viewer, and nothing is written for a request that cannot be met.
   std::vector<Scenario> scenarios;
-  for (const auto& id : options.runs) scenarios.push_back(parse_scenario(read_scenario_json(id)));
+  for (const auto& id : options.runs) scenarios.push_back(parse_scenario(read_scenario_json(id), {}, scenario_directory(id)));
   copy_viewer_files(dir);
   const std::string module = fmt::format("wasm/wlx_{}.js", gen::kModelName);
   if (!std::filesystem::is_regular_file(dir / module))

@@ -160,7 +160,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
       progress_(fmt::format("simulating {}{}: {}", id, weighting ? " (" + weighting->label() + ")" : "", sc.description));
       ReportRun r{id, scenario_id, sc, simulate(sc, stop_on_signal), id + ".csv", verify};
       if (!r.trajectory.complete) throw Error(id, r.trajectory.error);
-      write_trajectory(data_file(r.csv), r.trajectory, sc.weighting.has_value());
+      write_trajectory(data_file(r.csv), r.trajectory, sc);
       runs_.push_back(std::move(r));
     }
   }

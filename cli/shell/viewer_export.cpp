@@ -1,6 +1,7 @@
 #include "viewer_export.hpp"
 
 #include "bounded_input.hpp"
+#include "csv_columns.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -10,7 +11,6 @@
 #include <wlx/error.hpp>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -36,63 +36,10 @@ void check_run_id(const std::string& id) {
                                       excerpt(id)));
 }
 
-std::vector<std::string> split(std::string_view line) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    out.emplace_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
-// The CSV's columns by name (only those asked for), every value parsed and finite.
+// The run's CSV columns by name (only those asked for), every value parsed and finite.
 std::map<std::string, std::vector<double>> read_columns(const ViewerRun& run, const std::vector<std::string>& wanted,
                                                         std::vector<std::string>* header_out) {
-  std::istringstream in(run.trajectory_csv);
-  std::string line;
-  if (!std::getline(in, line)) throw Error("run " + run.id, "the trajectory CSV is empty");
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  const std::vector<std::string> header = split(line);
-  if (header_out != nullptr) *header_out = header;
-  std::map<std::string, std::size_t> position;
-  for (std::size_t k = 0; k < header.size(); ++k) position.emplace(header[k], k);
-  std::map<std::string, std::vector<double>> columns;
-  std::vector<std::pair<std::size_t, std::vector<double>*>> targets;
-  for (const auto& name : wanted) {
-    const auto it = position.find(name);
-    if (it == position.end()) {
-      const std::string hint = nearest(name, header);
-      throw Error("run " + run.id, fmt::format("the trajectory CSV has no column '{}'{}", excerpt(name),
-                                               hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
-    }
-    if (!columns.contains(name)) targets.emplace_back(it->second, &columns[name]);
-  }
-  long row = 1;  // the header is row 1, as an editor counts lines
-  long samples = 0;
-  while (std::getline(in, line)) {
-    ++row;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    ++samples;
-    const std::vector<std::string> cells = split(line);
-    if (cells.size() != header.size())
-      throw Error("run " + run.id, fmt::format("row {} of the trajectory CSV has {} values for {} columns", row, cells.size(),
-                                               header.size()));
-    for (const auto& [index, values] : targets) {
-      const std::string& cell = cells[index];
-      double v = 0;
-      const auto [end, error] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
-      if (error != std::errc() || end != cell.data() + cell.size() || !std::isfinite(v))
-        throw Error("run " + run.id, fmt::format("row {}, column '{}' of the trajectory CSV: '{}' is not a finite number",
-                                                 row, header[index], excerpt(cell)));
-      values->push_back(v);
-    }
-  }
-  if (samples == 0) throw Error("run " + run.id, "the trajectory CSV has no samples");
-  return columns;
+  return read_csv_columns(run.trajectory_csv, "run " + run.id, "the trajectory CSV", wanted, header_out);
 }
 
 // The default plot: torques of a dynamics run, else the input rates that vary (the dependent ones).

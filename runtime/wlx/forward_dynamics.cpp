@@ -1,7 +1,6 @@
 #include "wlx/forward_dynamics.hpp"
 
 #include "wlx/error.hpp"
-#include "wlx/simulation.hpp"
 
 #include <Eigen/Cholesky>
 #include <fmt/format.h>
@@ -33,8 +32,8 @@ void forward_dynamics(const Model& model, Data& d, const Coordinates& s, const C
 #endif
 }
 
-TorqueTable::TorqueTable(std::vector<double> times, std::vector<TorqueVector> torques)
-    : times_(std::move(times)), torques_(std::move(torques)) {
+TorqueTable::TorqueTable(std::vector<double> times, std::vector<TorqueVector> torques, Interpolation interpolation)
+    : times_(std::move(times)), torques_(std::move(torques)), interpolation_(interpolation) {
   if (times_.empty() || times_.size() != torques_.size())
     throw Error("torques", fmt::format("a table needs one torque vector per time, at least one: got {} times and {} rows",
                                        times_.size(), torques_.size()));
@@ -54,67 +53,24 @@ TorqueVector TorqueTable::at(double t) const {
   const auto next = std::upper_bound(times_.begin(), times_.end(), t);
   if (next == times_.begin()) return torques_.front();
   if (next == times_.end()) return torques_.back();
-  const std::size_t k = static_cast<std::size_t>(next - times_.begin());
-  const double w = (t - times_[k - 1]) / (times_[k] - times_[k - 1]);
-  return (1 - w) * torques_[k - 1] + w * torques_[k];
-}
-
-TorqueVector TorqueTable::operator()(double t, const Coordinates&, const CommandVector&) const { return at(t); }
-
-void TorqueRun::validate() const {
-  validate_time_grid(duration, dt);  // the kinematic runs' grid rules (wlx/simulation.hpp)
-  if (!speeds.allFinite()) throw Error("speeds", "must be finite");
-  if (!initial.allFinite()) throw Error("initial", "must be finite");
-  if (!torques) throw Error("torques", "no torque source given");
-}
-
-TorqueTrajectory simulate_torques(const Model& model, const TorqueRun& run) {
-  run.validate();
-  using Inputs = Eigen::Matrix<double, kInputCount, 1>;
-  Data d;
-  DynamicsTerms terms;
-  TorqueTrajectory out;
-  Coordinates s = run.initial;
-  TorqueVector tau = TorqueVector::Zero();
-  // One evaluation: the dependents at q, u' under the source's torques at (t, s, u), q' = (T u)'s inputs.
-  const auto rhs = [&](double t, const Inputs& q, const CommandVector& u, Inputs& dq, CommandVector& du) {
-    ++out.evaluations;
-    s.head<kInputCount>() = q;
-    solve_ik_closed_form(model, s, run.branches);
-    tau = run.torques(t, s, u);
-    forward_dynamics(model, d, s, u, tau, du, terms, run.nonholonomic);
-    dq = terms.sdot.head<kInputCount>();
-  };
-  const long steps = std::lround(run.duration / run.dt);
-  out.samples.reserve(static_cast<std::size_t>(steps + 1));
-  Inputs q = run.initial.head<kInputCount>();
-  CommandVector u = run.speeds;
-  double t = 0;
-  try {
-    for (long k = 0;; ++k) {
-      t = static_cast<double>(k) * run.dt;
-      Inputs k1q, k2q, k3q, k4q;
-      CommandVector k1u, k2u, k3u, k4u;
-      rhs(t, q, u, k1q, k1u);  // leaves s, tau and terms at the step's start: the sample
-      TorqueSample& smp = out.samples.emplace_back();
-      smp.t = t, smp.s = s, smp.sdot = terms.sdot, smp.u = u, smp.u_dot = k1u, smp.tau = tau;
-      smp.kinetic = kinetic_energy(model, d, s, terms.sdot);
-      smp.potential = potential_energy(model, d, s);
-      smp.power = tau.dot(terms.J_beta * u);
-      if (k == steps) break;
-      rhs(t + 0.5 * run.dt, q + 0.5 * run.dt * k1q, u + 0.5 * run.dt * k1u, k2q, k2u);
-      rhs(t + 0.5 * run.dt, q + 0.5 * run.dt * k2q, u + 0.5 * run.dt * k2u, k3q, k3u);
-      rhs(t + run.dt, q + run.dt * k3q, u + run.dt * k3u, k4q, k4u);
-      q += run.dt / 6 * (k1q + 2 * k2q + 2 * k3q + k4q);
-      u += run.dt / 6 * (k1u + 2 * k2u + 2 * k3u + k4u);
-      if (!q.allFinite() || !u.allFinite())
-        throw Error("", "the state became non-finite (inf or NaN): torques too large for the step, or a singular pose");
-    }
-  } catch (const Error& e) {
-    out.complete = false;
-    out.error = fmt::format("stopped at t = {:.6f} s: {}", t, e.what());
+  const std::size_t k = static_cast<std::size_t>(next - times_.begin());  // t in [times_[k-1], times_[k])
+  if (interpolation_ == Interpolation::linear || times_.size() < 3) {
+    const double w = (t - times_[k - 1]) / (times_[k] - times_[k - 1]);
+    return (1 - w) * torques_[k - 1] + w * torques_[k];
+  }
+  // Lagrange's form on the (up to) four rows nearest the interval: exact for cubics, on any spacing.
+  const std::size_t n = std::min<std::size_t>(4, times_.size());
+  const std::size_t first = std::min(k >= 2 ? k - 2 : 0, times_.size() - n);
+  TorqueVector out = TorqueVector::Zero();
+  for (std::size_t i = first; i < first + n; ++i) {
+    double weight = 1;
+    for (std::size_t j = first; j < first + n; ++j)
+      if (j != i) weight *= (t - times_[j]) / (times_[i] - times_[j]);
+    out += weight * torques_[i];
   }
   return out;
 }
+
+TorqueVector TorqueTable::operator()(double t, const Coordinates&, const CommandVector&) const { return at(t); }
 
 WLX_MODEL_NAMESPACE_END

@@ -7,7 +7,6 @@
 #include "wlx/ik.hpp"
 
 #include <functional>
-#include <string>
 #include <vector>
 
 WLX_MODEL_NAMESPACE_BEGIN
@@ -22,55 +21,29 @@ void forward_dynamics(const Model& model, Data& data, const Coordinates& s, cons
                       CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options = {});
 
 // The actuator torques of a run at time t in the state (s, u): a table over time, a controller.
+// A run driven by torques is a Scenario with its `torques` set (wlx/simulation.hpp).
 using TorqueSource = std::function<TorqueVector(double t, const Coordinates& s, const CommandVector& u)>;
 
-// A torque table: the torques at the given times (strictly increasing, finite), linear in between.
-// Throws wlx::Error (field "torques") for a table that is empty, out of order or not finite, and
-// when asked for a time outside it.
+// A torque table: the torques at the given times (strictly increasing, finite). Between them,
+// linear interpolation (what a table of set points means: a step between two rows is a ramp), or
+// cubic: the cubic through the four nearest rows (two on each side; at an end, the four nearest),
+// error ~h^4 |tau''''| / 24 for rows h apart against h^2 |tau''| / 8 for linear, so that a smooth
+// table sampled at 1 ms (an inverse-dynamics run's torques) is reproduced between its rows to
+// ~1e-12 of its scale. Throws wlx::Error (field "torques") for a table that is empty, out of order
+// or not finite, and when asked for a time outside it.
 class TorqueTable {
  public:
-  TorqueTable(std::vector<double> times, std::vector<TorqueVector> torques);
+  enum class Interpolation { linear, cubic };
+  TorqueTable(std::vector<double> times, std::vector<TorqueVector> torques, Interpolation interpolation = Interpolation::linear);
   TorqueVector operator()(double t, const Coordinates& s, const CommandVector& u) const;
   TorqueVector at(double t) const;
+  double start() const { return times_.front(); }
+  double end() const { return times_.back(); }
 
  private:
   std::vector<double> times_;
   std::vector<TorqueVector> torques_;
+  Interpolation interpolation_;
 };
-
-// A run driven by torques. The state is the inputs q and the commanded speeds u: each evaluation
-// solves the dependent joints by the closed-form IK (the closure cannot drift), the dependent
-// rates (the rolling rows hold exactly, at velocity level) and u' by forward_dynamics; the inputs
-// that are neither commanded nor in the dynamics pair keep their start values. RK4 with step dt.
-struct TorqueRun {
-  Coordinates initial = nominal_inputs();        // inputs; the dependents are solved
-  CommandVector speeds = CommandVector::Zero();  // u at t = 0
-  double duration = 0;                           // s
-  double dt = 1e-3;                              // s
-  Branches branches;
-  NonholonomicOptions nonholonomic;
-  TorqueSource torques;
-  // Throws wlx::Error naming the field for a bad duration or step (validate_time_grid), start
-  // state or speed, or a missing source.
-  void validate() const;
-};
-
-struct TorqueSample {
-  double t = 0;
-  Coordinates s, sdot;
-  CommandVector u, u_dot;
-  TorqueVector tau;
-  double kinetic = 0, potential = 0;  // J
-  double power = 0;                   // the actuators' power tau . J_beta u, W
-};
-
-struct TorqueTrajectory {
-  std::vector<TorqueSample> samples;  // t = 0, dt, ..., duration
-  bool complete = true;
-  std::string error;  // why the run stopped early (with its time), when !complete
-  long evaluations = 0;
-};
-
-TorqueTrajectory simulate_torques(const Model& model, const TorqueRun& run);
 
 WLX_MODEL_NAMESPACE_END

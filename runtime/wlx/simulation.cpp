@@ -16,31 +16,58 @@ namespace {
 
 using InputVector = Eigen::Matrix<double, kInputCount, 1>;
 
-// The scenario's right-hand side: input rates at the inputs q (dependents re-solved first).
-struct RightHandSide {
+// A kinematic run's right-hand side: the input rates at the inputs q (dependents re-solved first).
+struct KinematicRates {
   const Scenario& sc;
   const Model& model;
   Data& data;
-  Coordinates s, sdot;
+  Coordinates s = Coordinates::Zero(), sdot = Coordinates::Zero();
+  long evaluations = 0;
 
-  const InputVector& operator()(const InputVector& q) {
+  InputVector operator()(double /*t: the commanded rates are constant*/, const InputVector& q) {
     ++evaluations;
     s.head<kInputCount>() = q;
     solve_ik_closed_form(model, s, sc.branches);
     sdot.head<kInputCount>() = sc.rates;
     solve_dependent_rates(model, data, s, sdot, sc.pair, sc.nonholonomic);
-    rate = sdot.head<kInputCount>();
-    return rate;
+    return sdot.head<kInputCount>();
   }
-  InputVector rate;
-  long evaluations = 0;
 };
 
-// The Dormand-Prince 5(4) pair (Hairer, Norsett, Wanner, Solving ODEs I, table 5.2): the stages,
-// the 5th-order weights (= the last stage row: first same as last) and the difference to the
-// embedded 4th-order weights, which estimates the local error. The right-hand side does not
-// depend on t, so the nodes c_i are not needed.
+// A torque-driven run's state: the inputs q, then the commanded speeds u.
+using TorqueState = Eigen::Matrix<double, kInputCount + kCommandedCount, 1>;
+
+// Its right-hand side: the dependents at q by the IK, u' by forward_dynamics under the source's
+// torques at (t, s, u), and q' = the inputs' part of s' = T u.
+struct TorqueRates {
+  const Scenario& sc;
+  const Model& model;
+  Data& data;
+  Coordinates s = Coordinates::Zero();
+  CommandVector u = CommandVector::Zero(), u_dot = CommandVector::Zero();
+  TorqueVector tau = TorqueVector::Zero();
+  DynamicsTerms terms = {};
+  long evaluations = 0;
+
+  TorqueState operator()(double t, const TorqueState& x) {
+    ++evaluations;
+    s.head<kInputCount>() = x.head<kInputCount>();
+    u = x.tail<kCommandedCount>();
+    solve_ik_closed_form(model, s, sc.branches);
+    tau = sc.torques(t, s, u);
+    if (!tau.allFinite()) throw Error("torques", fmt::format("the torque source gave a non-finite torque at t = {:.6f} s", t));
+    forward_dynamics(model, data, s, u, tau, u_dot, terms, sc.nonholonomic);
+    TorqueState rate;
+    rate << terms.sdot.head<kInputCount>(), u_dot;
+    return rate;
+  }
+};
+
+// The Dormand-Prince 5(4) pair (Hairer, Norsett, Wanner, Solving ODEs I, table 5.2): the nodes c_i,
+// the stages, the 5th-order weights (= the last stage row: first same as last) and the difference
+// to the embedded 4th-order weights, which estimates the local error.
 namespace dopri {
+constexpr double c2 = 1.0 / 5, c3 = 3.0 / 10, c4 = 4.0 / 5, c5 = 8.0 / 9;
 constexpr double a21 = 1.0 / 5;
 constexpr double a31 = 3.0 / 40, a32 = 9.0 / 40;
 constexpr double a41 = 44.0 / 45, a42 = -56.0 / 15, a43 = 32.0 / 9;
@@ -51,10 +78,10 @@ constexpr double e1 = 71.0 / 57600, e3 = -71.0 / 16695, e4 = 71.0 / 1920, e5 = -
                  e7 = -1.0 / 40;
 }  // namespace dopri
 
-// Advances q from t to t + span with Dormand-Prince steps under error control. `h` carries the
-// step size from one call to the next; k1 = f(q) on entry.
-void dopri5_span(RightHandSide& f, InputVector& q, InputVector k1, double t, double span, double tolerance, double& h,
-                 Trajectory& stats) {
+// Advances x from t to t + span with Dormand-Prince steps under error control; f(t, x) is the
+// right-hand side. `h` carries the step size from one call to the next; k1 = f(t, x) on entry.
+template <class State, class F>
+void dopri5_span(F& f, State& x, State k1, double t, double span, double tolerance, double& h, Trajectory& stats) {
   using namespace dopri;
   const double end = t + span;
   double now = t;
@@ -62,19 +89,19 @@ void dopri5_span(RightHandSide& f, InputVector& q, InputVector k1, double t, dou
   while (now < end) {
     const bool last = h >= (end - now) * (1 - 1e-12);  // finish the span rather than leave a sliver
     const double step = last ? end - now : h;
-    InputVector next, k7;
+    State next, k7;
     double scaled = 0;
     std::string failure;  // a stage that left the workspace (unreachable pose, singular J_beta)
     try {
-      const InputVector k2 = f(q + step * a21 * k1);
-      const InputVector k3 = f(q + step * (a31 * k1 + a32 * k2));
-      const InputVector k4 = f(q + step * (a41 * k1 + a42 * k2 + a43 * k3));
-      const InputVector k5 = f(q + step * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4));
-      const InputVector k6 = f(q + step * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5));
-      next = q + step * (b1 * k1 + b3 * k3 + b4 * k4 + b5 * k5 + b6 * k6);
-      k7 = f(next);
-      const InputVector error = step * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
-      scaled = (error.array().abs() / (tolerance * (1 + q.array().abs().max(next.array().abs())))).maxCoeff();
+      const State k2 = f(now + c2 * step, x + step * a21 * k1);
+      const State k3 = f(now + c3 * step, x + step * (a31 * k1 + a32 * k2));
+      const State k4 = f(now + c4 * step, x + step * (a41 * k1 + a42 * k2 + a43 * k3));
+      const State k5 = f(now + c5 * step, x + step * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4));
+      const State k6 = f(now + step, x + step * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5));
+      next = x + step * (b1 * k1 + b3 * k3 + b4 * k4 + b5 * k5 + b6 * k6);
+      k7 = f(now + step, next);
+      const State error = step * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
+      scaled = (error.array().abs() / (tolerance * (1 + x.array().abs().max(next.array().abs())))).maxCoeff();
       if (!std::isfinite(scaled)) {  // an overflow, not an error estimate: shrink, and say so if it persists
         failure = "a stage of the step became non-finite (inf or NaN)";
         scaled = 1e10;
@@ -89,7 +116,7 @@ void dopri5_span(RightHandSide& f, InputVector& q, InputVector k1, double t, dou
     // The usual controller: the error scales as step^5; a safety factor and bounded changes.
     const double factor = std::clamp(0.9 * std::pow(std::max(scaled, 1e-10), -0.2), 0.2, 5.0);
     if (scaled <= 1) {
-      q = next;
+      x = next;
       k1 = k7;  // first same as last
       now = last ? end : now + step;
       ++stats.steps;
@@ -168,6 +195,12 @@ std::optional<Integrator> integrator_from_name(std::string_view name) noexcept {
   return std::nullopt;
 }
 
+CommandVector Scenario::commanded_speeds() const {
+  CommandVector u;
+  for (int k = 0; k < kCommandedCount; ++k) u(k) = rates(kCommandedSpeeds[static_cast<std::size_t>(k)]);
+  return u;
+}
+
 long Scenario::samples() const { return std::lround(duration / dt) + 1; }
 
 void validate_time_grid(double duration, double dt) {
@@ -189,10 +222,12 @@ void Scenario::validate() const {
       throw Error(fmt::format("rates.{}", gen::kCoordinateNames[static_cast<std::size_t>(k)]),
                   fmt::format("{} is a dependent rate in this scenario (pair {}): it is computed, not commanded",
                               gen::kCoordinateNames[static_cast<std::size_t>(k)], pair.label()));
-  if (weighting) {
+  if (weighting && torques)
+    throw Error("torques", "a run is driven by its rates (the weighting then splits their torques) or by torques, not both");
+  if (weighting || torques) {
+    const char* run = torques ? "a forward-dynamics run" : "an inverse-dynamics run";
     if (pair.index != dynamics_pair().index)
-      throw Error("dependent", fmt::format("an inverse-dynamics run needs the dependent pair {} (the model's dynamics "
-                                           "section), got {}",
+      throw Error("dependent", fmt::format("{} needs the dependent pair {} (the model's dynamics section), got {}", run,
                                            dynamics_pair().label(), pair.label()));
     for (int k = 0; k < kInputCount; ++k)
       if (rates(k) != 0 && std::find(kCommandedSpeeds.begin(), kCommandedSpeeds.end(), k) == kCommandedSpeeds.end()) {
@@ -201,7 +236,7 @@ void Scenario::validate() const {
           commanded += fmt::format("{}{}", i == 0 ? "" : i + 1 == kCommandedSpeeds.size() ? " and " : ", ",
                                    gen::kCoordinateNames[static_cast<std::size_t>(kCommandedSpeeds[i])]);
         throw Error(fmt::format("rates.{}", gen::kCoordinateNames[static_cast<std::size_t>(k)]),
-                    fmt::format("an inverse-dynamics run commands only {}; every other input is constant", commanded));
+                    fmt::format("{} commands only {}; every other input is constant", run, commanded));
       }
   }
   for (int k = 0; k < kInputCount; ++k) {
@@ -238,66 +273,105 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
   const Model model(sc.params);
   auto data_storage = std::make_unique<Data>();  // ~7 KB: kept off the stack
   Data& data = *data_storage;
-  RightHandSide f{sc, model, data, sc.initial, Coordinates::Zero(), InputVector::Zero()};
   Trajectory out;
   const long n = sc.samples();
-  InputVector q = sc.initial.head<kInputCount>();
-  DynamicsTerms terms;
-  CommandVector u;
-  for (int k = 0; k < kCommandedCount; ++k) u(k) = sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]);
   double h = sc.dt;  // dopri5's step, adapted as it goes
-  for (long k = 0; k < n; ++k) {
-    const double t = static_cast<double>(k) * sc.dt;
-    try {
-      const InputVector k1 = f(q);
-      Sample smp;
-      smp.t = t;
-      smp.s = f.s;
-      smp.sdot = f.sdot;
-      smp.cond_J_beta = data.cond_J_beta;
-      forward_kinematics(model, data, f.s);
-      for (int w = 0; w < kWheelCount; ++w) {
-        const int f = gen::kWheels[static_cast<std::size_t>(w)].contact_frame;
-        for (int i = 0; i < 2; ++i) smp.contacts(2 * w + i) = data.frame_positions(i, f);  // compiles for no wheels
+
+  // The samples' kinematic part: what the run's last evaluation left in (s, s') and data.
+  const auto kinematic_sample = [&](Sample& smp, const Coordinates& s, const Coordinates& sdot) {
+    smp.s = s;
+    smp.sdot = sdot;
+    smp.cond_J_beta = data.cond_J_beta;
+    forward_kinematics(model, data, s);
+    for (int w = 0; w < kWheelCount; ++w) {
+      const int f = gen::kWheels[static_cast<std::size_t>(w)].contact_frame;
+      for (int i = 0; i < 2; ++i) smp.contacts(2 * w + i) = data.frame_positions(i, f);  // compiles for no wheels
+    }
+    smp.contact_velocity = contact_velocities(model, data, s, sdot);  // also fills data.C, data.spin
+    smp.nh_residual = data.C * sdot;
+    smp.spin_rate = data.spin * sdot;
+    smp.clearance = lowest_clearance(model.params(), s);
+  };
+
+  // The loop of every run: a sample after each step's first evaluation, then the step. `name(i)`
+  // names the state's entry i for a message about a value that became non-finite.
+  const auto integrate = [&](auto& f, auto x, const auto& fill, const auto& name) {
+    using State = decltype(x);
+    for (long k = 0; k < n; ++k) {
+      const double t = static_cast<double>(k) * sc.dt;
+      try {
+        const State k1 = f(t, x);
+        Sample smp;
+        smp.t = t;
+        fill(smp);
+        check_finite(smp, sc);
+        on_sample(smp);
+        if (progress) progress(k + 1, n);
+        if (k + 1 == n) break;
+        if (sc.integrator == Integrator::euler) {
+          x += sc.dt * k1;
+          ++out.steps;
+        } else if (sc.integrator == Integrator::rk4) {
+          const State k2 = f(t + 0.5 * sc.dt, State(x + 0.5 * sc.dt * k1));
+          const State k3 = f(t + 0.5 * sc.dt, State(x + 0.5 * sc.dt * k2));
+          const State k4 = f(t + sc.dt, State(x + sc.dt * k3));
+          x += sc.dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+          ++out.steps;
+        } else {
+          dopri5_span(f, x, k1, t, sc.dt, sc.tolerance, h, out);
+        }
+        // Checked after every step: an overflow is reported in the step that made it.
+        for (int i = 0; i < x.size(); ++i)
+          if (!std::isfinite(x(i)))
+            throw Error(name(i), fmt::format("became non-finite ({}) in the step to t = {:.6f} s; {}", x(i),
+                                             static_cast<double>(k + 1) * sc.dt, drivers(sc)));
+      } catch (const Error& e) {
+        out.complete = false;
+        out.error = fmt::format("stopped at t = {:.4f} s (step {} of {}): {}", t, k, n - 1, e.what());
+        break;
       }
-      smp.contact_velocity = contact_velocities(model, data, f.s, f.sdot);  // also fills data.C, data.spin
-      smp.nh_residual = data.C * f.sdot;
-      smp.spin_rate = data.spin * f.sdot;
-      smp.clearance = lowest_clearance(model.params(), f.s);
+    }
+    out.evaluations = f.evaluations;
+  };
+  const auto coordinate = [](int i) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(i)]); };
+
+  if (sc.driven_by_torques()) {
+    TorqueRates f{sc, model, data};
+    TorqueState x;
+    x << sc.initial.head<kInputCount>(), sc.commanded_speeds();
+    f.s = sc.initial;
+    const auto fill = [&](Sample& smp) {
+      kinematic_sample(smp, f.s, f.terms.sdot);
+      smp.tau = f.tau;
+      smp.Qstar = f.terms.Qstar;
+      smp.u = f.u;
+      smp.u_dot = f.u_dot;
+      smp.power = f.tau.dot(f.terms.J_beta * f.u);
+      smp.kinetic = kinetic_energy(model, data, f.s, f.terms.sdot);
+      smp.potential = potential_energy(model, data, f.s);
+      // Driven by torques, the body may fall: the model has no contact but its feet and wheels.
+      if (smp.clearance < 0)
+        throw Error("clearance", fmt::format("the clearance box's lowest corner is {:.4f} m below the ground: the body "
+                                             "touches it, which the model does not describe", -smp.clearance));
+    };
+    integrate(f, x, fill, [&](int i) {
+      return i < kInputCount ? coordinate(i) : "u." + coordinate(kCommandedSpeeds[static_cast<std::size_t>(i - kInputCount)]);
+    });
+  } else {
+    KinematicRates f{sc, model, data};
+    f.s = sc.initial;
+    const CommandVector u = sc.commanded_speeds();
+    DynamicsTerms terms;
+    const auto fill = [&](Sample& smp) {
+      kinematic_sample(smp, f.s, f.sdot);
       if (sc.weighting) {
         inverse_dynamics(model, data, f.s, u, CommandVector::Zero(), terms, sc.nonholonomic);
         smp.Qstar = terms.Qstar;
         smp.tau = distribute_torques(terms.J_beta, terms.Qstar, *sc.weighting);
       }
-      check_finite(smp, sc);
-      on_sample(smp);
-      if (progress) progress(k + 1, n);
-      if (k + 1 == n) break;
-      if (sc.integrator == Integrator::euler) {
-        q += sc.dt * k1;
-        ++out.steps;
-      } else if (sc.integrator == Integrator::rk4) {
-        const InputVector k2 = f(q + 0.5 * sc.dt * k1);
-        const InputVector k3 = f(q + 0.5 * sc.dt * k2);
-        const InputVector k4 = f(q + sc.dt * k3);
-        q += sc.dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
-        ++out.steps;
-      } else {
-        dopri5_span(f, q, k1, t, sc.dt, sc.tolerance, h, out);
-      }
-      // Checked after every step: an overflow is reported in the step that made it.
-      for (int i = 0; i < kInputCount; ++i)
-        if (!std::isfinite(q(i)))
-          throw Error(std::string(gen::kCoordinateNames[static_cast<std::size_t>(i)]),
-                      fmt::format("became non-finite ({}) in the step to t = {:.6f} s; {}", q(i),
-                                  static_cast<double>(k + 1) * sc.dt, drivers(sc)));
-    } catch (const Error& e) {
-      out.complete = false;
-      out.error = fmt::format("stopped at t = {:.4f} s (step {} of {}): {}", t, k, n - 1, e.what());
-      break;
-    }
+    };
+    integrate(f, InputVector(sc.initial.head<kInputCount>()), fill, coordinate);
   }
-  out.evaluations = f.evaluations;
   return out;
 }
 

@@ -1,9 +1,11 @@
 // Time integration of a scenario (thesis 4.2, 5; docs/excavator.md sections 5 and 8): the commanded input
 // rates and the dependent pair are integrated; the holonomic dependents are re-solved by the
-// closed-form IK at every evaluation, so the loop closure cannot drift.
+// closed-form IK at every evaluation, so the loop closure cannot drift. A run is driven by rates
+// (kinematic, or inverse dynamics with a weighting) or by torques (forward dynamics).
 #pragma once
 
 #include "wlx/dynamics.hpp"
+#include "wlx/forward_dynamics.hpp"
 #include "wlx/ik.hpp"
 #include "wlx/model.hpp"
 #include "wlx/nonholonomic.hpp"
@@ -44,10 +46,20 @@ struct Scenario {
   // Set: an inverse-dynamics run (docs/excavator.md section 7): pair A, only u = [z_C', x_C', roll',
   // pitch'] commanded (constant, so u' = 0), torques distributed with this weighting.
   std::optional<Weighting> weighting;
+  // Set: a forward-dynamics run. The state is the inputs and the commanded speeds u (their values
+  // at t = 0 in `rates`, which may name only the commanded inputs); u' comes from forward_dynamics
+  // under these torques, the dependent pair must be the dynamics section's, the other inputs keep
+  // their start values. Every integrator applies (dopri5's error control covers u too). The run
+  // also stops when the clearance box reaches the ground: the model has no contact there.
+  TorqueSource torques;
 
+  bool driven_by_torques() const { return static_cast<bool>(torques); }
+  // The commanded speeds u at t = 0: the commanded inputs' rates.
+  CommandVector commanded_speeds() const;
   // Number of output samples: duration / dt steps plus t = 0 (the thesis' "2001 integrations" for 2 s).
   long samples() const;
-  // Throws wlx::Error naming the field for a bad duration, step, or a commanded dependent rate.
+  // Throws wlx::Error naming the field for a bad duration, step, or a commanded dependent rate, and
+  // for a run given both a weighting and torques.
   void validate() const;
 };
 
@@ -61,9 +73,13 @@ struct Sample {
   WheelVector spin_rate;                                   // wheel spin rates, rad/s
   double cond_J_beta = 0;
   double clearance = 0;  // the clearance box's lowest corner above z = 0, m (+infinity without a box)
-  // Inverse-dynamics runs only:
+  // Inverse- and forward-dynamics runs only:
   TorqueVector tau = TorqueVector::Zero();      // actuator torques, order of kActuatedJoints
-  CommandVector Qstar = CommandVector::Zero();  // generalized forces on u
+  CommandVector Qstar = CommandVector::Zero();  // generalized forces on u (J_beta^T tau)
+  // Forward-dynamics runs only:
+  CommandVector u = CommandVector::Zero(), u_dot = CommandVector::Zero();  // commanded speeds and their rates
+  double kinetic = 0, potential = 0;  // J
+  double power = 0;                   // the actuators' power tau . J_beta u, W
 };
 
 struct Trajectory {

@@ -191,6 +191,27 @@ def test_forward_dynamics_inverts_the_inverse_dynamics_for_every_model():
         robot.forward_dynamics(s, [0.0, 3.0, 0.0, 0.0], [float("nan")] + [0.0] * 7)
 
 
+
+def test_simulate_driven_by_torques_retraces_the_inverse_dynamics_run_for_every_model():
+    # A dict scenario whose "torques" are an inverse-dynamics run's columns (what m.simulate gave),
+    # cubic between the 1 ms rows, integrated by dopri5: the motion of that run again.
+    for name, run_id in (("excavator", "ID-1"), ("walker", "ID-W1"), ("wheeled_quadruped", "ID-Q1")):
+        robot = wlx.model(name)
+        inverse = robot.simulate(run_id)
+        assert inverse["complete"]
+        spec = json.loads((Path(__file__).resolve().parents[2] / "scenarios" / name / (run_id + ".json")).read_text())
+        torques = {"t": list(inverse["t"]), "interpolation": "cubic"}
+        torques.update({"tau_" + a: list(inverse["tau_" + a]) for a in robot.actuators})
+        forward = robot.simulate({"rates": spec["rates"], "duration": spec["duration"], "dt": spec["dt"],
+                                  "integrator": "dopri5", "tolerance": 1e-12, "torques": torques})
+        assert forward["complete"], forward["stopped"]
+        for c in robot.coordinates:
+            np.testing.assert_allclose(forward[c], inverse[c], rtol=0, atol=1e-8)  # the bound for a round trip
+        assert forward["kinetic"].shape == inverse["t"].shape
+    with pytest.raises(wlx.Error, match=r"^torques: has \"t\" but no column"):
+        wlx.model("excavator").simulate({"duration": 0.01, "torques": {"t": [0, 0.01]}})
+
+
 BAD_IK = [
     {"legD": 1},
     {"params": {"legD": -1}},

@@ -298,10 +298,11 @@ TEST_CASE("forward dynamics: the torques of ID-1..3, fed back, reproduce their t
       std::vector<TorqueVector> torques;
       for (const Sample& smp : id.samples) times.push_back(smp.t), torques.push_back(smp.tau);
       for (int k = 0; k < kCommandedCount; ++k) u0(k) = sc.rates(kCommandedSpeeds[static_cast<std::size_t>(k)]);
-      const Model model;
-      const TorqueTrajectory fd = simulate_torques(
-          model, {.initial = id.samples.front().s, .speeds = u0, .duration = sc.duration, .dt = dt,
-                  .torques = TorqueTable(std::move(times), std::move(torques))});
+      Scenario forward = sc;
+      forward.weighting.reset();
+      forward.dt = dt;
+      forward.torques = TorqueTable(std::move(times), std::move(torques));
+      const Trajectory fd = simulate(forward);
       CAPTURE(fd.error);
       REQUIRE(fd.complete);
       const std::size_t every = exact ? 2 : 1;  // the kinematic run's samples at the forward run's times
@@ -333,14 +334,37 @@ TEST_CASE("forward dynamics: a torque table refuses bad rows and times outside i
   CHECK((table.at(0.25) - 0.5 * one).cwiseAbs().maxCoeff() <= 1e-15);
   CHECK_THROWS_WITH_AS(table.at(1.5), doctest::Contains("t = 1.5 s is outside the table's times [0, 1] s"), Error);
   // A run with a source that stops answering ends early and says when and why.
-  const Model model;
-  const TorqueTrajectory short_table = simulate_torques(model, {.duration = 0.01, .dt = 1e-3, .torques = TorqueTable({0.0, 0.005}, {one, one})});
+  // Cubic: exact for a cubic in t on uneven rows (linear is not), at the ends too.
+  const auto cubic = [](double t) { return 2 - t + 3 * t * t - 0.5 * t * t * t; };
+  std::vector<double> times{0.0, 0.3, 0.5, 1.1, 1.2, 2.0};
+  std::vector<TorqueVector> rows;
+  for (double t : times) rows.push_back(cubic(t) * one);
+  const TorqueTable smooth(times, rows, TorqueTable::Interpolation::cubic), ramp(times, rows);
+  for (double t : {0.01, 0.2, 0.4, 0.8, 1.15, 1.9, 1.999})
+    CHECK((smooth.at(t) - cubic(t) * one).cwiseAbs().maxCoeff() <= 1e-14);
+  CHECK((ramp.at(0.8) - cubic(0.8) * one).cwiseAbs().maxCoeff() > 1e-2);
+  // A run with a source that stops answering ends early and says when and why.
+  Scenario sc;
+  sc.pair = dynamics_pair();
+  sc.duration = 0.01;
+  sc.torques = TorqueTable({0.0, 0.005}, {one, one});
+  const Trajectory short_table = simulate(sc);
   CHECK(!short_table.complete);
-  CHECK(short_table.error.find("stopped at t = 0.005000 s: torques: t = 0.0055 s is outside") != std::string::npos);
-  CHECK_THROWS_WITH_AS(simulate_torques(model, {.duration = 1, .dt = 0}), doctest::Contains("dt: must be a positive number of seconds, got 0"), Error);
-  CHECK_THROWS_WITH_AS(simulate_torques(model, {.duration = 0.0105, .dt = 1e-3, .torques = TorqueTable({0.0, 1.0}, {one, one})}),
-                       doctest::Contains("dt: the duration 0.0105 s is not a whole number of steps of 0.001 s"), Error);
-  CHECK_THROWS_WITH_AS(simulate_torques(model, {.duration = 1}), doctest::Contains("torques: no torque source given"), Error);
+  CHECK(short_table.error.find("stopped at t = 0.0050 s (step 5 of 10): torques: t = 0.0055 s is outside") != std::string::npos);
+  sc.weighting = Weighting::model_weights();
+  CHECK_THROWS_WITH_AS(simulate(sc), doctest::Contains("torques: a run is driven by its rates"), Error);
+  sc.weighting.reset();
+  sc.rates(c::theta_l5) = 0.1;
+  CHECK_THROWS_WITH_AS(simulate(sc), doctest::Contains("rates.theta_l5: a forward-dynamics run commands only z_C, x_C, roll and pitch"), Error);
+  sc.rates(c::theta_l5) = 0;
+  sc.pair = dependent_pair({"theta_l5", "theta_r5"});
+  CHECK_THROWS_WITH_AS(simulate(sc), doctest::Contains("dependent: a forward-dynamics run needs the dependent pair"), Error);
+  // A controller that answers NaN stops the run at once, named.
+  sc.pair = dynamics_pair();
+  sc.torques = [](double, const Coordinates&, const CommandVector&) { return TorqueVector::Constant(NAN).eval(); };
+  const Trajectory nan_source = simulate(sc);
+  CHECK(!nan_source.complete);
+  CHECK(nan_source.error.find("stopped at t = 0.0000 s (step 0 of 10): torques: the torque source gave a non-finite torque") != std::string::npos);
 }
 
 TEST_CASE("dynamics: ID-3 ends 7 mm above the ground: the cabin would touch it at t ~ 0.583 s") {
