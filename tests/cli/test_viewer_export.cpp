@@ -195,3 +195,22 @@ TEST_CASE("viewer run: a run index that is not a regular file (a link to /dev/ze
                        wlx::Error);
   fs::remove_all(dir);
 }
+
+TEST_CASE("wlx viewer: a run driven by torques is played like any other, its torques plotted") {
+  const fs::path out = wlx_test::work_dir() / "viewer-torques";
+  const fs::path scenario = wlx_test::work_dir() / "fd.json";
+  wlx_test::write(scenario, R"({"id": "FD-T", "description": "ID-1's torques fed back", "rates": {"x_C": 3.0},
+                               "duration": 0.05, "torques": {"run": "ID-1"}})");
+  const auto r = wlx_test::run({"viewer", "--out", out.string(), scenario.string()});
+  if (r.code == 2 && r.err.find("viewer.html is missing") != std::string::npos) {
+    MESSAGE("this build has no viewer (WLX_BUILD_VIEWER off): the run file is not written");
+    return;
+  }
+  REQUIRE(r.code == 0);
+  const auto run = registered(out / "runs" / "FD-T.js", "wlxViewer.registerRun(");
+  CHECK(run["samples"] == 51);
+  CHECK(run["plot"]["title"] == "joint torques");
+  CHECK(run["plot"]["columns"].size() == 8);
+  CHECK(run["columns"]["x_C"].size() == 51);
+  CHECK(run["columns"]["x_C"].back().get<double>() > run["columns"]["x_C"].front().get<double>() + 0.1);  // it drove
+}
