@@ -4,7 +4,6 @@
 #pragma once
 
 #include "wlx/dynamics.hpp"
-#include "wlx/ik.hpp"
 
 #include <functional>
 #include <vector>
