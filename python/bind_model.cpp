@@ -212,11 +212,32 @@ void bind_python(py::module_& parent) {
 
   m.def(
       "simulate",
-      [](const std::string& scenario_json, long every) {
+      [](const std::string& scenario_json, long every, const py::object& torques) {
         const nlohmann::json j = parse_json(scenario_json, "scenario");
+        // A Python function as the torque source: a controller in the loop, called at every
+        // evaluation of the right-hand side (each stage of a step) with t, s and u. Its own
+        // exceptions reach the caller unchanged; a wrong shape is a TypeError, not a stopped run.
+        TorqueSource function;
+        if (!torques.is_none()) {
+          if (!PyCallable_Check(torques.ptr())) throw Error("torques", "must be a function f(t, s, u) -> tau, or None");
+          function = [f = py::function(torques)](double t, const Coordinates& s, const CommandVector& u) -> TorqueVector {
+            const py::object r = f(t, Eigen::VectorXd(s), Eigen::VectorXd(u));
+            Eigen::VectorXd tau;
+            try {
+              tau = r.cast<Eigen::VectorXd>();
+            } catch (const py::cast_error&) {
+              throw py::type_error("torques: the function must return " + std::to_string(kActuatedCount) +
+                                   " numbers (the order of .actuators), got " + std::string(py::str(py::type::of(r))));
+            }
+            if (tau.size() != kActuatedCount)
+              throw py::type_error("torques: the function returned " + std::to_string(tau.size()) + " numbers; the model has " +
+                                   std::to_string(kActuatedCount) + " actuators (.actuators)");
+            return tau;
+          };
+        }
         const Scenario sc = j.is_string() ? parse_scenario(read_scenario_json(j.get<std::string>()), {},
-                                                           scenario_directory(j.get<std::string>()))
-                                          : parse_scenario(j);
+                                                           scenario_directory(j.get<std::string>()), std::move(function))
+                                          : parse_scenario(j, {}, {}, std::move(function));
         if (every < 1) throw Error("every", "must be at least 1 (keep every k-th sample), got " + std::to_string(every));
         const std::vector<std::string> header = trajectory_header(sc);
         // The columns are written as the run streams its samples (no table, no copy), and bounded:
@@ -253,8 +274,9 @@ void bind_python(py::module_& parent) {
         out["evaluations"] = run.evaluations;
         return out;
       },
-      py::arg("scenario_json"), py::arg("every") = 1,
-      "simulate(scenario_json, every=1) -> dict: columns (the CSV's, as arrays; every k-th sample), complete, stopped (why, if early)");
+      py::arg("scenario_json"), py::arg("every") = 1, py::arg("torques") = py::none(),
+      "simulate(scenario_json, every=1, torques=None) -> dict: columns (the CSV's, as arrays; every k-th sample), complete, "
+      "stopped (why, if early); torques: a function f(t, s, u) -> tau driving the run");
 }
 
 WLX_COMMANDS_END

@@ -249,7 +249,7 @@ TorqueSource parse_torques(const nlohmann::json& v, const Params& params, double
   return torque_table(table, key, interpolation, duration);
 }
 
-Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::string& directory) {
+Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::string& directory, TorqueSource function) {
   if (!j.is_object()) throw Error("", fmt::format("a scenario is a JSON object, got {}", j.type_name()));
   reject_unknown_keys(j, {"id", "description", "observation", "verify", "initial", "params", "rates", "dependent", "duration",
                           "dt", "integrator", "tolerance", "branch", "max_condition", "weighting", "torques"},
@@ -285,7 +285,8 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::
       else sc.rates(k) = v;
     }
   }
-  if (!j.contains("dependent") && j.contains("torques")) {
+  const bool by_torques = j.contains("torques") || static_cast<bool>(function);
+  if (!j.contains("dependent") && by_torques) {
     sc.pair = dynamics_pair();  // the only pair a forward-dynamics run can have
   } else if (!j.contains("dependent")) {
     std::string example;
@@ -328,6 +329,13 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::
       throw Error("torques", "a run is driven by its rates (the weighting then splits their torques) or by torques, not both");
     sc.validate();  // the time grid first: the table is checked against it
     sc.torques = parse_torques(j.at("torques"), sc.params, sc.duration, directory);
+  }
+  if (function) {
+    if (j.contains("torques"))
+      throw Error("torques", "given twice: in the scenario and as a function; keep one");
+    if (sc.weighting)
+      throw Error("torques", "a run is driven by its rates (the weighting then splits their torques) or by torques, not both");
+    sc.torques = std::move(function);
   }
   sc.validate();
   return sc;

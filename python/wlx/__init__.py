@@ -114,19 +114,27 @@ class Model:
         return self._m.forward_dynamics(_np.asarray(s, dtype=float), _np.asarray(u, dtype=float),
                                         _np.asarray(tau, dtype=float), _params_json(params))
 
-    def simulate(self, scenario, every=1):
+    def simulate(self, scenario, every=1, torques=None):
         """Runs a scenario: an embedded id ("NH-1"), a path to a JSON file, or a dict in the scenario
         format. Returns the CSV's columns as arrays by name (every `every`-th sample, from t = 0),
         plus "complete", "stopped" (why a run ended early) and "evaluations". A run whose kept
         samples would take more than 256 MiB is refused (ValueError naming `every`): keep fewer, or
-        stream it to a file with `wlx simulate`."""
+        stream it to a file with `wlx simulate`.
+
+        torques: a function f(t, s, u) -> tau (in the order of `actuators`) that drives the run
+        (forward dynamics, as a scenario's "torques" does): a controller in the loop. It is called
+        at every evaluation of the equations of motion (each stage of an integrator step) with the
+        time, all coordinates and the commanded speeds; the scenario then has neither "torques" nor
+        "weighting", and its "rates" are the commanded speeds at t = 0."""
         if isinstance(scenario, dict):
             text = _to_json(scenario, "scenario")
         else:
             text = _to_json(str(scenario), "scenario")
         if isinstance(every, bool) or not isinstance(every, int):
             raise TypeError("every: must be an integer")
-        result = self._m.simulate(text, every)
+        if torques is not None and not callable(torques):
+            raise TypeError("torques: must be a function f(t, s, u) -> tau, or None")
+        result = self._m.simulate(text, every, torques)
         out = dict(result["columns"])
         for k in ("id", "complete", "stopped", "evaluations"):
             out[k] = result[k]

@@ -212,6 +212,51 @@ def test_simulate_driven_by_torques_retraces_the_inverse_dynamics_run_for_every_
         wlx.model("excavator").simulate({"duration": 0.01, "torques": {"t": [0, 0.01]}})
 
 
+def test_simulate_driven_by_a_function_is_the_run_of_the_same_torques_as_a_table():
+    # A function of time alone that interpolates a table linearly is the table's run (the same
+    # torques at every stage): two paths into the same integration, equal to rounding. The times
+    # it is asked at are the integrator's stages, inside [0, duration].
+    robot = wlx.model("excavator")
+    inverse = robot.simulate("ID-1")
+    table = {"tau_" + a: inverse["tau_" + a] for a in robot.actuators}
+    asked = []
+    def torques(t, s, u):
+        asked.append(t)
+        assert s.shape == (len(robot.coordinates),) and u.shape == (len(robot.commanded),)
+        return [np.interp(t, inverse["t"], table["tau_" + a]) for a in robot.actuators]
+    scenario = {"rates": {"x_C": 3.0}, "duration": 0.494, "dt": 0.001}
+    by_function = robot.simulate(scenario, torques=torques)
+    by_table = robot.simulate({**scenario, "torques": {"t": list(inverse["t"]), **{k: list(v) for k, v in table.items()}}})
+    assert by_function["complete"] and by_table["complete"]
+    for c in robot.coordinates:
+        np.testing.assert_allclose(by_function[c], by_table[c], rtol=0, atol=1e-12)
+    assert len(asked) == by_function["evaluations"] and min(asked) == 0 and max(asked) == pytest.approx(0.494, abs=1e-12)
+
+
+def test_simulate_torque_function_errors():
+    robot = wlx.model("excavator")
+    zero = lambda t, s, u: np.zeros(len(robot.actuators))
+    with pytest.raises(wlx.Error, match=r"^torques: given twice"):
+        robot.simulate({"duration": 0.01, "torques": {"run": "ID-1"}}, torques=zero)
+    with pytest.raises(wlx.Error, match=r"^torques: a run is driven by its rates"):
+        robot.simulate({"duration": 0.01, "weighting": 1, "dependent": ["y_C", "yaw"]}, torques=zero)
+    with pytest.raises(TypeError, match=r"^torques: must be a function"):
+        robot.simulate({"duration": 0.01}, torques=[0.0] * 8)
+    with pytest.raises(TypeError, match=r"^torques: the function returned 3 numbers; the model has 8 actuators"):
+        robot.simulate({"duration": 0.01}, torques=lambda t, s, u: [0.0, 0.0, 0.0])
+    with pytest.raises(TypeError, match=r"^torques: the function must return 8 numbers"):
+        robot.simulate({"duration": 0.01}, torques=lambda t, s, u: "torques")
+    class Broken(Exception):
+        pass
+    def broken(t, s, u):
+        raise Broken("the controller's own error")
+    with pytest.raises(Broken, match="the controller's own error"):  # the caller's exception, unchanged
+        robot.simulate({"duration": 0.01}, torques=broken)
+    # A non-finite torque stops the run (its samples up to then are kept) and says why.
+    run = robot.simulate({"duration": 0.01}, torques=lambda t, s, u: np.full(8, np.nan if t > 0.005 else 0.0))
+    assert not run["complete"] and "non-finite torque" in run["stopped"] and run["t"][-1] <= 0.005 + 1e-12
+
+
 BAD_IK = [
     {"legD": 1},
     {"params": {"legD": -1}},
@@ -247,16 +292,32 @@ def test_array_arguments_are_checked():
         wlx.model("tractor")
 
 
-def test_readme_python_example_runs(tmp_path):
-    # The README's Python example (the python block after "<!-- ci: python -->"), run as it stands.
-    text = README.read_text()
-    block = re.search(r"<!-- ci: python -->\s*```python\n(.*?)```", text, re.S)
-    assert block, "README.md: no python block after <!-- ci: python -->"
+def readme_python_blocks():
+    # The README's Python examples: each python block after "<!-- ci: python -->", as it stands.
+    blocks = re.findall(r"<!-- ci: python -->\s*```python\n(.*?)```", README.read_text(), re.S)
+    assert len(blocks) == 2, "README.md: expected the design study and the closed loop after <!-- ci: python -->"
+    return blocks
+
+
+def run_block(block, cwd):
     env = {**os.environ, "MPLBACKEND": "Agg"}
-    done = subprocess.run([sys.executable, "-c", block.group(1)], cwd=tmp_path, env=env, capture_output=True, text=True)
+    done = subprocess.run([sys.executable, "-c", block], cwd=cwd, env=env, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+def test_readme_python_example_runs(tmp_path):
+    stdout = run_block(readme_python_blocks()[0], tmp_path)
     assert (tmp_path / "legD_sweep.png").stat().st_size > 10000
-    assert "legD" in done.stdout
+    assert "legD" in stdout
+
+
+def test_readme_closed_loop_example_meets_its_bound(tmp_path):
+    # The block asserts its own bound (5 mm from t = 0.5 s); here its printed figures are read too.
+    stdout = run_block(readme_python_blocks()[1], tmp_path)
+    start, late = map(float, re.search(r"error (\S+) mm at t = 0, (\S+) mm from t = 0.5 s", stdout).groups())
+    assert start == pytest.approx(30, abs=0.5)  # the perturbed start: 30 mm in x_C
+    assert late < 5
 
 
 def test_nan_and_out_of_bound_arguments_are_errors_not_nan_results():
