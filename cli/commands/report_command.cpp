@@ -203,6 +203,41 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
     out.push_back(s);
   }
   if (any(is_dynamics)) out.push_back({"dynamics", title("dynamics", "Inverse dynamics"), "", {runs_table(is_dynamics)}, figures.dynamics, {}});
+  if (!runner_.forward().empty()) {
+    report::Table trips{{"run", "samples", "evaluations", "max |s_forward - s_inverse| (m or rad)", "max |E - E0 - W| (J)",
+                         "relative to max |W|", "CSV"},
+                        {}};
+    report::Table loops{{"run", "tracking error at t = 0 (m or rad)", "max tracking error, second half (m or rad)", "CSV"}, {}};
+    for (const auto& r : runner_.forward()) {
+      trips.rows.push_back({{r.id}, {std::to_string(r.samples)}, {std::to_string(r.evaluations)}, {fmt::format("{:.2e}", r.round_trip)},
+                            {fmt::format("{:.2e}", r.energy_balance)}, {fmt::format("{:.1e}", r.energy_balance / std::max(r.work, 1.0))},
+                            {r.csv, "data/" + r.csv}});
+      loops.rows.push_back({{r.id}, {fmt::format("{:.2e}", r.start_error)},
+                            {r.closed_loop_complete ? fmt::format("{:.2e}", r.late_error) : "stopped " + r.closed_loop_stopped},
+                            {r.closed_loop_csv, "data/" + r.closed_loop_csv}});
+    }
+    report::Section s{"forward", title("forward", "Forward dynamics"),
+                      "The machine moved by its actuators: from the torques and the state, forward_dynamics solves the reduced "
+                      "equations of motion M(s) u' = J_beta^T tau - b(s, u) - Q_gravity(s) for the accelerations of the commanded "
+                      "speeds u; the closure is re-solved by the closed-form IK at every evaluation and the rolling rows hold at "
+                      "velocity level, so neither can drift. Round trip: each inverse-dynamics run's torques, cubic between its "
+                      "samples, drive the machine from the run's start (dopri5 at " +
+                          fmt::format("{:.0e}", kRoundTripTolerance) +
+                          "); the deviation from the run and the energy balance (kinetic + potential energy against the "
+                          "actuators' work, trapezoid rule on the samples) are shown.",
+                      {trips}, figures.forward, {}};
+    s.subsections.push_back(
+        {"closed-loop", "A controller in the loop",
+         fmt::format("Computed torque on the model (its inverse dynamics, the run's weighting) with PD feedback on the commanded "
+                     "coordinates (Kp {:g} 1/s^2, Kd {:g} 1/s) tracks each run on a plant that is not the model: every body's mass "
+                     "and inertia x{:g}, and a start {:g} mm or {:g} deg off in every commanded coordinate. The controller reads the "
+                     "plant's coordinates and speeds and is evaluated continuously (at every stage of RK4 at the run's step); the "
+                     "reference is the run's motion, cubic Hermite between its samples. What is left after the start has decayed is "
+                     "the plant's extra weight, which the model does not know.",
+                     kTrackingKp, kTrackingKd, kPlantMassFactor, kStartOffsetLength * 1e3, kStartOffsetAngle * kDegPerRad),
+         {loops}, figures.closed_loop, {}});
+    out.push_back(s);
+  }
   if (!figures.poses.empty()) out.push_back({"poses", "Poses at the start and the end of each run", "", {}, figures.poses, {}});
   return out;
 }
@@ -274,7 +309,8 @@ int Report::run() {
   const ReportFigures figures = make_figures(runner_, spec_, (root_ / "data").string());
   report::Document doc = document(figures);
   std::vector<report::FigureSpec> all;
-  for (const auto* group : {&figures.ik, &figures.nonholonomic, &figures.kinematic, &figures.dynamics, &figures.poses})
+  for (const auto* group : {&figures.ik, &figures.nonholonomic, &figures.kinematic, &figures.dynamics, &figures.forward,
+                            &figures.closed_loop, &figures.poses})
     all.insert(all.end(), group->begin(), group->end());
   progress(fmt::format("rendering {} figures with gnuplot (PNG and SVG)", all.size()));
   report::render(root_.string(), all);

@@ -76,6 +76,7 @@ class Figures {
     nonholonomic(f.nonholonomic);
     runs(f.kinematic);
     dynamics(f.dynamics);
+    forward(f.forward, f.closed_loop);
     poses(f.poses);
     return f;
   }
@@ -316,6 +317,42 @@ class Figures {
       if (reference) caption += fmt::format("; cf. thesis {}", fmt::join(reference->figures, ", "));
       out.push_back({"id-" + r.id, caption, fmt::format("1100,{}", 380 * panels.size()), b});
     }
+  }
+
+  // The round trips' deviations in one figure, over time on a log axis (they span orders of
+  // magnitude); the closed loops' signed tracking errors per commanded coordinate (mm, deg), one
+  // panel per motion (weighting 1; the table has both).
+  void forward(std::vector<FigureSpec>& trips, std::vector<FigureSpec>& loops) {
+    const auto& rows = runner_.forward();
+    if (rows.empty()) return;
+    std::string t = "set xlabel 't (s)'\nset ylabel 'max |s_forward - s_inverse| (m or rad)'\nset logscale y\nset format y '1e%L'\n"
+                    "set key outside right top\nset title 'round trips: the torques of each inverse-dynamics run fed back'\nplot ";
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      t += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(data_path(rows[k].csv)), column("t"),
+                       log_column("round_trip_deviation"), dash(k), q(rows[k].id));
+    trips.push_back({"forward-round-trips", "Round trips: the largest deviation of the forward-dynamics run from the inverse-dynamics "
+                                            "run whose torques drive it, over time", "1100,500", t + "\n"});
+    std::vector<const ForwardRow*> shown;
+    for (const auto& r : rows)
+      if (r.id.size() < 3 || r.id.substr(r.id.size() - 3) != "-w2") shown.push_back(&r);
+    std::string l = fmt::format("set multiplot layout {},1\nset xlabel 't (s)'\nset ylabel 'q_ref - q (mm or deg)'\n"
+                                "set key outside right top\n",
+                                shown.size());
+    for (const ForwardRow* r : shown) {
+      l += fmt::format("set title {}\nplot ", q(r->id + ": closed-loop tracking error, computed torque + PD on a plant 10% heavier"));
+      for (std::size_t j = 0; j < kCommandedSpeeds.size(); ++j) {
+        const int c = kCommandedSpeeds[j];
+        const bool angle = display_unit(c) == "deg";
+        l += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", j ? ", " : "", q(data_path(r->closed_loop_csv)), column("t"),
+                         column("error_" + coordinate_name(c), angle ? kDegPerRad : 1e3), dash(j),
+                         q(coordinate_name(c) + (angle ? " (deg)" : " (mm)")));
+      }
+      l += "\n";
+    }
+    l += "unset multiplot\n";
+    loops.push_back({"forward-closed-loop", "A controller in the loop: the tracking error of computed torque with PD feedback on a "
+                                            "plant 10% heavier than its model, from a perturbed start, per commanded coordinate",
+                     fmt::format("1100,{}", 330 * shown.size()), l});
   }
 
   void poses(std::vector<FigureSpec>& out) {

@@ -131,7 +131,7 @@ std::vector<std::string> ReportRunner::selected_scenarios() const {
 
 int ReportRunner::steps() const {
   int n = static_cast<int>(selected_sweeps().size());
-  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? 2 : 1;
+  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? 4 : 1;  // each weighting's run and its forward dynamics
   if (!quick_ && !spec_.integrator_scenarios.empty()) ++n;
   return n;
 }
@@ -163,6 +163,12 @@ void ReportRunner::run_all(const std::string& data_dir) {
       write_trajectory(data_file(r.csv), r.trajectory, sc);
       runs_.push_back(std::move(r));
     }
+  }
+  const std::size_t inverse_runs = runs_.size();
+  for (std::size_t k = 0; k < inverse_runs; ++k) {
+    if (!runs_[k].scenario.weighting) continue;
+    progress_(fmt::format("forward dynamics of {}: its torques fed back, and a controller tracking it on a heavier plant", runs_[k].id));
+    forward_.push_back(forward_dynamics_of(runs_[k], data_dir));
   }
   if (!quick_ && !spec_.integrator_scenarios.empty()) {
     progress_(fmt::format("comparing integrators: Euler, RK4, dopri5 against RK4 at {:g} s on {} runs", spec_.reference_step,
@@ -211,6 +217,106 @@ void ReportRunner::compare_integrators(const std::string& data_dir) {
     csv.row({r.id, std::string(integrator_name(r.integrator))}, values);
   }
   csv.commit();
+}
+
+ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::string& data_dir) {
+  const std::vector<Sample>& reference = run.trajectory.samples;
+  ForwardRow row;
+  row.id = run.id;
+  row.csv = run.id + "-forward.csv";
+  row.closed_loop_csv = run.id + "-closed-loop.csv";
+
+  // The round trip: the run's torques, cubic between its samples, drive the same machine from the
+  // same start; dopri5 at a tight tolerance, samples at the run's.
+  std::vector<double> times;
+  std::vector<TorqueVector> torques;
+  for (const Sample& smp : reference) times.push_back(smp.t), torques.push_back(smp.tau);
+  Scenario trip = run.scenario;
+  trip.weighting.reset();
+  trip.integrator = Integrator::dopri5;
+  trip.tolerance = kRoundTripTolerance;
+  trip.torques = TorqueTable(times, torques, TorqueTable::Interpolation::cubic);
+  const Trajectory forward = simulate(trip, stop_on_signal);
+  if (!forward.complete) throw Error(run.id, "its torques fed back: " + forward.error);
+  row.samples = static_cast<long>(forward.samples.size());
+  row.evaluations = forward.evaluations;
+
+  // The closed loop. The reference at any t: cubic Hermite between the run's samples (its
+  // coordinates and rates), so the controller's evaluations between samples see the motion, not a
+  // staircase; an inverse-dynamics run's commanded speeds are constant, so u_ref' = 0.
+  const auto reference_at = [&](double t, CommandVector& q, CommandVector& u) {
+    const double dt = run.scenario.dt;
+    const std::size_t k = std::min(static_cast<std::size_t>(std::max(t / dt, 0.0)), reference.size() - 2);
+    const Sample &a = reference[k], &b = reference[k + 1];
+    const double h = b.t - a.t, x = std::clamp((t - a.t) / h, 0.0, 1.0);
+    const double h00 = (1 + 2 * x) * (1 - x) * (1 - x), h10 = x * (1 - x) * (1 - x), h01 = x * x * (3 - 2 * x), h11 = x * x * (x - 1);
+    for (int j = 0; j < kCommandedCount; ++j) {
+      const int c = kCommandedSpeeds[static_cast<std::size_t>(j)];
+      q(j) = h00 * a.s(c) + h10 * h * a.sdot(c) + h01 * b.s(c) + h11 * h * b.sdot(c);
+      u(j) = a.sdot(c) + x * (b.sdot(c) - a.sdot(c));
+    }
+  };
+  Scenario plant = run.scenario;
+  plant.weighting.reset();
+  for (const auto& body : gen::kBodyMass) {
+    plant.params.*body.mass *= kPlantMassFactor;
+    for (auto inertia : body.inertia) plant.params.*inertia *= kPlantMassFactor;
+  }
+  for (int j = 0; j < kCommandedCount; ++j) {
+    const int c = kCommandedSpeeds[static_cast<std::size_t>(j)];
+    plant.initial(c) += display_unit(c) == "deg" ? kStartOffsetAngle : kStartOffsetLength;
+  }
+  const Weighting weighting = *run.scenario.weighting;
+  DynamicsTerms terms;
+  plant.torques = [&](double t, const Coordinates& s, const CommandVector& u) -> TorqueVector {
+    CommandVector q_ref, u_ref;
+    reference_at(t, q_ref, u_ref);
+    CommandVector q;
+    for (int j = 0; j < kCommandedCount; ++j) q(j) = s(kCommandedSpeeds[static_cast<std::size_t>(j)]);
+    const CommandVector u_dot = kTrackingKd * (u_ref - u) + kTrackingKp * (q_ref - q);
+    inverse_dynamics(model_, data_, s, u, u_dot, terms);  // the model's: it does not know the plant
+    return distribute_torques(terms.J_beta, terms.Qstar, weighting);
+  };
+  const Trajectory loop = simulate(plant, stop_on_signal);
+  row.closed_loop_complete = loop.complete;
+  row.closed_loop_stopped = loop.error;
+
+  CsvWriter csv(data_dir + "/" + row.csv, {"t", "round_trip_deviation", "energy_balance"});
+  double energy0 = 0, work = 0;
+  for (std::size_t k = 0; k < forward.samples.size(); ++k) {
+    const Sample& f = forward.samples[k];
+    const double energy = f.kinetic + f.potential;
+    if (k == 0) energy0 = energy;
+    else work += 0.5 * (f.t - forward.samples[k - 1].t) * (f.power + forward.samples[k - 1].power);
+    const double deviation = (f.s - reference[k].s).cwiseAbs().maxCoeff();
+    const double balance = std::abs(energy - energy0 - work);
+    row.round_trip = std::max(row.round_trip, deviation);
+    row.energy_balance = std::max(row.energy_balance, balance);
+    row.work = std::max(row.work, std::abs(work));
+    csv.row({f.t, deviation, balance});
+  }
+  csv.commit();
+
+  std::vector<std::string> header{"t", "tracking_error"};
+  for (int c : kCommandedSpeeds) header.push_back("error_" + coordinate_name(c));
+  CsvWriter tracking(data_dir + "/" + row.closed_loop_csv, header);
+  for (std::size_t k = 0; k < loop.samples.size(); ++k) {
+    const Sample& smp = loop.samples[k];
+    CommandVector q_ref, u_ref;
+    reference_at(smp.t, q_ref, u_ref);
+    std::vector<double> values{smp.t, 0};
+    for (int j = 0; j < kCommandedCount; ++j) {
+      const double e = q_ref(j) - smp.s(kCommandedSpeeds[static_cast<std::size_t>(j)]);
+      values[1] = std::max(values[1], std::abs(e));
+      values.push_back(e);
+    }
+    if (k == 0) row.start_error = values[1];
+    if (2 * k >= reference.size() - 1) row.late_error = std::max(row.late_error, values[1]);
+    tracking.row(values);
+  }
+  tracking.commit();
+  if (!loop.complete) row.late_error = NAN;
+  return row;
 }
 
 const ReportRun* ReportRunner::find_run(const std::string& id) const {
@@ -301,6 +407,20 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
       for (const auto& smp : r->trajectory.samples) worst = std::max(worst, smp.tau.cwiseAbs().maxCoeff());
     }
     return Measured{worst, "N m"};
+  }
+  if (q == "round_trip_deviation" || q == "energy_balance" || q == "closed_loop_error") {
+    double worst = 0;
+    bool any = false;
+    for (const ForwardRow& r : forward_) {
+      if (!m.runs.empty() && std::find(m.runs.begin(), m.runs.end(), r.id) == m.runs.end()) continue;
+      any = true;
+      if (q == "round_trip_deviation") worst = std::max(worst, r.round_trip);
+      else if (q == "energy_balance") worst = std::max(worst, r.energy_balance / std::max(r.work, 1.0));
+      else worst = r.closed_loop_complete ? std::max(worst, r.late_error) : NAN;  // a stopped loop fails every criterion
+      if (std::isnan(worst)) break;
+    }
+    if (!any) return std::nullopt;
+    return Measured{worst, q == "energy_balance" ? "" : "m or rad"};
   }
   // The rest concern one run.
   const ReportRun* run = find_run(m.run);

@@ -44,6 +44,29 @@ struct IntegratorRow {
   std::vector<double> coordinates;  // max |s_c - ref| per compared coordinate
 };
 
+// The forward dynamics of one inverse-dynamics run (the report's "Forward dynamics" section): its
+// torques fed back (the round trip), and a computed-torque controller on the model tracking the
+// run on a plant whose bodies are heavier than the model's, from a start off the run's (the
+// closed loop). Generic: the plant, the start and the gains are the same for every model.
+struct ForwardRow {
+  std::string id;   // the inverse-dynamics run's
+  std::string csv;             // data/<id>-forward.csv: t, round_trip_deviation, energy_balance
+  std::string closed_loop_csv;  // data/<id>-closed-loop.csv: t, tracking_error, error_<commanded coordinate> ...
+  long samples = 0, evaluations = 0;  // the round trip's
+  double round_trip = 0;      // max |s_forward - s_inverse| over the samples and coordinates, m or rad
+  double energy_balance = 0;  // max |E(t) - E(0) - W(t)| over the samples, J (W: the actuators' work, trapezoid rule)
+  double work = 0;            // max |W(t)|, J: the scale of energy_balance
+  bool closed_loop_complete = false;
+  std::string closed_loop_stopped;    // why the closed loop ended early
+  double start_error = 0, late_error = 0;  // max |q_ref - q| over the commanded coordinates (m or rad): at t = 0, and over the second half
+};
+// The closed loop's plant and controller (ForwardRow).
+inline constexpr double kPlantMassFactor = 1.10;     // every body's mass and inertia, plant / model
+inline constexpr double kStartOffsetLength = 0.02;   // m, added to every commanded length coordinate at t = 0
+inline constexpr double kStartOffsetAngle = 0.0174532925199432957;  // 1 deg, to every commanded angle
+inline constexpr double kTrackingKp = 400, kTrackingKd = 40;  // 1/s^2, 1/s: critically damped at 20 rad/s
+inline constexpr double kRoundTripTolerance = 1e-12;  // dopri5's, for the round trip
+
 // A measured value in the unit the report shows it in.
 struct Measured {
   double value = 0;
@@ -68,6 +91,7 @@ class ReportRunner {
   const std::vector<IkSweepResult>& sweeps() const { return sweeps_; }
   const std::vector<ReportRun>& runs() const { return runs_; }
   const std::vector<IntegratorRow>& integrators() const { return integrators_; }
+  const std::vector<ForwardRow>& forward() const { return forward_; }
   const std::vector<int>& compared_coordinates() const { return compared_; }
   const Model& model() const { return model_; }
   Data& data() { return data_; }
@@ -77,6 +101,7 @@ class ReportRunner {
   std::vector<const IkSweep*> selected_sweeps() const;
   std::vector<std::string> selected_scenarios() const;
   void compare_integrators(const std::string& data_dir);
+  ForwardRow forward_dynamics_of(const ReportRun& run, const std::string& data_dir);
 
   const report::ReportSpec& spec_;
   bool quick_;
@@ -87,6 +112,7 @@ class ReportRunner {
   std::vector<IkSweepResult> sweeps_;
   std::vector<ReportRun> runs_;
   std::vector<IntegratorRow> integrators_;
+  std::vector<ForwardRow> forward_;
 };
 
 // The unit a coordinate is shown in ("deg" for angles, "m") and the factor from SI to it.

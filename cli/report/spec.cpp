@@ -31,7 +31,11 @@ struct QuantityRule {
 // integrator_deviation: the largest deviation of `integrator` from the reference over `runs` (default:
 // all compared) in `coordinates` (default: every input). static_torque: the largest |tau| of `joints`
 // at the nominal pose at rest with `weighting`. peak_torque: the largest |tau| over `runs`.
-// param_product: factor x the product of `params` (x the total mass).
+// param_product: factor x the product of `params` (x the total mass). round_trip_deviation: the
+// largest |s_forward - s_inverse| when the torques of the inverse-dynamics `runs` (default: all)
+// drive the machine (m or rad); energy_balance: the largest |E(t) - E(0) - W(t)| of those forward
+// runs over the largest |W(t)| (relative); closed_loop_error: the largest tracking error over the
+// second half of the closed loop of `runs` (m or rad; none if a loop stopped early).
 const std::vector<QuantityRule>& rules() {
   static const std::vector<QuantityRule> all{
       {"total_mass", {}, {}},
@@ -49,6 +53,9 @@ const std::vector<QuantityRule>& rules() {
       {"static_torque", {"joints"}, {"weighting"}},
       {"peak_torque", {"runs"}, {}},
       {"param_product", {"params"}, {"factor", "times_total_mass", "unit"}},
+      {"round_trip_deviation", {}, {"runs"}},
+      {"energy_balance", {}, {"runs"}},
+      {"closed_loop_error", {}, {"runs"}},
   };
   return all;
 }
@@ -266,7 +273,7 @@ class Parser {
       for (const auto& kv : src) s.sources[kv.first.as<std::string>()] = text(kv.second, "sources." + kv.first.as<std::string>());
     }
     if (const YAML::Node sec = root["sections"]) {
-      keys(sec, "sections", {"ik", "nonholonomic", "kinematic", "dynamics"});
+      keys(sec, "sections", {"ik", "nonholonomic", "kinematic", "dynamics", "forward"});
       for (const auto& kv : sec) s.section_titles[kv.first.as<std::string>()] = text(kv.second, "sections." + kv.first.as<std::string>());
     }
     if (const YAML::Node lines = root["reference_lines"]) {
