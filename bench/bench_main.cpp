@@ -789,6 +789,18 @@ int main(int argc, char** argv) {
         first = false;
       }
     }
+    // The target for forward dynamics: no dearer than an inverse-dynamics step of the
+    // same model (speedup >= 1: the forward step is the cheaper).
+    bool first_pair = true;
+    for (const std::string& model : models) {
+      const std::string forward = model + "/forward_dynamics_step", inverse = model + "/inverse_dynamics_step";
+      if (!collector.median_ns.count(forward) || !collector.median_ns.count(inverse)) continue;
+      rows.push_back({texts.emplace_back(fmt::format("{}: forward_dynamics_step vs its inverse_dynamics_step", model)).c_str(),
+                      texts.emplace_back(forward).c_str(), texts.emplace_back(inverse).c_str(), 0, false,
+                      first_pair ? "each model's forward-dynamics step against its own inverse-dynamics step (speedup: inverse / forward)"
+                                 : nullptr});
+      first_pair = false;
+    }
   }
   const auto get = [&](const char* name) {
     const auto it = collector.median_ns.find(name);

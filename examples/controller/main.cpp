@@ -185,7 +185,7 @@ int main() {
 
   // --- the closed loop: the controller above drives a plant that is not the machine it knows ---
   // The plant is the forward dynamics (wlx/simulation.hpp: a run driven by torques) of a machine
-  // whose every body is 10% heavier and whose thighs are 2 cm longer than the model's, started
+  // whose every body is 10% heavier (mass and inertia) and whose thighs are 2 cm longer than the model's, started
   // off the reference (cabin 2 cm high and 3 cm behind). Every millisecond the controller reads the
   // plant's inputs and commanded speeds, solves its own model's IK for the joints, and applies the
   // torques of computed torque control, the inverse dynamics for u' = u'_ref + Kd (u_ref - u) +
@@ -201,7 +201,10 @@ int main() {
     const Manoeuvre& m = manoeuvres[0];
     const int slot = commanded_slot(m.coordinate);
     wlx::Params plant_params = model.params();
-    for (const auto& body : gen::kBodyMass) plant_params.*body.mass *= 1.10;
+    for (const auto& body : gen::kBodyMass) {  // the same shapes, 10% denser: mass and inertia
+      plant_params.*body.mass *= 1.10;
+      for (auto inertia : body.inertia) plant_params.*inertia *= 1.10;
+    }
     plant_params.thighD += 0.02;
     const wlx::Coordinates reference_start = wlx::nominal_inputs();
     wlx::Coordinates plant = reference_start, seen = reference_start;
@@ -210,7 +213,7 @@ int main() {
     wlx::CommandVector plant_u = wlx::CommandVector::Zero();
     const long steps = std::lround(m.period / dt);
     double late_error = 0;
-    std::printf("\nclosed loop: %s\n  plant: masses +10%%, thighD %.3f m (model %.3f m); start z_C +20 mm, x_C -30 mm; "
+    std::printf("\nclosed loop: %s\n  plant: masses and inertias +10%%, thighD %.3f m (model %.3f m); start z_C +20 mm, x_C -30 mm; "
                 "Kp %.0f, Kd %.0f\n",
                 m.name, plant_params.thighD, model.params().thighD, kp, kd);
     try {

@@ -23,12 +23,14 @@ void forward_dynamics(const Model& model, Data& d, const Coordinates& s, const C
       throw Error(fmt::format("tau.{}", kActuatorNames[static_cast<std::size_t>(r)]),
                   fmt::format("must be a finite number, got {}", tau(r)));
   equations_of_motion(model, d, s, u, out, options);  // M, b, Q_gravity, J_beta; s'' at u' = 0
-  out.Qstar.noalias() = out.J_beta.transpose() * tau;
+  // Coefficient-based products (lazyProduct): at these fixed sizes Eigen's general
+  // matrix-vector kernel costs more in set-up than in arithmetic.
+  out.Qstar.noalias() = out.J_beta.transpose().lazyProduct(tau);
   const Eigen::LLT<CommandMatrix> llt(out.M);
   if (llt.info() != Eigen::Success)
     throw Error("M", "the mass matrix on the commanded speeds is not positive definite: some commanded speed moves no body");
   u_dot = llt.solve(out.Qstar - out.b + out.Q_gravity);
-  out.sddot.noalias() += out.T * u_dot;
+  out.sddot.noalias() += out.T.lazyProduct(u_dot);
 #endif
 }
 
