@@ -219,7 +219,7 @@ class Examples:
             out = args[args.index("--out") + 1] if "--out" in args else "out/simulate"  # --help's default
             scenario = next(a for a in args if not a.startswith("-") and a not in (out,) and not re.fullmatch(r"[\d.e+-]+", a)
                             and a not in ("rk4", "euler", "dopri5"))
-            self.check_trajectory(where, model, scenario, os.path.join(work, out, "trajectory.csv"))
+            self.check_trajectory(where, model, scenario, os.path.join(work, out, "trajectory.csv"), os.path.join(work, scenario))
         elif sub == "fk":
             self.check_fk(where, model, "--json" in args, stdout)
         elif sub == "models":
@@ -251,7 +251,7 @@ class Examples:
             if key not in coordinates and not any(matches(key, t) for t in always + newton_only):
                 raise ContractError(f"{where}: output key `{key}` is not documented in README.md's 'Output keys:'")
 
-    def check_trajectory(self, where, model, scenario, path):
+    def check_trajectory(self, where, model, scenario, path, scenario_file):
         if not os.path.isfile(path):
             raise ContractError(f"{where}: {path} was not written")
         with open(path, newline="") as f:
@@ -260,6 +260,7 @@ class Examples:
         if said.count("inverse-dynamics runs") != 1:
             raise ContractError(f"{where}: README.md no longer says which columns only 'inverse-dynamics runs' have")
         plain, dynamics = said.split("inverse-dynamics runs")
+        driven, forward = dynamics.split("runs driven by torques") if "runs driven by torques" in dynamics else (dynamics, "")
         coordinates = self.coordinates(model)
         count = re.search(r"the (\d+)\s+coordinates", plain)
         if count and int(count[1]) != len(coordinates) and model == "excavator":
@@ -269,9 +270,15 @@ class Examples:
         dot_columns = [c for c in header if c.endswith("_dot")]
         if rates and int(rates[1]) != len(dot_columns):
             raise ContractError(f"{where}: the README says {rates[1]} input rates `<name>_dot`, the CSV has {len(dot_columns)}")
-        inverse_dynamics = scenario.startswith("ID-")
+        # A run driven by torques (a scenario file with "torques") has the inverse-dynamics
+        # columns and its own; an inverse-dynamics run (ID-*) only the former.
+        by_torques = os.path.isfile(scenario_file) and '"torques"' in open(scenario_file, encoding="utf-8").read()
+        inverse_dynamics = scenario.startswith("ID-") or by_torques
         named = backticked_names(plain)
-        for template in named + (backticked_names(dynamics) if inverse_dynamics else []):
+        expected = named + (backticked_names(driven) if inverse_dynamics else []) + (backticked_names(forward) if by_torques else [])
+        if by_torques:
+            named = named + backticked_names(forward)
+        for template in expected:
             if template.startswith("DIR/"):
                 continue
             if not any(matches(c, template) for c in header):
