@@ -35,6 +35,16 @@ else
   exit 1
 fi
 
+echo "-- the installed wlx compiles a model file of its own (wlx --model-file)"
+# The installed sources (share/wlx), not the source tree's: the plugin is built from what was
+# installed. -O0: this checks the installed layout; tests/cli/test_model_file_plugin.cpp the rest.
+sed 's/^model: .*/model: installed_check/' build/install/share/wlx/models/excavator.yaml > "$work/installed_check.yaml"
+echo '{"z_C": 1.8}' | WLX_CACHE_DIR="$work/cache" WLX_PLUGIN_CXXFLAGS=-O0 \
+  build/install/bin/wlx --model-file "$work/installed_check.yaml" fk --json > "$work/fk.json"
+grep -q '"closure_residual"' "$work/fk.json"
+grep -rq "share/wlx/cli/commands" "$work/cache"/installed_check-*/commands_unity.cpp || {
+  echo "the plugin was not compiled from the installed sources" >&2; exit 1; }
+
 echo "-- add_subdirectory(), runtime only"
 cmake -S tests/package -B "$work/subdirectory" -G Ninja -DWLX_SOURCE_DIR="$PWD" > "$work/configure.log"
 for needless in GINAC CLI11_DIR nlohmann_json_DIR yaml-cpp_DIR; do

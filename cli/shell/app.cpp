@@ -15,6 +15,9 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
   const auto add_model_options = [&](CLI::App* a) {
     a->add_option("--model", inv.model_name, "the built-in model (" + names + "; wlx models lists them)")
         ->capture_default_str();
+    a->add_option("--model-file", inv.model_file,
+                  "your own model file (docs/model-format.md): compiled on first use into a cached plugin, then loaded "
+                  "(instead of --model)");
     a->add_option("--params", inv.model_options.params_file,
                   "JSON file {\"name\": value, ...} overriding the model's parameters (SI units; default: the model file's values)");
   };

@@ -15,6 +15,7 @@ namespace wlx::cli {
 // which was given).
 struct Invocation {
   std::string model_name;
+  std::string model_file;  // --model-file: a model file of the user's (cli/shell/model_plugin.hpp)
   ModelOptions model_options;
   CLI::App* list_models = nullptr;
   CLI::App* fk = nullptr;

@@ -5,6 +5,7 @@
 #include "command_line.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "model_plugin.hpp"
 #include "output_checks.hpp"
 
 #include <CLI/CLI.hpp>
@@ -22,7 +23,7 @@ int main(int argc, char** argv) {
   for (const auto& m : models()) names.emplace_back(m.name);
   Invocation inv;
   define_command_line(app, inv, names, WLX_VERSION);
-  auto& [model_name, model_options, list_models, fk, fk_json, ik, batch, verify_ik, ik_out, sweep_ids, verify_nh, nh_out,
+  auto& [model_name, model_file, model_options, list_models, fk, fk_json, ik, batch, verify_ik, ik_out, sweep_ids, verify_nh, nh_out,
          simulate, sim, report, report_options, viewer, viewer_options] = inv;
   std::string model_names;
   for (const auto& n : names) model_names += (model_names.empty() ? "" : ", ") + n;
@@ -40,6 +41,11 @@ int main(int argc, char** argv) {
     for (const auto& m : models()) {
       names.emplace_back(m.name);
       if (m.name == model_name) model = &m;
+    }
+    if (!model_file.empty()) {
+      if (model_name != names.front())
+        throw wlx::Error("--model-file", "give --model (a built-in model) or --model-file (your own), not both");
+      if (!list_models->parsed()) model = &load_model_file(model_file, WLX_VERSION);
     }
     if (model == nullptr) {
       const std::string hint = nearest(model_name, names);
@@ -75,6 +81,9 @@ int main(int argc, char** argv) {
   } catch (const wlx::OutputError& e) {
     fmt::print(stderr, "wlx: error: {}\n", e.what());
     return kExitOutputError;
+  } catch (const PluginBuildError& e) {  // a correct model file that did not compile
+    fmt::print(stderr, "wlx: error: {}\n", e.what());
+    return 1;
   } catch (const wlx::Error& e) {
     fmt::print(stderr, "wlx: error: {}\n", e.what());
     return 2;

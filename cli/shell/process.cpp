@@ -13,7 +13,10 @@ namespace wlx::cli {
 
 ProgramRun run_program(const std::vector<std::string>& argv, const std::string& working_directory,
                        const std::string& log_path) {
-  ProgramRun result;
+  return wait_program(start_program(argv, working_directory, log_path));
+}
+
+int start_program(const std::vector<std::string>& argv, const std::string& working_directory, const std::string& log_path) {
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
@@ -35,6 +38,7 @@ ProgramRun run_program(const std::vector<std::string>& argv, const std::string& 
   sigaddset(&defaults, SIGPIPE);
   sigaddset(&defaults, SIGINT);
   sigaddset(&defaults, SIGTERM);
+  sigaddset(&defaults, SIGHUP);
   posix_spawnattr_setsigdefault(&attributes, &defaults);
   posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF);
 
@@ -42,11 +46,22 @@ ProgramRun run_program(const std::vector<std::string>& argv, const std::string& 
   const int spawned = posix_spawnp(&pid, args[0], &actions, &attributes, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
-  if (spawned != 0) return result;
+  return spawned == 0 ? static_cast<int>(pid) : -1;
+}
+
+namespace {
+
+ProgramRun wait_for(pid_t which, int& reaped) {
+  ProgramRun result;
   int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return result;  // EINTR: our own SIGINT/SIGTERM handler ran; keep waiting
+  pid_t pid = 0;
+  while ((pid = ::waitpid(which, &status, 0)) < 0) {
+    if (errno != EINTR) {  // EINTR: our own SIGINT/SIGTERM handler ran; keep waiting
+      reaped = 0;
+      return result;
+    }
   }
+  reaped = static_cast<int>(pid);
   result.started = true;
   if (WIFEXITED(status)) {
     result.exit_status = WEXITSTATUS(status);
@@ -56,5 +71,15 @@ ProgramRun run_program(const std::vector<std::string>& argv, const std::string& 
   if (WIFSIGNALED(status)) result.signal = WTERMSIG(status);
   return result;
 }
+
+}  // namespace
+
+ProgramRun wait_program(int pid) {
+  if (pid <= 0) return {};
+  int reaped = 0;
+  return wait_for(pid, reaped);
+}
+
+ProgramRun wait_any_program(int& pid) { return wait_for(-1, pid); }
 
 }  // namespace wlx::cli

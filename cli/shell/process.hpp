@@ -19,4 +19,13 @@ struct ProgramRun {
 ProgramRun run_program(const std::vector<std::string>& argv, const std::string& working_directory = {},
                        const std::string& log_path = {});
 
+// The same in two halves, to run several programs at once: start_program returns the child's pid
+// (or -1 if it could not be started), wait_program waits for it (a signal to wlx while waiting
+// does not stop the wait: the caller decides, after, what to do with the other children).
+int start_program(const std::vector<std::string>& argv, const std::string& working_directory = {},
+                  const std::string& log_path = {});
+ProgramRun wait_program(int pid);
+// Waits for whichever child of this process ends first; `pid` is set to it (0 if there is none).
+ProgramRun wait_any_program(int& pid);
+
 }  // namespace wlx::cli

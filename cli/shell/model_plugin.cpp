@@ -1,0 +1,493 @@
+#include "model_plugin.hpp"
+
+#include "bounded_input.hpp"
+#include "interrupt.hpp"
+#include "process.hpp"
+
+#include <fmt/format.h>
+#include <wlx/atomic_file.hpp>
+#include <wlx/bounded_file.hpp>
+#include <wlx/error.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <dlfcn.h>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <thread>
+#include <unistd.h>
+
+// Set by CMake (CMakeLists.txt, wlx_cli_common): the compiler wlx was built with, the include
+// folders of Eigen, fmt and nlohmann-json, fmt's library, the source tree, and where an installed
+// wlx keeps the runtime's headers and the sources a plugin compiles (relative to its bin folder).
+#ifndef WLX_PLUGIN_CXX
+#define WLX_PLUGIN_CXX "c++"
+#endif
+#ifndef WLX_PLUGIN_INCLUDES
+#define WLX_PLUGIN_INCLUDES ""
+#endif
+#ifndef WLX_PLUGIN_LIBRARIES
+#define WLX_PLUGIN_LIBRARIES ""
+#endif
+#ifndef WLX_SOURCE_TREE
+#define WLX_SOURCE_TREE ""
+#endif
+#ifndef WLX_SHARE_FROM_BINDIR
+#define WLX_SHARE_FROM_BINDIR "../share/wlx"
+#endif
+#ifndef WLX_INCLUDE_FROM_BINDIR
+#define WLX_INCLUDE_FROM_BINDIR "../include"
+#endif
+
+namespace wlx::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The plugin's entry point: its commands, and the key it was built for.
+using PluginEntry = const ModelCommands* (*)(const char** key);
+constexpr const char* kEntrySymbol = "wlx_model_plugin_v1";
+static_assert(kPluginInterface == 1, "rename kEntrySymbol with the interface's version");
+
+// The runtime's sources (their generated-function files apart: each is its own translation unit)
+// and the per-model commands, as CMakeLists.txt lists them for the built-in models.
+// In one translation unit, which shares Eigen's templates (measured at -O2: 27 s, where the
+// files one by one take 48 s of CPU); it runs on one core while the commands and the generated
+// functions take the others.
+const std::vector<std::vector<std::string>> kRuntimeSources{{"dynamics.cpp", "forward_dynamics.cpp", "ik.cpp", "model.cpp",
+                                                             "kinematics.cpp", "ik_verification.cpp", "simulation.cpp",
+                                                             "nonholonomic.cpp"}};
+const std::vector<std::string> kGeneratedFunctionSources{"generated_kinematics.cpp", "generated_rates.cpp", "generated_bodies.cpp",
+                                                         "generated_reduced_dynamics.cpp"};
+const std::vector<std::string> kCommandSources{"commands/input.cpp",          "commands/limits.cpp",        "commands/scenario_io.cpp",
+                                               "commands/ik_commands.cpp",    "commands/simulate_commands.cpp",
+                                               "commands/simulate_stream.cpp", "commands/fk_command.cpp",   "commands/report_command.cpp",
+                                               "report/runner.cpp",           "report/figures.cpp",         "commands/viewer_command.cpp"};
+
+// FNV-1a, twice with different offsets: a 128-bit content key (a cache key, not a signature).
+struct Hash {
+  std::uint64_t a = 14695981039346656037ull, b = 1099511628211ull * 31 + 7;
+  void add(std::string_view text) {
+    for (const unsigned char c : text) {
+      a = (a ^ c) * 1099511628211ull;
+      b = (b ^ c) * 1099511628211ull + 0x9e3779b97f4a7c15ull;
+    }
+    a = (a ^ 0xff) * 1099511628211ull;  // a separator: ("ab", "c") and ("a", "bc") differ
+  }
+  std::string hex() const { return fmt::format("{:016x}{:016x}", a, b); }
+};
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, '|'))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+fs::path executable_dir() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::path() : exe.parent_path();
+}
+
+// Where the sources a plugin compiles are: an installed wlx's share/wlx, else the source tree.
+struct Sources {
+  fs::path runtime_include;  // holds wlx/*.hpp
+  fs::path runtime_sources;  // the runtime's *.cpp
+  fs::path cli;              // holds shell/, commands/, report/
+};
+
+Sources find_sources() {
+  std::error_code ec;
+  const fs::path bin = executable_dir();
+  const fs::path share = (bin / WLX_SHARE_FROM_BINDIR).lexically_normal();
+  if (!bin.empty() && fs::is_regular_file(share / "cli" / "commands" / "per_model.hpp", ec))
+    return {(bin / WLX_INCLUDE_FROM_BINDIR).lexically_normal(), share / "runtime", share / "cli"};
+  const fs::path tree = WLX_SOURCE_TREE;
+  if (!tree.empty() && fs::is_regular_file(tree / "cli" / "commands" / "per_model.hpp", ec))
+    return {tree / "runtime", tree / "runtime" / "wlx", tree / "cli"};
+  throw Error("--model-file", fmt::format("the sources a model's plugin is compiled from are missing (looked in {} and {}): "
+                                          "reinstall wlx",
+                                          share.string(), tree.string()));
+}
+
+fs::path generator_program() {
+  if (const char* env = std::getenv("WLX_GEN"); env != nullptr && *env != '\0') return env;
+  const fs::path beside = executable_dir() / "wlx-gen";
+  std::error_code ec;
+  if (fs::is_regular_file(beside, ec)) return beside;
+  return "wlx-gen";  // from PATH
+}
+
+std::string compiler() {
+  if (const char* env = std::getenv("CXX"); env != nullptr && *env != '\0') return env;
+  return WLX_PLUGIN_CXX;
+}
+
+// -O2 by default (the code runs in users' loops); WLX_PLUGIN_CXXFLAGS replaces it (part of the key).
+std::vector<std::string> optimization_flags() {
+  const char* env = std::getenv("WLX_PLUGIN_CXXFLAGS");
+  std::vector<std::string> out;
+  std::istringstream in(env != nullptr && *env != '\0' ? env : "-O2");
+  for (std::string flag; in >> flag;) out.push_back(flag);
+  return out;
+}
+
+// The model's name, from its `model:` line (the namespace of its runtime; wlx-gen checks it).
+std::string model_name_of(const std::string& text) {
+  static const std::regex line(R"(^model:[ \t]*([A-Za-z_][A-Za-z0-9_]*)[ \t]*(#.*)?$)");
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) {
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    std::smatch m;
+    if (std::regex_match(l, m, line)) return m[1];
+  }
+  return {};
+}
+
+// A URDF the model file reads (`urdf: robot.urdf`, relative to the file), so it is keyed too.
+std::string urdf_of(const std::string& text) {
+  static const std::regex line(R"(^urdf:[ \t]*([^ \t#]+).*$)");
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) {
+    std::smatch m;
+    if (std::regex_match(l, m, line)) return m[1];
+  }
+  return {};
+}
+
+std::string read_small(const fs::path& path, std::size_t limit) {
+  const BoundedRead r = read_bounded_file(path.string(), limit);
+  return r.ok() ? r.text : std::string();
+}
+
+std::string file_checksum(const fs::path& path, std::uintmax_t& size) {
+  std::ifstream in(path, std::ios::binary);
+  Hash h;
+  size = 0;
+  std::vector<char> buffer(1 << 16);
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const auto n = static_cast<std::size_t>(in.gcount());
+    h.add(std::string_view(buffer.data(), n));
+    size += n;
+  }
+  return h.hex();
+}
+
+std::string manifest_value(const std::string& manifest, const std::string& key) {
+  std::istringstream in(manifest);
+  for (std::string l; std::getline(in, l);)
+    if (l.rfind(key + " ", 0) == 0) return l.substr(key.size() + 1);
+  return {};
+}
+
+// The plugin of a complete entry, or null with the reason it cannot be used.
+const ModelCommands* try_load(const fs::path& entry, const std::string& key, std::string& why) {
+  std::error_code ec;
+  if (!fs::exists(entry, ec)) {
+    why = "not built yet";
+    return nullptr;
+  }
+  const std::string manifest = read_small(entry / "manifest", 1 << 16);
+  std::uintmax_t size = 0;
+  const fs::path library = entry / "plugin.so";
+  if (manifest_value(manifest, "key") != key) {
+    why = "its manifest is missing or names another key";
+    return nullptr;
+  }
+  const std::string checksum = fs::is_regular_file(library, ec) ? file_checksum(library, size) : std::string();
+  if (checksum.empty() || checksum != manifest_value(manifest, "checksum") || std::to_string(size) != manifest_value(manifest, "size")) {
+    why = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
+    return nullptr;
+  }
+  void* handle = ::dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (handle == nullptr) {
+    why = fmt::format("dlopen refused it ({})", ::dlerror());
+    return nullptr;
+  }
+  const auto entry_point = reinterpret_cast<PluginEntry>(::dlsym(handle, kEntrySymbol));
+  const char* built_for = nullptr;
+  const ModelCommands* commands = entry_point != nullptr ? entry_point(&built_for) : nullptr;
+  if (commands == nullptr || built_for == nullptr || key != built_for) {
+    ::dlclose(handle);
+    why = "it is not a plugin of this wlx (no entry point of this interface, or another key)";
+    return nullptr;
+  }
+  return commands;  // never closed: its code and strings are in use until exit
+}
+
+// An exclusive lock on a file, held while the object lives (flock: released if the process dies).
+class FileLock {
+ public:
+  explicit FileLock(const fs::path& path, const std::string& waiting_message) {
+    fd_ = ::open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC | O_NOFOLLOW, 0600);
+    if (fd_ < 0) throw Error("--model-file", fmt::format("cannot open the cache's lock {} ({})", path.string(), std::strerror(errno)));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
+    fmt::print(stderr, "{}\n", waiting_message);
+    while (::flock(fd_, LOCK_EX) != 0) {
+      if (errno != EINTR) throw Error("--model-file", fmt::format("cannot lock {} ({})", path.string(), std::strerror(errno)));
+      throw_if_interrupted();
+    }
+  }
+  ~FileLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+// A folder removed when the object goes, unless kept.
+struct TemporaryFolder {
+  fs::path path;
+  bool keep = false;
+  ~TemporaryFolder() {
+    std::error_code ec;
+    if (!keep && !path.empty()) fs::remove_all(path, ec);
+  }
+};
+
+// The first line of a compiler's log that reports an error (else its first line).
+std::string first_error(const std::string& log) {
+  std::istringstream in(log);
+  std::string first;
+  for (std::string l; std::getline(in, l);) {
+    if (first.empty() && !l.empty()) first = l;
+    if (l.find("error") != std::string::npos) return l;
+  }
+  return first.empty() ? "(no output)" : first;
+}
+
+// A path written into an #include: refused if it holds what a quoted include cannot carry.
+std::string include_line(const fs::path& path) {
+  const std::string p = path.string();
+  if (p.find_first_of("\"\\\n\r") != std::string::npos)
+    throw Error("--model-file", fmt::format("the path {} holds a quote, backslash or newline: move wlx or the cache "
+                                            "(WLX_CACHE_DIR) to a plain path",
+                                            excerpt(p)));
+  return "#include \"" + p + "\"\n";
+}
+
+struct Job {
+  std::string name;
+  std::vector<std::string> argv;
+  fs::path log;
+};
+
+// Runs the jobs, up to `parallel` at once; stops the others at the first failure or signal.
+void run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path& failed_logs) {
+  std::vector<std::pair<int, const Job*>> running;
+  std::size_t next = 0;
+  const auto stop_all = [&] {
+    for (const auto& [pid, job] : running) ::kill(pid, SIGTERM);
+    for (const auto& [pid, job] : running) wait_program(pid);
+    running.clear();
+  };
+  while (next < jobs.size() || !running.empty()) {
+    while (next < jobs.size() && running.size() < parallel) {
+      const Job& job = jobs[next++];
+      const int pid = start_program(job.argv, {}, job.log.string());
+      if (pid < 0) {
+        stop_all();
+        throw Error("--model-file", fmt::format("cannot run the C++ compiler '{}' (set CXX to one)", job.argv.front()));
+      }
+      running.emplace_back(pid, &job);
+    }
+    // Whichever finishes first frees its core for the next job.
+    int pid = 0;
+    const ProgramRun r = wait_any_program(pid);
+    const auto done = std::find_if(running.begin(), running.end(), [&](const auto& p) { return p.first == pid; });
+    if (done == running.end()) {
+      stop_all();
+      throw PluginBuildError("lost track of the compiler's processes");
+    }
+    const Job* job = done->second;
+    running.erase(done);
+    if (interrupt_signal() != 0) {
+      stop_all();
+      throw_if_interrupted();
+    }
+    if (!r.ok()) {
+      stop_all();
+      const std::string log = read_small(job->log, kMaxFileBytes);
+      std::error_code ec;
+      fs::remove_all(failed_logs, ec);
+      fs::create_directories(failed_logs, ec);
+      fs::copy_file(job->log, failed_logs / job->log.filename(), fs::copy_options::overwrite_existing, ec);
+      throw PluginBuildError(fmt::format("compiling the model's {} failed: {}\n  the whole log: {}", job->name,
+                                         first_error(log), (failed_logs / job->log.filename()).string()));
+    }
+  }
+}
+
+// Generates the model's headers and compiles its plugin into `dir`.
+void build_plugin(const fs::path& model_file, const std::string& name, const std::string& key, const fs::path& dir,
+                  const fs::path& failed_logs) {
+  // wlx-gen first: a mistake in the model file is reported as wlx-gen reports it, before any compiling.
+  const auto start = std::chrono::steady_clock::now();
+  const fs::path gen = dir / "generated";
+  const fs::path gen_log = dir / "wlx-gen.log";
+  const ProgramRun generated =
+      run_program({generator_program().string(), fs::absolute(model_file).string(), "--out", gen.string(), "--quiet"}, {}, gen_log.string());
+  throw_if_interrupted();
+  if (!generated.started) throw Error("--model-file", fmt::format("cannot run wlx-gen ({}): reinstall wlx", generator_program().string()));
+  if (!generated.ok()) {
+    std::string message = read_small(gen_log, kMaxFileBytes);
+    for (const std::string prefix : {"wlx-gen: error: ", "wlx-gen: "})
+      if (message.rfind(prefix, 0) == 0) message = message.substr(prefix.size());
+    while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
+    if (generated.exit_status == 2) throw Error("", message);  // the file's mistake, as wlx-gen states it
+    throw PluginBuildError(fmt::format("wlx-gen failed on {} (exit {}): {}", model_file.string(), generated.exit_status, message));
+  }
+
+  fmt::print(stderr, "wlx: compiling model {} for first use ({}) ...\n", name, model_file.string());
+  const Sources src = find_sources();
+  const auto write = [&](const fs::path& path, const std::string& text) { write_file_atomically(path.string(), text); };
+  for (std::size_t g = 0; g < kRuntimeSources.size(); ++g) {
+    std::string unity = "// A group of the runtime's sources in one translation unit.\n";
+    for (const auto& f : kRuntimeSources[g]) unity += include_line(src.runtime_sources / f);
+    write(dir / fmt::format("runtime_{}.cpp", g + 1), unity);
+  }
+  std::string commands_unity = "// The per-model commands in one translation unit (as CMake's unity build of wlx_cli_<model>).\n";
+  for (const auto& f : kCommandSources) commands_unity += include_line(src.cli / f);
+  // No embedded scenarios or report file: a model file brings its runs as files.
+  commands_unity += fmt::format(
+      "namespace wlx {{ inline namespace {0} {{ namespace commands {{\n"
+      "extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios;\n"
+      "const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios = {{}};\n"
+      "extern const char* const kEmbeddedReportFile;\n"
+      "const char* const kEmbeddedReportFile = \"\";\n"
+      "}} }} }}\n"
+      "// The entry point wlx looks up with dlsym: the commands, and the key this plugin was built for.\n"
+      "extern \"C\" __attribute__((visibility(\"default\"))) const wlx::cli::ModelCommands* {1}(const char** key) {{\n"
+      "  *key = \"{2}\";\n"
+      "  return &wlx::{0}::commands::entry();\n"
+      "}}\n",
+      name, kEntrySymbol, key);
+  write(dir / "commands_unity.cpp", commands_unity);
+
+  const std::string cxx = compiler();
+  std::vector<std::string> common{cxx, "-std=c++20", "-fPIC", "-DNDEBUG", "-DWLX_MODEL=" + name, "-DWLX_GEN_COMPILED_" + name};
+  for (const auto& f : optimization_flags()) common.push_back(f);
+  for (const fs::path& include : {gen, src.runtime_include, src.cli / "shell", src.cli, src.cli / "commands"}) common.push_back("-I" + include.string());
+  for (const auto& include : split_list(WLX_PLUGIN_INCLUDES)) common.push_back("-isystem" + include);
+  std::vector<Job> jobs;
+  std::vector<std::string> objects;
+  const auto compile = [&](const std::string& what, const fs::path& source, const std::string& stem) {
+    std::vector<std::string> argv = common;
+    argv.insert(argv.end(), {"-c", source.string(), "-o", (dir / (stem + ".o")).string()});
+    jobs.push_back({what, argv, dir / (stem + ".log")});
+    objects.push_back((dir / (stem + ".o")).string());
+  };
+  // The longest first, so that the cores finish together.
+  compile("runtime (" + kRuntimeSources[0].front() + ", ...)", dir / "runtime_1.cpp", "runtime_1");
+  compile("commands", dir / "commands_unity.cpp", "commands_unity");
+  for (std::size_t g = 1; g < kRuntimeSources.size(); ++g)
+    compile("runtime (" + kRuntimeSources[g].front() + ", ...)", dir / fmt::format("runtime_{}.cpp", g + 1), fmt::format("runtime_{}", g + 1));
+  for (auto it = kGeneratedFunctionSources.rbegin(); it != kGeneratedFunctionSources.rend(); ++it)
+    compile("generated functions " + *it, src.runtime_sources / *it, fs::path(*it).stem().string());
+  const unsigned cores = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
+  run_jobs(jobs, cores, failed_logs);
+
+  // -Bsymbolic: the plugin's calls stay inside it, even where wlx itself has a model of the same
+  // name (a user's copy of a built-in model, with other geometry, must not run wlx's).
+  std::vector<std::string> link{cxx, "-shared", "-Wl,-Bsymbolic", "-o", (dir / "plugin.so").string()};
+  link.insert(link.end(), objects.begin(), objects.end());
+  for (const auto& library : split_list(WLX_PLUGIN_LIBRARIES)) link.push_back(library);
+  run_jobs({{"link", link, dir / "link.log"}}, 1, failed_logs);
+
+  std::uintmax_t size = 0;
+  const std::string checksum = file_checksum(dir / "plugin.so", size);
+  write(dir / "manifest", fmt::format("wlx model plugin (interface {})\nkey {}\nmodel {}\nsize {}\nchecksum {}\nsource {}\n",
+                                      kPluginInterface, key, name, size, checksum, fs::absolute(model_file).string()));
+  // What the plugin no longer needs: the objects and the unity sources (the headers stay, to read).
+  std::error_code ec;
+  for (const auto& object : objects) fs::remove(object, ec);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  fmt::print(stderr, "wlx: compiled model {} in {:.1f} s\n", name, seconds);
+}
+
+}  // namespace
+
+std::string model_cache_dir() {
+  fs::path dir;
+  if (const char* env = std::getenv("WLX_CACHE_DIR"); env != nullptr && *env != '\0') dir = env;
+  else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg == '/') dir = fs::path(xdg) / "wlx";
+  else if (const char* home = std::getenv("HOME"); home != nullptr && *home == '/') dir = fs::path(home) / ".cache" / "wlx";
+  else throw Error("--model-file", "no cache folder: set WLX_CACHE_DIR (or HOME)");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir, ec))
+    throw Error("--model-file", fmt::format("the cache folder {} cannot be created ({})", dir.string(), ec.message()));
+  return dir.string();
+}
+
+const ModelCommands& load_model_file(const std::string& model_file, const std::string& version) {
+  const BoundedRead file = read_bounded_file(model_file, kMaxFileBytes);
+  if (!file.ok()) throw Error("--model-file", fmt::format("{}: {}", excerpt(model_file), file.error));
+  const std::string name = model_name_of(file.text);
+
+  // The key: everything the plugin's code depends on.
+  Hash h;
+  h.add(fmt::format("wlx model plugin, interface {}", kPluginInterface));
+  h.add(version);
+  h.add(file.text);
+  if (const std::string urdf = urdf_of(file.text); !urdf.empty()) {
+    const fs::path path = fs::path(urdf).is_absolute() ? fs::path(urdf) : fs::path(model_file).parent_path() / urdf;
+    h.add(read_small(path, kMaxFileBytes));
+  }
+  const std::string cxx = compiler();
+  h.add(cxx);
+  for (const auto& f : optimization_flags()) h.add(f);
+  h.add(WLX_PLUGIN_INCLUDES);
+  h.add(WLX_PLUGIN_LIBRARIES);
+  // This wlx binary itself (a rebuilt wlx may have other sources under the same version).
+  struct stat self {};
+  if (::stat("/proc/self/exe", &self) == 0) h.add(fmt::format("{} {} {}", self.st_size, self.st_mtim.tv_sec, self.st_mtim.tv_nsec));
+  const std::string key = h.hex();
+
+  const fs::path cache = model_cache_dir();
+  const std::string stem = (name.empty() ? std::string("model") : name) + "-" + key.substr(0, 24);
+  const fs::path entry = cache / stem;
+  std::string why;
+  if (const ModelCommands* commands = try_load(entry, key, why)) return *commands;
+
+  const FileLock lock(cache / (stem + ".lock"),
+                      fmt::format("wlx: waiting for another wlx compiling model {} ({})", name, (cache / stem).string()));
+  if (const ModelCommands* commands = try_load(entry, key, why)) return *commands;  // the other one built it
+  std::error_code ec;
+  if (fs::exists(entry, ec)) {
+    fmt::print(stderr, "wlx: the cached plugin {} cannot be used ({}): building it again\n", entry.string(), why);
+    fs::remove_all(entry, ec);
+  }
+  TemporaryFolder building{cache / (stem + ".build-" + std::to_string(::getpid()))};
+  fs::remove_all(building.path, ec);
+  fs::create_directories(building.path, ec);
+  if (ec) throw Error("--model-file", fmt::format("cannot create {} ({})", building.path.string(), ec.message()));
+  build_plugin(model_file, name, key, building.path, cache / (stem + ".failed"));
+  fs::rename(building.path, entry, ec);
+  if (ec) throw Error("--model-file", fmt::format("cannot put the plugin in place at {} ({})", entry.string(), ec.message()));
+  building.keep = true;
+  fs::remove_all(cache / (stem + ".failed"), ec);
+  fmt::print(stderr, "wlx: cached in {}\n", entry.string());
+  if (const ModelCommands* commands = try_load(entry, key, why)) return *commands;
+  throw PluginBuildError(fmt::format("the plugin just built for model {} cannot be loaded: {}", name, why));
+}
+
+}  // namespace wlx::cli

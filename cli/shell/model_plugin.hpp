@@ -1,0 +1,43 @@
+// `wlx --model-file FILE`: a user's own model in every command, without rebuilding wlx. On first
+// use wlx runs wlx-gen on the file and compiles the runtime and the per-model commands for it with
+// the system's C++ compiler into a shared library (a plugin), which it loads with dlopen; later
+// uses load the cached plugin. The cache entry is keyed by the model file's content (and its
+// URDF's), wlx's version, the plugin interface's version, the compiler and the flags.
+//
+// Cache: $WLX_CACHE_DIR, else $XDG_CACHE_HOME/wlx, else $HOME/.cache/wlx; one folder per entry,
+// <model>-<key>/ with plugin.so and manifest (the key, and the plugin's size and checksum). An
+// entry appears under its final name only when complete (built in a temporary folder, renamed);
+// two processes building the same entry take turns (flock on <model>-<key>.lock): one compiles,
+// the other waits and loads its result. An entry whose manifest, checksum or key does not match,
+// or that dlopen refuses, is removed and rebuilt, never used.
+#pragma once
+
+#include "commands.hpp"
+
+#include <wlx/error.hpp>
+
+#include <string>
+
+namespace wlx::cli {
+
+// The plugin interface's version: part of every key and of the entry point's name, so a plugin
+// of another interface is never loaded.
+inline constexpr int kPluginInterface = 1;
+
+// A plugin that could not be built from a correct model file (the compiler failed): exit 1, not
+// the 2 of a bad input.
+class PluginBuildError : public Error {
+ public:
+  explicit PluginBuildError(const std::string& reason) : Error("--model-file", reason) {}
+};
+
+// Loads the commands of the model in `model_file` (building the plugin on first use, with progress
+// on stderr). Throws wlx::Error naming --model-file for a missing file or a mistake wlx-gen
+// finds in it (its message, `file:line:column: field: reason`, before any compiling), and for a
+// failed compile (the compiler's first error and where the whole log is).
+const ModelCommands& load_model_file(const std::string& model_file, const std::string& version);
+
+// The cache folder (created if missing).
+std::string model_cache_dir();
+
+}  // namespace wlx::cli
