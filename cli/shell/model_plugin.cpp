@@ -312,6 +312,10 @@ void run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path& f
     // Whichever finishes first frees its core for the next job.
     int pid = 0;
     const ProgramRun r = wait_any_program(pid);
+    if (pid == 0 && interrupt_signal() != 0) {  // within milliseconds of the signal, not when the compiles end
+      stop_all();
+      throw_if_interrupted();
+    }
     const auto done = std::find_if(running.begin(), running.end(), [&](const auto& p) { return p.first == pid; });
     if (done == running.end()) {
       stop_all();

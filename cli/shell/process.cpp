@@ -1,5 +1,7 @@
 #include "process.hpp"
 
+#include "interrupt.hpp"
+
 #include <cerrno>
 #include <csignal>
 #include <fcntl.h>
@@ -51,12 +53,13 @@ int start_program(const std::vector<std::string>& argv, const std::string& worki
 
 namespace {
 
-ProgramRun wait_for(pid_t which, int& reaped) {
+ProgramRun wait_for(pid_t which, int& reaped, bool stop_on_signal) {
   ProgramRun result;
   int status = 0;
   pid_t pid = 0;
   while ((pid = ::waitpid(which, &status, 0)) < 0) {
-    if (errno != EINTR) {  // EINTR: our own SIGINT/SIGTERM handler ran; keep waiting
+    // EINTR: our own SIGINT/SIGTERM/SIGHUP handler ran; keep waiting, unless the caller stops then.
+    if (errno != EINTR || (stop_on_signal && interrupt_signal() != 0)) {
       reaped = 0;
       return result;
     }
@@ -77,9 +80,9 @@ ProgramRun wait_for(pid_t which, int& reaped) {
 ProgramRun wait_program(int pid) {
   if (pid <= 0) return {};
   int reaped = 0;
-  return wait_for(pid, reaped);
+  return wait_for(pid, reaped, false);
 }
 
-ProgramRun wait_any_program(int& pid) { return wait_for(-1, pid); }
+ProgramRun wait_any_program(int& pid) { return wait_for(-1, pid, true); }
 
 }  // namespace wlx::cli

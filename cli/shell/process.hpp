@@ -25,7 +25,8 @@ ProgramRun run_program(const std::vector<std::string>& argv, const std::string& 
 int start_program(const std::vector<std::string>& argv, const std::string& working_directory = {},
                   const std::string& log_path = {});
 ProgramRun wait_program(int pid);
-// Waits for whichever child of this process ends first; `pid` is set to it (0 if there is none).
+// Waits for whichever child of this process ends first; `pid` is set to it, or to 0 if there is
+// none or a signal arrived (interrupt.hpp) while waiting: then the caller stops its children.
 ProgramRun wait_any_program(int& pid);
 
 }  // namespace wlx::cli

@@ -10,9 +10,12 @@
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <regex>
+#include <thread>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -223,4 +226,34 @@ TEST_CASE("--model-file: a compiler that fails: its first error and where the lo
   CHECK(again.code == 1);
   CHECK(again.err.find("cannot be used (its manifest is missing or names another key)") != std::string::npos);
   CHECK(!fs::exists(place));
+}
+
+TEST_CASE("--model-file: SIGINT, SIGTERM or SIGHUP while compiling: stopped at once, the compilers too, exit 130 / 143 / 129, nothing left behind") {
+  const Setup& s = setup();
+  for (const auto& pair : {std::pair{SIGINT, 130}, std::pair{SIGTERM, 143}, std::pair{SIGHUP, 129}}) {
+    const int signal = pair.first, code = pair.second;
+    CAPTURE(signal);
+    // Flags of their own: a key with no entry yet, so this run compiles.
+    ::setenv("WLX_PLUGIN_CXXFLAGS", ("-O0 -DWLX_SIGNAL_TEST=" + std::to_string(signal)).c_str(), 1);
+    const auto started = std::chrono::steady_clock::now();
+    auto p = wlx_test::start({"--model-file", s.model.string(), "fk"}, {.input = "{}"});
+    // Until it says it compiles (wlx-gen is done and the compilers run), at most 20 s.
+    while (slurp(p.err).find("compiling model") == std::string::npos &&
+           std::chrono::steady_clock::now() - started < std::chrono::seconds(20))
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the compilers well under way
+    const auto sent = std::chrono::steady_clock::now();
+    ::kill(p.pid, signal);
+    const auto r = wlx_test::finish(p);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+    ::setenv("WLX_PLUGIN_CXXFLAGS", "-O0", 1);
+    INFO(r.err);
+    CHECK(r.code == code);
+    CHECK(seconds < 2.0);  // the compiles take 20 s: stopped, not waited for (2 s: a loaded machine's slack)
+    for (const auto& e : fs::directory_iterator(s.cache)) {
+      CAPTURE(e.path());
+      CHECK(e.path().filename().string().find(".build-") == std::string::npos);
+    }
+  }
+  CHECK(entries().size() == 1);  // only the entry of the other cases
 }
