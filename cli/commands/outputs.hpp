@@ -21,6 +21,26 @@ std::vector<std::string> trajectory_header(const Scenario& scenario);
 std::vector<double> trajectory_row(const Sample& sample, const Scenario& scenario);
 void write_trajectory(const std::string& path, const Trajectory& trajectory, const Scenario& scenario);
 
+// The energy balance of a run driven by torques, sample by sample: the kinetic + potential
+// energy against the actuators' work since the first sample (the trapezoid rule on the samples'
+// power, error ~dt^2 per unit time). residual() is E - E(first sample) - W, 0 for exact motion.
+struct EnergyBalance {
+  long samples = 0;
+  double first = 0, last = 0, work = 0;
+  void add(const Sample& smp) {
+    const double energy = smp.kinetic + smp.potential;
+    if (samples++ == 0) first = energy;
+    else work += 0.5 * (smp.t - last_t_) * (smp.power + last_power_);
+    last = energy;
+    last_t_ = smp.t;
+    last_power_ = smp.power;
+  }
+  double residual() const { return last - first - work; }
+
+ private:
+  double last_t_ = 0, last_power_ = 0;
+};
+
 // `wlx simulate`'s run: samples streamed to <out_dir>/trajectory.csv as they are computed
 // (constant memory), the file put in place when the run ends, also when it stops early or is
 // interrupted (then marked partial by the message and the exit code). Returns the exit code.

@@ -30,16 +30,10 @@ struct Summary {
   long samples = 0;
   double last_t = 0;
   double worst_residual = 0, worst_cond = 0, min_clearance = 0, peak_tau = 0;
-  // Runs driven by torques: the energy at the first and the last sample, and the actuators' work
-  // in between (the trapezoid rule on the samples' power, error ~dt^2 per unit time).
-  double first_energy = 0, last_energy = 0, work = 0, last_power = 0;
+  EnergyBalance energy;  // runs driven by torques
 
   void add(const Sample& smp) {
-    const double energy = smp.kinetic + smp.potential;
-    if (samples == 0) first_energy = energy;
-    else work += 0.5 * (smp.t - last_t) * (smp.power + last_power);
-    last_energy = energy;
-    last_power = smp.power;
+    energy.add(smp);
     const double residual = smp.nh_residual.cwiseAbs().maxCoeff(), tau = smp.tau.cwiseAbs().maxCoeff();
     if (samples == 0) {
       worst_residual = residual, worst_cond = smp.cond_J_beta, min_clearance = smp.clearance, peak_tau = tau;
@@ -99,8 +93,8 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
     if (sc.driven_by_torques())
       fmt::print("driven by torques: largest |tau| = {:.4g} N m; kinetic + potential energy {:.6g} -> {:.6g} J, the "
                  "actuators' work {:.6g} J (trapezoid on the samples): balance off by {:.2e} J\n",
-                 summary.peak_tau, summary.first_energy, summary.last_energy, summary.work,
-                 summary.last_energy - summary.first_energy - summary.work);
+                 summary.peak_tau, summary.energy.first, summary.energy.last, summary.energy.work,
+                 summary.energy.residual());
   }
   fmt::print("wrote {}\n", path);
   if (interrupted) {

@@ -3,6 +3,8 @@
 // outside the plots; top views show the whole machine with equal axis scales and its heading.
 #include "report/figures.hpp"
 
+#include "limits.hpp"
+
 #include <fmt/format.h>
 #include <wlx/atomic_file.hpp>
 #include <wlx/dynamics.hpp>
@@ -342,7 +344,7 @@ class Figures {
       l += fmt::format("set title {}\nplot ", q(r->id + ": closed-loop tracking error, computed torque + PD on a plant 10% heavier"));
       for (std::size_t j = 0; j < kCommandedSpeeds.size(); ++j) {
         const int c = kCommandedSpeeds[j];
-        const bool angle = display_unit(c) == "deg";
+        const bool angle = is_angle(c);
         l += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", j ? ", " : "", q(data_path(r->closed_loop_csv)), column("t"),
                          column("error_" + coordinate_name(c), angle ? kDegPerRad : 1e3), dash(j),
                          q(coordinate_name(c) + (angle ? " (deg)" : " (mm)")));

@@ -3,6 +3,7 @@
 
 #include "bounded_input.hpp"
 #include "interrupt.hpp"
+#include "limits.hpp"
 #include "outputs.hpp"
 #include "scenario_io.hpp"
 
@@ -264,7 +265,7 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
   }
   for (int j = 0; j < kCommandedCount; ++j) {
     const int c = kCommandedSpeeds[static_cast<std::size_t>(j)];
-    plant.initial(c) += display_unit(c) == "deg" ? kStartOffsetAngle : kStartOffsetLength;
+    plant.initial(c) += is_angle(c) ? kStartOffsetAngle : kStartOffsetLength;
   }
   const Weighting weighting = *run.scenario.weighting;
   DynamicsTerms terms;
@@ -282,17 +283,15 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
   row.closed_loop_stopped = loop.error;
 
   CsvWriter csv(data_dir + "/" + row.csv, {"t", "round_trip_deviation", "energy_balance"});
-  double energy0 = 0, work = 0;
+  EnergyBalance energy;
   for (std::size_t k = 0; k < forward.samples.size(); ++k) {
     const Sample& f = forward.samples[k];
-    const double energy = f.kinetic + f.potential;
-    if (k == 0) energy0 = energy;
-    else work += 0.5 * (f.t - forward.samples[k - 1].t) * (f.power + forward.samples[k - 1].power);
+    energy.add(f);
     const double deviation = (f.s - reference[k].s).cwiseAbs().maxCoeff();
-    const double balance = std::abs(energy - energy0 - work);
+    const double balance = std::abs(energy.residual());
     row.round_trip = std::max(row.round_trip, deviation);
     row.energy_balance = std::max(row.energy_balance, balance);
-    row.work = std::max(row.work, std::abs(work));
+    row.work = std::max(row.work, std::abs(energy.work));
     csv.row({f.t, deviation, balance});
   }
   csv.commit();

@@ -65,9 +65,8 @@ static_assert(kPluginInterface == 1, "rename kEntrySymbol with the interface's v
 // In one translation unit, which shares Eigen's templates (measured at -O2: 27 s, where the
 // files one by one take 48 s of CPU); it runs on one core while the commands and the generated
 // functions take the others.
-const std::vector<std::vector<std::string>> kRuntimeSources{{"dynamics.cpp", "forward_dynamics.cpp", "ik.cpp", "model.cpp",
-                                                             "kinematics.cpp", "ik_verification.cpp", "simulation.cpp",
-                                                             "nonholonomic.cpp"}};
+const std::vector<std::string> kRuntimeSources{"dynamics.cpp",   "forward_dynamics.cpp", "ik.cpp",         "model.cpp",
+                                               "kinematics.cpp", "ik_verification.cpp",  "simulation.cpp", "nonholonomic.cpp"};
 const std::vector<std::string> kGeneratedFunctionSources{"generated_kinematics.cpp", "generated_rates.cpp", "generated_bodies.cpp",
                                                          "generated_reduced_dynamics.cpp"};
 const std::vector<std::string> kCommandSources{"commands/input.cpp",          "commands/limits.cpp",        "commands/scenario_io.cpp",
@@ -363,11 +362,9 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
   fmt::print(stderr, "wlx: compiling model {} for first use ({}) ...\n", name, model_file.string());
   const Sources src = find_sources();
   const auto write = [&](const fs::path& path, const std::string& text) { write_file_atomically(path.string(), text); };
-  for (std::size_t g = 0; g < kRuntimeSources.size(); ++g) {
-    std::string unity = "// A group of the runtime's sources in one translation unit.\n";
-    for (const auto& f : kRuntimeSources[g]) unity += include_line(src.runtime_sources / f);
-    write(dir / fmt::format("runtime_{}.cpp", g + 1), unity);
-  }
+  std::string runtime_unity = "// The runtime's sources in one translation unit.\n";
+  for (const auto& f : kRuntimeSources) runtime_unity += include_line(src.runtime_sources / f);
+  write(dir / "runtime_unity.cpp", runtime_unity);
   std::string commands_unity = "// The per-model commands in one translation unit (as CMake's unity build of wlx_cli_<model>).\n";
   for (const auto& f : kCommandSources) commands_unity += include_line(src.cli / f);
   // No embedded scenarios or report file: a model file brings its runs as files.
@@ -400,10 +397,8 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
     objects.push_back((dir / (stem + ".o")).string());
   };
   // The longest first, so that the cores finish together.
-  compile("runtime (" + kRuntimeSources[0].front() + ", ...)", dir / "runtime_1.cpp", "runtime_1");
+  compile("runtime", dir / "runtime_unity.cpp", "runtime_unity");
   compile("commands", dir / "commands_unity.cpp", "commands_unity");
-  for (std::size_t g = 1; g < kRuntimeSources.size(); ++g)
-    compile("runtime (" + kRuntimeSources[g].front() + ", ...)", dir / fmt::format("runtime_{}.cpp", g + 1), fmt::format("runtime_{}", g + 1));
   for (auto it = kGeneratedFunctionSources.rbegin(); it != kGeneratedFunctionSources.rend(); ++it)
     compile("generated functions " + *it, src.runtime_sources / *it, fs::path(*it).stem().string());
   const unsigned cores = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
