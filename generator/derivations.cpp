@@ -9,6 +9,7 @@
 #include <iterator>
 #include <map>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 namespace wlx::codegen {
@@ -937,6 +938,41 @@ class ScalarWriter {
     code += line + ";\n";
     return name;
   }
+  // The code without the values nothing reads (a link turning about one axis: of its I omega only
+  // the component along that axis, which the cross product omega x I omega never reads), over and
+  // over until each value left is read; their operations are taken off `ops`.
+  std::string finish() {
+    std::vector<std::string> lines;
+    std::istringstream in(code);
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+    const std::string prefix = "    const Scalar ";
+    for (bool dropped = true; dropped;) {
+      dropped = false;
+      std::map<std::string, int> uses;
+      for (const auto& l : lines)
+        for (const auto& w : identifiers(l)) ++uses[w];
+      for (auto it = lines.begin(); it != lines.end();) {
+        const std::size_t eq = it->find(" = ");
+        if (it->rfind(prefix, 0) != 0 || eq == std::string::npos || uses[it->substr(prefix.size(), eq - prefix.size())] > 1) {
+          ++it;
+          continue;
+        }
+        const std::string value = it->substr(eq + 3);
+        const auto count = [&](const std::string& what) {
+          int n = 0;
+          for (auto at = value.find(what); at != std::string::npos; at = value.find(what, at + 1)) ++n;
+          return n;
+        };
+        ops.adds -= count(" + ") + count(" - ") + (value.rfind('-', 0) == 0 ? 1 : 0);
+        ops.muls -= count(" * ");
+        it = lines.erase(it);
+        dropped = true;
+      }
+    }
+    std::string out;
+    for (const auto& l : lines) out += l + "\n";
+    return out;
+  }
   std::string code;
   OpCount ops;
 };
@@ -1108,7 +1144,12 @@ FunctionSpec derive_generalized_forces(const Model& m) {
   w.code += "    }\n    if (tau != nullptr) {\n      tau->setZero();\n";
   for (const auto& [j, t] : tau_of) w.code += fmt::format("      (*tau)({}) = {};\n", j, t);
   w.code += "    }\n";
-  fn.lane_code = w.code;
+  fn.lane_code = w.finish();
+  // A body whose rotation or offset the recursion never reads (one link on a fixed joint: its
+  // wrench needs only p and the mass) leaves those scalars unread: they are not computed.
+  const auto words = identifiers(fn.lane_code);
+  const std::set<std::string> lane_words(words.begin(), words.end());
+  std::erase_if(fn.lane_scalars, [&](const auto& named) { return !lane_words.count(named.first); });
   // The pass runs for either output: its operations are Q*'s (tau adds no operation of its own).
   OutputSpec Qo{"Qstar", "CommandVector", "M u' + b - Q_gravity for s'' = sddot: T^T tau, the forces the actuators must supply on u", "", {}};
   OutputSpec to{"tau", "Coordinates", "the bodies' generalized inertia, velocity and gravity forces on each coordinate (0 on the held inputs; computed with Qstar)", "", {}};

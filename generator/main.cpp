@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <wlx/diagnostics.hpp>
 #include <wlx/atomic_file.hpp>
 #include <wlx/bounded_file.hpp>
 
@@ -105,7 +106,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // Like every bad input: the option and the reason, exit code 2.
-    fmt::print(stderr, "wlx-gen: error: {}\n", e.what());
+    wlx::diagnose("wlx-gen: error: {}\n", e.what());
     return 2;
   }
 
@@ -221,17 +222,17 @@ int main(int argc, char** argv) {
                  removed ? fmt::format(", {} stale removed", removed) : "");
     }
   } catch (const ModelFileError& e) {
-    fmt::print(stderr, "wlx-gen: error: {}\n", e.what());
+    wlx::diagnose("wlx-gen: error: {}\n", e.what());
     return 2;
   } catch (const wlx::OutputError& e) {
     // As wlx: 74 (EX_IOERR) when an output cannot be written; the previous headers are intact.
-    fmt::print(stderr, "wlx-gen: error: {}: {}\n", e.field(), e.reason());
+    wlx::diagnose("wlx-gen: error: {}: {}\n", e.field(), e.reason());
     return 74;
   } catch (const fs::filesystem_error& e) {
-    fmt::print(stderr, "wlx-gen: error: {}: {}\n", e.path1().string(), e.code().message());
+    wlx::diagnose("wlx-gen: error: {}: {}\n", e.path1().string(), e.code().message());
     return 74;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "wlx-gen: error: {}\n", e.what());
+    wlx::diagnose("wlx-gen: error: {}\n", e.what());
     return 1;
   }
   return 0;

@@ -108,12 +108,17 @@ std::string reserved_reason(const std::string& n) {
       "s", "sdot", "p", "zero_fill", "angle", "sin_angle", "cos_angle", "std", "Eigen", "positions", "rotations",
       "Phi", "dPhi_ds", "C", "spin", "dPhi_ds_dot_sdot", "C_dot_sdot", "com", "Jv", "Jw", "Jv_dot_sdot",
       "Jw_dot_sdot", "T", "sddot", "Qstar", "tau", "out", "Params", "Coordinates", "Pi", "pi", "sin", "cos", "tan", "asin", "acos", "atan", "sqrt",
-      "exp", "log", "abs"};
+      "exp", "log", "abs",
+      // The generated functions' template parameter, outputs and lane types (a parameter or
+      // coordinate of that name compiled into a header that does not compile).
+      "Scalar", "M", "b_velocity", "B_bias", "Q_gravity", "L", "LW", "detail", "gen", "wlx", "trig_detail", "NonDeduced"};
   if (keywords.count(n)) return "it is a C++ keyword";
   if (locals.count(n)) return "the generated functions use that name themselves";
   if (n.size() > 1 && n[0] == 't' && std::all_of(n.begin() + 1, n.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
     return "t<number> names the generated code's intermediate terms";
   if (n.rfind("sin_", 0) == 0 || n.rfind("cos_", 0) == 0) return "sin_<angle> and cos_<angle> name the generated code's sines and cosines";
+  if (n.rfind("kane_", 0) == 0 || n.rfind("ik_", 0) == 0)
+    return "kane_<...> and ik_<...> name the generated code's dynamics sums and inverse kinematics terms";
   if (n.size() > 4 && n.compare(n.size() - 4, 4, "_dot") == 0) return "<coordinate>_dot names the generated code's rates";
   if (n[0] == '_' || n.find("__") != std::string::npos) return "C++ reserves names starting with _ or containing __";
   return {};

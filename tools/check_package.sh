@@ -44,6 +44,41 @@ echo '{"z_C": 1.8}' | WLX_CACHE_DIR="$work/cache" WLX_PLUGIN_CXXFLAGS=-O0 \
 grep -q '"closure_residual"' "$work/fk.json"
 grep -rq "share/wlx/cli/commands" "$work/cache"/installed_check-*/commands_unity.cpp || {
   echo "the plugin was not compiled from the installed sources" >&2; exit 1; }
+# The installed Python package loads the same file from the same cache entry (one plugin serves
+# `wlx --model-file` and wlx.load), without compiling again.
+WLX_CACHE_DIR="$work/cache" WLX_PLUGIN_CXXFLAGS=-O0 PYTHONPATH="$PWD/build/install/lib/python3/dist-packages" \
+  /usr/bin/python3 -c '
+import json, sys, time, wlx
+start = time.monotonic()
+robot = wlx.load(sys.argv[1])
+seconds = time.monotonic() - start
+answer = robot.ik({"z_C": 1.8})
+cli = json.load(open(sys.argv[2]))
+assert robot.name == "installed_check" and answer["closure_residual"] <= 1e-12, answer
+assert abs(answer["s"][robot.coordinates.index("psi_l2")] - cli["coordinates"]["psi_l2"]) <= 1e-12, (answer, cli)
+assert seconds < 5, f"wlx.load compiled again ({seconds:.1f} s): the cache entry was not shared"
+print(f"installed wlx.load: {robot!r} from the cache in {seconds * 1000:.0f} ms")' "$work/installed_check.yaml" "$work/fk.json" 2> "$work/load.err"
+if grep -q "compiling" "$work/load.err"; then cat "$work/load.err" >&2; echo "wlx.load compiled again" >&2; exit 1; fi
+# The same model file through the installed wlx's other commands (issue 25: verify, simulate,
+# report and viewer with the installed package only), with a run of the user's own.
+mkdir -p "$work/runs"
+echo '{"model": "installed_check", "description": "forward", "rates": {"x_C": 0.5}, "dependent": ["y_C", "yaw"], "duration": 0.2}' \
+  > "$work/runs/forward.json"
+installed_wlx() { WLX_CACHE_DIR="$work/cache" WLX_PLUGIN_CXXFLAGS=-O0 build/install/bin/wlx --model-file "$work/installed_check.yaml" "$@"; }
+installed_wlx verify ik --sweep IK-L3 --out "$work/verify" > /dev/null
+installed_wlx --scenarios "$work/runs" simulate forward --out "$work/simulate" > /dev/null
+[ "$(wc -l < "$work/simulate/trajectory.csv")" -eq 202 ] || { echo "installed simulate: not 201 samples" >&2; exit 1; }
+installed_wlx --scenarios "$work/runs" report --quick --out "$work/report" > /dev/null 2> "$work/report.err" || {
+  cat "$work/report.err" >&2; exit 1; }
+grep -q "forward" "$work/report/index.html"
+if [ -d build/install/share/wlx/viewer ]; then
+  installed_wlx --scenarios "$work/runs" viewer forward --out "$work/viewer" > /dev/null
+  [ -f "$work/viewer/wasm/wlx_installed_check.js" ] && [ -f "$work/viewer/runs/forward.js" ] || {
+    echo "installed viewer: the model file's module or its run is missing" >&2; exit 1; }
+  grep -rq "share/wlx/viewer_module/viewer_module.cpp" "$work/cache"/installed_check-*/viewer.build-* 2>/dev/null && {
+    echo "a viewer build folder was left behind" >&2; exit 1; }
+fi
+echo "installed wlx --model-file: verify ik, simulate, report and viewer of a model file it had not seen"
 
 echo "-- add_subdirectory(), runtime only"
 cmake -S tests/package -B "$work/subdirectory" -G Ninja -DWLX_SOURCE_DIR="$PWD" > "$work/configure.log"

@@ -770,6 +770,78 @@ def controller_figures(build):
             "; ".join(parts) + ".\n")
 
 
+MODEL_FILE_ROWS = ("first use, in all", "cached use: `wlx --model-file FILE fk`")
+
+
+def model_file_figures(build, today):
+    """`wlx --model-file`'s compile times on this machine: a first use of a copy of the excavator's
+    file in a fresh cache (each part's wall time from the entry's build-times.tsv, which the plugin
+    writes), its viewer module, and cached uses against the built-in model's cold start."""
+    wlx = os.path.join(build, "wlx")
+    with tempfile.TemporaryDirectory(prefix=f"wlx_figures_{os.getpid()}_") as work:
+        env = dict(os.environ, WLX_CACHE_DIR=os.path.join(work, "cache"))
+        env.pop("WLX_PLUGIN_CXXFLAGS", None)
+        env.pop("CXX", None)
+        model = os.path.join(work, "my_excavator.yaml")
+        with open(os.path.join(ROOT, "models", "excavator.yaml")) as src, open(model, "w") as dst:
+            dst.write(src.read())
+
+        def timed(argv, stdin_text="{}", extra_env=None):
+            start = time.monotonic()
+            r = subprocess.run(argv, input=stdin_text, capture_output=True, text=True, env=extra_env or env,
+                               timeout=COMMAND_TIMEOUT_S)
+            if r.returncode != 0:
+                raise ContractError(f"{' '.join(argv)}: exit {r.returncode}\n{r.stderr}")
+            return time.monotonic() - start
+
+        first = timed([wlx, "--model-file", model, "fk"])
+        entries = [e for e in os.listdir(env["WLX_CACHE_DIR"]) if os.path.isdir(os.path.join(env["WLX_CACHE_DIR"], e))
+                   and "." not in e]
+        entry = os.path.join(env["WLX_CACHE_DIR"], entries[0])
+        with open(os.path.join(entry, "build-times.tsv")) as f:
+            parts = [line.rstrip("\n").split("\t") for line in f][1:]
+        viewer = None
+        if os.path.exists(os.path.join(build, "viewer", "dist", "viewer.html")):
+            timed([wlx, "--model-file", model, "viewer", "--out", os.path.join(work, "viewer")])
+            with open(os.path.join(entry, "viewer", "build-times.tsv")) as f:
+                viewer = float([line.split("\t") for line in f][1][1])
+        cached = sorted(timed([wlx, "--model-file", model, "fk"]) for _ in range(11))[5]
+        builtin = sorted(timed([wlx, "fk"]) for _ in range(11))[5]
+        python_dir = os.path.join(build, "python")
+        loaded = None
+        if os.path.isdir(python_dir):
+            script = ("import sys, time, wlx; t = time.monotonic(); wlx.load(sys.argv[1]); "
+                      "print(time.monotonic() - t)")
+            penv = dict(env, PYTHONPATH=python_dir)
+            loads = []
+            for _ in range(5):
+                r = subprocess.run([sys.executable, "-c", script, model], capture_output=True, text=True, env=penv,
+                                   timeout=COMMAND_TIMEOUT_S)
+                if r.returncode != 0:
+                    raise ContractError(f"wlx.load: exit {r.returncode}\n{r.stderr}")
+                loads.append(float(r.stdout))
+            loaded = sorted(loads)[2]
+    rows = [f"| {name} | {float(seconds):.1f} s |" for name, seconds in parts if name != MODEL_FILE_ROWS[0]]
+    rows.append(f"| **{MODEL_FILE_ROWS[0]}** (wall time of the first `wlx --model-file FILE fk`: {first:.1f} s) | "
+                f"**{float(dict(parts)[MODEL_FILE_ROWS[0]]):.1f} s** |")
+    if viewer is not None:
+        rows.append(f"| the viewer's module (emscripten, on the first `viewer` or `report`) | {viewer:.1f} s |")
+    rows.append(f"| {MODEL_FILE_ROWS[1]} (median of 11) | {cached * 1000:.0f} ms |")
+    rows.append(f"| the built-in model's cold start, `wlx fk` (median of 11) | {builtin * 1000:.0f} ms |")
+    if loaded is not None:
+        rows.append(f"| cached `wlx.load(FILE)` in Python (median of 5) | {loaded * 1000:.0f} ms |")
+    return (f"Measured {today} on {machine()} by `tools/readme_figures.sh`: a copy of `models/excavator.yaml` in a "
+            "fresh cache, the default flags (the runtime and the generated functions at `-O2`, the commands at `-O1`); "
+            "the parts from the entry's `build-times.tsv`.\n\n| part | wall time |\n|---|---:|\n" + "\n".join(rows) + "\n")
+
+
+def model_file_problems(body):
+    table = readme_table(body)
+    names = [r[0] for r in table[1:]]
+    return [f"README.md's model-file table has no row '{row}' (tools/readme_figures.sh writes it)"
+            for row in MODEL_FILE_ROWS if not any(row in n for n in names)]
+
+
 def readme_with(readme, name, body):
     found = False
 
@@ -819,6 +891,8 @@ def cmd_figures(options):
         readme = readme_with(readme, "benchmarks", stated + "\n\n" + benchmark_table(rows))
         print("wlx_bench_generator and tools/header_compile_times.py (a minute or two) ...")
         readme = readme_with(readme, "generation", generation_figures(options.build, today))
+        print("wlx --model-file: a first use in a fresh cache (a minute) ...")
+        readme = readme_with(readme, "model-file", model_file_figures(options.build, today))
         controller = controller_figures(options.build)
         if controller:
             readme = readme_with(readme, "controller", controller)
@@ -860,6 +934,10 @@ def cmd_figures(options):
                                 f"the generated code has {reported[name] or 'none'}")
     else:
         print("wlx_bench not built: the benchmark table's operation counts are not checked")
+    if "model-file" not in sections:
+        problems.append("README.md: no <!-- figures: model-file --> section")
+    else:
+        problems += model_file_problems(sections["model-file"])
     if "generation" not in sections:
         problems.append("README.md: no <!-- figures: generation --> section")
     else:

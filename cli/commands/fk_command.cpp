@@ -107,7 +107,7 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
 
 const ModelCommands& entry() {
   static const ModelCommands commands{gen::kModelName, gen::kModelDescription, &run_fk, &run_ik, &run_verify_ik,
-                                      &run_verify_nonholonomic, &run_simulate, &run_report, &run_viewer};
+                                      &run_verify_nonholonomic, &run_simulate, &run_report, &run_viewer, &api()};
   return commands;
 }
 

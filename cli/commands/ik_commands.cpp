@@ -8,6 +8,7 @@
 #include "outputs.hpp"
 
 #include <fmt/format.h>
+#include <wlx/diagnostics.hpp>
 #include <wlx/csv.hpp>
 #include <wlx/error.hpp>
 #include <wlx/ik_verification.hpp>
@@ -128,7 +129,7 @@ int run_ik(const ModelOptions& model_options, bool batch) {
       std::cout << solve_ik_request(parse_ik_request(j, base), &warm).dump() << "\n";
     } catch (const Error& e) {
       ++failures;
-      fmt::print(stderr, "wlx ik: line {}: {}\n", number, e.what());
+      wlx::diagnose("wlx ik: line {}: {}\n", number, e.what());
       // replace: an ill-formed byte in a message must not end the batch (excerpts are valid UTF-8 already).
       std::cout << nlohmann::ordered_json{{"error", e.what()}, {"line", number}}.dump(-1, ' ', false,
                                                                                      nlohmann::json::error_handler_t::replace)
@@ -138,7 +139,7 @@ int run_ik(const ModelOptions& model_options, bool batch) {
   throw_if_interrupted();
   std::string reason;
   if (!stdout_ok(reason)) throw OutputError("stdout", fmt::format("writing failed at input line {} ({})", number, reason));
-  if (failures > 0) fmt::print(stderr, "wlx ik: {} of the input lines failed\n", failures);
+  if (failures > 0) wlx::diagnose("wlx ik: {} of the input lines failed\n", failures);
   return failures > 0 ? 2 : 0;
 }
 

@@ -36,5 +36,7 @@ void write_viewer_run(const std::filesystem::path& dir, const Scenario& scenario
 
 // This model's entry in the registry.
 const ModelCommands& entry();
+// Its computations for a binding that names no model (model_api.cpp).
+const ModelApi& api();
 
 WLX_COMMANDS_END

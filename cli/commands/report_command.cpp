@@ -13,9 +13,11 @@
 #include "report/html.hpp"
 #include "report/runner.hpp"
 #include "report/spec.hpp"
+#include "scenario_folder.hpp"
 #include "viewer_export.hpp"
 
 #include <fmt/format.h>
+#include <wlx/diagnostics.hpp>
 #include <wlx/bounded_file.hpp>
 #include <wlx/atomic_file.hpp>
 #include <wlx/error.hpp>
@@ -37,6 +39,10 @@ namespace fs = std::filesystem;
 using report::ClaimRow;
 
 report::ReportSpec load_spec(const std::string& claims_file) {
+  // --scenarios DIR: its report.yaml, else a report of its runs (no claims); not the embedded
+  // file, whose runs are not these.
+  if (const ScenarioFolder* folder = scenario_folder(); claims_file.empty() && folder != nullptr)
+    return report::parse_report_spec(folder->report_text, folder->report_text.empty() ? folder->dir + "/report.yaml" : folder->report_path);
   if (claims_file.empty())
     return report::parse_report_spec(kEmbeddedReportFile, fmt::format("scenarios/{}/report.yaml", gen::kModelName));
   // Bounded, regular files only (wlx/bounded_file.hpp): /dev/zero or a FIFO is an error, not a hang.
@@ -323,7 +329,7 @@ int Report::run() {
              doc.checks.size() - failed, doc.checks.size(), doc.inputs.size(), doc.observations.size(), all.size(), seconds,
              fs::absolute(root_ / "index.html").string());
   for (const auto& c : doc.checks)
-    if (c.result != ClaimRow::Result::pass) fmt::print(stderr, "wlx: check failed: {}: {}\n", c.id, c.claim);
+    if (c.result != ClaimRow::Result::pass) wlx::diagnose("wlx: check failed: {}: {}\n", c.id, c.claim);
   return failed == 0 ? 0 : 1;
 }
 
@@ -337,7 +343,7 @@ int run_report(const ModelOptions& model_options, const ReportOptions& options) 
     return report.run();
   } catch (const Interrupted& e) {
     std::fflush(stdout);
-    fmt::print(stderr, "wlx: {}: the report in {} is partial: no index.html was written; the files in data/ and fig/ "
+    wlx::diagnose("wlx: {}: the report in {} is partial: no index.html was written; the files in data/ and fig/ "
                        "that exist are complete\n", e.what(), options.out_dir);
     return e.exit_code();
   }

@@ -6,6 +6,7 @@
 #include "interrupt.hpp"
 #include "input.hpp"
 #include "limits.hpp"
+#include "scenario_folder.hpp"
 
 #include <fmt/format.h>
 #include <wlx/text.hpp>
@@ -24,14 +25,23 @@ WLX_COMMANDS_BEGIN
 // Defined in the build tree's embedded_scenarios.cpp (CMakeLists.txt writes it from scenarios/).
 extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios;
 
+namespace {
+// The model's runs: those of --scenarios DIR if given (cli/shell/scenario_folder.hpp), else the
+// embedded ones.
+const std::vector<std::pair<std::string, std::string>>& scenario_set() {
+  const ScenarioFolder* folder = scenario_folder();
+  return folder != nullptr ? folder->scenarios : kEmbeddedScenarios;
+}
+}  // namespace
+
 std::vector<std::string> scenario_ids() {
   std::vector<std::string> ids;
-  for (const auto& [id, text] : kEmbeddedScenarios) ids.push_back(id);
+  for (const auto& [id, text] : scenario_set()) ids.push_back(id);
   return ids;
 }
 
 std::string embedded_scenario(const std::string& id) {
-  for (const auto& [i, text] : kEmbeddedScenarios)
+  for (const auto& [i, text] : scenario_set())
     if (i == id) return text;
   return {};
 }
@@ -51,6 +61,16 @@ nlohmann::json read_scenario_json(const std::string& arg) {
       throw Error("SCENARIO", fmt::format("'{}' is neither a file nor a scenario id{}", excerpt(arg),
                                           hint.empty() ? " (wlx simulate --list shows them)" : "; did you mean '" + hint + "'?"));
     }
+    // A run of the model's (or of --scenarios DIR) is known by its file's name: its "id", if it
+    // has one, must say the same, else the report and the viewer would name it otherwise.
+    nlohmann::json j = parse_json_bounded(text, arg);
+    if (j.is_object()) {
+      if (!j.contains("id")) j["id"] = arg;
+      else if (j.at("id") != arg)
+        throw Error(arg + ": id", fmt::format("is {}, but the run's file is named {}.json: a run's id is its file's name",
+                                              excerpt(j.at("id")), arg));
+    }
+    return j;
   }
   return parse_json_bounded(text, arg);
 }
@@ -124,7 +144,11 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
 
 std::string scenario_directory(const std::string& path_or_id) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path_or_id, ec)) return {};
+  if (!std::filesystem::is_regular_file(path_or_id, ec)) {
+    // An id of --scenarios DIR: its files (a torque table) are beside it.
+    const ScenarioFolder* folder = scenario_folder();
+    return folder != nullptr && !embedded_scenario(path_or_id).empty() ? folder->dir : std::string();
+  }
   return std::filesystem::path(path_or_id).parent_path().string();
 }
 
@@ -251,9 +275,19 @@ TorqueSource parse_torques(const nlohmann::json& v, const Params& params, double
 
 Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::string& directory, TorqueSource function) {
   if (!j.is_object()) throw Error("", fmt::format("a scenario is a JSON object, got {}", j.type_name()));
-  reject_unknown_keys(j, {"id", "description", "observation", "verify", "initial", "params", "rates", "dependent", "duration",
+  reject_unknown_keys(j, {"id", "model", "description", "observation", "verify", "initial", "params", "rates", "dependent", "duration",
                           "dt", "integrator", "tolerance", "branch", "max_condition", "weighting", "torques"},
                       "");
+  // "model": the model the run was written for. Names alone may match another machine's (two
+  // models with an x_C), so a run says whose it is, and running it on another is an error.
+  if (j.contains("model")) {
+    const nlohmann::json& m = j.at("model");
+    if (!m.is_string()) throw Error("model", fmt::format("must be the model's name (a string), got {}", excerpt(m)));
+    if (m.get<std::string>() != gen::kModelName)
+      throw Error("model", fmt::format("the scenario is for model '{}', not for '{}', the model it would run on "
+                                       "(--model or --model-file chooses the model)",
+                                       excerpt(m.get<std::string>()), gen::kModelName));
+  }
   // "verify": "nonholonomic" puts the scenario into `wlx verify nonholonomic`.
   if (j.contains("verify") && j.at("verify") != "nonholonomic")
     throw Error("verify", fmt::format("the only verification a scenario joins is \"nonholonomic\", got {}", excerpt(j.at("verify"))));
@@ -316,7 +350,15 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::
     if (!integrator) throw Error("integrator", fmt::format("must be \"rk4\", \"euler\" or \"dopri5\", got {}", excerpt(in)));
     sc.integrator = *integrator;
   }
-  if (j.contains("tolerance")) sc.tolerance = finite_number(j.at("tolerance"), "tolerance");
+  if (j.contains("tolerance")) {
+    // Only the adaptive integrator has a tolerance: on rk4 or euler it would be ignored without a
+    // word, and the writer would believe the run accurate to it.
+    if (sc.integrator != Integrator::dopri5)
+      throw Error("tolerance", fmt::format("applies to the adaptive integrator only; this run integrates with {} at a fixed "
+                                           "dt (set \"integrator\": \"dopri5\", or remove the tolerance)",
+                                           sc.integrator == Integrator::rk4 ? "rk4" : "euler"));
+    sc.tolerance = finite_number(j.at("tolerance"), "tolerance");
+  }
   if (j.contains("branch")) sc.branches = parse_ik_request(nlohmann::json{{"branch", j.at("branch")}}).branches;
   if (j.contains("max_condition")) {
     sc.nonholonomic.max_condition = finite_number(j.at("max_condition"), "max_condition");

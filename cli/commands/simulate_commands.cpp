@@ -1,6 +1,7 @@
 // `wlx simulate` and `wlx verify nonholonomic`.
 #include "per_model.hpp"
 #include "model_commands.hpp"
+#include "bounded_input.hpp"
 #include "interrupt.hpp"
 #include "output_checks.hpp"
 #include "outputs.hpp"
@@ -72,19 +73,21 @@ void write_trajectory(const std::string& path, const Trajectory& tr, const Scena
 int run_simulate(const ModelOptions& model_options, const SimulateOptions& o) {
   if (o.list) {
     for (const auto& id : scenario_ids()) {
-      const auto j = nlohmann::json::parse(embedded_scenario(id));
+      const auto j = parse_json_bounded(embedded_scenario(id), id);
       fmt::print("{:<8} {}\n", id, j.value("description", ""));
       // A closed pipe or a full disk: stop and say so (main checks stdout again at the end).
       if (std::ferror(stdout)) break;
     }
     return 0;
   }
-  Scenario sc = parse_scenario(read_scenario_json(o.scenario), load_params(model_options), scenario_directory(o.scenario));
+  nlohmann::json file = read_scenario_json(o.scenario);
+  // --integrator replaces the file's before it is read, so that what depends on the integrator
+  // (a tolerance applies to dopri5 only) is checked against the one that runs.
   if (!o.integrator.empty()) {
-    const auto integrator = integrator_from_name(o.integrator);
-    if (!integrator) throw Error("--integrator", fmt::format("must be rk4, euler or dopri5, got '{}'", o.integrator));
-    sc.integrator = *integrator;
+    if (!integrator_from_name(o.integrator)) throw Error("--integrator", fmt::format("must be rk4, euler or dopri5, got '{}'", o.integrator));
+    if (file.is_object()) file["integrator"] = o.integrator;
   }
+  Scenario sc = parse_scenario(file, load_params(model_options), scenario_directory(o.scenario));
   if (o.dt) sc.dt = *o.dt;
   if (o.tolerance) {
     if (sc.integrator != Integrator::dopri5)
@@ -111,11 +114,11 @@ int run_verify_nonholonomic(const ModelOptions& model_options, const std::string
   fmt::print("{} {:>14}\n", header, "max cond");
   std::vector<std::string> ids;  // the model's scenarios marked "verify": "nonholonomic"
   for (const auto& id : scenario_ids())
-    if (nlohmann::json::parse(embedded_scenario(id)).value("verify", "") == "nonholonomic") ids.push_back(id);
+    if (parse_json_bounded(embedded_scenario(id), id).value("verify", "") == "nonholonomic") ids.push_back(id);
   if (ids.empty()) throw Error("verify nonholonomic", "the model has no scenario marked \"verify\": \"nonholonomic\"");
   for (const std::string& id : ids) {
     throw_if_interrupted();
-    const Scenario sc = parse_scenario(read_scenario_json(id), params);
+    const Scenario sc = parse_scenario(parse_json_bounded(embedded_scenario(id), id), params);
     const Trajectory tr = simulate(sc);
     write_trajectory((std::filesystem::path(out_dir) / (id + ".csv")).string(), tr, sc);
     WheelVector worst = WheelVector::Zero();

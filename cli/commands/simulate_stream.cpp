@@ -6,6 +6,7 @@
 #include "outputs.hpp"
 
 #include <fmt/format.h>
+#include <wlx/diagnostics.hpp>
 #include <wlx/csv.hpp>
 #include <wlx/error.hpp>
 
@@ -98,12 +99,12 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
   }
   fmt::print("wrote {}\n", path);
   if (interrupted) {
-    fmt::print(stderr, "wlx: {} at t = {:.4f} s: the run is partial; {} holds the {} samples computed before\n",
+    wlx::diagnose("wlx: {} at t = {:.4f} s: the run is partial; {} holds the {} samples computed before\n",
                interrupted->what(), summary.last_t, path, summary.samples);
     return interrupted->exit_code();
   }
   if (!tr.complete) {
-    fmt::print(stderr, "wlx: error: {}; {} wrote the {} samples computed before\n", tr.error, path, summary.samples);
+    wlx::diagnose("wlx: error: {}; {} wrote the {} samples computed before\n", tr.error, path, summary.samples);
     return 2;
   }
   return 0;

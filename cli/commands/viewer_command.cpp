@@ -8,6 +8,7 @@
 #include "viewer_export.hpp"
 
 #include <fmt/format.h>
+#include <wlx/diagnostics.hpp>
 #include <wlx/error.hpp>
 
 #include <filesystem>
@@ -66,7 +67,7 @@ int run_viewer(const ModelOptions& model_options, const ViewerOptions& options) 
     // Asked after every sample: SIGINT, SIGTERM or SIGHUP stop a long run at once (exit 128 + signal),
     // and the run's file is not written.
     const Trajectory trajectory = simulate(scenario, [](long, long) { throw_if_interrupted(); });
-    if (!trajectory.complete) fmt::print(stderr, "wlx viewer: run {} stopped early ({}); its samples up to then are shown\n", scenario.id, trajectory.error);
+    if (!trajectory.complete) wlx::diagnose("wlx viewer: run {} stopped early ({}); its samples up to then are shown\n", scenario.id, trajectory.error);
     write_viewer_run(dir, scenario, trajectory);
     fmt::print("run {}: {} samples -> {}\n", scenario.id, trajectory.samples.size(), (dir / "runs" / (scenario.id + ".js")).string());
   }

@@ -22,7 +22,7 @@ WLX_COMMANDS_BEGIN
 namespace {
 
 bool is_dynamics(const std::string& scenario_id) {
-  return nlohmann::json::parse(embedded_scenario(scenario_id)).contains("weighting");
+  return parse_json_bounded(embedded_scenario(scenario_id), scenario_id).contains("weighting");
 }
 
 // Asked after every sample: a signal stops a long simulation at once, not when it ends.
@@ -146,7 +146,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
     write_ik_sweep_csv(data_file(sweep->id + ".csv"), sweeps_.back());
   }
   for (const auto& scenario_id : selected_scenarios()) {
-    const nlohmann::json json = read_scenario_json(scenario_id);
+    const nlohmann::json json = parse_json_bounded(embedded_scenario(scenario_id), scenario_id);
     const bool verify = json.value("verify", "") == "nonholonomic";
     std::vector<std::pair<std::string, std::optional<Weighting>>> variants;
     if (json.contains("weighting")) {

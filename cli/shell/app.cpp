@@ -18,6 +18,9 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
     a->add_option("--model-file", inv.model_file,
                   "your own model file (docs/model-format.md): compiled on first use into a cached plugin, then loaded "
                   "(instead of --model)");
+    a->add_option("--scenarios", inv.scenarios_dir,
+                  "a folder of scenario files (*.json, and report.yaml for `report`) replacing the model's own runs; "
+                  "a model file has none of its own");
     a->add_option("--params", inv.model_options.params_file,
                   "JSON file {\"name\": value, ...} overriding the model's parameters (SI units; default: the model file's values)");
   };

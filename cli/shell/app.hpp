@@ -16,6 +16,7 @@ namespace wlx::cli {
 struct Invocation {
   std::string model_name;
   std::string model_file;  // --model-file: a model file of the user's (cli/shell/model_plugin.hpp)
+  std::string scenarios_dir;  // --scenarios: a folder of runs replacing the model's (cli/shell/scenario_folder.hpp)
   ModelOptions model_options;
   CLI::App* list_models = nullptr;
   CLI::App* fk = nullptr;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <unordered_set>
 #include <cctype>
 #include <cmath>
 #include <wlx/error.hpp>
@@ -67,8 +68,22 @@ nlohmann::json parse_json_bounded(std::string_view text, const std::string& wher
       --depth;
     }
   }
+  // A key given twice in one object: nlohmann::json keeps the last one without a word, so a
+  // request like {"z_C": 1.8, "z_C": 2.0} would run on a value its writer may not have meant.
+  std::vector<std::unordered_set<std::string>> keys;  // the keys seen so far, per open object (hashed: a hostile object has 1e6)
+  const auto reject_duplicates = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    if (event == Event::object_start) keys.emplace_back();
+    else if (event == Event::object_end && !keys.empty()) keys.pop_back();
+    else if (event == Event::key && !keys.empty()) {
+      const std::string key = parsed.get<std::string>();
+      if (!keys.back().insert(key).second)
+        throw Error(where.empty() ? excerpt(key) : where + ": " + excerpt(key), "given twice in one object (give each key once)");
+    }
+    return true;
+  };
   try {
-    return nlohmann::json::parse(text);
+    return nlohmann::json::parse(text, reject_duplicates);
   } catch (const nlohmann::json::exception& e) {
     // The parser's message quotes the token it read last, which can be the whole input.
     const std::string message = e.what();

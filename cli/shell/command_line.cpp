@@ -3,6 +3,7 @@
 #include "bounded_input.hpp"
 
 #include <fmt/format.h>
+#include <wlx/diagnostics.hpp>
 #include <wlx/error.hpp>
 
 #include <regex>
@@ -120,9 +121,9 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
     std::smatch m;
     const std::string what = e.what();
     if (std::regex_match(what, m, pattern))
-      fmt::print(stderr, "wlx: error: {}: '{}' is not a valid value (a number is expected)\n", m[1].str(), excerpt(m[2].str()));
+      wlx::diagnose("wlx: error: {}: '{}' is not a valid value (a number is expected)\n", m[1].str(), excerpt(m[2].str()));
     else
-      fmt::print(stderr, "wlx: error: {}\n", excerpt(what));
+      wlx::diagnose("wlx: error: {}\n", excerpt(what));
     return 2;
   } catch (const CLI::ArgumentMismatch& e) {
     // A single-valued option given twice: "--dt: At Most 1 required but received 2".
@@ -130,15 +131,15 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
     std::smatch m;
     const std::string what = e.what();
     if (std::regex_match(what, m, pattern))
-      fmt::print(stderr, "wlx: error: {}: given {} times; give it once\n", m[1].str(), m[2].str());
+      wlx::diagnose("wlx: error: {}: given {} times; give it once\n", m[1].str(), m[2].str());
     else
-      fmt::print(stderr, "wlx: error: {} (wlx --help)\n", what);
+      wlx::diagnose("wlx: error: {} (wlx --help)\n", what);
     return 2;
   } catch (const CLI::ParseError& e) {
-    fmt::print(stderr, "wlx: error: {} (wlx --help)\n", e.what());
+    wlx::diagnose("wlx: error: {} (wlx --help)\n", e.what());
     return 2;
   } catch (const Error& e) {
-    fmt::print(stderr, "wlx: error: {}\n", e.what());
+    wlx::diagnose("wlx: error: {}\n", e.what());
     return 2;
   }
   return std::nullopt;

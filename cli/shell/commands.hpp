@@ -10,6 +10,8 @@
 
 namespace wlx::cli {
 
+struct ModelApi;  // model_api.hpp
+
 struct SimulateOptions {
   std::string scenario;
   std::string out_dir = "out/simulate";
@@ -49,6 +51,7 @@ struct ModelCommands {
   int (*simulate)(const ModelOptions& model, const SimulateOptions& options);
   int (*report)(const ModelOptions& model, const ReportOptions& options);
   int (*viewer)(const ModelOptions& model, const ViewerOptions& options);
+  const ModelApi* api;  // its computations for a binding that names no model (Python)
 };
 
 // The built-in models, the default (the thesis excavator) first.

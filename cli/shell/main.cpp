@@ -7,9 +7,12 @@
 #include "interrupt.hpp"
 #include "model_plugin.hpp"
 #include "output_checks.hpp"
+#include "scenario_folder.hpp"
+#include "viewer_export.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <wlx/diagnostics.hpp>
 #include <wlx/atomic_file.hpp>
 #include <wlx/error.hpp>
 
@@ -23,7 +26,7 @@ int main(int argc, char** argv) {
   for (const auto& m : models()) names.emplace_back(m.name);
   Invocation inv;
   define_command_line(app, inv, names, WLX_VERSION);
-  auto& [model_name, model_file, model_options, list_models, fk, fk_json, ik, batch, verify_ik, ik_out, sweep_ids, verify_nh, nh_out,
+  auto& [model_name, model_file, scenarios_dir, model_options, list_models, fk, fk_json, ik, batch, verify_ik, ik_out, sweep_ids, verify_nh, nh_out,
          simulate, sim, report, report_options, viewer, viewer_options] = inv;
   std::string model_names;
   for (const auto& n : names) model_names += (model_names.empty() ? "" : ", ") + n;
@@ -52,6 +55,7 @@ int main(int argc, char** argv) {
       throw wlx::Error("--model", fmt::format("no built-in model '{}'{}; the models are {}", excerpt(model_name),
                                               hint.empty() ? "" : " (did you mean '" + hint + "'?)", model_names));
     }
+    if (!scenarios_dir.empty() && !list_models->parsed()) load_scenario_folder(scenarios_dir);
     if (list_models->parsed()) {
       std::size_t width = 0;
       for (const auto& m : models()) width = std::max(width, std::string_view(m.name).size());
@@ -67,6 +71,16 @@ int main(int argc, char** argv) {
     if (ik->parsed()) return finish(model->ik(model_options, batch));
     if (verify_ik->parsed()) return finish(model->verify_ik(model_options, ik_out, sweep_ids));
     if (verify_nh->parsed()) return finish(model->verify_nonholonomic(model_options, nh_out));
+    // A model file's viewer module is its own (a built-in module of the same name would draw
+    // another machine): built on first use; the report stands without it, the viewer does not.
+    if (!model_file.empty() && viewer->parsed()) use_viewer_module(std::string(model->name), model_file_viewer_module());
+    if (!model_file.empty() && report->parsed()) {
+      try {
+        use_viewer_module(std::string(model->name), model_file_viewer_module());
+      } catch (const wlx::Error& e) {
+        use_viewer_module(std::string(model->name), {}, e.what());
+      }
+    }
     if (viewer->parsed()) return finish(require(model->viewer, "viewer")(model_options, viewer_options));
     if (report->parsed()) return finish(require(model->report, "report")(model_options, report_options));
     if (simulate->parsed()) {
@@ -75,22 +89,22 @@ int main(int argc, char** argv) {
     }
   } catch (const Interrupted& e) {
     finish(0);
-    fmt::print(stderr, "wlx: {}: stopped before the end; the files finished before are complete, none was left cut\n",
+    wlx::diagnose("wlx: {}: stopped before the end; the files finished before are complete, none was left cut\n",
                e.what());
     return e.exit_code();
   } catch (const wlx::OutputError& e) {
-    fmt::print(stderr, "wlx: error: {}\n", e.what());
+    wlx::diagnose("wlx: error: {}\n", e.what());
     return kExitOutputError;
   } catch (const PluginBuildError& e) {  // a correct model file that did not compile
-    fmt::print(stderr, "wlx: error: {}\n", e.what());
+    wlx::diagnose("wlx: error: {}\n", e.what());
     return 1;
   } catch (const wlx::Error& e) {
-    fmt::print(stderr, "wlx: error: {}\n", e.what());
+    wlx::diagnose("wlx: error: {}\n", e.what());
     return 2;
   } catch (const std::exception& e) {
     // Library messages (std::filesystem's) quote whole arguments: bound them like wlx's own.
     const std::string message = e.what();
-    fmt::print(stderr, "wlx: error: {}\n", message.size() > 500 ? message.substr(0, 500) + "..." : message);
+    wlx::diagnose("wlx: error: {}\n", message.size() > 500 ? message.substr(0, 500) + "..." : message);
     return 2;
   }
   return 0;

@@ -5,6 +5,7 @@
 #include "process.hpp"
 
 #include <fmt/format.h>
+#include <wlx/diagnostics.hpp>
 #include <wlx/atomic_file.hpp>
 #include <wlx/bounded_file.hpp>
 #include <wlx/error.hpp>
@@ -19,6 +20,7 @@
 #include <dlfcn.h>
 #include <fcntl.h>
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -57,22 +59,17 @@ namespace fs = std::filesystem;
 
 // The plugin's entry point: its commands, and the key it was built for.
 using PluginEntry = const ModelCommands* (*)(const char** key);
-constexpr const char* kEntrySymbol = "wlx_model_plugin_v1";
-static_assert(kPluginInterface == 1, "rename kEntrySymbol with the interface's version");
+constexpr const char* kEntrySymbol = "wlx_model_plugin_v2";
+static_assert(kPluginInterface == 2, "rename kEntrySymbol with the interface's version");
 
 // The runtime's sources (their generated-function files apart: each is its own translation unit)
-// and the per-model commands, as CMakeLists.txt lists them for the built-in models.
-// In one translation unit, which shares Eigen's templates (measured at -O2: 27 s, where the
-// files one by one take 48 s of CPU); it runs on one core while the commands and the generated
-// functions take the others.
-const std::vector<std::string> kRuntimeSources{"dynamics.cpp",   "forward_dynamics.cpp", "ik.cpp",         "model.cpp",
-                                               "kinematics.cpp", "ik_verification.cpp",  "simulation.cpp", "nonholonomic.cpp"};
-const std::vector<std::string> kGeneratedFunctionSources{"generated_kinematics.cpp", "generated_rates.cpp", "generated_bodies.cpp",
-                                                         "generated_reduced_dynamics.cpp"};
-const std::vector<std::string> kCommandSources{"commands/input.cpp",          "commands/limits.cpp",        "commands/scenario_io.cpp",
-                                               "commands/ik_commands.cpp",    "commands/simulate_commands.cpp",
-                                               "commands/simulate_stream.cpp", "commands/fk_command.cpp",   "commands/report_command.cpp",
-                                               "report/runner.cpp",           "report/figures.cpp",         "commands/viewer_command.cpp"};
+// and the per-model commands: CMakeLists.txt's lists for the built-in models, '|'-separated.
+// The runtime in one translation unit, which shares Eigen's templates (measured at -O2: 27 s,
+// where the files one by one take 48 s of CPU); it runs on one core while the commands and the
+// generated functions take the others.
+#ifndef WLX_PLUGIN_RUNTIME_SOURCES
+#error "CMakeLists.txt defines WLX_PLUGIN_RUNTIME_SOURCES, WLX_PLUGIN_GENERATED_SOURCES and WLX_PLUGIN_COMMAND_SOURCES"
+#endif
 
 // FNV-1a, twice with different offsets: a 128-bit content key (a cache key, not a signature).
 struct Hash {
@@ -96,10 +93,23 @@ std::vector<std::string> split_list(const std::string& text) {
   return out;
 }
 
+fs::path& host_bin_dir() {
+  static fs::path dir;
+  return dir;
+}
+
+// The folder of wlx's programs: the host's (the Python module says where they are), else this
+// program's own.
 fs::path executable_dir() {
+  if (!host_bin_dir().empty()) return host_bin_dir();
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   return ec ? fs::path() : exe.parent_path();
+}
+
+std::string read_small(const fs::path& path, std::size_t limit) {
+  const BoundedRead r = read_bounded_file(path.string(), limit);
+  return r.ok() ? r.text : std::string();
 }
 
 // Where the sources a plugin compiles are: an installed wlx's share/wlx, else the source tree.
@@ -107,6 +117,7 @@ struct Sources {
   fs::path runtime_include;  // holds wlx/*.hpp
   fs::path runtime_sources;  // the runtime's *.cpp
   fs::path cli;              // holds shell/, commands/, report/
+  fs::path viewer_module;    // holds viewer_module.cpp (the viewer's WebAssembly interface)
 };
 
 Sources find_sources() {
@@ -114,13 +125,29 @@ Sources find_sources() {
   const fs::path bin = executable_dir();
   const fs::path share = (bin / WLX_SHARE_FROM_BINDIR).lexically_normal();
   if (!bin.empty() && fs::is_regular_file(share / "cli" / "commands" / "per_model.hpp", ec))
-    return {(bin / WLX_INCLUDE_FROM_BINDIR).lexically_normal(), share / "runtime", share / "cli"};
+    return {(bin / WLX_INCLUDE_FROM_BINDIR).lexically_normal(), share / "runtime", share / "cli", share / "viewer_module"};
   const fs::path tree = WLX_SOURCE_TREE;
   if (!tree.empty() && fs::is_regular_file(tree / "cli" / "commands" / "per_model.hpp", ec))
-    return {tree / "runtime", tree / "runtime" / "wlx", tree / "cli"};
+    return {tree / "runtime", tree / "runtime" / "wlx", tree / "cli", tree / "viewer" / "wasm"};
   throw Error("--model-file", fmt::format("the sources a model's plugin is compiled from are missing (looked in {} and {}): "
                                           "reinstall wlx",
                                           share.string(), tree.string()));
+}
+
+// Every header and source a plugin compiles, by name and content, into the key.
+void hash_sources(const Sources& src, Hash& h) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (const fs::path& dir : {src.runtime_include / "wlx", src.runtime_sources, src.cli / "shell", src.cli / "commands", src.cli / "report",
+                              src.viewer_module})
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+      if (const auto ext = it->path().extension(); (ext == ".hpp" || ext == ".cpp") && it->is_regular_file(ec)) files.push_back(it->path());
+  std::sort(files.begin(), files.end());
+  files.erase(std::unique(files.begin(), files.end()), files.end());
+  for (const auto& f : files) {
+    h.add(f.filename().string());
+    h.add(read_small(f, kMaxFileBytes));
+  }
 }
 
 fs::path generator_program() {
@@ -136,11 +163,15 @@ std::string compiler() {
   return WLX_PLUGIN_CXX;
 }
 
-// -O2 by default (the code runs in users' loops); WLX_PLUGIN_CXXFLAGS replaces it (part of the key).
-std::vector<std::string> optimization_flags() {
+// -O2 by default for the runtime and the generated functions (the code runs in users' loops), -O1
+// for the commands, which parse, check and write around those calls (measured on 2 cores: 31 s
+// at -O2, 25 s at -O1, on the core that is the first use's critical path). WLX_PLUGIN_CXXFLAGS
+// replaces both (all part of the key).
+const char* const kCommandsOptimization = "-O1";
+std::vector<std::string> optimization_flags(bool commands = false) {
   const char* env = std::getenv("WLX_PLUGIN_CXXFLAGS");
   std::vector<std::string> out;
-  std::istringstream in(env != nullptr && *env != '\0' ? env : "-O2");
+  std::istringstream in(env != nullptr && *env != '\0' ? env : commands ? kCommandsOptimization : "-O2");
   for (std::string flag; in >> flag;) out.push_back(flag);
   return out;
 }
@@ -166,11 +197,6 @@ std::string urdf_of(const std::string& text) {
     if (std::regex_match(l, m, line)) return m[1];
   }
   return {};
-}
-
-std::string read_small(const fs::path& path, std::size_t limit) {
-  const BoundedRead r = read_bounded_file(path.string(), limit);
-  return r.ok() ? r.text : std::string();
 }
 
 std::string file_checksum(const fs::path& path, std::uintmax_t& size) {
@@ -236,7 +262,7 @@ class FileLock {
     fd_ = ::open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC | O_NOFOLLOW, 0600);
     if (fd_ < 0) throw Error("--model-file", fmt::format("cannot open the cache's lock {} ({})", path.string(), std::strerror(errno)));
     if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
-    fmt::print(stderr, "{}\n", waiting_message);
+    wlx::diagnose("{}\n", waiting_message);
     while (::flock(fd_, LOCK_EX) != 0) {
       if (errno != EINTR) throw Error("--model-file", fmt::format("cannot lock {} ({})", path.string(), std::strerror(errno)));
       throw_if_interrupted();
@@ -289,9 +315,16 @@ struct Job {
   fs::path log;
 };
 
+// The wall time of each part of a first use (written to the entry's build-times.tsv: where the
+// time goes, for the user and for tools/readme_figures.sh).
+using Timings = std::vector<std::pair<std::string, double>>;
+
 // Runs the jobs, up to `parallel` at once; stops the others at the first failure or signal.
-void run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path& failed_logs) {
+// Returns each job's wall time, in the order they finished.
+Timings run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path& failed_logs) {
   std::vector<std::pair<int, const Job*>> running;
+  std::map<int, std::chrono::steady_clock::time_point> started;
+  Timings timings;
   std::size_t next = 0;
   const auto stop_all = [&] {
     for (const auto& [pid, job] : running) ::kill(pid, SIGTERM);
@@ -307,6 +340,7 @@ void run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path& f
         throw Error("--model-file", fmt::format("cannot run the C++ compiler '{}' (set CXX to one)", job.argv.front()));
       }
       running.emplace_back(pid, &job);
+      started[pid] = std::chrono::steady_clock::now();
     }
     // Whichever finishes first frees its core for the next job.
     int pid = 0;
@@ -322,6 +356,7 @@ void run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path& f
     }
     const Job* job = done->second;
     running.erase(done);
+    timings.emplace_back(job->name, std::chrono::duration<double>(std::chrono::steady_clock::now() - started[pid]).count());
     if (interrupt_signal() != 0) {
       stop_all();
       throw_if_interrupted();
@@ -337,6 +372,13 @@ void run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path& f
                                          first_error(log), (failed_logs / job->log.filename()).string()));
     }
   }
+  return timings;
+}
+
+std::string timings_text(const Timings& timings) {
+  std::string out = "part\tseconds\n";
+  for (const auto& [name, seconds] : timings) out += fmt::format("{}\t{:.2f}\n", name, seconds);
+  return out;
 }
 
 // Generates the model's headers and compiles its plugin into `dir`.
@@ -349,6 +391,7 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
   const ProgramRun generated =
       run_program({generator_program().string(), fs::absolute(model_file).string(), "--out", gen.string(), "--quiet"}, {}, gen_log.string());
   throw_if_interrupted();
+  Timings timings{{"wlx-gen", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
   if (!generated.started) throw Error("--model-file", fmt::format("cannot run wlx-gen ({}): reinstall wlx", generator_program().string()));
   if (!generated.ok()) {
     std::string message = read_small(gen_log, kMaxFileBytes);
@@ -359,14 +402,14 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
     throw PluginBuildError(fmt::format("wlx-gen failed on {} (exit {}): {}", model_file.string(), generated.exit_status, message));
   }
 
-  fmt::print(stderr, "wlx: compiling model {} for first use ({}) ...\n", name, model_file.string());
+  wlx::diagnose("wlx: compiling model {} for first use ({}) ...\n", name, model_file.string());
   const Sources src = find_sources();
   const auto write = [&](const fs::path& path, const std::string& text) { write_file_atomically(path.string(), text); };
   std::string runtime_unity = "// The runtime's sources in one translation unit.\n";
-  for (const auto& f : kRuntimeSources) runtime_unity += include_line(src.runtime_sources / f);
+  for (const auto& f : split_list(WLX_PLUGIN_RUNTIME_SOURCES)) runtime_unity += include_line(src.runtime_sources / f);
   write(dir / "runtime_unity.cpp", runtime_unity);
   std::string commands_unity = "// The per-model commands in one translation unit (as CMake's unity build of wlx_cli_<model>).\n";
-  for (const auto& f : kCommandSources) commands_unity += include_line(src.cli / f);
+  for (const auto& f : split_list(WLX_PLUGIN_COMMAND_SOURCES)) commands_unity += include_line(src.cli / f);
   // No embedded scenarios or report file: a model file brings its runs as files.
   commands_unity += fmt::format(
       "namespace wlx {{ inline namespace {0} {{ namespace commands {{\n"
@@ -385,13 +428,13 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
 
   const std::string cxx = compiler();
   std::vector<std::string> common{cxx, "-std=c++20", "-fPIC", "-DNDEBUG", "-DWLX_MODEL=" + name, "-DWLX_GEN_COMPILED_" + name};
-  for (const auto& f : optimization_flags()) common.push_back(f);
   for (const fs::path& include : {gen, src.runtime_include, src.cli / "shell", src.cli, src.cli / "commands"}) common.push_back("-I" + include.string());
   for (const auto& include : split_list(WLX_PLUGIN_INCLUDES)) common.push_back("-isystem" + include);
   std::vector<Job> jobs;
   std::vector<std::string> objects;
   const auto compile = [&](const std::string& what, const fs::path& source, const std::string& stem) {
     std::vector<std::string> argv = common;
+    for (const auto& f : optimization_flags(what == "commands")) argv.push_back(f);
     argv.insert(argv.end(), {"-c", source.string(), "-o", (dir / (stem + ".o")).string()});
     jobs.push_back({what, argv, dir / (stem + ".log")});
     objects.push_back((dir / (stem + ".o")).string());
@@ -399,17 +442,21 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
   // The longest first, so that the cores finish together.
   compile("runtime", dir / "runtime_unity.cpp", "runtime_unity");
   compile("commands", dir / "commands_unity.cpp", "commands_unity");
-  for (auto it = kGeneratedFunctionSources.rbegin(); it != kGeneratedFunctionSources.rend(); ++it)
+  const std::vector<std::string> generated_sources = split_list(WLX_PLUGIN_GENERATED_SOURCES);
+  for (auto it = generated_sources.rbegin(); it != generated_sources.rend(); ++it)
     compile("generated functions " + *it, src.runtime_sources / *it, fs::path(*it).stem().string());
   const unsigned cores = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
-  run_jobs(jobs, cores, failed_logs);
+  const auto compiling = std::chrono::steady_clock::now();
+  for (const auto& t : run_jobs(jobs, cores, failed_logs)) timings.push_back(t);
+  timings.emplace_back(fmt::format("all compiles, {} at once", cores),
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - compiling).count());
 
   // -Bsymbolic: the plugin's calls stay inside it, even where wlx itself has a model of the same
   // name (a user's copy of a built-in model, with other geometry, must not run wlx's).
   std::vector<std::string> link{cxx, "-shared", "-Wl,-Bsymbolic", "-o", (dir / "plugin.so").string()};
   link.insert(link.end(), objects.begin(), objects.end());
   for (const auto& library : split_list(WLX_PLUGIN_LIBRARIES)) link.push_back(library);
-  run_jobs({{"link", link, dir / "link.log"}}, 1, failed_logs);
+  for (const auto& t : run_jobs({{"link", link, dir / "link.log"}}, 1, failed_logs)) timings.push_back(t);
 
   std::uintmax_t size = 0;
   const std::string checksum = file_checksum(dir / "plugin.so", size);
@@ -419,10 +466,24 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
   std::error_code ec;
   for (const auto& object : objects) fs::remove(object, ec);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  fmt::print(stderr, "wlx: compiled model {} in {:.1f} s\n", name, seconds);
+  timings.emplace_back("first use, in all", seconds);
+  write(dir / "build-times.tsv", timings_text(timings));
+  wlx::diagnose("wlx: compiled model {} in {:.1f} s\n", name, seconds);
+}
+
+// The cache entry of the model file loaded last (load_model_file), for its viewer module.
+struct LoadedEntry {
+  fs::path cache, entry;
+  std::string stem, name;
+};
+LoadedEntry& loaded_entry() {
+  static LoadedEntry e;
+  return e;
 }
 
 }  // namespace
+
+void set_plugin_host_bin_dir(const std::string& bin_dir) { host_bin_dir() = bin_dir; }
 
 std::string model_cache_dir() {
   fs::path dir;
@@ -453,17 +514,23 @@ const ModelCommands& load_model_file(const std::string& model_file, const std::s
   }
   const std::string cxx = compiler();
   h.add(cxx);
-  for (const auto& f : optimization_flags()) h.add(f);
+  for (const bool commands : {false, true})
+    for (const auto& f : optimization_flags(commands)) h.add(f);
   h.add(WLX_PLUGIN_INCLUDES);
   h.add(WLX_PLUGIN_LIBRARIES);
-  // This wlx binary itself (a rebuilt wlx may have other sources under the same version).
-  struct stat self {};
-  if (::stat("/proc/self/exe", &self) == 0) h.add(fmt::format("{} {} {}", self.st_size, self.st_mtim.tv_sec, self.st_mtim.tv_nsec));
+  // The sources the plugin is compiled from and the interface it is loaded through (a rebuilt wlx
+  // may have other sources under the same version), and the generator that writes its headers.
+  // Not the loading binary: `wlx` and Python's module share one entry per model.
+  hash_sources(find_sources(), h);
+  struct stat generator {};
+  if (::stat(generator_program().c_str(), &generator) == 0)
+    h.add(fmt::format("wlx-gen {} {} {}", generator.st_size, generator.st_mtim.tv_sec, generator.st_mtim.tv_nsec));
   const std::string key = h.hex();
 
   const fs::path cache = model_cache_dir();
   const std::string stem = (name.empty() ? std::string("model") : name) + "-" + key.substr(0, 24);
   const fs::path entry = cache / stem;
+  loaded_entry() = {cache, entry, stem, name};  // for its viewer module, once loaded
   std::string why;
   if (const ModelCommands* commands = try_load(entry, key, why)) return *commands;
 
@@ -472,7 +539,7 @@ const ModelCommands& load_model_file(const std::string& model_file, const std::s
   if (const ModelCommands* commands = try_load(entry, key, why)) return *commands;  // the other one built it
   std::error_code ec;
   if (fs::exists(entry, ec)) {
-    fmt::print(stderr, "wlx: the cached plugin {} cannot be used ({}): building it again\n", entry.string(), why);
+    wlx::diagnose("wlx: the cached plugin {} cannot be used ({}): building it again\n", entry.string(), why);
     fs::remove_all(entry, ec);
   }
   TemporaryFolder building{cache / (stem + ".build-" + std::to_string(::getpid()))};
@@ -484,9 +551,69 @@ const ModelCommands& load_model_file(const std::string& model_file, const std::s
   if (ec) throw Error("--model-file", fmt::format("cannot put the plugin in place at {} ({})", entry.string(), ec.message()));
   building.keep = true;
   fs::remove_all(cache / (stem + ".failed"), ec);
-  fmt::print(stderr, "wlx: cached in {}\n", entry.string());
+  wlx::diagnose("wlx: cached in {}\n", entry.string());
   if (const ModelCommands* commands = try_load(entry, key, why)) return *commands;
   throw PluginBuildError(fmt::format("the plugin just built for model {} cannot be loaded: {}", name, why));
+}
+
+}  // namespace wlx::cli
+
+namespace wlx::cli {
+
+std::string model_file_viewer_module() {
+  const LoadedEntry& loaded = loaded_entry();
+  if (loaded.entry.empty()) throw Error("viewer", "no model file is loaded");
+  const fs::path module = loaded.entry / "viewer" / ("wlx_" + loaded.name + ".js");
+  std::error_code ec;
+  if (fs::is_regular_file(module, ec)) return module.string();
+#ifndef WLX_VIEWER_EMCC
+  throw Error("viewer", "this wlx was built without the viewer (emscripten, node and npm were missing when it was built), so it "
+                        "cannot build one for a model file");
+#else
+  const FileLock lock(loaded.cache / (loaded.stem + ".lock"),
+                      fmt::format("wlx: waiting for another wlx building model {}'s viewer module", loaded.name));
+  if (fs::is_regular_file(module, ec)) return module.string();  // the other one built it
+  const fs::path emcc = WLX_VIEWER_EMCC;
+  if (!fs::is_regular_file(emcc, ec))
+    throw Error("viewer", fmt::format("the viewer's module for model file {} is compiled with emscripten, and {} is missing "
+                                      "(Debian: apt-get install emscripten)",
+                                      loaded.name, emcc.string()));
+  const auto start = std::chrono::steady_clock::now();
+  wlx::diagnose("wlx: compiling model {}'s viewer module with emscripten for first use ...\n", loaded.name);
+  const Sources src = find_sources();
+  TemporaryFolder building{loaded.entry / ("viewer.build-" + std::to_string(::getpid()))};
+  fs::remove_all(building.path, ec);
+  fs::create_directories(building.path / "include", ec);
+  if (ec) throw Error("viewer", fmt::format("cannot create {} ({})", building.path.string(), ec.message()));
+  // fmt's headers alone on the include path: all of /usr/include would shadow emscripten's libc.
+  fs::create_directory_symlink(fs::path(WLX_VIEWER_FMT_INCLUDE) / "fmt", building.path / "include" / "fmt", ec);
+  if (ec) throw Error("viewer", fmt::format("cannot link fmt's headers into {} ({})", building.path.string(), ec.message()));
+  std::string unity = "// The viewer module's sources in one translation unit (viewer/CMakeLists.txt's lists).\n";
+  for (const auto& f : split_list(WLX_VIEWER_RUNTIME_SOURCES)) unity += include_line(src.runtime_sources / f);
+  for (const auto& f : split_list(WLX_VIEWER_CLI_SOURCES)) unity += include_line(src.cli / f);
+  unity += include_line(src.viewer_module / "viewer_module.cpp");
+  write_file_atomically((building.path / "module_unity.cpp").string(), unity);
+  const fs::path out = building.path / module.filename();
+  // emcc runs node, whose optimizer needs Debian's acorn: env sets NODE_PATH (a program, no shell).
+  std::vector<std::string> argv{"/usr/bin/env", std::string("NODE_PATH=") + WLX_VIEWER_NODE_PATH, emcc.string(), "-std=c++20", "-O2",
+                                "-fexceptions", "-DFMT_HEADER_ONLY", "-DWLX_MODEL=" + loaded.name,
+                                "-I" + src.runtime_include.string(), "-I" + (src.cli / "commands").string(), "-I" + (src.cli / "shell").string(),
+                                "-isystem" + (building.path / "include").string(), "-isystem" + (loaded.entry / "generated").string()};
+  for (const auto& include : split_list(WLX_VIEWER_EIGEN_INCLUDES)) argv.push_back("-isystem" + include);
+  // SINGLE_FILE: the WebAssembly inlined in the script, which a page opened from file:// can load.
+  argv.insert(argv.end(), {(building.path / "module_unity.cpp").string(), "-o", out.string(), "-sMODULARIZE=1",
+                           "-sEXPORT_NAME=wlxModule_" + loaded.name, "-sSINGLE_FILE=1", "-sALLOW_MEMORY_GROWTH=1",
+                           std::string("-sEXPORTED_FUNCTIONS=") + WLX_VIEWER_EXPORTS, "-sEXPORTED_RUNTIME_METHODS=UTF8ToString"});
+  const Timings timings = run_jobs({{"viewer module (emcc)", argv, building.path / "emcc.log"}}, 1,
+                                    loaded.cache / (loaded.stem + ".viewer-failed"));
+  fs::create_directories(module.parent_path(), ec);
+  write_file_atomically((module.parent_path() / "build-times.tsv").string(), timings_text(timings));
+  fs::rename(out, module, ec);
+  if (ec) throw Error("viewer", fmt::format("cannot put the viewer module in place at {} ({})", module.string(), ec.message()));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  wlx::diagnose("wlx: compiled model {}'s viewer module in {:.1f} s\n", loaded.name, seconds);
+  return module.string();
+#endif
 }
 
 }  // namespace wlx::cli

@@ -22,7 +22,7 @@ namespace wlx::cli {
 
 // The plugin interface's version: part of every key and of the entry point's name, so a plugin
 // of another interface is never loaded.
-inline constexpr int kPluginInterface = 1;
+inline constexpr int kPluginInterface = 2;
 
 // A plugin that could not be built from a correct model file (the compiler failed): exit 1, not
 // the 2 of a bad input.
@@ -36,6 +36,15 @@ class PluginBuildError : public Error {
 // finds in it (its message, `file:line:column: field: reason`, before any compiling), and for a
 // failed compile (the compiler's first error and where the whole log is).
 const ModelCommands& load_model_file(const std::string& model_file, const std::string& version);
+
+// Where wlx's programs (wlx-gen) and, beside them, its installed sources are, for a host other than
+// the wlx program (the Python module); by default, the running program's folder.
+void set_plugin_host_bin_dir(const std::string& bin_dir);
+
+// The viewer's WebAssembly module (a script, wasm/wlx_<model>.js) of the model file loaded last:
+// compiled with the emscripten wlx was built with into its cache entry on first use (about half a
+// minute; progress on stderr), then reused. Throws Error when there is no emscripten.
+std::string model_file_viewer_module();
 
 // The cache folder (created if missing).
 std::string model_cache_dir();

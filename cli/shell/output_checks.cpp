@@ -1,6 +1,7 @@
 #include "output_checks.hpp"
 
 #include <fmt/format.h>
+#include <wlx/diagnostics.hpp>
 #include <wlx/atomic_file.hpp>
 #include <wlx/error.hpp>
 
@@ -51,7 +52,7 @@ namespace wlx::cli {
 int finish(int code) {
   std::string reason;
   if (stdout_ok(reason)) return code;
-  fmt::print(stderr, "wlx: error: stdout: writing the output failed ({}); the output is incomplete\n", reason);
+  wlx::diagnose("wlx: error: stdout: writing the output failed ({}); the output is incomplete\n", reason);
   return kExitOutputError;
 }
 

@@ -219,22 +219,40 @@ fs::path built_viewer_dir() {
 #endif
 }
 
+namespace {
+struct ViewerModule {
+  std::string model, path, reason;
+};
+ViewerModule& own_module() {
+  static ViewerModule m;
+  return m;
+}
+}  // namespace
+
+void use_viewer_module(const std::string& model, const std::string& module_js, const std::string& reason) {
+  own_module() = {model, module_js, reason};
+}
+
 void copy_viewer_files(const fs::path& dir, const fs::path& source) {
   const std::string how = "build it with emscripten and node installed (tools/setup.sh installs them; CMake option "
                           "WLX_BUILD_VIEWER), or point WLX_VIEWER_DIR at a built viewer folder";
   if (source.empty()) throw Error("viewer", "this wlx was built without the viewer: " + how);
-  std::vector<fs::path> files{"viewer.html", "viewer.js"};
+  const ViewerModule& own = own_module();
+  if (!own.model.empty() && own.path.empty()) throw Error("viewer", own.reason);
+  const fs::path own_name = own.model.empty() ? fs::path() : fs::path("wasm") / ("wlx_" + own.model + ".js");
+  std::vector<std::pair<fs::path, fs::path>> files{{source / "viewer.html", "viewer.html"}, {source / "viewer.js", "viewer.js"}};
   std::error_code ec;
   if (fs::is_directory(source / "wasm", ec))
     for (const auto& e : fs::directory_iterator(source / "wasm", ec))
-      if (e.path().extension() == ".js") files.push_back(fs::path("wasm") / e.path().filename());
-  if (files.size() == 2) files.emplace_back("wasm/wlx_<model>.js");  // reported missing below
-  for (const auto& file : files)
-    if (!fs::is_regular_file(source / file))
-      throw Error("viewer", fmt::format("{} is missing: {}", (source / file).string(), how));
+      if (const fs::path name = fs::path("wasm") / e.path().filename(); e.path().extension() == ".js" && name != own_name)
+        files.emplace_back(e.path(), name);
+  if (!own.model.empty()) files.emplace_back(own.path, own_name);
+  if (files.size() == 2) files.emplace_back(source / "wasm/wlx_<model>.js", "");  // reported missing below
+  for (const auto& [from, to] : files)
+    if (!fs::is_regular_file(from)) throw Error("viewer", fmt::format("{} is missing: {}", from.string(), how));
   create_folder(dir / "wasm");
   create_folder(dir / "runs");
-  for (const auto& file : files) write_file_atomically((dir / file).string(), read_text(source / file, kMaxViewerFileBytes));
+  for (const auto& [from, to] : files) write_file_atomically((dir / to).string(), read_text(from, kMaxViewerFileBytes));
   if (!fs::exists(dir / "runs" / "index.js")) write_index(dir / "runs" / "index.js", {});
 }
 

@@ -59,4 +59,10 @@ std::filesystem::path built_viewer_dir();
 // wlx::Error when `source` lacks one of them (the viewer was not built: its message says how).
 void copy_viewer_files(const std::filesystem::path& dir, const std::filesystem::path& source = built_viewer_dir());
 
+// A model file's own viewer module (cli/shell/model_plugin.hpp, built with emscripten on first use):
+// copy_viewer_files then writes it as wasm/wlx_<model>.js instead of any built-in module of that
+// name (a user's copy of a built-in model has its own geometry). An empty module with a reason:
+// there is none, and copy_viewer_files fails with that reason rather than copy another model's.
+void use_viewer_module(const std::string& model, const std::string& module_js, const std::string& reason = {});
+
 }  // namespace wlx::cli

@@ -1,9 +1,9 @@
-"""wlx from Python: the built-in models' kinematics, inverse kinematics, wheel rates, inverse
+"""wlx from Python: a model's kinematics, inverse kinematics, wheel rates, inverse and forward
 dynamics and simulations, computed by the same C++ as the `wlx` command (same inputs, same checks,
-same error messages), with NumPy arrays out.
+same error messages), with NumPy arrays out. The built-in models by name, or any model file:
 
     import wlx
-    robot = wlx.model("excavator")
+    robot = wlx.model("excavator")          # or wlx.load("my_robot.yaml"): compiled on first use
     s = robot.ik({"z_C": 1.8, "params": {"legD": 1.7}})["s"]
     run = robot.simulate("NH-1")            # or a scenario dict, as in scenarios/*.json
     run["t"], run["x_C"], run["tau_psi_l2"]
@@ -19,7 +19,7 @@ import numpy as _np
 from . import _wlx
 from ._wlx import Error
 
-__all__ = ["Error", "Model", "model", "models"]
+__all__ = ["Error", "Model", "load", "model", "models"]
 
 
 def models():
@@ -31,7 +31,21 @@ def model(name="excavator"):
     """The built-in model of that name."""
     if name not in _wlx.models:
         raise Error(f"model: unknown model {name!r}; the built-in ones: {', '.join(_wlx.models)}")
-    return Model(getattr(_wlx, name))
+    return Model(_wlx.model(name))
+
+
+def load(path):
+    """The model of a model file (a YAML model file, or one that names its URDF), as `wlx
+    --model-file` loads it: on first use wlx-gen generates its headers and the C++ compiler builds
+    them into a plugin (about half a minute; progress on stderr), cached by the file's content
+    (in $WLX_CACHE_DIR, else $XDG_CACHE_HOME/wlx, else ~/.cache/wlx); later loads take
+    milliseconds. A mistake in the file raises wlx.Error with wlx-gen's message
+    (file:line:column: field: reason)."""
+    import os as _os
+
+    model = Model(_wlx.load(_os.fspath(path)))
+    model._path = _os.fspath(path)
+    return model
 
 
 def _to_json(value, field):
@@ -46,11 +60,12 @@ def _params_json(params):
 
 
 class Model:
-    """One built-in model: its tables (names, units, parameters) and its computations."""
+    """One model: its tables (names, units, parameters) and its computations."""
 
-    def __init__(self, module):
-        self._m = module
-        info = module.info
+    def __init__(self, handle):
+        self._m = handle
+        self._path = None
+        info = handle.info
         self.name = info["name"]
         self.description = info["description"]
         self.coordinates = list(info["coordinates"])  # s = [inputs, dependent joints]
@@ -64,7 +79,7 @@ class Model:
         self.actuators = list(info["actuators"])  # tau's order: joints, and wheel drives (spin_<wheel>)
 
     def __repr__(self):
-        return f"wlx.model({self.name!r})"
+        return f"wlx.load({self._path!r})" if self._path is not None else f"wlx.model({self.name!r})"
 
     def ik(self, request=None, **values):
         """Inverse kinematics: `wlx ik`'s request (inputs by name, "params", "method": "closed-form"

@@ -307,6 +307,22 @@ TEST_CASE("faults: scenario files: physical bounds, depth, sizes, excerpts, weig
        e("duration"), "must be a number"},
       {"tolerance below rounding", {"simulate", "{file}", "--out", "{dir}"}, "", "{" + kOk + R"(, "integrator": "dopri5", "tolerance": 1e-20})",
        2, e("tolerance"), "between 1e-14"},
+      // A tolerance on a fixed-step integrator was ignored without a word (issue 26).
+      {"tolerance with rk4", {"simulate", "{file}", "--out", "{dir}"}, "", "{" + kOk + R"(, "tolerance": 1e-8})", 2, e("tolerance"),
+       "applies to the adaptive integrator only; this run integrates with rk4"},
+      {"tolerance with euler", {"simulate", "{file}", "--out", "{dir}"}, "", "{" + kOk + R"(, "integrator": "euler", "tolerance": 1e-8})",
+       2, e("tolerance"), "integrates with euler"},
+      {"tolerance, the file's rk4 replaced by --integrator dopri5", {"simulate", "{file}", "--out", "{dir}", "--integrator", "dopri5"}, "",
+       "{" + kOk + R"(, "tolerance": 1e-8})", 0, "", ""},
+      {"tolerance, the file's dopri5 replaced by --integrator rk4", {"simulate", "{file}", "--out", "{dir}", "--integrator", "rk4"}, "",
+       "{" + kOk + R"(, "integrator": "dopri5", "tolerance": 1e-8})", 2, e("tolerance"), "integrates with rk4"},
+      // Duplicate keys: nlohmann::json kept the last one without a word (issue 26).
+      {"a key twice", {"simulate", "{file}", "--out", "{dir}"}, "", R"({"dependent": ["y_C", "yaw"], "duration": 0.01, "duration": 5})", 2,
+       "scenario.json: duration: given twice in one object", ""},
+      {"a nested key twice", {"simulate", "{file}", "--out", "{dir}"}, "", "{" + kOk + R"(, "rates": {"z_C": 0.01, "z_C": 0.02}})", 2,
+       "scenario.json: z_C: given twice in one object", ""},
+      {"the same key in two objects: valid", {"simulate", "{file}", "--out", "{dir}"}, "",
+       "{" + kOk + R"(, "initial": {"z_C": 1.8}, "rates": {"z_C": 0.01}})", 0, "", ""},
       {"10^12 steps", {"simulate", "{file}", "--out", "{dir}"}, "", R"({"dependent": ["y_C", "yaw"], "duration": 1, "dt": 1e-12})", 2,
        e("dt"), "more than the limit of 1e8"},
       {"initial not an object", {"simulate", "{file}", "--out", "{dir}"}, "", "{" + kOk + R"(, "initial": [1, 2]})", 2, e("initial"),
@@ -375,6 +391,27 @@ TEST_CASE("faults: stdout that fails (/dev/full, a closed pipe) is an error with
   CHECK(batch.code == 74);
   CHECK(batch.err.find("at input line") != std::string::npos);
   CHECK(incomplete_files(dir).empty());
+}
+
+TEST_CASE("faults: stderr that cannot be written loses the message, not the exit code (never abort)") {
+  // fmt::print(stderr) threw on a full stderr, which in main's error handler ended wlx with abort
+  // (134); a stdout failure reported on a failing stderr still exits 74.
+  const std::vector<std::pair<std::vector<std::string>, int>> commands = {
+      {{"models"}, 0},
+      {{"--model", "no_such_model", "fk"}, 2},
+      {{"fk", "--no-such-option"}, 2},
+      {{"ik"}, 2},  // stdin "[]": not a request
+  };
+  for (const auto& [args, code] : commands) {
+    const auto shown = args[0] + (args.size() > 1 ? " " + args[1] : "");
+    CAPTURE(shown);
+    const Result r = run(args, {.input = "[]", .stderr_path = "/dev/full"});
+    CHECK(r.signal == 0);
+    CHECK(r.code == code);
+  }
+  const Result both = run({"fk"}, {.stdout_path = "/dev/full", .stderr_path = "/dev/full"});
+  CHECK(both.signal == 0);
+  CHECK(both.code == 74);
 }
 
 namespace {

@@ -177,6 +177,55 @@ TEST_CASE("--model-file: a corrupt cache entry is never loaded but rebuilt, and 
   // (A plugin of another key in an entry's place: the last case.)
 }
 
+#ifdef WLX_PYTHON
+TEST_CASE("wlx.load in Python: the plugin `wlx --model-file` built, from the same cache entry; its model is its own beside the built-in of the same name") {
+  const Setup& s = setup();
+  REQUIRE(run({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose}).code == 0);  // built (by the cases above)
+  const std::vector<fs::path> before = entries();
+  REQUIRE(before.size() == 1);
+  ::setenv("PYTHONPATH", WLX_PYTHON_DIR, 1);
+  // The loaded model keeps the built-in's name (excavator) with thighs of 2.3 m: Python holds both,
+  // and each must compute its own (the module is made global for the plugin; the plugin binds to
+  // itself). With the built-in given thighD = 2.3, the two agree to rounding.
+  const std::string script = R"py(
+import sys, numpy as np, wlx
+mine, builtin = wlx.load(sys.argv[1]), wlx.model("excavator")
+assert repr(mine) == f"wlx.load({sys.argv[1]!r})" and mine.name == "excavator" and mine.params["thighD"] == 2.3, mine.params
+assert builtin.params["thighD"] == 2.0
+pose = {"z_C": 1.8, "x_Fl": 2.4}
+s_mine, s_default = mine.ik(pose)["s"], builtin.ik(pose)["s"]
+s_same = builtin.ik(pose, params={"thighD": 2.3})["s"]
+assert np.max(np.abs(s_mine - s_default)) > 1e-3, "the loaded model computed the built-in's geometry"
+assert np.max(np.abs(s_mine - s_same)) <= 1e-12, np.max(np.abs(s_mine - s_same))
+u, u_dot = [0.0, 0.3, 0.0, 0.0], [0.1, 0.0, 0.0, 0.2]
+a = mine.inverse_dynamics(s_mine, u, u_dot)
+b = builtin.inverse_dynamics(s_same, u, u_dot, params={"thighD": 2.3})
+assert np.max(np.abs(a["tau"] - b["tau"])) <= 1e-9 * np.max(np.abs(b["tau"])), (a["tau"], b["tau"])
+run = {"id": "T", "initial": pose, "rates": {"x_C": 0.2}, "dependent": ["y_C", "yaw"], "duration": 0.2, "dt": 0.01}
+r_mine = mine.simulate(run)
+r_same = builtin.simulate({**run, "params": {"thighD": 2.3}})
+assert r_mine["complete"] and len(r_mine["t"]) == 21, r_mine["stopped"]
+assert np.max(np.abs(r_mine["psi_l2"] - r_same["psi_l2"])) <= 1e-12
+for bad, message in ((sys.argv[2], "bad.yaml:1:1: missing field 'parameters'"), (sys.argv[2] + ".missing", "load: ")):
+    try:
+        wlx.load(bad)
+    except wlx.Error as e:
+        assert message in str(e), str(e)
+    else:
+        raise AssertionError("loaded " + bad)
+print("ok")
+)py";
+  const fs::path bad = wlx_test::work_dir() / "bad.yaml";
+  write(bad, "model: broken\n");
+  const auto r = run({"-c", script, s.model.string(), bad.string()}, {.program = WLX_PYTHON});
+  INFO(r.err);
+  CHECK(r.code == 0);
+  CHECK(r.out == "ok\n");
+  CHECK(r.err.find("compiling") == std::string::npos);  // the CLI's entry, not a second build
+  CHECK(entries() == before);
+}
+#endif
+
 TEST_CASE("--model-file: a mistake in the model file is reported as wlx-gen reports it, before any compiling (exit 2)") {
   const Setup& s = setup();
   const fs::path bad = wlx_test::work_dir() / "bad.yaml";
@@ -257,3 +306,139 @@ TEST_CASE("--model-file: SIGINT, SIGTERM or SIGHUP while compiling: stopped at o
   }
   CHECK(entries().size() == 1);  // only the entry of the other cases
 }
+
+TEST_CASE("--model-file with --scenarios: a user's runs in every command; a run written for another model is refused") {
+  const Setup& s = setup();
+  const fs::path runs = wlx_test::work_dir() / "my_runs";
+  fs::create_directories(runs);
+  // Two runs of the user's: one says whose it is, one does not (both run).
+  write(runs / "drive.json", R"({"model": "excavator", "description": "forward at 0.5 m/s", "initial": {"z_C": 1.8},
+    "rates": {"x_C": 0.5}, "dependent": ["y_C", "yaw"], "duration": 0.2, "dt": 0.01})");
+  write(runs / "lift.json", R"({"description": "the body up at 0.1 m/s", "rates": {"z_C": 0.1}, "dependent": ["y_C", "yaw"],
+    "duration": 0.1, "dt": 0.01})");
+  const auto list = run({"--model-file", s.model.string(), "--scenarios", runs.string(), "simulate", "--list"});
+  INFO(list.err);
+  REQUIRE(list.code == 0);
+  CHECK(list.out.find("drive") != std::string::npos);
+  CHECK(list.out.find("forward at 0.5 m/s") != std::string::npos);
+  CHECK(list.out.find("lift") != std::string::npos);
+  CHECK(list.out.find("NH-1") == std::string::npos);  // the folder replaces the model's own runs
+  const fs::path out = wlx_test::work_dir() / "sim-drive";
+  const auto sim = run({"--model-file", s.model.string(), "--scenarios", runs.string(), "simulate", "drive", "--out", out.string()});
+  INFO(sim.err);
+  REQUIRE(sim.code == 0);
+  const auto [header, rows] = read_csv(out / "trajectory.csv");
+  CHECK(rows.size() == 21);
+  // The built-in model with the same folder: the same run (its thighs given by --params).
+  const fs::path builtin_out = wlx_test::work_dir() / "sim-drive-builtin";
+  REQUIRE(run({"--params", s.params.string(), "--scenarios", runs.string(), "simulate", "drive", "--out", builtin_out.string()}).code == 0);
+  const auto [builtin_header, builtin_rows] = read_csv(builtin_out / "trajectory.csv");
+  REQUIRE(builtin_rows.size() == rows.size());
+  double worst = 0;
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    for (std::size_t c = 0; c < rows[r].size(); ++c) worst = std::max(worst, std::abs(rows[r][c] - builtin_rows[r][c]));
+  CHECK(worst <= 1e-9);
+
+  // The report of the user's runs (no report.yaml: a report of its runs, no claims).
+  const fs::path report = wlx_test::work_dir() / "report-runs";
+  const auto rep = run({"--model-file", s.model.string(), "--scenarios", runs.string(), "report", "--out", report.string()});
+  INFO(rep.out);
+  INFO(rep.err);
+  CHECK(rep.code == 0);
+#ifdef WLX_VIEWER_DIST  // the report's viewer: the model's own module, compiled now (the viewer case takes it from the cache)
+  CHECK(rep.err.find("wlx: compiling model excavator's viewer module with emscripten for first use") != std::string::npos);
+  CHECK(fs::is_regular_file(report / "viewer" / "wasm" / "wlx_excavator.js"));
+  CHECK(fs::is_regular_file(report / "viewer" / "runs" / "drive.js"));
+#endif
+  const std::string html = slurp(report / "index.html");
+  CHECK(html.find("forward at 0.5 m/s") != std::string::npos);
+  CHECK(html.find("the body up at 0.1 m/s") != std::string::npos);
+  CHECK(html.find("ID-1") == std::string::npos);
+
+  // A run written for another model, by its "model", on this one: refused, named.
+  const fs::path other = wlx_test::work_dir() / "walker_run.json";
+  write(other, R"({"model": "walker", "rates": {"x_C": 0.5}, "duration": 0.1})");
+  const auto wrong = run({"--model-file", s.model.string(), "simulate", other.string(), "--out", out.string()});
+  CHECK(wrong.code == 2);
+  CHECK(wrong.err.find("model: the scenario is for model 'walker', not for 'excavator'") != std::string::npos);
+  // Folder errors: not a folder, no scenario in it, a file name that is no id.
+  const auto missing = run({"--scenarios", (runs / "nope").string(), "simulate", "--list"});
+  CHECK(missing.code == 2);
+  CHECK(missing.err.find("--scenarios: ") != std::string::npos);
+  CHECK(missing.err.find("is not a folder") != std::string::npos);
+  const fs::path empty = wlx_test::work_dir() / "no_runs";
+  fs::create_directories(empty);
+  const auto none = run({"--scenarios", empty.string(), "simulate", "--list"});
+  CHECK(none.code == 2);
+  CHECK(none.err.find("holds no scenario file") != std::string::npos);
+  const fs::path odd = wlx_test::work_dir() / "odd_runs";
+  fs::create_directories(odd);
+  write(odd / "a run.json", "{}");
+  const auto bad_id = run({"--scenarios", odd.string(), "simulate", "--list"});
+  CHECK(bad_id.code == 2);
+  CHECK(bad_id.err.find("a scenario's id is its file name") != std::string::npos);
+  const fs::path renamed = wlx_test::work_dir() / "renamed_runs";
+  fs::create_directories(renamed);
+  write(renamed / "forward.json", R"({"id": "backward", "rates": {"x_C": 0.5}, "dependent": ["y_C", "yaw"], "duration": 0.1})");
+  const auto mismatch = run({"--scenarios", renamed.string(), "simulate", "forward", "--out", out.string()});
+  CHECK(mismatch.code == 2);
+  CHECK(mismatch.err.find("forward: id: is \"backward\", but the run's file is named forward.json") != std::string::npos);
+}
+
+#ifdef WLX_VIEWER_DIST
+TEST_CASE("--model-file viewer: the model file's own WebAssembly module (emscripten, on first use, cached), not the built-in's of the same name") {
+  const Setup& s = setup();
+  const fs::path runs = wlx_test::work_dir() / "viewer_runs";
+  fs::create_directories(runs);
+  write(runs / "drive.json", R"({"model": "excavator", "rates": {"x_C": 0.5}, "dependent": ["y_C", "yaw"], "duration": 0.2, "dt": 0.01})");
+  const fs::path out = wlx_test::work_dir() / "viewer-own";
+  const auto first = run({"--model-file", s.model.string(), "--scenarios", runs.string(), "viewer", "drive", "--out", out.string()});
+  INFO(first.err);
+  REQUIRE(first.code == 0);
+  // The report of the case above compiled the module into the entry: taken from there.
+  CHECK(first.err.find("compiling") == std::string::npos);
+  REQUIRE(fs::is_regular_file(out / "wasm" / "wlx_excavator.js"));
+  CHECK(fs::is_regular_file(out / "runs" / "drive.js"));
+  // The built-in modules of other models come along; this model's is its own, not the built-in's.
+  CHECK(fs::is_regular_file(out / "wasm" / "wlx_walker.js"));
+  CHECK(slurp(out / "wasm" / "wlx_excavator.js") != slurp(fs::path(WLX_VIEWER_DIST) / "wasm" / "wlx_excavator.js"));
+  // Run both modules in node: the closed-form IK at the nominal inputs. The file's module gives
+  // what `wlx --model-file ... ik` gives (thighs 2.3 m); the built-in's gives other angles.
+  const fs::path script = wlx_test::work_dir() / "module_ik.cjs";
+  write(script, R"js(
+const factory = require(process.argv[2]);
+factory().then((m) => {
+  const info = JSON.parse(m.UTF8ToString(m._wlx_model_info_json()));
+  const n = info.coordinates.length;
+  const inputs = m._malloc(8 * info.inputCount), branches = m._malloc(4 * info.limbs.length), s = m._malloc(8 * n);
+  info.nominalInputs.forEach((v, k) => m.HEAPF64[inputs / 8 + k] = v);
+  for (let k = 0; k < info.limbs.length; ++k) m.HEAP32[branches / 4 + k] = 0;
+  if (!m._wlx_solve_ik(inputs, branches, s)) throw new Error(m.UTF8ToString(m._wlx_last_error()));
+  const out = {};
+  info.coordinates.forEach((c, k) => out[c.name] = m.HEAPF64[s / 8 + k]);
+  console.log(JSON.stringify({inputs: Object.fromEntries(info.nominalInputs.map((v, k) => [info.coordinates[k].name, v])), s: out}));
+});
+)js");
+  const auto own = run({script.string(), (out / "wasm" / "wlx_excavator.js").string()}, {.program = WLX_NODE});
+  INFO(own.err);
+  REQUIRE(own.code == 0);
+  const nlohmann::json own_ik = nlohmann::json::parse(own.out);
+  const auto cli = run({"--model-file", s.model.string(), "ik"}, {.input = own_ik["inputs"].dump()});
+  INFO(cli.err);
+  REQUIRE(cli.code == 0);
+  const nlohmann::json reference = nlohmann::json::parse(cli.out);  // the dependent joints by name, and more
+  int compared = 0;
+  for (const auto& item : own_ik["s"].items()) {
+    const std::string coordinate = item.key();
+    if (!reference.contains(coordinate)) continue;  // an input: given, not solved
+    CAPTURE(coordinate);
+    CHECK(item.value().get<double>() == doctest::Approx(reference[coordinate].get<double>()).epsilon(1e-9));
+    ++compared;
+  }
+  CHECK(compared >= 14);  // the legs' and the wheel levers' joints, the wheels' positions
+  const auto builtin = run({script.string(), (fs::path(WLX_VIEWER_DIST) / "wasm" / "wlx_excavator.js").string()}, {.program = WLX_NODE});
+  REQUIRE(builtin.code == 0);
+  CHECK(std::abs(nlohmann::json::parse(builtin.out)["s"]["psi_l4"].get<double>() - reference["psi_l4"].get<double>()) > 0.01);
+
+}
+#endif

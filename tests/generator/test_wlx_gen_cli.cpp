@@ -160,6 +160,11 @@ TEST_CASE("wlx-gen: names that are keywords or macros of the compiler or the hea
       {"{name: forearm, value", "{name: std, value"},
       {"{name: fore, frame: fore", "{name: Eigen, frame: fore"},
       {"model: arm", "model: gen"},
+      // The generated functions' own names: the template parameter, an output, a sum's prefix.
+      {"{name: forearm, value", "{name: Scalar, value"},
+      {"{name: elbow_y, value", "{name: Q_gravity, value"},
+      {"{name: turn, unit: rad", "{name: kane_R_0_1_1, unit: rad"},
+      {"{name: lift, unit: rad", "{name: ik_residual, unit: rad"},
   };
   for (const auto& [from, to] : cases) {
     const auto shown = to;  // a copy: clang 14 cannot capture a structured binding
@@ -428,3 +433,78 @@ TEST_CASE("wlx-gen: robot.urdf --with robot.yaml, and --print-model") {
   CHECK(compared >= 10);
 }
 #endif
+
+TEST_CASE("wlx-gen: a single link on a fixed base (one coordinate, one body): headers that compile warning-free and its dynamics by hand") {
+  // The smallest model: a rod of length 0.5 m and mass 2 kg turning about y. Before, wlx-gen
+  // failed on it ("lane scalar kane_R_0_0_0 is never read": the recursion never reads a body's
+  // rotation when the one joint turns it about a fixed axis), and then wrote a value nothing
+  // read (unused-variable warnings in a user's -Werror build).
+  const std::filesystem::path dir = wlx_test::work_dir() / "one_link";
+  std::filesystem::create_directories(dir);
+  wlx_test::write(dir / "pendulum.yaml", R"(model: pendulum
+description: one rod turning about y on a fixed base
+parameters:
+  - {name: len, value: 0.5, unit: m, kind: length, meaning: rod length}
+  - {name: m1, value: 2, unit: kg, kind: mass, meaning: rod mass}
+  - {name: I1, value: 0.01, unit: kg*m^2, kind: inertia, meaning: rod inertia about its centre}
+  - {name: g, value: 9.81, unit: m/s^2, kind: gravity, meaning: gravity}
+coordinates:
+  inputs:
+    - {name: swing, unit: rad, meaning: rod angle below the horizontal}
+frames:
+  - {name: rod, parent: K0, chain: [ry: swing]}
+  - {name: tip, parent: rod, chain: [translate: [len, 0, 0]]}
+bodies:
+  - {name: rod, frame: rod, com: [len/2, 0, 0], mass: m1, inertia: [I1, I1, I1]}
+dynamics:
+  gravity: g
+  commanded: [swing]
+  actuated: [swing]
+)");
+  const auto r = wlx_test::run({(dir / "pendulum.yaml").string(), "--out", (dir / "out").string(), "--quiet"});
+  CAPTURE(r.err);
+  REQUIRE(r.code == 0);
+  // By hand, at q = 0.3 (the centre at (l/2 cos q, 0, -l/2 sin q)): M = I + m (l/2)^2 = 0.135;
+  // Q_gravity = -dV/dq = m g (l/2) cos q; the actuator's force for q' = 1.5, q'' = 2 is
+  // M q'' - Q_gravity (no velocity term for one joint about a fixed axis).
+  wlx_test::write(dir / "check.cpp", R"(#include <wlx/gen/all.hpp>
+#include <cmath>
+using namespace wlx::pendulum::gen;
+int main() {
+  Coordinates s, sdot, sddot;
+  s << 0.3;
+  sdot << 1.5;
+  sddot << 2.0;
+  RateBasis T;
+  T.setIdentity();
+  const Params p;
+  CommandMatrix M;
+  CommandVector Q, Qstar;
+  reduced_dynamics(s, Coordinates::Zero(), T, p, {.M = &M, .Q_gravity = &Q});
+  generalized_forces(s, sdot, sddot, T, p, {.Qstar = &Qstar});
+  const double mass = 2, half = 0.25, inertia = 0.01, g = 9.81, M_hand = inertia + mass * half * half;
+  const double Q_hand = mass * g * half * std::cos(0.3);
+  const bool ok = std::abs(M(0, 0) - M_hand) <= 1e-15 && std::abs(Q(0) - Q_hand) <= 1e-14 &&
+                  std::abs(Qstar(0) - (M_hand * 2.0 - Q_hand)) <= 1e-14;
+  return ok ? 0 : 1;
+}
+)");
+  const std::string exe = (dir / "check").string();
+  const std::string compile = std::string(WLX_TEST_CXX) + " -std=c++20 -Wall -Wextra -Werror -isystem " + WLX_EIGEN_INCLUDE + " -I'" +
+                              (dir / "out").string() + "' '" + (dir / "check.cpp").string() + "' -o '" + exe + "' 2>&1";
+  INFO(compile);
+  REQUIRE(std::system(compile.c_str()) == 0);
+  CHECK(std::system(("'" + exe + "'").c_str()) == 0);
+}
+
+TEST_CASE("wlx-gen: stderr that cannot be written loses the message, not the exit code (never abort)") {
+  const std::filesystem::path dir = wlx_test::work_dir() / "stderr_full";
+  std::filesystem::create_directories(dir);
+  wlx_test::write(dir / "bad.yaml", "model: broken\n");
+  const auto r = wlx_test::run({(dir / "bad.yaml").string(), "--out", (dir / "out").string()}, {.stderr_path = "/dev/full"});
+  CHECK(r.signal == 0);
+  CHECK(r.code == 2);
+  const auto usage = wlx_test::run({"--no-such-option"}, {.stderr_path = "/dev/full"});
+  CHECK(usage.signal == 0);
+  CHECK(usage.code == 2);
+}

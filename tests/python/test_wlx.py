@@ -326,10 +326,22 @@ def test_nan_and_out_of_bound_arguments_are_errors_not_nan_results():
     s = robot.ik()["s"]
     with pytest.raises(wlx.Error, match=r"^rates\.x_C: is not a finite number"):
         robot.dependent_rates(s, {"x_C": float("nan")}, dependent=["y_C", "yaw"])
-    with pytest.raises(wlx.Error, match=r"^u\[1\]: is not a finite number"):
+    # u and u_dot are named by their commanded coordinates (z_C, x_C, roll, pitch here).
+    with pytest.raises(wlx.Error, match=r"^u\.x_C: is not a finite number"):
         robot.inverse_dynamics(s, [0.0, float("nan"), 0.0, 0.0])
-    with pytest.raises(wlx.Error, match=r"^u_dot\[0\]: is not a finite number"):
+    with pytest.raises(wlx.Error, match=r"^u_dot\.z_C: is not a finite number"):
         robot.inverse_dynamics(s, [0.0, 3.0, 0.0, 0.0], u_dot=[float("inf"), 0.0, 0.0, 0.0])
+    # The CLI's bounds: a commanded speed 100 m/s or rad/s, its rate 1e4, a torque 1e9.
+    with pytest.raises(wlx.Error, match=r"^u\.roll: .*bound"):
+        robot.inverse_dynamics(s, [0.0, 0.0, 101.0, 0.0])
+    with pytest.raises(wlx.Error, match=r"^u_dot\.pitch: is beyond the bound of 1e4 rad/s\^2"):
+        robot.inverse_dynamics(s, [0.0, 0.0, 0.0, 0.0], u_dot=[0.0, 0.0, 0.0, 2e4])
+    with pytest.raises(wlx.Error, match=r"^u\.x_C: .*bound"):
+        robot.forward_dynamics(s, [0.0, -1e3, 0.0, 0.0], np.zeros(8))
+    with pytest.raises(wlx.Error, match=r"^tau\.theta_r6: is beyond the bound of 1e9"):
+        robot.forward_dynamics(s, np.zeros(4), [0, 0, 0, 0, 0, 0, 0, 2e9])
+    with pytest.raises(wlx.Error, match=r"^tau\.psi_l2: is not a finite number"):
+        robot.forward_dynamics(s, np.zeros(4), [float("nan"), 0, 0, 0, 0, 0, 0, 0])
     huge = np.array(s, dtype=float)
     huge[robot.coordinates.index("x_C")] = 1e308
     with pytest.raises(wlx.Error, match=r"^s\.x_C: "):

@@ -55,6 +55,8 @@ struct Io {
   bool stdout_closed_pipe = false;  // stdout is a pipe whose reading end is already closed
   bool stdin_pipe = false;     // stdin is a pipe the test writes to (Spawned::stdin_fd)
   fs::path cwd;                // empty: the test's
+  std::string program;         // empty: wlx; else the program to run (args are its arguments)
+  std::string stderr_path;     // empty: captured; else where stderr goes (e.g. /dev/full)
 };
 
 struct Spawned {
@@ -79,7 +81,7 @@ inline Spawned start(const std::vector<std::string>& args, const Io& io = {}) {
   const fs::path in = work_dir() / ("in-" + tag);
   write(in, io.input);
 
-  std::vector<std::string> argv{WLX_BINARY};
+  std::vector<std::string> argv{io.program.empty() ? std::string(WLX_BINARY) : io.program};
   argv.insert(argv.end(), args.begin(), args.end());
   std::vector<char*> cargs;
   for (auto& a : argv) cargs.push_back(a.data());
@@ -104,7 +106,8 @@ inline Spawned start(const std::vector<std::string>& args, const Io& io = {}) {
     const std::string out = io.stdout_path.empty() ? s.out.string() : io.stdout_path;
     posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   }
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, s.err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const std::string err = io.stderr_path.empty() ? s.err.string() : io.stderr_path;
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (!io.cwd.empty()) posix_spawn_file_actions_addchdir_np(&actions, io.cwd.c_str());
   if (io.stdout_closed_pipe) ::close(out_pipe[0]);  // closed before wlx writes anything
   const int spawned = posix_spawn(&s.pid, cargs[0], &actions, nullptr, cargs.data(), environ);
@@ -127,7 +130,7 @@ inline Result finish(const Spawned& s) {
   if (WIFEXITED(status)) r.code = WEXITSTATUS(status);
   if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
   r.out = slurp(s.out);
-  r.err = slurp(s.err);
+  r.err = fs::exists(s.err) ? slurp(s.err) : std::string();
   r.peak_rss_kib = usage.ru_maxrss;
   return r;
 }

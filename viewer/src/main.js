@@ -552,9 +552,12 @@ const ready = (async () => {
   const entry = runId ? index.find((r) => r.id === runId) : null;
   if (runId && !entry) throw new Error(`run '${runId}' is not in runs/index.js (runs: ${index.map((r) => r.id).join(', ') || 'none'})`);
   const modelName = entry ? entry.model : (params.get('model') || index[0]?.model || window.WLX_VIEWER_MODELS[0]);
-  if (!window.WLX_VIEWER_MODELS.includes(modelName))
-    throw new Error(`model '${modelName}': this viewer was built for ${window.WLX_VIEWER_MODELS.join(', ')}`);
-  app.model = await WasmModel.load(modelName, loadScript);
+  // A built-in model's module comes with the page; a model file's (`wlx viewer --model-file`) is
+  // written beside it by wlx: any model whose wasm/wlx_<name>.js is in the folder is drawn.
+  app.model = await WasmModel.load(modelName, loadScript).catch((e) => {
+    throw new Error(`model '${modelName}': ${e.message} (this folder's page came with ${window.WLX_VIEWER_MODELS.join(', ')}; ` +
+                    'wlx viewer --model-file FILE writes a model file\'s own module)');
+  });
   app.info = app.model.info;
   app.branches = new Int32Array(app.info.limbs.length);
   // The nominal pose first, so that a run that fails to load still leaves a machine on screen, and

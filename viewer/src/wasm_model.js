@@ -4,7 +4,7 @@
 
 export class WasmModel {
   static async load(name, loadScript) {
-    if (!/^[a-z][a-z0-9_]*$/.test(name)) throw new Error(`model name '${name}': letters, digits and _ only`);
+    if (!/^[A-Za-z][A-Za-z0-9_]*$/.test(name)) throw new Error(`model name '${name}': a model's name is an identifier (letters, digits, _)`);
     await loadScript(`wasm/wlx_${name}.js`);
     const factory = window[`wlxModule_${name}`];
     if (typeof factory !== 'function') throw new Error(`wasm/wlx_${name}.js did not define wlxModule_${name}`);

@@ -1,0 +1,66 @@
+// One model's computations as functions of run-time sizes: what a binding that names no model
+// (Python's wlx.Model, python/module.cpp) calls, for a built-in model and for a model file's plugin
+// alike. Each model compiles its own (cli/commands/model_api.cpp); the inputs are the JSON the
+// command line reads (so the grammar, the checks and the messages are the CLI's own) and vectors
+// checked against the model's sizes; results are finite, or an error (never NaN torques).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace wlx::cli {
+
+// A named result: a vector (one column) or a matrix.
+struct NamedArray {
+  std::string name;
+  Eigen::MatrixXd value;
+  bool is_vector = true;
+};
+using NamedArrays = std::vector<NamedArray>;
+
+// The model's tables, by name (a JSON object: name, description, coordinates, units, input_count,
+// frames, params (defaults, SI), scenarios, commanded, actuators), as text.
+using ModelInfoText = std::string;
+
+// The torques of a controller in the loop: f(t, s, u) -> tau, one per actuator. Whatever it throws
+// reaches the caller of simulate unchanged.
+using TorqueFunction = std::function<Eigen::VectorXd(double t, const Eigen::VectorXd& s, const Eigen::VectorXd& u)>;
+
+// A run as it streams: `begin` is told the columns and the number of rows that will be kept (it
+// may refuse by throwing), `row` gets each kept row.
+struct SimulationSink {
+  std::function<void(const std::vector<std::string>& header, long kept)> begin;
+  std::function<void(long row, const std::vector<double>& values)> row;
+};
+struct SimulationOutcome {
+  std::string id;
+  bool complete = false;
+  std::string stopped;  // why a run ended early
+  long evaluations = 0;
+  long rows = 0;
+};
+
+struct ModelApi {
+  ModelInfoText (*info)();
+  // `wlx ik`'s answer (JSON text) for a request, and all coordinates.
+  std::pair<Eigen::VectorXd, std::string> (*ik)(const std::string& request_json);
+  // Frame origins (frames x 3) and orientations at s.
+  std::pair<Eigen::MatrixXd, std::vector<Eigen::Matrix3d>> (*fk)(const Eigen::VectorXd& s, const std::string& params_json);
+  // All rates from the inputs' rates, for the dependent pair (empty: the model's); and cond(J_beta).
+  std::pair<Eigen::VectorXd, double> (*dependent_rates)(const Eigen::VectorXd& s, const Eigen::VectorXd& input_rates,
+                                                         const std::vector<std::string>& pair, const std::string& params_json);
+  // tau, Qstar, M, b, Q_gravity, J_beta, sdot.
+  NamedArrays (*inverse_dynamics)(const Eigen::VectorXd& s, const Eigen::VectorXd& u, const Eigen::VectorXd& u_dot,
+                                  const std::string& params_json, const std::string& weighting_json);
+  // u_dot, sddot, sdot, Qstar, M.
+  NamedArrays (*forward_dynamics)(const Eigen::VectorXd& s, const Eigen::VectorXd& u, const Eigen::VectorXd& tau,
+                                  const std::string& params_json);
+  // A scenario (JSON: an object, or a string naming an embedded id or a file), every k-th sample.
+  SimulationOutcome (*simulate)(const std::string& scenario_json, long every, TorqueFunction torques, const SimulationSink& sink);
+};
+
+}  // namespace wlx::cli
