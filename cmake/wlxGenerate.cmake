@@ -1,4 +1,4 @@
-# wlx_generate(TARGET <name> MODEL <file> [NAMESPACE <ns>] [BAKE <name=value>...])
+# wlx_generate(TARGET <name> MODEL <file> [NAMESPACE <ns>] [BAKE <name=value>...] [PYTHON])
 #
 # Runs wlx-gen on a model file at build time (again only when the file or wlx-gen changes) into
 # <build>/wlx_generated/<name>/wlx/gen/ and defines the target <name> to link:
@@ -8,9 +8,13 @@
 #   - with NAMESPACE: the generated headers alone (INTERFACE), in that namespace (the runtime needs
 #     the default one).
 # BAKE name=value bakes parameters in as constants (wlx-gen --bake).
+# PYTHON (not with NAMESPACE) also builds the Python package wlx for this model: the target
+# <name>_python, the module in <build>/wlx_python/<name>/wlx/ (PYTHONPATH=<build>/wlx_python/<name>,
+# then `import wlx; wlx.model("<model>")`: the same API as the installed package's models, with
+# this one built in; wlx.load() works there too). Needs pybind11 and Python's headers.
 # Used by the installed package (lib/cmake/wlx) and, the same way, inside the source tree.
 function(wlx_generate)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "" "TARGET;MODEL;NAMESPACE" "BAKE")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "PYTHON" "TARGET;MODEL;NAMESPACE" "BAKE")
   if(arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "wlx_generate: unknown arguments: ${arg_UNPARSED_ARGUMENTS}")
   endif()
@@ -80,4 +84,64 @@ function(wlx_generate)
     target_link_libraries(${arg_TARGET} PUBLIC wlx::runtime)
   endif()
   add_dependencies(${arg_TARGET} ${arg_TARGET}_wlx_gen)
+  if(arg_PYTHON)
+    if(arg_NAMESPACE)
+      message(FATAL_ERROR "wlx_generate: PYTHON needs the runtime, which NAMESPACE leaves out")
+    endif()
+    wlx_generate_python(${arg_TARGET} ${model_name})
+  endif()
+endfunction()
+
+# The Python package for one model: its commands (the command line's parsing and solving, which
+# Python's API calls, cli/shell/model_api.hpp) compiled for it, and python/module.cpp with a
+# registry that lists it, linked with the shell (wlx::cli_common).
+function(wlx_generate_python target model_name)
+  if(NOT TARGET wlx::cli_common OR NOT WLX_COMMAND_SOURCES)
+    message(FATAL_ERROR "wlx_generate: PYTHON: this wlx was built without its command line (WLX_BUILD_CLI=OFF)")
+  endif()
+  if(NOT COMMAND pybind11_add_module)
+    find_package(Python3 COMPONENTS Interpreter Development.Module REQUIRED)
+    find_package(pybind11 CONFIG REQUIRED)
+  endif()
+  set(dir "${CMAKE_CURRENT_BINARY_DIR}/wlx_python/${target}")
+  # No embedded runs (a model file brings its runs as files), and the registry of this one model.
+  file(CONFIGURE OUTPUT "${dir}/model_${model_name}.cpp" CONTENT "// Written by wlx_generate(PYTHON). Do not edit.
+#include <string>
+#include <utility>
+#include <vector>
+namespace wlx { inline namespace ${model_name} { namespace commands {
+extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios;
+const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios = {};
+extern const char* const kEmbeddedReportFile;
+const char* const kEmbeddedReportFile = \"\";
+} } }
+")
+  file(CONFIGURE OUTPUT "${dir}/registry.cpp" CONTENT "// Written by wlx_generate(PYTHON). Do not edit.
+#include \"commands.hpp\"
+namespace wlx { inline namespace ${model_name} { namespace commands { const cli::ModelCommands& entry(); } } }
+namespace wlx::cli {
+const std::vector<ModelCommands>& models() {
+  static const std::vector<ModelCommands> all{wlx::${model_name}::commands::entry()};
+  return all;
+}
+}  // namespace wlx::cli
+")
+  set(sources ${WLX_COMMAND_SOURCES})
+  list(TRANSFORM sources PREPEND "${WLX_CLI_SOURCE_DIR}/")
+  add_library(${target}_commands STATIC ${sources} "${dir}/model_${model_name}.cpp")
+  set_target_properties(${target}_commands ${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  set_target_properties(${target}_commands PROPERTIES UNITY_BUILD ON)  # they share Eigen's templates
+  target_include_directories(${target}_commands PUBLIC "${WLX_CLI_SOURCE_DIR}/commands")
+  target_link_libraries(${target}_commands PUBLIC ${target} wlx::cli_common)
+  pybind11_add_module(${target}_python MODULE NO_EXTRAS "${WLX_PYTHON_SOURCE_DIR}/module.cpp" "${dir}/registry.cpp")
+  # Link only: the model's WLX_MODEL must not reach module.cpp, which names no model. The shell
+  # whole: a model file's plugin (wlx.load) calls its functions from this module.
+  target_link_libraries(${target}_python PRIVATE $<LINK_ONLY:${target}_commands> wlx::cli_common Eigen3::Eigen)
+  target_link_options(${target}_python PRIVATE "LINKER:--whole-archive" "$<TARGET_FILE:wlx::cli_common>" "LINKER:--no-whole-archive")
+  target_compile_features(${target}_python PRIVATE cxx_std_20)
+  # wlx.load() runs wlx-gen: the package's own.
+  target_compile_definitions(${target}_python PRIVATE WLX_VERSION="${wlx_VERSION}" WLX_BIN_FROM_PYTHON_MODULE="wlx-gen-is-not-here"
+                                                     WLX_BUILD_BIN_DIR="$<TARGET_FILE_DIR:wlx::wlx-gen>")
+  set_target_properties(${target}_python PROPERTIES OUTPUT_NAME _wlx LIBRARY_OUTPUT_DIRECTORY "${dir}/wlx")
+  configure_file("${WLX_PYTHON_SOURCE_DIR}/wlx/__init__.py" "${dir}/wlx/__init__.py" COPYONLY)
 endfunction()

@@ -80,6 +80,29 @@ if [ -d build/install/share/wlx/viewer ]; then
 fi
 echo "installed wlx --model-file: verify ik, simulate, report and viewer of a model file it had not seen"
 
+echo "-- wlx_generate(... PYTHON): the Python package built for a model in a project of one's own"
+# -O0: this checks the package's layout and the module's API; its numbers are the CLI's.
+sed 's/^model: .*/model: python_check/' "$work/installed_check.yaml" > "$work/python_check.yaml"
+cmake -S tests/package/python -B "$work/python" -G Ninja -DCMAKE_PREFIX_PATH="$PWD/build/install" -DCMAKE_CXX_FLAGS=-O0 \
+      -DMODEL="$work/python_check.yaml" > "$work/python-configure.log" || { cat "$work/python-configure.log" >&2; exit 1; }
+cmake --build "$work/python" --parallel "$(nproc)" > "$work/python-build.log" || { tail -50 "$work/python-build.log" >&2; exit 1; }
+PYTHONPATH="$work/python/wlx_python/my_robot" /usr/bin/python3 -c '
+import json, sys, wlx
+assert wlx.models() == ["python_check"], wlx.models()
+robot = wlx.model("python_check")
+answer = robot.ik({"z_C": 1.8})
+cli = json.load(open(sys.argv[1]))
+assert abs(answer["s"][robot.coordinates.index("psi_l2")] - cli["coordinates"]["psi_l2"]) <= 1e-12, (answer, cli)
+run = robot.simulate({"model": "python_check", "rates": {"x_C": 0.5}, "dependent": ["y_C", "yaw"], "duration": 0.2})
+assert run["complete"] and len(run["t"]) == 201, run["stopped"]
+try:
+    robot.simulate(sys.argv[2])
+except wlx.Error as e:
+    assert "the scenario is for model \x27installed_check\x27, not for \x27python_check\x27" in str(e), str(e)
+else:
+    raise AssertionError("a run of another model ran")
+print("wlx_generate(PYTHON): wlx.model(\"python_check\") from", wlx.__file__)' "$work/fk.json" "$work/runs/forward.json"
+
 echo "-- add_subdirectory(), runtime only"
 cmake -S tests/package -B "$work/subdirectory" -G Ninja -DWLX_SOURCE_DIR="$PWD" > "$work/configure.log"
 for needless in GINAC CLI11_DIR nlohmann_json_DIR yaml-cpp_DIR; do

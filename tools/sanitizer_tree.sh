@@ -10,7 +10,9 @@
 # (and the excavator's hip variant): the excavator (two wheels, eight actuators) and the wheeled
 # quadruped (four, sixteen) take every path of the generic runtime and the commands, the walker's
 # runtime is the same code on other numbers, and each sanitized model costs minutes of CI's CPU.
-# The tree is ${WLX_SANITIZER_DIR:-build-sanitize}.
+# The wheeled quadruped enters as a model file's path (models/wheeled_quadruped.yaml), so that CI
+# builds a model from a file as users building from source do. The tree is
+# ${WLX_SANITIZER_DIR:-build-sanitize}.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what=${1:?usage: tools/sanitizer_tree.sh test | fuzz SECONDS}
@@ -29,7 +31,7 @@ if [ ! -f "$tree/CMakeCache.txt" ]; then
   cmake -S . -B "$tree" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_COMPILER=clang++-14 \
         -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -gline-tables-only -DNDEBUG" \
         -DWLX_SANITIZE=ON -DWLX_FUZZ=ON -DWLX_BUILD_BENCHMARKS=OFF -DWLX_BUILD_PYTHON=OFF -DWLX_BUILD_VIEWER=OFF \
-        -DWLX_INSTALL=OFF -DWLX_USE_KDL=OFF "-DWLX_MODELS=excavator;wheeled_quadruped" > /dev/null
+        -DWLX_INSTALL=OFF -DWLX_USE_KDL=OFF "-DWLX_MODELS=excavator;models/wheeled_quadruped.yaml" > /dev/null
 fi
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # CLN and GiNaC keep memory until exit (tools/lsan.supp). print_suppressions=0: the tests compare
@@ -40,6 +42,10 @@ fuzz_targets=(ik_numbers json_input model_file command_line)
 case "$what" in
   test)
     cmake --build "$tree" --parallel "$(nproc)"
+    # The wheeled quadruped is given as a model file (-DWLX_MODELS takes paths): generated into the
+    # build tree, the source tree's generated/ untouched (its freshness test runs below).
+    [ -f "$tree/generated-models/wheeled_quadruped/wlx/gen/all.hpp" ] || {
+      echo "WLX_MODELS' model file was not generated into $tree/generated-models/" >&2; exit 1; }
     ctest --test-dir "$tree" --output-on-failure --parallel "$(nproc)"
     ;;
   fuzz)
