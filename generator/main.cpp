@@ -10,13 +10,20 @@
 #include <wlx/bounded_file.hpp>
 
 #include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <iterator>
 #include <regex>
 #include <set>
 #include <sstream>
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 #ifndef WLX_VERSION
 #define WLX_VERSION "unknown"
@@ -27,14 +34,114 @@ using namespace wlx::codegen;
 
 namespace {
 
+// ---- signals ----
+// SIGINT, SIGTERM and SIGHUP. While wlx-gen derives (GiNaC, possibly minutes, with no place to
+// poll often enough) it has written nothing, so the handler ends the process at once. Once the
+// headers are being written it only records the signal: the writing polls it before every step
+// and unwinds, so the temporaries are removed and the previous header set is restored.
+volatile std::sig_atomic_t received_signal = 0;
+volatile std::sig_atomic_t writing = 0;
+
+const char* signal_message(int signal) {
+  return signal == SIGINT ? "wlx-gen: interrupted (SIGINT)\n" : signal == SIGTERM ? "wlx-gen: terminated (SIGTERM)\n" : "wlx-gen: hung up (SIGHUP)\n";
+}
+
+extern "C" void on_signal(int signal) {
+  received_signal = signal;
+  if (writing) return;
+  // Only async-signal-safe calls here: write(2) and _exit(2).
+  const char* message = signal_message(signal);
+  const ssize_t ignored = ::write(STDERR_FILENO, message, std::strlen(message));
+  static_cast<void>(ignored);
+  ::_exit(128 + signal);
+}
+
+void install_signal_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigemptyset(&action.sa_mask);
+  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) sigaction(signal, &action, nullptr);
+  // A closed stdout is then a write error with a message and exit code 74, not a silent death.
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGPIPE, &ignore, nullptr);
+}
+
+struct Interrupted {
+  int signal;
+};
+
+// A check point of the writing: unwinds (removing temporaries, restoring the old set) on a signal.
+void stop_if_signalled() {
+  if (const int signal = received_signal) throw Interrupted{signal};
+}
+
+// Everything wlx-gen prints goes through here, and stdout is checked when flushed: a full disk or
+// a closed pipe is an output error (exit 74), not a success with the output lost.
+void write_stdout(const std::string& text) {
+  if (!text.empty() && std::fwrite(text.data(), 1, text.size(), stdout) != text.size())
+    throw wlx::OutputError("stdout", std::strerror(errno));
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) throw wlx::OutputError("stdout", std::strerror(errno));
+}
+
+// The replacement of a header set: each header renamed over the old one, which stays reachable
+// under a backup name (a hard link, created exclusively) until all are in place. Unless keep()
+// is called (a failed rename, a signal), the destructor undoes every replacement in reverse, so
+// the folder holds the previous set again, and removes the backups.
+class SetReplacement {
+ public:
+  SetReplacement() = default;
+  SetReplacement(const SetReplacement&) = delete;
+  SetReplacement& operator=(const SetReplacement&) = delete;
+  ~SetReplacement() {
+    for (auto step = steps_.rbegin(); step != steps_.rend(); ++step) {
+      if (!kept_ && step->renamed) {
+        if (step->backup.empty()) ::unlink(step->path.c_str());  // a header that was not there before
+        else if (::rename(step->backup.c_str(), step->path.c_str()) == 0) continue;
+      }
+      if (!step->backup.empty()) ::unlink(step->backup.c_str());
+    }
+  }
+
+  void replace(wlx::AtomicFile& file) {
+    Step step{file.path(), {}, false};
+    struct stat old {};
+    // Regular files and links are kept (a link as itself: link(2) does not follow it); anything
+    // else under a header's name makes the rename fail, which undoes the set.
+    if (::lstat(step.path.c_str(), &old) == 0 && (S_ISREG(old.st_mode) || S_ISLNK(old.st_mode))) {
+      for (int attempt = 0; step.backup.empty(); ++attempt) {
+        const std::string name = fmt::format("{}.{}-{}.old", step.path, static_cast<long>(::getpid()), attempt);
+        if (::link(step.path.c_str(), name.c_str()) == 0) step.backup = name;
+        else if (errno != EEXIST || attempt >= 100)
+          throw wlx::OutputError(step.path, fmt::format("cannot keep the previous version while replacing it ({})", std::strerror(errno)));
+      }
+    }
+    steps_.push_back(step);
+    file.commit();
+    steps_.back().renamed = true;
+  }
+  void keep() { kept_ = true; }
+
+ private:
+  struct Step {
+    std::string path, backup;  // backup: the previous header's second name; empty when there was none
+    bool renamed;
+  };
+  std::vector<Step> steps_;
+  bool kept_ = false;
+};
+
 // The header set is replaced as a whole: every changed header is first written and synced under
 // a unique temporary name beside it (created with O_EXCL, so a planted file or symlink there is
 // never written through; wlx::AtomicFile), and only when all are complete are they renamed into
-// place. A full disk or any other failure leaves the previous set intact and no temporary behind
-// (the AtomicFiles' destructors remove them). Unchanged headers keep their time stamps.
+// place (SetReplacement). A full disk, a failed rename, a signal or any other failure leaves the
+// previous set intact and no temporary behind (the AtomicFiles' destructors remove them).
+// Unchanged headers keep their time stamps.
 int write_header_set(const fs::path& out_dir, const std::vector<EmittedFile>& files) {
   std::vector<std::unique_ptr<wlx::AtomicFile>> pending;
   for (const auto& f : files) {
+    stop_if_signalled();
     const fs::path path = out_dir / f.path;
     // A header's size is far below the bound; an old "header" that is a device or a link to one
     // is simply replaced (the rename replaces the link, not its target).
@@ -45,10 +152,17 @@ int write_header_set(const fs::path& out_dir, const std::vector<EmittedFile>& fi
     if (error) throw wlx::OutputError(path.parent_path().string(), fmt::format("cannot create the folder ({})", error.message()));
     auto file = std::make_unique<wlx::AtomicFile>(path.string());
     file->write(f.text);
+    stop_if_signalled();
     file->finish();
     pending.push_back(std::move(file));
   }
-  for (auto& file : pending) file->commit();
+  SetReplacement replacement;
+  for (auto& file : pending) {
+    stop_if_signalled();
+    replacement.replace(*file);
+  }
+  stop_if_signalled();
+  replacement.keep();
   return static_cast<int>(pending.size());
 }
 
@@ -100,10 +214,17 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "print nothing on success");
   app.add_flag("--stats", stats_only, "print the operation-count table (always printed unless --quiet)");
   app.set_version_flag("--version", WLX_VERSION, "print the version and exit");
+  install_signal_handlers();
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --version
-    return app.exit(e);
+    const int code = app.exit(e);
+    std::cout.flush();
+    if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+      wlx::diagnose("wlx-gen: error: stdout: {}\n", std::strerror(errno));
+      return 74;
+    }
+    return code;
   } catch (const CLI::ParseError& e) {
     // Like every bad input: the option and the reason, exit code 2.
     wlx::diagnose("wlx-gen: error: {}\n", e.what());
@@ -141,7 +262,7 @@ int main(int argc, char** argv) {
       throw ModelFileError("--with: only a URDF as MODEL takes --with (a model file names its URDF with `urdf:`)");
     }
     if (print_model) {
-      std::cout << print_model_file(model_path, urdf_path);
+      write_stdout(print_model_file(model_path, urdf_path));
       return 0;
     }
     if (out_dir.empty()) throw ModelFileError("--out is required (the output root; headers go to OUT/wlx/gen/)");
@@ -203,24 +324,34 @@ int main(int argc, char** argv) {
     std::vector<std::string> ik_report;
     files.push_back(emit_ik_header(model, opt, ik_report));
     files.push_back(emit_umbrella(model, fns, stats, opt));
+    writing = 1;  // from here a signal is polled (stop_if_signalled), so that the writing can undo itself
     const int changed = write_header_set(out_dir, files);
     const int removed = remove_stale(out_dir, files);
+    writing = 0;
+    if (const int signal = received_signal) throw Interrupted{signal};  // the new set is whole; still stop as asked
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!quiet || stats_only) {
-      fmt::print("{:<14} {:>8} {:>12} {:>11} {:>9}\n", "function", "temps", "ops before", "ops after", "seconds");
+      std::string report;
+      const auto out = std::back_inserter(report);
+      fmt::format_to(out, "{:<14} {:>8} {:>12} {:>11} {:>9}\n", "function", "temps", "ops before", "ops after", "seconds");
       long b = 0, a = 0;
       for (const auto& s : stats) {
-        fmt::print("{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", s.name, s.intermediates, s.before_cse.total(),
+        fmt::format_to(out, "{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", s.name, s.intermediates, s.before_cse.total(),
                    s.after_cse.total(), s.seconds);
         b += s.before_cse.total();
         a += s.after_cse.total();
       }
-      fmt::print("{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", "total", "", b, a, total);
-      for (const auto& line : ik_report) fmt::print("closed-form IK, {}\n", line);
-      fmt::print("model built in {:.3f} s; {} files written to {} ({} changed{})\n",
+      fmt::format_to(out, "{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", "total", "", b, a, total);
+      for (const auto& line : ik_report) fmt::format_to(out, "closed-form IK, {}\n", line);
+      fmt::format_to(out, "model built in {:.3f} s; {} files written to {} ({} changed{})\n",
                  std::chrono::duration<double>(t1 - t0).count(), files.size(), out_dir, changed,
                  removed ? fmt::format(", {} stale removed", removed) : "");
+      write_stdout(report);
     }
+  } catch (const Interrupted& e) {
+    // The shell's convention: 128 + the signal (130 SIGINT, 143 SIGTERM, 129 SIGHUP).
+    wlx::diagnose("{}", signal_message(e.signal));
+    return 128 + e.signal;
   } catch (const ModelFileError& e) {
     wlx::diagnose("wlx-gen: error: {}\n", e.what());
     return 2;

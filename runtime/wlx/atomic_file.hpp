@@ -68,9 +68,10 @@ inline AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   if (path_.empty()) throw OutputError("(empty path)", "cannot write a file without a name");
   for (int attempt = 0; attempt < 100 && fd_ < 0; ++attempt) {
     temporary_ = fmt::format("{}.{}-{}.tmp", path_, static_cast<long>(::getpid()), detail::temporary_counter++);
-    // O_EXCL: never reuse (or follow a symlink planted at) a temporary name. 0666: the umask
-    // applies, so the finished file gets the same permissions as one written directly.
-    fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    // O_EXCL: never reuse (or follow a symlink planted at) a temporary name; O_NOFOLLOW says the
+    // same to systems whose O_EXCL would not. 0666: the umask applies, so the finished file gets
+    // the same permissions as one written directly.
+    fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
     if (fd_ < 0 && errno != EEXIST) break;
   }
   if (fd_ < 0) {

@@ -11,6 +11,10 @@
 #include <sys/statvfs.h>
 
 #include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <thread>
 #include <cerrno>
 #include <cstring>
 #include <map>
@@ -275,6 +279,112 @@ TEST_CASE("wlx-gen: a full disk exits 74 naming the header; the previous header 
   CHECK(r.err.find("No space left on device") != std::string::npos);
   CHECK(tree(out) == before);  // byte for byte the earlier set, nothing added
   ::umount2(disk.c_str(), MNT_DETACH);
+}
+
+TEST_CASE("wlx-gen: a rename that fails midway leaves the previous header set whole, no temporary or backup left") {
+  const std::filesystem::path dir = wlx_test::work_dir() / "rename-fails", out = dir / "out", gen = out / "wlx" / "gen";
+  std::filesystem::create_directories(dir);
+  REQUIRE(wlx_test::run({WLX_ARM_MODEL_FILE, "--out", out.string(), "--quiet"}).code == 0);
+  // all.hpp is renamed last: a folder under its name makes that rename fail after the others
+  // were renamed, so they have to be put back.
+  std::filesystem::remove(gen / "all.hpp");
+  std::filesystem::create_directories(gen / "all.hpp");
+  wlx_test::write(gen / "all.hpp" / "keep", "x");
+  const auto before = tree(out);
+  REQUIRE(before.size() > 5);
+  const std::filesystem::path model = dir / "arm-changed.yaml";
+  wlx_test::write(model, replaced(arm_text(), "value: 0.6, unit: m", "value: 0.61, unit: m"));  // every header changes
+  const auto r = wlx_test::run({model.string(), "--out", out.string(), "--quiet"});
+  CAPTURE(r.err);
+  CHECK(r.code == 74);
+  CHECK(r.err.find("all.hpp: rename into place failed") != std::string::npos);
+  CHECK(tree(out) == before);  // byte for byte the earlier set, nothing added
+}
+
+namespace {
+
+// A fixed-base arm of n links, each with a body: its dynamics take wlx-gen about a second for
+// n = 60, long enough to be interrupted while deriving.
+std::string long_arm(int n) {
+  std::string t = "model: long_arm\nparameters:\n"
+                  "  - {name: l, value: 0.3, unit: m, kind: length, meaning: link length}\n"
+                  "  - {name: m, value: 1, unit: kg, kind: mass, meaning: link mass}\n"
+                  "  - {name: Ia, value: 0.004, unit: kg*m^2, kind: inertia, meaning: along}\n"
+                  "  - {name: Ib, value: 0.09, unit: kg*m^2, kind: inertia, meaning: across}\n"
+                  "  - {name: g, value: 9.81, unit: m/s^2, kind: gravity, meaning: gravity}\n"
+                  "coordinates:\n  inputs:\n";
+  std::string frames = "frames:\n", bodies = "bodies:\n", joints;
+  for (int k = 0; k < n; ++k) {
+    const std::string q = "q" + std::to_string(k), f = "f" + std::to_string(k);
+    t += "    - {name: " + q + ", unit: rad, meaning: joint}\n";
+    frames += "  - {name: " + f + ", parent: " + (k == 0 ? std::string("K0") : "f" + std::to_string(k - 1)) +
+              ", chain: [translate: [l, 0, 0], " + (k % 2 ? "ry: " : "rz: ") + q + "]}\n";
+    bodies += "  - {name: b" + std::to_string(k) + ", frame: " + f + ", com: [l/2, 0, 0], mass: m, inertia: [Ia, Ib, Ib]}\n";
+    joints += (k ? ", " : "") + q;
+  }
+  return t + frames + bodies + "dynamics:\n  gravity: g\n  commanded: [" + joints + "]\n  actuated: [" + joints + "]\n";
+}
+
+// Whether the process has handlers for SIGINT, SIGTERM and SIGHUP (its SigCgt mask in /proc):
+// a signal sent before would find the default action and prove nothing about wlx-gen.
+bool catches_signals(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("SigCgt:", 0) == 0) {
+      const unsigned long long mask = std::stoull(line.substr(7), nullptr, 16);
+      const auto bit = [&](int s) { return (mask >> (s - 1)) & 1ULL; };
+      return bit(SIGINT) && bit(SIGTERM) && bit(SIGHUP);
+    }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("wlx-gen: SIGINT, SIGTERM and SIGHUP stop it at once with 128 + signal; the previous header set stays, no temporary") {
+  const std::filesystem::path dir = wlx_test::work_dir() / "signals", out = dir / "out";
+  std::filesystem::create_directories(dir);
+  wlx_test::write(dir / "long_arm.yaml", long_arm(60));
+  REQUIRE(wlx_test::run({WLX_ARM_MODEL_FILE, "--out", out.string(), "--quiet"}).code == 0);
+  const auto before = tree(out);
+  for (const auto& [signal, code] : std::vector<std::pair<int, int>>{{SIGINT, 130}, {SIGTERM, 143}, {SIGHUP, 129}}) {
+    const int sent = signal;  // a copy: clang 14 cannot capture a structured binding
+    CAPTURE(sent);
+    const auto spawned = wlx_test::start({(dir / "long_arm.yaml").string(), "--out", out.string(), "--quiet"});
+    const auto started = std::chrono::steady_clock::now();
+    while (!catches_signals(spawned.pid) && std::chrono::steady_clock::now() - started < std::chrono::seconds(10))
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const auto signalled = std::chrono::steady_clock::now();
+    REQUIRE(::kill(spawned.pid, signal) == 0);
+    const auto r = wlx_test::finish(spawned);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - signalled).count();
+    CAPTURE(r.err);
+    CHECK(r.signal == 0);
+    CHECK(r.code == code);
+    CHECK(r.err.find(signal == SIGINT ? "interrupted (SIGINT)" : signal == SIGTERM ? "terminated (SIGTERM)" : "hung up (SIGHUP)") !=
+          std::string::npos);
+    CHECK(seconds < 0.5);  // the model alone takes about a second
+    CHECK(tree(out) == before);  // nothing of the long arm's set, no temporary
+  }
+}
+
+TEST_CASE("wlx-gen: stdout that cannot be written exits 74 naming stdout") {
+  const std::filesystem::path out = wlx_test::work_dir() / "stdout-full";
+  const std::vector<std::vector<std::string>> runs = {
+      {WLX_ARM_MODEL_FILE, "--print-model"}, {WLX_ARM_MODEL_FILE, "--out", out.string()}, {"--version"}};
+  for (const auto& args : runs) {
+    const std::string shown = args.back();
+    CAPTURE(shown);
+    const auto full = wlx_test::run(args, {.stdout_path = "/dev/full"});
+    CAPTURE(full.err);
+    CHECK(full.code == 74);
+    CHECK(full.err.find("wlx-gen: error: stdout: No space left on device") != std::string::npos);
+    const auto closed = wlx_test::run(args, {.stdout_closed_pipe = true});
+    CAPTURE(closed.err);
+    CHECK(closed.signal == 0);  // not killed by SIGPIPE
+    CHECK(closed.code == 74);
+    CHECK(closed.err.find("wlx-gen: error: stdout: Broken pipe") != std::string::npos);
+  }
 }
 
 #ifdef WLX_HAVE_URDF_TESTS
