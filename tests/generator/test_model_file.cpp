@@ -324,6 +324,43 @@ TEST_CASE("model file: an expression that is NaN, complex, infinite or singular 
   CHECK(with("sqrt(a)/a") == "");
 }
 
+TEST_CASE("model file: an expression finite in exact arithmetic but not in double names its field and the operation") {
+  const auto with = [](const std::string& expression) {
+    return error_of(tiny_model(fmt::format("  - {{name: base, parent: K0, chain: [rz: q, tx: {}]}}\n", expression)));
+  };
+  // e exactly; in double exp(1000) and exp(999) are both inf, so the emitted code computes inf/inf.
+  const std::string ratio = with("exp(1000)/exp(999)");
+  CAPTURE(ratio);
+  CHECK(ratio.rfind("hostile.yaml:8:", 0) == 0);
+  CHECK(ratio.find("frames[0].chain[1].tx: 'exp(1000)/exp(999)' evaluates to nan in double at the default parameters "
+                   "(overflow: exp(") != std::string::npos);  // exp(1000) or exp(999), whichever GiNaC orders first
+  // The same through a parameter (a = 0.5).
+  const std::string through_a = with("exp(a*2000)/exp(a*1998)");
+  CAPTURE(through_a);
+  CHECK(through_a.find("evaluates to nan in double at the default parameters (overflow: exp(") != std::string::npos);
+  CHECK(with("exp(700)/exp(699)") == "");  // both within double's range
+}
+
+TEST_CASE("model file: a pole, a complex value or a domain error at the default parameters is an error naming the field") {
+  const std::string text = "model: tiny\n"
+                           "parameters:\n"
+                           "  - {name: a, value: 1, unit: m, kind: length, meaning: a length}\n"
+                           "  - {name: b, value: 1, unit: m, kind: length, meaning: another}\n"
+                           "coordinates:\n  inputs:\n    - {name: q, unit: rad, meaning: a joint}\n"
+                           "frames:\n  - {name: base, parent: K0, chain: [rz: q, translate: [0, EXPR, 0]]}\n";
+  const auto with = [&](const std::string& expression) {
+    std::string t = text;
+    return error_of(t.replace(t.find("EXPR"), 4, expression));
+  };
+  const std::string pole = with("1/(a-b)");
+  CAPTURE(pole);
+  CHECK(pole.rfind("hostile.yaml:9:", 0) == 0);
+  CHECK(pole.find("frames[0].chain[1].translate[1]: '1/(a-b)' at the default parameters is singular") != std::string::npos);
+  CHECK(with("acos(2*a)").find("translate[1]: 'acos(2*a)' at the default parameters is complex") != std::string::npos);
+  CHECK(with("sqrt(a-2)").find("translate[1]: 'sqrt(a-2)' at the default parameters is complex") != std::string::npos);
+  CHECK(with("1/(a-b+1)") == "");
+}
+
 // Wheel drives on hubs (the quadruped's): their names, and the mistakes a file can make with them.
 TEST_CASE("model file: a wheel on a hub may be driven; the drive's name and its mistakes") {
   std::ifstream in(WLX_SOURCE_DIR "/tests/models/quadruped.yaml");
