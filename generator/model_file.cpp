@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <ginac/ginac.h>
+#include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 #include <wlx/bounded_file.hpp>
 #include <wlx/text.hpp>
@@ -1701,23 +1703,107 @@ std::string did_you_mean(const std::string& name, const std::vector<std::string>
 
 namespace {
 
-YAML::Node load_yaml(const std::string& text, const std::string& source_name) {
-  // yaml-cpp reads nested flow collections recursively: bound the depth before it sees the text.
-  int depth = 0, line = 1;
-  for (char c : text) {
-    if (c == '\n') ++line;
-    if (c == '[' || c == '{') {
-      if (++depth > 64)
-        throw ModelFileError(fmt::format("{}:{}: lists and maps nest more than 64 levels deep", source_name, line));
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
+// A first pass over the file's parse events, before yaml-cpp builds nodes. Its Node API keeps both
+// entries of a key given twice but answers a lookup with one of them, and a key that is a list or
+// a map has no name to report; here each key is seen with its place. Bounding the nesting here
+// (yaml-cpp recurses once per level) also counts real collections only, not brackets inside
+// quoted strings or comments.
+class KeyCheck : public YAML::EventHandler {
+ public:
+  static constexpr std::size_t kMaxNesting = 64;
+
+  explicit KeyCheck(const Source& source) : source_(source) {}
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string& value) override {
+    if (at_key()) key(mark, value);
+    else value_done();
   }
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override {
+    if (at_key()) source_.fail(mark, stack_.back().path, "a key is empty: keys are names");
+    value_done();
+  }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
+    if (at_key()) source_.fail(mark, stack_.back().path, "a key is an alias (*name): keys are names");
+    value_done();
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    open(mark, false);
+  }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    open(mark, true);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapEnd() override { close(); }
+
+ private:
+  struct Level {
+    bool map;
+    std::string path;
+    std::size_t index = 0;                // a list's next element
+    bool expecting_key = true;            // a map's next event is a key
+    std::string key;                      // a map's current key
+    std::map<std::string, int> key_line;  // a map's keys so far, with their lines
+  };
+
+  bool at_key() const { return !stack_.empty() && stack_.back().map && stack_.back().expecting_key; }
+
+  // The path of the value that starts now (the parser's own paths: frames[3].chain).
+  std::string child_path() const {
+    if (stack_.empty()) return "";
+    const Level& top = stack_.back();
+    if (!top.map) return fmt::format("{}[{}]", top.path, top.index);
+    return top.path.empty() ? top.key : top.path + "." + top.key;
+  }
+
+  void key(const YAML::Mark& mark, const std::string& name) {
+    Level& top = stack_.back();
+    top.key = name;
+    const auto [first, added] = top.key_line.emplace(name, mark.line + 1);
+    if (!added) source_.fail(mark, child_path(), fmt::format("given twice (first at line {})", first->second));
+    top.expecting_key = false;
+  }
+
+  void value_done() {
+    if (stack_.empty()) return;
+    Level& top = stack_.back();
+    if (top.map) top.expecting_key = true;
+    else ++top.index;
+  }
+
+  void open(const YAML::Mark& mark, bool map) {
+    if (at_key())
+      source_.fail(mark, stack_.back().path, fmt::format("a key is a {}: keys are names", map ? "map" : "list"));
+    // The place says where; a path 64 levels long would not say more.
+    if (stack_.size() >= kMaxNesting)
+      source_.fail(mark, "", fmt::format("lists and maps nest more than {} levels deep (the limit)", kMaxNesting));
+    stack_.push_back({map, child_path(), 0, true, {}, {}});
+  }
+
+  void close() {
+    stack_.pop_back();
+    value_done();
+  }
+
+  const Source& source_;
+  std::vector<Level> stack_;
+};
+
+YAML::Node load_yaml(const std::string& text, const std::string& source_name) {
+  const Source source{source_name};
   YAML::Node root;
   try {
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    KeyCheck check(source);
+    parser.HandleNextDocument(check);
     root = YAML::Load(text);
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp's own guard (its message is only "bad file"); the check above stops first.
+    source.fail(e.mark, "", fmt::format("lists and maps nest more than {} levels deep (the limit)", KeyCheck::kMaxNesting));
   } catch (const YAML::Exception& e) {
-    throw ModelFileError(fmt::format("{}:{}:{}: not valid YAML: {}", source_name, e.mark.line + 1, e.mark.column + 1, e.msg));
+    source.fail(e.mark, "", fmt::format("not valid YAML: {}", e.msg));
   }
   if (!root.IsMap()) throw ModelFileError(fmt::format("{}: the model file must be a YAML map (model:, parameters:, ...)", source_name));
   return root;

@@ -120,7 +120,7 @@ TEST_CASE("model file: every kind of mistake names the place, the field and the 
       {"a C++ keyword as a name", "{name: roll, unit: rad", "{name: int, unit: rad", {"'int' cannot be used as a name", "C++ keyword"}},
       {"a name that is not an identifier", "{name: roll, unit: rad", "{name: 2roll, unit: rad", {"'2roll' is not a name"}},
       {"a power that would not finish", "[cxd/2, <sign>*cyd/2, 0]", "[cxd/2, 9^9^9, 0]", {"an exponent is a small integer"}},
-      {"flow collections nested too deep", "  - {name: cxd, value: 3.0,", "  - {name: cxd, value: [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[3]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]],",
+      {"flow collections nested too deep", "  - {name: cxd, value: 3.0,", "  - {name: cxd, value: [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[3]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]],",
        {"nest more than 64 levels"}, false},
       {"a gravity parameter of the wrong kind", "  gravity: g", "  gravity: w", {"'w' is a parameter of kind length; one of kind gravity"}},
       {"a drive for a wheel whose contact frame the file builds", "actuated: [psi_l2,", "actuated: [{wheel: l}, psi_l2,",
@@ -189,6 +189,44 @@ std::string error_of(const std::string& text) {
 
 TEST_CASE("model file: the tiny model the hostile cases start from reads") {
   CHECK(error_of(tiny_model("  - {name: base, parent: K0, chain: [rz: q]}\n")) == "");
+}
+
+TEST_CASE("model file: a key given twice is an error naming the key and both lines") {
+  const std::string frames = "  - {name: base, parent: K0, chain: [rz: q]}\n";
+  const std::string top = error_of(tiny_model(frames) + "model: other\n");
+  CAPTURE(top);
+  CHECK(top == "hostile.yaml:9:1: model: given twice (first at line 1)");
+  const std::string in_flow = error_of(tiny_model("  - {name: base, parent: K0, name: other, chain: [rz: q]}\n"));
+  CAPTURE(in_flow);
+  CHECK(in_flow == "hostile.yaml:8:30: frames[0].name: given twice (first at line 8)");
+  const std::string in_block = error_of(tiny_model(frames) + "nominal:\n  q: 0.1\n  q: 0.2\n");
+  CAPTURE(in_block);
+  CHECK(in_block == "hostile.yaml:11:3: nominal.q: given twice (first at line 10)");
+}
+
+TEST_CASE("model file: a key that is a list or a map is reported with its place") {
+  const std::string frames = "  - {name: base, parent: K0, chain: [rz: q]}\n";
+  const std::string list_key = error_of(tiny_model(frames) + "? [a, b]\n: 1\n");
+  CAPTURE(list_key);
+  CHECK(list_key == "hostile.yaml:9:3: a key is a list: keys are names");
+  const std::string map_key = error_of(tiny_model("  - {name: base, parent: K0, chain: [{[1]: 2}]}\n"));
+  CAPTURE(map_key);
+  CHECK(map_key == "hostile.yaml:8:39: frames[0].chain[0]: a key is a list: keys are names");
+}
+
+TEST_CASE("model file: nesting is bounded with a message naming the limit; brackets in strings and comments do not count") {
+  const std::string frames = "  - {name: base, parent: K0, chain: [rz: q]}\n";
+  const std::string brackets(70, '[');
+  CHECK(error_of(tiny_model(frames) + "description: \"" + brackets + "\"\n") == "");
+  CHECK(error_of(tiny_model(frames) + "description: '" + brackets + "'\n") == "");
+  CHECK(error_of(tiny_model(frames) + "# " + brackets + "\n") == "");
+  CHECK(error_of(tiny_model(frames + "  # " + brackets + "\n")) == "");
+  // Block lists 600 deep: yaml-cpp's own guard (500) said only "bad file".
+  std::string deep = "description:\n";
+  for (int k = 0; k < 600; ++k) deep += "- ";
+  const std::string message = error_of(tiny_model(frames) + deep + "x\n");
+  CAPTURE(message);
+  CHECK(message == "hostile.yaml:10:127: lists and maps nest more than 64 levels deep (the limit)");  // the 64th "- "
 }
 
 TEST_CASE("model file: a cycle through 10^5 frames is an error, not a stack overflow") {
