@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <iterator>
 #include <regex>
@@ -274,11 +275,14 @@ int main(int argc, char** argv) {
         if (kind == ParameterKind::length || kind == ParameterKind::offset || kind == ParameterKind::angle)
           opt.baked[model.parameters[k].name] = model.parameters[k].default_value;
       }
+    std::map<std::string, std::string> baked_by;  // NAME -> its --bake argument: a second one would silently win
     for (const auto& arg : bake_args) {
       const auto eq = arg.find('=');
       const std::string shown = arg.substr(0, 60);
       if (eq == std::string::npos) throw ModelFileError(fmt::format("--bake {}: expected NAME=VALUE", shown));
       const std::string name = arg.substr(0, eq);
+      if (const auto [first, added] = baked_by.emplace(name, shown); !added)
+        throw ModelFileError(fmt::format("--bake {}: '{}' is given twice (first as --bake {})", shown, name.substr(0, 60), first->second));
       std::vector<std::string> names;
       std::size_t index = model.parameters.size();
       for (std::size_t k = 0; k < model.parameters.size(); ++k) {

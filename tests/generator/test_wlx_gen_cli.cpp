@@ -40,6 +40,7 @@ TEST_CASE("wlx-gen: every bad option or value exits 2 with the reason, and write
       {"not a number", {"--bake", "legD=abc"}, "the value of 'legD' is not a finite number"},
       {"infinite", {"--bake", "legD=inf"}, "the value of 'legD' is not a finite number"},
       {"no value", {"--bake", "legD"}, "expected NAME=VALUE"},
+      {"the same parameter baked twice", {"--bake", "legD=1.6", "--bake", "legD=1.7"}, "--bake legD=1.7: 'legD' is given twice (first as --bake legD=1.6)"},
       {"code in the namespace", {"--namespace", "x { } int evil(){return 1;} namespace y"}, "is not a C++ qualified name"},
       {"namespace starting with a digit", {"--namespace", "1bad"}, "is not a C++ qualified name"},
       {"unknown option", {"--bogus"}, "--bogus"},
