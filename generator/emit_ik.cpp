@@ -1048,7 +1048,14 @@ inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& c
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
   const Scalar r = std::sqrt(a * a + b * b);
-  if (!(r > 0)) return false;
+  if (!(r > 0)) {
+    // The joint does not move what it solves for: the reachable range is the one value c = 0
+    // (reported as [v, v]), where every x solves; x = 0 is the root nearest zero.
+    if (!(std::abs(c) <= ik_reach_slack<Scalar>())) return false;
+    cos_x = 1;
+    sin_x = 0;
+    return true;
+  }
   Scalar ratio = c / r;
   if (!(std::abs(ratio) <= 1)) {
     if (!(std::abs(ratio) <= 1 + ik_reach_slack<Scalar>())) return false;

@@ -388,6 +388,32 @@ TEST_CASE("wlx-gen: stdout that cannot be written exits 74 naming stdout") {
   }
 }
 
+TEST_CASE("wlx-gen: the closed-form IK accepts a target on a one-value range ([v, v]) and refuses one beside it") {
+  // A joint that does not move what it solves for (a lever whose point row does not depend on it)
+  // leaves a cos x + b sin x = c with a = b = 0: reachable only at c = 0, where every x solves.
+  const std::filesystem::path dir = wlx_test::work_dir() / "one-value-range";
+  std::filesystem::create_directories(dir);
+  REQUIRE(wlx_test::run({WLX_MODEL_FILE, "--out", (dir / "out").string(), "--quiet"}).code == 0);
+  wlx_test::write(dir / "check.cpp", R"(#include <wlx/gen/ik.hpp>
+#include <cmath>
+using namespace wlx::excavator::gen;
+int main() {
+  double c = 0, s = 0;
+  if (!ik_solve_cos_sin(0.0, 0.0, 0.0, false, c, s) || c != 1 || s != 0) return 1;  // x = 0, nearest zero
+  if (!ik_solve_cos_sin(0.0, 0.0, 1e-14, true, c, s) || c != 1 || s != 0) return 2;  // rounding
+  if (ik_solve_cos_sin(0.0, 0.0, 1e-6, false, c, s)) return 3;                       // beside the value
+  if (!ik_solve_cos_sin(2.0, 0.0, 1.0, false, c, s) || std::abs(c - 0.5) > 1e-15) return 4;  // a regular range
+  return 0;
+}
+)");
+  const auto compiled = wlx_test::run({"-std=c++17", "-isystem", WLX_EIGEN_INCLUDE, "-I", (dir / "out").string(),
+                                       (dir / "check.cpp").string(), "-o", (dir / "check").string()},
+                                      {.program = WLX_TEST_CXX});
+  CAPTURE(compiled.err);
+  REQUIRE(compiled.code == 0);
+  CHECK(wlx_test::run({}, {.program = (dir / "check").string()}).code == 0);
+}
+
 #ifdef WLX_HAVE_URDF_TESTS
 namespace {
 
