@@ -301,12 +301,11 @@ int main(int argc, char** argv) {
       }
       if (used == 0 || used != arg.size() - eq - 1 || !std::isfinite(value))
         throw ModelFileError(fmt::format("--bake {}: the value of '{}' is not a finite number", shown, name));
-      // Baked values obey the rules of the parameter's kind, as values given at run time do.
+      // Baked values obey the rules of the parameter's kind, as the model file's values do.
       const ParameterKind kind = model.parameter_kinds[index];
-      if ((kind == ParameterKind::length || kind == ParameterKind::mass || kind == ParameterKind::inertia) && !(value > 0))
-        throw ModelFileError(fmt::format("--bake {}: '{}' is a {}, which must be positive", shown, name, kind_name(kind)));
-      if (kind == ParameterKind::gravity && !(value >= 0))
-        throw ModelFileError(fmt::format("--bake {}: '{}' is gravity, which must be non-negative", shown, name));
+      if (const std::string why = parameter_value_problem(kind, value); !why.empty())
+        throw ModelFileError(fmt::format("--bake {}: '{}' is {}, which {}", shown, name,
+                                         kind == ParameterKind::gravity ? std::string("gravity") : fmt::format("a {}", kind_name(kind)), why));
       opt.baked[name] = value;
     }
 

@@ -1097,9 +1097,8 @@ class Parser {
         f["unit"].fail(fmt::format("a parameter of kind {} has unit {}, not '{}'", kind, k->second.second, excerpt(unit)));
       const double value = f["value"].number();
       const ParameterKind pk = k->second.first;
-      if ((pk == ParameterKind::length || pk == ParameterKind::mass || pk == ParameterKind::inertia) && !(value > 0))
-        f["value"].fail(fmt::format("a {} must be positive, got {}", kind, value));
-      if (pk == ParameterKind::gravity && !(value >= 0)) f["value"].fail(fmt::format("gravity must be non-negative, got {}", value));
+      if (const std::string why = parameter_value_problem(pk, value); !why.empty())
+        f["value"].fail(fmt::format("{} {}, got {}", pk == ParameterKind::gravity ? "gravity" : "a " + kind, why, value));
       m_.parameters.push_back({n, value, unit, f.optional("meaning") ? f["meaning"].text() : "", GiNaC::realsymbol(n)});
       m_.parameter_kinds.push_back(pk);
       params_[n] = m_.parameters.back().symbol;
@@ -1695,6 +1694,13 @@ std::string model_name_problem(const std::string& name) {
   static const std::set<std::string> taken = {"wlx", "gen", "detail", "cli", "commands", "report", "text", "dopri", "codegen"};
   if (taken.count(name)) return "wlx and its runtime use that namespace name themselves";
   return cpp_name_problem(name);
+}
+
+std::string parameter_value_problem(ParameterKind kind, double value) {
+  if ((kind == ParameterKind::length || kind == ParameterKind::mass || kind == ParameterKind::inertia) && !(value > 0))
+    return "must be positive";
+  if (kind == ParameterKind::gravity && !(value >= 0)) return "must be non-negative";
+  return {};
 }
 
 std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates) {

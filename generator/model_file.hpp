@@ -40,6 +40,10 @@ std::string cpp_name_problem(const std::string& name);
 // The same for the model's name, which also must not be one of wlx's own namespaces.
 std::string model_name_problem(const std::string& name);
 
+// Why `value` cannot be the value of a parameter of this kind ("must be positive"), or "" when it
+// can: the one rule for the model file's values and for wlx-gen's --bake.
+std::string parameter_value_problem(ParameterKind kind, double value);
+
 // " (did you mean 'x'?)" when one of the candidates is close to `name`, else "".
 std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates);
 

@@ -37,7 +37,7 @@ export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktra
 # CLN and GiNaC keep memory until exit (tools/lsan.supp). print_suppressions=0: the tests compare
 # the exact standard error of the programs they run, which must not gain LeakSanitizer's summary.
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tools/lsan.supp:print_suppressions=0}
-fuzz_targets=(ik_numbers json_input model_file command_line)
+fuzz_targets=(ik_numbers json_input model_file command_line report_file)
 
 case "$what" in
   test)
@@ -60,6 +60,7 @@ case "$what" in
       echo "fuzz_$target: ${seconds} s"
       seeds=("tests/fuzz/corpus/$target" "tests/fuzz/regressions/$target")
       [ "$target" = model_file ] && seeds+=(models)
+      [ "$target" = report_file ] && seeds+=(scenarios/excavator)  # as the replay test (tests/CMakeLists.txt)
       if ! ASAN_OPTIONS=detect_leaks=1 "$tree/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -max_len=4096 \
           -timeout=10 -artifact_prefix="$artifacts/" "$work" "${seeds[@]}" > "$tree/fuzz-$target.log" 2>&1; then
         status=1

@@ -113,6 +113,9 @@ TEST_CASE("model file: every kind of mistake names the place, the field and the 
       {"weights that do not match the actuators", "weights: [0.01, 100, 1, 0.01, 100, 1, 0.01, 0.01]",
        "weights: [0.01, 100, 1, 0.01, 100, 1, 0.01]", {"one weight per actuated joint: 8 needed"}},
       {"a weight that is not positive", "weights: [0.01, 100, 1,", "weights: [0.01, -100, 1,", {"a weight must be positive"}},
+      {"gravity that is negative", "{name: g, value: 9.81,", "{name: g, value: -9.81,", {"gravity must be non-negative, got -9.81"}},
+      // 1e308 deg is 1.7e306 rad: the sweep's bound, not an overflow, is what refuses it.
+      {"a sweep of 1e308 degrees", "from: -30, to: 30, step: 0.1", "from: -1e308, to: 1e308, step: 0.1", {"step: more than 10^6 points"}},
       {"a body mass that is not a mass parameter", "mass: m_M1,", "mass: cxd,", {"'cxd' is a parameter of kind length; one of kind mass"}},
       {"a nominal value for an unknown input", "  z_Wr: 0.05", "  z_Wx: 0.05", {"no coordinate 'z_Wx'", "did you mean"}},
       {"a name the generated code uses itself", "{name: pitch, unit: rad", "{name: t12, unit: rad",
