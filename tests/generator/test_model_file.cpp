@@ -194,27 +194,20 @@ TEST_CASE("model file: the tiny model the hostile cases start from reads") {
   CHECK(error_of(tiny_model("  - {name: base, parent: K0, chain: [rz: q]}\n")) == "");
 }
 
-TEST_CASE("model file: a key given twice is an error naming the key and both lines") {
+TEST_CASE("model file: a key given twice, or a key that is a list or a map, is reported with its place") {
   const std::string frames = "  - {name: base, parent: K0, chain: [rz: q]}\n";
-  const std::string top = error_of(tiny_model(frames) + "model: other\n");
-  CAPTURE(top);
-  CHECK(top == "hostile.yaml:9:1: model: given twice (first at line 1)");
-  const std::string in_flow = error_of(tiny_model("  - {name: base, parent: K0, name: other, chain: [rz: q]}\n"));
-  CAPTURE(in_flow);
-  CHECK(in_flow == "hostile.yaml:8:30: frames[0].name: given twice (first at line 8)");
-  const std::string in_block = error_of(tiny_model(frames) + "nominal:\n  q: 0.1\n  q: 0.2\n");
-  CAPTURE(in_block);
-  CHECK(in_block == "hostile.yaml:11:3: nominal.q: given twice (first at line 10)");
-}
-
-TEST_CASE("model file: a key that is a list or a map is reported with its place") {
-  const std::string frames = "  - {name: base, parent: K0, chain: [rz: q]}\n";
-  const std::string list_key = error_of(tiny_model(frames) + "? [a, b]\n: 1\n");
-  CAPTURE(list_key);
-  CHECK(list_key == "hostile.yaml:9:3: a key is a list: keys are names");
-  const std::string map_key = error_of(tiny_model("  - {name: base, parent: K0, chain: [{[1]: 2}]}\n"));
-  CAPTURE(map_key);
-  CHECK(map_key == "hostile.yaml:8:39: frames[0].chain[0]: a key is a list: keys are names");
+  // (the file, the whole message): the places are counted in the text here (tiny_model: 8 lines).
+  const std::pair<std::string, std::string> cases[] = {
+      {tiny_model(frames) + "model: other\n", "hostile.yaml:9:1: model: given twice (first at line 1)"},
+      {tiny_model("  - {name: base, parent: K0, name: other, chain: [rz: q]}\n"),
+       "hostile.yaml:8:30: frames[0].name: given twice (first at line 8)"},
+      {tiny_model(frames) + "nominal:\n  q: 0.1\n  q: 0.2\n", "hostile.yaml:11:3: nominal.q: given twice (first at line 10)"},
+      {tiny_model(frames) + "? [a, b]\n: 1\n", "hostile.yaml:9:3: a key is a list: keys are names"},
+      {tiny_model("  - {name: base, parent: K0, chain: [{[1]: 2}]}\n"),
+       "hostile.yaml:8:39: frames[0].chain[0]: a key is a list: keys are names"},
+      {tiny_model(frames) + "? {a: 1}\n: 1\n", "hostile.yaml:9:3: a key is a map: keys are names"},
+  };
+  for (const auto& c : cases) CHECK(error_of(c.first) == c.second);
 }
 
 TEST_CASE("model file: nesting is bounded with a message naming the limit; brackets in strings and comments do not count") {
@@ -363,13 +356,9 @@ TEST_CASE("model file: an expression that is NaN, complex, infinite or singular 
   CHECK(with("exp(a*2000)").find("at the default parameters is not finite") != std::string::npos);
   CHECK(with("acos(a)") == "");  // a = 0.5: fine
   CHECK(with("sqrt(a)/a") == "");
-}
 
-TEST_CASE("model file: an expression finite in exact arithmetic but not in double names its field and the operation") {
-  const auto with = [](const std::string& expression) {
-    return error_of(tiny_model(fmt::format("  - {{name: base, parent: K0, chain: [rz: q, tx: {}]}}\n", expression)));
-  };
-  // e exactly; in double exp(1000) and exp(999) are both inf, so the emitted code computes inf/inf.
+  // Finite in exact arithmetic but not in double, which the emitted code computes in: the message
+  // names the operation. e exactly; in double exp(1000) and exp(999) are both inf, so the emitted code computes inf/inf.
   const std::string ratio = with("exp(1000)/exp(999)");
   CAPTURE(ratio);
   CHECK(ratio.rfind("hostile.yaml:8:", 0) == 0);
