@@ -1,4 +1,5 @@
 #include "emit.hpp"
+#include "model_file.hpp"
 #include "printer.hpp"
 
 #include <fmt/format.h>
@@ -342,10 +343,39 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
   return {{"wlx/gen/types.hpp", t}, {"wlx/gen/params.hpp", p}};
 }
 
+namespace {
+
+struct Element {
+  std::string lvalue;
+  int id;
+};
+
+// Every output evaluated in double at the default (or baked) parameters and the nominal state, as
+// the emitted code computes it: an output that is NaN or infinite there would be emitted as code
+// that yields it in the model's first call. Outputs that use other inputs (rates, lanes) are not
+// known here and pass.
+void refuse_non_finite(const Model& m, const FunctionSpec& fn, const EmitOptions& opt, const ExprGraph& g,
+                       const std::vector<std::vector<Element>>& outs) {
+  std::map<std::string, double> at;
+  for (const Parameter& p : m.parameters) {
+    const auto baked = opt.baked.find(p.name);
+    at[p.name] = baked == opt.baked.end() ? p.default_value : baked->second;
+  }
+  for (std::size_t k = 0; k < m.coordinates.size() && k < m.nominal.size(); ++k) at[m.coordinates[k].name] = m.nominal[k];
+  const DoubleValues values = evaluate_in_double(g, at);
+  for (const auto& block : outs)
+    for (const Element& el : block)
+      if (values.known[static_cast<std::size_t>(el.id)] && !std::isfinite(values.value[static_cast<std::size_t>(el.id)]))
+        throw ModelFileError(fmt::format("{}(): {} evaluates to {} at the {} parameters and the nominal state ({}: {})", fn.name,
+                                         el.lvalue, values.shown(el.id), opt.baked.empty() ? "default" : "default and baked",
+                                         values.why, node_text(g, values.first_bad)));
+}
+
+}  // namespace
+
 EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOptions& opt, FunctionStats& stats) {
   const auto start = std::chrono::steady_clock::now();
   ExprGraph g;
-  struct Element { std::string lvalue; int id; };
   std::vector<std::vector<Element>> outs;
   std::vector<int> roots;
   for (const auto& o : fn.outputs) {
@@ -369,6 +399,7 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
     }
     outs.push_back(std::move(els));
   }
+  refuse_non_finite(m, fn, opt, g, outs);
   const CsePlan plan = eliminate_common_subexpressions(g, roots);
   const TrigBatch trig = batch_trig(m, g, roots);
 

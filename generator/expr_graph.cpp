@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <sstream>
 
 #include <fmt/format.h>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -248,6 +250,117 @@ CsePlan eliminate_common_subexpressions(const ExprGraph& g, const std::vector<in
   };
   for (int r : roots) order(r);
   return plan;
+}
+
+std::string DoubleValues::shown(int id) const {
+  const double v = value[static_cast<std::size_t>(id)];
+  return std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
+}
+
+DoubleValues evaluate_in_double(const ExprGraph& g, const std::map<std::string, double>& symbols) {
+  static const std::map<std::string, double (*)(double)> functions = {
+      {"sin", [](double x) { return std::sin(x); }},   {"cos", [](double x) { return std::cos(x); }},
+      {"tan", [](double x) { return std::tan(x); }},   {"asin", [](double x) { return std::asin(x); }},
+      {"acos", [](double x) { return std::acos(x); }}, {"atan", [](double x) { return std::atan(x); }},
+      {"exp", [](double x) { return std::exp(x); }},   {"log", [](double x) { return std::log(x); }},
+      {"abs", [](double x) { return std::abs(x); }}};
+  DoubleValues out;
+  out.value.assign(g.size(), std::numeric_limits<double>::quiet_NaN());
+  out.known.assign(g.size(), 0);
+  // A node's arguments are made before it: one pass in id order.
+  for (std::size_t id = 0; id < g.size(); ++id) {
+    const Node& n = g.node(static_cast<int>(id));
+    bool known = true, finite = true;
+    std::vector<double> a;
+    for (const int arg : n.args) {
+      known = known && out.known[static_cast<std::size_t>(arg)];
+      finite = finite && std::isfinite(out.value[static_cast<std::size_t>(arg)]);
+      a.push_back(out.value[static_cast<std::size_t>(arg)]);
+    }
+    double v = std::numeric_limits<double>::quiet_NaN();
+    std::string why = "overflow";
+    switch (n.kind) {
+      case NodeKind::Number: v = n.value; break;
+      case NodeKind::Symbol: {
+        const auto it = symbols.find(n.text);
+        known = it != symbols.end();
+        if (known) v = it->second;
+        break;
+      }
+      case NodeKind::Add:
+        v = 0;
+        for (const double x : a) v += x;
+        break;
+      case NodeKind::Mul:
+        v = 1;
+        for (const double x : a) v *= x;
+        break;
+      case NodeKind::Pow:
+        v = n.value == 0.5 ? std::sqrt(a[0]) : std::pow(a[0], n.value);
+        if (a[0] == 0 && n.value < 0) why = "division by zero";
+        else if (a[0] < 0 && !is_integer_exponent(n.value)) why = "root of a negative number";
+        break;
+      case NodeKind::Call:
+        if (n.text == "atan2" && a.size() == 2) {
+          v = std::atan2(a[0], a[1]);
+        } else if (const auto f = functions.find(n.text); f != functions.end() && a.size() == 1) {
+          v = f->second(a[0]);
+          why = std::isnan(v) ? n.text + " outside its domain" : n.text == "log" || n.text == "tan" ? n.text + " at its pole" : "overflow";
+        }
+        break;
+    }
+    out.known[id] = known;
+    out.value[id] = v;
+    if (known && finite && !std::isfinite(v) && out.first_bad < 0) {
+      out.first_bad = static_cast<int>(id);
+      out.why = why;
+    }
+  }
+  return out;
+}
+
+std::string node_text(const ExprGraph& g, int id, std::size_t limit) {
+  std::string out;
+  // bare: inside a call's own parentheses, where a sum needs none of its own.
+  std::function<void(int, bool)> print = [&](int k, bool bare) {
+    if (out.size() > limit) return;
+    const Node& n = g.node(k);
+    switch (n.kind) {
+      case NodeKind::Number:
+      case NodeKind::Symbol: out += n.text; break;
+      case NodeKind::Add:
+        out += bare ? "" : "(";
+        for (std::size_t i = 0; i < n.args.size(); ++i) {
+          if (i) out += " + ";
+          print(n.args[i], false);
+        }
+        out += bare ? "" : ")";
+        break;
+      case NodeKind::Mul:
+        for (std::size_t i = 0; i < n.args.size(); ++i) {
+          if (i) out += "*";
+          print(n.args[i], false);
+        }
+        break;
+      case NodeKind::Pow: {
+        const bool leaf = g.is_leaf(n.args[0]) || g.node(n.args[0]).kind == NodeKind::Add;
+        out += n.value == -1 ? (leaf ? "1/" : "1/(") : n.value == 0.5 ? "sqrt(" : leaf ? "" : "(";
+        print(n.args[0], n.value == 0.5);
+        out += n.value == -1 ? (leaf ? "" : ")") : n.value == 0.5 ? ")" : (leaf ? "^" : ")^") + n.text;
+        break;
+      }
+      case NodeKind::Call:
+        out += n.text + "(";
+        for (std::size_t i = 0; i < n.args.size(); ++i) {
+          if (i) out += ", ";
+          print(n.args[i], true);
+        }
+        out += ")";
+        break;
+    }
+  };
+  print(id, false);
+  return out.size() > limit ? out.substr(0, limit) + "..." : out;
 }
 
 }  // namespace wlx::codegen

@@ -48,6 +48,7 @@ class ExprGraph {
     return node(id).kind == NodeKind::Symbol || node(id).kind == NodeKind::Number;
   }
   bool is_zero(int id) const { return node(id).kind == NodeKind::Number && node(id).value == 0.0; }
+  std::size_t size() const { return nodes_.size(); }
   // Operations needed to evaluate just this node from its (already evaluated) arguments.
   OpCount own_ops(int id) const;
   // Operations of the whole expression as a tree, every repeated subexpression counted again.
@@ -78,6 +79,24 @@ struct CsePlan {
   std::vector<int> temporaries;
   std::unordered_map<int, int> temp_index;  // node id -> position in temporaries
 };
+
+// Every node's value in double, operation by operation as the printed code computes it, for the
+// symbols given; a node using any other symbol is unknown. GiNaC's exact arithmetic can be finite
+// where double is not (exp(1000)/exp(999) is e exactly, inf/inf in double).
+struct DoubleValues {
+  std::vector<double> value;
+  std::vector<char> known;
+  int first_bad = -1;  // the first node that is NaN or infinite although its arguments are finite
+  std::string why;     // what happened there: "division by zero", "overflow", ...
+
+  // "nan", "inf" or "-inf" for a node that is not finite.
+  std::string shown(int id) const;
+};
+DoubleValues evaluate_in_double(const ExprGraph& g, const std::map<std::string, double>& symbols);
+
+// A node as text for messages, cut after about `limit` characters (a derived expression can be
+// far larger printed as a tree than as the graph).
+std::string node_text(const ExprGraph& g, int id, std::size_t limit = 80);
 
 // Every non-leaf node reached twice or more becomes a temporary (so does the base of an integer
 // power, which would otherwise be evaluated once per factor).

@@ -1,5 +1,6 @@
 #include "model_file.hpp"
 
+#include "expr_graph.hpp"
 #include "urdf_import.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -126,76 +127,6 @@ std::string reserved_reason(const std::string& n) {
   if (n[0] == '_' || n.find("__") != std::string::npos) return "C++ reserves names starting with _ or containing __";
   return {};
 }
-
-// ---- evaluation in double ----------------------------------------------------------------------
-
-// The value of `e` computed as the emitted code computes it: in double, operation by operation.
-// GiNaC's exact arithmetic can miss what double cannot hold: exp(1000)/exp(999) is e exactly, but
-// inf/inf in double. `culprit` gets the first operation (innermost, leftmost) whose value is
-// NaN or infinite although its operands are finite, with why.
-class DoubleEvaluation {
- public:
-  explicit DoubleEvaluation(const GiNaC::exmap& values) {
-    for (const auto& [symbol, value] : values) values_[symbol] = GiNaC::ex_to<GiNaC::numeric>(value).to_double();
-  }
-
-  double operator()(const ex& e) {
-    std::vector<double> operands;
-    for (std::size_t k = 0; k < e.nops(); ++k) operands.push_back((*this)(e.op(k)));
-    const bool finite_operands = std::all_of(operands.begin(), operands.end(), [](double v) { return std::isfinite(v); });
-    double v = std::numeric_limits<double>::quiet_NaN();
-    std::string why = "not defined";
-    if (GiNaC::is_a<GiNaC::numeric>(e)) {
-      const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(e);
-      if (n.is_real()) v = n.to_double();
-      else why = "a complex number";
-    } else if (GiNaC::is_a<GiNaC::symbol>(e)) {
-      const auto it = values_.find(e);
-      if (it != values_.end()) v = it->second;
-    } else if (GiNaC::is_a<GiNaC::constant>(e)) {
-      v = GiNaC::ex_to<GiNaC::numeric>(e.evalf()).to_double();
-    } else if (GiNaC::is_a<GiNaC::add>(e)) {
-      v = 0;
-      for (const double x : operands) v += x;
-      why = "overflow";
-    } else if (GiNaC::is_a<GiNaC::mul>(e)) {
-      v = 1;
-      for (const double x : operands) v *= x;
-      why = "overflow";
-    } else if (GiNaC::is_a<GiNaC::power>(e)) {
-      const double base = operands[0], exponent = operands[1];
-      v = exponent == 0.5 ? std::sqrt(base) : std::pow(base, exponent);
-      why = base == 0 && exponent < 0 ? "division by zero" : base < 0 && exponent != std::floor(exponent) ? "root of a negative number" : "overflow";
-    } else if (GiNaC::is_a<GiNaC::function>(e) && operands.size() == 1) {
-      static const std::map<std::string, double (*)(double)> functions = {
-          {"sin", [](double x) { return std::sin(x); }},   {"cos", [](double x) { return std::cos(x); }},
-          {"tan", [](double x) { return std::tan(x); }},   {"asin", [](double x) { return std::asin(x); }},
-          {"acos", [](double x) { return std::acos(x); }}, {"atan", [](double x) { return std::atan(x); }},
-          {"exp", [](double x) { return std::exp(x); }},   {"log", [](double x) { return std::log(x); }},
-          {"abs", [](double x) { return std::abs(x); }}};
-      const auto f = functions.find(GiNaC::ex_to<GiNaC::function>(e).get_name());
-      if (f != functions.end()) {
-        v = f->second(operands[0]);
-        why = std::isinf(v) && (f->first == "log" || f->first == "tan") ? "a pole" : std::isinf(v) ? "overflow" : "outside its domain";
-      }
-    }
-    if (!std::isfinite(v) && finite_operands && culprit.empty()) culprit = fmt::format("{}: {}", why, shown(e));
-    return v;
-  }
-
-  std::string culprit;
-
- private:
-  // x^-1 as 1/(x), which is how a reader wrote it.
-  static std::string shown(const ex& e) {
-    std::ostringstream out;
-    if (GiNaC::is_a<GiNaC::power>(e) && e.op(1).is_equal(-1)) out << "1/(" << e.op(0) << ")";
-    else out << e;
-    return excerpt(out.str());
-  }
-
-  std::map<ex, double, GiNaC::ex_is_less> values_;
-};
 
 // ---- places, items and fields -----------------------------------------------------------------
 
@@ -1060,12 +991,15 @@ class Parser {
     }
     if (!problem.empty()) it.fail(fmt::format("'{}' at the default parameters {}", excerpt(s), problem));
     // Exact arithmetic can be finite where double is not (exp(1000)/exp(999)): the emitted code
-    // computes in double, so the expression is also evaluated so.
-    DoubleEvaluation in_double(param_defaults_);
-    const double value = in_double(e);
-    if (!std::isfinite(value))
-      it.fail(fmt::format("'{}' evaluates to {} in double at the default parameters ({})", excerpt(s),
-                          std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf", in_double.culprit));
+    // computes in double, so the expression is also evaluated so, as the printed code would.
+    ExprGraph graph;
+    const int root = graph.add(e.subs(GiNaC::Pi == GiNaC::Pi.evalf()));  // the graph takes numbers, not constants
+    std::map<std::string, double> defaults;
+    for (const Parameter& p : m_.parameters) defaults[p.name] = p.default_value;
+    const DoubleValues values = evaluate_in_double(graph, defaults);
+    if (!std::isfinite(values.value[static_cast<std::size_t>(root)]))
+      it.fail(fmt::format("'{}' evaluates to {} in double at the default parameters ({}: {})", excerpt(s), values.shown(root),
+                          values.why, node_text(graph, values.first_bad)));
   }
 
   Vec3 vector3(const Item& it) const {

@@ -74,6 +74,26 @@ TEST_CASE("wlx-gen: a baked parameter's field in params.hpp holds the baked valu
   CHECK(params.find("double legD = 1.5;") == std::string::npos);
 }
 
+TEST_CASE("wlx-gen: a baked value that makes an output infinite at the nominal state exits 2 naming the function and output") {
+  const std::filesystem::path dir = wlx_test::work_dir() / "baked-pole", out = dir / "out";
+  std::filesystem::create_directories(dir);
+  wlx_test::write(dir / "pole.yaml", "model: pole\n"
+                                     "parameters:\n"
+                                     "  - {name: a, value: 1, unit: m, kind: length, meaning: a length}\n"
+                                     "  - {name: b, value: 2, unit: m, kind: length, meaning: another}\n"
+                                     "coordinates:\n  inputs:\n    - {name: q, unit: rad, meaning: a joint}\n"
+                                     "frames:\n  - {name: base, parent: K0, chain: [rz: q, translate: [1/(a-b), 0, 0]]}\n");
+  REQUIRE(wlx_test::run({(dir / "pole.yaml").string(), "--out", out.string(), "--quiet"}).code == 0);  // a - b = -1
+  std::filesystem::remove_all(out);
+  // b = 1 = a: the generated kinematics would divide by zero in every call at these parameters.
+  const auto r = wlx_test::run({(dir / "pole.yaml").string(), "--out", out.string(), "--quiet", "--bake", "b=1"});
+  CAPTURE(r.err);
+  CHECK(r.code == 2);
+  CHECK(r.err.rfind("wlx-gen: error: kinematics(): ", 0) == 0);
+  CHECK(r.err.find(" at the default and baked parameters and the nominal state (division by zero: 1/(") != std::string::npos);
+  CHECK(!std::filesystem::exists(out));
+}
+
 TEST_CASE("wlx-gen: a header an earlier wlx-gen wrote and this one no longer produces is removed; others stay") {
   const std::filesystem::path out = wlx_test::work_dir() / "stale";
   std::filesystem::remove_all(out);
