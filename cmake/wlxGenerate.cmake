@@ -34,6 +34,8 @@ function(wlx_generate)
     message(FATAL_ERROR "wlx_generate: ${model_file}: no line 'model: <name>' (a C++ identifier) found")
   endif()
   string(REGEX REPLACE "^model:[ \t]*([A-Za-z_][A-Za-z0-9_]*).*$" "\\1" model_name "${name_line}")
+  # Read at configure time: configure again when the file changes (a renamed model, another URDF).
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${model_file}")
 
   # A model file that reads a URDF (`urdf: robot.urdf`, relative to the file): generated again
   # when the URDF changes too.

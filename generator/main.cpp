@@ -100,6 +100,11 @@ class SetReplacement {
       if (!kept_ && step->renamed) {
         if (step->backup.empty()) ::unlink(step->path.c_str());  // a header that was not there before
         else if (::rename(step->backup.c_str(), step->path.c_str()) == 0) continue;
+        else {  // the only copy of the previous header: kept, and said where
+          wlx::diagnose("wlx-gen: error: {}: the previous version could not be put back ({}); it is kept as {}\n", step->path,
+                        std::strerror(errno), step->backup);
+          continue;
+        }
       }
       if (!step->backup.empty()) ::unlink(step->backup.c_str());
     }
@@ -114,7 +119,13 @@ class SetReplacement {
       for (int attempt = 0; step.backup.empty(); ++attempt) {
         const std::string name = fmt::format("{}.{}-{}.old", step.path, static_cast<long>(::getpid()), attempt);
         if (::link(step.path.c_str(), name.c_str()) == 0) step.backup = name;
-        else if (errno != EEXIST || attempt >= 100)
+        // A file system without hard links (vfat, some FUSE): a copy, created exclusively.
+        else if ((errno == EPERM || errno == EOPNOTSUPP || errno == EXDEV) && S_ISREG(old.st_mode)) {
+          std::error_code ec;
+          if (std::filesystem::copy_file(step.path, name, std::filesystem::copy_options::none, ec)) step.backup = name;
+          else if (ec != std::errc::file_exists || attempt >= 100)
+            throw wlx::OutputError(step.path, fmt::format("cannot keep the previous version while replacing it ({})", ec.message()));
+        } else if (errno != EEXIST || attempt >= 100)
           throw wlx::OutputError(step.path, fmt::format("cannot keep the previous version while replacing it ({})", std::strerror(errno)));
       }
     }

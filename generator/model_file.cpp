@@ -11,6 +11,7 @@
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 #include <wlx/bounded_file.hpp>
+#include <wlx/yaml_key_check.hpp>
 #include <wlx/text.hpp>
 
 #include <algorithm>
@@ -993,7 +994,12 @@ class Parser {
     // Exact arithmetic can be finite where double is not (exp(1000)/exp(999)): the emitted code
     // computes in double, so the expression is also evaluated so, as the printed code would.
     ExprGraph graph;
-    const int root = graph.add(e.subs(GiNaC::Pi == GiNaC::Pi.evalf()));  // the graph takes numbers, not constants
+    int root = 0;
+    try {
+      root = graph.add(e.subs(GiNaC::Pi == GiNaC::Pi.evalf()));  // the graph takes numbers, not constants
+    } catch (const std::exception& error) {  // what the emitted code cannot compute (a power of a parameter's power)
+      it.fail(fmt::format("'{}' cannot be written as code: {}", excerpt(s), error.what()));
+    }
     std::map<std::string, double> defaults;
     for (const Parameter& p : m_.parameters) defaults[p.name] = p.default_value;
     const DoubleValues values = evaluate_in_double(graph, defaults);
@@ -1643,105 +1649,20 @@ std::string did_you_mean(const std::string& name, const std::vector<std::string>
 
 namespace {
 
-// A first pass over the file's parse events, before yaml-cpp builds nodes. Its Node API keeps both
-// entries of a key given twice but answers a lookup with one of them, and a key that is a list or
-// a map has no name to report; here each key is seen with its place. Bounding the nesting here
-// (yaml-cpp recurses once per level) also counts real collections only, not brackets inside
-// quoted strings or comments.
-class KeyCheck : public YAML::EventHandler {
- public:
-  static constexpr std::size_t kMaxNesting = 64;
-
-  explicit KeyCheck(const Source& source) : source_(source) {}
-
-  void OnDocumentStart(const YAML::Mark&) override {}
-  void OnDocumentEnd() override {}
-  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string& value) override {
-    if (at_key()) key(mark, value);
-    else value_done();
-  }
-  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override {
-    if (at_key()) source_.fail(mark, stack_.back().path, "a key is empty: keys are names");
-    value_done();
-  }
-  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
-    if (at_key()) source_.fail(mark, stack_.back().path, "a key is an alias (*name): keys are names");
-    value_done();
-  }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
-    open(mark, false);
-  }
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
-    open(mark, true);
-  }
-  void OnSequenceEnd() override { close(); }
-  void OnMapEnd() override { close(); }
-
- private:
-  struct Level {
-    bool map;
-    std::string path;
-    std::size_t index = 0;                // a list's next element
-    bool expecting_key = true;            // a map's next event is a key
-    std::string key;                      // a map's current key
-    std::map<std::string, int> key_line;  // a map's keys so far, with their lines
-  };
-
-  bool at_key() const { return !stack_.empty() && stack_.back().map && stack_.back().expecting_key; }
-
-  // The path of the value that starts now (the parser's own paths: frames[3].chain).
-  std::string child_path() const {
-    if (stack_.empty()) return "";
-    const Level& top = stack_.back();
-    if (!top.map) return fmt::format("{}[{}]", top.path, top.index);
-    return top.path.empty() ? top.key : top.path + "." + top.key;
-  }
-
-  void key(const YAML::Mark& mark, const std::string& name) {
-    Level& top = stack_.back();
-    top.key = name;
-    const auto [first, added] = top.key_line.emplace(name, mark.line + 1);
-    if (!added) source_.fail(mark, child_path(), fmt::format("given twice (first at line {})", first->second));
-    top.expecting_key = false;
-  }
-
-  void value_done() {
-    if (stack_.empty()) return;
-    Level& top = stack_.back();
-    if (top.map) top.expecting_key = true;
-    else ++top.index;
-  }
-
-  void open(const YAML::Mark& mark, bool map) {
-    if (at_key())
-      source_.fail(mark, stack_.back().path, fmt::format("a key is a {}: keys are names", map ? "map" : "list"));
-    // The place says where; a path 64 levels long would not say more.
-    if (stack_.size() >= kMaxNesting)
-      source_.fail(mark, "", fmt::format("lists and maps nest more than {} levels deep (the limit)", kMaxNesting));
-    stack_.push_back({map, child_path(), 0, true, {}, {}});
-  }
-
-  void close() {
-    stack_.pop_back();
-    value_done();
-  }
-
-  const Source& source_;
-  std::vector<Level> stack_;
-};
-
 YAML::Node load_yaml(const std::string& text, const std::string& source_name) {
   const Source source{source_name};
   YAML::Node root;
   try {
     std::istringstream stream(text);
     YAML::Parser parser(stream);
-    KeyCheck check(source);
+    wlx::YamlKeyCheck check([&](const YAML::Mark& mark, const std::string& path, const std::string& reason) {
+      source.fail(mark, path, reason);
+    });
     parser.HandleNextDocument(check);
     root = YAML::Load(text);
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp's own guard (its message is only "bad file"); the check above stops first.
-    source.fail(e.mark, "", fmt::format("lists and maps nest more than {} levels deep (the limit)", KeyCheck::kMaxNesting));
+    source.fail(e.mark, "", fmt::format("lists and maps nest more than {} levels deep (the limit)", wlx::YamlKeyCheck::kMaxNesting));
   } catch (const YAML::Exception& e) {
     source.fail(e.mark, "", fmt::format("not valid YAML: {}", e.msg));
   }

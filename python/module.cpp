@@ -59,8 +59,10 @@ void export_shell_to_plugins() {
   static bool done = false;
   if (done) return;
   const std::filesystem::path self = this_module();
-  if (self.empty() || ::dlopen(self.c_str(), RTLD_NOW | RTLD_NOLOAD | RTLD_GLOBAL) == nullptr)
-    throw Error("load", "cannot make wlx's module visible to a model's plugin (" + std::string(::dlerror() ? ::dlerror() : "dladdr") + ")");
+  if (self.empty() || ::dlopen(self.c_str(), RTLD_NOW | RTLD_NOLOAD | RTLD_GLOBAL) == nullptr) {
+    const char* why = ::dlerror();  // once: a second call returns null
+    throw Error("load", "cannot make wlx's module visible to a model's plugin (" + std::string(why != nullptr ? why : "dladdr found no file") + ")");
+  }
   // wlx-gen and the sources: beside an installed module's bin folder, else this build's.
   std::error_code ec;
   const std::filesystem::path installed = (self.parent_path() / WLX_BIN_FROM_PYTHON_MODULE).lexically_normal();
@@ -193,7 +195,13 @@ PYBIND11_MODULE(_wlx, m) {
       [](const std::string& path) {
         export_shell_to_plugins();
         try {
-          return handle_of(wlx::cli::load_model_file(path, WLX_VERSION));
+          const wlx::cli::ModelCommands* commands = nullptr;
+          {
+            // A first use compiles for half a minute: other Python threads run meanwhile.
+            py::gil_scoped_release unlocked;
+            commands = &wlx::cli::load_model_file(path, WLX_VERSION);
+          }
+          return handle_of(*commands);
         } catch (const Error& e) {  // the command line's option is Python's argument here
           if (e.field() == "--model-file") throw Error("load", e.reason());
           throw;

@@ -803,7 +803,8 @@ def model_file_figures(build, today):
         viewer = None
         if os.path.exists(os.path.join(build, "viewer", "dist", "viewer.html")):
             timed([wlx, "--model-file", model, "viewer", "--out", os.path.join(work, "viewer")])
-            with open(os.path.join(entry, "viewer", "build-times.tsv")) as f:
+            viewer_folder = next(e for e in os.listdir(entry) if e.startswith("viewer-"))
+            with open(os.path.join(entry, viewer_folder, "build-times.tsv")) as f:
                 viewer = float([line.split("\t") for line in f][1][1])
         cached = sorted(timed([wlx, "--model-file", model, "fk"]) for _ in range(11))[5]
         builtin = sorted(timed([wlx, "fk"]) for _ in range(11))[5]

@@ -1,6 +1,7 @@
 // One model's computations for a binding that names no model (cli/shell/model_api.hpp; Python's
 // wlx.Model). They take the same JSON the command line reads and reuse the command line's parsing
 // and solving, so the grammar, the checks and the error messages are the CLI's own.
+#include "bounded_input.hpp"
 #include "input.hpp"
 #include "limits.hpp"
 #include "model_api.hpp"
@@ -23,13 +24,8 @@ WLX_COMMANDS_BEGIN
 
 namespace {
 
-nlohmann::json parse_json(const std::string& text, const char* what) {
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(what, std::string("not JSON: ") + e.what());
-  }
-}
+// The command line's reader (bounded depth, keys given once), so Python's JSON meets the same rules.
+nlohmann::json parse_json(const std::string& text, const char* what) { return parse_json_bounded(text, what); }
 
 // The CLI's checks, argument by argument: finite values within the bounds of cli/commands/limits.hpp (a
 // rate of NaN or a coordinate of 1e308 gave NaN torques before), so Python and the command line

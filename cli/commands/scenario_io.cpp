@@ -61,18 +61,29 @@ nlohmann::json read_scenario_json(const std::string& arg) {
       throw Error("SCENARIO", fmt::format("'{}' is neither a file nor a scenario id{}", excerpt(arg),
                                           hint.empty() ? " (wlx simulate --list shows them)" : "; did you mean '" + hint + "'?"));
     }
-    // A run of the model's (or of --scenarios DIR) is known by its file's name: its "id", if it
-    // has one, must say the same, else the report and the viewer would name it otherwise.
-    nlohmann::json j = parse_json_bounded(text, arg);
-    if (j.is_object()) {
-      if (!j.contains("id")) j["id"] = arg;
-      else if (j.at("id") != arg)
-        throw Error(arg + ": id", fmt::format("is {}, but the run's file is named {}.json: a run's id is its file's name",
-                                              excerpt(j.at("id")), arg));
-    }
-    return j;
+    return model_scenario_json(arg);
   }
   return parse_json_bounded(text, arg);
+}
+
+nlohmann::json model_scenario_json(const std::string& id) {
+  const std::string text = embedded_scenario(id);
+  if (text.empty()) throw Error("SCENARIO", fmt::format("the model has no scenario '{}'", excerpt(id)));
+  // A run of the model's (or of --scenarios DIR) is known by its file's name: its "id", if it
+  // has one, must say the same, else the report and the viewer would name it otherwise.
+  nlohmann::json j = parse_json_bounded(text, id);
+  if (j.is_object()) {
+    if (!j.contains("id")) j["id"] = id;
+    else if (j.at("id") != id)
+      throw Error(id + ": id", fmt::format("is {}, but the run's file is named {}.json: a run's id is its file's name",
+                                           excerpt(j.at("id")), id));
+  }
+  return j;
+}
+
+std::string model_scenario_directory() {
+  const ScenarioFolder* folder = scenario_folder();
+  return folder != nullptr ? folder->dir : std::string();
 }
 
 Quantity quantity_of(bool angle, bool rate) {
@@ -144,11 +155,8 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
 
 std::string scenario_directory(const std::string& path_or_id) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path_or_id, ec)) {
-    // An id of --scenarios DIR: its files (a torque table) are beside it.
-    const ScenarioFolder* folder = scenario_folder();
-    return folder != nullptr && !embedded_scenario(path_or_id).empty() ? folder->dir : std::string();
-  }
+  if (!std::filesystem::is_regular_file(path_or_id, ec))
+    return embedded_scenario(path_or_id).empty() ? std::string() : model_scenario_directory();
   return std::filesystem::path(path_or_id).parent_path().string();
 }
 
@@ -355,7 +363,8 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::
     // word, and the writer would believe the run accurate to it.
     if (sc.integrator != Integrator::dopri5)
       throw Error("tolerance", fmt::format("applies to the adaptive integrator only; this run integrates with {} at a fixed "
-                                           "dt (set \"integrator\": \"dopri5\", or remove the tolerance)",
+                                           "dt (the file's \"integrator\" or `wlx simulate --integrator`: choose dopri5, or "
+                                           "remove the tolerance)",
                                            sc.integrator == Integrator::rk4 ? "rk4" : "euler"));
     sc.tolerance = finite_number(j.at("tolerance"), "tolerance");
   }

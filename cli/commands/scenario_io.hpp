@@ -17,6 +17,11 @@ std::string embedded_scenario(const std::string& id);
 
 // A path to a JSON file, or the id of an embedded scenario; errors suggest the nearest id.
 nlohmann::json read_scenario_json(const std::string& path_or_id);
+// One of the model's runs (scenario_ids(): embedded, or of --scenarios DIR) by its id, with its
+// "id" checked against the file's name (or set from it); and the folder its relative files (a
+// torque table) are found in: --scenarios' DIR, else none.
+nlohmann::json model_scenario_json(const std::string& id);
+std::string model_scenario_directory();
 // The folder of a scenario file (where the files it names are looked for), or empty for an id.
 std::string scenario_directory(const std::string& path_or_id);
 

@@ -73,7 +73,7 @@ void write_trajectory(const std::string& path, const Trajectory& tr, const Scena
 int run_simulate(const ModelOptions& model_options, const SimulateOptions& o) {
   if (o.list) {
     for (const auto& id : scenario_ids()) {
-      const auto j = parse_json_bounded(embedded_scenario(id), id);
+      const auto j = model_scenario_json(id);
       fmt::print("{:<8} {}\n", id, j.value("description", ""));
       // A closed pipe or a full disk: stop and say so (main checks stdout again at the end).
       if (std::ferror(stdout)) break;
@@ -114,11 +114,11 @@ int run_verify_nonholonomic(const ModelOptions& model_options, const std::string
   fmt::print("{} {:>14}\n", header, "max cond");
   std::vector<std::string> ids;  // the model's scenarios marked "verify": "nonholonomic"
   for (const auto& id : scenario_ids())
-    if (parse_json_bounded(embedded_scenario(id), id).value("verify", "") == "nonholonomic") ids.push_back(id);
+    if (model_scenario_json(id).value("verify", "") == "nonholonomic") ids.push_back(id);
   if (ids.empty()) throw Error("verify nonholonomic", "the model has no scenario marked \"verify\": \"nonholonomic\"");
   for (const std::string& id : ids) {
     throw_if_interrupted();
-    const Scenario sc = parse_scenario(parse_json_bounded(embedded_scenario(id), id), params);
+    const Scenario sc = parse_scenario(model_scenario_json(id), params, model_scenario_directory());
     const Trajectory tr = simulate(sc);
     write_trajectory((std::filesystem::path(out_dir) / (id + ".csv")).string(), tr, sc);
     WheelVector worst = WheelVector::Zero();

@@ -22,7 +22,7 @@ WLX_COMMANDS_BEGIN
 namespace {
 
 bool is_dynamics(const std::string& scenario_id) {
-  return parse_json_bounded(embedded_scenario(scenario_id), scenario_id).contains("weighting");
+  return model_scenario_json(scenario_id).contains("weighting");
 }
 
 // Asked after every sample: a signal stops a long simulation at once, not when it ends.
@@ -146,7 +146,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
     write_ik_sweep_csv(data_file(sweep->id + ".csv"), sweeps_.back());
   }
   for (const auto& scenario_id : selected_scenarios()) {
-    const nlohmann::json json = parse_json_bounded(embedded_scenario(scenario_id), scenario_id);
+    const nlohmann::json json = model_scenario_json(scenario_id);
     const bool verify = json.value("verify", "") == "nonholonomic";
     std::vector<std::pair<std::string, std::optional<Weighting>>> variants;
     if (json.contains("weighting")) {
@@ -156,7 +156,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
       variants.emplace_back(scenario_id, std::nullopt);
     }
     for (const auto& [id, weighting] : variants) {
-      Scenario sc = parse_scenario(json, model_.params());
+      Scenario sc = parse_scenario(json, model_.params(), model_scenario_directory());
       if (weighting) sc.weighting = weighting;
       progress_(fmt::format("simulating {}{}: {}", id, weighting ? " (" + weighting->label() + ")" : "", sc.description));
       ReportRun r{id, scenario_id, sc, simulate(sc, stop_on_signal), id + ".csv", verify};
@@ -181,7 +181,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
 void ReportRunner::compare_integrators(const std::string& data_dir) {
   const double step = spec_.reference_step;
   for (const auto& id : spec_.integrator_scenarios) {
-    Scenario sc = parse_scenario(read_scenario_json(id), model_.params());
+    Scenario sc = parse_scenario(model_scenario_json(id), model_.params(), model_scenario_directory());
     Scenario ref_sc = sc;
     ref_sc.dt = step;
     const Trajectory ref = simulate(ref_sc, stop_on_signal);

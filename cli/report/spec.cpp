@@ -8,9 +8,11 @@
 #include <wlx/error.hpp>
 #include <wlx/text.hpp>
 #include <yaml-cpp/yaml.h>
+#include <wlx/yaml_key_check.hpp>
 
 #include <cmath>
 #include <set>
+#include <sstream>
 
 namespace wlx::cli::report {
 
@@ -72,6 +74,7 @@ class Parser {
   void keys(const YAML::Node& map, const std::string& path, const std::vector<std::string>& valid) const {
     if (!map.IsMap()) fail(map, path, "must be a mapping (key: value)");
     for (const auto& kv : map) {
+      if (!kv.first.IsScalar()) fail(kv.first, path, "a key is a list or a map: keys are names");
       const std::string key = kv.first.as<std::string>();
       if (std::find(valid.begin(), valid.end(), key) != valid.end()) continue;
       const std::string near = nearest(key, valid);
@@ -242,9 +245,17 @@ class Parser {
   ReportSpec parse(const std::string& text_in) const {
     YAML::Node root;
     try {
+      // Keys given twice, keys that are lists or maps, and deep nesting, each with its place,
+      // before yaml-cpp builds nodes (which would keep one of two keys without a word).
+      std::istringstream stream(text_in);
+      YAML::Parser parser(stream);
+      YamlKeyCheck check([&](const YAML::Mark& mark, const std::string& path, const std::string& reason) {
+        throw Error(fmt::format("{}:{}: {}", file_, mark.line + 1, path.empty() ? "(top level)" : path), reason);
+      });
+      parser.HandleNextDocument(check);
       root = YAML::Load(text_in);
-    } catch (const YAML::ParserException& e) {
-      throw Error(fmt::format("{}:{}", file_, e.mark.line + 1), e.msg);
+    } catch (const YAML::Exception& e) {
+      throw Error(fmt::format("{}:{}", file_, e.mark.line + 1), e.msg.empty() ? std::string("not valid YAML") : e.msg);
     }
     ReportSpec s;
     s.file = file_;

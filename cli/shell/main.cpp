@@ -45,6 +45,8 @@ int main(int argc, char** argv) {
       names.emplace_back(m.name);
       if (m.name == model_name) model = &m;
     }
+    // The folder first: a mistake in it is said before a model file's first compile.
+    if (!scenarios_dir.empty() && !list_models->parsed()) load_scenario_folder(scenarios_dir);
     if (!model_file.empty()) {
       if (model_name != names.front())
         throw wlx::Error("--model-file", "give --model (a built-in model) or --model-file (your own), not both");
@@ -55,7 +57,6 @@ int main(int argc, char** argv) {
       throw wlx::Error("--model", fmt::format("no built-in model '{}'{}; the models are {}", excerpt(model_name),
                                               hint.empty() ? "" : " (did you mean '" + hint + "'?)", model_names));
     }
-    if (!scenarios_dir.empty() && !list_models->parsed()) load_scenario_folder(scenarios_dir);
     if (list_models->parsed()) {
       std::size_t width = 0;
       for (const auto& m : models()) width = std::max(width, std::string_view(m.name).size());
@@ -72,15 +73,9 @@ int main(int argc, char** argv) {
     if (verify_ik->parsed()) return finish(model->verify_ik(model_options, ik_out, sweep_ids));
     if (verify_nh->parsed()) return finish(model->verify_nonholonomic(model_options, nh_out));
     // A model file's viewer module is its own (a built-in module of the same name would draw
-    // another machine): built on first use; the report stands without it, the viewer does not.
-    if (!model_file.empty() && viewer->parsed()) use_viewer_module(std::string(model->name), model_file_viewer_module());
-    if (!model_file.empty() && report->parsed()) {
-      try {
-        use_viewer_module(std::string(model->name), model_file_viewer_module());
-      } catch (const wlx::Error& e) {
-        use_viewer_module(std::string(model->name), {}, e.what());
-      }
-    }
+    // another machine): built when a viewer is written (`viewer`, `report`), on first use; the
+    // report stands without it, the viewer does not.
+    if (!model_file.empty()) use_viewer_module(std::string(model->name), &model_file_viewer_module);
     if (viewer->parsed()) return finish(require(model->viewer, "viewer")(model_options, viewer_options));
     if (report->parsed()) return finish(require(model->report, "report")(model_options, report_options));
     if (simulate->parsed()) {

@@ -337,14 +337,17 @@ Timings run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path
       const int pid = start_program(job.argv, {}, job.log.string());
       if (pid < 0) {
         stop_all();
-        throw Error("--model-file", fmt::format("cannot run the C++ compiler '{}' (set CXX to one)", job.argv.front()));
+        throw Error("--model-file", fmt::format("cannot run '{}' for the {}{}", job.argv.front(), job.name,
+                                                job.argv.front() == compiler() ? " (set CXX to a C++ compiler)" : ""));
       }
       running.emplace_back(pid, &job);
       started[pid] = std::chrono::steady_clock::now();
     }
     // Whichever finishes first frees its core for the next job.
     int pid = 0;
-    const ProgramRun r = wait_any_program(pid);
+    std::vector<int> pids;
+    for (const auto& [p, job] : running) pids.push_back(p);
+    const ProgramRun r = wait_any_program(pids, pid);
     if (pid == 0 && interrupt_signal() != 0) {  // within milliseconds of the signal, not when the compiles end
       stop_all();
       throw_if_interrupted();
@@ -563,17 +566,34 @@ namespace wlx::cli {
 std::string model_file_viewer_module() {
   const LoadedEntry& loaded = loaded_entry();
   if (loaded.entry.empty()) throw Error("viewer", "no model file is loaded");
-  const fs::path module = loaded.entry / "viewer" / ("wlx_" + loaded.name + ".js");
-  std::error_code ec;
-  if (fs::is_regular_file(module, ec)) return module.string();
 #ifndef WLX_VIEWER_EMCC
   throw Error("viewer", "this wlx was built without the viewer (emscripten, node and npm were missing when it was built), so it "
                         "cannot build one for a model file");
 #else
+  // -O2 by default; WLX_PLUGIN_EMCCFLAGS replaces it (the tests' -O0).
+  std::vector<std::string> flags;
+  const char* env = std::getenv("WLX_PLUGIN_EMCCFLAGS");
+  std::istringstream in(env != nullptr && *env != '\0' ? env : "-O2");
+  for (std::string flag; in >> flag;) flags.push_back(flag);
+  // The module's folder is named by what it is compiled with beyond the entry's key (which holds
+  // the sources): emscripten itself, the flags, the exports and the source lists that
+  // viewer/CMakeLists.txt gave this wlx. Another wlx or other flags: another folder, never a stale
+  // module.
+  const fs::path emcc = WLX_VIEWER_EMCC;
+  Hash h;
+  for (const char* fact : {WLX_VIEWER_EMCC, WLX_VIEWER_NODE_PATH, WLX_VIEWER_FMT_INCLUDE, WLX_VIEWER_EIGEN_INCLUDES, WLX_VIEWER_EXPORTS,
+                           WLX_VIEWER_RUNTIME_SOURCES, WLX_VIEWER_CLI_SOURCES})
+    h.add(fact);
+  for (const auto& f : flags) h.add(f);
+  struct stat emcc_file {};
+  if (::stat(emcc.c_str(), &emcc_file) == 0)
+    h.add(fmt::format("{} {} {}", emcc_file.st_size, emcc_file.st_mtim.tv_sec, emcc_file.st_mtim.tv_nsec));
+  const fs::path module = loaded.entry / ("viewer-" + h.hex().substr(0, 16)) / ("wlx_" + loaded.name + ".js");
+  std::error_code ec;
+  if (fs::is_regular_file(module, ec)) return module.string();
   const FileLock lock(loaded.cache / (loaded.stem + ".lock"),
                       fmt::format("wlx: waiting for another wlx building model {}'s viewer module", loaded.name));
   if (fs::is_regular_file(module, ec)) return module.string();  // the other one built it
-  const fs::path emcc = WLX_VIEWER_EMCC;
   if (!fs::is_regular_file(emcc, ec))
     throw Error("viewer", fmt::format("the viewer's module for model file {} is compiled with emscripten, and {} is missing "
                                       "(Debian: apt-get install emscripten)",
@@ -595,10 +615,11 @@ std::string model_file_viewer_module() {
   write_file_atomically((building.path / "module_unity.cpp").string(), unity);
   const fs::path out = building.path / module.filename();
   // emcc runs node, whose optimizer needs Debian's acorn: env sets NODE_PATH (a program, no shell).
-  std::vector<std::string> argv{"/usr/bin/env", std::string("NODE_PATH=") + WLX_VIEWER_NODE_PATH, emcc.string(), "-std=c++20", "-O2",
-                                "-fexceptions", "-DFMT_HEADER_ONLY", "-DWLX_MODEL=" + loaded.name,
-                                "-I" + src.runtime_include.string(), "-I" + (src.cli / "commands").string(), "-I" + (src.cli / "shell").string(),
-                                "-isystem" + (building.path / "include").string(), "-isystem" + (loaded.entry / "generated").string()};
+  std::vector<std::string> argv{"/usr/bin/env", std::string("NODE_PATH=") + WLX_VIEWER_NODE_PATH, emcc.string(), "-std=c++20"};
+  argv.insert(argv.end(), flags.begin(), flags.end());
+  argv.insert(argv.end(), {"-fexceptions", "-DFMT_HEADER_ONLY", "-DWLX_MODEL=" + loaded.name, "-I" + src.runtime_include.string(),
+                           "-I" + (src.cli / "commands").string(), "-I" + (src.cli / "shell").string(),
+                           "-isystem" + (building.path / "include").string(), "-isystem" + (loaded.entry / "generated").string()});
   for (const auto& include : split_list(WLX_VIEWER_EIGEN_INCLUDES)) argv.push_back("-isystem" + include);
   // SINGLE_FILE: the WebAssembly inlined in the script, which a page opened from file:// can load.
   argv.insert(argv.end(), {(building.path / "module_unity.cpp").string(), "-o", out.string(), "-sMODULARIZE=1",

@@ -1,5 +1,7 @@
 #include "process.hpp"
 
+#include <ctime>
+
 #include "interrupt.hpp"
 
 #include <cerrno>
@@ -53,17 +55,8 @@ int start_program(const std::vector<std::string>& argv, const std::string& worki
 
 namespace {
 
-ProgramRun wait_for(pid_t which, int& reaped, bool stop_on_signal) {
+ProgramRun run_of(pid_t pid, int status, int& reaped) {
   ProgramRun result;
-  int status = 0;
-  pid_t pid = 0;
-  while ((pid = ::waitpid(which, &status, 0)) < 0) {
-    // EINTR: our own SIGINT/SIGTERM/SIGHUP handler ran; keep waiting, unless the caller stops then.
-    if (errno != EINTR || (stop_on_signal && interrupt_signal() != 0)) {
-      reaped = 0;
-      return result;
-    }
-  }
   reaped = static_cast<int>(pid);
   result.started = true;
   if (WIFEXITED(status)) {
@@ -79,10 +72,31 @@ ProgramRun wait_for(pid_t which, int& reaped, bool stop_on_signal) {
 
 ProgramRun wait_program(int pid) {
   if (pid <= 0) return {};
-  int reaped = 0;
-  return wait_for(pid, reaped, false);
+  int status = 0, reaped = 0;
+  pid_t done = 0;
+  // EINTR: our own SIGINT/SIGTERM/SIGHUP handler ran; the caller decides after, keep waiting.
+  while ((done = ::waitpid(pid, &status, 0)) < 0)
+    if (errno != EINTR) return {};
+  return run_of(done, status, reaped);
 }
 
-ProgramRun wait_any_program(int& pid) { return wait_for(-1, pid, true); }
+ProgramRun wait_any_program(const std::vector<int>& pids, int& pid) {
+  // Only these children, never waitpid(-1): in a host that has children of its own (Python's
+  // subprocess, a multiprocessing pool) that would reap theirs and lose track of ours. Polled
+  // every 10 ms, which a compile of seconds does not notice, and a signal stops the wait in 10 ms.
+  for (;;) {
+    for (const int candidate : pids) {
+      int status = 0;
+      const pid_t done = ::waitpid(candidate, &status, WNOHANG);
+      if (done == candidate) return run_of(done, status, pid);
+    }
+    if (pids.empty() || interrupt_signal() != 0) {
+      pid = 0;
+      return {};
+    }
+    const timespec pause{0, 10'000'000};
+    ::nanosleep(&pause, nullptr);
+  }
+}
 
 }  // namespace wlx::cli

@@ -25,8 +25,9 @@ ProgramRun run_program(const std::vector<std::string>& argv, const std::string& 
 int start_program(const std::vector<std::string>& argv, const std::string& working_directory = {},
                   const std::string& log_path = {});
 ProgramRun wait_program(int pid);
-// Waits for whichever child of this process ends first; `pid` is set to it, or to 0 if there is
-// none or a signal arrived (interrupt.hpp) while waiting: then the caller stops its children.
-ProgramRun wait_any_program(int& pid);
+// Waits for whichever of `pids` (children started by start_program) ends first; `pid` is set to
+// it, or to 0 if there is none or a signal arrived (interrupt.hpp) while waiting: then the caller
+// stops its children. Other children of the process (a host's own) are left alone.
+ProgramRun wait_any_program(const std::vector<int>& pids, int& pid);
 
 }  // namespace wlx::cli

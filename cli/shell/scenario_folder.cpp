@@ -38,7 +38,8 @@ void load_scenario_folder(const std::string& dir) {
   out->dir = dir;
   std::vector<fs::path> files;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    if (it->path().extension() != ".json") continue;
+    // Hidden files (an editor's lock file, .#run.json) are not runs.
+    if (it->path().extension() != ".json" || it->path().filename().string().front() == '.') continue;
     if (files.size() == kMaxScenarioFiles)
       throw Error("--scenarios", fmt::format("'{}' holds more than {} scenario files", excerpt(dir), kMaxScenarioFiles));
     files.push_back(it->path());

@@ -221,7 +221,8 @@ fs::path built_viewer_dir() {
 
 namespace {
 struct ViewerModule {
-  std::string model, path, reason;
+  std::string model;
+  std::function<std::string()> path;
 };
 ViewerModule& own_module() {
   static ViewerModule m;
@@ -229,8 +230,8 @@ ViewerModule& own_module() {
 }
 }  // namespace
 
-void use_viewer_module(const std::string& model, const std::string& module_js, const std::string& reason) {
-  own_module() = {model, module_js, reason};
+void use_viewer_module(const std::string& model, std::function<std::string()> module_js) {
+  own_module() = {model, std::move(module_js)};
 }
 
 void copy_viewer_files(const fs::path& dir, const fs::path& source) {
@@ -238,7 +239,6 @@ void copy_viewer_files(const fs::path& dir, const fs::path& source) {
                           "WLX_BUILD_VIEWER), or point WLX_VIEWER_DIR at a built viewer folder";
   if (source.empty()) throw Error("viewer", "this wlx was built without the viewer: " + how);
   const ViewerModule& own = own_module();
-  if (!own.model.empty() && own.path.empty()) throw Error("viewer", own.reason);
   const fs::path own_name = own.model.empty() ? fs::path() : fs::path("wasm") / ("wlx_" + own.model + ".js");
   std::vector<std::pair<fs::path, fs::path>> files{{source / "viewer.html", "viewer.html"}, {source / "viewer.js", "viewer.js"}};
   std::error_code ec;
@@ -246,7 +246,7 @@ void copy_viewer_files(const fs::path& dir, const fs::path& source) {
     for (const auto& e : fs::directory_iterator(source / "wasm", ec))
       if (const fs::path name = fs::path("wasm") / e.path().filename(); e.path().extension() == ".js" && name != own_name)
         files.emplace_back(e.path(), name);
-  if (!own.model.empty()) files.emplace_back(own.path, own_name);
+  if (!own.model.empty()) files.emplace_back(own.path(), own_name);
   if (files.size() == 2) files.emplace_back(source / "wasm/wlx_<model>.js", "");  // reported missing below
   for (const auto& [from, to] : files)
     if (!fs::is_regular_file(from)) throw Error("viewer", fmt::format("{} is missing: {}", from.string(), how));

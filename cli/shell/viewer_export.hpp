@@ -19,6 +19,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -60,9 +61,10 @@ std::filesystem::path built_viewer_dir();
 void copy_viewer_files(const std::filesystem::path& dir, const std::filesystem::path& source = built_viewer_dir());
 
 // A model file's own viewer module (cli/shell/model_plugin.hpp, built with emscripten on first use):
-// copy_viewer_files then writes it as wasm/wlx_<model>.js instead of any built-in module of that
-// name (a user's copy of a built-in model has its own geometry). An empty module with a reason:
-// there is none, and copy_viewer_files fails with that reason rather than copy another model's.
-void use_viewer_module(const std::string& model, const std::string& module_js, const std::string& reason = {});
+// copy_viewer_files then asks `module_js` for its path (only then: a command that writes no viewer
+// compiles none) and writes it as wasm/wlx_<model>.js instead of any built-in module of that name
+// (a user's copy of a built-in model has its own geometry). What `module_js` throws (no
+// emscripten) is copy_viewer_files' error: never another model's module in its place.
+void use_viewer_module(const std::string& model, std::function<std::string()> module_js);
 
 }  // namespace wlx::cli

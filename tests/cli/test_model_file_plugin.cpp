@@ -36,6 +36,7 @@ struct Setup {
   Setup() {
     ::setenv("WLX_CACHE_DIR", cache.c_str(), 1);
     ::setenv("WLX_PLUGIN_CXXFLAGS", "-O0", 1);
+    ::setenv("WLX_PLUGIN_EMCCFLAGS", "-O0", 1);  // the viewer's module likewise (its IK is checked, not timed)
     ::unsetenv("CXX");
     std::string text = slurp(fs::path(WLX_SOURCE_DIR) / "models" / "excavator.yaml");
     const std::string from = "{name: thighD, value: 2.0,";

@@ -152,6 +152,14 @@ TEST_CASE("report file: each error names the file, the line, the key and the rea
   CHECK(error_of("integrator_comparison: {scenarios: [R], reference_step: 1}\n") ==
         "claims.yaml:1: integrator_comparison.reference_step: must be in (0, 0.01] s");
   CHECK(error_of("run_figures: [{id: F, runs: [R], x: a}]\n") == "claims.yaml:1: run_figures[0]: missing key 'y'");
+  // Keys given twice (yaml-cpp kept one without a word), keys that are lists or maps (they crashed
+  // the reader: the fuzzer's tests/fuzz/regressions/report_file/crash-ea478c2d...), deep nesting.
+  CHECK(error_of("title: a\ntitle: b\n") == "claims.yaml:2: title: given twice (first at line 1)");
+  CHECK(error_of(variant("    kind: check\n", "    kind: check\n    kind: input\n")) == "claims.yaml:4: claims[0].kind: given twice (first at line 3)");
+  CHECK(error_of("sources: {[a, b]: x}\n") == "claims.yaml:1: sources: a key is a list: keys are names");
+  CHECK(error_of("claims: [{id: a, {quantity: x}: 1}]\n") == "claims.yaml:1: claims[0]: a key is a map: keys are names");
+  CHECK(error_of(std::string(70, '[') + std::string(70, ']') + "\n").find("nest more than 64 levels deep") != std::string::npos);
+  CHECK(error_of("title: \"[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[\"\n") == "");  // brackets in text are text
 }
 
 TEST_CASE("report file: a check fails when the measured value is outside its criterion") {
