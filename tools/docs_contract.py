@@ -816,7 +816,9 @@ def model_file_figures(build, today):
             penv = dict(env, PYTHONPATH=python_dir)
             loads = []
             for _ in range(5):
-                r = subprocess.run([sys.executable, "-c", script, model], capture_output=True, text=True, env=penv,
+                # Debian's python3, whose dist-packages hold numpy (as CMake's tests use it).
+                python = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
+                r = subprocess.run([python, "-c", script, model], capture_output=True, text=True, env=penv,
                                    timeout=COMMAND_TIMEOUT_S)
                 if r.returncode != 0:
                     raise ContractError(f"wlx.load: exit {r.returncode}\n{r.stderr}")
@@ -832,15 +834,20 @@ def model_file_figures(build, today):
     if loaded is not None:
         rows.append(f"| cached `wlx.load(FILE)` in Python (median of 5) | {loaded * 1000:.0f} ms |")
     return (f"Measured {today} on {machine()} by `tools/readme_figures.sh`: a copy of `models/excavator.yaml` in a "
-            "fresh cache, the default flags (the runtime and the generated functions at `-O2`, the commands at `-O1`); "
+            "fresh cache, the default flags (the runtime and the generated functions at `-O2`, the commands at `-O0`); "
             "the parts from the entry's `build-times.tsv`.\n\n| part | wall time |\n|---|---:|\n" + "\n".join(rows) + "\n")
 
 
 def model_file_problems(body):
     table = readme_table(body)
-    names = [r[0] for r in table[1:]]
-    return [f"README.md's model-file table has no row '{row}' (tools/readme_figures.sh writes it)"
-            for row in MODEL_FILE_ROWS if not any(row in n for n in names)]
+    problems = []
+    for row in MODEL_FILE_ROWS:
+        found = [r for r in table[1:] if row in r[0]]
+        if not found:
+            problems.append(f"README.md's model-file table has no row '{row}' (tools/readme_figures.sh writes it)")
+        elif not re.fullmatch(r"\**[\d.]+ m?s\**", found[0][-1]):
+            problems.append(f"README.md's model-file row '{row}' has no measured time ('{found[0][-1]}'): tools/readme_figures.sh")
+    return problems
 
 
 def readme_with(readme, name, body):

@@ -68,7 +68,7 @@ static_assert(kPluginInterface == 2, "rename kEntrySymbol with the interface's v
 // where the files one by one take 48 s of CPU); it runs on one core while the commands and the
 // generated functions take the others.
 #ifndef WLX_PLUGIN_RUNTIME_SOURCES
-#error "CMakeLists.txt defines WLX_PLUGIN_RUNTIME_SOURCES, WLX_PLUGIN_GENERATED_SOURCES and WLX_PLUGIN_COMMAND_SOURCES"
+#error "CMakeLists.txt defines WLX_PLUGIN_RUNTIME_SOURCES, WLX_PLUGIN_RUNTIME_APART, WLX_PLUGIN_GENERATED_SOURCES and WLX_PLUGIN_COMMAND_SOURCES"
 #endif
 
 // FNV-1a, twice with different offsets: a 128-bit content key (a cache key, not a signature).
@@ -163,11 +163,12 @@ std::string compiler() {
   return WLX_PLUGIN_CXX;
 }
 
-// -O2 by default for the runtime and the generated functions (the code runs in users' loops), -O1
-// for the commands, which parse, check and write around those calls (measured on 2 cores: 31 s
-// at -O2, 25 s at -O1, on the core that is the first use's critical path). WLX_PLUGIN_CXXFLAGS
-// replaces both (all part of the key).
-const char* const kCommandsOptimization = "-O1";
+// -O2 by default for the runtime and the generated functions (the code runs in users' loops), -O0
+// for the commands, which parse, check and write around those calls (the excavator's, alone on a
+// core: 27 s at -O2, 19 s at -O1, 10 s at -O0; a report of its runs takes 28 s against 26.5 s
+// with them at -O1, most of both the viewer's module). WLX_PLUGIN_CXXFLAGS replaces both (all
+// part of the key).
+const char* const kCommandsOptimization = "-O0";
 std::vector<std::string> optimization_flags(bool commands = false) {
   const char* env = std::getenv("WLX_PLUGIN_CXXFLAGS");
   std::vector<std::string> out;
@@ -408,8 +409,13 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
   wlx::diagnose("wlx: compiling model {} for first use ({}) ...\n", name, model_file.string());
   const Sources src = find_sources();
   const auto write = [&](const fs::path& path, const std::string& text) { write_file_atomically(path.string(), text); };
-  std::string runtime_unity = "// The runtime's sources in one translation unit.\n";
-  for (const auto& f : split_list(WLX_PLUGIN_RUNTIME_SOURCES)) runtime_unity += include_line(src.runtime_sources / f);
+  // The runtime's sources in one translation unit, but those CMake names apart
+  // (WLX_PLUGIN_RUNTIME_APART: dynamics.cpp, 18 s of the runtime's 32 at -O2 on its own), so that
+  // the two cores share the longest compile instead of one core waiting for it.
+  const std::vector<std::string> apart = split_list(WLX_PLUGIN_RUNTIME_APART);
+  std::string runtime_unity = "// The runtime's sources in one translation unit (those compiled apart excepted).\n";
+  for (const auto& f : split_list(WLX_PLUGIN_RUNTIME_SOURCES))
+    if (std::find(apart.begin(), apart.end(), f) == apart.end()) runtime_unity += include_line(src.runtime_sources / f);
   write(dir / "runtime_unity.cpp", runtime_unity);
   std::string commands_unity = "// The per-model commands in one translation unit (as CMake's unity build of wlx_cli_<model>).\n";
   for (const auto& f : split_list(WLX_PLUGIN_COMMAND_SOURCES)) commands_unity += include_line(src.cli / f);
@@ -444,6 +450,7 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
   };
   // The longest first, so that the cores finish together.
   compile("runtime", dir / "runtime_unity.cpp", "runtime_unity");
+  for (const auto& f : apart) compile("runtime " + f, src.runtime_sources / f, "runtime_" + fs::path(f).stem().string());
   compile("commands", dir / "commands_unity.cpp", "commands_unity");
   const std::vector<std::string> generated_sources = split_list(WLX_PLUGIN_GENERATED_SOURCES);
   for (auto it = generated_sources.rbegin(); it != generated_sources.rend(); ++it)
