@@ -13,6 +13,30 @@
 # then `import wlx; wlx.model("<model>")`: the same API as the installed package's models, with
 # this one built in; wlx.load() works there too). Needs pybind11 and Python's headers.
 # Used by the installed package (lib/cmake/wlx) and, the same way, inside the source tree.
+# What CMake needs of a model file before wlx-gen runs: its model's name (the runtime's namespace;
+# wlx-gen checks the rest) into NAME_VAR, and the files it is generated from (itself and the URDF
+# it names, `urdf: robot.urdf` relative to it) into INPUTS_VAR. Both are read at configure time,
+# so the file becomes a configure dependency (a renamed model, another URDF). WHO names the caller
+# in errors.
+function(wlx_read_model_file file name_var inputs_var who)
+  file(STRINGS "${file}" name_line REGEX "^model:[ \t]*[A-Za-z_][A-Za-z0-9_]*[ \t]*(#.*)?$" LIMIT_COUNT 1)
+  if(NOT name_line)
+    message(FATAL_ERROR "${who}: ${file}: no line 'model: <name>' (a C++ identifier) found")
+  endif()
+  string(REGEX REPLACE "^model:[ \t]*([A-Za-z_][A-Za-z0-9_]*).*$" "\\1" name "${name_line}")
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${file}")
+  set(inputs "${file}")
+  file(STRINGS "${file}" urdf_line REGEX "^urdf:[ \t]*[^ \t#]+" LIMIT_COUNT 1)
+  if(urdf_line)
+    string(REGEX REPLACE "^urdf:[ \t]*([^ \t#]+).*$" "\\1" urdf "${urdf_line}")
+    get_filename_component(folder "${file}" DIRECTORY)
+    get_filename_component(urdf "${urdf}" ABSOLUTE BASE_DIR "${folder}")
+    list(APPEND inputs "${urdf}")
+  endif()
+  set(${name_var} ${name} PARENT_SCOPE)
+  set(${inputs_var} ${inputs} PARENT_SCOPE)
+endfunction()
+
 function(wlx_generate)
   cmake_parse_arguments(PARSE_ARGV 0 arg "PYTHON" "TARGET;MODEL;NAMESPACE" "BAKE")
   if(arg_UNPARSED_ARGUMENTS)
@@ -28,25 +52,7 @@ function(wlx_generate)
   if(NOT EXISTS "${model_file}")
     message(FATAL_ERROR "wlx_generate: MODEL ${model_file}: no such file")
   endif()
-  # The runtime's namespace is the model's name: read it from the file (wlx-gen checks the rest).
-  file(STRINGS "${model_file}" name_line REGEX "^model:[ \t]*[A-Za-z_][A-Za-z0-9_]*[ \t]*(#.*)?$" LIMIT_COUNT 1)
-  if(NOT name_line)
-    message(FATAL_ERROR "wlx_generate: ${model_file}: no line 'model: <name>' (a C++ identifier) found")
-  endif()
-  string(REGEX REPLACE "^model:[ \t]*([A-Za-z_][A-Za-z0-9_]*).*$" "\\1" model_name "${name_line}")
-  # Read at configure time: configure again when the file changes (a renamed model, another URDF).
-  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${model_file}")
-
-  # A model file that reads a URDF (`urdf: robot.urdf`, relative to the file): generated again
-  # when the URDF changes too.
-  set(model_inputs "${model_file}")
-  file(STRINGS "${model_file}" urdf_line REGEX "^urdf:[ \t]*[^ \t#]+" LIMIT_COUNT 1)
-  if(urdf_line)
-    string(REGEX REPLACE "^urdf:[ \t]*([^ \t#]+).*$" "\\1" urdf_file "${urdf_line}")
-    get_filename_component(model_dir "${model_file}" DIRECTORY)
-    get_filename_component(urdf_file "${urdf_file}" ABSOLUTE BASE_DIR "${model_dir}")
-    list(APPEND model_inputs "${urdf_file}")
-  endif()
+  wlx_read_model_file("${model_file}" model_name model_inputs "wlx_generate")
 
   set(out "${CMAKE_CURRENT_BINARY_DIR}/wlx_generated/${arg_TARGET}")
   set(stamp "${CMAKE_CURRENT_BINARY_DIR}/wlx_generated/${arg_TARGET}.stamp")
