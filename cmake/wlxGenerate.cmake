@@ -11,7 +11,7 @@
 # PYTHON (not with NAMESPACE) also builds the Python package wlx for this model: the target
 # <name>_python, the module in <build>/wlx_python/<name>/wlx/ (PYTHONPATH=<build>/wlx_python/<name>,
 # then `import wlx; wlx.model("<model>")`: the same API as the installed package's models, with
-# this one built in; wlx.load() works there too). Needs pybind11 and Python's headers.
+# this one built in). Needs pybind11 and Python's headers.
 # Used by the installed package (lib/cmake/wlx) and, the same way, inside the source tree.
 # What CMake needs of a model file before wlx-gen runs: its model's name (the runtime's namespace;
 # wlx-gen checks the rest) into NAME_VAR, and the files it is generated from (itself and the URDF
