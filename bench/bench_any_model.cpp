@@ -2,9 +2,10 @@
 // WLX_BENCH_MODELS, linked into wlx_bench), registered as <model>/<row>, so that models of other
 // sizes are compared side by side in one run: the IK of every limb, the dependent rates, and one
 // inverse-dynamics step (IK, rates, the Newton-Euler pass, the torque split; and the same by Kane's
-// sums) and one forward-dynamics step,
-// from the model's tables alone.
+// sums) and one forward-dynamics step, and what the contacts add to an inverse-dynamics step (the
+// forces, the margins, the momentum check, weighting 3), from the model's tables alone.
 #include <benchmark/benchmark.h>
+#include <wlx/contacts.hpp>
 #include <wlx/dynamics.hpp>
 #include <wlx/error.hpp>
 #include <wlx/forward_dynamics.hpp>
@@ -98,6 +99,48 @@ void forward_dynamics_step(benchmark::State& st) {
   }
 }
 
+// The contacts of an inverse-dynamics step, each part alone after the step (its factorizations
+// current): the forces (multipliers), the support polygon and margins, the momentum check by the
+// bodies' accelerations, and weighting 3 (its cutting-plane programmes), against the step itself.
+struct ContactStep : Pose {
+  TorqueVector tau;
+  ContactForces forces;
+  Stability stability;
+  ContactStep() {
+    inverse_dynamics(model, d, s, u, CommandVector::Zero(), terms);
+    tau = distribute_torques(terms.J_beta, terms.Qstar, Weighting::model_weights());
+    contact_forces(model, d, s, terms, tau, forces);
+  }
+};
+void contact_forces_part(benchmark::State& st) {
+  auto x = std::make_unique<ContactStep>();
+  for (auto _ : st) {
+    contact_forces(x->model, x->d, x->s, x->terms, x->tau, x->forces);
+    benchmark::DoNotOptimize(x->forces.normal.data());
+  }
+}
+void contact_margins_part(benchmark::State& st) {
+  auto x = std::make_unique<ContactStep>();
+  for (auto _ : st) {
+    stability(x->model, x->d, x->s, x->forces, x->stability);
+    benchmark::DoNotOptimize(&x->stability.tip_angle);
+  }
+}
+void momentum_check_part(benchmark::State& st) {
+  auto x = std::make_unique<ContactStep>();
+  for (auto _ : st) {
+    const MomentumBalance b = momentum_balance(x->model, x->d, x->s, x->terms.sdot, x->terms.sddot, x->forces);
+    benchmark::DoNotOptimize(&b);
+  }
+}
+void weighting_3_part(benchmark::State& st) {
+  auto x = std::make_unique<ContactStep>();
+  for (auto _ : st) {
+    const ContactDistribution r = distribute_torques_on_contacts(x->model, x->d, x->s, x->terms);
+    benchmark::DoNotOptimize(r.tau.data());
+  }
+}
+
 const bool registered = [] {
   const std::string model(gen::kModelName);
   benchmark::RegisterBenchmark((model + "/ik_all_limbs").c_str(), ik);
@@ -106,6 +149,12 @@ const bool registered = [] {
     benchmark::RegisterBenchmark((model + "/inverse_dynamics_step").c_str(), inverse_dynamics_step);
     benchmark::RegisterBenchmark((model + "/inverse_dynamics_step_by_kane").c_str(), inverse_dynamics_step_by_kane);
     benchmark::RegisterBenchmark((model + "/forward_dynamics_step").c_str(), forward_dynamics_step);
+    if (kContactCount > 0) {
+      benchmark::RegisterBenchmark((model + "/contact_forces").c_str(), contact_forces_part);
+      benchmark::RegisterBenchmark((model + "/contact_margins").c_str(), contact_margins_part);
+      benchmark::RegisterBenchmark((model + "/momentum_check").c_str(), momentum_check_part);
+      benchmark::RegisterBenchmark((model + "/weighting_3").c_str(), weighting_3_part);
+    }
   }
   return true;
 }();

@@ -65,6 +65,9 @@ function(wlx_generate)
   endif()
   add_custom_command(
     OUTPUT "${stamp}"
+    # wlx-gen rewrites all.hpp whenever any header changes: named here, Ninja recompiles what
+    # includes it after an edit of the model file (else objects built from the old headers stay).
+    BYPRODUCTS "${out}/wlx/gen/all.hpp"
     COMMAND wlx::wlx-gen "${model_file}" --out "${out}" ${options}
     COMMAND "${CMAKE_COMMAND}" -E touch "${stamp}"
     DEPENDS ${model_inputs} "$<TARGET_FILE:wlx::wlx-gen>"

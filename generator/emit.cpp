@@ -810,6 +810,9 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
       names.push_back(quoted(a.name));
     }
     for (double w : d.weights) weights += (weights.empty() ? "" : ", ") + literal(w);
+    std::string limits;
+    for (std::size_t a = 0; a < d.actuated.size(); ++a)
+      limits += (limits.empty() ? "" : ", ") + literal(d.torque_limits.empty() ? 0.0 : d.torque_limits[a]);
     t += fmt::format(
         "// Inverse dynamics: the commanded speeds u ({}), the dependent pair, the actuators\n"
         "// ({}), their default weights, and gravity (along -z of K0).\n"
@@ -822,11 +825,16 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
         "inline constexpr std::array<int, {}> kActuatedWheels{{{{{}}}}};\n"
         "inline constexpr std::array<std::string_view, {}> kActuatorNames{{{{{}}}}};\n"
         "inline constexpr std::array<double, {}> kDefaultWeights{{{{{}}}}};\n"
-        "inline constexpr double Params::*kGravity = {};\n\n",
+        "inline constexpr double Params::*kGravity = {};\n"
+        "// The actuators' torque limits (|tau_i| <= limit, N m; the model file's dynamics.torque_limits),\n"
+        "// respected by the contact-keeping torque distribution; kHasTorqueLimits false: unlimited (zeros).\n"
+        "inline constexpr bool kHasTorqueLimits = {};\n"
+        "inline constexpr std::array<double, {}> kTorqueLimits{{{{{}}}}};\n\n",
         m.dynamics ? commanded : "none: the model file has no dynamics section", actuated, m.dynamics ? "true" : "false",
         d.commanded.size(), int_list(d.commanded), pair, m.dynamics ? d.pair : "none", joints.size(), int_list(joints),
         wheels.size(), int_list(wheels), names.size(), fmt::join(names, ", "), d.weights.size(), weights,
-        m.dynamics ? "&Params::" + d.gravity : "nullptr");
+        m.dynamics ? "&Params::" + d.gravity : "nullptr", d.torque_limits.empty() ? "false" : "true", d.actuated.size(),
+        limits);
   }
 
   // The rate basis' structure.
@@ -913,6 +921,65 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
                      static_cast<int>(c.axis), c.target, c.name);
   }
   t += "}};\n\n";
+
+  // Contacts with the ground: every frame that closure rows tie to K0 (point rows carry a force,
+  // level rows a moment) and every wheel's contact frame (its rolling row carries the lateral
+  // force, its drive the longitudinal one). Their multipliers are the forces the ground exerts;
+  // the runtime reads which rows belong to which contact from here and names no robot.
+  {
+    struct Contact {
+      int frame = -1;
+      int wheel = -1;
+      std::array<int, 3> point{-1, -1, -1}, level{-1, -1, -1};
+    };
+    std::vector<Contact> contacts;
+    const auto contact_of = [&](int frame) -> Contact& {
+      for (auto& c : contacts)
+        if (c.frame == frame) return c;
+      contacts.push_back({frame, -1, {-1, -1, -1}, {-1, -1, -1}});
+      return contacts.back();
+    };
+    for (std::size_t i = 0; i < m.closure.size(); ++i) {
+      const auto& c = m.closure[i];
+      if (c.kind == ClosureCondition::Kind::CoordinateSum) continue;  // joints among themselves: internal
+      Contact& contact = contact_of(m.frame_index(c.frame));
+      auto& rows = c.kind == ClosureCondition::Kind::PointEqualsCoordinate ? contact.point : contact.level;
+      rows[static_cast<std::size_t>(c.axis)] = static_cast<int>(i);
+    }
+    for (std::size_t w = 0; w < m.wheels.size(); ++w) contact_of(m.frame_index(m.wheels[w].contact)).wheel = static_cast<int>(w);
+    // Output columns are named by the frame without underscores (F_l: f_n_Fl), the contact points'
+    // columns' convention; the frame's own name where two would collide.
+    std::vector<std::string> names;
+    for (const auto& c : contacts) {
+      std::string name = m.frames[static_cast<std::size_t>(c.frame)].name;
+      name.erase(std::remove(name.begin(), name.end(), '_'), name.end());
+      names.push_back(name);
+    }
+    for (std::size_t a = 0; a < contacts.size(); ++a)
+      for (std::size_t b = 0; b < contacts.size(); ++b)
+        if (a != b && names[a] == names[b]) names[a] = m.frames[static_cast<std::size_t>(contacts[a].frame)].name;
+    t += "// Contacts with the ground: each frame that closure rows tie to K0 and each wheel's contact frame.\n"
+         "// The multipliers of a contact's point rows are the force the ground exerts on it (K0 components),\n"
+         "// those of its level rows a moment about (axis x e_z); a wheel's rolling row adds the lateral force\n"
+         "// along its contact frame's lateral axis, its drive torque / radius the longitudinal one. The\n"
+         "// ground's normal is K0's z axis; `supports` says whether a z point row holds the contact up.\n"
+         "enum class ContactKind { foot, wheel };\n"
+         "struct ContactInfo {\n  std::string_view name;  // in output columns: f_n_<name>, ...\n  ContactKind kind;\n"
+         "  int frame;\n  int wheel;  // kWheels' index, -1 for a foot\n"
+         "  std::array<int, 3> point_rows;  // the closure rows of the origin's K0 x, y, z (-1: none)\n"
+         "  std::array<int, 3> level_rows;  // the closure rows keeping the frame's x, y, z axis level (-1: none)\n"
+         "  bool supports;\n  double friction;  // Coulomb coefficient (the model file's contacts.friction)\n};\n";
+    t += fmt::format("inline constexpr int kContactCount = {};\n", contacts.size());
+    t += fmt::format("inline constexpr std::array<ContactInfo, {}> kContacts{{{{\n", contacts.size());
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      const auto& c = contacts[k];
+      t += fmt::format("    {{\"{}\", ContactKind::{}, {}, {}, {{{{{}}}}}, {{{{{}}}}}, {}, {}}},  // {}\n", names[k],
+                       c.wheel >= 0 ? "wheel" : "foot", c.frame, c.wheel, int_list(std::vector<int>(c.point.begin(), c.point.end())),
+                       int_list(std::vector<int>(c.level.begin(), c.level.end())), c.point[2] >= 0 ? "true" : "false",
+                       literal(c.wheel >= 0 ? m.friction.wheels : m.friction.feet), m.frames[static_cast<std::size_t>(c.frame)].name);
+    }
+    t += "}};\n\n";
+  }
 
   // IK verification sweeps.
   std::string start;

@@ -149,16 +149,26 @@ class SetReplacement {
 // never written through; wlx::AtomicFile), and only when all are complete are they renamed into
 // place (SetReplacement). A full disk, a failed rename, a signal or any other failure leaves the
 // previous set intact and no temporary behind (the AtomicFiles' destructors remove them).
-// Unchanged headers keep their time stamps.
+// Unchanged headers keep their time stamps, except all.hpp: it is written whenever any header
+// changes, so that a build system that names it as the generation's output (CMake's BYPRODUCTS)
+// recompiles everything that includes it, which every runtime source does; without that, Ninja
+// decides what is stale before the generator runs and keeps objects built from the old headers.
 int write_header_set(const fs::path& out_dir, const std::vector<EmittedFile>& files) {
-  std::vector<std::unique_ptr<wlx::AtomicFile>> pending;
-  for (const auto& f : files) {
-    stop_if_signalled();
-    const fs::path path = out_dir / f.path;
+  std::vector<bool> changed(files.size(), false);
+  bool any = false;
+  for (std::size_t i = 0; i < files.size(); ++i) {
     // A header's size is far below the bound; an old "header" that is a device or a link to one
     // is simply replaced (the rename replaces the link, not its target).
-    const wlx::BoundedRead old = wlx::read_bounded_file(path.string(), std::size_t{64} << 20);
-    if (old.ok() && old.text == f.text) continue;
+    const wlx::BoundedRead old = wlx::read_bounded_file((out_dir / files[i].path).string(), std::size_t{64} << 20);
+    changed[i] = !(old.ok() && old.text == files[i].text);
+    any = any || changed[i];
+  }
+  std::vector<std::unique_ptr<wlx::AtomicFile>> pending;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const auto& f = files[i];
+    stop_if_signalled();
+    const fs::path path = out_dir / f.path;
+    if (!changed[i] && !(any && path.filename() == "all.hpp")) continue;
     std::error_code error;
     fs::create_directories(path.parent_path(), error);
     if (error) throw wlx::OutputError(path.parent_path().string(), fmt::format("cannot create the folder ({})", error.message()));

@@ -108,6 +108,7 @@ struct Dynamics {
   std::string pair;  // name of the dependent pair
   std::vector<Actuator> actuated;
   std::vector<double> weights;  // default weighting, one per actuator
+  std::vector<double> torque_limits;  // the largest |torque| of each actuator (N m), or empty: unlimited
 };
 
 // A box attached to a frame (centred on its origin, along its axes) whose lowest corner must
@@ -124,6 +125,13 @@ struct IkSweep {
   double from = 0, to = 0, step = 0;  // SI (radians for angles)
   bool degrees = false;               // quoted in degrees
   int limb = -1;
+};
+
+// Coulomb friction coefficients of the contacts with the ground, per kind of contact (the model
+// file's `contacts.friction`; the defaults are documented in docs/model-format.md).
+struct ContactFriction {
+  double feet = 0.5;
+  double wheels = 0.5;
 };
 
 struct Model {
@@ -144,6 +152,7 @@ struct Model {
   std::string default_pair;
   std::optional<Dynamics> dynamics;
   std::optional<ClearanceBox> clearance;
+  ContactFriction friction;
   std::vector<double> nominal;  // one value per coordinate: the inputs' nominal values, the dependent
                                 // joints' start values for Newton's method (0 where none is given)
   std::vector<double> sweep_start;  // the IK sweeps' initial inputs (nominal with overrides)

@@ -304,7 +304,7 @@ class Parser {
     const YAML::Node root = with_urdf(file_root);
     const Item top(src_, root, "", {});
     const Fields f(top, {"model", "description", "repeat", "parameters", "coordinates", "frames", "bodies", "closure",
-                         "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "nominal", "ik_sweeps"});
+                         "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "contacts", "nominal", "ik_sweeps"});
     m_.name = f["model"].name();
     if (const std::string why = model_name_problem(m_.name); !why.empty())
       f["model"].fail(fmt::format("'{}' cannot be the model's name: {}", m_.name, why));
@@ -322,6 +322,7 @@ class Parser {
     nonholonomic(f.optional("nonholonomic"), top);
     if (auto d = f.optional("dynamics")) dynamics(*d);
     if (auto c = f.optional("clearance")) clearance(*c);
+    if (auto c = f.optional("contacts")) contacts(*c);
     nominal(f.optional("nominal"));
     sweeps(f.optional("ik_sweeps"));
     return std::move(m_);
@@ -341,8 +342,8 @@ class Parser {
     }
     const Item top(src_, root, "", {});
     const Fields f(top, {"model", "description", "urdf", "rename", "base", "repeat", "parameters", "coordinates", "frames",
-                         "bodies", "closure", "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "nominal",
-                         "ik_sweeps"});
+                         "bodies", "closure", "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "contacts",
+                         "nominal", "ik_sweeps"});
     if (auto r = f.optional("repeat")) repeats(*r);
     const std::optional<Item> urdf_item = f.optional("urdf");
     const Item& where = urdf_item ? *urdf_item : top;
@@ -738,7 +739,8 @@ class Parser {
     merged["coordinates"] = coordinates;
     merged["frames"] = frames;
     if (bodies.size() > 0) merged["bodies"] = bodies;
-    for (const char* key : {"wheels", "closure", "limbs", "nonholonomic", "dynamics", "clearance", "nominal", "ik_sweeps"})
+    for (const char* key : {"wheels", "closure", "limbs", "nonholonomic", "dynamics", "clearance", "contacts", "nominal",
+                            "ik_sweeps"})
       if (root[key].IsDefined()) merged[key] = root[key];
     return merged;
   }
@@ -1448,7 +1450,7 @@ class Parser {
 
   void dynamics(const Item& section) {
     if (m_.bodies.empty()) section.fail("inverse dynamics needs bodies");
-    const Fields f(section, {"gravity", "commanded", "pair", "actuated", "weights"});
+    const Fields f(section, {"gravity", "commanded", "pair", "actuated", "weights", "torque_limits"});
     Dynamics d;
     d.gravity = parameter(f["gravity"], ParameterKind::gravity).name;
     // The wheels' dependent rates: a named pair (any model with wheels), none without wheels.
@@ -1534,6 +1536,17 @@ class Parser {
     } else {
       d.weights.assign(d.actuated.size(), 1.0);
     }
+    // The actuators' limits, which the contact-keeping torque distribution respects. Bounded like
+    // every number a model file gives: 1e9 N m is beyond any machine's drive.
+    if (auto l = f.optional("torque_limits")) {
+      for (const Item& x : l->list()) {
+        const double v = x.number();
+        if (!(v > 0 && v <= 1e9)) x.fail(fmt::format("a torque limit must be in (0, 1e9] N m, got {}", v));
+        d.torque_limits.push_back(v);
+      }
+      if (d.torque_limits.size() != d.actuated.size())
+        l->fail(fmt::format("one limit per actuator: {} needed", d.actuated.size()));
+    }
     m_.dynamics = std::move(d);
   }
 
@@ -1544,6 +1557,22 @@ class Parser {
     const Vec3 size = vector3(f["size"]);
     box.size = {size[0], size[1], size[2]};
     m_.clearance = std::move(box);
+  }
+
+  // Friction coefficients per kind of contact. Bounded: no ground grips with mu above 10 (rubber on
+  // dry concrete is about 1); a coefficient of 0 would make every tangential force a slip.
+  void contacts(const Item& section) {
+    const Fields f(section, {"friction"});
+    const Item friction_item = f["friction"];  // (Fields keeps a reference)
+    const Fields friction(friction_item, {"feet", "wheels"});
+    for (auto [key, value] : {std::pair{"feet", &m_.friction.feet}, std::pair{"wheels", &m_.friction.wheels}}) {
+      const std::optional<Item> item = friction.optional(key);
+      if (!item) continue;
+      const double mu = item->number();
+      if (!(mu > 0 && mu <= 10))
+        item->fail(fmt::format("a friction coefficient must be in (0, 10], got {}", mu));
+      *value = mu;
+    }
   }
 
   // The inputs' nominal values, and for dependent joints the start of Newton's method (a limb's

@@ -10,6 +10,7 @@
 #include "scenario_io.hpp"
 
 #include <nlohmann/json.hpp>
+#include <wlx/contacts.hpp>
 #include <wlx/dynamics.hpp>
 #include <wlx/error.hpp>
 #include <wlx/forward_dynamics.hpp>
@@ -106,7 +107,7 @@ TorqueVector torques_of(const Eigen::VectorXd& tau, const char* field) {
 
 std::string info_text() {
   nlohmann::json info;
-  std::vector<std::string> coordinates, units, frames, scenarios, commanded, actuators;
+  std::vector<std::string> coordinates, units, frames, scenarios, commanded, actuators, contacts;
   for (auto n : gen::kCoordinateNames) coordinates.emplace_back(n);
   for (auto u : gen::kCoordinateUnits) units.emplace_back(u);
   for (auto f : gen::kFrameNames) frames.emplace_back(f);
@@ -116,6 +117,7 @@ std::string info_text() {
   for (const auto& id : scenario_ids()) scenarios.push_back(id);
   for (int k : kCommandedSpeeds) commanded.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
   for (const std::string_view a : kActuatorNames) actuators.emplace_back(a);
+  for (int c = 0; c < kContactCount; ++c) contacts.push_back(contact_name(c));
   info["name"] = std::string(gen::kModelName);
   info["description"] = std::string(gen::kModelDescription);
   info["coordinates"] = coordinates;
@@ -126,6 +128,7 @@ std::string info_text() {
   info["scenarios"] = scenarios;
   info["commanded"] = commanded;
   info["actuators"] = actuators;
+  info["contacts"] = contacts;
   return info.dump();
 }
 
@@ -174,13 +177,29 @@ NamedArrays api_inverse_dynamics(const Eigen::VectorXd& s_in, const Eigen::Vecto
   inverse_dynamics(model, data, s, u, u_dot, terms);
   DynamicsTerms motion;  // M, b and Q_gravity, which the result returns too (Kane's sums)
   equations_of_motion(model, data, s, u, motion);
-  const TorqueVector tau = distribute_torques(terms.J_beta, terms.Qstar, weighting);
+  const TorqueVector tau = weighting.kind == Weighting::Kind::contacts
+                               ? distribute_torques_on_contacts(model, data, s, terms).tau
+                               : distribute_torques(terms.J_beta, terms.Qstar, weighting);
   check_result(tau, "tau");
   check_result(motion.M, "M");
-  return {{"tau", Eigen::VectorXd(tau)},           {"Qstar", Eigen::VectorXd(terms.Qstar)},
-          {"M", Eigen::MatrixXd(motion.M), false}, {"b", Eigen::VectorXd(motion.b)},
-          {"Q_gravity", Eigen::VectorXd(motion.Q_gravity)}, {"J_beta", Eigen::MatrixXd(terms.J_beta), false},
-          {"sdot", Eigen::VectorXd(terms.sdot)}};
+  NamedArrays out{{"tau", Eigen::VectorXd(tau)},           {"Qstar", Eigen::VectorXd(terms.Qstar)},
+                  {"M", Eigen::MatrixXd(motion.M), false}, {"b", Eigen::VectorXd(motion.b)},
+                  {"Q_gravity", Eigen::VectorXd(motion.Q_gravity)}, {"J_beta", Eigen::MatrixXd(terms.J_beta), false},
+                  {"sdot", Eigen::VectorXd(terms.sdot)}};
+  // The ground's forces for these torques (one column per contact, in .contacts' order; K0) and the
+  // margins: inverse_dynamics above left data's factorizations at s.
+  if constexpr (kContactCount > 0) {
+    ContactForces forces;
+    Stability st;
+    contact_forces(model, data, s, terms, tau, forces);
+    stability(model, data, s, forces, st);
+    check_result(forces.force, "contact_force");
+    out.push_back({"contact_force", Eigen::MatrixXd(forces.force.transpose()), false});
+    out.push_back({"contact_point", Eigen::MatrixXd(forces.point.transpose()), false});
+    out.push_back({"friction_margin", Eigen::VectorXd(forces.friction_margin)});
+    out.push_back({"margins", Eigen::VectorXd(Eigen::Vector3d(st.static_margin, st.zmp_margin, st.tip_angle))});
+  }
+  return out;
 }
 
 NamedArrays api_forward_dynamics(const Eigen::VectorXd& s_in, const Eigen::VectorXd& u_in, const Eigen::VectorXd& tau_in,

@@ -16,7 +16,12 @@ void write_ik_sweep_csv(const std::string& path, const IkSweepResult& result);
 // t, the coordinates, per wheel x_/y_<contact> (x_Wl, y_Wl, ...), nh_residual_<wheel>, spin_rate_<wheel>,
 // the input rates (<name>_dot), cond_J_beta, clearance, the contact velocities vx_/vy_/vz_<contact>, and for
 // dynamics runs tau_<joint> and Qstar_<speed>, and for runs driven by torques the commanded speeds'
-// accelerations <name>_ddot, the kinetic and potential energy (J) and the actuators' power (W).
+// accelerations <name>_ddot, the kinetic and potential energy (J) and the actuators' power (W); for
+// dynamics runs of a model with contacts, per contact (gen::kContacts' names) the ground's force
+// f_x_/f_y_ (K0), f_n_ (normal), f_t_ (tangential), for a wheel f_lat_/f_long_, for a contact with
+// level rows moment_ (|moment|), for a supporting one friction_margin_ (mu f_n - f_t, N), then the
+// CoM com_x/y/z, the zero-moment point zmp_x/y, margin_static and margin_zmp (m, positive inside
+// the support polygon), margin_tip (the force-angle margin, rad) and momentum_residual.
 std::vector<std::string> trajectory_header(const Scenario& scenario);
 std::vector<double> trajectory_row(const Sample& sample, const Scenario& scenario);
 void write_trajectory(const std::string& path, const Trajectory& trajectory, const Scenario& scenario);

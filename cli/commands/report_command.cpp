@@ -209,6 +209,48 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
     out.push_back(s);
   }
   if (any(is_dynamics)) out.push_back({"dynamics", title("dynamics", "Inverse dynamics"), "", {runs_table(is_dynamics)}, figures.dynamics, {}});
+  // Will it tip, will it slip: each dynamics run's smallest margins under each weighting, side by side.
+  if (kContactCount > 0 && any(is_dynamics)) {
+    report::Table t{{"run", "weighting", "smallest normal force (N)", "smallest friction margin (N)", "first slip",
+                     "first lift-off", "smallest tip-over margin (deg)", "max momentum residual"},
+                    {}};
+    for (const auto& r : runner_.runs()) {
+      if (!is_dynamics(r) || r.trajectory.samples.empty()) continue;
+      double normal = 1e300, friction = 1e300, tip = 1e300, residual = 0;
+      int normal_c = -1, friction_c = -1, tip_a = -1, tip_b = -1;
+      double normal_t = 0, friction_t = 0;
+      std::string slip = "none", lift = "none";
+      for (const Sample& smp : r.trajectory.samples) {
+        for (int c = 0; c < kContactCount; ++c) {
+          if (!gen::kContacts[static_cast<std::size_t>(c)].supports) continue;
+          if (smp.forces.normal(c) < normal) normal = smp.forces.normal(c), normal_c = c, normal_t = smp.t;
+          if (smp.forces.friction_margin(c) < friction) friction = smp.forces.friction_margin(c), friction_c = c, friction_t = smp.t;
+          if (slip == "none" && smp.forces.friction_margin(c) < 0) slip = fmt::format("{} at {:.3f} s", contact_name(c), smp.t);
+          if (lift == "none" && smp.forces.normal(c) < 0) lift = fmt::format("{} at {:.3f} s", contact_name(c), smp.t);
+        }
+        if (smp.stability.tip_angle < tip) tip = smp.stability.tip_angle, tip_a = smp.stability.tip_edge[0], tip_b = smp.stability.tip_edge[1];
+        residual = std::max(residual, smp.momentum_residual);
+      }
+      t.rows.push_back({{r.id},
+                        {r.scenario.weighting->label()},
+                        {fmt::format("{:.6g} ({} at {:.3f} s)", normal, normal_c >= 0 ? contact_name(normal_c) : "-", normal_t)},
+                        {fmt::format("{:.6g} ({} at {:.3f} s)", friction, friction_c >= 0 ? contact_name(friction_c) : "-", friction_t)},
+                        {slip},
+                        {lift},
+                        {tip_a >= 0 ? fmt::format("{:.4g} (edge {}-{})", tip * kDegPerRad, contact_name(tip_a), contact_name(tip_b))
+                                    : std::string("-")},
+                        {fmt::format("{:.1e}", residual)}});
+    }
+    out.push_back({"contacts", title("contacts", "Contacts: will it tip, will it slip"),
+                   "The force the ground exerts at each contact, from the equations of motion for the torques applied (the "
+                   "multipliers of the closure and rolling rows), for each inverse-dynamics run under the model file's weighting "
+                   "(1), weighting by contribution (2) and the torques that keep the machine on its contacts (3: the largest "
+                   "smallest normal force and friction margin mu f_n - |f_t|). A negative normal force would pull on the ground "
+                   "(the contact lifts off), a negative friction margin slides; the tip-over margin is the force-angle measure "
+                   "about the support polygon's edges. The momentum residual checks the forces against the bodies' "
+                   "accelerations. The per-sample forces and margins are in each run's CSV.",
+                   {t}, {}, {}});
+  }
   if (!runner_.forward().empty()) {
     report::Table trips{{"run", "samples", "evaluations", "max |s_forward - s_inverse| (m or rad)", "max |E - E0 - W| (J)",
                          "relative to max |W|", "CSV"},

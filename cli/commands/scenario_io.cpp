@@ -114,6 +114,7 @@ std::string actuator_list() {
 
 Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
   if (v.is_number_integer() && (v == 1 || v == 2)) return v == 1 ? Weighting::model_weights() : Weighting::contribution();
+  if ((v.is_number_integer() && v == 3) || v == "contacts") return Weighting::contacts();
   if (v.is_object() && v.size() == 1 && v.contains("diag")) {
     const auto& d = v.at("diag");
     if (!d.is_array() || d.size() != static_cast<std::size_t>(kActuatedCount))
@@ -149,7 +150,7 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
       throw Error(key + ".matrix", e.reason());
     }
   }
-  throw Error(key, fmt::format("must be 1, 2, {{\"diag\": [{0} weights]}} or {{\"matrix\": [[{0} x {0}]]}}, got {1}",
+  throw Error(key, fmt::format("must be 1, 2, 3 (\"contacts\"), {{\"diag\": [{0} weights]}} or {{\"matrix\": [[{0} x {0}]]}}, got {1}",
                                kActuatedCount, excerpt(v)));
 }
 
@@ -284,7 +285,8 @@ TorqueSource parse_torques(const nlohmann::json& v, const Params& params, double
 Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::string& directory, TorqueSource function) {
   if (!j.is_object()) throw Error("", fmt::format("a scenario is a JSON object, got {}", j.type_name()));
   reject_unknown_keys(j, {"id", "model", "description", "observation", "verify", "initial", "params", "rates", "dependent", "duration",
-                          "dt", "integrator", "tolerance", "branch", "max_condition", "weighting", "torques"},
+                          "dt", "integrator", "tolerance", "branch", "max_condition", "weighting", "torques",
+                          "on_contact_loss"},
                       "");
   // "model": the model the run was written for. Names alone may match another machine's (two
   // models with an x_C), so a run says whose it is, and running it on another is an error.
@@ -375,6 +377,12 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::
       throw Error("max_condition", fmt::format("must be above 1, got {}", sc.nonholonomic.max_condition));
   }
   if (j.contains("weighting")) sc.weighting = parse_weighting(j.at("weighting"), "weighting");
+  if (j.contains("on_contact_loss")) {
+    const nlohmann::json& v = j.at("on_contact_loss");
+    if (!(v == "stop" || v == "continue"))
+      throw Error("on_contact_loss", fmt::format("must be \"stop\" or \"continue\", got {}", excerpt(v)));
+    sc.stop_on_contact_loss = v == "stop";
+  }
   if (j.contains("torques")) {
     if (sc.weighting)
       throw Error("torques", "a run is driven by its rates (the weighting then splits their torques) or by torques, not both");

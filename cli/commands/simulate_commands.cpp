@@ -16,6 +16,14 @@
 
 WLX_COMMANDS_BEGIN
 
+namespace {
+bool has_level_rows(int contact) {
+  for (int row : gen::kContacts[static_cast<std::size_t>(contact)].level_rows)
+    if (row >= 0) return true;
+  return false;
+}
+}  // namespace
+
 std::vector<std::string> trajectory_header(const Scenario& sc) {
   const bool dynamics = sc.weighting || sc.driven_by_torques();
   const auto name = [](int k) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]); };
@@ -37,6 +45,20 @@ std::vector<std::string> trajectory_header(const Scenario& sc) {
   if (sc.driven_by_torques()) {
     for (int k : kCommandedSpeeds) h.push_back(name(k) + "_ddot");
     for (const char* energy : {"kinetic", "potential", "power"}) h.emplace_back(energy);
+  }
+  if (dynamics && kContactCount > 0) {
+    for (int c = 0; c < kContactCount; ++c) {
+      const gen::ContactInfo& info = gen::kContacts[static_cast<std::size_t>(c)];
+      const std::string stem = contact_name(c);
+      for (const char* q : {"f_x_", "f_y_", "f_n_", "f_t_"}) h.push_back(q + stem);
+      if (info.wheel >= 0)
+        for (const char* q : {"f_lat_", "f_long_"}) h.push_back(q + stem);
+      if (has_level_rows(c)) h.push_back("moment_" + stem);
+      if (info.supports) h.push_back("friction_margin_" + stem);
+    }
+    for (const char* q : {"com_x", "com_y", "com_z", "zmp_x", "zmp_y", "margin_static", "margin_zmp", "margin_tip",
+                          "momentum_residual"})
+      h.emplace_back(q);
   }
   return h;
 }
@@ -60,6 +82,19 @@ std::vector<double> trajectory_row(const Sample& smp, const Scenario& sc) {
   if (sc.driven_by_torques()) {
     for (int k = 0; k < kCommandedCount; ++k) row.push_back(smp.u_dot(k));
     row.insert(row.end(), {smp.kinetic, smp.potential, smp.power});
+  }
+  if (dynamics && kContactCount > 0) {
+    const ContactForces& f = smp.forces;
+    for (int c = 0; c < kContactCount; ++c) {
+      const gen::ContactInfo& info = gen::kContacts[static_cast<std::size_t>(c)];
+      row.insert(row.end(), {f.force(0, c), f.force(1, c), f.normal(c), f.tangential(c)});
+      if (info.wheel >= 0) row.insert(row.end(), {f.lateral(c), f.longitudinal(c)});
+      if (has_level_rows(c)) row.push_back(f.moment.col(c).norm());
+      if (info.supports) row.push_back(f.friction_margin(c));
+    }
+    const Stability& st = smp.stability;
+    row.insert(row.end(), {st.com.x(), st.com.y(), st.com.z(), st.zmp.x(), st.zmp.y(), st.static_margin, st.zmp_margin,
+                           st.tip_angle, smp.momentum_residual});
   }
   return row;
 }
@@ -95,8 +130,11 @@ int run_simulate(const ModelOptions& model_options, const SimulateOptions& o) {
     sc.tolerance = *o.tolerance;
   }
   if (!o.weighting.empty()) {
-    if (o.weighting != "1" && o.weighting != "2") throw Error("--weighting", fmt::format("must be 1 or 2, got '{}'", o.weighting));
-    sc.weighting = o.weighting == "1" ? Weighting::model_weights() : Weighting::contribution();
+    if (o.weighting != "1" && o.weighting != "2" && o.weighting != "3")
+      throw Error("--weighting", fmt::format("must be 1, 2 or 3, got '{}'", excerpt(o.weighting)));
+    sc.weighting = o.weighting == "1"   ? Weighting::model_weights()
+                   : o.weighting == "2" ? Weighting::contribution()
+                                        : Weighting::contacts();
   }
   sc.validate();
   prepare_out_dir("--out", o.out_dir);

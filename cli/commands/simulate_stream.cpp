@@ -32,6 +32,33 @@ struct Summary {
   double last_t = 0;
   double worst_residual = 0, worst_cond = 0, min_clearance = 0, peak_tau = 0;
   EnergyBalance energy;  // runs driven by torques
+  // Dynamics runs of a model with contacts: the lowest normal force, friction margin and tip
+  // angle with their contact (or edge) and time, the first sample where a contact slips or pulls.
+  struct Lowest {
+    double value = 0, t = 0;
+    int contact = -1, other = -1;
+    void add(double v, int c, double time, int d = -1) {
+      if (contact < 0 || v < value) value = v, contact = c, other = d, t = time;
+    }
+  } normal, friction, tip;
+  int first_slip = -1, first_pull = -1;
+  double slip_t = 0, pull_t = 0, worst_momentum = 0;
+
+  void add_contacts(const Sample& smp) {
+    if constexpr (kContactCount > 0) {
+      for (int c = 0; c < kContactCount; ++c) {
+        if (!gen::kContacts[static_cast<std::size_t>(c)].supports) continue;
+        normal.add(smp.forces.normal(c), c, smp.t);
+        friction.add(smp.forces.friction_margin(c), c, smp.t);
+        if (first_slip < 0 && smp.forces.friction_margin(c) < 0) first_slip = c, slip_t = smp.t;
+        if (first_pull < 0 && smp.forces.normal(c) < 0) first_pull = c, pull_t = smp.t;
+      }
+      tip.add(smp.stability.tip_angle, smp.stability.tip_edge[0], smp.t, smp.stability.tip_edge[1]);
+      worst_momentum = std::max(worst_momentum, smp.momentum_residual);
+    } else {
+      static_cast<void>(smp);
+    }
+  }
 
   void add(const Sample& smp) {
     energy.add(smp);
@@ -66,6 +93,7 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
         throw StopRun{std::current_exception()};
       }
       summary.add(smp);
+      if (sc.weighting || sc.driven_by_torques()) summary.add_contacts(smp);
     });
   } catch (const StopRun& stop) {
     try {
@@ -91,6 +119,22 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
     fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, min clearance = {:.4f} m\n",
                summary.worst_residual, summary.worst_cond, summary.min_clearance);
     if (sc.weighting) fmt::print("inverse dynamics with {}: largest |tau| = {:.4g} N m\n", sc.weighting->label(), summary.peak_tau);
+    if ((sc.weighting || sc.driven_by_torques()) && summary.normal.contact >= 0) {
+      const auto& st = summary;
+      fmt::print("contacts: smallest normal force {:.6g} N ({} at t = {:.4f} s), smallest friction margin {:.6g} N ({} at t = "
+                 "{:.4f} s), smallest tip-over margin {:.4g} deg (edge {}-{} at t = {:.4f} s); momentum balance to {:.1e}\n",
+                 st.normal.value, contact_name(st.normal.contact), st.normal.t, st.friction.value,
+                 contact_name(st.friction.contact), st.friction.t, st.tip.value * 180 / 3.14159265358979323846,
+                 st.tip.contact >= 0 ? contact_name(st.tip.contact) : "-", st.tip.other >= 0 ? contact_name(st.tip.other) : "-",
+                 st.tip.t, st.worst_momentum);
+      if (st.first_slip >= 0)
+        fmt::print("contacts: {} slips first, at t = {:.4f} s (its friction margin turns negative)\n",
+                   contact_name(st.first_slip), st.slip_t);
+      if (st.first_pull >= 0)
+        wlx::diagnose("wlx: warning: contact {} pulls on the ground from t = {:.4f} s (the run goes on, as its "
+                      "\"on_contact_loss\" asks: the model's contacts hold both ways)\n",
+                      contact_name(st.first_pull), st.pull_t);
+    }
     if (sc.driven_by_torques())
       fmt::print("driven by torques: largest |tau| = {:.4g} N m; kinetic + potential energy {:.6g} -> {:.6g} J, the "
                  "actuators' work {:.6g} J (trapezoid on the samples): balance off by {:.2e} J\n",

@@ -132,7 +132,8 @@ std::vector<std::string> ReportRunner::selected_scenarios() const {
 
 int ReportRunner::steps() const {
   int n = static_cast<int>(selected_sweeps().size());
-  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? 4 : 1;  // each weighting's run and its forward dynamics
+  // Each weighting's run (weighting 3 with contacts) and the forward dynamics of weightings 1 and 2.
+  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? (kContactCount > 0 ? 5 : 4) : 1;
   if (!quick_ && !spec_.integrator_scenarios.empty()) ++n;
   return n;
 }
@@ -152,12 +153,16 @@ void ReportRunner::run_all(const std::string& data_dir) {
     if (json.contains("weighting")) {
       variants.emplace_back(scenario_id + "-w1", Weighting::model_weights());
       variants.emplace_back(scenario_id + "-w2", Weighting::contribution());
+      if (kContactCount > 0) variants.emplace_back(scenario_id + "-w3", Weighting::contacts());
     } else {
       variants.emplace_back(scenario_id, std::nullopt);
     }
     for (const auto& [id, weighting] : variants) {
       Scenario sc = parse_scenario(json, model_.params(), model_scenario_directory());
       if (weighting) sc.weighting = weighting;
+      // The report compares the weightings' contacts over the whole run: a lift-off is a row of
+      // its contacts table, not the end of the report.
+      if (weighting) sc.stop_on_contact_loss = false;
       progress_(fmt::format("simulating {}{}: {}", id, weighting ? " (" + weighting->label() + ")" : "", sc.description));
       ReportRun r{id, scenario_id, sc, simulate(sc, stop_on_signal), id + ".csv", verify};
       if (!r.trajectory.complete) throw Error(id, r.trajectory.error);
@@ -167,7 +172,8 @@ void ReportRunner::run_all(const std::string& data_dir) {
   }
   const std::size_t inverse_runs = runs_.size();
   for (std::size_t k = 0; k < inverse_runs; ++k) {
-    if (!runs_[k].scenario.weighting) continue;
+    // Forward dynamics for weightings 1 and 2 (weighting 3's torques retrace the same motion).
+    if (!runs_[k].scenario.weighting || runs_[k].scenario.weighting->kind == Weighting::Kind::contacts) continue;
     progress_(fmt::format("forward dynamics of {}: its torques fed back, and a controller tracking it on a heavier plant", runs_[k].id));
     forward_.push_back(forward_dynamics_of(runs_[k], data_dir));
   }

@@ -23,7 +23,7 @@ struct NamedArray {
 using NamedArrays = std::vector<NamedArray>;
 
 // The model's tables, by name (a JSON object: name, description, coordinates, units, input_count,
-// frames, params (defaults, SI), scenarios, commanded, actuators), as text.
+// frames, params (defaults, SI), scenarios, commanded, actuators, contacts), as text.
 using ModelInfoText = std::string;
 
 // The torques of a controller in the loop: f(t, s, u) -> tau, one per actuator. Whatever it throws
@@ -53,7 +53,8 @@ struct ModelApi {
   // All rates from the inputs' rates, for the dependent pair (empty: the model's); and cond(J_beta).
   std::pair<Eigen::VectorXd, double> (*dependent_rates)(const Eigen::VectorXd& s, const Eigen::VectorXd& input_rates,
                                                          const std::vector<std::string>& pair, const std::string& params_json);
-  // tau, Qstar, M, b, Q_gravity, J_beta, sdot.
+  // tau, Qstar, M, b, Q_gravity, J_beta, sdot; for a model with contacts contact_force and contact_point
+  // (contacts x 3), friction_margin, margins (static, zmp, tip angle).
   NamedArrays (*inverse_dynamics)(const Eigen::VectorXd& s, const Eigen::VectorXd& u, const Eigen::VectorXd& u_dot,
                                   const std::string& params_json, const std::string& weighting_json);
   // u_dot, sddot, sdot, Qstar, M.

@@ -77,6 +77,8 @@ class Model:
         self.scenarios = list(info["scenarios"])
         self.commanded = list(info["commanded"])  # u: the commanded speeds, in inverse_dynamics' order
         self.actuators = list(info["actuators"])  # tau's order: joints, and wheel drives (spin_<wheel>)
+        # The contacts with the ground (contact_force's rows; f_n_<name> in simulate's columns).
+        self.contacts = list(info.get("contacts", []))
 
     def __repr__(self):
         return f"wlx.load({self._path!r})" if self._path is not None else f"wlx.model({self.name!r})"
@@ -115,8 +117,11 @@ class Model:
     def inverse_dynamics(self, s, u, u_dot=None, params=None, weighting=1):
         """Q* and the actuator torques at s for the commanded speeds u and their rates u_dot
         (default 0), in the order of `commanded` (the model file's dynamics section); tau is in the
-        order of `actuators`; `weighting` as in scenario files (1, 2, {"diag": [...]},
-        {"matrix": [[...]]})."""
+        order of `actuators`; `weighting` as in scenario files (1, 2, 3 or "contacts": the torques
+        that keep the machine on its contacts, {"diag": [...]}, {"matrix": [[...]]}). For a model
+        with contacts also "contact_force" and "contact_point" (one row per contact, in the order
+        of `contacts`, K0, N and m), "friction_margin" (mu f_n - |f_t|, N) and "margins" (static
+        and zero-moment-point margins in m, the force-angle margin in rad)."""
         if u_dot is None:
             u_dot = _np.zeros(len(self.commanded))
         return self._m.inverse_dynamics(_np.asarray(s, dtype=float), _np.asarray(u, dtype=float),

@@ -94,7 +94,7 @@ void inverse_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   gen::convective(s, out.sdot, p, {.dPhi_ds_dot_sdot = &d.dPhi_ds_dot_sdot, .C_dot_sdot = &d.C_dot_sdot});
   solve_bias_accelerations(d, out.sddot_bias, pair);
   out.sddot = out.T.lazyProduct(u_dot) + out.sddot_bias;
-  gen::generalized_forces(s, out.sdot, out.sddot, out.T, p, {.Qstar = &out.Qstar});
+  gen::generalized_forces(s, out.sdot, out.sddot, out.T, p, {.Qstar = &out.Qstar, .tau = &out.tau_bodies});
 #endif
 }
 
@@ -154,6 +154,7 @@ std::string Weighting::label() const {
     case Kind::contribution: return "weighting 2 (contribution)";
     case Kind::diagonal: return "diagonal weights";
     case Kind::matrix: return "weight matrix";
+    case Kind::contacts: return "weighting 3 (keeps the contacts)";
   }
   return {};
 }
@@ -508,6 +509,9 @@ TorqueVector distribute_torques(const ActuatorJacobian& J_beta, const CommandVec
   // S with S S^T = W^-1: tau = S x and |x| = sqrt(tau^T W tau). Diagonal for every kind but a full
   // weight matrix (out of line below: its 8 x 8 products cost more than the QR).
   if (weighting.kind == Weighting::Kind::matrix) return distribute_torques_weight_matrix(J_beta, Qstar, weighting);
+  if (weighting.kind == Weighting::Kind::contacts)
+    throw Error("weighting", "weighting 3 (keeps the contacts) needs the step's contact forces: distribute_torques_on_contacts "
+                             "(contacts.hpp) computes it");
   TorqueVector S;
   switch (weighting.kind) {
     case Weighting::Kind::model_weights: {

@@ -49,6 +49,9 @@ struct DynamicsTerms {
   Coordinates sddot;                                           // T u' + s''_bias
   Coordinates sddot_bias;                                      // s''_bias: s'' at u' = 0
   CommandVector Qstar;                                         // M u' + b - Q_gravity
+  // The bodies' inertia, velocity and gravity forces on every coordinate (generalized_forces' tau,
+  // free with Q*; 0 on the held inputs): what contact_forces() balances. inverse_dynamics only.
+  Coordinates tau_bodies = Coordinates::Zero();
   ActuatorJacobian J_beta;                                     // actuator rates beta' = J_beta u
   // Written by equations_of_motion() (inverse_dynamics needs none of them):
   CommandMatrix M;          // generalized mass matrix on u
@@ -83,7 +86,7 @@ double potential_energy(const Model& model, Data& data, const Coordinates& s);
 double kinetic_energy(const Model& model, Data& data, const Coordinates& s, const Coordinates& sdot);
 
 struct Weighting {
-  enum class Kind { model_weights, contribution, diagonal, matrix };
+  enum class Kind { model_weights, contribution, diagonal, matrix, contacts };
   Kind kind = Kind::model_weights;
   TorqueVector diagonal = TorqueVector::Ones();  // W for Kind::diagonal
   // W for Kind::matrix, else null: shared, so that a Weighting made at every step (model_weights())
@@ -95,6 +98,10 @@ struct Weighting {
   static Weighting model_weights() { return {}; }
   // Thesis 6.3.3 weighting 2: W_ii = 1 / |row i of J_beta|, recomputed at every step.
   static Weighting contribution() { return {Kind::contribution, TorqueVector::Ones(), nullptr}; }
+  // Weighting 3: the torques that keep the machine on its contacts (contacts.hpp,
+  // distribute_torques_on_contacts: it needs the step's contact forces, so distribute_torques
+  // refuses it).
+  static Weighting contacts() { return {Kind::contacts, TorqueVector::Ones(), nullptr}; }
   // Throws wlx::Error (field "weighting") unless every entry is positive and finite.
   static Weighting diagonal_of(const TorqueVector& w);
   // Throws unless symmetric positive definite.

@@ -293,6 +293,41 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
     smp.clearance = lowest_clearance(model.params(), s);
   };
 
+  // A dynamics sample's contact forces, margins and momentum balance; the run stops where a
+  // contact would pull on the ground or the machine would tip (unless asked to go on), and always
+  // where the forces do not balance the bodies' accelerations: a result the model does not satisfy.
+  const auto contact_sample = [&](Sample& smp, const Coordinates& s, const DynamicsTerms& terms, const TorqueVector& tau) {
+    if constexpr (kContactCount > 0) {
+      // A non-finite torque or force is named by check_finite, which runs next, by its column.
+      if (!(tau.allFinite() && terms.tau_bodies.allFinite())) return;
+      contact_forces(model, data, s, terms, tau, smp.forces);
+      const MomentumBalance balance = momentum_balance(model, data, s, terms.sdot, terms.sddot, smp.forces);
+      smp.momentum_residual = std::max(balance.force, balance.moment);
+      if (!(smp.momentum_residual <= 1e-6))
+        throw Error("contacts", fmt::format("the contact forces do not balance the bodies' accelerations (relative residual "
+                                            "{:.3g}): a held input moves the machine as a whole, or the model's contacts are "
+                                            "not all closure rows to the ground",
+                                            smp.momentum_residual));
+      stability(model, data, s, smp.forces, smp.stability);
+      if (!sc.stop_on_contact_loss) return;
+      // Tipping first: where it happens a contact also unloads, and the edge says more.
+      if (smp.stability.polygon_size == 0)
+        throw Error("contacts", "no contact carries load: the machine leaves the ground, which the model does not describe");
+      if (smp.stability.tip_angle <= 0)
+        throw Error("contacts", fmt::format("the machine tips over the edge {}-{} (force-angle margin {:.4g} deg)",
+                                            contact_name(smp.stability.tip_edge[0]), contact_name(smp.stability.tip_edge[1]),
+                                            smp.stability.tip_angle * 180 / 3.14159265358979323846));
+      for (int c = 0; c < kContactCount; ++c)
+        if (gen::kContacts[static_cast<std::size_t>(c)].supports && smp.forces.normal(c) < 0)
+          throw Error("contacts", fmt::format("contact {} would pull on the ground (normal force {:.6g} N): it lifts off, which "
+                                              "the model does not describe; another weighting may keep it down, or "
+                                              "\"on_contact_loss\": \"continue\" goes on",
+                                              contact_name(c), smp.forces.normal(c)));
+    } else {
+      static_cast<void>(smp), static_cast<void>(s), static_cast<void>(terms), static_cast<void>(tau);
+    }
+  };
+
   // The loop of every run: a sample after each step's first evaluation, then the step. `name(i)`
   // names the state's entry i for a message about a value that became non-finite.
   const auto integrate = [&](auto& f, auto x, const auto& fill, const auto& name) {
@@ -349,6 +384,12 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       smp.power = f.tau.dot(f.terms.J_beta * f.u);
       smp.kinetic = kinetic_energy(model, data, f.s, f.terms.sdot);
       smp.potential = potential_energy(model, data, f.s);
+      // The bodies' forces on s at this s'' (forward_dynamics' equations of motion do not give them).
+      DynamicsTerms& t = f.terms;
+#if __has_include(<wlx/gen/generalized_forces.hpp>)  // (a run driven by torques needs a dynamics section)
+      gen::generalized_forces(f.s, t.sdot, t.sddot, t.T, model.params(), {.tau = &t.tau_bodies});
+#endif
+      contact_sample(smp, f.s, t, f.tau);
       // Driven by torques, the body may fall: the model has no contact but its feet and wheels.
       if (smp.clearance < 0)
         throw Error("clearance", fmt::format("the clearance box's lowest corner is {:.4f} m below the ground: the body "
@@ -367,7 +408,10 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       if (sc.weighting) {
         inverse_dynamics(model, data, f.s, u, CommandVector::Zero(), terms, sc.nonholonomic);
         smp.Qstar = terms.Qstar;
-        smp.tau = distribute_torques(terms.J_beta, terms.Qstar, *sc.weighting);
+        smp.tau = sc.weighting->kind == Weighting::Kind::contacts
+                      ? distribute_torques_on_contacts(model, data, f.s, terms).tau
+                      : distribute_torques(terms.J_beta, terms.Qstar, *sc.weighting);
+        contact_sample(smp, f.s, terms, smp.tau);
       }
     };
     integrate(f, InputVector(sc.initial.head<kInputCount>()), fill, coordinate);

@@ -4,6 +4,7 @@
 // (kinematic, or inverse dynamics with a weighting) or by torques (forward dynamics).
 #pragma once
 
+#include "wlx/contacts.hpp"
 #include "wlx/dynamics.hpp"
 #include "wlx/forward_dynamics.hpp"
 #include "wlx/ik.hpp"
@@ -52,6 +53,10 @@ struct Scenario {
   // their start values. Every integrator applies (dopri5's error control covers u too). The run
   // also stops when the clearance box reaches the ground: the model has no contact there.
   TorqueSource torques;
+  // Dynamics runs: stop when a contact would pull on the ground (a negative normal force) or the
+  // machine would tip (the force-angle margin reaches zero), naming the contact or the edge; false
+  // reports those samples and goes on (the scenario's "on_contact_loss": "continue").
+  bool stop_on_contact_loss = true;
 
   bool driven_by_torques() const { return static_cast<bool>(torques); }
   // The commanded speeds u at t = 0: the commanded inputs' rates.
@@ -80,6 +85,11 @@ struct Sample {
   CommandVector u = CommandVector::Zero(), u_dot = CommandVector::Zero();  // commanded speeds and their rates
   double kinetic = 0, potential = 0;  // J
   double power = 0;                   // the actuators' power tau . J_beta u, W
+  // Dynamics runs: the ground's forces at the contacts, the margins (contacts.hpp), and the whole
+  // machine's momentum balance with them (relative residual: rounding when the forces are right).
+  ContactForces forces = {};
+  Stability stability = {};
+  double momentum_residual = 0;
 };
 
 struct Trajectory {

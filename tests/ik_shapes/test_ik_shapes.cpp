@@ -4,6 +4,7 @@
 // solution solves the limb's closure rows to 1e-12 m, and the solution Newton's method finds from
 // near those angles is one of the branches (to 1e-9 rad). Newton uses the generated dPhi/ds, the
 // closed form nothing of it: the two share only the model's chains.
+#include <wlx/gen/all.hpp>  // its time stamp moves with any header's (wlx-gen): the build recompiles this
 #include <wlx/gen/closure.hpp>
 #include <wlx/gen/ik.hpp>
 #include <wlx/gen/structure.hpp>

@@ -374,3 +374,36 @@ def test_the_wheeled_quadruped_commands_ten_speeds_with_sixteen_actuators():
     assert np.allclose(rates[12:], 5.0, rtol=0, atol=1e-12)
     with pytest.raises(wlx.Error, match=r"^u: has 4 entries; the model commands 10 speeds"):
         robot.inverse_dynamics(s, [0.0, 3.0, 0.0, 0.0])
+
+
+def test_contact_forces_carry_the_weight_and_weighting_3_keeps_the_contacts():
+    # At rest on the nominal pose the ground carries the machine's weight (the sum of the bodies'
+    # masses times g, from the model's own parameters, not from wlx's forces); weighting 3's smallest
+    # margin (the smaller of a contact's normal force and friction margin) is at least weighting 1's.
+    m = wlx.model("excavator")
+    s = m.ik()["s"]
+    u = np.zeros(len(m.commanded))
+    masses = sum(v for k, v in m.params.items() if k.startswith("m_"))
+    weight = masses * m.params["g"]
+    smallest = {}
+    for w in (1, 3):
+        r = m.inverse_dynamics(s, u, weighting=w)
+        f = r["contact_force"]
+        assert f.shape == (len(m.contacts), 3)
+        assert m.contacts == ["Fl", "Fr", "Wl", "Wr"]
+        assert abs(f[:, 2].sum() - weight) <= 1e-9 * weight
+        assert abs(f[:, 0].sum()) <= 1e-9 * weight and abs(f[:, 1].sum()) <= 1e-9 * weight
+        smallest[w] = min(f[:, 2].min(), r["friction_margin"].min())
+        assert r["margins"].shape == (3,) and r["margins"][2] > 0  # standing: no tipping
+    assert smallest[3] >= smallest[1] - 1e-9 * weight
+
+
+def test_simulate_columns_name_the_contacts():
+    m = wlx.model("excavator")
+    run = m.simulate({"id": "ID-3", "rates": {"z_C": -3.0}, "dependent": ["y_C", "yaw"], "duration": 0.05,
+                      "weighting": 3})
+    assert run["complete"]
+    for c in m.contacts:
+        assert (run["f_n_" + c] > 0).all()
+    assert (run["momentum_residual"] <= 1e-9).all()
+    assert (run["margin_tip"] > 0).all()

@@ -263,6 +263,9 @@ TEST_CASE("dynamics: ID-1..3 reach the thesis' end states with torques of order 
       sc.rates(r.coordinate) = r.rate;
       sc.duration = r.duration;
       sc.weighting = w;
+      // The thesis' contacts are bilateral: with its weightings ID-2 pulls on the ground (the test
+      // of weighting 3 below says how much); its reproduction goes on, as the thesis did.
+      sc.stop_on_contact_loss = false;
       const Trajectory tr = simulate(sc);
       REQUIRE(tr.complete);
       CHECK(tr.samples.back().s(r.coordinate) == doctest::Approx(r.end).epsilon(1e-9));
@@ -292,6 +295,7 @@ TEST_CASE("forward dynamics: the torques of ID-1..3, fed back, reproduce their t
       sc.duration = r.duration;
       sc.dt = exact ? dt / 2 : dt;
       sc.weighting = Weighting::model_weights();
+      sc.stop_on_contact_loss = false;  // as above: the thesis' bilateral contacts
       const Trajectory id = simulate(sc);
       REQUIRE(id.complete);
       std::vector<double> times;
@@ -402,4 +406,51 @@ TEST_CASE("dynamics: a rank-deficient J_beta and bad weights are clear errors; z
   Eigen::Matrix<double, 8, 8> W = Eigen::Matrix<double, 8, 8>::Identity();
   W(7, 7) = -1;
   CHECK_THROWS_WITH_AS(Weighting::matrix_of(W), "weighting: the weight matrix must be positive definite", Error);
+}
+
+TEST_CASE("weighting 3 keeps the contacts: on ID-1..3 its smallest contact margin is at least the better of weightings 1 and 2 at every step") {
+  // The three runs share their motion (inverse dynamics: the torques follow it), so their samples
+  // pair up. Weighting 3 maximises the smallest of every contact's normal force and friction
+  // margin over the weight; weighting 1's torques are feasible for it (z = 0), so it may not fall
+  // below them beyond the cutting planes' tolerance (1e-10); weighting 2's are feasible at the
+  // penalty 1e-7 |z_2|^2 / 2 of the tie-break, with |z_2| below 3 here: 1e-6 bounds it.
+  struct Run { const char* id; int coordinate; double rate, duration; };
+  const Model model;
+  for (const Run& r : {Run{"ID-1", c::x_C, 3.0, 0.494}, Run{"ID-2", c::roll, -10 * kDeg, 0.541}, Run{"ID-3", c::z_C, -3.0, 0.581}}) {
+    std::vector<Trajectory> runs;
+    for (const Weighting& w : {Weighting::model_weights(), Weighting::contribution(), Weighting::contacts()}) {
+      Scenario sc;
+      sc.rates(r.coordinate) = r.rate;
+      sc.duration = r.duration;
+      sc.weighting = w;
+      sc.stop_on_contact_loss = false;  // weightings 1 and 2 may lift a contact: compare every step
+      runs.push_back(simulate(sc));
+      CAPTURE(runs.back().error);
+      REQUIRE(runs.back().complete);
+    }
+    REQUIRE(runs[0].samples.size() == runs[2].samples.size());
+    double worst_1 = 1e300, worst_2 = 1e300, lowest[3] = {1e300, 1e300, 1e300}, normal[3] = {1e300, 1e300, 1e300},
+           friction[3] = {1e300, 1e300, 1e300}, residual = 0;
+    for (std::size_t k = 0; k < runs[0].samples.size(); ++k) {
+      double m[3];
+      for (int w = 0; w < 3; ++w) {
+        const Sample& smp = runs[static_cast<std::size_t>(w)].samples[k];
+        m[w] = smallest_contact_margin(model, smp.forces);
+        lowest[w] = std::min(lowest[w], m[w]);
+        normal[w] = std::min(normal[w], smp.forces.normal.minCoeff());
+        friction[w] = std::min(friction[w], smp.forces.friction_margin.minCoeff());
+        residual = std::max(residual, smp.momentum_residual);  // weighting 3's torques produce Q* too
+      }
+      worst_1 = std::min(worst_1, m[2] - m[0]);
+      worst_2 = std::min(worst_2, m[2] - m[1]);
+    }
+    MESSAGE(std::string(r.id) << ": smallest contact margin / weight, weightings 1, 2, 3: " << lowest[0] << ", " << lowest[1] << ", "
+                 << lowest[2] << "; smallest normal force (N) " << normal[0] << ", " << normal[1] << ", " << normal[2]
+                 << "; smallest friction margin (N) " << friction[0] << ", " << friction[1] << ", " << friction[2]
+                 << "; weighting 3 minus the better, worst step: " << std::min(worst_1, worst_2));
+    CHECK(worst_1 >= -1e-10);
+    CHECK(worst_2 >= -1e-6);
+    CHECK(lowest[2] >= std::max(lowest[0], lowest[1]) - 1e-6);
+    CHECK(residual <= 1e-9);
+  }
 }

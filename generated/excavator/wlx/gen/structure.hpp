@@ -96,6 +96,10 @@ inline constexpr std::array<int, 8> kActuatedWheels{{-1, -1, -1, -1, -1, -1, -1,
 inline constexpr std::array<std::string_view, 8> kActuatorNames{{"psi_l2", "psi_l3", "psi_l4", "psi_r2", "psi_r3", "psi_r4", "theta_l6", "theta_r6"}};
 inline constexpr std::array<double, 8> kDefaultWeights{{0.01, 100.0, 1.0, 0.01, 100.0, 1.0, 0.01, 0.01}};
 inline constexpr double Params::*kGravity = &Params::g;
+// The actuators' torque limits (|tau_i| <= limit, N m; the model file's dynamics.torque_limits),
+// respected by the contact-keeping torque distribution; kHasTorqueLimits false: unlimited (zeros).
+inline constexpr bool kHasTorqueLimits = false;
+inline constexpr std::array<double, 8> kTorqueLimits{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
 
 // The rate basis T (s' = T u, one column per commanded speed): whether a coordinate's rate can
 // depend on a commanded speed. The closure's and the wheels' rows split the dependent rates into
@@ -184,6 +188,30 @@ inline constexpr std::array<ClosureRowInfo, 14> kClosureRows{{
     {RowKind::level, 12, 0, -1},  // level_x_r
     {RowKind::level, 12, 1, -1},  // level_y_r
     {RowKind::sum, -1, 0, -1},  // guidance_r
+}};
+
+// Contacts with the ground: each frame that closure rows tie to K0 and each wheel's contact frame.
+// The multipliers of a contact's point rows are the force the ground exerts on it (K0 components),
+// those of its level rows a moment about (axis x e_z); a wheel's rolling row adds the lateral force
+// along its contact frame's lateral axis, its drive torque / radius the longitudinal one. The
+// ground's normal is K0's z axis; `supports` says whether a z point row holds the contact up.
+enum class ContactKind { foot, wheel };
+struct ContactInfo {
+  std::string_view name;  // in output columns: f_n_<name>, ...
+  ContactKind kind;
+  int frame;
+  int wheel;  // kWheels' index, -1 for a foot
+  std::array<int, 3> point_rows;  // the closure rows of the origin's K0 x, y, z (-1: none)
+  std::array<int, 3> level_rows;  // the closure rows keeping the frame's x, y, z axis level (-1: none)
+  bool supports;
+  double friction;  // Coulomb coefficient (the model file's contacts.friction)
+};
+inline constexpr int kContactCount = 4;
+inline constexpr std::array<ContactInfo, 4> kContacts{{
+    {"Fl", ContactKind::foot, 3, -1, {{0, 1, 2}}, {{-1, -1, -1}}, true, 0.5},  // F_l
+    {"Fr", ContactKind::foot, 6, -1, {{3, 4, 5}}, {{-1, -1, -1}}, true, 0.5},  // F_r
+    {"Wl", ContactKind::wheel, 9, 0, {{-1, -1, 6}}, {{7, 8, -1}}, true, 0.5},  // W_l
+    {"Wr", ContactKind::wheel, 12, 1, {{-1, -1, 10}}, {{11, 12, -1}}, true, 0.5},  // W_r
 }};
 
 // The IK verification: each sweep moves one input over [from, to] in steps (SI units), from the

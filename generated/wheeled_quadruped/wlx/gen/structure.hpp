@@ -98,6 +98,10 @@ inline constexpr std::array<int, 16> kActuatedWheels{{-1, -1, -1, -1, -1, -1, -1
 inline constexpr std::array<std::string_view, 16> kActuatorNames{{"haa_lf", "hfe_lf", "kfe_lf", "haa_rf", "hfe_rf", "kfe_rf", "haa_lh", "hfe_lh", "kfe_lh", "haa_rh", "hfe_rh", "kfe_rh", "wheel_joint_lf", "wheel_joint_rf", "wheel_joint_lh", "wheel_joint_rh"}};
 inline constexpr std::array<double, 16> kDefaultWeights{{1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0}};
 inline constexpr double Params::*kGravity = &Params::g;
+// The actuators' torque limits (|tau_i| <= limit, N m; the model file's dynamics.torque_limits),
+// respected by the contact-keeping torque distribution; kHasTorqueLimits false: unlimited (zeros).
+inline constexpr bool kHasTorqueLimits = false;
+inline constexpr std::array<double, 16> kTorqueLimits{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
 
 // The rate basis T (s' = T u, one column per commanded speed): whether a coordinate's rate can
 // depend on a commanded speed. The closure's and the wheels' rows split the dependent rates into
@@ -194,6 +198,30 @@ inline constexpr std::array<ClosureRowInfo, 12> kClosureRows{{
     {RowKind::point, 24, 0, 15},  // contact_x_rh
     {RowKind::point, 24, 1, 16},  // contact_y_rh
     {RowKind::point, 24, 2, 17},  // contact_z_rh
+}};
+
+// Contacts with the ground: each frame that closure rows tie to K0 and each wheel's contact frame.
+// The multipliers of a contact's point rows are the force the ground exerts on it (K0 components),
+// those of its level rows a moment about (axis x e_z); a wheel's rolling row adds the lateral force
+// along its contact frame's lateral axis, its drive torque / radius the longitudinal one. The
+// ground's normal is K0's z axis; `supports` says whether a z point row holds the contact up.
+enum class ContactKind { foot, wheel };
+struct ContactInfo {
+  std::string_view name;  // in output columns: f_n_<name>, ...
+  ContactKind kind;
+  int frame;
+  int wheel;  // kWheels' index, -1 for a foot
+  std::array<int, 3> point_rows;  // the closure rows of the origin's K0 x, y, z (-1: none)
+  std::array<int, 3> level_rows;  // the closure rows keeping the frame's x, y, z axis level (-1: none)
+  bool supports;
+  double friction;  // Coulomb coefficient (the model file's contacts.friction)
+};
+inline constexpr int kContactCount = 4;
+inline constexpr std::array<ContactInfo, 4> kContacts{{
+    {"contactlf", ContactKind::wheel, 21, 0, {{0, 1, 2}}, {{-1, -1, -1}}, true, 0.5},  // contact_lf
+    {"contactrf", ContactKind::wheel, 22, 1, {{3, 4, 5}}, {{-1, -1, -1}}, true, 0.5},  // contact_rf
+    {"contactlh", ContactKind::wheel, 23, 2, {{6, 7, 8}}, {{-1, -1, -1}}, true, 0.5},  // contact_lh
+    {"contactrh", ContactKind::wheel, 24, 3, {{9, 10, 11}}, {{-1, -1, -1}}, true, 0.5},  // contact_rh
 }};
 
 // The IK verification: each sweep moves one input over [from, to] in steps (SI units), from the

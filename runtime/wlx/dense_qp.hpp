@@ -1,0 +1,90 @@
+// A small dense convex quadratic programme, min 1/2 x^T H x + c^T x subject to A x >= b, by a
+// primal-dual interior-point method with Mehrotra's predictor-corrector (Nocedal and Wright,
+// Numerical Optimization, 2nd ed., algorithm 16.4). For the contact-keeping torque distribution:
+// a handful of variables and up to a few hundred constraints per step, where a factorization of
+// the n x n normal matrix per iteration costs microseconds. H is positive semidefinite, and
+// H + A^T D A positive definite for positive D (every variable bounded by the constraints or
+// penalized by H). Debian has no small dense QP solver library (OSQP, qpOASES and quadprog are not
+// packaged for C++); docs/architecture.md says why this one.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace wlx::qp {
+
+struct Result {
+  Eigen::VectorXd x;       // the solution
+  Eigen::VectorXd lambda;  // the constraints' multipliers (>= 0)
+  int iterations = 0;
+  bool converged = false;
+  double gap = 0;        // the mean complementarity s . lambda / m at the end
+  double residual = 0;   // the largest relative primal or dual residual at the end
+};
+
+// Converged when the complementarity and the residuals, relative to the data's scale, are below
+// `tolerance`. A problem without a solution (infeasible constraints) ends with converged false.
+inline Result solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& c, const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+                    double tolerance = 1e-11, int max_iterations = 120) {
+  const Eigen::Index n = H.rows(), m = A.rows();
+  Result out;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd s = (A * x - b).cwiseMax(1.0);
+  Eigen::VectorXd lambda = Eigen::VectorXd::Ones(m);
+  const double scale = 1 + std::max({H.cwiseAbs().maxCoeff(), c.cwiseAbs().maxCoeff(), m ? A.cwiseAbs().maxCoeff() : 0.0,
+                                     m ? b.cwiseAbs().maxCoeff() : 0.0});
+  Eigen::MatrixXd K(n, n);
+  Eigen::LLT<Eigen::MatrixXd> llt(n);
+  Eigen::VectorXd rd(n), rp(m), dx(n), ds(m), dl(m), rhs(n), w(m);
+  // The Newton step for the residuals (rd, rp) and complementarity target r_sl = s o lambda - sigma mu:
+  // eliminating ds = A dx + rp and dl = -(lambda o ds + r_sl) / s gives (H + A^T D A) dx = -rd - A^T (...).
+  const auto step = [&](const Eigen::VectorXd& r_sl) {
+    w = (lambda.cwiseProduct(rp) + r_sl).cwiseQuotient(s);  // D rp + r_sl / s
+    rhs = -rd - A.transpose() * w;
+    dx = llt.solve(rhs);
+    ds = A * dx + rp;
+    dl = -(lambda.cwiseProduct(ds) + r_sl).cwiseQuotient(s);
+  };
+  const auto max_step = [](const Eigen::VectorXd& v, const Eigen::VectorXd& dv) {
+    double alpha = 1;
+    for (Eigen::Index i = 0; i < v.size(); ++i)
+      if (dv(i) < 0) alpha = std::min(alpha, -v(i) / dv(i));
+    return alpha;
+  };
+  for (int it = 0; it < max_iterations; ++it) {
+    rd = H * x + c - A.transpose() * lambda;
+    rp = A * x - s - b;  // (primal residual, with the slack)
+    const double mu = m ? s.dot(lambda) / static_cast<double>(m) : 0.0;
+    out.gap = mu;
+    out.residual = std::max(rd.cwiseAbs().maxCoeff(), m ? rp.cwiseAbs().maxCoeff() : 0.0) / scale;
+    out.iterations = it;
+    if (mu <= tolerance * scale && out.residual <= tolerance) {
+      out.converged = true;
+      break;
+    }
+    K = H;
+    K.noalias() += A.transpose() * lambda.cwiseQuotient(s).asDiagonal() * A;
+    llt.compute(K);
+    if (llt.info() != Eigen::Success) break;
+    // Predictor (affine scaling), then the corrector with Mehrotra's centring.
+    step(s.cwiseProduct(lambda));
+    const double a_aff = std::min(max_step(s, ds), max_step(lambda, dl));
+    const double mu_aff = (s + a_aff * ds).dot(lambda + a_aff * dl) / static_cast<double>(m);
+    const double sigma = std::pow(mu_aff / mu, 3);
+    step(s.cwiseProduct(lambda) + ds.cwiseProduct(dl) - Eigen::VectorXd::Constant(m, sigma * mu));
+    const double alpha = 0.995 * std::min(max_step(s, ds), max_step(lambda, dl));
+    x += alpha * dx;
+    s += alpha * ds;
+    lambda += alpha * dl;
+    if (!(x.allFinite() && s.allFinite() && lambda.allFinite())) break;
+  }
+  out.x = x;
+  out.lambda = lambda;
+  return out;
+}
+
+}  // namespace wlx::qp
