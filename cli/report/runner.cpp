@@ -132,8 +132,7 @@ std::vector<std::string> ReportRunner::selected_scenarios() const {
 
 int ReportRunner::steps() const {
   int n = static_cast<int>(selected_sweeps().size());
-  // Each weighting's run (weighting 3 with contacts) and the forward dynamics of weightings 1 and 2.
-  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? (kContactCount > 0 ? 5 : 4) : 1;
+  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? 4 : 1;  // each weighting's run and its forward dynamics
   if (!quick_ && !spec_.integrator_scenarios.empty()) ++n;
   return n;
 }
@@ -153,7 +152,6 @@ void ReportRunner::run_all(const std::string& data_dir) {
     if (json.contains("weighting")) {
       variants.emplace_back(scenario_id + "-w1", Weighting::model_weights());
       variants.emplace_back(scenario_id + "-w2", Weighting::contribution());
-      if (kContactCount > 0) variants.emplace_back(scenario_id + "-w3", Weighting::contacts());
     } else {
       variants.emplace_back(scenario_id, std::nullopt);
     }

@@ -389,7 +389,7 @@ ContactDistribution distribute_torques_on_contacts(const Model& model, Data& d, 
       out.iterations += r.iterations;
       ++out.programmes;
       // Converged, or stalled at rounding (the last digits of a degenerate optimum): both are the answer.
-      if (!(r.converged || (r.residual <= 1e-8 && r.gap <= 1e-8)))
+      if (!(r.converged || (r.residual <= 1e-6 && r.gap <= 1e-6)))
         throw Error("weighting", gen::kHasTorqueLimits
                                      ? fmt::format("no torques within the actuators' limits (dynamics.torque_limits) produce "
                                                    "the generalized forces here (the contact-keeping programme has no solution: "

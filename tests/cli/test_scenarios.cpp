@@ -145,7 +145,7 @@ TEST_CASE("scenarios: a run driven by the torques of ID-1..3 retraces each (roun
     REQUIRE(inverse.complete);
     const std::string duration = fmt::format("{}", inverse.samples.back().t);
     const std::string common = std::string(R"({"rates": )") + k.rates + R"(, "duration": )" + duration +
-                               R"(, "dt": 0.001, "integrator": "dopri5", "tolerance": 1e-12, )";
+                               R"(, "dt": 0.001, "integrator": "dopri5", "tolerance": 1e-12, "on_contact_loss": "continue", )";
     // The same torques written inline as the CSV's columns (t, tau_<actuator>), cubic between them.
     nlohmann::json table;
     table["interpolation"] = "cubic";

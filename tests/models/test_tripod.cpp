@@ -83,6 +83,7 @@ TEST_CASE("tripod: backing up at constant speed, it tips over the rear feet's ed
   sc.rates(coordinate_index("x_B")) = kSpeed;
   sc.duration = 1.2;
   sc.dt = 1e-3;
+  sc.stop_on_contact_loss = true;
   const Trajectory run = simulate(sc);
   REQUIRE_FALSE(run.complete);
   MESSAGE(run.error);
