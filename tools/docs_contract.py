@@ -278,6 +278,8 @@ class Examples:
         expected = named + (backticked_names(driven) if inverse_dynamics else []) + (backticked_names(forward) if by_torques else [])
         if by_torques:
             named = named + backticked_names(forward)
+        if inverse_dynamics:  # (the dynamics runs' own columns: the contacts' forces and margins)
+            named = named + backticked_names(driven)
         for template in expected:
             if template.startswith("DIR/"):
                 continue
