@@ -801,19 +801,6 @@ int main(int argc, char** argv) {
                                  : nullptr});
       first_pair = false;
     }
-    // What the contacts add to a step: each part against the model's own inverse-dynamics step
-    // (speedup: the step's time over the part's; below 1, the part costs more than the step).
-    bool first_contact = true;
-    for (const std::string& model : models)
-      for (const char* part : {"contact_forces", "contact_margins", "momentum_check", "weighting_3"}) {
-        const std::string name = model + "/" + part, inverse = model + "/inverse_dynamics_step";
-        if (!collector.median_ns.count(name) || !collector.median_ns.count(inverse)) continue;
-        rows.push_back({texts.emplace_back(fmt::format("{}: {} vs its inverse_dynamics_step", model, part)).c_str(),
-                        texts.emplace_back(name).c_str(), texts.emplace_back(inverse).c_str(), 0, false,
-                        first_contact ? "the contacts of an inverse-dynamics step, each part against the step (speedup: step / part)"
-                                      : nullptr});
-        first_contact = false;
-      }
   }
   const auto get = [&](const char* name) {
     const auto it = collector.median_ns.find(name);
