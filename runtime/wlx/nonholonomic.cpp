@@ -50,7 +50,9 @@ void reduce(Data& d) {
     for (int j = 0; j < b.size; ++j) {
       const int joint = b.joints[static_cast<std::size_t>(j)];
       for (int i = 0; i < b.size; ++i) block(i, j) = d.dPhi_ds(b.rows[static_cast<std::size_t>(i)], joint);
-      rhs.row(j) = d.C.col(joint).transpose();
+      // A row of a matrix with no columns is a block at an offset from a null pointer (undefined
+      // behaviour that UBSan reports) for a model without wheels: nothing to copy there.
+      if constexpr (kWheelCount > 0) rhs.row(j) = d.C.col(joint).transpose();
     }
     auto& inverse = d.limb_inverse[static_cast<std::size_t>(limb)];
     inverse = block.inverse();
@@ -63,8 +65,10 @@ void reduce(Data& d) {
                               std::isfinite(rcond) ? rcond : 0.0,  // an exactly singular block inverts to inf/NaN
                               "its joints cannot move its targets in every direction here (a chain stretched straight "
                               "or folded, or two joint axes aligned)"));
-    const Eigen::Matrix<double, kLimbMax, kWheelCount> lambda = inverse.transpose().lazyProduct(rhs);
-    for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.rows[static_cast<std::size_t>(i)]) = lambda.row(i);
+    if constexpr (kWheelCount > 0) {
+      const Eigen::Matrix<double, kLimbMax, kWheelCount> lambda = inverse.transpose().lazyProduct(rhs);
+      for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.rows[static_cast<std::size_t>(i)]) = lambda.row(i);
+    }
   });
 }
 
