@@ -154,5 +154,7 @@ const std::vector<ModelCommands>& models() {
   target_compile_definitions(${target}_python PRIVATE WLX_VERSION="${wlx_VERSION}" WLX_BIN_FROM_PYTHON_MODULE="wlx-gen-is-not-here"
                                                      WLX_BUILD_BIN_DIR="$<TARGET_FILE_DIR:wlx::wlx-gen>")
   set_target_properties(${target}_python PROPERTIES OUTPUT_NAME _wlx LIBRARY_OUTPUT_DIRECTORY "${dir}/wlx")
-  configure_file("${WLX_PYTHON_SOURCE_DIR}/wlx/__init__.py" "${dir}/wlx/__init__.py" COPYONLY)
+  foreach(file __init__.py _sweep.py __main__.py)  # the package's Python files (the sweep engine too)
+    configure_file("${WLX_PYTHON_SOURCE_DIR}/wlx/${file}" "${dir}/wlx/${file}" COPYONLY)
+  endforeach()
 endfunction()

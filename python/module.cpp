@@ -118,7 +118,7 @@ PYBIND11_MODULE(_wlx, m) {
            "forward_dynamics(s, u, tau, params_json) -> dict u_dot, sddot, sdot, Qstar (= J_beta^T tau), M")
       .def(
           "simulate",
-          [](const ModelHandle& h, const std::string& scenario_json, long every, const py::object& torques) {
+          [](const ModelHandle& h, const std::string& scenario_json, const std::string& params_json, long every, const py::object& torques) {
             // A Python function as the torque source: a controller in the loop, called at every
             // evaluation of the right-hand side. Its own exceptions reach the caller unchanged; a
             // result of the wrong shape is a TypeError, not a stopped run.
@@ -161,7 +161,7 @@ PYBIND11_MODULE(_wlx, m) {
             sink.row = [&](long row, const std::vector<double>& values) {
               for (std::size_t c = 0; c < values.size() && c < columns.size(); ++c) columns[c].mutable_at(row) = values[c];
             };
-            const wlx::cli::SimulationOutcome run = h.api->simulate(scenario_json, every, std::move(function), sink);
+            const wlx::cli::SimulationOutcome run = h.api->simulate(scenario_json, params_json, every, std::move(function), sink);
             py::dict out_columns;
             for (std::size_t c = 0; c < columns.size(); ++c) {
               columns[c].resize({run.rows}, false);  // a run that stopped early: only its samples
@@ -175,8 +175,8 @@ PYBIND11_MODULE(_wlx, m) {
             out["evaluations"] = run.evaluations;
             return out;
           },
-          py::arg("scenario_json"), py::arg("every") = 1, py::arg("torques") = py::none(),
-          "simulate(scenario_json, every=1, torques=None) -> dict: columns (the CSV's, as arrays; every k-th sample), complete, "
+          py::arg("scenario_json"), py::arg("params_json") = "{}", py::arg("every") = 1, py::arg("torques") = py::none(),
+          "simulate(scenario_json, params_json=\"{}\", every=1, torques=None) -> dict: columns (the CSV's, as arrays; every k-th sample), complete, "
           "stopped (why, if early); torques: a function f(t, s, u) -> tau driving the run");
 
   py::list models;

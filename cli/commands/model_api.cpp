@@ -111,9 +111,12 @@ std::string info_text() {
   for (auto n : gen::kCoordinateNames) coordinates.emplace_back(n);
   for (auto u : gen::kCoordinateUnits) units.emplace_back(u);
   for (auto f : gen::kFrameNames) frames.emplace_back(f);
-  nlohmann::json defaults = nlohmann::json::object();
+  nlohmann::json defaults = nlohmann::json::object(), param_units = nlohmann::json::object();
   const Params p;
-  for (const auto& info_p : gen::kParamInfo) defaults[std::string(info_p.name)] = p.*info_p.member;
+  for (const auto& info_p : gen::kParamInfo) {
+    defaults[std::string(info_p.name)] = p.*info_p.member;
+    param_units[std::string(info_p.name)] = std::string(info_p.unit);
+  }
   for (const auto& id : scenario_ids()) scenarios.push_back(id);
   for (int k : kCommandedSpeeds) commanded.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
   for (const std::string_view a : kActuatorNames) actuators.emplace_back(a);
@@ -125,6 +128,7 @@ std::string info_text() {
   info["input_count"] = kInputCount;
   info["frames"] = frames;
   info["params"] = defaults;
+  info["param_units"] = param_units;
   info["scenarios"] = scenarios;
   info["commanded"] = commanded;
   info["actuators"] = actuators;
@@ -221,8 +225,11 @@ NamedArrays api_forward_dynamics(const Eigen::VectorXd& s_in, const Eigen::Vecto
           {"M", Eigen::MatrixXd(terms.M), false}};
 }
 
-SimulationOutcome api_simulate(const std::string& scenario_json, long every, TorqueFunction torques, const SimulationSink& sink) {
+SimulationOutcome api_simulate(const std::string& scenario_json, const std::string& params_json, long every, TorqueFunction torques,
+                               const SimulationSink& sink) {
   const nlohmann::json j = parse_json(scenario_json, "scenario");
+  const nlohmann::json overrides = parse_json(params_json, "params");
+  if (!overrides.is_object()) throw Error("params", "must be an object {\"name\": value}, got " + excerpt(overrides));
   if (every < 1) throw Error("every", "must be at least 1 (keep every k-th sample), got " + std::to_string(every));
   // A function as the torque source: a controller in the loop, called at every evaluation of the
   // right-hand side (each stage of a step) with t, s and u.
@@ -235,9 +242,13 @@ SimulationOutcome api_simulate(const std::string& scenario_json, long every, Tor
                                    std::to_string(kActuatedCount) + " actuators");
       return tau;
     };
-  const Scenario sc = j.is_string() ? parse_scenario(read_scenario_json(j.get<std::string>()), {}, scenario_directory(j.get<std::string>()),
-                                                     std::move(function))
-                                    : parse_scenario(j, {}, {}, std::move(function));
+  // The overrides win over the scenario's own "params" (an id's, a file's or an object's), key by
+  // key, and go through the scenario's checks with them.
+  nlohmann::json scenario = j.is_string() ? read_scenario_json(j.get<std::string>()) : j;
+  if (!overrides.empty() && scenario.is_object())
+    for (const auto& [name, value] : overrides.items()) scenario["params"][name] = value;
+  const Scenario sc = parse_scenario(scenario, {}, j.is_string() ? scenario_directory(j.get<std::string>()) : std::string(),
+                                     std::move(function));
   const std::vector<std::string> header = trajectory_header(sc);
   const long kept = (sc.samples() + every - 1) / every;
   sink.begin(header, kept);

@@ -6,10 +6,18 @@
 
 #include <CLI/CLI.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace wlx::cli {
+
+// `wlx sweep`: a parameter sweep, run by the Python package on Dask (python3 -m wlx sweep ...).
+struct SweepOptions {
+  std::string spec;
+  std::string out, scheduler;  // empty: the spec's folder, a local cluster
+  std::optional<long> workers, batch_size;
+};
 
 // What a parsed command line asks for: the option values, and the subcommands (parsed() tells
 // which was given).
@@ -34,6 +42,8 @@ struct Invocation {
   ReportOptions report_options;
   CLI::App* viewer = nullptr;
   ViewerOptions viewer_options;
+  CLI::App* sweep = nullptr;
+  SweepOptions sweep_options;
 };
 
 // Adds wlx's subcommands and options to `app` (model_names: the built-in models, the default

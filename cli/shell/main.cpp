@@ -16,8 +16,57 @@
 #include <wlx/atomic_file.hpp>
 #include <wlx/error.hpp>
 
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace {
+
+// `wlx sweep`: the sweep engine is the Python package's (python/wlx/_sweep.py, on Dask). This
+// process becomes `python3 -m wlx sweep ...` (exec, no shell): its exit code and its signals are
+// the sweep's. The package is the build tree's, or the one installed beside this bin/.
+int run_sweep(const wlx::cli::SweepOptions& o, bool model_options_given) {
+  namespace fs = std::filesystem;
+  if (model_options_given)
+    throw wlx::Error("sweep", "the model and its runs are the spec's (model, runs): --model, --model-file, --scenarios and --params do not apply");
+  if (o.spec.empty()) throw wlx::Error("SPEC", "missing: give the sweep's spec file (YAML)");
+#ifdef WLX_PYTHON_EXECUTABLE
+  std::error_code ec;
+  fs::path package = WLX_PYTHON_BUILD_DIR;
+  if (!fs::is_regular_file(package / "wlx" / "_sweep.py", ec)) {
+    const fs::path executable = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec) package = (executable.parent_path() / WLX_PYTHON_FROM_BINDIR).lexically_normal();
+  }
+  if (!fs::is_regular_file(package / "wlx" / "_sweep.py", ec))
+    throw wlx::Error("sweep", "the Python package wlx was not found (" + package.string() + "): build it (pybind11-dev)");
+  const char* old_path = std::getenv("PYTHONPATH");
+  const std::string python_path = package.string() + (old_path != nullptr && *old_path != '\0' ? ":" + std::string(old_path) : "");
+  setenv("PYTHONPATH", python_path.c_str(), 1);
+  std::vector<std::string> args{WLX_PYTHON_EXECUTABLE, "-m", "wlx", "sweep", o.spec};
+  if (!o.out.empty()) args.insert(args.end(), {"--out", o.out});
+  if (!o.scheduler.empty()) args.insert(args.end(), {"--scheduler", o.scheduler});
+  if (o.workers) args.insert(args.end(), {"--workers", std::to_string(*o.workers)});
+  if (o.batch_size) args.insert(args.end(), {"--batch-size", std::to_string(*o.batch_size)});
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::fflush(stdout);
+  execv(argv[0], argv.data());
+  throw wlx::Error("sweep", std::string("cannot run ") + WLX_PYTHON_EXECUTABLE + ": " + std::strerror(errno));
+#else
+  throw wlx::Error("sweep", "wlx was built without its Python package (pybind11-dev), which runs sweeps");
+#endif
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace wlx::cli;
@@ -27,7 +76,7 @@ int main(int argc, char** argv) {
   Invocation inv;
   define_command_line(app, inv, names, WLX_VERSION);
   auto& [model_name, model_file, scenarios_dir, model_options, list_models, fk, fk_json, ik, batch, verify_ik, ik_out, sweep_ids, verify_nh, nh_out,
-         simulate, sim, report, report_options, viewer, viewer_options] = inv;
+         simulate, sim, report, report_options, viewer, viewer_options, sweep, sweep_options] = inv;
   std::string model_names;
   for (const auto& n : names) model_names += (model_names.empty() ? "" : ", ") + n;
   install_interrupt_handlers();
@@ -39,6 +88,8 @@ int main(int argc, char** argv) {
     report_options.command_line += (k ? " " : "") + (plain ? arg : "'" + arg + "'");
   }
   try {
+    if (sweep->parsed()) return run_sweep(sweep_options, !model_file.empty() || !scenarios_dir.empty() || !model_options.params_file.empty() ||
+                                                            model_name != names.front());
     const ModelCommands* model = nullptr;
     std::vector<std::string> names;
     for (const auto& m : models()) {

@@ -23,7 +23,7 @@ struct NamedArray {
 using NamedArrays = std::vector<NamedArray>;
 
 // The model's tables, by name (a JSON object: name, description, coordinates, units, input_count,
-// frames, params (defaults, SI), scenarios, commanded, actuators, contacts), as text.
+// frames, params (defaults, SI), param_units, scenarios, commanded, actuators, contacts), as text.
 using ModelInfoText = std::string;
 
 // The torques of a controller in the loop: f(t, s, u) -> tau, one per actuator. Whatever it throws
@@ -60,8 +60,10 @@ struct ModelApi {
   // u_dot, sddot, sdot, Qstar, M.
   NamedArrays (*forward_dynamics)(const Eigen::VectorXd& s, const Eigen::VectorXd& u, const Eigen::VectorXd& tau,
                                   const std::string& params_json);
-  // A scenario (JSON: an object, or a string naming an embedded id or a file), every k-th sample.
-  SimulationOutcome (*simulate)(const std::string& scenario_json, long every, TorqueFunction torques, const SimulationSink& sink);
+  // A scenario (JSON: an object, or a string naming an embedded id or a file), every k-th sample;
+  // params_json (an object) overrides the scenario's own parameters (a sweep's variant over a run).
+  SimulationOutcome (*simulate)(const std::string& scenario_json, const std::string& params_json, long every, TorqueFunction torques,
+                                const SimulationSink& sink);
 };
 
 }  // namespace wlx::cli

@@ -19,7 +19,7 @@ import numpy as _np
 from . import _wlx
 from ._wlx import Error
 
-__all__ = ["Error", "Model", "load", "model", "models"]
+__all__ = ["Error", "Model", "load", "model", "models", "sweep"]
 
 
 def models():
@@ -74,6 +74,7 @@ class Model:
         self.inputs = self.coordinates[: self.input_count]
         self.frames = list(info["frames"])
         self.params = dict(info["params"])  # defaults, SI units
+        self.param_units = dict(info["param_units"])  # each parameter's unit (m, kg, rad, ...)
         self.scenarios = list(info["scenarios"])
         self.commanded = list(info["commanded"])  # u: the commanded speeds, in inverse_dynamics' order
         self.actuators = list(info["actuators"])  # tau's order: joints, and wheel drives (spin_<wheel>)
@@ -134,9 +135,10 @@ class Model:
         return self._m.forward_dynamics(_np.asarray(s, dtype=float), _np.asarray(u, dtype=float),
                                         _np.asarray(tau, dtype=float), _params_json(params))
 
-    def simulate(self, scenario, every=1, torques=None):
+    def simulate(self, scenario, every=1, torques=None, params=None):
         """Runs a scenario: an embedded id ("NH-1"), a path to a JSON file, or a dict in the scenario
-        format. Returns the CSV's columns as arrays by name (every `every`-th sample, from t = 0),
+        format; `params` ({name: value}) override the scenario's own parameters, key by key (as a
+        sweep's variant does). Returns the CSV's columns as arrays by name (every `every`-th sample, from t = 0),
         plus "complete", "stopped" (why a run ended early) and "evaluations". A run whose kept
         samples would take more than 256 MiB is refused (ValueError naming `every`): keep fewer, or
         stream it to a file with `wlx simulate`.
@@ -154,8 +156,11 @@ class Model:
             raise TypeError("every: must be an integer")
         if torques is not None and not callable(torques):
             raise TypeError("torques: must be a function f(t, s, u) -> tau, or None")
-        result = self._m.simulate(text, every, torques)
+        result = self._m.simulate(text, _params_json(params), every, torques)
         out = dict(result["columns"])
         for k in ("id", "complete", "stopped", "evaluations"):
             out[k] = result[k]
         return out
+
+
+from ._sweep import sweep  # noqa: E402 - after Model, which it uses

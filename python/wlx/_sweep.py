@@ -1,0 +1,912 @@
+"""Parameter sweeps on Dask: wlx.sweep(...) in Python, `wlx sweep SPEC.yaml` on the command line.
+
+A sweep runs every variant (a set of parameter values) through every run (a scenario) and reduces
+each run to a row of metrics. The variants are cut into batches; a batch is one Dask task (a
+task costs about a millisecond to schedule, a run a few: batches make the overhead small, see
+_batch_size). Each finished batch is written to its own CSV under a temporary name and renamed, so
+a killed sweep restarted with the same spec skips the variants already written and ends with the
+same table (results.csv, rows in variant and run order) as an uninterrupted one. README.md,
+"Parameter sweeps", documents the spec, the metrics and the files.
+"""
+
+import csv
+import io
+import json
+import math
+import os
+import re
+import signal
+import sys
+import time
+
+import numpy as np
+
+# Bounds on every input (README.md, "Parameter sweeps"): beyond them a sweep is an error, not a
+# machine that runs out of memory or disk hours later.
+MAX_VARIANTS = 1_000_000
+MAX_RUNS = 100
+MAX_ROWS = 10_000_000
+MAX_BATCH = 10_000
+MAX_WORKERS = 256
+MAX_SPEC_BYTES = 1 << 20
+# A batch should take about this long on a worker: ~500 times the per-task overhead measured on a
+# local cluster (about 1 ms, README.md), so scheduling costs well under 1%, while a kill loses at
+# most this much work per worker and the progress bar still moves.
+TARGET_BATCH_SECONDS = 0.5
+# ...and each worker should get at least this many batches, so that a slow batch does not leave
+# the others idle at the end.
+MIN_BATCHES_PER_WORKER = 4
+
+# The metrics: name -> (unit, what it is). peak_tau and rms_tau also give one column per actuator.
+METRICS = {
+    "peak_tau": ("N m or N", "largest |tau| over the run, of all actuators (and peak_tau_<actuator> each)"),
+    "rms_tau": ("N m or N", "largest RMS of tau over the samples, of all actuators (and rms_tau_<actuator> each)"),
+    "peak_cond_J_beta": ("1", "largest cond(J_beta) over the run"),
+    "min_clearance": ("m", "smallest clearance over the run"),
+    "energy": ("J", "the actuators' positive work, each actuator's own (none recovered), trapezoidal over the samples"),
+    "reach_failure": ("1", "1 if the run stopped at a pose out of reach, else 0"),
+}
+_MODES = ("grid", "list", "random")
+
+
+class SweepError(ValueError):
+    """A mistake in a sweep's spec or arguments: the message names the field and the reason."""
+
+
+def _error(field, reason):
+    # wlx.Error when the package is there (a ValueError either way), so callers catch one type.
+    try:
+        from . import Error
+    except ImportError:  # pragma: no cover - only without the compiled module
+        raise SweepError(f"{field}: {reason}") from None
+    raise Error(f"{field}: {reason}") from None
+
+
+def _excerpt(value):
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _nearest(name, names):
+    import difflib
+
+    close = difflib.get_close_matches(str(name), list(names), n=1, cutoff=0.6)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
+def _number(value, field):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        _error(field, f"expected a number, got {_excerpt(value)}")
+    if not math.isfinite(value):
+        _error(field, f"must be a finite number, got {value}")
+    return float(value)
+
+
+def _count(value, field, low, high):
+    if isinstance(value, bool) or not isinstance(value, int):
+        _error(field, f"expected a whole number, got {_excerpt(value)}")
+    if not low <= value <= high:
+        _error(field, f"must be between {low} and {high}, got {value}")
+    return value
+
+
+def _keys(mapping, field, allowed, required=()):
+    if not isinstance(mapping, dict):
+        _error(field, f"expected a mapping, got {_excerpt(mapping)}")
+    for k in mapping:
+        if k not in allowed:
+            _error(f"{field}.{k}" if field else str(k), f"unknown key{_nearest(k, allowed)} (known: {', '.join(allowed)})")
+    for k in required:
+        if k not in mapping:
+            _error(f"{field}.{k}" if field else k, "missing")
+
+
+# ---------------------------------------------------------------- the plan: variants and runs
+
+
+class _Plan:
+    """What a sweep computes: the parameter names and units, the variants (rows of values, SI),
+    the runs (label, scenario), the metrics; and, for a grid, its shape."""
+
+    def __init__(self, model, names, units, values, mode, shape, runs, metrics):
+        self.model, self.names, self.units, self.values = model, names, units, values
+        self.mode, self.shape, self.runs, self.metrics = mode, shape, runs, metrics
+
+    def identity(self):
+        """What must match for a restart to reuse written rows: everything that changes a row."""
+        return {"model": self.model.name, "model_file": self.model._path, "names": self.names,
+                "values": [[v.hex() for v in row] for row in self.values.tolist()],
+                "runs": [[label, source] for label, source in self.runs], "metrics": self.metrics}
+
+
+def _parameter_values(model, parameters):
+    """The variants of a `parameters` mapping: (names, SI values as a variants x names array, mode,
+    grid shape or None, units by name)."""
+    _keys(parameters, "parameters", _MODES + ("units",))
+    modes = [m for m in _MODES if m in parameters]
+    if len(modes) != 1:
+        _error("parameters", f"give exactly one of grid, list or random, got {modes or 'none'}")
+    mode = modes[0]
+    spec = parameters[mode]
+    field = f"parameters.{mode}"
+    known = model.params
+
+    def check_name(name, where):
+        if not isinstance(name, str) or name not in known:
+            _error(where, f"not a parameter of {model.name}{_nearest(name, known)}")
+
+    shape = None
+    if mode == "grid":
+        if not isinstance(spec, dict) or not spec:
+            _error(field, "expected a mapping {parameter: values} with at least one parameter")
+        names, axes = [], []
+        for name, axis in spec.items():
+            where = f"{field}.{name}"
+            check_name(name, where)
+            if isinstance(axis, list):
+                if not axis:
+                    _error(where, "an empty list of values")
+                if len(axis) > MAX_VARIANTS:
+                    _error(where, f"more than {MAX_VARIANTS} values")
+                points = [_number(v, f"{where}[{k}]") for k, v in enumerate(axis)]
+            elif isinstance(axis, dict):
+                _keys(axis, where, ("from", "to", "count"), ("from", "to", "count"))
+                count = _count(axis["count"], f"{where}.count", 1, MAX_VARIANTS)
+                points = list(np.linspace(_number(axis["from"], f"{where}.from"), _number(axis["to"], f"{where}.to"), count))
+            else:
+                _error(where, f"expected a list of values or {{from, to, count}}, got {_excerpt(axis)}")
+            names.append(name)
+            axes.append(points)
+        total = math.prod(len(a) for a in axes)
+        if total > MAX_VARIANTS:
+            _error(field, f"{total} variants (the product of the axes' lengths) is more than the bound of {MAX_VARIANTS}")
+        shape = tuple(len(a) for a in axes)
+        mesh = np.meshgrid(*[np.array(a, dtype=float) for a in axes], indexing="ij")  # the last parameter varies fastest
+        values = np.stack([m.ravel() for m in mesh], axis=1)
+    elif mode == "list":
+        if not isinstance(spec, list) or not spec:
+            _error(field, "expected a non-empty list of variants, each {parameter: value}")
+        if len(spec) > MAX_VARIANTS:
+            _error(field, f"{len(spec)} variants is more than the bound of {MAX_VARIANTS}")
+        if not isinstance(spec[0], dict) or not spec[0]:
+            _error(f"{field}[0]", f"expected a mapping {{parameter: value}}, got {_excerpt(spec[0])}")
+        names = list(spec[0])
+        for name in names:
+            check_name(name, f"{field}[0].{name}")
+        rows = []
+        for k, variant in enumerate(spec):
+            if not isinstance(variant, dict):
+                _error(f"{field}[{k}]", f"expected a mapping {{parameter: value}}, got {_excerpt(variant)}")
+            if sorted(variant) != sorted(names):
+                missing, extra = sorted(set(names) - set(variant)), sorted(set(variant) - set(names))
+                _error(f"{field}[{k}]", "every variant sets the same parameters as the first"
+                       + (f"; missing {', '.join(missing)}" if missing else "") + (f"; not in the first: {', '.join(map(str, extra))}" if extra else ""))
+            rows.append([_number(variant[n], f"{field}[{k}].{n}") for n in names])
+        values = np.array(rows, dtype=float)
+    else:
+        _keys(spec, field, ("samples", "seed", "distributions"), ("samples", "seed", "distributions"))
+        samples = _count(spec["samples"], f"{field}.samples", 1, MAX_VARIANTS)
+        seed = _count(spec["seed"], f"{field}.seed", 0, 2**63 - 1)
+        dists = spec["distributions"]
+        if not isinstance(dists, dict) or not dists:
+            _error(f"{field}.distributions", "expected a mapping {parameter: {uniform: [low, high]} or {normal: [mean, sd]}}")
+        # One generator for the whole sweep, drawn parameter after parameter in the spec's order:
+        # the same spec and seed give the same variants on any machine (NumPy's PCG64).
+        rng = np.random.Generator(np.random.PCG64(seed))
+        names, columns = [], []
+        for name, dist in dists.items():
+            where = f"{field}.distributions.{name}"
+            check_name(name, where)
+            if not isinstance(dist, dict) or len(dist) != 1:
+                _error(where, "expected one of {uniform: [low, high]} or {normal: [mean, sd]}")
+            kind, args = next(iter(dist.items()))
+            if kind not in ("uniform", "normal"):
+                _error(f"{where}.{kind}", f"unknown distribution{_nearest(kind, ('uniform', 'normal'))} (known: uniform, normal)")
+            if not isinstance(args, list) or len(args) != 2:
+                _error(f"{where}.{kind}", f"expected two numbers, got {_excerpt(args)}")
+            a, b = (_number(v, f"{where}.{kind}[{k}]") for k, v in enumerate(args))
+            if kind == "uniform":
+                if not a < b:
+                    _error(f"{where}.uniform", f"low ({a}) must be below high ({b})")
+                columns.append(rng.uniform(a, b, samples))
+            else:
+                if not b > 0:
+                    _error(f"{where}.normal", f"the standard deviation must be positive, got {b}")
+                columns.append(rng.normal(a, b, samples))
+            names.append(name)
+        values = np.stack(columns, axis=1)
+    if not np.all(np.isfinite(values)):  # a linspace or a draw of huge bounds
+        _error(field, "the values are not all finite numbers")
+
+    units = {n: model.param_units.get(n, "") for n in names}
+    given = parameters.get("units", {})
+    if not isinstance(given, dict):
+        _error("parameters.units", f"expected a mapping {{parameter: unit}}, got {_excerpt(given)}")
+    for name, unit in given.items():
+        where = f"parameters.units.{name}"
+        if name not in names:
+            _error(where, f"not a swept parameter{_nearest(name, names)}")
+        if unit == units[name]:
+            continue
+        if unit == "deg" and units[name] == "rad":  # angles may be given in degrees, as in scenario files
+            values[:, names.index(name)] = np.radians(values[:, names.index(name)])
+            continue
+        _error(where, f"{model.name}'s {name} is in {units[name]!r}, not {unit!r}" + (" (or 'deg')" if units[name] == "rad" else ""))
+    return names, units, values, mode, shape
+
+
+def _runs(model, runs, base_dir):
+    """The runs as (label, source): source a scenario id, an absolute file path, or a JSON text."""
+    if isinstance(runs, (str, dict)):
+        runs = [runs]
+    if not isinstance(runs, list) or not runs:
+        _error("runs", "expected a non-empty list of scenario ids, files or scenarios")
+    if len(runs) > MAX_RUNS:
+        _error("runs", f"{len(runs)} runs is more than the bound of {MAX_RUNS}")
+    out, labels = [], set()
+    for k, run in enumerate(runs):
+        where = f"runs[{k}]"
+        if isinstance(run, str):
+            path = run if os.path.isabs(run) or base_dir is None else os.path.join(base_dir, run)
+            if run in model.scenarios:
+                label, source = run, run
+            elif os.path.isfile(path):
+                label, source = os.path.splitext(os.path.basename(run))[0], os.path.abspath(path)
+            else:
+                _error(where, f"{run!r} is neither a scenario id of {model.name} nor a file{_nearest(run, model.scenarios)}")
+        elif isinstance(run, dict):
+            label = run.get("id", f"run{k + 1}")
+            if not isinstance(label, str):
+                _error(f"{where}.id", f"must be a string, got {_excerpt(label)}")
+            from . import _to_json
+
+            source = "json:" + _to_json(run, where)
+        else:
+            _error(where, f"expected a scenario id, a file or a scenario mapping, got {_excerpt(run)}")
+        if not label or any(not c.isprintable() for c in label) or len(label) > 200:
+            _error(where, f"its name {_excerpt(label)} is not one printable line of at most 200 characters")
+        if label in labels:
+            _error(where, f"a second run named {label!r} (give each its own \"id\")")
+        labels.add(label)
+        out.append((label, source))
+    return out
+
+
+def _metrics(metrics):
+    if isinstance(metrics, str):
+        metrics = [metrics]
+    if not isinstance(metrics, (list, tuple)) or not metrics:
+        _error("metrics", f"expected a non-empty list of metric names ({', '.join(METRICS)})")
+    out = []
+    for k, m in enumerate(metrics):
+        if m not in METRICS:
+            _error(f"metrics[{k}]", f"unknown metric {_excerpt(m)}{_nearest(m, METRICS)} (known: {', '.join(METRICS)})")
+        if m in out:
+            _error(f"metrics[{k}]", f"{m} given twice")
+        out.append(m)
+    return out
+
+
+def _plan(model, parameters, runs, metrics, base_dir=None):
+    names, units, values, mode, shape = _parameter_values(model, parameters)
+    plan = _Plan(model, names, units, values, mode, shape, _runs(model, runs, base_dir), _metrics(metrics))
+    rows = len(values) * len(plan.runs)
+    if rows > MAX_ROWS:
+        _error("runs", f"{len(values)} variants x {len(plan.runs)} runs = {rows} rows, more than the bound of {MAX_ROWS}")
+    return plan
+
+
+# ---------------------------------------------------------------- one batch, on a worker
+
+_MODELS = {}  # per worker process: the model, loaded once (a model file's plugin: from the cache)
+
+
+def _model_of(reference):
+    if reference not in _MODELS:
+        import wlx
+
+        kind, name = reference
+        _MODELS[reference] = wlx.model(name) if kind == "builtin" else wlx.load(name)
+    return _MODELS[reference]
+
+
+def _columns(plan_names, runs_actuators, metrics):
+    """The CSV's header."""
+    header = ["variant", *plan_names, "run", "complete", "stopped", "t_end"]
+    for m in metrics:
+        header.append(m)
+        if m in ("peak_tau", "rms_tau"):
+            header += [f"{m}_{a}" for a in runs_actuators]
+    return header
+
+
+def _energy(run, actuators):
+    """The actuators' positive work: the sum over actuators of the integral of max(tau_a q'_a, 0)
+    (what each puts in; none recovered when another brakes). The rates q'_a are central differences
+    of the sampled coordinates (second order in the step: runs write angles, not all rates); an
+    actuator with no coordinate of its own (a wheel's spin) takes the run's total `power` instead,
+    when it has one."""
+    t = run["t"]
+    if len(t) < 2:
+        return 0.0
+    if all(f"tau_{a}" in run and a in run for a in actuators):
+        powers = [np.maximum(run[f"tau_{a}"] * np.gradient(run[a], t), 0.0) for a in actuators]
+    elif "power" in run:
+        powers = [np.maximum(run["power"], 0.0)]
+    else:
+        return None
+    return float(sum(np.sum(0.5 * (p[1:] + p[:-1]) * np.diff(t)) for p in powers))
+
+
+def _reduce(run, metrics, actuators):
+    """One run's metric values, in the header's order (None: the run has no such quantity)."""
+    out = []
+    taus = [run.get(f"tau_{a}") for a in actuators]
+    has_tau = all(x is not None and len(x) for x in taus)
+    for m in metrics:
+        if m in ("peak_tau", "rms_tau"):
+            if not has_tau:
+                out += [None] * (1 + len(actuators))
+                continue
+            each = [float(np.abs(x).max()) if m == "peak_tau" else float(np.sqrt(np.mean(np.square(x)))) for x in taus]
+            out += [max(each), *each]
+        elif m == "peak_cond_J_beta":
+            c = run.get("cond_J_beta")
+            out.append(float(c.max()) if c is not None and len(c) else None)
+        elif m == "min_clearance":
+            c = run.get("clearance")
+            out.append(float(c.min()) if c is not None and len(c) else None)
+        elif m == "energy":
+            out.append(_energy(run, actuators))
+        elif m == "reach_failure":
+            out.append(0)
+    return out
+
+
+_REACH = re.compile(r"reach|unreachable|no real solution|no solution", re.I)
+
+
+def _failed(metrics, actuators, reason):
+    """The metric cells of a run that did not complete: empty, except reach_failure."""
+    out = []
+    for m in metrics:
+        if m in ("peak_tau", "rms_tau"):
+            out += [None] * (1 + len(actuators))
+        elif m == "reach_failure":
+            out.append(1 if _REACH.search(reason) else 0)
+        else:
+            out.append(None)
+    return out
+
+
+def _one_line(text):
+    text = " ".join(str(text).split())
+    return text if len(text) <= 500 else text[:497] + "..."
+
+
+def run_batch(reference, names, runs, metrics, indices, values):
+    """Runs the variants `indices` (their parameter values `values`, SI) through every run; returns
+    their rows. A variant that cannot run (bad parameters, a pose out of reach, a singular J_beta)
+    is a row saying why: it never stops the batch."""
+    from . import Error
+
+    model = _model_of(reference)
+    actuators = model.actuators
+    rows = []
+    for index, row_values in zip(indices, values):
+        params = dict(zip(names, row_values))
+        for label, source in runs:
+            scenario = json.loads(source[5:]) if source.startswith("json:") else source
+            try:
+                run = model.simulate(scenario, params=params)
+            except Error as e:  # wlx's own checks: bad parameters, a start out of reach, ...
+                reason = _one_line(e)
+                rows.append([index, *row_values, label, False, reason, 0.0, *_failed(metrics, actuators, reason)])
+                continue
+            except Exception as e:  # noqa: BLE001 - a variant never aborts the sweep; its row says what happened
+                reason = _one_line(f"{type(e).__name__}: {e}")
+                rows.append([index, *row_values, label, False, reason, 0.0, *_failed(metrics, actuators, reason)])
+                continue
+            t_end = float(run["t"][-1]) if len(run["t"]) else 0.0
+            if run["complete"]:
+                rows.append([index, *row_values, label, True, "", t_end, *_reduce(run, metrics, actuators)])
+            else:
+                reason = _one_line(run["stopped"])
+                rows.append([index, *row_values, label, False, reason, t_end, *_failed(metrics, actuators, reason)])
+    return rows
+
+
+# ---------------------------------------------------------------- files
+
+
+def _cell(value):
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)  # round-trip exact: a restarted sweep writes the same bytes
+    return str(value)
+
+
+def _csv_text(header, rows):
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")  # quotes what needs quoting (commas, quotes, newlines)
+    if header is not None:
+        writer.writerow(header)
+    writer.writerows([[_cell(v) for v in row] for row in rows])
+    return buffer.getvalue()
+
+
+def _write_atomically(path, text):
+    """Written under a temporary name beside it, then renamed: a file under its own name is never cut."""
+    temp = os.path.join(os.path.dirname(path), f".{os.path.basename(path)}.{os.getpid()}.tmp")
+    try:
+        with open(temp, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(temp, path)
+    except OSError as e:
+        try:
+            os.unlink(temp)
+        except OSError:
+            pass
+        raise OutputError(f"{path}: writing failed: {e.strerror or e}") from None
+
+
+class OutputError(OSError):
+    """An output that could not be written (full disk, no permission): exit 74 on the command line."""
+
+
+_BATCH_FILE = re.compile(r"^rows-(\d+)\.csv$")
+
+
+def _parse_cell(text, column):
+    if column in ("run", "stopped"):
+        return text
+    if column == "complete":
+        return text == "true"
+    if column == "variant":
+        return int(text)
+    return float(text) if text != "" else None
+
+
+def _read_rows(path):
+    with open(path, newline="", encoding="utf-8") as f:
+        reader = csv.reader(f)
+        header = next(reader)
+        return header, [[_parse_cell(c, h) for c, h in zip(row, header)] for row in reader]
+
+
+# ---------------------------------------------------------------- progress
+
+
+class _Progress:
+    """count done, rate and time left on stderr: in place on a terminal, else a line at most every
+    10 s (a log file is not flooded)."""
+
+    def __init__(self, total, done, unit, enabled):
+        self.total, self.done, self.unit, self.enabled = total, done, unit, enabled
+        self.start_done, self.started, self.last = done, time.monotonic(), 0.0
+        self.tty = enabled and sys.stderr.isatty()
+
+    def add(self, n, final=False):
+        self.done += n
+        now = time.monotonic()
+        if not self.enabled or (not final and now - self.last < (0.2 if self.tty else 10.0)):
+            return
+        self.last = now
+        elapsed = max(now - self.started, 1e-9)
+        rate = (self.done - self.start_done) / elapsed
+        left = (self.total - self.done) / rate if rate > 0 else float("inf")
+        width = 30
+        filled = int(width * self.done / max(self.total, 1))
+        bar = "#" * filled + "-" * (width - filled)
+        eta = "--" if not math.isfinite(left) else (f"{left:.0f} s" if left < 120 else f"{left / 60:.1f} min")
+        line = f"sweep [{bar}] {self.done}/{self.total} {self.unit} {rate:.1f}/s, {eta} left"
+        try:
+            sys.stderr.write(("\r" + line + ("\n" if final else "")) if self.tty else line + "\n")
+            sys.stderr.flush()
+        except OSError:  # a closed stderr never stops a sweep
+            pass
+
+
+# ---------------------------------------------------------------- the sweep
+
+
+def _batch_size(plan, reference, pending, workers, given):
+    """Variants per task: `given`, else sized so that a batch takes about TARGET_BATCH_SECONDS on
+    a worker (timed on one variant here) and each worker gets at least MIN_BATCHES_PER_WORKER."""
+    if given is not None:
+        return given
+    if not pending:
+        return 1
+    index = pending[0]
+    started = time.perf_counter()
+    run_batch(reference, plan.names, plan.runs, plan.metrics, [index], plan.values[index:index + 1].tolist())
+    per_variant = max(time.perf_counter() - started, 1e-6)
+    by_time = max(1, int(TARGET_BATCH_SECONDS / per_variant))
+    by_balance = max(1, math.ceil(len(pending) / (MIN_BATCHES_PER_WORKER * max(workers, 1))))
+    return max(1, min(by_time, by_balance, MAX_BATCH))
+
+
+def _reference(model):
+    return ("file", os.path.abspath(model._path)) if model._path is not None else ("builtin", model.name)
+
+
+def _client_for(client, scheduler, workers):
+    """(client, cluster we started or None). A local cluster: one single-threaded worker process per
+    core (the runs hold the GIL, so threads would not run in parallel)."""
+    if client is not None:
+        return client, None
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        if not isinstance(scheduler, str) or not re.fullmatch(r"(tcp|tls|inproc|ucx)://[^\s/]+(:\d+)?", scheduler):
+            _error("scheduler", f"expected an address such as tcp://HOST:8786, got {_excerpt(scheduler)}")
+        try:
+            return Client(scheduler, timeout="10s"), None
+        except (OSError, TimeoutError) as e:
+            _error("scheduler", f"cannot reach {scheduler}: {e}")
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                           silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+def _default_workers():
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
+def sweep(model, parameters, runs, metrics=("peak_tau",), out=None, client=None, scheduler=None, workers=None,
+          batch_size=None, progress=True):
+    """Runs every variant of `parameters` through every run and returns the table as a dict of
+    columns (lists): variant, the parameters, run, complete, stopped, t_end, the metrics (None where a
+    run has no such value or did not complete). On Dask: `client` (a distributed.Client), else
+    `scheduler` ("tcp://HOST:8786"), else a local cluster of `workers` processes (default: this
+    machine's cores). With `out` (a folder) the rows are written as each batch finishes and a
+    restart skips the variants written; results.csv, sweep.json and plots/ are written at the end.
+    README.md, "Parameter sweeps", has the format of `parameters` and `runs` and the metrics."""
+    return _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, batch_size, progress, base_dir=None)
+
+
+def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, batch_size, progress, base_dir):
+    from . import Model
+
+    if not isinstance(model, Model):
+        _error("model", f"expected a wlx.Model (wlx.model(name) or wlx.load(path)), got {_excerpt(model)}")
+    plan = _plan(model, parameters, runs, metrics, base_dir)
+    if workers is not None:
+        workers = _count(workers, "workers", 1, MAX_WORKERS)
+    if batch_size is not None:
+        batch_size = _count(batch_size, "batch_size", 1, MAX_BATCH)
+    if client is not None and scheduler is not None:
+        _error("scheduler", "give client or scheduler, not both")
+    header = _columns(plan.names, model.actuators, plan.metrics)
+    n = len(plan.values)
+    done_rows = {}
+    batches_dir = None
+    if out is not None:
+        out = os.fspath(out)
+        batches_dir = os.path.join(out, "batches")
+        try:
+            os.makedirs(batches_dir, exist_ok=True)
+        except OSError as e:
+            raise OutputError(f"{out}: cannot create the folder: {e.strerror or e}") from None
+        identity = json.dumps(plan.identity(), sort_keys=True)
+        identity_path = os.path.join(out, "spec.json")
+        if os.path.exists(identity_path):
+            with open(identity_path, encoding="utf-8") as f:
+                if f.read() != identity:
+                    _error("out", f"{out} holds the rows of another sweep (another model, parameters, runs or metrics): "
+                                  "remove it or give another folder")
+        else:
+            _write_atomically(identity_path, identity)
+        for name in sorted(os.listdir(batches_dir)):
+            path = os.path.join(batches_dir, name)
+            if name.startswith(".") and name.endswith(".tmp"):
+                os.unlink(path)  # a batch being written when the sweep was killed: run again
+            elif _BATCH_FILE.match(name):
+                file_header, rows = _read_rows(path)
+                if file_header != header:
+                    _error("out", f"{path}: its columns are not this sweep's")
+                for row in rows:
+                    done_rows.setdefault(row[0], []).append(row)
+    pending = [i for i in range(n) if i not in done_rows]
+    reference = _reference(model)
+    started_client, cluster = None, None
+    workers_n = workers or _default_workers()
+    bar = _Progress(n, n - len(pending), "variants", progress)
+    if progress and done_rows:
+        try:
+            sys.stderr.write(f"sweep: resuming: {n - len(pending)} of {n} variants already written in {batches_dir}\n")
+        except OSError:
+            pass
+    try:
+        if pending:
+            active, cluster = _client_for(client, scheduler, workers_n)
+            started_client = active if client is None else None
+            if client is not None or scheduler is not None:
+                workers_n = max(1, len(active.nthreads()))
+            size = _batch_size(plan, reference, pending, workers_n, batch_size)
+            batches = [pending[k:k + size] for k in range(0, len(pending), size)]
+            from distributed import as_completed
+
+            futures = {}
+            for b in batches:
+                f = active.submit(run_batch, reference, plan.names, plan.runs, plan.metrics, b, plan.values[b].tolist(), pure=False)
+                futures[f] = b
+            for future in as_completed(list(futures)):
+                b = futures.pop(future)
+                try:
+                    rows = future.result()
+                except Exception as e:  # noqa: BLE001 - e.g. a worker that died: the batch's rows say so
+                    reason = _one_line(f"the batch's task failed: {type(e).__name__}: {e}")
+                    rows = [[i, *plan.values[i].tolist(), label, False, reason, 0.0, *_failed(plan.metrics, model.actuators, reason)]
+                            for i in b for label, _ in plan.runs]
+                if batches_dir is not None:
+                    _write_atomically(os.path.join(batches_dir, f"rows-{b[0]:07d}.csv"), _csv_text(header, rows))
+                for row in rows:
+                    done_rows.setdefault(row[0], []).append(row)
+                bar.add(len(b))
+                del future
+        bar.add(0, final=True)
+    finally:
+        if started_client is not None:
+            started_client.close()
+        if cluster is not None:
+            cluster.close()
+    order = {label: k for k, (label, _) in enumerate(plan.runs)}
+    table = [row for i in range(n) for row in sorted(done_rows[i], key=lambda r: order[r[len(plan.names) + 1]])]
+    if out is not None:
+        _write_atomically(os.path.join(out, "results.csv"), _csv_text(header, table))
+        manifest = {"model": model.name, "mode": plan.mode, "parameters": plan.names, "units": plan.units,
+                    "grid_shape": list(plan.shape) if plan.shape else None, "runs": [label for label, _ in plan.runs],
+                    "metrics": {m: METRICS[m][0] for m in plan.metrics}, "variants": n, "rows": len(table),
+                    "complete_rows": sum(1 for r in table if r[len(plan.names) + 2])}
+        _write_atomically(os.path.join(out, "sweep.json"), json.dumps(manifest, indent=1) + "\n")
+        _plots(out, plan, header, table)
+    return {name: [row[k] for row in table] for k, name in enumerate(header)}
+
+
+# ---------------------------------------------------------------- plots
+
+
+def _label(name, unit):
+    return f"{name} ({unit})" if unit and unit != "1" else name
+
+
+def _sensitivities(x, y):
+    """Standardized coefficients of the least-squares linear fit y ~ x (each column of x and y
+    scaled to unit standard deviation): the change of y, in its standard deviations, per standard
+    deviation of each parameter, the others held. A constant column gives 0."""
+    sx, sy = x.std(axis=0), y.std()
+    if sy == 0 or len(y) < x.shape[1] + 2:
+        return np.zeros(x.shape[1])
+    z = np.where(sx > 0, (x - x.mean(axis=0)) / np.where(sx > 0, sx, 1), 0.0)
+    a = np.column_stack([np.ones(len(y)), z])
+    coefficients, *_ = np.linalg.lstsq(a, (y - y.mean()) / sy, rcond=None)
+    return coefficients[1:]
+
+
+def _plots(out, plan, header, table):
+    """One parameter: each metric against it (a line per run). Two on a grid: a heat map per metric
+    and run. Random samples (or a grid of more than two): the standardized sensitivities of each
+    metric to each parameter (also in sensitivity.csv). Rows that did not complete are left out."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    plots = os.path.join(out, "plots")
+    os.makedirs(plots, exist_ok=True)
+    p = len(plan.names)
+    col = {h: k for k, h in enumerate(header)}
+    complete = col["complete"]
+    written = []
+
+    def save(fig, name):
+        path = os.path.join(plots, name)
+        temp = os.path.join(plots, f".{name}.{os.getpid()}.tmp.png")
+        fig.savefig(temp, dpi=100)
+        plt.close(fig)
+        os.replace(temp, path)
+        written.append(path)
+
+    sensitivity_rows = []
+    for metric in plan.metrics:
+        unit = METRICS[metric][0]
+        for label, _ in plan.runs:
+            rows = [r for r in table if r[col["run"]] == label and r[complete] and r[col[metric]] is not None]
+            left_out = sum(1 for r in table if r[col["run"]] == label) - len(rows)
+            if not rows:
+                continue
+            x = np.array([[r[1 + k] for k in range(p)] for r in rows], dtype=float)
+            y = np.array([r[col[metric]] for r in rows], dtype=float)
+            note = f" ({left_out} variants left out: not complete)" if left_out else ""
+            safe = re.sub(r"[^A-Za-z0-9_.+-]", "_", label)
+            if plan.mode != "random" and p == 1:
+                continue  # one figure per metric with every run, below
+            if plan.mode == "grid" and p == 2:
+                fig, ax = plt.subplots(figsize=(6, 4.5))
+                grid = np.full(plan.shape, np.nan)  # a missing cell stays blank in the picture (no file holds it)
+                a0 = np.unique(plan.values[:, 0])
+                a1 = np.unique(plan.values[:, 1])
+                for (u, v), value in zip(x, y):
+                    grid[np.searchsorted(a0, u), np.searchsorted(a1, v)] = value
+                mesh = ax.pcolormesh(_edges(a1), _edges(a0), grid, shading="flat", cmap="viridis")
+                fig.colorbar(mesh, ax=ax, label=_label(metric, unit))
+                ax.set_xlabel(_label(plan.names[1], plan.units[plan.names[1]]))
+                ax.set_ylabel(_label(plan.names[0], plan.units[plan.names[0]]))
+                ax.set_title(f"{metric}, run {label}{note}", fontsize=9)
+                save(fig, f"{metric}-{safe}-heatmap.png")
+            else:
+                s = _sensitivities(x, y)
+                sensitivity_rows += [[metric, label, name, float(v)] for name, v in zip(plan.names, s)]
+                fig, ax = plt.subplots(figsize=(max(4, 0.8 * p + 2), 3.5))
+                ax.bar(plan.names, s, color=["tab:blue" if v >= 0 else "tab:red" for v in s])
+                ax.axhline(0, color="black", linewidth=0.5)
+                ax.set_ylabel(f"standardized effect on {metric}")
+                ax.set_title(f"{metric}, run {label}: linear fit over {len(y)} variants{note}", fontsize=9)
+                fig.tight_layout()
+                save(fig, f"{metric}-{safe}-sensitivity.png")
+        if plan.mode != "random" and p == 1:
+            fig, ax = plt.subplots(figsize=(6, 4))
+            drawn = False
+            for label, _ in plan.runs:
+                rows = [r for r in table if r[col["run"]] == label and r[complete] and r[col[metric]] is not None]
+                if rows:
+                    order = np.argsort([r[1] for r in rows], kind="stable")
+                    ax.plot([rows[i][1] for i in order], [rows[i][col[metric]] for i in order], "o-", label=label)
+                    drawn = True
+            if drawn:
+                ax.set_xlabel(_label(plan.names[0], plan.units[plan.names[0]]))
+                ax.set_ylabel(_label(metric, unit))
+                ax.legend(fontsize=8)
+                fig.tight_layout()
+                save(fig, f"{metric}-vs-{plan.names[0]}.png")
+            else:
+                plt.close(fig)
+    if sensitivity_rows:
+        _write_atomically(os.path.join(out, "sensitivity.csv"),
+                          _csv_text(["metric", "run", "parameter", "standardized_coefficient"], sensitivity_rows))
+    return written
+
+
+def _edges(centres):
+    """Cell edges around sorted centres (a heat map's cells), half-way between neighbours."""
+    c = np.asarray(centres, dtype=float)
+    if len(c) == 1:
+        return np.array([c[0] - 0.5, c[0] + 0.5])
+    mid = (c[1:] + c[:-1]) / 2
+    return np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
+
+
+# ---------------------------------------------------------------- the spec file and the command line
+
+
+def _yaml_loader():
+    import yaml
+
+    class Loader(yaml.SafeLoader):
+        """YAML with a key given twice in one mapping an error (PyYAML would keep the last)."""
+
+    def construct_mapping(loader, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = loader.construct_object(key_node, deep=deep)
+            if not isinstance(key, (str, int, float)):
+                raise yaml.constructor.ConstructorError(None, None, "a key must be a name", key_node.start_mark)
+            if key in seen:
+                raise yaml.constructor.ConstructorError(None, None, f"{key}: given twice in one mapping", key_node.start_mark)
+            seen.add(key)
+        return yaml.SafeLoader.construct_mapping(loader, node, deep=deep)
+
+    Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, construct_mapping)
+    return Loader
+
+
+def read_spec(path):
+    """The spec file as a mapping (bounded, a regular file only, keys given once)."""
+    import stat
+
+    import yaml
+
+    try:
+        st = os.stat(path)
+    except OSError as e:
+        _error(path, f"cannot read: {e.strerror}")
+    if not stat.S_ISREG(st.st_mode):
+        _error(path, "not a regular file")
+    if st.st_size > MAX_SPEC_BYTES:
+        _error(path, f"larger than {MAX_SPEC_BYTES} bytes")
+    with open(path, "rb") as f:
+        data = f.read(MAX_SPEC_BYTES + 1)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        _error(path, f"not UTF-8 text (byte {e.start})")
+    try:
+        spec = yaml.load(text, Loader=_yaml_loader())
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
+        where = f"{path}:{mark.line + 1}" if mark is not None else path
+        _error(where, _one_line(getattr(e, "problem", None) or e))
+    if not isinstance(spec, dict):
+        _error(path, "a sweep spec is a mapping (model, parameters, runs, metrics, out, batch_size)")
+    _keys(spec, "", ("model", "parameters", "runs", "metrics", "out", "batch_size"), ("parameters", "runs", "metrics"))
+    return spec
+
+
+def run_spec(path, out=None, scheduler=None, workers=None, batch_size=None, progress=True):
+    """`wlx sweep SPEC`: the spec file's sweep; relative names in it are relative to its folder."""
+    import wlx
+
+    spec = read_spec(path)
+    base = os.path.dirname(os.path.abspath(path))
+    model_name = spec.get("model", "excavator")
+    if not isinstance(model_name, str) or not model_name:
+        _error("model", f"expected a built-in model's name or a model file, got {_excerpt(model_name)}")
+    if model_name in wlx.models():
+        model = wlx.model(model_name)
+    else:
+        file = model_name if os.path.isabs(model_name) else os.path.join(base, model_name)
+        if not os.path.isfile(file):
+            _error("model", f"{model_name!r} is neither a built-in model ({', '.join(wlx.models())}) nor a file"
+                            f"{_nearest(model_name, wlx.models())}")
+        model = wlx.load(file)
+    if out is None:
+        given = spec.get("out", "sweep")
+        if not isinstance(given, str) or not given:
+            _error("out", f"expected a folder name, got {_excerpt(given)}")
+        out = given if os.path.isabs(given) else os.path.join(base, given)
+    if batch_size is None and "batch_size" in spec:
+        batch_size = spec["batch_size"]
+    return _sweep(model, spec["parameters"], spec["runs"], spec["metrics"], out, None, scheduler, workers, batch_size,
+                  progress, base_dir=base), out
+
+
+def main(argv=None):
+    """The command line: python3 -m wlx sweep SPEC [--out DIR] [--scheduler ADDRESS] [--workers N]
+    [--batch-size N] (what `wlx sweep` runs). Exit 0 done, 2 a bad spec or option, 74 an output that
+    could not be written, 130 / 143 / 129 interrupted (the batches written are complete)."""
+    import argparse
+
+    class Parser(argparse.ArgumentParser):
+        def error(self, message):  # the house's exit code for a bad option: 2, one line
+            sys.stderr.write(f"wlx sweep: error: {message}\n")
+            raise SystemExit(2)
+
+    parser = Parser(prog="wlx sweep", description="a parameter sweep on Dask (README.md, \"Parameter sweeps\")")
+    parser.add_argument("spec", metavar="SPEC", help="the sweep's spec file (YAML)")
+    parser.add_argument("--out", help="output folder (default: the spec's `out`, else sweep/ beside the spec)")
+    parser.add_argument("--scheduler", help="a running Dask scheduler, tcp://HOST:8786 (default: a local cluster)")
+    parser.add_argument("--workers", type=int, help="the local cluster's worker processes (default: this machine's cores)")
+    parser.add_argument("--batch-size", type=int, help="variants per task (default: sized to about 0.5 s a task)")
+    args = parser.parse_args(argv)
+
+    def stop(signum, frame):
+        raise KeyboardInterrupt(signum)
+
+    signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGHUP, stop)
+    try:
+        table, out = run_spec(args.spec, args.out, args.scheduler, args.workers, args.batch_size)
+    except KeyboardInterrupt as e:
+        code = {signal.SIGTERM: 143, signal.SIGHUP: 129}.get(e.args[0] if e.args else None, 130)
+        sys.stderr.write("\nwlx sweep: interrupted: the batches written are complete; run the same command again to resume\n")
+        return code
+    except OutputError as e:
+        sys.stderr.write(f"wlx sweep: error: {e}\n")
+        return 74
+    except ValueError as e:  # wlx.Error and the spec's errors: they name the field
+        sys.stderr.write(f"wlx sweep: error: {e}\n")
+        return 2
+    stopped = sum(1 for c in table["complete"] if not c)
+    print(f"{len(table['variant'])} rows ({stopped} did not complete) in {os.path.join(out, 'results.csv')}")
+    return 0
