@@ -7,6 +7,7 @@ cd "$(dirname "$0")/.."
 packages=(cmake g++ clang-14 ninja-build pkg-config libginac-dev libeigen3-dev libfmt-dev doctest-dev
           libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev gnuplot-nox fonts-dejavu-core
           python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
+          python3-yaml python3-dask python3-distributed   # wlx sweep: spec files, and Dask for the runs
           liborocos-kdl-dev   # Orocos KDL: the peer in wlx_bench and the KDL test (optional in CMake)
           liburdfdom-dev)     # URDF import in wlx-gen (optional in CMake)
 # The 3D viewer (viewer/, CMake option WLX_BUILD_VIEWER): emscripten compiles the model's WebAssembly,

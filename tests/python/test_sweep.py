@@ -1,0 +1,430 @@
+"""Parameter sweeps (wlx.sweep, `wlx sweep SPEC.yaml`) on Dask: the same numbers as a plain loop
+over m.simulate, rows for variants that cannot run, files that survive a kill, plots, and the
+spec's mistakes as errors naming the field. Run by ctest as `python_sweep` (PYTHONPATH at the built
+package, WLX_BINARY the built `wlx`). Small sweeps on 1-2 local workers: the speed figures are
+tools/sweep_scaling.py's, not a test's."""
+
+import csv
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import wlx
+from wlx import _sweep
+
+distributed = pytest.importorskip("distributed")  # tools/setup.sh installs python3-distributed
+
+WLX = os.environ["WLX_BINARY"]
+README = Path(__file__).resolve().parents[2] / "README.md"
+# The README's design study: ID-1 shortened to 0.4 s (docs/excavator.md's run is 0.494 s).
+ID1 = {"id": "ID-1", "rates": {"x_C": 3.0}, "dependent": ["y_C", "yaw"], "duration": 0.4, "weighting": 1}
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return wlx.model("excavator")
+
+
+@pytest.fixture(scope="module")
+def client():
+    # One local cluster for the in-process tests: two single-threaded worker processes, as the
+    # default cluster is made (the runs hold the GIL).
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    c = distributed.Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def peak_tau(run):
+    return max(np.abs(run[c]).max() for c in run if c.startswith("tau_"))
+
+
+def sweep_cli(args, cwd=None, **kwargs):
+    return subprocess.run([WLX, "sweep", *args], capture_output=True, text=True, cwd=cwd, check=False, **kwargs)
+
+
+def write_spec(path, spec):
+    path.write_text(json.dumps(spec))  # JSON is YAML
+    return path
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+# ---------------------------------------------------------------- the numbers
+
+
+def test_design_study_through_the_sweep_gives_the_plain_loops_numbers(robot, client, tmp_path):
+    lengths = np.linspace(1.3, 2.2, 10)
+    loop = [peak_tau(robot.simulate({**ID1, "params": {"legD": legD}})) for legD in lengths]
+    table = wlx.sweep(robot, {"grid": {"legD": {"from": 1.3, "to": 2.2, "count": 10}}, "units": {"legD": "m"}}, [ID1],
+                      ["peak_tau"], out=tmp_path / "study", client=client, progress=False)
+    assert table["legD"] == list(lengths)
+    assert table["peak_tau"] == loop  # the same C++ on the same inputs: equal to the last bit
+    assert table["complete"] == [True] * 10 and table["stopped"] == [""] * 10
+    assert table["t_end"] == [pytest.approx(0.4, abs=1e-12)] * 10
+    # Written as read: the CSV's numbers round-trip exactly.
+    rows = read_csv(tmp_path / "study" / "results.csv")
+    assert [float(r["peak_tau"]) for r in rows] == loop
+    # Each actuator's column: their largest is peak_tau.
+    for k in range(10):
+        assert max(table[f"peak_tau_{a}"][k] for a in robot.actuators) == table["peak_tau"][k]
+    assert (tmp_path / "study" / "plots" / "peak_tau-vs-legD.png").stat().st_size > 10000
+
+
+def test_the_readme_sweep_block_runs_on_a_local_cluster_and_prints_the_loops_numbers(robot, tmp_path):
+    blocks = re.findall(r"<!-- ci: python -->\s*```python\n(.*?)```", README.read_text(), re.S)
+    sweep_blocks = [b for b in blocks if "wlx.sweep(" in b]
+    assert len(sweep_blocks) == 1
+    done = subprocess.run([sys.executable, "-c", sweep_blocks[0]], cwd=tmp_path, capture_output=True, text=True,
+                          env={**os.environ, "MPLBACKEND": "Agg"}, check=False)
+    assert done.returncode == 0, done.stderr
+    printed = [float(x) for x in re.findall(r"peak torque (\S+) N m", done.stdout)]
+    loop = [peak_tau(robot.simulate({**ID1, "params": {"legD": legD}})) for legD in np.linspace(1.3, 2.2, 10)]
+    assert printed == [float(f"{v:.0f}") for v in loop]  # the plain loop's lines, as it prints them
+    assert (tmp_path / "legD_study" / "plots" / "peak_tau-vs-legD.png").stat().st_size > 10000
+
+
+def test_every_metric_against_its_definition(robot, client):
+    run = {**ID1, "duration": 0.2}
+    table = wlx.sweep(robot, {"list": [{"legD": 1.6}]}, [run], list(_sweep.METRICS), client=client, progress=False)
+    r = robot.simulate(run, params={"legD": 1.6})
+    taus = {a: r[f"tau_{a}"] for a in robot.actuators}
+    rms = {a: float(np.sqrt(np.mean(x ** 2))) for a, x in taus.items()}
+    assert table["rms_tau"] == [max(rms.values())]
+    assert all(table[f"rms_tau_{a}"] == [rms[a]] for a in robot.actuators)
+    assert table["peak_cond_J_beta"] == [r["cond_J_beta"].max()]
+    assert table["min_clearance"] == [r["clearance"].min()]
+    assert table["reach_failure"] == [0]
+    # Energy: each actuator's positive work, rates by central differences of its angle.
+    work = 0.0
+    for a in robot.actuators:
+        p = np.maximum(taus[a] * np.gradient(r[a], r["t"]), 0.0)
+        work += np.trapz(p, r["t"])
+    assert table["energy"][0] == pytest.approx(work, rel=1e-12)
+    assert table["energy"][0] > 1e3  # the knees lift the machine: work is done
+
+
+def test_energy_rates_by_differences_agree_with_a_torque_driven_runs_power(robot):
+    # The metric takes the actuators' rates as central differences of their sampled angles. A run
+    # driven by torques writes the exact power, sum of tau q': inside the run the two agree to
+    # 1e-4 of the peak power at the 1 ms step (second order in the step; the ends are one-sided).
+    run = robot.simulate({"rates": {"x_C": 3.0}, "duration": 0.3, "dt": 0.001, "integrator": "dopri5",
+                          "torques": {"run": "ID-1"}})
+    estimated = sum(run[f"tau_{a}"] * np.gradient(run[a], run["t"]) for a in robot.actuators)
+    assert np.abs(estimated - run["power"])[1:-1].max() < 1e-4 * np.abs(run["power"]).max()
+    assert _sweep._energy(run, robot.actuators) > 0
+
+
+# ---------------------------------------------------------------- rows that say why
+
+
+def test_an_infeasible_variant_is_a_row_with_its_reason(robot, client, tmp_path):
+    # legD = -1: a bad parameter; legD = 0.5: the feet out of reach at t = 0; 1.5: the nominal.
+    table = wlx.sweep(robot, {"list": [{"legD": 1.5}, {"legD": -1.0}, {"legD": 0.5}]}, [{**ID1, "duration": 0.1}],
+                      ["peak_tau", "reach_failure", "energy"], out=tmp_path / "s", client=client, progress=False)
+    assert table["variant"] == [0, 1, 2]
+    assert table["complete"] == [True, False, False]
+    assert table["stopped"][0] == ""
+    assert table["stopped"][1].startswith("params.legD: a length must be positive")
+    assert "out of reach" in table["stopped"][2]
+    assert table["reach_failure"] == [0, 0, 1]
+    assert table["peak_tau"][1:] == [None, None] and table["energy"][1:] == [None, None]
+    text = (tmp_path / "s" / "results.csv").read_text()
+    assert "nan" not in text.lower()
+    rows = read_csv(tmp_path / "s" / "results.csv")
+    assert rows[1]["peak_tau"] == "" and rows[2]["stopped"] == table["stopped"][2]
+    assert json.loads((tmp_path / "s" / "sweep.json").read_text())["complete_rows"] == 1
+
+
+def test_names_with_commas_and_quotes_are_quoted_for_csv(robot, client, tmp_path):
+    label = 'a, "quoted" run'
+    table = wlx.sweep(robot, {"list": [{"legD": 1.5}]}, [{**ID1, "id": label, "duration": 0.05}], ["peak_tau"],
+                      out=tmp_path / "q", client=client, progress=False)
+    assert read_csv(tmp_path / "q" / "results.csv")[0]["run"] == label == table["run"][0]
+
+
+# ---------------------------------------------------------------- samples, sensitivities, plots
+
+
+def test_random_samples_are_seeded_and_the_sensitivities_find_the_parameter_that_matters(robot, client, tmp_path):
+    parameters = {"random": {"samples": 24, "seed": 7, "distributions": {
+        "m_M1": {"uniform": [4000.0, 7000.0]}, "cabin_height": {"normal": [0.5, 0.05]}}}}
+    run = {**ID1, "duration": 0.05}
+    a = wlx.sweep(robot, parameters, [run], ["peak_tau"], out=tmp_path / "r", client=client, progress=False)
+    b = wlx.sweep(robot, parameters, [run], ["peak_tau"], client=client, progress=False)
+    assert a == b
+    rng = np.random.Generator(np.random.PCG64(7))  # the documented draw: parameter after parameter
+    assert a["m_M1"] == list(rng.uniform(4000.0, 7000.0, 24)) and a["cabin_height"] == list(rng.normal(0.5, 0.05, 24))
+    rows = {r["parameter"]: float(r["standardized_coefficient"]) for r in read_csv(tmp_path / "r" / "sensitivity.csv")}
+    # The cabin's mass moves the peak torque almost linearly; the cabin box's height (drawing and
+    # clearance only) not at all: its coefficient is the fit's spurious correlation, small.
+    assert rows["m_M1"] > 0.99
+    assert abs(rows["cabin_height"]) < 0.02
+    assert (tmp_path / "r" / "plots" / "peak_tau-ID-1-sensitivity.png").stat().st_size > 5000
+
+
+def test_standardized_coefficients_of_an_exactly_linear_metric():
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(50, 3)) * [1.0, 10.0, 0.1]
+    y = 2.0 * x[:, 0] - 0.5 * x[:, 1]  # the third has no effect
+    s = _sweep._sensitivities(x, y)
+    expected = np.array([2.0 * x[:, 0].std(), -0.5 * x[:, 1].std(), 0.0]) / y.std()
+    assert np.allclose(s, expected, atol=1e-12)
+
+
+def test_two_parameters_on_a_grid_give_a_heat_map(robot, client, tmp_path):
+    run = {**ID1, "duration": 0.05}
+    table = wlx.sweep(robot, {"grid": {"m_M1": [4000.0, 5400.0, 7000.0], "legD": [1.4, 1.6]}}, [run], ["peak_tau"],
+                      out=tmp_path / "h", client=client, progress=False)
+    # The grid's order: the last parameter varies fastest.
+    assert table["m_M1"] == [4000.0, 4000.0, 5400.0, 5400.0, 7000.0, 7000.0] and table["legD"] == [1.4, 1.6] * 3
+    assert table["peak_tau"][5] == peak_tau(robot.simulate(run, params={"m_M1": 7000.0, "legD": 1.6}))
+    png = tmp_path / "h" / "plots" / "peak_tau-ID-1-heatmap.png"
+    import matplotlib.image
+
+    image = matplotlib.image.imread(png)
+    # Six cells of a colour map over a strongly varying metric: many distinct colours.
+    assert len(np.unique(image[..., :3].reshape(-1, 3), axis=0)) > 50
+
+
+# ---------------------------------------------------------------- the command line, kill and resume
+
+
+def long_spec(tmp_path, out="out"):
+    # 24 variants of a 1 s run (about 10 ms each), one per task on one worker: a kill lands mid-way.
+    return write_spec(tmp_path / "spec.yaml", {
+        "model": "excavator",
+        "parameters": {"grid": {"legD": {"from": 1.3, "to": 2.2, "count": 24}}, "units": {"legD": "m"}},
+        "runs": [{**ID1, "duration": 1.0}],
+        "metrics": ["peak_tau", "energy"],
+        "out": out,
+    })
+
+
+def test_a_killed_sweep_resumes_and_ends_with_the_uninterrupted_table(tmp_path):
+    reference = tmp_path / "reference"
+    reference.mkdir()
+    done = sweep_cli([str(long_spec(reference)), "--workers", "1", "--batch-size", "1"])
+    assert done.returncode == 0, done.stderr
+    assert "24 rows (0 did not complete)" in done.stdout
+    assert re.search(r"24/24 variants [\d.]+/s, \d+ s left", done.stderr)  # the progress bar's last line
+
+    work = tmp_path / "killed"
+    work.mkdir()
+    spec = long_spec(work)
+    batches = work / "out" / "batches"
+    # Its own process group: the sweep and its cluster's worker processes, killed together.
+    p = subprocess.Popen([WLX, "sweep", str(spec), "--workers", "1", "--batch-size", "1"], stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and p.poll() is None:
+        if batches.is_dir() and len(list(batches.glob("rows-*.csv"))) >= 2:
+            os.killpg(p.pid, signal.SIGKILL)
+            break
+        time.sleep(0.002)
+    p.wait()
+    assert p.returncode == -signal.SIGKILL, "the sweep ended before the test could kill it"
+    written = {f.name: (f.stat().st_ino, f.stat().st_mtime_ns) for f in batches.glob("rows-*.csv")}
+    assert 2 <= len(written) < 24
+    assert not (work / "out" / "results.csv").exists()
+
+    resumed = sweep_cli([str(spec), "--workers", "1", "--batch-size", "1"])
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"resuming: {len(written)} of 24 variants already written" in resumed.stderr
+    for name, stamp in written.items():  # skipped: not run or written again
+        f = batches / name
+        assert (f.stat().st_ino, f.stat().st_mtime_ns) == stamp
+    assert not list(batches.glob(".*.tmp"))
+    assert (work / "out" / "results.csv").read_bytes() == (reference / "out" / "results.csv").read_bytes()
+
+
+def test_sigterm_stops_with_143_and_the_written_batches_stay(tmp_path):
+    spec = long_spec(tmp_path)
+    batches = tmp_path / "out" / "batches"
+    p = subprocess.Popen([WLX, "sweep", str(spec), "--workers", "1", "--batch-size", "1"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and p.poll() is None:
+        if batches.is_dir() and list(batches.glob("rows-*.csv")):
+            p.send_signal(signal.SIGTERM)  # wlx became python3 (exec): its pid is the sweep's
+            break
+        time.sleep(0.002)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 143, err
+    assert "interrupted: the batches written are complete" in err and "Traceback" not in err
+    for f in batches.glob("rows-*.csv"):
+        assert len(read_csv(f)) == 1  # whole files only
+
+
+def test_a_restart_with_another_spec_in_the_same_folder_is_an_error(tmp_path):
+    spec = write_spec(tmp_path / "a.yaml", {"parameters": {"list": [{"legD": 1.5}]}, "runs": [{**ID1, "duration": 0.05}],
+                                            "metrics": ["peak_tau"], "out": "o"})
+    assert sweep_cli([str(spec), "--workers", "1"]).returncode == 0
+    spec = write_spec(tmp_path / "a.yaml", {"parameters": {"list": [{"legD": 1.6}]}, "runs": [{**ID1, "duration": 0.05}],
+                                            "metrics": ["peak_tau"], "out": "o"})
+    done = sweep_cli([str(spec), "--workers", "1"])
+    assert done.returncode == 2
+    assert "out: " in done.stderr and "holds the rows of another sweep" in done.stderr
+
+
+def test_batches_are_sized_as_documented(tmp_path):
+    # Auto: a variant costs milliseconds, so the balance rule decides: ceil(10 / (4 batches x 2
+    # workers)) = 2 variants a batch, 5 files. --batch-size 3: ceil(10 / 3) = 4 files.
+    spec = write_spec(tmp_path / "s.yaml", {"parameters": {"grid": {"legD": {"from": 1.3, "to": 2.2, "count": 10}}},
+                                            "runs": [{**ID1, "duration": 0.05}], "metrics": ["peak_tau"], "out": "auto"})
+    assert sweep_cli([str(spec), "--workers", "2"]).returncode == 0
+    assert sorted(f.name for f in (tmp_path / "auto" / "batches").glob("rows-*.csv")) == \
+        [f"rows-{k:07d}.csv" for k in (0, 2, 4, 6, 8)]
+    assert sweep_cli([str(spec), "--workers", "1", "--batch-size", "3", "--out", str(tmp_path / "three")]).returncode == 0
+    assert sorted(f.name for f in (tmp_path / "three" / "batches").glob("rows-*.csv")) == \
+        [f"rows-{k:07d}.csv" for k in (0, 3, 6, 9)]
+    assert (tmp_path / "three" / "results.csv").read_bytes() == (tmp_path / "auto" / "results.csv").read_bytes()
+
+
+def test_a_running_scheduler_takes_the_same_sweep(robot, tmp_path):
+    # A cluster started apart (here in this process, its worker a thread): --scheduler on the
+    # command line, scheduler= and client= in Python give the same table as the local cluster.
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None,
+                                       protocol="tcp", host="127.0.0.1", scheduler_port=0)
+    try:
+        spec = write_spec(tmp_path / "s.yaml", {"parameters": {"list": [{"legD": 1.4}, {"legD": 1.7}]},
+                                                "runs": ["NH-1"], "metrics": ["peak_cond_J_beta"], "out": "remote"})
+        done = sweep_cli([str(spec), "--scheduler", cluster.scheduler_address])
+        assert done.returncode == 0, done.stderr
+        by_address = wlx.sweep(robot, {"list": [{"legD": 1.4}, {"legD": 1.7}]}, ["NH-1"], ["peak_cond_J_beta"],
+                               scheduler=cluster.scheduler_address, progress=False)
+        with distributed.Client(cluster) as c:
+            by_client = wlx.sweep(robot, {"list": [{"legD": 1.4}, {"legD": 1.7}]}, ["NH-1"], ["peak_cond_J_beta"],
+                                  client=c, progress=False)
+    finally:
+        cluster.close()
+    expected = [robot.simulate("NH-1", params={"legD": v})["cond_J_beta"].max() for v in (1.4, 1.7)]
+    assert by_address["peak_cond_J_beta"] == by_client["peak_cond_J_beta"] == expected
+    assert [float(r["peak_cond_J_beta"]) for r in read_csv(tmp_path / "remote" / "results.csv")] == expected
+
+
+def test_a_run_from_a_file_beside_the_spec(robot, tmp_path):
+    (tmp_path / "runs").mkdir()
+    (tmp_path / "runs" / "short.json").write_text(json.dumps({**ID1, "duration": 0.05}))
+    spec = write_spec(tmp_path / "s.yaml", {"parameters": {"list": [{"legD": 1.6}]}, "runs": ["runs/short.json"],
+                                            "metrics": ["peak_tau"]})
+    done = sweep_cli([str(spec), "--workers", "1"], cwd="/")
+    assert done.returncode == 0, done.stderr
+    rows = read_csv(tmp_path / "sweep" / "results.csv")  # the default folder: sweep/ beside the spec
+    assert rows[0]["run"] == "short"
+    assert float(rows[0]["peak_tau"]) == peak_tau(robot.simulate({**ID1, "duration": 0.05}, params={"legD": 1.6}))
+
+
+# ---------------------------------------------------------------- mistakes
+
+
+BAD_SPECS = {
+    "unknown parameter": ({"grid": {"legd": [1.5]}}, r"parameters\.grid\.legd: not a parameter of excavator; did you mean 'legD'\?"),
+    "bad distribution": ({"random": {"samples": 3, "seed": 1, "distributions": {"legD": {"gauss": [1.5, 0.1]}}}},
+                         r"parameters\.random\.distributions\.legD\.gauss: unknown distribution"),
+    "negative count": ({"grid": {"legD": {"from": 1.3, "to": 2.2, "count": -3}}},
+                       r"parameters\.grid\.legD\.count: must be between 1 and 1000000, got -3"),
+    "zero samples": ({"random": {"samples": 0, "seed": 1, "distributions": {"legD": {"uniform": [1.3, 2.2]}}}},
+                     r"parameters\.random\.samples: must be between 1 and 1000000, got 0"),
+    "negative standard deviation": ({"random": {"samples": 3, "seed": 1, "distributions": {"legD": {"normal": [1.5, -0.1]}}}},
+                                    r"parameters\.random\.distributions\.legD\.normal: the standard deviation must be positive"),
+    "too many variants": ({"grid": {"legD": {"from": 1.3, "to": 2.2, "count": 1001}, "thighD": {"from": 1.8, "to": 2.2, "count": 1000}}},
+                          r"parameters\.grid: 1001000 variants .* more than the bound of 1000000"),
+    "a unit that is not the parameter's": ({"grid": {"legD": [1.5]}, "units": {"legD": "kg"}},
+                                          r"parameters\.units\.legD: excavator's legD is in 'm', not 'kg'"),
+    "two modes": ({"grid": {"legD": [1.5]}, "list": [{"legD": 1.5}]}, r"parameters: give exactly one of grid, list or random"),
+    "a value that is not a number": ({"list": [{"legD": "long"}]}, r"parameters\.list\[0\]\.legD: expected a number"),
+    "a variant without the first's parameters": ({"list": [{"legD": 1.5}, {"thighD": 2.0}]},
+                                                 r"parameters\.list\[1\]: every variant sets the same parameters as the first"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_SPECS))
+def test_a_bad_parameters_section_is_an_error_naming_the_field(robot, case, tmp_path):
+    parameters, message = BAD_SPECS[case]
+    with pytest.raises(wlx.Error, match=message):
+        wlx.sweep(robot, parameters, [ID1], ["peak_tau"], progress=False)
+    spec = write_spec(tmp_path / "s.yaml", {"parameters": parameters, "runs": [ID1], "metrics": ["peak_tau"]})
+    done = sweep_cli([str(spec)])
+    assert done.returncode == 2
+    assert re.search(message, done.stderr) and "Traceback" not in done.stderr
+    assert not (tmp_path / "sweep").exists()  # nothing written for a spec that cannot run
+
+
+@pytest.mark.parametrize("spec, message", [
+    ({"parameters": {"list": [{"legD": 1.5}]}, "runs": ["NH1"], "metrics": ["peak_tau"]},
+     r"runs\[0\]: 'NH1' is neither a scenario id of excavator nor a file; did you mean 'NH-1'\?"),
+    ({"parameters": {"list": [{"legD": 1.5}]}, "runs": ["ID-1", "ID-1"], "metrics": ["peak_tau"]},
+     r"runs\[1\]: a second run named 'ID-1'"),
+    ({"parameters": {"list": [{"legD": 1.5}]}, "runs": ["ID-1"], "metrics": ["peak_torque"]},
+     r"metrics\[0\]: unknown metric 'peak_torque'; did you mean 'peak_tau'\?"),
+    ({"parameters": {"list": [{"legD": 1.5}]}, "runs": ["ID-1"], "metrics": ["peak_tau"], "batchsize": 3},
+     r"batchsize: unknown key; did you mean 'batch_size'\?"),
+    ({"parameters": {"list": [{"legD": 1.5}]}, "runs": ["ID-1"], "metrics": ["peak_tau"], "batch_size": 0},
+     r"batch_size: must be between 1 and 10000, got 0"),
+    ({"model": "excavater", "parameters": {"list": [{"legD": 1.5}]}, "runs": ["ID-1"], "metrics": ["peak_tau"]},
+     r"model: 'excavater' is neither a built-in model .* nor a file; did you mean 'excavator'\?"),
+    ({"parameters": {"list": [{"legD": 1.5}]}, "runs": ["ID-1"]}, r"metrics: missing"),
+])
+def test_a_bad_spec_exits_2_naming_the_field(spec, message, tmp_path):
+    done = sweep_cli([str(write_spec(tmp_path / "s.yaml", spec))])
+    assert done.returncode == 2
+    assert re.search(message, done.stderr), done.stderr
+    assert "Traceback" not in done.stderr
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--workers", "0"], r"workers: must be between 1 and 256, got 0"),
+    (["--batch-size", "-2"], r"batch_size: must be between 1 and 10000, got -2"),
+    (["--scheduler", "localhost 8786"], r"scheduler: expected an address such as tcp://HOST:8786"),
+    (["--workers", "two"], r"--workers: 'two' is not a valid value|Could not convert"),
+])
+def test_bad_options_exit_2(args, message, tmp_path):
+    spec = write_spec(tmp_path / "s.yaml", {"parameters": {"list": [{"legD": 1.5}]}, "runs": ["ID-1"], "metrics": ["peak_tau"]})
+    done = sweep_cli([str(spec), *args])
+    assert done.returncode == 2
+    assert re.search(message, done.stderr), done.stderr
+
+
+def test_spec_files_are_read_strictly(tmp_path):
+    twice = tmp_path / "twice.yaml"
+    twice.write_text("parameters: {list: [{legD: 1.5}]}\nruns: [ID-1]\nmetrics: [peak_tau]\nruns: [ID-2]\n")
+    done = sweep_cli([str(twice)])
+    assert done.returncode == 2 and re.search(r"twice\.yaml:4: runs: given twice in one mapping", done.stderr), done.stderr
+    done = sweep_cli([str(tmp_path)])
+    assert done.returncode == 2 and "not a regular file" in done.stderr
+    big = tmp_path / "big.yaml"
+    big.write_text("#" * (1 << 20) + "\n")
+    done = sweep_cli([str(big)])
+    assert done.returncode == 2 and "larger than 1048576 bytes" in done.stderr
+    # The model's options are the spec's: given to wlx they are an error, not ignored.
+    done = subprocess.run([WLX, "--model", "walker", "sweep", str(twice)], capture_output=True, text=True, check=False)
+    assert done.returncode == 2 and "--model, --model-file, --scenarios and --params do not apply" in done.stderr
+    done = sweep_cli([])
+    assert done.returncode == 2 and "SPEC: missing" in done.stderr
+
+
+def test_python_m_wlx_needs_the_sweep_subcommand():
+    done = subprocess.run([sys.executable, "-m", "wlx"], capture_output=True, text=True, check=False)
+    assert done.returncode == 2 and "usage: python3 -m wlx sweep SPEC" in done.stderr
+
+
+def test_python_arguments_are_checked(robot):
+    with pytest.raises(wlx.Error, match=r"^model: expected a wlx\.Model"):
+        wlx.sweep("excavator", {"list": [{"legD": 1.5}]}, ["ID-1"])
+    with pytest.raises(wlx.Error, match=r"^scheduler: give client or scheduler, not both"):
+        wlx.sweep(robot, {"list": [{"legD": 1.5}]}, ["ID-1"], client=object(), scheduler="tcp://x:1")
+    with pytest.raises(wlx.Error, match=r"^runs\[0\]\.id: must be a string"):
+        wlx.sweep(robot, {"list": [{"legD": 1.5}]}, [{"id": 3}])
