@@ -25,7 +25,7 @@ import numpy as np
 # machine that runs out of memory or disk hours later.
 MAX_VARIANTS = 1_000_000
 MAX_RUNS = 100
-MAX_ROWS = 10_000_000
+MAX_ROWS = 20_000_000  # 10^6 variants x 12 runs and a margin; `wlx sweep` streams them to disk
 MAX_BATCH = 10_000
 MAX_WORKERS = 256
 MAX_SPEC_BYTES = 1 << 20
@@ -113,9 +113,13 @@ class _Plan:
         self.mode, self.shape, self.runs, self.metrics = mode, shape, runs, metrics
 
     def identity(self):
-        """What must match for a restart to reuse written rows: everything that changes a row."""
-        return {"model": self.model.name, "model_file": self.model._path, "names": self.names,
-                "values": [[v.hex() for v in row] for row in self.values.tolist()],
+        """What must match for a restart to reuse written rows: everything that changes a row (the
+        values by their SHA-256, exact to the bit)."""
+        import hashlib
+
+        path = os.path.abspath(self.model._path) if self.model._path is not None else None
+        return {"model": self.model.name, "model_file": path, "names": self.names, "variants": len(self.values),
+                "values_sha256": hashlib.sha256(np.ascontiguousarray(self.values, dtype="<f8").tobytes()).hexdigest(),
                 "runs": [[label, source] for label, source in self.runs], "metrics": self.metrics}
 
 
@@ -459,7 +463,8 @@ class OutputError(OSError):
     """An output that could not be written (full disk, no permission): exit 74 on the command line."""
 
 
-_BATCH_FILE = re.compile(r"^rows-(\d+)\.csv$")
+# A batch's file: its variants are first..last, every one of them (batches never span a gap).
+_BATCH_FILE = re.compile(r"^rows-(\d+)-(\d+)\.csv$")
 
 
 def _parse_cell(text, column):
@@ -545,7 +550,7 @@ def _client_for(client, scheduler, workers):
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
-        if not isinstance(scheduler, str) or not re.fullmatch(r"(tcp|tls|inproc|ucx)://[^\s/]+(:\d+)?", scheduler):
+        if not isinstance(scheduler, str) or not re.fullmatch(r"(tcp|tls|ucx)://[^\s/]+(:\d+)?", scheduler):
             _error("scheduler", f"expected an address such as tcp://HOST:8786, got {_excerpt(scheduler)}")
         try:
             return Client(scheduler, timeout="10s"), None
@@ -575,7 +580,22 @@ def sweep(model, parameters, runs, metrics=("peak_tau",), out=None, client=None,
     return _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, batch_size, progress, base_dir=None)
 
 
-def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, batch_size, progress, base_dir):
+def _batches(pending, size):
+    """Runs of consecutive pending variants, cut into batches of at most `size`: a batch never
+    spans a variant already written, so every batch file covers one range and results.csv is the
+    files concatenated in order."""
+    out, start = [], 0
+    for k in range(1, len(pending) + 1):
+        if k == len(pending) or pending[k] != pending[k - 1] + 1:
+            run = pending[start:k]
+            out += [run[j:j + size] for j in range(0, len(run), size)]
+            start = k
+    return out
+
+
+def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, batch_size, progress, base_dir, keep=True):
+    """The sweep; keep=False (the command line) holds no rows in memory: they go to the batch
+    files, and results.csv is those files concatenated."""
     from . import Model
 
     if not isinstance(model, Model):
@@ -589,7 +609,9 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
         _error("scheduler", "give client or scheduler, not both")
     header = _columns(plan.names, model.actuators, plan.metrics)
     n = len(plan.values)
-    done_rows = {}
+    done = np.zeros(n, dtype=bool)
+    kept = {}  # variant -> its rows (keep=True)
+    files = []  # (first, last, path) of every batch file
     batches_dir = None
     if out is not None:
         out = os.fspath(out)
@@ -609,24 +631,35 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
             _write_atomically(identity_path, identity)
         for name in sorted(os.listdir(batches_dir)):
             path = os.path.join(batches_dir, name)
+            m = _BATCH_FILE.match(name)
             if name.startswith(".") and name.endswith(".tmp"):
-                os.unlink(path)  # a batch being written when the sweep was killed: run again
-            elif _BATCH_FILE.match(name):
-                file_header, rows = _read_rows(path)
+                os.unlink(path)  # a batch being written when the sweep was killed: it runs again
+            elif m:
+                first, last = int(m[1]), int(m[2])
+                if not 0 <= first <= last < n or done[first:last + 1].any():
+                    _error("out", f"{path}: not a batch of this sweep (variants {first}..{last} of {n})")
+                if keep:
+                    file_header, rows = _read_rows(path)
+                    for row in rows:
+                        kept.setdefault(row[0], []).append(row)
+                else:
+                    with open(path, newline="", encoding="utf-8") as f:
+                        file_header = next(csv.reader(f), None)
                 if file_header != header:
                     _error("out", f"{path}: its columns are not this sweep's")
-                for row in rows:
-                    done_rows.setdefault(row[0], []).append(row)
-    pending = [i for i in range(n) if i not in done_rows]
+                done[first:last + 1] = True
+                files.append((first, last, path))
+    pending = np.flatnonzero(~done).tolist()
     reference = _reference(model)
     started_client, cluster = None, None
     workers_n = workers or _default_workers()
     bar = _Progress(n, n - len(pending), "variants", progress)
-    if progress and done_rows:
+    if progress and len(pending) < n:
         try:
             sys.stderr.write(f"sweep: resuming: {n - len(pending)} of {n} variants already written in {batches_dir}\n")
         except OSError:
             pass
+    order = {label: k for k, (label, _) in enumerate(plan.runs)}
     try:
         if pending:
             active, cluster = _client_for(client, scheduler, workers_n)
@@ -634,11 +667,10 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
             if client is not None or scheduler is not None:
                 workers_n = max(1, len(active.nthreads()))
             size = _batch_size(plan, reference, pending, workers_n, batch_size)
-            batches = [pending[k:k + size] for k in range(0, len(pending), size)]
             from distributed import as_completed
 
             futures = {}
-            for b in batches:
+            for b in _batches(pending, size):
                 f = active.submit(run_batch, reference, plan.names, plan.runs, plan.metrics, b, plan.values[b].tolist(), pure=False)
                 futures[f] = b
             for future in as_completed(list(futures)):
@@ -649,10 +681,14 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
                     reason = _one_line(f"the batch's task failed: {type(e).__name__}: {e}")
                     rows = [[i, *plan.values[i].tolist(), label, False, reason, 0.0, *_failed(plan.metrics, model.actuators, reason)]
                             for i in b for label, _ in plan.runs]
+                rows.sort(key=lambda r: (r[0], order[r[len(plan.names) + 1]]))
                 if batches_dir is not None:
-                    _write_atomically(os.path.join(batches_dir, f"rows-{b[0]:07d}.csv"), _csv_text(header, rows))
-                for row in rows:
-                    done_rows.setdefault(row[0], []).append(row)
+                    path = os.path.join(batches_dir, f"rows-{b[0]:07d}-{b[-1]:07d}.csv")
+                    _write_atomically(path, _csv_text(header, rows))
+                    files.append((b[0], b[-1], path))
+                if keep:
+                    for row in rows:
+                        kept.setdefault(row[0], []).append(row)
                 bar.add(len(b))
                 del future
         bar.add(0, final=True)
@@ -661,17 +697,49 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
             started_client.close()
         if cluster is not None:
             cluster.close()
-    order = {label: k for k, (label, _) in enumerate(plan.runs)}
-    table = [row for i in range(n) for row in sorted(done_rows[i], key=lambda r: order[r[len(plan.names) + 1]])]
     if out is not None:
-        _write_atomically(os.path.join(out, "results.csv"), _csv_text(header, table))
+        results = os.path.join(out, "results.csv")
+        complete_rows, total_rows = _concatenate(sorted(files), header, results)
         manifest = {"model": model.name, "mode": plan.mode, "parameters": plan.names, "units": plan.units,
                     "grid_shape": list(plan.shape) if plan.shape else None, "runs": [label for label, _ in plan.runs],
-                    "metrics": {m: METRICS[m][0] for m in plan.metrics}, "variants": n, "rows": len(table),
-                    "complete_rows": sum(1 for r in table if r[len(plan.names) + 2])}
+                    "metrics": {m: METRICS[m][0] for m in plan.metrics}, "variants": n, "rows": total_rows,
+                    "complete_rows": complete_rows}
         _write_atomically(os.path.join(out, "sweep.json"), json.dumps(manifest, indent=1) + "\n")
-        _plots(out, plan, header, table)
+        _plots(out, plan, header, results)
+    if not keep:
+        return None
+    table = [row for i in range(n) for row in kept[i]]
     return {name: [row[k] for row in table] for k, name in enumerate(header)}
+
+
+def _concatenate(files, header, path):
+    """results.csv: the batch files' rows in variant order (each file holds one range, in order),
+    streamed to a temporary name and renamed. Returns (rows that completed, rows)."""
+    temp = os.path.join(os.path.dirname(path), f".{os.path.basename(path)}.{os.getpid()}.tmp")
+    complete_column = header.index("complete")
+    complete = total = 0
+    try:
+        with open(temp, "w", encoding="utf-8", newline="") as out:
+            csv.writer(out, lineterminator="\n").writerow(header)
+            for _, _, batch in files:
+                with open(batch, newline="", encoding="utf-8") as f:
+                    reader = csv.reader(f)
+                    next(reader)
+                    writer = csv.writer(out, lineterminator="\n")
+                    for row in reader:
+                        writer.writerow(row)
+                        total += 1
+                        complete += row[complete_column] == "true"
+            out.flush()
+            os.fsync(out.fileno())
+        os.replace(temp, path)
+    except OSError as e:
+        try:
+            os.unlink(temp)
+        except OSError:
+            pass
+        raise OutputError(f"{path}: writing failed: {e.strerror or e}") from None
+    return complete, total
 
 
 # ---------------------------------------------------------------- plots
@@ -694,10 +762,35 @@ def _sensitivities(x, y):
     return coefficients[1:]
 
 
-def _plots(out, plan, header, table):
+def _plot_data(plan, header, results):
+    """From results.csv, streamed: per run, the parameters and metrics of its complete rows (8
+    bytes a value), and how many rows of it did not complete."""
+    from array import array
+
+    col = {h: k for k, h in enumerate(header)}
+    data = {label: {"x": [array("d") for _ in plan.names], "y": {m: array("d") for m in plan.metrics}, "left_out": 0}
+            for label, _ in plan.runs}
+    with open(results, newline="", encoding="utf-8") as f:
+        reader = csv.reader(f)
+        next(reader)
+        for row in reader:
+            d = data[row[col["run"]]]
+            if row[col["complete"]] != "true":
+                d["left_out"] += 1
+                continue
+            for k in range(len(plan.names)):
+                d["x"][k].append(float(row[1 + k]))
+            for m in plan.metrics:
+                cell = row[col[m]]
+                d["y"][m].append(float(cell) if cell else math.nan)  # a run without that quantity: not drawn
+    return data
+
+
+def _plots(out, plan, header, results):
     """One parameter: each metric against it (a line per run). Two on a grid: a heat map per metric
-    and run. Random samples (or a grid of more than two): the standardized sensitivities of each
-    metric to each parameter (also in sensitivity.csv). Rows that did not complete are left out."""
+    and run. Random samples (or a grid of more than two, or a list): the standardized sensitivities
+    of each metric to each parameter (also in sensitivity.csv). Rows that did not complete are left
+    out (the title says how many)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -706,8 +799,7 @@ def _plots(out, plan, header, table):
     plots = os.path.join(out, "plots")
     os.makedirs(plots, exist_ok=True)
     p = len(plan.names)
-    col = {h: k for k, h in enumerate(header)}
-    complete = col["complete"]
+    data = _plot_data(plan, header, results)
     written = []
 
     def save(fig, name):
@@ -718,60 +810,64 @@ def _plots(out, plan, header, table):
         os.replace(temp, path)
         written.append(path)
 
+    def axis_label(k):
+        return _label(plan.names[k], plan.units[plan.names[k]])
+
     sensitivity_rows = []
     for metric in plan.metrics:
         unit = METRICS[metric][0]
-        for label, _ in plan.runs:
-            rows = [r for r in table if r[col["run"]] == label and r[complete] and r[col[metric]] is not None]
-            left_out = sum(1 for r in table if r[col["run"]] == label) - len(rows)
-            if not rows:
-                continue
-            x = np.array([[r[1 + k] for k in range(p)] for r in rows], dtype=float)
-            y = np.array([r[col[metric]] for r in rows], dtype=float)
-            note = f" ({left_out} variants left out: not complete)" if left_out else ""
-            safe = re.sub(r"[^A-Za-z0-9_.+-]", "_", label)
-            if plan.mode != "random" and p == 1:
-                continue  # one figure per metric with every run, below
-            if plan.mode == "grid" and p == 2:
-                fig, ax = plt.subplots(figsize=(6, 4.5))
-                grid = np.full(plan.shape, np.nan)  # a missing cell stays blank in the picture (no file holds it)
-                a0 = np.unique(plan.values[:, 0])
-                a1 = np.unique(plan.values[:, 1])
-                for (u, v), value in zip(x, y):
-                    grid[np.searchsorted(a0, u), np.searchsorted(a1, v)] = value
-                mesh = ax.pcolormesh(_edges(a1), _edges(a0), grid, shading="flat", cmap="viridis")
-                fig.colorbar(mesh, ax=ax, label=_label(metric, unit))
-                ax.set_xlabel(_label(plan.names[1], plan.units[plan.names[1]]))
-                ax.set_ylabel(_label(plan.names[0], plan.units[plan.names[0]]))
-                ax.set_title(f"{metric}, run {label}{note}", fontsize=9)
-                save(fig, f"{metric}-{safe}-heatmap.png")
-            else:
-                s = _sensitivities(x, y)
-                sensitivity_rows += [[metric, label, name, float(v)] for name, v in zip(plan.names, s)]
-                fig, ax = plt.subplots(figsize=(max(4, 0.8 * p + 2), 3.5))
-                ax.bar(plan.names, s, color=["tab:blue" if v >= 0 else "tab:red" for v in s])
-                ax.axhline(0, color="black", linewidth=0.5)
-                ax.set_ylabel(f"standardized effect on {metric}")
-                ax.set_title(f"{metric}, run {label}: linear fit over {len(y)} variants{note}", fontsize=9)
-                fig.tight_layout()
-                save(fig, f"{metric}-{safe}-sensitivity.png")
         if plan.mode != "random" and p == 1:
             fig, ax = plt.subplots(figsize=(6, 4))
             drawn = False
             for label, _ in plan.runs:
-                rows = [r for r in table if r[col["run"]] == label and r[complete] and r[col[metric]] is not None]
-                if rows:
-                    order = np.argsort([r[1] for r in rows], kind="stable")
-                    ax.plot([rows[i][1] for i in order], [rows[i][col[metric]] for i in order], "o-", label=label)
+                x, y = np.asarray(data[label]["x"][0]), np.asarray(data[label]["y"][metric])
+                keep = np.isfinite(y)
+                if keep.any():
+                    order = np.argsort(x[keep], kind="stable")
+                    left_out = data[label]["left_out"]
+                    ax.plot(x[keep][order], y[keep][order], "o-",
+                            label=label + (f" ({left_out} variants did not complete)" if left_out else ""))
                     drawn = True
             if drawn:
-                ax.set_xlabel(_label(plan.names[0], plan.units[plan.names[0]]))
+                ax.set_xlabel(axis_label(0))
                 ax.set_ylabel(_label(metric, unit))
                 ax.legend(fontsize=8)
                 fig.tight_layout()
                 save(fig, f"{metric}-vs-{plan.names[0]}.png")
             else:
                 plt.close(fig)
+            continue
+        for label, _ in plan.runs:
+            x = np.column_stack([np.asarray(c) for c in data[label]["x"]]) if p else np.zeros((0, 0))
+            y = np.asarray(data[label]["y"][metric])
+            keep = np.isfinite(y)
+            if not keep.any():
+                continue
+            x, y = x[keep], y[keep]
+            left_out = data[label]["left_out"]
+            note = f" ({left_out} variants did not complete)" if left_out else ""
+            safe = re.sub(r"[^A-Za-z0-9_.+-]", "_", label)
+            if plan.mode == "grid" and p == 2:
+                a0, a1 = np.unique(plan.values[:, 0]), np.unique(plan.values[:, 1])
+                grid = np.full((len(a0), len(a1)), np.nan)  # a cell without a value stays blank
+                grid[np.searchsorted(a0, x[:, 0]), np.searchsorted(a1, x[:, 1])] = y
+                fig, ax = plt.subplots(figsize=(6, 4.5))
+                mesh = ax.pcolormesh(_edges(a1), _edges(a0), grid, shading="flat", cmap="viridis")
+                fig.colorbar(mesh, ax=ax, label=_label(metric, unit))
+                ax.set_xlabel(axis_label(1))
+                ax.set_ylabel(axis_label(0))
+                ax.set_title(f"{metric}, run {label}{note}", fontsize=9)
+                save(fig, f"{metric}-{safe}-heatmap.png")
+            else:
+                coefficients = _sensitivities(x, y)
+                sensitivity_rows += [[metric, label, name, float(v)] for name, v in zip(plan.names, coefficients)]
+                fig, ax = plt.subplots(figsize=(max(4, 0.8 * p + 2), 3.5))
+                ax.bar(plan.names, coefficients, color=["tab:blue" if v >= 0 else "tab:red" for v in coefficients])
+                ax.axhline(0, color="black", linewidth=0.5)
+                ax.set_ylabel(f"standardized effect on {metric}")
+                ax.set_title(f"{metric}, run {label}: linear fit over {len(y)} variants{note}", fontsize=9)
+                fig.tight_layout()
+                save(fig, f"{metric}-{safe}-sensitivity.png")
     if sensitivity_rows:
         _write_atomically(os.path.join(out, "sensitivity.csv"),
                           _csv_text(["metric", "run", "parameter", "standardized_coefficient"], sensitivity_rows))
@@ -867,8 +963,10 @@ def run_spec(path, out=None, scheduler=None, workers=None, batch_size=None, prog
         out = given if os.path.isabs(given) else os.path.join(base, given)
     if batch_size is None and "batch_size" in spec:
         batch_size = spec["batch_size"]
-    return _sweep(model, spec["parameters"], spec["runs"], spec["metrics"], out, None, scheduler, workers, batch_size,
-                  progress, base_dir=base), out
+    _sweep(model, spec["parameters"], spec["runs"], spec["metrics"], out, None, scheduler, workers, batch_size,
+           progress, base_dir=base, keep=False)
+    with open(os.path.join(out, "sweep.json"), encoding="utf-8") as f:
+        return json.load(f), out
 
 
 def main(argv=None):
@@ -896,7 +994,7 @@ def main(argv=None):
     signal.signal(signal.SIGTERM, stop)
     signal.signal(signal.SIGHUP, stop)
     try:
-        table, out = run_spec(args.spec, args.out, args.scheduler, args.workers, args.batch_size)
+        manifest, out = run_spec(args.spec, args.out, args.scheduler, args.workers, args.batch_size)
     except KeyboardInterrupt as e:
         code = {signal.SIGTERM: 143, signal.SIGHUP: 129}.get(e.args[0] if e.args else None, 130)
         sys.stderr.write("\nwlx sweep: interrupted: the batches written are complete; run the same command again to resume\n")
@@ -907,6 +1005,6 @@ def main(argv=None):
     except ValueError as e:  # wlx.Error and the spec's errors: they name the field
         sys.stderr.write(f"wlx sweep: error: {e}\n")
         return 2
-    stopped = sum(1 for c in table["complete"] if not c)
-    print(f"{len(table['variant'])} rows ({stopped} did not complete) in {os.path.join(out, 'results.csv')}")
+    stopped = manifest["rows"] - manifest["complete_rows"]
+    print(f"{manifest['rows']} rows ({stopped} did not complete) in {os.path.join(out, 'results.csv')}")
     return 0

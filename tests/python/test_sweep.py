@@ -240,7 +240,8 @@ def test_a_killed_sweep_resumes_and_ends_with_the_uninterrupted_table(tmp_path):
     assert 2 <= len(written) < 24
     assert not (work / "out" / "results.csv").exists()
 
-    resumed = sweep_cli([str(spec), "--workers", "1", "--batch-size", "1"])
+    # Resumed with larger batches: they never span a variant already written (a file is one range).
+    resumed = sweep_cli([str(spec), "--workers", "1", "--batch-size", "5"])
     assert resumed.returncode == 0, resumed.stderr
     assert f"resuming: {len(written)} of 24 variants already written" in resumed.stderr
     for name, stamp in written.items():  # skipped: not run or written again
@@ -248,6 +249,12 @@ def test_a_killed_sweep_resumes_and_ends_with_the_uninterrupted_table(tmp_path):
         assert (f.stat().st_ino, f.stat().st_mtime_ns) == stamp
     assert not list(batches.glob(".*.tmp"))
     assert (work / "out" / "results.csv").read_bytes() == (reference / "out" / "results.csv").read_bytes()
+
+
+def test_batches_never_span_a_written_variant():
+    assert _sweep._batches([0, 1, 2, 5, 6, 9], 2) == [[0, 1], [2], [5, 6], [9]]
+    assert _sweep._batches(list(range(7)), 3) == [[0, 1, 2], [3, 4, 5], [6]]
+    assert _sweep._batches([], 4) == []
 
 
 def test_sigterm_stops_with_143_and_the_written_batches_stay(tmp_path):
@@ -286,10 +293,10 @@ def test_batches_are_sized_as_documented(tmp_path):
                                             "runs": [{**ID1, "duration": 0.05}], "metrics": ["peak_tau"], "out": "auto"})
     assert sweep_cli([str(spec), "--workers", "2"]).returncode == 0
     assert sorted(f.name for f in (tmp_path / "auto" / "batches").glob("rows-*.csv")) == \
-        [f"rows-{k:07d}.csv" for k in (0, 2, 4, 6, 8)]
+        [f"rows-{k:07d}-{k + 1:07d}.csv" for k in (0, 2, 4, 6, 8)]
     assert sweep_cli([str(spec), "--workers", "1", "--batch-size", "3", "--out", str(tmp_path / "three")]).returncode == 0
     assert sorted(f.name for f in (tmp_path / "three" / "batches").glob("rows-*.csv")) == \
-        [f"rows-{k:07d}.csv" for k in (0, 3, 6, 9)]
+        [f"rows-{a:07d}-{b:07d}.csv" for a, b in ((0, 2), (3, 5), (6, 8), (9, 9))]
     assert (tmp_path / "three" / "results.csv").read_bytes() == (tmp_path / "auto" / "results.csv").read_bytes()
 
 
