@@ -68,7 +68,7 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
   inv.sweep->add_option("--scheduler", inv.sweep_options.scheduler,
                         "a running Dask scheduler, tcp://HOST:8786 (default: a local cluster on this machine's cores)");
   inv.sweep->add_option("--workers", inv.sweep_options.workers, "the local cluster's worker processes (default: this machine's cores)");
-  inv.sweep->add_option("--batch-size", inv.sweep_options.batch_size, "variants per Dask task (default: sized to about 0.5 s a task)");
+  inv.sweep->add_option("--batch-size", inv.sweep_options.batch_size, "variants per Dask task (default: sized to about 2 s a task)");
 
   for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report, inv.viewer}) add_model_options(a);
 }

@@ -29,10 +29,11 @@ MAX_ROWS = 20_000_000  # 10^6 variants x 12 runs and a margin; `wlx sweep` strea
 MAX_BATCH = 10_000
 MAX_WORKERS = 256
 MAX_SPEC_BYTES = 1 << 20
-# A batch should take about this long on a worker: ~500 times the per-task overhead measured on a
-# local cluster (about 1 ms, README.md), so scheduling costs well under 1%, while a kill loses at
-# most this much work per worker and the progress bar still moves.
-TARGET_BATCH_SECONDS = 0.5
+# A batch should take about this long on a worker: hundreds of times a task's overhead (a few ms
+# through a local scheduler and back, README.md's scaling table), so scheduling costs well under
+# 1%; a 10^6-variant sweep stays at tens of thousands of tasks and batch files; a kill loses at
+# most this much work per worker, and the progress bar still moves.
+TARGET_BATCH_SECONDS = 2.0
 # ...and each worker should get at least this many batches, so that a slow batch does not leave
 # the others idle at the end.
 MIN_BATCHES_PER_WORKER = 4
@@ -985,7 +986,7 @@ def main(argv=None):
     parser.add_argument("--out", help="output folder (default: the spec's `out`, else sweep/ beside the spec)")
     parser.add_argument("--scheduler", help="a running Dask scheduler, tcp://HOST:8786 (default: a local cluster)")
     parser.add_argument("--workers", type=int, help="the local cluster's worker processes (default: this machine's cores)")
-    parser.add_argument("--batch-size", type=int, help="variants per task (default: sized to about 0.5 s a task)")
+    parser.add_argument("--batch-size", type=int, help="variants per task (default: sized to about 2 s a task)")
     args = parser.parse_args(argv)
 
     def stop(signum, frame):
