@@ -202,24 +202,19 @@ def test_two_parameters_on_a_grid_give_a_heat_map(robot, client, tmp_path):
 # ---------------------------------------------------------------- the command line, kill and resume
 
 
+# 24 variants of a 1 s run (about 10 ms each), one per task on one worker: a kill lands mid-way.
+LONG = {"parameters": {"grid": {"legD": {"from": 1.3, "to": 2.2, "count": 24}}, "units": {"legD": "m"}},
+        "runs": [{**ID1, "duration": 1.0}], "metrics": ["peak_tau", "energy"]}
+
+
 def long_spec(tmp_path, out="out"):
-    # 24 variants of a 1 s run (about 10 ms each), one per task on one worker: a kill lands mid-way.
-    return write_spec(tmp_path / "spec.yaml", {
-        "model": "excavator",
-        "parameters": {"grid": {"legD": {"from": 1.3, "to": 2.2, "count": 24}}, "units": {"legD": "m"}},
-        "runs": [{**ID1, "duration": 1.0}],
-        "metrics": ["peak_tau", "energy"],
-        "out": out,
-    })
+    return write_spec(tmp_path / "spec.yaml", {"model": "excavator", **LONG, "out": out})
 
 
-def test_a_killed_sweep_resumes_and_ends_with_the_uninterrupted_table(tmp_path):
+def test_a_killed_sweep_resumes_and_ends_with_the_uninterrupted_table(robot, client, tmp_path):
+    # The uninterrupted table: the same engine in this process, on the shared cluster.
     reference = tmp_path / "reference"
-    reference.mkdir()
-    done = sweep_cli([str(long_spec(reference)), "--workers", "1", "--batch-size", "1"])
-    assert done.returncode == 0, done.stderr
-    assert "24 rows (0 did not complete)" in done.stdout
-    assert re.search(r"24/24 variants [\d.]+/s, \d+ s left", done.stderr)  # the progress bar's last line
+    wlx.sweep(robot, LONG["parameters"], LONG["runs"], LONG["metrics"], out=reference, client=client, progress=False)
 
     work = tmp_path / "killed"
     work.mkdir()
@@ -248,7 +243,7 @@ def test_a_killed_sweep_resumes_and_ends_with_the_uninterrupted_table(tmp_path):
         f = batches / name
         assert (f.stat().st_ino, f.stat().st_mtime_ns) == stamp
     assert not list(batches.glob(".*.tmp"))
-    assert (work / "out" / "results.csv").read_bytes() == (reference / "out" / "results.csv").read_bytes()
+    assert (work / "out" / "results.csv").read_bytes() == (reference / "results.csv").read_bytes()
 
 
 def test_batches_never_span_a_written_variant():
@@ -275,10 +270,9 @@ def test_sigterm_stops_with_143_and_the_written_batches_stay(tmp_path):
         assert len(read_csv(f)) == 1  # whole files only
 
 
-def test_a_restart_with_another_spec_in_the_same_folder_is_an_error(tmp_path):
-    spec = write_spec(tmp_path / "a.yaml", {"parameters": {"list": [{"legD": 1.5}]}, "runs": [{**ID1, "duration": 0.05}],
-                                            "metrics": ["peak_tau"], "out": "o"})
-    assert sweep_cli([str(spec), "--workers", "1"]).returncode == 0
+def test_a_restart_with_another_spec_in_the_same_folder_is_an_error(robot, client, tmp_path):
+    wlx.sweep(robot, {"list": [{"legD": 1.5}]}, [{**ID1, "duration": 0.05}], ["peak_tau"], out=tmp_path / "o", client=client,
+              progress=False)
     spec = write_spec(tmp_path / "a.yaml", {"parameters": {"list": [{"legD": 1.6}]}, "runs": [{**ID1, "duration": 0.05}],
                                             "metrics": ["peak_tau"], "out": "o"})
     done = sweep_cli([str(spec), "--workers", "1"])
@@ -286,15 +280,14 @@ def test_a_restart_with_another_spec_in_the_same_folder_is_an_error(tmp_path):
     assert "out: " in done.stderr and "holds the rows of another sweep" in done.stderr
 
 
-def test_batches_are_sized_as_documented(tmp_path):
+def test_batches_are_sized_as_documented(robot, client, tmp_path):
     # Auto: a variant costs milliseconds, so the balance rule decides: ceil(10 / (4 batches x 2
-    # workers)) = 2 variants a batch, 5 files. --batch-size 3: ceil(10 / 3) = 4 files.
-    spec = write_spec(tmp_path / "s.yaml", {"parameters": {"grid": {"legD": {"from": 1.3, "to": 2.2, "count": 10}}},
-                                            "runs": [{**ID1, "duration": 0.05}], "metrics": ["peak_tau"], "out": "auto"})
-    assert sweep_cli([str(spec), "--workers", "2"]).returncode == 0
+    # workers)) = 2 variants a batch, 5 files. batch_size 3: ceil(10 / 3) = 4 files.
+    parameters, runs = {"grid": {"legD": {"from": 1.3, "to": 2.2, "count": 10}}}, [{**ID1, "duration": 0.05}]
+    wlx.sweep(robot, parameters, runs, ["peak_tau"], out=tmp_path / "auto", client=client, progress=False)
     assert sorted(f.name for f in (tmp_path / "auto" / "batches").glob("rows-*.csv")) == \
         [f"rows-{k:07d}-{k + 1:07d}.csv" for k in (0, 2, 4, 6, 8)]
-    assert sweep_cli([str(spec), "--workers", "1", "--batch-size", "3", "--out", str(tmp_path / "three")]).returncode == 0
+    wlx.sweep(robot, parameters, runs, ["peak_tau"], out=tmp_path / "three", client=client, batch_size=3, progress=False)
     assert sorted(f.name for f in (tmp_path / "three" / "batches").glob("rows-*.csv")) == \
         [f"rows-{a:07d}-{b:07d}.csv" for a, b in ((0, 2), (3, 5), (6, 8), (9, 9))]
     assert (tmp_path / "three" / "results.csv").read_bytes() == (tmp_path / "auto" / "results.csv").read_bytes()
@@ -329,6 +322,8 @@ def test_a_run_from_a_file_beside_the_spec(robot, tmp_path):
                                             "metrics": ["peak_tau"]})
     done = sweep_cli([str(spec), "--workers", "1"], cwd="/")
     assert done.returncode == 0, done.stderr
+    assert "1 rows (0 did not complete)" in done.stdout
+    assert re.search(r"1/1 variants [\d.]+/s, \d+ s left", done.stderr)  # the progress bar's last line
     rows = read_csv(tmp_path / "sweep" / "results.csv")  # the default folder: sweep/ beside the spec
     assert rows[0]["run"] == "short"
     assert float(rows[0]["peak_tau"]) == peak_tau(robot.simulate({**ID1, "duration": 0.05}, params={"legD": 1.6}))
