@@ -160,6 +160,8 @@ def _parameter_values(model, parameters):
                 points = list(np.linspace(_number(axis["from"], f"{where}.from"), _number(axis["to"], f"{where}.to"), count))
             else:
                 _error(where, f"expected a list of values or {{from, to, count}}, got {_excerpt(axis)}")
+            if len(set(points)) != len(points):
+                _error(where, "a value given twice (a grid's axis lists each value once)")
             names.append(name)
             axes.append(points)
         total = math.prod(len(a) for a in axes)
@@ -669,6 +671,7 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
                 workers_n = max(1, len(active.nthreads()))
             size = _batch_size(plan, reference, pending, workers_n, batch_size)
             from distributed import as_completed
+            from distributed.scheduler import KilledWorker
 
             futures = {}
             for b in _batches(pending, size):
@@ -678,10 +681,15 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
                 b = futures.pop(future)
                 try:
                     rows = future.result()
-                except Exception as e:  # noqa: BLE001 - e.g. a worker that died: the batch's rows say so
-                    reason = _one_line(f"the batch's task failed: {type(e).__name__}: {e}")
+                except KilledWorker as e:
+                    # The batch took down every worker Dask tried it on (its allowed failures): a
+                    # variant that crashes the process is a result, the batch's rows say so.
+                    reason = _one_line(f"the batch's worker process died each time it ran it ({e})")
                     rows = [[i, *plan.values[i].tolist(), label, False, reason, 0.0, *_failed(plan.metrics, model.actuators, reason)]
                             for i in b for label, _ in plan.runs]
+                except Exception as e:  # noqa: BLE001 - the cluster, not a variant: stop, resumable
+                    _error("sweep", f"a task failed ({_one_line(f'{type(e).__name__}: {e}')}); the batches written are kept: "
+                                    "run the same sweep again to resume")
                 rows.sort(key=lambda r: (r[0], order[r[len(plan.names) + 1]]))
                 if batches_dir is not None:
                     path = os.path.join(batches_dir, f"rows-{b[0]:07d}-{b[-1]:07d}.csv")

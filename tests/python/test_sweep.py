@@ -346,6 +346,7 @@ BAD_SPECS = {
                           r"parameters\.grid: 1001000 variants .* more than the bound of 1000000"),
     "a unit that is not the parameter's": ({"grid": {"legD": [1.5]}, "units": {"legD": "kg"}},
                                           r"parameters\.units\.legD: excavator's legD is in 'm', not 'kg'"),
+    "a grid value given twice": ({"grid": {"legD": [1.5, 1.6, 1.5]}}, r"parameters\.grid\.legD: a value given twice"),
     "two modes": ({"grid": {"legD": [1.5]}, "list": [{"legD": 1.5}]}, r"parameters: give exactly one of grid, list or random"),
     "a value that is not a number": ({"list": [{"legD": "long"}]}, r"parameters\.list\[0\]\.legD: expected a number"),
     "a variant without the first's parameters": ({"list": [{"legD": 1.5}, {"thighD": 2.0}]},
@@ -416,6 +417,17 @@ def test_spec_files_are_read_strictly(tmp_path):
     assert done.returncode == 2 and "--model, --model-file, --scenarios and --params do not apply" in done.stderr
     done = sweep_cli([])
     assert done.returncode == 2 and "SPEC: missing" in done.stderr
+
+
+def test_a_worker_that_cannot_load_the_model_stops_the_sweep_resumably(client, tmp_path):
+    # As when a model file is not at the same path on the workers: the task fails, not a variant.
+    # The sweep stops with the reason (exit 2 on the command line); nothing is written as a row.
+    elsewhere = wlx.model("excavator")
+    elsewhere._path = str(tmp_path / "not-on-the-workers.yaml")
+    with pytest.raises(wlx.Error, match=r"^sweep: a task failed \(Error: load: .*cannot open it .*run the same sweep again to resume"):
+        wlx.sweep(elsewhere, {"list": [{"legD": 1.5}]}, [{**ID1, "duration": 0.05}], ["peak_tau"], out=tmp_path / "o",
+                  client=client, batch_size=1, progress=False)
+    assert not list((tmp_path / "o" / "batches").iterdir())
 
 
 def test_python_m_wlx_needs_the_sweep_subcommand():
