@@ -29,7 +29,12 @@ if [ -d build/install/lib/python3/dist-packages/wlx ]; then
 import wlx
 answer = wlx.model("excavator").ik({"z_C": 1.8})
 assert answer["closure_residual"] <= 1e-12, answer
+assert callable(wlx.sweep)  # the sweep engine (python/wlx/_sweep.py) was installed with it
 print("installed wlx:", wlx.__file__, "ik closure residual", answer["closure_residual"])'
+  # wlx sweep: the installed wlx runs the installed package (python3 -m wlx sweep).
+  printf '%s\n' 'parameters: {list: [{legD: 1.5}, {legD: 1.6}]}' 'runs: [NH-1]' 'metrics: [peak_cond_J_beta]' > "$work/sweep.yaml"
+  env -u PYTHONPATH build/install/bin/wlx sweep "$work/sweep.yaml" --workers 1 --out "$work/sweep"
+  grep -q '^1,1.6,NH-1,true,' "$work/sweep/results.csv"
 else
   echo "no Python package installed (pybind11 or Python headers missing at configure time)" >&2
   exit 1

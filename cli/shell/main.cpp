@@ -39,12 +39,13 @@ int run_sweep(const wlx::cli::SweepOptions& o, bool model_options_given) {
     throw wlx::Error("sweep", "the model and its runs are the spec's (model, runs): --model, --model-file, --scenarios and --params do not apply");
   if (o.spec.empty()) throw wlx::Error("SPEC", "missing: give the sweep's spec file (YAML)");
 #ifdef WLX_PYTHON_EXECUTABLE
+  // An installed wlx's own package first (<prefix>/bin/wlx: <prefix>/lib/python3/dist-packages),
+  // so that it never runs a build tree's that is still there; else the build tree's.
   std::error_code ec;
-  fs::path package = WLX_PYTHON_BUILD_DIR;
-  if (!fs::is_regular_file(package / "wlx" / "_sweep.py", ec)) {
-    const fs::path executable = fs::read_symlink("/proc/self/exe", ec);
-    if (!ec) package = (executable.parent_path() / WLX_PYTHON_FROM_BINDIR).lexically_normal();
-  }
+  fs::path package;
+  if (const fs::path executable = fs::read_symlink("/proc/self/exe", ec); !ec)
+    package = (executable.parent_path() / WLX_PYTHON_FROM_BINDIR).lexically_normal();
+  if (package.empty() || !fs::is_regular_file(package / "wlx" / "_sweep.py", ec)) package = WLX_PYTHON_BUILD_DIR;
   if (!fs::is_regular_file(package / "wlx" / "_sweep.py", ec))
     throw wlx::Error("sweep", "the Python package wlx was not found (" + package.string() + "): build it (pybind11-dev)");
   const char* old_path = std::getenv("PYTHONPATH");
