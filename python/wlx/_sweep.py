@@ -954,7 +954,7 @@ def run_spec(path, out=None, scheduler=None, workers=None, batch_size=None, prog
 
     spec = read_spec(path)
     base = os.path.dirname(os.path.abspath(path))
-    model_name = spec.get("model", "excavator")
+    model_name = spec.get("model", wlx.models()[0])  # the default model, as the command line's
     if not isinstance(model_name, str) or not model_name:
         _error("model", f"expected a built-in model's name or a model file, got {_excerpt(model_name)}")
     if model_name in wlx.models():
