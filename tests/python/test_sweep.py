@@ -318,15 +318,16 @@ def test_a_running_scheduler_takes_the_same_sweep(robot, tmp_path):
 def test_a_run_from_a_file_beside_the_spec(robot, tmp_path):
     (tmp_path / "runs").mkdir()
     (tmp_path / "runs" / "short.json").write_text(json.dumps({**ID1, "duration": 0.05}))
-    spec = write_spec(tmp_path / "s.yaml", {"parameters": {"list": [{"legD": 1.6}]}, "runs": ["runs/short.json"],
-                                            "metrics": ["peak_tau"]})
+    spec = write_spec(tmp_path / "s.yaml", {"parameters": {"list": [{"legD": 1.6}, {"legD": 1.7}]}, "runs": ["runs/short.json"],
+                                            "metrics": ["peak_tau"], "batch_size": 1})
     done = sweep_cli([str(spec), "--workers", "1"], cwd="/")
     assert done.returncode == 0, done.stderr
-    assert "1 rows (0 did not complete)" in done.stdout
-    assert re.search(r"1/1 variants [\d.]+/s, \d+ s left", done.stderr)  # the progress bar's last line
+    assert "2 rows (0 did not complete)" in done.stdout
+    assert re.search(r"2/2 variants [\d.]+/s, \d+ s left", done.stderr)  # the progress bar's last line
     rows = read_csv(tmp_path / "sweep" / "results.csv")  # the default folder: sweep/ beside the spec
-    assert rows[0]["run"] == "short"
-    assert float(rows[0]["peak_tau"]) == peak_tau(robot.simulate({**ID1, "duration": 0.05}, params={"legD": 1.6}))
+    assert [r["run"] for r in rows] == ["short", "short"]
+    assert float(rows[1]["peak_tau"]) == peak_tau(robot.simulate({**ID1, "duration": 0.05}, params={"legD": 1.7}))
+    assert len(list((tmp_path / "sweep" / "batches").glob("rows-*.csv"))) == 2  # the spec's batch_size
 
 
 # ---------------------------------------------------------------- mistakes
@@ -428,6 +429,17 @@ def test_a_worker_that_cannot_load_the_model_stops_the_sweep_resumably(client, t
         wlx.sweep(elsewhere, {"list": [{"legD": 1.5}]}, [{**ID1, "duration": 0.05}], ["peak_tau"], out=tmp_path / "o",
                   client=client, batch_size=1, progress=False)
     assert not list((tmp_path / "o" / "batches").iterdir())
+
+
+def test_an_angle_given_in_degrees_is_swept_in_radians():
+    # The quadruped's sensor mount angles are its parameters in rad.
+    quadruped = wlx.model("wheeled_quadruped")
+    assert quadruped.param_units["imu_joint_roll"] == "rad"
+    plan = _sweep._plan(quadruped, {"grid": {"imu_joint_roll": [0.0, 5.0, 90.0]}, "units": {"imu_joint_roll": "deg"}},
+                        [quadruped.scenarios[0]], ["peak_tau"])
+    assert plan.values[:, 0].tolist() == [0.0, np.pi / 36, np.pi / 2]
+    with pytest.raises(wlx.Error, match=r"^parameters\.units\.imu_joint_roll: wheeled_quadruped's imu_joint_roll is in 'rad', not 'grad' \(or 'deg'\)"):
+        _sweep._plan(quadruped, {"grid": {"imu_joint_roll": [5.0]}, "units": {"imu_joint_roll": "grad"}}, ["NH-Q1"], ["peak_tau"])
 
 
 def test_python_m_wlx_needs_the_sweep_subcommand():
