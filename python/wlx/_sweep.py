@@ -499,6 +499,9 @@ class _Progress:
         self.start_done, self.started, self.last = done, time.monotonic(), 0.0
         self.tty = enabled and sys.stderr.isatty()
 
+    def restart(self):
+        self.start_done, self.started = self.done, time.monotonic()
+
     def add(self, n, final=False):
         self.done += n
         now = time.monotonic()
@@ -610,6 +613,8 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
         batch_size = _count(batch_size, "batch_size", 1, MAX_BATCH)
     if client is not None and scheduler is not None:
         _error("scheduler", "give client or scheduler, not both")
+    if workers is not None and (client is not None or scheduler is not None):
+        _error("workers", "sizes the local cluster: a running one (client, scheduler) has its own workers")
     header = _columns(plan.names, model.actuators, plan.metrics)
     n = len(plan.values)
     done = np.zeros(n, dtype=bool)
@@ -673,6 +678,7 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
             from distributed import as_completed
             from distributed.scheduler import KilledWorker
 
+            bar.restart()  # the rate and the time left from here: the cluster's start is not the sweep's pace
             futures = {}
             for b in _batches(pending, size):
                 f = active.submit(run_batch, reference, plan.names, plan.runs, plan.metrics, b, plan.values[b].tolist(), pure=False)

@@ -452,5 +452,7 @@ def test_python_arguments_are_checked(robot):
         wlx.sweep("excavator", {"list": [{"legD": 1.5}]}, ["ID-1"])
     with pytest.raises(wlx.Error, match=r"^scheduler: give client or scheduler, not both"):
         wlx.sweep(robot, {"list": [{"legD": 1.5}]}, ["ID-1"], client=object(), scheduler="tcp://x:1")
+    with pytest.raises(wlx.Error, match=r"^workers: sizes the local cluster"):
+        wlx.sweep(robot, {"list": [{"legD": 1.5}]}, ["ID-1"], client=object(), workers=2)
     with pytest.raises(wlx.Error, match=r"^runs\[0\]\.id: must be a string"):
         wlx.sweep(robot, {"list": [{"legD": 1.5}]}, [{"id": 3}])
