@@ -38,6 +38,7 @@ def main():
         parser.error("--variants must be 1..100000 and --repeat 1..20")
     import distributed
 
+    load_before = os.getloadavg()[0]
     robot = wlx.model("excavator")
     parameters = {"grid": {"legD": {"from": 1.3, "to": 2.2, "count": args.variants}}}
     figures = {}
@@ -83,6 +84,7 @@ def main():
         client.close()
         cluster.close()
     n = args.variants
+    figures["load_average"] = [load_before, os.getloadavg()[0]]  # other work on the machine, before and after
     figures["variants"] = n
     cpu = "unknown CPU"
     try:
@@ -97,7 +99,8 @@ def main():
         return 0
     per = lambda s: f"{s / n * 1e3:.2f}"  # noqa: E731
     print(f"Measured {figures['date']} on {figures['machine']} by `tools/sweep_scaling.py --variants {n}` "
-          f"(median of {args.repeat}; each cluster started and warmed first).\n")
+          f"(median of {args.repeat}; each cluster started and warmed first; 1-minute load average "
+          f"{figures['load_average'][0]:.2f} before, {figures['load_average'][1]:.2f} after).\n")
     print("| the sweep of N = %d variants (ID-1, 0.4 s, peak torque) | wall time, s | ms per variant | speedup over the loop |" % n)
     print("|---|---:|---:|---:|")
     print(f"| plain loop over `m.simulate` in one process | {figures['loop_s']:.2f} | {per(figures['loop_s'])} | 1.0x |")
