@@ -705,7 +705,8 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
                     for row in rows:
                         kept.setdefault(row[0], []).append(row)
                 bar.add(len(b))
-                del future
+                if _interrupted:  # a signal whose KeyboardInterrupt was swallowed (raised inside a __del__)
+                    raise KeyboardInterrupt(_interrupted[0])
         bar.add(0, final=True)
     finally:
         if started_client is not None:
@@ -984,6 +985,9 @@ def run_spec(path, out=None, scheduler=None, workers=None, batch_size=None, prog
         return json.load(f), out
 
 
+_interrupted = []  # the signals that asked the command line to stop (main)
+
+
 def main(argv=None):
     """The command line: python3 -m wlx sweep SPEC [--out DIR] [--scheduler ADDRESS] [--workers N]
     [--batch-size N] (what `wlx sweep` runs). Exit 0 done, 2 a bad spec or option, 74 an output that
@@ -1004,14 +1008,25 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     def stop(signum, frame):
+        # Remembered too: the exception may land in a finalizer, which Python ignores; the sweep's
+        # loop checks the flag after each batch.
+        _interrupted.append(signum)
         raise KeyboardInterrupt(signum)
 
-    signal.signal(signal.SIGTERM, stop)
-    signal.signal(signal.SIGHUP, stop)
+    for number in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(number, stop)
+    default_hook = sys.unraisablehook
+
+    def unraisable(report):  # the swallowed interrupt is not an error to print (the flag acts on it)
+        if not isinstance(report.exc_value, KeyboardInterrupt):
+            default_hook(report)
+
+    sys.unraisablehook = unraisable
     try:
         manifest, out = run_spec(args.spec, args.out, args.scheduler, args.workers, args.batch_size)
     except KeyboardInterrupt as e:
-        code = {signal.SIGTERM: 143, signal.SIGHUP: 129}.get(e.args[0] if e.args else None, 130)
+        signum = _interrupted[0] if _interrupted else (e.args[0] if e.args else None)
+        code = {signal.SIGTERM: 143, signal.SIGHUP: 129}.get(signum, 130)
         sys.stderr.write("\nwlx sweep: interrupted: the batches written are complete; run the same command again to resume\n")
         return code
     except OutputError as e:
