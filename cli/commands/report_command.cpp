@@ -244,8 +244,9 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
     out.push_back({"contacts", title("contacts", "Contacts: will it tip, will it slip"),
                    "The force the ground exerts at each contact, from the equations of motion for the torques applied (the "
                    "multipliers of the closure and rolling rows), for each inverse-dynamics run under the model file's weighting "
-                   "(1) and weighting by contribution (2) (weighting 3, which keeps the machine on its contacts, is "
-                   "`wlx simulate --weighting 3`). A negative normal force would pull on the ground "
+                   "(1), weighting by contribution (2) and the weighting that keeps the machine on its contacts (3: the largest "
+                   "smallest margin of normal forces and friction at each step, within the torque limits). A negative normal "
+                   "force would pull on the ground "
                    "(the contact lifts off), a negative friction margin slides; the tip-over margin is the force-angle measure "
                    "about the support polygon's edges. The momentum residual checks the forces against the bodies' "
                    "accelerations. The per-sample forces and margins are in each run's CSV.",

@@ -54,6 +54,7 @@ void ReportRunner::validate() const {
     if (is_dynamics(id)) {
       runs.push_back(id + "-w1");
       runs.push_back(id + "-w2");
+      if (kContactCount > 0) runs.push_back(id + "-w3");
     } else {
       runs.push_back(id);
     }
@@ -132,7 +133,8 @@ std::vector<std::string> ReportRunner::selected_scenarios() const {
 
 int ReportRunner::steps() const {
   int n = static_cast<int>(selected_sweeps().size());
-  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? 4 : 1;  // each weighting's run and its forward dynamics
+  // Each weighting's run, and the forward dynamics of weightings 1 and 2.
+  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? (kContactCount > 0 ? 5 : 4) : 1;
   if (!quick_ && !spec_.integrator_scenarios.empty()) ++n;
   return n;
 }
@@ -152,6 +154,8 @@ void ReportRunner::run_all(const std::string& data_dir) {
     if (json.contains("weighting")) {
       variants.emplace_back(scenario_id + "-w1", Weighting::model_weights());
       variants.emplace_back(scenario_id + "-w2", Weighting::contribution());
+      // Weighting 3 keeps the machine on its contacts: compared with 1 and 2 in the contacts table.
+      if (kContactCount > 0) variants.emplace_back(scenario_id + "-w3", Weighting::contacts());
     } else {
       variants.emplace_back(scenario_id, std::nullopt);
     }

@@ -54,10 +54,11 @@ struct Scenario {
   // also stops when the clearance box reaches the ground: the model has no contact there.
   TorqueSource torques;
   // Dynamics runs: stop where a contact would pull on the ground (a negative normal force) or the
-  // machine would tip (the force-angle margin reaches zero), naming the contact or the edge (the
-  // scenario's "on_contact_loss": "stop"); false, the default for now, reports those samples in the
-  // columns and the summary and goes on, as the thesis' bilateral contacts do.
-  bool stop_on_contact_loss = false;
+  // machine would tip (the force-angle margin reaches zero), naming the contact or the edge: the
+  // model's contacts hold both ways, so what follows such a sample is not the machine's motion.
+  // false (the scenario's "on_contact_loss": "continue") reports those samples in the columns and
+  // the summary and goes on, as the thesis' bilateral contacts do.
+  bool stop_on_contact_loss = true;
 
   bool driven_by_torques() const { return static_cast<bool>(torques); }
   // The commanded speeds u at t = 0: the commanded inputs' rates.
