@@ -232,6 +232,7 @@ TEST_CASE("cli: wlx simulate ID-1 --weighting 2 adds the torque and Q* columns")
   CHECK(run_wlx("simulate ID-1 --weighting 4 --out " + dir.string()).err == "wlx: error: --weighting: must be 1, 2 or 3, got '4'\n");
 }
 
+#ifdef WLX_BUILT_MODEL_wheeled_quadruped  // not in the sanitized tree
 TEST_CASE("cli: the wheeled quadruped's inverse dynamics has a column per actuator, drives too, and weightings of its size") {
   const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "quadruped";
   fs::remove_all(dir);
@@ -255,6 +256,7 @@ TEST_CASE("cli: the wheeled quadruped's inverse dynamics has a column per actuat
                              "weighting": {"diag": [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 2, 2, 2, 2]}})";
   CHECK(run_wlx("--model wheeled_quadruped simulate " + file.string() + " --out " + dir.string()).code == 0);
 }
+#endif
 
 TEST_CASE("cli: every validation rule names the field, the value and the rule, with exit code 2") {
   const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "rules";
