@@ -11,6 +11,7 @@
 #include <wlx/error.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -151,6 +152,25 @@ void write_viewer_run(const fs::path& dir, const ViewerRun& run, std::span<const
   if (title.empty()) title = default_title;
   if (unit.empty()) unit = default_unit;
   wanted.insert(wanted.end(), plot.begin(), plot.end());
+  // A dynamics run's contacts (`wlx simulate`'s columns, cli/commands/outputs.hpp): each contact's
+  // force in K0 (f_x_, f_y_, f_n_: the ground's normal is K0's z) and friction margin, the CoM, the
+  // zero-moment point and the margins, for the page's force overlay. The contacts' names are the
+  // stems of the f_x_ columns (the model's, in its order); the page finds their frames by name.
+  std::vector<std::string> contacts;
+  const auto has = [&](const std::string& c) { return std::find(header.begin(), header.end(), c) != header.end(); };
+  for (const auto& c : header) {
+    if (!c.starts_with("f_x_")) continue;
+    const std::string stem = c.substr(4);
+    if (has("f_y_" + stem) && has("f_n_" + stem) && has("friction_margin_" + stem)) contacts.push_back(stem);
+  }
+  const std::array<std::string_view, 8> overall{"com_x", "com_y", "com_z", "zmp_x", "zmp_y", "margin_static", "margin_zmp", "margin_tip"};
+  if (!contacts.empty() && std::all_of(overall.begin(), overall.end(), [&](std::string_view c) { return has(std::string(c)); })) {
+    for (const auto& stem : contacts)
+      for (const char* q : {"f_x_", "f_y_", "f_n_", "friction_margin_"}) wanted.push_back(q + stem);
+    wanted.insert(wanted.end(), overall.begin(), overall.end());
+  } else {
+    contacts.clear();
+  }
   const auto columns = read_columns(run, wanted, nullptr);
   const std::size_t n = columns.at("t").size();
   // Evenly thinned to at most max_samples, keeping the first and the last sample.
@@ -168,6 +188,7 @@ void write_viewer_run(const fs::path& dir, const ViewerRun& run, std::span<const
   head["description"] = run.description;
   head["samples"] = kept.size();
   head["plot"] = {{"title", title}, {"unit", unit}, {"columns", plot}};
+  if (!contacts.empty()) head["contacts"] = contacts;
   std::string head_text = js_json(head);
   head_text.pop_back();  // the closing brace: the columns follow
   text += head_text + ",\"columns\":{";

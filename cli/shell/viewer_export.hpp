@@ -15,6 +15,9 @@
 // runs/<id>.js holds one object: {"format": "wlx-viewer-run 1", "id", "model", "description",
 // "samples": n, "plot": {"title", "unit", "columns": [names]}, "columns": {"t": [n numbers], each
 // coordinate by name: [n], each plotted column: [n]}}. Numbers carry 10 significant digits.
+// A dynamics run whose CSV has the contacts' columns also has "contacts": [names], and the columns
+// f_x_<c>, f_y_<c>, f_n_<c>, friction_margin_<c> for each, com_x/y/z, zmp_x/y, margin_static,
+// margin_zmp and margin_tip (the page's force overlay).
 #pragma once
 
 #include <cstddef>

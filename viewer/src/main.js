@@ -126,6 +126,10 @@ scene.add(tracks);
 const comGroup = new THREE.Group();
 comGroup.visible = false;
 scene.add(comGroup);
+// A dynamics run's contacts: the ground's force at each contact, the support polygon, the CoM over
+// it and the zero-moment point (filled by prepareRun when the run carries them).
+const forceGroup = new THREE.Group();
+scene.add(forceGroup);
 
 let parts = null;  // meshes made from the model's tables
 
@@ -460,7 +464,127 @@ function prepareRun(run) {
     tube.name = `track ${w.name}`;
     tracks.add(tube);
   }
-  return { ...run, frames, t: run.columns.t };
+  const prepared = { ...run, frames, t: run.columns.t };
+  prepareForces(prepared);
+  return prepared;
+}
+
+// --- the contacts' overlay -----------------------------------------------------------------------
+// Colours by margin: green, orange where it runs low, red where it is gone (a pull on the ground, a
+// slip, tipping). "Low": a friction margin under a fifth of mu f_n, a tip-over angle under 10 deg.
+const marginColours = { ok: 0x2e9d4a, low: 0xf08c00, gone: 0xd62828 };
+
+function prepareForces(run) {
+  forceGroup.clear();
+  app.forces = null;
+  if (!run.contacts) return;
+  const byName = new Map(app.info.contacts.map((c) => [c.name, c]));
+  const contacts = run.contacts.map((name) => {
+    const c = byName.get(name);
+    if (!c) throw new Error(`run '${run.id}': contact '${name}' is not one of model ${app.info.name}'s`);
+    return c;
+  });
+  // N to m: the mean contact's share of the total normal force at the start (the machine's weight
+  // when it starts at rest) is drawn one view unit long (a seventh of the machine's size), so any
+  // machine's arrows fit beside it.
+  const total = contacts.reduce((sum, c) => sum + Math.abs(run.columns['f_n_' + c.name][0]), 0);
+  let largest = 0;
+  for (const c of contacts)
+    for (let i = 0; i < run.columns.t.length; ++i)
+      largest = Math.max(largest, Math.hypot(run.columns['f_x_' + c.name][i], run.columns['f_y_' + c.name][i], run.columns['f_n_' + c.name][i]));
+  const reference = total > 0 ? total : largest;
+  const metresPerNewton = reference > 0 ? (app.viewScale * contacts.length) / reference : 0;
+  const arrows = contacts.map((c) => {
+    const arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 1, marginColours.ok);
+    arrow.name = `force ${c.name}`;
+    forceGroup.add(arrow);
+    return { contact: c, arrow, length: 0, colour: 'ok' };
+  });
+  const polygon = new THREE.LineLoop(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: marginColours.ok }));
+  polygon.name = 'support polygon';
+  const fill = new THREE.Mesh(new THREE.BufferGeometry(), new THREE.MeshBasicMaterial({ color: marginColours.ok, transparent: true, opacity: 0.25, side: THREE.DoubleSide, depthWrite: false }));
+  fill.name = 'support polygon area';
+  const com = new THREE.Mesh(new THREE.SphereGeometry(0.12 * app.viewScale, 16, 12), new THREE.MeshStandardMaterial({ color: 0x7b2cbf }));
+  com.name = 'centre of mass';
+  const comDrop = new THREE.Line(new THREE.BufferGeometry(), new THREE.LineDashedMaterial({ color: 0x7b2cbf, dashSize: 0.1, gapSize: 0.06 }));
+  const comGround = new THREE.Mesh(new THREE.RingGeometry(0.08 * app.viewScale, 0.13 * app.viewScale, 24), new THREE.MeshBasicMaterial({ color: 0x7b2cbf, side: THREE.DoubleSide }));
+  comGround.name = 'centre of mass on the ground';
+  const zmp = new THREE.Mesh(new THREE.CircleGeometry(0.1 * app.viewScale, 4), new THREE.MeshBasicMaterial({ color: 0x0077b6, side: THREE.DoubleSide }));
+  zmp.name = 'zero-moment point';
+  forceGroup.add(polygon, fill, com, comDrop, comGround, zmp);
+  forceGroup.visible = ui('show-forces').checked;
+  app.forces = { contacts, arrows, polygon, fill, com, comDrop, comGround, zmp, metresPerNewton, vertices: [], tip: NaN };
+  ui('forces-panel').style.display = 'block';
+  ui('force-scale').textContent = `${fmt(1000 * metresPerNewton, 3)} m per kN`;
+}
+
+// The convex hull of points in the ground plane, counter-clockwise (Andrew's monotone chain): the
+// support polygon of the contacts carrying load, as the runtime forms it for its margins.
+function convexHull(points) {
+  const p = points.slice().sort((a, b) => a.x - b.x || a.y - b.y);
+  if (p.length < 3) return p;
+  const cross = (o, a, b) => (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+  const lower = [], upper = [];
+  for (const q of p) { while (lower.length >= 2 && cross(lower[lower.length - 2], lower[lower.length - 1], q) <= 0) lower.pop(); lower.push(q); }
+  for (const q of p.slice().reverse()) { while (upper.length >= 2 && cross(upper[upper.length - 2], upper[upper.length - 1], q) <= 0) upper.pop(); upper.push(q); }
+  return lower.slice(0, -1).concat(upper.slice(0, -1));
+}
+
+function placeForces(positions, i) {
+  const f = app.forces, cols = app.run.columns;
+  const loaded = [];
+  let height = 0;
+  for (const a of f.arrows) {
+    const c = a.contact, o = 3 * c.frame;
+    const origin = new THREE.Vector3(positions[o], positions[o + 1], positions[o + 2]);
+    const force = new THREE.Vector3(cols['f_x_' + c.name][i], cols['f_y_' + c.name][i], cols['f_n_' + c.name][i]);
+    const normal = force.z, margin = cols['friction_margin_' + c.name][i];
+    a.colour = (c.supports && normal <= 0) || margin < 0 ? 'gone' : margin < 0.2 * c.friction * Math.max(normal, 0) ? 'low' : 'ok';
+    a.length = force.length() * f.metresPerNewton;
+    a.arrow.visible = a.length > 1e-9;
+    if (a.arrow.visible) {
+      // From the contact along the ground's force on the machine (up when it carries load).
+      a.arrow.position.copy(origin);
+      a.arrow.setDirection(force.clone().normalize());
+      a.arrow.setLength(a.length, Math.min(0.25 * a.length, 0.3 * app.viewScale), Math.min(0.12 * a.length, 0.15 * app.viewScale));
+      a.arrow.setColor(marginColours[a.colour]);
+    }
+    if (c.supports && normal > 0) { loaded.push(new THREE.Vector2(origin.x, origin.y)); height += origin.z; }
+  }
+  height = loaded.length ? height / loaded.length : 0;
+  const lift = 0.02 * app.viewScale;  // just above the ground, so the ground's grid does not hide it
+  f.vertices = convexHull(loaded);
+  f.tip = cols.margin_tip[i];
+  const tipColour = !(f.tip > 0) ? 'gone' : f.tip < (10 * Math.PI) / 180 ? 'low' : 'ok';
+  f.tipColour = tipColour;
+  const ring = f.vertices.map((v) => new THREE.Vector3(v.x, v.y, height + lift));
+  f.polygon.geometry.dispose();
+  f.polygon.geometry = new THREE.BufferGeometry().setFromPoints(ring);
+  f.polygon.material.color.setHex(marginColours[tipColour]);
+  f.fill.geometry.dispose();
+  f.fill.geometry = ring.length >= 3 ? new THREE.ShapeGeometry(new THREE.Shape(f.vertices)) : new THREE.BufferGeometry();
+  f.fill.position.z = height + 0.5 * lift;
+  f.fill.material.color.setHex(marginColours[tipColour]);
+  const comPoint = new THREE.Vector3(cols.com_x[i], cols.com_y[i], cols.com_z[i]);
+  f.com.position.copy(comPoint);
+  f.comGround.position.set(comPoint.x, comPoint.y, height + lift);
+  f.comDrop.geometry.dispose();
+  f.comDrop.geometry = new THREE.BufferGeometry().setFromPoints([comPoint, new THREE.Vector3(comPoint.x, comPoint.y, height + lift)]);
+  f.comDrop.computeLineDistances();
+  f.zmp.position.set(cols.zmp_x[i], cols.zmp_y[i], height + 1.5 * lift);
+  ui('margin-static').textContent = fmt(cols.margin_static[i], 3) + ' m';
+  ui('margin-zmp').textContent = fmt(cols.margin_zmp[i], 3) + ' m';
+  ui('margin-tip').textContent = fmt((f.tip * 180) / Math.PI, 2) + '°';
+  ui('margin-tip').style.color = tipColour === 'ok' ? '' : '#' + marginColours[tipColour].toString(16).padStart(6, '0');
+  const rows = ui('contact-rows');
+  rows.textContent = '';
+  for (const a of f.arrows) {
+    const tr = document.createElement('tr');
+    const cells = [a.contact.name, fmt(cols['f_n_' + a.contact.name][i] / 1000, 2), fmt(cols['friction_margin_' + a.contact.name][i] / 1000, 2)];
+    for (const text of cells) { const td = document.createElement('td'); td.textContent = text; tr.appendChild(td); }
+    tr.style.color = a.colour === 'ok' ? '' : '#' + marginColours[a.colour].toString(16).padStart(6, '0');
+    rows.appendChild(tr);
+  }
 }
 
 function sampleIndex(t) {
@@ -482,6 +606,7 @@ function showTime(t) {
   app.inputs = app.s.slice(0, app.info.inputCount);
   showMessage('');
   placeMachine();
+  if (app.forces) placeForces(app.model.forwardKinematics(app.s).positions, i);
   ui('scrub').value = String(Math.round(((app.time - t0) / Math.max(t1 - t0, 1e-12)) * 1000));
   ui('time').textContent = `t = ${app.time.toFixed(3)} s of ${t1.toFixed(3)} s`;
   drawPlot(ui('plot'), app.run, app.time);
@@ -511,6 +636,7 @@ ui('scrub').oninput = () => {
 };
 ui('show-com').onchange = () => { comGroup.visible = ui('show-com').checked; placeMachine(); };
 ui('show-tracks').onchange = () => { tracks.visible = ui('show-tracks').checked; };
+ui('show-forces').onchange = () => { forceGroup.visible = ui('show-forces').checked; };
 
 // --- frame loop -------------------------------------------------------------------------------
 let lastFrame = performance.now();
@@ -650,6 +776,17 @@ viewer.api = {
   runInfo: () => app.run && { id: app.run.id, samples: app.run.t.length, start: app.run.t[0], end: app.run.t[app.run.t.length - 1], plot: app.run.plot },
   ikTimes: () => app.ikTimes.slice(),
   tracks: () => app.tracks,
+  // The contacts' overlay at the time shown: each arrow's contact, drawn length (m), scale (m/N)
+  // and colour, the support polygon's vertices, the tip-over margin; null for a run without it.
+  forces: () => app.forces && {
+    metresPerNewton: app.forces.metresPerNewton,
+    arrows: app.forces.arrows.map((a) => ({ name: a.contact.name, length: a.length, visible: a.arrow.visible, colour: a.colour })),
+    vertices: app.forces.vertices.map((v) => [v.x, v.y]),
+    tip: app.forces.tip,
+    tipColour: app.forces.tipColour,
+    sampleIndex: sampleIndex(app.time),
+    shown: forceGroup.visible,
+  },
   // Where a handle is on the page, in CSS pixels (to drag it with the mouse).
   screenPoint(id) {
     const h = app.handles.find((x) => x.id === id);

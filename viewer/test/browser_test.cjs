@@ -204,6 +204,37 @@ function cliIk(inputs) {
     check(dynamicsRun.plot.columns.every((c) => c.startsWith('tau_')) && dynamicsRun.plot.columns.length === 8, 'ID-1 plots the joint torques', dynamicsRun.plot.columns.join(' '));
     await api(dynamics, (t) => wlxViewer.api.seek(t), (dynamicsRun.start + dynamicsRun.end) / 2);
     await dynamics.screenshot({ path: path.join(outDir, 'dynamics-run.png') });
+    // --- the contacts' overlay: arrows as long as the run file's forces, the support polygon ----------
+    const runText = fs.readFileSync(path.join(folder, 'runs/ID-1.js'), 'utf8');
+    const runFile = JSON.parse(runText.slice(runText.indexOf('registerRun(') + 'registerRun('.length, runText.lastIndexOf(');')));
+    const modelInfo = await api(dynamics, () => wlxViewer.api.info());
+    const overlay = await api(dynamics, () => wlxViewer.api.forces());
+    check(overlay && overlay.shown, 'ID-1 shows the contacts overlay');
+    check(JSON.stringify(runFile.contacts) === JSON.stringify(modelInfo.contacts.map((c) => c.name)),
+          "the run carries every contact of the model's table, in its order", JSON.stringify(runFile.contacts));
+    check(overlay.arrows.length === modelInfo.contacts.length, 'one arrow per contact', `${overlay.arrows.length}`);
+    const k = overlay.sampleIndex, col = runFile.columns;
+    let worstArrow = 0;
+    for (const a of overlay.arrows) {
+      const expected = Math.hypot(col['f_x_' + a.name][k], col['f_y_' + a.name][k], col['f_n_' + a.name][k]) * overlay.metresPerNewton;
+      worstArrow = Math.max(worstArrow, Math.abs(a.length - expected) / expected);
+    }
+    check(worstArrow < 1e-12, "each arrow's length is its force from the run file times the shown scale", `relative error ${worstArrow}`);
+    const loaded = overlay.arrows.filter((a) => col['f_n_' + a.name][k] > 0).length;
+    check(overlay.vertices.length >= 3 && overlay.vertices.length <= loaded, 'the support polygon has at most the loaded contacts as vertices',
+          `${overlay.vertices.length} of ${loaded}`);
+    // The page's polygon and the runtime's static margin agree on where the CoM is: inside exactly
+    // when the margin is positive (the polygon drawn is the one the margin was measured against).
+    const inside = (x, y, v) => v.every((p, i) => { const q = v[(i + 1) % v.length]; return (q[0] - p[0]) * (y - p[1]) - (q[1] - p[1]) * (x - p[0]) > 0; });
+    check(inside(col.com_x[k], col.com_y[k], overlay.vertices) === col.margin_static[k] > 0,
+          "the CoM is inside the drawn polygon exactly when the run's static margin is positive", `margin ${col.margin_static[k]} m`);
+    check(Number.isFinite(overlay.tip) && Math.abs(overlay.tip - col.margin_tip[k]) === 0, 'the tip-over margin shown is the run\'s', `${overlay.tip}`);
+    const panelText = await api(dynamics, () => document.getElementById('forces-panel').innerText);
+    check(!/NaN|undefined/.test(panelText) && /°/.test(panelText), 'the contacts panel shows finite margins', panelText.replace(/\s+/g, ' ').slice(0, 160));
+    await api(dynamics, () => { document.getElementById('show-forces').click(); });
+    check(!(await api(dynamics, () => wlxViewer.api.forces().shown)), 'the checkbox hides the overlay');
+    const kinematic = await open('?run=NH-1');
+    check((await api(kinematic, () => wlxViewer.api.forces())) === null, 'a kinematic run has no contacts overlay');
     // --- a run id with '+', encoded in the link as the report writes it; the scrub bar ------------
     const plus = await open('?run=' + encodeURIComponent('ST-A1+'));
     const plusRun = await api(plus, () => wlxViewer.api.runInfo());

@@ -164,6 +164,12 @@ std::string build_info_json() {
                 ",\"ground\":" + integer(w.ground) + ",\"radius\":" + number(p.*w.radius) +
                 ",\"forwardAxis\":" + integer(w.forward_axis) + ",\"lateralAxis\":" + integer(w.lateral_axis) + "}";
        });
+  // The contacts with the ground, in the order of a run's f_*_<name> columns (the force overlay).
+  j += ",\"contacts\":" + array(gen::kContacts, [](const gen::ContactInfo& c) {
+         return "{\"name\":" + quoted(c.name) + ",\"kind\":" + (c.kind == gen::ContactKind::wheel ? "\"wheel\"" : "\"foot\"") +
+                ",\"frame\":" + integer(c.frame) + ",\"supports\":" + (c.supports ? "true" : "false") +
+                ",\"friction\":" + number(c.friction) + "}";
+       });
   j += ",\"bodies\":" + array(std::array<int, gen::kBodyCount>{}, [k = 0](int) mutable {
          const auto i = static_cast<std::size_t>(k++);
          return "{\"name\":" + quoted(gen::kBodyNames[i]) + ",\"meaning\":" + quoted(gen::kBodyMeanings[i]) + "}";
