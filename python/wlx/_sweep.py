@@ -9,6 +9,7 @@ same table (results.csv, rows in variant and run order) as an uninterrupted one.
 "Parameter sweeps", documents the spec, the metrics and the files.
 """
 
+import contextlib
 import csv
 import io
 import json
@@ -445,12 +446,15 @@ def _csv_text(header, rows):
     return buffer.getvalue()
 
 
-def _write_atomically(path, text):
-    """Written under a temporary name beside it, then renamed: a file under its own name is never cut."""
+@contextlib.contextmanager
+def _atomic_output(path):
+    """A text file written under a temporary name beside `path`, synced and renamed to it when the
+    block ends: a file under its own name is never cut. A failed write removes the temporary and
+    raises OutputError naming `path`."""
     temp = os.path.join(os.path.dirname(path), f".{os.path.basename(path)}.{os.getpid()}.tmp")
     try:
         with open(temp, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
+            yield f
             f.flush()
             os.fsync(f.fileno())
         os.replace(temp, path)
@@ -460,6 +464,11 @@ def _write_atomically(path, text):
         except OSError:
             pass
         raise OutputError(f"{path}: writing failed: {e.strerror or e}") from None
+
+
+def _write_atomically(path, text):
+    with _atomic_output(path) as f:
+        f.write(text)
 
 
 class OutputError(OSError):
@@ -731,30 +740,19 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
 def _concatenate(files, header, path):
     """results.csv: the batch files' rows in variant order (each file holds one range, in order),
     streamed to a temporary name and renamed. Returns (rows that completed, rows)."""
-    temp = os.path.join(os.path.dirname(path), f".{os.path.basename(path)}.{os.getpid()}.tmp")
     complete_column = header.index("complete")
     complete = total = 0
-    try:
-        with open(temp, "w", encoding="utf-8", newline="") as out:
-            csv.writer(out, lineterminator="\n").writerow(header)
-            for _, _, batch in files:
-                with open(batch, newline="", encoding="utf-8") as f:
-                    reader = csv.reader(f)
-                    next(reader)
-                    writer = csv.writer(out, lineterminator="\n")
-                    for row in reader:
-                        writer.writerow(row)
-                        total += 1
-                        complete += row[complete_column] == "true"
-            out.flush()
-            os.fsync(out.fileno())
-        os.replace(temp, path)
-    except OSError as e:
-        try:
-            os.unlink(temp)
-        except OSError:
-            pass
-        raise OutputError(f"{path}: writing failed: {e.strerror or e}") from None
+    with _atomic_output(path) as out:
+        writer = csv.writer(out, lineterminator="\n")
+        writer.writerow(header)
+        for _, _, batch in files:
+            with open(batch, newline="", encoding="utf-8") as f:
+                reader = csv.reader(f)
+                next(reader)
+                for row in reader:
+                    writer.writerow(row)
+                    total += 1
+                    complete += row[complete_column] == "true"
     return complete, total
 
 
