@@ -106,3 +106,38 @@ TEST_CASE("tripod: backing up at constant speed, it tips over the rear feet's ed
   CHECK(on.samples.back().forces.normal(0) < 0);
   CHECK(on.samples.back().stability.tip_angle < 0);
 }
+
+TEST_CASE("tripod: weighting 3 keeps every torque within the model file's limits, and says so where none can carry the load") {
+  static_assert(gen::kHasTorqueLimits, "tripod.yaml gives dynamics.torque_limits");
+  for (double limit : gen::kTorqueLimits) CHECK(limit == 300.0);
+  Coordinates s = nominal_inputs();
+  const Model standing;
+  solve_ik_closed_form(standing, s);
+  // Carried within the limits: the torques respect them, the feet stay loaded and inside their
+  // cones, and the margin is at least weighting 1's (the programme could have chosen those).
+  Data d;
+  DynamicsTerms t;
+  inverse_dynamics(standing, d, s, CommandVector::Zero(), CommandVector::Zero(), t);
+  const ContactDistribution w3 = distribute_torques_on_contacts(standing, d, s, t);
+  CHECK(w3.tau.cwiseAbs().maxCoeff() <= 300.0 * (1 + 1e-9));
+  CHECK(w3.margin > 0);
+  const TorqueVector tau_1 = distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
+  ContactForces forces;
+  contact_forces(standing, d, s, t, tau_1, forces);
+  REQUIRE(tau_1.cwiseAbs().maxCoeff() <= 300.0);  // the limits are not what sets the margins here
+  if (tau_1.cwiseAbs().maxCoeff() <= 300.0) CHECK(w3.margin >= smallest_contact_margin(standing, forces) - 1e-9);
+  // The torques produce the generalized forces: J_beta^T tau = Q*.
+  CHECK((t.J_beta.transpose() * w3.tau - t.Qstar).norm() <= 1e-9 * t.Qstar.norm());
+  // Twenty times the payload (the machine 5.75 times as heavy): every distribution needs more than
+  // 300 N m somewhere.
+  gen::Params heavy_params = standing.params();
+  heavy_params.m_payload *= 20;
+  const Model heavy(heavy_params);
+  Data dh;
+  DynamicsTerms th;
+  inverse_dynamics(heavy, dh, s, CommandVector::Zero(), CommandVector::Zero(), th);
+  const TorqueVector least = distribute_torques(th.J_beta, th.Qstar, Weighting::model_weights());
+  INFO("weighting 1 needs ", least.cwiseAbs().maxCoeff(), " N m");
+  CHECK_THROWS_WITH_AS(distribute_torques_on_contacts(heavy, dh, s, th),
+                       doctest::Contains("no torques within the actuators' limits (dynamics.torque_limits)"), Error);
+}
