@@ -106,12 +106,12 @@ class Figures {
     return p;
   }
 
-  // The runs of one motion under weightings other than the model file's: the same poses.
-  static bool duplicate_motion(const ReportRun& r) { return r.scenario.weighting && r.scenario.weighting->kind != Weighting::Kind::model_weights; }
   // The thesis' number of a run's weighting (its torque figures are referenced by it).
   static int weighting_number(const Weighting& w) {
     return w.kind == Weighting::Kind::contribution ? 2 : w.kind == Weighting::Kind::contacts ? 3 : 1;
   }
+  // The runs of one motion under weightings other than the model file's: the same poses.
+  static bool duplicate_motion(const ReportRun& r) { return r.scenario.weighting && weighting_number(*r.scenario.weighting) != 1; }
   static std::string title_of(const ReportRun& r) { return r.scenario_id; }
 
   // data/<run>-pose.dat: index 0 the start, index 1 the end; in each, the body outline then one

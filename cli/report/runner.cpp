@@ -25,6 +25,16 @@ bool is_dynamics(const std::string& scenario_id) {
   return model_scenario_json(scenario_id).contains("weighting");
 }
 
+// The runs of a dynamics scenario in the report, one per weighting compared: the model file's (1),
+// by contribution (2) and, for a model with contacts, the one that keeps the machine on them (3,
+// compared with 1 and 2 in the contacts table). Their ids are what report files name.
+std::vector<std::pair<std::string, Weighting>> weighting_variants(const std::string& scenario_id) {
+  std::vector<std::pair<std::string, Weighting>> v{{scenario_id + "-w1", Weighting::model_weights()},
+                                                   {scenario_id + "-w2", Weighting::contribution()}};
+  if (kContactCount > 0) v.emplace_back(scenario_id + "-w3", Weighting::contacts());
+  return v;
+}
+
 // Asked after every sample: a signal stops a long simulation at once, not when it ends.
 void stop_on_signal(long, long) { throw_if_interrupted(); }
 
@@ -52,9 +62,7 @@ void ReportRunner::validate() const {
   std::vector<std::string> runs;
   for (const auto& id : scenarios) {
     if (is_dynamics(id)) {
-      runs.push_back(id + "-w1");
-      runs.push_back(id + "-w2");
-      if (kContactCount > 0) runs.push_back(id + "-w3");
+      for (const auto& variant : weighting_variants(id)) runs.push_back(variant.first);
     } else {
       runs.push_back(id);
     }
@@ -134,7 +142,7 @@ std::vector<std::string> ReportRunner::selected_scenarios() const {
 int ReportRunner::steps() const {
   int n = static_cast<int>(selected_sweeps().size());
   // Each weighting's run, and the forward dynamics of weightings 1 and 2.
-  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? (kContactCount > 0 ? 5 : 4) : 1;
+  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? static_cast<int>(weighting_variants(id).size()) + 2 : 1;
   if (!quick_ && !spec_.integrator_scenarios.empty()) ++n;
   return n;
 }
@@ -152,10 +160,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
     const bool verify = json.value("verify", "") == "nonholonomic";
     std::vector<std::pair<std::string, std::optional<Weighting>>> variants;
     if (json.contains("weighting")) {
-      variants.emplace_back(scenario_id + "-w1", Weighting::model_weights());
-      variants.emplace_back(scenario_id + "-w2", Weighting::contribution());
-      // Weighting 3 keeps the machine on its contacts: compared with 1 and 2 in the contacts table.
-      if (kContactCount > 0) variants.emplace_back(scenario_id + "-w3", Weighting::contacts());
+      for (auto& [id, weighting] : weighting_variants(scenario_id)) variants.emplace_back(id, weighting);
     } else {
       variants.emplace_back(scenario_id, std::nullopt);
     }
