@@ -19,6 +19,11 @@ struct EmitOptions {
   std::string model_name;  // set from the model
   // Parameters replaced by numeric constants (name -> value); empty: all read from Params.
   std::map<std::string, double> baked;
+  // The model file's numbers (parameters' values, nominal state, Newton's starts, IK sweeps,
+  // weights, torque limits, friction) left out of the code: the headers then depend on the model's
+  // structure alone, and a plugin reads the numbers from model.json at run time, so that editing
+  // them compiles nothing (wlx --model-file). Off: they are compiled in (settings.hpp), for embedding.
+  bool data_at_run_time = false;
 };
 
 struct FunctionStats {
@@ -49,9 +54,28 @@ std::string literal(double v);
 EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt);
 // Headers describing the model itself: parameters and coordinate/frame/body names and types.
 std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& opt);
+// Contacts with the ground: every frame that closure rows tie to K0 (point rows carry a force,
+// level rows a moment) and every wheel's contact frame (its rolling row carries the lateral
+// force, its drive the longitudinal one), in the order of the generated kContacts.
+struct GroundContact {
+  std::string name;  // in output columns: the frame's name without underscores, unless two collide
+  int frame = -1;
+  int wheel = -1;  // -1: a foot
+  std::array<int, 3> point{-1, -1, -1}, level{-1, -1, -1};  // closure rows (-1: none)
+  double friction = 0;  // the model file's contacts.friction for its kind
+};
+std::vector<GroundContact> ground_contacts(const Model& m);
+
 // structure.hpp: every fact about the model's structure the runtime needs, as constexpr tables
-// (limbs, wheels, dependent pairs, inverse-dynamics set-up, body Jacobian columns, nominal state).
-EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt);
+// (limbs, wheels, dependent pairs, inverse-dynamics set-up, body Jacobian columns, contacts); and,
+// unless opt.data_at_run_time, settings.hpp: the model file's run-time settings compiled in
+// (nominal state, Newton's starts, IK sweeps, weights, torque limits, friction).
+std::vector<EmittedFile> emit_structure_header(const Model& m, const EmitOptions& opt);
+// model.json: the description of the model as data (docs/model-format.md, "The description"):
+// its names and structure, and every number of the model file that no generated function holds
+// (parameters' values, nominal state, starts, sweeps, weights, torque limits, friction), with
+// `code_key`, a fingerprint of the code (every other emitted file), which a plugin's cache is keyed by.
+EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::vector<EmittedFile>& code);
 // ik.hpp: the closed-form inverse kinematics of every limb whose chain matches one of the solvable
 // patterns (emit_ik.cpp documents them), with all its branches; `report` receives one line per
 // limb: the pattern used, or why none applies (that limb is then left to Newton's method).

@@ -218,7 +218,7 @@ int main(int argc, char** argv) {
   CLI::App app{"wlx-gen: derive a model's kinematics and dynamics symbolically and emit C++ headers"};
   std::string model_path, out_dir, with_path;
   std::vector<std::string> bake_args;
-  bool bake_defaults = false, stats_only = false, quiet = false, print_model = false;
+  bool bake_defaults = false, stats_only = false, quiet = false, print_model = false, describe = false;
   EmitOptions opt;
   opt.generator_version = WLX_VERSION;
   app.add_option("MODEL", model_path,
@@ -229,6 +229,12 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "output root; headers go to OUT/wlx/gen/ (required unless --print-model)");
   app.add_flag("--print-model", print_model,
                "print the model file wlx-gen reads (for a URDF: the frames, joints and bodies it maps to) and exit");
+  app.add_flag("--data-at-run-time", opt.data_at_run_time,
+               "leave the model file's numbers out of the headers (no settings.hpp, NaN parameter defaults): a plugin "
+               "reads them from model.json, so that editing them compiles nothing");
+  app.add_flag("--describe", describe,
+               "derive everything, write nothing, and print model.json (the description, with the code's fingerprint "
+               "code_key) on stdout");
   app.add_option("--bake", bake_args, "bake a parameter in as a constant: NAME=VALUE (repeatable)");
   app.add_flag("--bake-defaults", bake_defaults, "bake every geometry parameter (kinds length, offset, angle) in at its default");
   app.add_option("--namespace", opt.name_space,
@@ -287,7 +293,10 @@ int main(int argc, char** argv) {
       write_stdout(print_model_file(model_path, urdf_path));
       return 0;
     }
-    if (out_dir.empty()) throw ModelFileError("--out is required (the output root; headers go to OUT/wlx/gen/)");
+    if (describe && !out_dir.empty()) throw ModelFileError("--describe writes nothing: give --out or --describe, not both");
+    if (out_dir.empty() && !describe) throw ModelFileError("--out is required (the output root; headers go to OUT/wlx/gen/)");
+    if (opt.data_at_run_time && (bake_defaults || !bake_args.empty()))
+      throw ModelFileError("--data-at-run-time reads every parameter's value at run time: it cannot bake any (--bake, --bake-defaults)");
     const Model model = load_model_file(model_path, urdf_path);
     opt.model_name = model.name;
     if (bake_defaults)
@@ -332,7 +341,7 @@ int main(int argc, char** argv) {
 
     std::vector<EmittedFile> files = emit_model_headers(model, opt);
     files.push_back(emit_trig_header(model, opt));
-    files.push_back(emit_structure_header(model, opt));
+    for (auto& f : emit_structure_header(model, opt)) files.push_back(std::move(f));
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<FunctionSpec> fns;
     std::vector<FunctionStats> stats;
@@ -348,6 +357,11 @@ int main(int argc, char** argv) {
     std::vector<std::string> ik_report;
     files.push_back(emit_ik_header(model, opt, ik_report));
     files.push_back(emit_umbrella(model, fns, stats, opt));
+    files.push_back(emit_description(model, opt, files));
+    if (describe) {
+      write_stdout(files.back().text);
+      return 0;
+    }
     writing = 1;  // from here a signal is polled (stop_if_signalled), so that the writing can undo itself
     const int changed = write_header_set(out_dir, files);
     const int removed = remove_stale(out_dir, files);

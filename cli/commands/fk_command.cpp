@@ -30,7 +30,7 @@ constexpr std::size_t kMaxParamsFileBytes = std::size_t{1} << 20;
 }  // namespace
 
 Params load_params(const ModelOptions& model) {
-  if (model.params_file.empty()) return {};
+  if (model.params_file.empty()) return settings().params;
   // Bounded, regular files only (wlx/bounded_file.hpp): a FIFO without a writer is an error, not a hang.
   const BoundedRead file = read_bounded_file(model.params_file, kMaxParamsFileBytes);
   if (!file.ok()) {

@@ -13,12 +13,12 @@
 WLX_COMMANDS_BEGIN
 
 // Applies {"name": value, ...} to params and validates the result (wlx::Model).
-Params parse_params(const nlohmann::json& object, Params params = {});
+Params parse_params(const nlohmann::json& object, Params params = settings().params);
 
 enum class IkMethod { closed_form, newton };
 
 struct IkRequest {
-  Params params;
+  Params params = settings().params;
   Coordinates s;            // inputs set (missing ones from the nominal state), dependents zero
   IkMethod method = IkMethod::closed_form;
   Branches branches;
@@ -26,7 +26,7 @@ struct IkRequest {
 };
 
 // `base`: the parameters the request's "params" override (the defaults, or those of --params).
-IkRequest parse_ik_request(const nlohmann::json& j, const Params& base = {});
+IkRequest parse_ik_request(const nlohmann::json& j, const Params& base = settings().params);
 
 // Solves a request: what `wlx ik` prints (the dependents by name, contacts, residual, check error,
 // branches, Newton's iterations). `warm`: Newton's start from a previous solution (batch mode), or

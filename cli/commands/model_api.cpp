@@ -112,7 +112,7 @@ std::string info_text() {
   for (auto u : gen::kCoordinateUnits) units.emplace_back(u);
   for (auto f : gen::kFrameNames) frames.emplace_back(f);
   nlohmann::json defaults = nlohmann::json::object(), param_units = nlohmann::json::object();
-  const Params p;
+  const Params& p = settings().params;
   for (const auto& info_p : gen::kParamInfo) {
     defaults[std::string(info_p.name)] = p.*info_p.member;
     param_units[std::string(info_p.name)] = std::string(info_p.unit);

@@ -29,7 +29,7 @@ std::string scenario_directory(const std::string& path_or_id);
 // names (a torque table) is looked for, relative names from the working directory when empty;
 // `function`: set, the run is driven by it (a controller in the loop: Python's
 // simulate(torques=f)), and the scenario may then have neither "torques" nor a weighting.
-Scenario parse_scenario(const nlohmann::json& j, const Params& base = {}, const std::string& directory = {},
+Scenario parse_scenario(const nlohmann::json& j, const Params& base = settings().params, const std::string& directory = {},
                         TorqueSource function = {});
 
 // A scenario's "torques": {"file": CSV}, {"run": an inverse-dynamics scenario, run first with

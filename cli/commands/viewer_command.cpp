@@ -32,7 +32,7 @@ std::string trajectory_csv_text(const Trajectory& trajectory, const Scenario& sc
 void write_viewer_run(const std::filesystem::path& dir, const Scenario& scenario, const Trajectory& trajectory,
                       const std::string& id, const std::string& description) {
   for (const auto& info : gen::kParamInfo)
-    if (scenario.params.*info.member != Params{}.*info.member)
+    if (scenario.params.*info.member != settings().params.*info.member)
       throw Error("run " + scenario.id,
                   fmt::format("sets params.{} = {:g}; the viewer draws the model's default parameters (its WebAssembly "
                               "module is built from them), so it would show another machine",

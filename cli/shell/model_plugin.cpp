@@ -5,6 +5,7 @@
 #include "process.hpp"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <wlx/diagnostics.hpp>
 #include <wlx/atomic_file.hpp>
 #include <wlx/bounded_file.hpp>
@@ -22,7 +23,6 @@
 #include <filesystem>
 #include <map>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <sys/file.h>
 #include <sys/stat.h>
@@ -57,10 +57,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The plugin's entry point: its commands, and the key it was built for.
+// The plugin's entry points: its commands and the key it was built for; and its settings, from
+// the model's description (model.json's text), null on success, else why they were refused.
 using PluginEntry = const ModelCommands* (*)(const char** key);
-constexpr const char* kEntrySymbol = "wlx_model_plugin_v2";
-static_assert(kPluginInterface == 2, "rename kEntrySymbol with the interface's version");
+using PluginSettings = const char* (*)(const char* description);
+constexpr const char* kEntrySymbol = "wlx_model_plugin_v3";
+constexpr const char* kSettingsSymbol = "wlx_model_plugin_v3_settings";
+static_assert(kPluginInterface == 3, "rename kEntrySymbol and kSettingsSymbol with the interface's version");
 
 // The runtime's sources (their generated-function files apart: each is its own translation unit)
 // and the per-model commands: CMakeLists.txt's lists for the built-in models, '|'-separated.
@@ -158,6 +161,10 @@ fs::path generator_program() {
   return "wlx-gen";  // from PATH
 }
 
+// The compiler that builds a missing plugin: CXX, else the one wlx was built with. Not part of the
+// key: a cached plugin is loaded whichever compiler built it (they share the C++ ABI and the
+// standard library), so that a run whose compiler cannot work (CXX=/bin/false) still loads what is
+// cached; another compiler's code for a key of its own takes other flags (WLX_PLUGIN_CXXFLAGS).
 std::string compiler() {
   if (const char* env = std::getenv("CXX"); env != nullptr && *env != '\0') return env;
   return WLX_PLUGIN_CXX;
@@ -175,29 +182,6 @@ std::vector<std::string> optimization_flags(bool commands = false) {
   std::istringstream in(env != nullptr && *env != '\0' ? env : commands ? kCommandsOptimization : "-O2");
   for (std::string flag; in >> flag;) out.push_back(flag);
   return out;
-}
-
-// The model's name, from its `model:` line (the namespace of its runtime; wlx-gen checks it).
-std::string model_name_of(const std::string& text) {
-  static const std::regex line(R"(^model:[ \t]*([A-Za-z_][A-Za-z0-9_]*)[ \t]*(#.*)?$)");
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);) {
-    if (!l.empty() && l.back() == '\r') l.pop_back();
-    std::smatch m;
-    if (std::regex_match(l, m, line)) return m[1];
-  }
-  return {};
-}
-
-// A URDF the model file reads (`urdf: robot.urdf`, relative to the file), so it is keyed too.
-std::string urdf_of(const std::string& text) {
-  static const std::regex line(R"(^urdf:[ \t]*([^ \t#]+).*$)");
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);) {
-    std::smatch m;
-    if (std::regex_match(l, m, line)) return m[1];
-  }
-  return {};
 }
 
 std::string file_checksum(const fs::path& path, std::uintmax_t& size) {
@@ -221,8 +205,31 @@ std::string manifest_value(const std::string& manifest, const std::string& key) 
   return {};
 }
 
-// The plugin of a complete entry, or null with the reason it cannot be used.
-const ModelCommands* try_load(const fs::path& entry, const std::string& key, std::string& why) {
+// The settings of each plugin loaded in this process, by library: a second description of the same
+// code (the same model with other numbers, in one Python process) gets a copy of the library of its
+// own, since a library's settings are its globals and dlopen() returns the same handle for one file.
+std::map<std::string, std::string>& loaded_descriptions() {
+  static std::map<std::string, std::string> loaded;
+  return loaded;
+}
+
+// A private copy of `library` for a second description, checked against the manifest as copied.
+fs::path private_copy(const fs::path& library, const std::string& checksum, const std::string& description) {
+  Hash h;
+  h.add(description);
+  const fs::path copy = library.parent_path() / ("instance-" + h.hex().substr(0, 16) + "-" + std::to_string(::getpid()) + ".so");
+  std::error_code ec;
+  fs::remove(copy, ec);
+  if (!fs::copy_file(library, copy, ec) || ec)
+    throw Error("--model-file", fmt::format("cannot copy {} for a second set of numbers of the same model ({})", library.string(), ec.message()));
+  std::uintmax_t size = 0;
+  if (file_checksum(copy, size) != checksum) throw Error("--model-file", fmt::format("the copy {} does not match its manifest", copy.string()));
+  return copy;
+}
+
+// The plugin of a complete entry, or null with the reason it cannot be used. Once loaded, it is
+// given the model's settings from `description` (model.json's text); a refusal is an error.
+const ModelCommands* try_load(const fs::path& entry, const std::string& key, const std::string& description, std::string& why) {
   std::error_code ec;
   if (!fs::exists(entry, ec)) {
     why = "not built yet";
@@ -240,7 +247,11 @@ const ModelCommands* try_load(const fs::path& entry, const std::string& key, std
     why = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
     return nullptr;
   }
-  void* handle = ::dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
+  fs::path load = library;
+  if (const auto it = loaded_descriptions().find(library.string()); it != loaded_descriptions().end() && it->second != description)
+    load = private_copy(library, checksum, description);
+  void* handle = ::dlopen(load.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (load != library) fs::remove(load, ec);  // mapped: the name is no longer needed
   if (handle == nullptr) {
     why = fmt::format("dlopen refused it ({})", ::dlerror());
     return nullptr;
@@ -248,11 +259,15 @@ const ModelCommands* try_load(const fs::path& entry, const std::string& key, std
   const auto entry_point = reinterpret_cast<PluginEntry>(::dlsym(handle, kEntrySymbol));
   const char* built_for = nullptr;
   const ModelCommands* commands = entry_point != nullptr ? entry_point(&built_for) : nullptr;
-  if (commands == nullptr || built_for == nullptr || key != built_for) {
+  const auto settings = reinterpret_cast<PluginSettings>(::dlsym(handle, kSettingsSymbol));
+  if (commands == nullptr || built_for == nullptr || key != built_for || settings == nullptr) {
     ::dlclose(handle);
     why = "it is not a plugin of this wlx (no entry point of this interface, or another key)";
     return nullptr;
   }
+  if (const char* refused = settings(description.c_str()); refused != nullptr)
+    throw PluginBuildError(fmt::format("the plugin for model {} refused its description: {}", manifest_value(manifest, "model"), refused));
+  loaded_descriptions().emplace(library.string(), description);
   return commands;  // never closed: its code and strings are in use until exit
 }
 
@@ -385,26 +400,79 @@ std::string timings_text(const Timings& timings) {
   return out;
 }
 
+// A run of wlx-gen that did not succeed, as an error: the model file's mistake as wlx-gen states it
+// (exit 2), else wlx-gen's failure.
+void check_generator_run(const ProgramRun& run, const fs::path& log, const fs::path& model_file) {
+  throw_if_interrupted();
+  if (!run.started) throw Error("--model-file", fmt::format("cannot run wlx-gen ({}): reinstall wlx", generator_program().string()));
+  if (run.ok()) return;
+  std::string message = read_small(log, kMaxFileBytes);
+  for (const std::string prefix : {"wlx-gen: error: ", "wlx-gen: "})
+    if (message.rfind(prefix, 0) == 0) message = message.substr(prefix.size());
+  while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
+  if (run.exit_status == 2) throw Error("", message);  // the file's mistake, as wlx-gen states it
+  throw PluginBuildError(fmt::format("wlx-gen failed on {} (exit {}): {}", model_file.string(), run.exit_status, message));
+}
+
+// What wlx-gen parsed and derived from a model file (model.json): its text, the model's name and
+// the fingerprint of its code. The cache key is made of these, never of the file's text.
+struct Description {
+  std::string text, name, code_key;
+};
+
+Description description_of(const std::string& text, const std::string& where) {
+  Description d{text, {}, {}};
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    d.name = j.at("model").get<std::string>();
+    d.code_key = j.at("code_key").get<std::string>();
+  } catch (const nlohmann::json::exception& e) {
+    throw PluginBuildError(fmt::format("wlx-gen's description of the model ({}) cannot be read: {}", where, e.what()));
+  }
+  // Pasted into the plugin's sources and file names: wlx-gen allows identifiers only; checked again.
+  const bool identifier = !d.name.empty() && !std::isdigit(static_cast<unsigned char>(d.name[0])) &&
+                          std::all_of(d.name.begin(), d.name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+  if (!identifier || d.code_key.size() != 32 || d.code_key.find_first_not_of("0123456789abcdef") != std::string::npos)
+    throw PluginBuildError(fmt::format("wlx-gen's description of the model ({}) names no model or code key", where));
+  return d;
+}
+
+// wlx-gen --data-at-run-time --describe: the model file checked and derived (tens of milliseconds),
+// nothing written; its mistakes are reported as wlx-gen reports them.
+Description describe(const fs::path& model_file, const fs::path& scratch) {
+  const std::string tag = std::to_string(::getpid());
+  struct Scratch {
+    fs::path out, log;
+    ~Scratch() {
+      std::error_code ec;
+      fs::remove(out, ec);
+      fs::remove(log, ec);
+    }
+  } files{scratch / (".describe-" + tag + ".json"), scratch / (".describe-" + tag + ".log")};
+  const ProgramRun run = run_program(
+      {generator_program().string(), fs::absolute(model_file).string(), "--data-at-run-time", "--describe", "--quiet"}, {},
+      files.out.string(), files.log.string());
+  check_generator_run(run, files.log, model_file);
+  return description_of(read_small(files.out, kMaxFileBytes), "wlx-gen --describe");
+}
+
 // Generates the model's headers and compiles its plugin into `dir`.
-void build_plugin(const fs::path& model_file, const std::string& name, const std::string& key, const fs::path& dir,
+void build_plugin(const fs::path& model_file, const Description& description, const std::string& key, const fs::path& dir,
                   const fs::path& failed_logs) {
+  const std::string& name = description.name;
   // wlx-gen first: a mistake in the model file is reported as wlx-gen reports it, before any compiling.
+  // The headers leave the file's numbers out (--data-at-run-time): they come from model.json at load.
   const auto start = std::chrono::steady_clock::now();
   const fs::path gen = dir / "generated";
   const fs::path gen_log = dir / "wlx-gen.log";
-  const ProgramRun generated =
-      run_program({generator_program().string(), fs::absolute(model_file).string(), "--out", gen.string(), "--quiet"}, {}, gen_log.string());
-  throw_if_interrupted();
+  const ProgramRun generated = run_program(
+      {generator_program().string(), fs::absolute(model_file).string(), "--data-at-run-time", "--out", gen.string(), "--quiet"}, {},
+      gen_log.string());
   Timings timings{{"wlx-gen", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
-  if (!generated.started) throw Error("--model-file", fmt::format("cannot run wlx-gen ({}): reinstall wlx", generator_program().string()));
-  if (!generated.ok()) {
-    std::string message = read_small(gen_log, kMaxFileBytes);
-    for (const std::string prefix : {"wlx-gen: error: ", "wlx-gen: "})
-      if (message.rfind(prefix, 0) == 0) message = message.substr(prefix.size());
-    while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
-    if (generated.exit_status == 2) throw Error("", message);  // the file's mistake, as wlx-gen states it
-    throw PluginBuildError(fmt::format("wlx-gen failed on {} (exit {}): {}", model_file.string(), generated.exit_status, message));
-  }
+  check_generator_run(generated, gen_log, model_file);
+  // The file may have changed since it was described: the code must be the code the key names.
+  if (description_of(read_small(gen / "wlx" / "gen" / "model.json", kMaxFileBytes), "model.json").code_key != description.code_key)
+    throw Error("--model-file", fmt::format("{} changed while wlx was reading it: run the command again", model_file.string()));
 
   wlx::diagnose("wlx: compiling model {} for first use ({}) ...\n", name, model_file.string());
   const Sources src = find_sources();
@@ -427,12 +495,18 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
       "extern const char* const kEmbeddedReportFile;\n"
       "const char* const kEmbeddedReportFile = \"\";\n"
       "}} }} }}\n"
-      "// The entry point wlx looks up with dlsym: the commands, and the key this plugin was built for.\n"
+      "// The entry points wlx looks up with dlsym: the commands, and the key this plugin was built for;\n"
+      "// and the model's settings, from its description (model.json), which its headers leave out.\n"
       "extern \"C\" __attribute__((visibility(\"default\"))) const wlx::cli::ModelCommands* {1}(const char** key) {{\n"
       "  *key = \"{2}\";\n"
       "  return &wlx::{0}::commands::entry();\n"
+      "}}\n"
+      "extern \"C\" __attribute__((visibility(\"default\"))) const char* {3}(const char* description) {{\n"
+      "  static std::string refused;\n"
+      "  refused = wlx::{0}::commands::load_description(description);\n"
+      "  return refused.empty() ? nullptr : refused.c_str();\n"
       "}}\n",
-      name, kEntrySymbol, key);
+      name, kEntrySymbol, key, kSettingsSymbol);
   write(dir / "commands_unity.cpp", commands_unity);
 
   const std::string cxx = compiler();
@@ -470,8 +544,9 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
 
   std::uintmax_t size = 0;
   const std::string checksum = file_checksum(dir / "plugin.so", size);
-  write(dir / "manifest", fmt::format("wlx model plugin (interface {})\nkey {}\nmodel {}\nsize {}\nchecksum {}\nsource {}\n",
-                                      kPluginInterface, key, name, size, checksum, fs::absolute(model_file).string()));
+  write(dir / "manifest", fmt::format("wlx model plugin (interface {})\nkey {}\nmodel {}\ncode {}\nsize {}\nchecksum {}\nsource {}\n",
+                                      kPluginInterface, key, name, description.code_key, size, checksum,
+                                      fs::absolute(model_file).string()));
   // What the plugin no longer needs: the objects and the unity sources (the headers stay, to read).
   std::error_code ec;
   for (const auto& object : objects) fs::remove(object, ec);
@@ -485,6 +560,8 @@ void build_plugin(const fs::path& model_file, const std::string& name, const std
 struct LoadedEntry {
   fs::path cache, entry;
   std::string stem, name;
+  fs::path model_file;
+  std::string description;  // model.json's text: the viewer's module compiles its numbers in
 };
 LoadedEntry& loaded_entry() {
   static LoadedEntry e;
@@ -511,42 +588,39 @@ std::string model_cache_dir() {
 const ModelCommands& load_model_file(const std::string& model_file, const std::string& version) {
   const BoundedRead file = read_bounded_file(model_file, kMaxFileBytes);
   if (!file.ok()) throw Error("--model-file", fmt::format("{}: {}", excerpt(model_file), file.error));
-  const std::string name = model_name_of(file.text);
+  const fs::path cache = model_cache_dir();
+  // What wlx-gen parsed and derived: the model's name and the fingerprint of the code its headers
+  // hold, which covers every file it read (a URDF too) and leaves out the numbers a plugin reads at
+  // run time (model.json): editing those finds the same plugin and compiles nothing.
+  const Description description = describe(model_file, cache);
+  const std::string& name = description.name;
 
   // The key: everything the plugin's code depends on.
   Hash h;
   h.add(fmt::format("wlx model plugin, interface {}", kPluginInterface));
   h.add(version);
-  h.add(file.text);
-  if (const std::string urdf = urdf_of(file.text); !urdf.empty()) {
-    const fs::path path = fs::path(urdf).is_absolute() ? fs::path(urdf) : fs::path(model_file).parent_path() / urdf;
-    h.add(read_small(path, kMaxFileBytes));
-  }
-  const std::string cxx = compiler();
-  h.add(cxx);
+  h.add(name);
+  h.add(description.code_key);
+  h.add(WLX_PLUGIN_CXX);
   for (const bool commands : {false, true})
     for (const auto& f : optimization_flags(commands)) h.add(f);
   h.add(WLX_PLUGIN_INCLUDES);
   h.add(WLX_PLUGIN_LIBRARIES);
   // The sources the plugin is compiled from and the interface it is loaded through (a rebuilt wlx
-  // may have other sources under the same version), and the generator that writes its headers.
+  // may have other sources under the same version); the generator's part is the code key.
   // Not the loading binary: `wlx` and Python's module share one entry per model.
   hash_sources(find_sources(), h);
-  struct stat generator {};
-  if (::stat(generator_program().c_str(), &generator) == 0)
-    h.add(fmt::format("wlx-gen {} {} {}", generator.st_size, generator.st_mtim.tv_sec, generator.st_mtim.tv_nsec));
   const std::string key = h.hex();
 
-  const fs::path cache = model_cache_dir();
-  const std::string stem = (name.empty() ? std::string("model") : name) + "-" + key.substr(0, 24);
+  const std::string stem = name + "-" + key.substr(0, 24);
   const fs::path entry = cache / stem;
-  loaded_entry() = {cache, entry, stem, name};  // for its viewer module, once loaded
+  loaded_entry() = {cache, entry, stem, name, fs::absolute(model_file), description.text};  // for its viewer module
   std::string why;
-  if (const ModelCommands* commands = try_load(entry, key, why)) return *commands;
+  if (const ModelCommands* commands = try_load(entry, key, description.text, why)) return *commands;
 
   const FileLock lock(cache / (stem + ".lock"),
                       fmt::format("wlx: waiting for another wlx compiling model {} ({})", name, (cache / stem).string()));
-  if (const ModelCommands* commands = try_load(entry, key, why)) return *commands;  // the other one built it
+  if (const ModelCommands* commands = try_load(entry, key, description.text, why)) return *commands;  // the other one built it
   std::error_code ec;
   if (fs::exists(entry, ec)) {
     wlx::diagnose("wlx: the cached plugin {} cannot be used ({}): building it again\n", entry.string(), why);
@@ -556,13 +630,13 @@ const ModelCommands& load_model_file(const std::string& model_file, const std::s
   fs::remove_all(building.path, ec);
   fs::create_directories(building.path, ec);
   if (ec) throw Error("--model-file", fmt::format("cannot create {} ({})", building.path.string(), ec.message()));
-  build_plugin(model_file, name, key, building.path, cache / (stem + ".failed"));
+  build_plugin(model_file, description, key, building.path, cache / (stem + ".failed"));
   fs::rename(building.path, entry, ec);
   if (ec) throw Error("--model-file", fmt::format("cannot put the plugin in place at {} ({})", entry.string(), ec.message()));
   building.keep = true;
   fs::remove_all(cache / (stem + ".failed"), ec);
   wlx::diagnose("wlx: cached in {}\n", entry.string());
-  if (const ModelCommands* commands = try_load(entry, key, why)) return *commands;
+  if (const ModelCommands* commands = try_load(entry, key, description.text, why)) return *commands;
   throw PluginBuildError(fmt::format("the plugin just built for model {} cannot be loaded: {}", name, why));
 }
 
@@ -592,6 +666,8 @@ std::string model_file_viewer_module() {
                            WLX_VIEWER_RUNTIME_SOURCES, WLX_VIEWER_CLI_SOURCES})
     h.add(fact);
   for (const auto& f : flags) h.add(f);
+  // The module compiles the model's numbers in (it has no loader for model.json): they are keyed too.
+  h.add(loaded.description);
   struct stat emcc_file {};
   if (::stat(emcc.c_str(), &emcc_file) == 0)
     h.add(fmt::format("{} {} {}", emcc_file.st_size, emcc_file.st_mtim.tv_sec, emcc_file.st_mtim.tv_nsec));
@@ -615,6 +691,19 @@ std::string model_file_viewer_module() {
   // fmt's headers alone on the include path: all of /usr/include would shadow emscripten's libc.
   fs::create_directory_symlink(fs::path(WLX_VIEWER_FMT_INCLUDE) / "fmt", building.path / "include" / "fmt", ec);
   if (ec) throw Error("viewer", fmt::format("cannot link fmt's headers into {} ({})", building.path.string(), ec.message()));
+  // The model's headers with its numbers compiled in (settings.hpp), which the plugin's leave out.
+  const fs::path gen_log = building.path / "wlx-gen.log";
+  const ProgramRun generated = run_program(
+      {generator_program().string(), loaded.model_file.string(), "--out", (building.path / "generated").string(), "--quiet"}, {},
+      gen_log.string());
+  check_generator_run(generated, gen_log, loaded.model_file);
+  // The numbers compiled in must be those the loaded plugin was given (the file may have changed since).
+  const auto numbers = [](const std::string& text) {
+    const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+    return j.is_object() ? nlohmann::json{j.value("parameters", nlohmann::json()), j.value("settings", nlohmann::json())} : nlohmann::json();
+  };
+  if (numbers(read_small(building.path / "generated" / "wlx" / "gen" / "model.json", kMaxFileBytes)) != numbers(loaded.description))
+    throw Error("viewer", fmt::format("{} changed while wlx was reading it: run the command again", loaded.model_file.string()));
   std::string unity = "// The viewer module's sources in one translation unit (viewer/CMakeLists.txt's lists).\n";
   for (const auto& f : split_list(WLX_VIEWER_RUNTIME_SOURCES)) unity += include_line(src.runtime_sources / f);
   for (const auto& f : split_list(WLX_VIEWER_CLI_SOURCES)) unity += include_line(src.cli / f);
@@ -626,7 +715,7 @@ std::string model_file_viewer_module() {
   argv.insert(argv.end(), flags.begin(), flags.end());
   argv.insert(argv.end(), {"-fexceptions", "-DFMT_HEADER_ONLY", "-DWLX_MODEL=" + loaded.name, "-I" + src.runtime_include.string(),
                            "-I" + (src.cli / "commands").string(), "-I" + (src.cli / "shell").string(),
-                           "-isystem" + (building.path / "include").string(), "-isystem" + (loaded.entry / "generated").string()});
+                           "-isystem" + (building.path / "include").string(), "-isystem" + (building.path / "generated").string()});
   for (const auto& include : split_list(WLX_VIEWER_EIGEN_INCLUDES)) argv.push_back("-isystem" + include);
   // SINGLE_FILE: the WebAssembly inlined in the script, which a page opened from file:// can load.
   argv.insert(argv.end(), {(building.path / "module_unity.cpp").string(), "-o", out.string(), "-sMODULARIZE=1",

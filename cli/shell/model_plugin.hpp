@@ -1,8 +1,15 @@
 // `wlx --model-file FILE`: a user's own model in every command, without rebuilding wlx. On first
 // use wlx runs wlx-gen on the file and compiles the runtime and the per-model commands for it with
 // the system's C++ compiler into a shared library (a plugin), which it loads with dlopen; later
-// uses load the cached plugin. The cache entry is keyed by the model file's content (and its
-// URDF's), wlx's version, the plugin interface's version, the compiler and the flags.
+// uses load the cached plugin. Every use runs `wlx-gen --data-at-run-time --describe` (tens of
+// milliseconds: the file checked and derived, nothing written), which gives the model's name and
+// its description (model.json): the model's structure, the numbers of the file that no generated
+// function holds (parameters' values, nominal state, starts, sweeps, weights, torque limits,
+// friction) and `code_key`, the fingerprint of the code its headers hold. The cache entry is keyed
+// by the code key (so by everything wlx-gen read, a URDF too, and by nothing that is data), wlx's
+// version, the plugin interface's version, the compiler, the flags and the sources; the loaded
+// plugin is handed the description's numbers. Editing only numbers finds the same plugin: no
+// compiler runs.
 //
 // Cache: $WLX_CACHE_DIR, else $XDG_CACHE_HOME/wlx, else $HOME/.cache/wlx; one folder per entry,
 // <model>-<key>/ with plugin.so and manifest (the key, and the plugin's size and checksum). An
@@ -22,7 +29,7 @@ namespace wlx::cli {
 
 // The plugin interface's version: part of every key and of the entry point's name, so a plugin
 // of another interface is never loaded.
-inline constexpr int kPluginInterface = 2;
+inline constexpr int kPluginInterface = 3;
 
 // A plugin that could not be built from a correct model file (the compiler failed): exit 1, not
 // the 2 of a bad input.

@@ -16,11 +16,12 @@ extern char** environ;
 namespace wlx::cli {
 
 ProgramRun run_program(const std::vector<std::string>& argv, const std::string& working_directory,
-                       const std::string& log_path) {
-  return wait_program(start_program(argv, working_directory, log_path));
+                       const std::string& log_path, const std::string& error_path) {
+  return wait_program(start_program(argv, working_directory, log_path, error_path));
 }
 
-int start_program(const std::vector<std::string>& argv, const std::string& working_directory, const std::string& log_path) {
+int start_program(const std::vector<std::string>& argv, const std::string& working_directory, const std::string& log_path,
+                  const std::string& error_path) {
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
@@ -30,7 +31,8 @@ int start_program(const std::vector<std::string>& argv, const std::string& worki
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
   const std::string log = log_path.empty() ? "/dev/null" : log_path;
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  if (error_path.empty()) posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  else posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, error_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);
   if (!working_directory.empty()) posix_spawn_file_actions_addchdir_np(&actions, working_directory.c_str());
 
   // The child starts with default dispositions: wlx ignores SIGPIPE and catches SIGINT/SIGTERM,

@@ -15,15 +15,16 @@ struct ProgramRun {
 };
 
 // Runs argv[0] (looked up in PATH) with `argv` in the folder `working_directory` (empty: this
-// process's), stdin from /dev/null, stdout and stderr written to `log_path` (truncated first) (empty: /dev/null).
+// process's), stdin from /dev/null, stdout and stderr written to `log_path` (truncated first) (empty:
+// /dev/null); stderr to `error_path` instead where one is given (the output apart from the messages).
 ProgramRun run_program(const std::vector<std::string>& argv, const std::string& working_directory = {},
-                       const std::string& log_path = {});
+                       const std::string& log_path = {}, const std::string& error_path = {});
 
 // The same in two halves, to run several programs at once: start_program returns the child's pid
 // (or -1 if it could not be started), wait_program waits for it (a signal to wlx while waiting
 // does not stop the wait: the caller decides, after, what to do with the other children).
 int start_program(const std::vector<std::string>& argv, const std::string& working_directory = {},
-                  const std::string& log_path = {});
+                  const std::string& log_path = {}, const std::string& error_path = {});
 ProgramRun wait_program(int pid);
 // Waits for whichever of `pids` (children started by start_program) ends first; `pid` is set to
 // it, or to 0 if there is none or a signal arrived (interrupt.hpp) while waiting: then the caller

@@ -136,7 +136,7 @@ void contact_forces(const Model& model, Data& d, const Coordinates& s, const Dyn
       out.lateral(c) = f.dot(R.col(wheel.lateral_axis));
       out.longitudinal(c) = f.dot(R.col(wheel.forward_axis));
     }
-    out.friction_margin(c) = info.supports ? info.friction * out.normal(c) - out.tangential(c) : 0.0;
+    out.friction_margin(c) = info.supports ? settings().friction[at(c)] * out.normal(c) - out.tangential(c) : 0.0;
   }
 }
 
@@ -352,6 +352,7 @@ ContactDistribution distribute_torques_on_contacts(const Model& model, Data& d, 
     // friction margin along tangent directions >= t, and the torque limits.
     std::vector<Eigen::Matrix<double, 1, kK + 1>> rows;
     std::vector<double> bounds;
+    const Settings& settings_in_use = settings();
     const auto add = [&](const Eigen::Matrix<double, 1, kK>& gain, double offset) {  // offset + gain z - t >= 0
       Eigen::Matrix<double, 1, kK + 1> row;
       row << gain, -1.0;
@@ -359,7 +360,7 @@ ContactDistribution distribute_torques_on_contacts(const Model& model, Data& d, 
       bounds.push_back(-offset);
     };
     const auto cone_cut = [&](int c, const Eigen::Vector2d& dir) {  // mu f_n - dir . f_t
-      const double mu = gen::kContacts[at(c)].friction;
+      const double mu = settings_in_use.friction[at(c)];
       add(mu * F.row(3 * c + 2) - dir.x() * F.row(3 * c) - dir.y() * F.row(3 * c + 1),
           mu * f0(3 * c + 2) - dir.x() * f0(3 * c) - dir.y() * f0(3 * c + 1));
     };
@@ -368,9 +369,9 @@ ContactDistribution distribute_torques_on_contacts(const Model& model, Data& d, 
       add(F.row(3 * c + 2), f0(3 * c + 2));
       for (int j = 0; j < 8; ++j) cone_cut(c, Eigen::Vector2d(std::cos(j * 0.7853981633974483), std::sin(j * 0.7853981633974483)));
     }
-    if constexpr (gen::kHasTorqueLimits)
+    if (settings_in_use.has_torque_limits)
       for (int a = 0; a < kA; ++a) {
-        const double limit = gen::kTorqueLimits[at(a)];
+        const double limit = settings_in_use.torque_limits[at(a)];
         Eigen::Matrix<double, 1, kK + 1> row;
         row << scale * N.row(a), 0.0;
         rows.push_back(row), bounds.push_back(-limit - tau_1(a));   // tau_a >= -limit
@@ -390,7 +391,7 @@ ContactDistribution distribute_torques_on_contacts(const Model& model, Data& d, 
       ++out.programmes;
       // Converged, or stalled at rounding (the last digits of a degenerate optimum): both are the answer.
       if (!(r.converged || (r.residual <= 1e-6 && r.gap <= 1e-6)))
-        throw Error("weighting", gen::kHasTorqueLimits
+        throw Error("weighting", settings_in_use.has_torque_limits
                                      ? fmt::format("no torques within the actuators' limits (dynamics.torque_limits) produce "
                                                    "the generalized forces here (the contact-keeping programme has no solution: "
                                                    "residual {:.3g})",
@@ -405,7 +406,7 @@ ContactDistribution distribute_torques_on_contacts(const Model& model, Data& d, 
       for (int c = 0; c < kContactCount; ++c) {
         if (!gen::kContacts[at(c)].supports) continue;
         const Eigen::Vector2d tangential(f(3 * c), f(3 * c + 1));
-        const double true_margin = gen::kContacts[at(c)].friction * f(3 * c + 2) - tangential.norm();
+        const double true_margin = settings_in_use.friction[at(c)] * f(3 * c + 2) - tangential.norm();
         if (true_margin < r.x(kK) - options.tolerance && tangential.norm() > 0) {
           cone_cut(c, tangential.normalized());
           cut = true;

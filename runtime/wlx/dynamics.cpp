@@ -515,8 +515,7 @@ TorqueVector distribute_torques(const ActuatorJacobian& J_beta, const CommandVec
   TorqueVector S;
   switch (weighting.kind) {
     case Weighting::Kind::model_weights: {
-      static const TorqueVector scale = kModelWeightDiagonal.cwiseInverse().cwiseSqrt();  // constant: once
-      S = scale;
+      S = model_weight_diagonal().cwiseInverse().cwiseSqrt();
       break;
     }
     case Weighting::Kind::contribution:  // W_ii^-1 = |row i| directly: a zero row gets zero torque

@@ -108,8 +108,8 @@ struct Weighting {
   static Weighting matrix_of(const TorqueMatrix& W);
 };
 
-// The model file's default weights (for the excavator, thesis 6.3.3 weighting 1).
-inline const TorqueVector kModelWeightDiagonal = Eigen::Map<const TorqueVector>(gen::kDefaultWeights.data());
+// The model file's default weights (settings().weights; for the excavator, thesis 6.3.3 weighting 1).
+inline TorqueVector model_weight_diagonal() { return Eigen::Map<const TorqueVector>(settings().weights.data()); }
 
 // tau = W^-1 J_beta (J_beta^T W^-1 J_beta)^-1 Q*, computed as the minimum-norm solution of the
 // row-scaled system J_beta^T S x = Q*, tau = S x with S S^T = W^-1, which stays accurate where

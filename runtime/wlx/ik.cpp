@@ -375,7 +375,8 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
 }  // namespace
 
 Coordinates dependent_start(Coordinates s) {
-  for (int k = kInputCount; k < kCoordinateCount; ++k) s(k) = gen::kDependentStart[static_cast<std::size_t>(k - kInputCount)];
+  const Settings& settings_in_use = settings();
+  for (int k = kInputCount; k < kCoordinateCount; ++k) s(k) = settings_in_use.dependent_start[static_cast<std::size_t>(k - kInputCount)];
   return s;
 }
 

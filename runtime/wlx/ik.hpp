@@ -79,7 +79,7 @@ struct NewtonReport {
 // max_iterations (naming the limb, its residual and what to try).
 NewtonReport solve_ik_newton(const Model& model, Data& data, Coordinates& s, const NewtonOptions& options = {});
 // The same for the limbs marked in `limbs`, first from the joints in s (continuation along a sweep
-// or a run), then, if that fails, from the model file's start values (gen::kDependentStart).
+// or a run), then, if that fails, from the model file's start values (settings().dependent_start).
 NewtonReport solve_newton_limbs(const Model& model, Data& data, const std::array<bool, kLimbCount>& limbs, Coordinates& s,
                                 const NewtonOptions& options = {});
 // s with its dependent joints at the model file's start values for Newton's method.

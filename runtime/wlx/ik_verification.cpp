@@ -25,16 +25,7 @@ double IkSweep::value(int k) const {
   return n == 1 ? from : from + (to - from) * k / (n - 1);
 }
 
-const std::vector<IkSweep>& model_ik_sweeps() {
-  static const std::vector<IkSweep> sweeps = [] {
-    std::vector<IkSweep> out;
-    for (const auto& sw : gen::kIkSweeps)
-      out.push_back({std::string(sw.id), std::string(gen::kCoordinateNames[static_cast<std::size_t>(sw.input)]), sw.from, sw.to,
-                     sw.step, sw.degrees, sw.limb});
-    return out;
-  }();
-  return sweeps;
-}
+const std::vector<IkSweep>& model_ik_sweeps() { return settings().ik_sweeps; }
 
 const IkSweep* find_ik_sweep(const std::string& id) {
   for (const auto& s : model_ik_sweeps())
@@ -44,7 +35,7 @@ const IkSweep* find_ik_sweep(const std::string& id) {
 
 Coordinates ik_sweep_inputs() {
   Coordinates s = nominal_inputs();  // the dependent joints at Newton's start values
-  for (int k = 0; k < kInputCount; ++k) s(k) = gen::kSweepStart[static_cast<std::size_t>(k)];
+  for (int k = 0; k < kInputCount; ++k) s(k) = settings().sweep_start[static_cast<std::size_t>(k)];
   return s;
 }
 

@@ -1,7 +1,7 @@
 // The verification of the inverse kinematics (the thesis' method, thesis 3.4): sweep one input,
 // solve the dependent joints, put them back into the forward kinematics and measure the distance
 // to the target; here with both the closed form and Newton's method. The sweeps are the model
-// file's (gen::kIkSweeps).
+// file's (settings().ik_sweeps).
 #pragma once
 
 #include "wlx/ik.hpp"
@@ -11,18 +11,7 @@
 
 WLX_MODEL_NAMESPACE_BEGIN
 
-struct IkSweep {
-  std::string id;      // "IK-L1", ...
-  std::string input;   // docs/excavator.md name of the swept input
-  double from = 0, to = 0, step = 0;  // SI units (radians for angles)
-  bool degrees = false;               // the thesis quotes this sweep in degrees
-  Limb limb = 0;
-  // Number of points, both ends included.
-  int points() const;
-  double value(int k) const;
-};
-
-// The model's sweeps (its file's ik_sweeps).
+// The model's sweeps (its file's ik_sweeps: settings().ik_sweeps; IkSweep is in settings.hpp).
 const std::vector<IkSweep>& model_ik_sweeps();
 const IkSweep* find_ik_sweep(const std::string& id);
 

@@ -73,8 +73,9 @@ double* find_param(Params& params, std::string_view name) noexcept {
 
 Coordinates nominal_inputs() {
   Coordinates s;
-  for (int k = 0; k < kInputCount; ++k) s(k) = gen::kNominalInputs[static_cast<std::size_t>(k)];
-  for (int k = kInputCount; k < kCoordinateCount; ++k) s(k) = gen::kDependentStart[static_cast<std::size_t>(k - kInputCount)];
+  const Settings& settings_in_use = settings();
+  for (int k = 0; k < kInputCount; ++k) s(k) = settings_in_use.nominal_inputs[static_cast<std::size_t>(k)];
+  for (int k = kInputCount; k < kCoordinateCount; ++k) s(k) = settings_in_use.dependent_start[static_cast<std::size_t>(k - kInputCount)];
   return s;
 }
 

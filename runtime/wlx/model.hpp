@@ -4,6 +4,7 @@
 #pragma once
 
 #include "wlx/model_namespace.hpp"
+#include "wlx/settings.hpp"
 
 #include <wlx/gen/all.hpp>
 
@@ -28,7 +29,9 @@ class Model {
  public:
   // Validates every parameter (finite; lengths and masses positive; inertias physical) and
   // throws wlx::Error naming the first bad one.
-  explicit Model(const Params& params = Params{});
+  explicit Model(const Params& params);
+  // The model at its settings' parameters (settings.hpp: the model file's values).
+  Model() : Model(settings().params) {}
 
   const Params& params() const noexcept { return params_; }
   double total_mass() const noexcept { return total_mass_; }

@@ -207,7 +207,7 @@ std::string raise_a_wheel_hint() {
   std::string grounds, nominal;
   for (const gen::WheelInfo& wheel : gen::kWheels) {
     grounds += fmt::format("{}{}", grounds.empty() ? "" : ", ", name_of(wheel.ground));
-    const double z = gen::kNominalInputs[static_cast<std::size_t>(wheel.ground)];
+    const double z = settings().nominal_inputs[static_cast<std::size_t>(wheel.ground)];
     if (z != 0) nominal += fmt::format("{}{} = {:g} m", nominal.empty() ? "" : ", ", name_of(wheel.ground), z);
   }
   return fmt::format("Raise one wheel ({}{}) or choose another dependent pair.", grounds,

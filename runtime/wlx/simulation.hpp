@@ -34,7 +34,7 @@ void validate_time_grid(double duration, double dt);
 struct Scenario {
   std::string id;
   std::string description;
-  Params params;
+  Params params = settings().params;
   Coordinates initial = nominal_inputs();                 // inputs; dependents are solved
   Eigen::Matrix<double, kInputCount, 1> rates = Eigen::Matrix<double, kInputCount, 1>::Zero();  // commanded
   DependentPair pair = default_pair();

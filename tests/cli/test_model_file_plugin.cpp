@@ -152,6 +152,69 @@ TEST_CASE("--model-file: compiled on first use, then loaded from the cache; it c
   CHECK(slurp(report / "index.html").find("has no report file with claims") != std::string::npos);
 }
 
+// Replaces `from` (which must be there) by `to` in `text`.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  REQUIRE_MESSAGE(at != std::string::npos, from);
+  return text.replace(at, from.size(), to);
+}
+
+TEST_CASE("--model-file: editing only the file's numbers compiles nothing (the compiler is /bin/false), and every edit takes effect") {
+  const Setup& s = setup();
+  REQUIRE(run({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose}).code == 0);  // compiled (the first case)
+  const std::size_t entries_before = entries().size();
+  // A parameter's value, the nominal state, a limb's Newton start, an IK sweep, the weights, torque
+  // limits and friction: each is data (model.json), none is in the plugin's code.
+  std::string text = slurp(s.model);
+  text = replaced(text, "{name: thighD, value: 2.3,", "{name: thighD, value: 2.25,");
+  text = replaced(text, "  z_C: 2.0\n", "  z_C: 1.9\n");
+  text = replaced(text, "    joints: [psi_<side>2, psi_<side>3, psi_<side>4]\n",
+                  "    joints: [psi_<side>2, psi_<side>3, psi_<side>4]\n    start: {psi_<side>3: -0.3}\n");
+  text = replaced(text, "from: 1.80, to: 4.30", "from: 2.00, to: 4.30");
+  text = replaced(text, "  weights: [0.01, 100, 1, 0.01, 100, 1, 0.01, 0.01]\n",
+                  "  weights: [0.02, 100, 1, 0.01, 100, 1, 0.01, 0.01]\n  torque_limits: [1e6, 1e6, 1e6, 1e6, 1e6, 1e6, 1e6, 1e6]\n");
+  text += "\ncontacts:\n  friction: {feet: 0.6, wheels: 0.8}\n";
+  const fs::path edited = wlx_test::work_dir() / "edited_numbers.yaml";
+  write(edited, text);
+  ::setenv("CXX", "/bin/false", 1);  // would fail any compile; it is not part of a plugin's key only if never run
+  const auto fk = run({"--model-file", edited.string(), "fk", "--json"}, {.input = "{}"});
+  const auto sweep = run({"--model-file", edited.string(), "verify", "ik", "--sweep", "IK-L1", "--out",
+                          (wlx_test::work_dir() / "verify-edited").string()});
+  ::unsetenv("CXX");
+  INFO(fk.err);
+  REQUIRE(fk.code == 0);
+  CHECK(fk.err.empty());  // nothing compiled, nothing to say
+  CHECK(entries().size() == entries_before);
+  // The nominal state and the thighs are the edited ones: the built-in model at those numbers agrees.
+  const nlohmann::json own = nlohmann::json::parse(fk.out);
+  CHECK(own["coordinates"]["z_C"].get<double>() == 1.9);
+  const fs::path params = wlx_test::work_dir() / "edited_numbers.json";
+  write(params, R"({"thighD": 2.25})");
+  const auto builtin = run({"--params", params.string(), "fk", "--json"}, {.input = R"({"z_C": 1.9})"});
+  REQUIRE(builtin.code == 0);
+  const nlohmann::json reference = nlohmann::json::parse(builtin.out);
+  for (const auto& item : reference["coordinates"].items()) {
+    CAPTURE(item.key());
+    CHECK(own["coordinates"][item.key()].get<double>() == doctest::Approx(item.value().get<double>()).epsilon(1e-12));
+  }
+  // The sweep starts at its new end.
+  INFO(sweep.err);
+  REQUIRE(sweep.code == 0);
+  const auto [header, rows] = read_csv(wlx_test::work_dir() / "verify-edited" / "IK-L1.csv");
+  REQUIRE(!rows.empty());
+  CHECK(rows.front().front() == doctest::Approx(2.0).epsilon(1e-12));
+  CHECK(rows.size() == 231);  // (4.30 - 2.00) / 0.01 + 1
+
+  // A change of structure is code: the same compiler now has to run, and fails.
+  const fs::path restructured = wlx_test::work_dir() / "restructured.yaml";
+  write(restructured, replaced(text, "{name: cyd, value: 3.0, unit: m, kind: length,", "{name: cyd, value: 3.0, unit: m, kind: offset,"));
+  ::setenv("CXX", "/bin/false", 1);
+  const auto code = run({"--model-file", restructured.string(), "fk", "--json"}, {.input = "{}"});
+  ::unsetenv("CXX");
+  CHECK(code.code == 1);
+  CHECK(code.err.find("wlx: compiling model excavator for first use") != std::string::npos);
+}
+
 TEST_CASE("--model-file: a corrupt cache entry is never loaded but rebuilt, and two processes that find it so compile once") {
   const Setup& s = setup();
   REQUIRE(run({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose}).code == 0);  // built (by the case above)
@@ -262,7 +325,10 @@ TEST_CASE("--model-file: a compiler that fails: its first error and where the lo
   write(compiler, "#!/bin/sh\necho 'some.cpp:12:3: warning: unused'\necho 'some.cpp:14:1: error: this compiler fails'\nexit 1\n");
   fs::permissions(compiler, fs::perms::owner_all);
   const std::size_t before = entries().size();
-  ::setenv("CXX", compiler.c_str(), 1);  // another compiler: another key
+  // Flags of their own: another key (the compiler is not part of it: a cached plugin is loaded
+  // whichever compiler built it).
+  ::setenv("WLX_PLUGIN_CXXFLAGS", "-O0 -DWLX_FAILING_COMPILER_TEST", 1);
+  ::setenv("CXX", compiler.c_str(), 1);
   const auto r = run({"--model-file", s.model.string(), "fk"}, {.input = "{}"});
   ::unsetenv("CXX");
   CHECK(r.code == 1);
@@ -286,6 +352,7 @@ TEST_CASE("--model-file: a compiler that fails: its first error and where the lo
   ::setenv("CXX", compiler.c_str(), 1);
   const auto again = run({"--model-file", s.model.string(), "fk"}, {.input = "{}"});
   ::unsetenv("CXX");
+  ::setenv("WLX_PLUGIN_CXXFLAGS", "-O0", 1);
   CHECK(again.code == 1);
   CHECK(again.err.find("cannot be used (its manifest is missing or names another key)") != std::string::npos);
   CHECK(!fs::exists(place));

@@ -3,6 +3,7 @@
 #include "../support/run_wlx.hpp"
 
 #include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
 
 #include <cstdlib>
 #include <filesystem>
@@ -72,6 +73,90 @@ TEST_CASE("wlx-gen: a baked parameter's field in params.hpp holds the baked valu
   const std::string params = wlx_test::slurp(out / "wlx" / "gen" / "params.hpp");
   CHECK(params.find("double legD = 1.75;  // m: knee-to-foot length of a leg (baked:") != std::string::npos);
   CHECK(params.find("double legD = 1.5;") == std::string::npos);
+}
+
+TEST_CASE("wlx-gen --data-at-run-time: files that differ only in numbers give byte-identical headers and one code key; model.json holds the numbers") {
+  const std::filesystem::path dir = wlx_test::work_dir() / "data-at-run-time";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::string text = wlx_test::slurp(WLX_MODEL_FILE);
+  const auto replace = [](std::string t, const std::string& from, const std::string& to) {
+    const auto at = t.find(from);
+    REQUIRE_MESSAGE(at != std::string::npos, from);
+    return t.replace(at, from.size(), to);
+  };
+  wlx_test::write(dir / "a.yaml", text);
+  // Every kind of number: a parameter's value, the nominal state, a limb's start, a sweep, the
+  // weights, torque limits and friction.
+  text = replace(text, "{name: legD, value: 1.5,", "{name: legD, value: 1.6,");
+  text = replace(text, "  z_C: 2.0\n", "  z_C: 1.95\n");
+  text = replace(text, "    joints: [psi_<side>2, psi_<side>3, psi_<side>4]\n",
+                 "    joints: [psi_<side>2, psi_<side>3, psi_<side>4]\n    start: {psi_<side>3: -0.3}\n");
+  text = replace(text, "from: -0.50, to: 3.50, step: 0.01", "from: -0.40, to: 3.40, step: 0.02");
+  text = replace(text, "  weights: [0.01, 100, 1,", "  torque_limits: [9, 9, 9, 9, 9, 9, 9, 9]\n  weights: [0.03, 100, 1,");
+  text += "contacts:\n  friction: {feet: 0.9, wheels: 0.7}\n";
+  wlx_test::write(dir / "b.yaml", text);
+  for (const char* name : {"a", "b"}) {
+    const auto r = wlx_test::run({(dir / (std::string(name) + ".yaml")).string(), "--data-at-run-time", "--out",
+                                  (dir / name).string(), "--quiet"});
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+  }
+  int compared = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "a" / "wlx" / "gen")) {
+    if (entry.path().filename() == "model.json") continue;
+    CAPTURE(entry.path().filename().string());
+    CHECK(wlx_test::slurp(entry.path()) == wlx_test::slurp(dir / "b" / "wlx" / "gen" / entry.path().filename()));
+    ++compared;
+  }
+  CHECK(compared >= 10);
+  CHECK(!std::filesystem::exists(dir / "a" / "wlx" / "gen" / "settings.hpp"));  // the numbers are not compiled in
+  const std::string params = wlx_test::slurp(dir / "a" / "wlx" / "gen" / "params.hpp");
+  CHECK(params.find("double legD = detail::param_defaults()[3];") != std::string::npos);
+  const nlohmann::json a = nlohmann::json::parse(wlx_test::slurp(dir / "a" / "wlx" / "gen" / "model.json"));
+  const nlohmann::json b = nlohmann::json::parse(wlx_test::slurp(dir / "b" / "wlx" / "gen" / "model.json"));
+  CHECK(a["code_key"] == b["code_key"]);
+  CHECK(a["data_at_run_time"] == true);
+  // The numbers are in the description, as given.
+  const auto value_of = [](const nlohmann::json& d, const std::string& parameter) {
+    for (const auto& p : d["parameters"])
+      if (p["name"] == parameter) return p["value"].get<double>();
+    return -1.0;
+  };
+  CHECK(value_of(a, "legD") == 1.5);
+  CHECK(value_of(b, "legD") == 1.6);
+  CHECK(b["settings"]["nominal"]["z_C"] == 1.95);
+  CHECK(b["settings"]["dependent_start"]["psi_l3"] == -0.3);
+  CHECK(b["settings"]["dependent_start"]["psi_r3"] == -0.3);
+  CHECK(a["settings"]["dependent_start"]["psi_l3"] == 0.0);
+  CHECK(b["settings"]["torque_limits"] == nlohmann::json::array({9, 9, 9, 9, 9, 9, 9, 9}));
+  CHECK(a["settings"]["torque_limits"].is_null());
+  CHECK(b["settings"]["weights"][0] == 0.03);
+  for (const auto& sweep : b["settings"]["ik_sweeps"])
+    if (sweep["id"] == "IK-L3") CHECK((sweep["from"] == -0.4 && sweep["step"] == 0.02));
+  for (std::size_t c = 0; c < b["contacts"].size(); ++c)
+    CHECK(b["settings"]["friction"][c] == (b["contacts"][c]["kind"] == "wheel" ? 0.7 : 0.9));
+  // Without the option the numbers are compiled in: settings.hpp, and another code key.
+  const auto compiled = wlx_test::run({(dir / "b.yaml").string(), "--out", (dir / "b-compiled").string(), "--quiet"});
+  REQUIRE(compiled.code == 0);
+  CHECK(wlx_test::slurp(dir / "b-compiled" / "wlx" / "gen" / "settings.hpp").find("kTorqueLimits{{9.0, 9.0,") != std::string::npos);
+  CHECK(nlohmann::json::parse(wlx_test::slurp(dir / "b-compiled" / "wlx" / "gen" / "model.json"))["code_key"] != b["code_key"]);
+  // A change of structure is another code key: a parameter's kind.
+  wlx_test::write(dir / "c.yaml", replace(text, "{name: cyd, value: 3.0, unit: m, kind: length,", "{name: cyd, value: 3.0, unit: m, kind: offset,"));
+  const auto c = wlx_test::run({(dir / "c.yaml").string(), "--data-at-run-time", "--describe"});
+  REQUIRE(c.code == 0);
+  CHECK(nlohmann::json::parse(c.out)["code_key"] != b["code_key"]);
+  // --describe prints what --out writes as model.json, and writes nothing.
+  const auto described = wlx_test::run({(dir / "b.yaml").string(), "--data-at-run-time", "--describe"});
+  REQUIRE(described.code == 0);
+  CHECK(described.out == wlx_test::slurp(dir / "b" / "wlx" / "gen" / "model.json"));
+  const auto both = wlx_test::run({(dir / "b.yaml").string(), "--describe", "--out", (dir / "d").string()});
+  CHECK(both.code == 2);
+  CHECK(both.err.find("--describe writes nothing") != std::string::npos);
+  CHECK(!std::filesystem::exists(dir / "d"));
+  const auto baked = wlx_test::run({(dir / "b.yaml").string(), "--data-at-run-time", "--bake-defaults", "--out", (dir / "e").string()});
+  CHECK(baked.code == 2);
+  CHECK(baked.err.find("--data-at-run-time reads every parameter's value at run time") != std::string::npos);
 }
 
 TEST_CASE("wlx-gen: a baked value that makes an output infinite at the nominal state exits 2 naming the function and output") {
@@ -271,7 +356,8 @@ TEST_CASE("wlx-gen: a planted symlink is never written through; a link under a h
   CHECK(!std::filesystem::is_symlink(gen / "params.hpp"));
   CHECK(wlx_test::slurp(gen / "params.hpp").find("struct Params") != std::string::npos);
   for (const auto& e : std::filesystem::directory_iterator(gen))
-    if (e.path().filename() != "types.hpp.tmp") CHECK(e.path().extension() == ".hpp");  // no temporary of this run left
+    if (e.path().filename() != "types.hpp.tmp" && e.path().filename() != "model.json")
+      CHECK(e.path().extension() == ".hpp");  // no temporary of this run left
 }
 
 TEST_CASE("wlx-gen: a full disk exits 74 naming the header; the previous header set stays whole, no temporary left") {
@@ -572,11 +658,15 @@ TEST_CASE("wlx-gen: robot.urdf --with robot.yaml, and --print-model") {
   const std::filesystem::path out_printed = wlx_test::work_dir() / "urdf_printed";
   std::filesystem::remove_all(out_printed);
   REQUIRE(wlx_test::run({printed_file.string(), "--out", out_printed.string(), "--quiet"}).code == 0);
+  // model.json names the files too ("source") and fingerprints the headers with their banners
+  // ("code_key"): apart from those two lines it is the same.
   const auto without_banner = [](const std::string& text) {
     std::string out, line;
     std::istringstream in(text);
     while (std::getline(in, line))
-      if (line.find("Generated by wlx-gen") == std::string::npos) out += line + "\n";
+      if (line.find("Generated by wlx-gen") == std::string::npos && line.rfind(" \"source\": ", 0) != 0 &&
+          line.rfind(" \"code_key\": ", 0) != 0)
+        out += line + "\n";
     return out;
   };
   int compared = 0;

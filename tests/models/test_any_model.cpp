@@ -388,7 +388,7 @@ void check_torque_split_against_long_double() {
       } catch (const Error&) {
         return;  // a rank loss (the nominal pose's free rolling): the refusal has its own test
       }
-      const TorqueVector S = kModelWeightDiagonal.cwiseInverse().cwiseSqrt();
+      const TorqueVector S = model_weight_diagonal().cwiseInverse().cwiseSqrt();
       const LongJacobian A = (S.asDiagonal() * J).cast<long double>();
       const Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<long double, kCommandedCount, kActuatedCount>> cod(A.transpose());
       const TorqueVector reference = (S.cast<long double>().asDiagonal() * cod.solve(Qstar.cast<long double>())).cast<double>();

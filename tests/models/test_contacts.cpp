@@ -187,7 +187,7 @@ TEST_CASE(contact_titled("margins: the support polygon holds the loaded contacts
         const gen::ContactInfo& info = gen::kContacts[static_cast<std::size_t>(c)];
         if (!info.supports) continue;
         CHECK(forces.friction_margin(c) ==
-              doctest::Approx(info.friction * forces.force(2, c) - forces.force.col(c).head<2>().norm()).epsilon(1e-12));
+              doctest::Approx(gen::kContactFriction[static_cast<std::size_t>(c)] * forces.force(2, c) - forces.force.col(c).head<2>().norm()).epsilon(1e-12));
       }
       // Every loaded supporting contact is a vertex or inside; the CoM's margin is the smallest
       // distance to an edge's line, with the edges counter-clockwise.

@@ -50,7 +50,7 @@ TEST_CASE("tripod: standing still, the feet carry the weight as statics says, un
     for (int c = 0; c < 3; ++c) {
       CHECK(forces.normal(c) == doctest::Approx(expected(c)).epsilon(1e-9));
       CHECK(forces.point.col(c).head<2>().isApprox(kFeet.col(c), 1e-12));
-      CHECK(gen::kContacts[static_cast<std::size_t>(c)].friction == 0.7);  // the model file's, not the default
+      CHECK(gen::kContactFriction[static_cast<std::size_t>(c)] == 0.7);  // the model file's, not the default
       CHECK(forces.friction_margin(c) == doctest::Approx(0.7 * expected(c) - forces.tangential(c)).epsilon(1e-9));
     }
     // At rest nothing pushes the machine sideways: the horizontal forces cancel.

@@ -116,7 +116,7 @@ TEST_CASE("dynamics: the torques are the weighted least-norm solution to roundin
       for (const Weighting& w : {Weighting::model_weights(), Weighting::contribution()}) {
         const TorqueVector tau = distribute_torques(J, Qstar, w);
         // S S^T = W^-1 as distribute_torques defines it for these two diagonal weightings.
-        TorqueVector S = w.kind == Weighting::Kind::model_weights ? kModelWeightDiagonal.cwiseInverse().cwiseSqrt().eval()
+        TorqueVector S = w.kind == Weighting::Kind::model_weights ? model_weight_diagonal().cwiseInverse().cwiseSqrt().eval()
                                                                 : J.rowwise().norm().cwiseSqrt().eval();
         const LongJacobian A = (S.asDiagonal() * J).cast<long double>();
         // tau = S x, x the minimum-norm solution of A^T x = Q*.
@@ -138,7 +138,7 @@ TEST_CASE("dynamics: the weighted least norm is the optimum (no other solution h
   const Coordinates s = random_state(rng, model);
   inverse_dynamics(model, d, s, CommandVector(0.1, 0.5, 0.05, 0.0), CommandVector::Zero(), t);
   const TorqueVector tau = distribute_torques(t.J_beta, t.Qstar, Weighting::model_weights());
-  const auto cost = [](const TorqueVector& x) { return x.dot(kModelWeightDiagonal.asDiagonal() * x); };
+  const auto cost = [](const TorqueVector& x) { return x.dot(model_weight_diagonal().asDiagonal() * x); };
   // Add null-space directions of J_beta^T: the constraint still holds, the cost only grows.
   const Eigen::FullPivLU<Eigen::Matrix<double, 4, 8>> lu(t.J_beta.transpose());
   const Eigen::MatrixXd null = lu.kernel();

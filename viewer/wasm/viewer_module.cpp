@@ -165,10 +165,10 @@ std::string build_info_json() {
                 ",\"forwardAxis\":" + integer(w.forward_axis) + ",\"lateralAxis\":" + integer(w.lateral_axis) + "}";
        });
   // The contacts with the ground, in the order of a run's f_*_<name> columns (the force overlay).
-  j += ",\"contacts\":" + array(gen::kContacts, [](const gen::ContactInfo& c) {
+  j += ",\"contacts\":" + array(gen::kContacts, [&, k = 0](const gen::ContactInfo& c) mutable {
          return "{\"name\":" + quoted(c.name) + ",\"kind\":" + (c.kind == gen::ContactKind::wheel ? "\"wheel\"" : "\"foot\"") +
                 ",\"frame\":" + integer(c.frame) + ",\"supports\":" + (c.supports ? "true" : "false") +
-                ",\"friction\":" + number(c.friction) + "}";
+                ",\"friction\":" + number(settings().friction[static_cast<std::size_t>(k++)]) + "}";
        });
   j += ",\"bodies\":" + array(std::array<int, gen::kBodyCount>{}, [k = 0](int) mutable {
          const auto i = static_cast<std::size_t>(k++);
@@ -183,7 +183,7 @@ std::string build_info_json() {
          return "{\"name\":" + quoted(gen::kClosureNames[i]) + ",\"kind\":" + kind(r.kind) + ",\"frame\":" + integer(r.frame) +
                 ",\"axis\":" + integer(r.axis) + ",\"target\":" + integer(r.target) + "}";
        });
-  j += ",\"nominalInputs\":" + array(gen::kNominalInputs, number);
+  j += ",\"nominalInputs\":" + array(settings().nominal_inputs, number);
   if (gen::kHasClearance) {
     const ClearanceBox box = clearance_box();
     if (box.frame >= 0)

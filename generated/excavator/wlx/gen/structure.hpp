@@ -94,12 +94,7 @@ inline constexpr int kDynamicsPair = 0;  // A
 inline constexpr std::array<int, 8> kActuated{{18, 19, 20, 21, 22, 23, 27, 31}};
 inline constexpr std::array<int, 8> kActuatedWheels{{-1, -1, -1, -1, -1, -1, -1, -1}};
 inline constexpr std::array<std::string_view, 8> kActuatorNames{{"psi_l2", "psi_l3", "psi_l4", "psi_r2", "psi_r3", "psi_r4", "theta_l6", "theta_r6"}};
-inline constexpr std::array<double, 8> kDefaultWeights{{0.01, 100.0, 1.0, 0.01, 100.0, 1.0, 0.01, 0.01}};
 inline constexpr double Params::*kGravity = &Params::g;
-// The actuators' torque limits (|tau_i| <= limit, N m; the model file's dynamics.torque_limits),
-// respected by the contact-keeping torque distribution; kHasTorqueLimits false: unlimited (zeros).
-inline constexpr bool kHasTorqueLimits = false;
-inline constexpr std::array<double, 8> kTorqueLimits{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
 
 // The rate basis T (s' = T u, one column per commanded speed): whether a coordinate's rate can
 // depend on a commanded speed. The closure's and the wheels' rows split the dependent rates into
@@ -204,19 +199,17 @@ struct ContactInfo {
   std::array<int, 3> point_rows;  // the closure rows of the origin's K0 x, y, z (-1: none)
   std::array<int, 3> level_rows;  // the closure rows keeping the frame's x, y, z axis level (-1: none)
   bool supports;
-  double friction;  // Coulomb coefficient (the model file's contacts.friction)
 };
 inline constexpr int kContactCount = 4;
 inline constexpr std::array<ContactInfo, 4> kContacts{{
-    {"Fl", ContactKind::foot, 3, -1, {{0, 1, 2}}, {{-1, -1, -1}}, true, 0.5},  // F_l
-    {"Fr", ContactKind::foot, 6, -1, {{3, 4, 5}}, {{-1, -1, -1}}, true, 0.5},  // F_r
-    {"Wl", ContactKind::wheel, 9, 0, {{-1, -1, 6}}, {{7, 8, -1}}, true, 0.5},  // W_l
-    {"Wr", ContactKind::wheel, 12, 1, {{-1, -1, 10}}, {{11, 12, -1}}, true, 0.5},  // W_r
+    {"Fl", ContactKind::foot, 3, -1, {{0, 1, 2}}, {{-1, -1, -1}}, true},  // F_l
+    {"Fr", ContactKind::foot, 6, -1, {{3, 4, 5}}, {{-1, -1, -1}}, true},  // F_r
+    {"Wl", ContactKind::wheel, 9, 0, {{-1, -1, 6}}, {{7, 8, -1}}, true},  // W_l
+    {"Wr", ContactKind::wheel, 12, 1, {{-1, -1, 10}}, {{11, 12, -1}}, true},  // W_r
 }};
 
 // The IK verification: each sweep moves one input over [from, to] in steps (SI units), from the
-// inputs kSweepStart, and checks one limb.
-inline constexpr std::array<double, 18> kSweepStart{{0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 3.5, 1.5, 0.0, 3.5, -1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
+// inputs kSweepStart, and checks one limb (the sweeps: settings.hpp or model.json).
 struct SweepInfo {
   std::string_view id;
   int input;
@@ -224,27 +217,6 @@ struct SweepInfo {
   bool degrees;  // quoted in degrees
   int limb;
 };
-inline constexpr std::array<SweepInfo, 12> kIkSweeps{{
-    {"IK-L1", 6, 1.8, 4.3, 0.01, false, 0},  // x_Fl
-    {"IK-L2", 7, -0.5, 3.5, 0.01, false, 0},  // y_Fl
-    {"IK-L3", 8, -0.5, 3.5, 0.01, false, 0},  // z_Fl
-    {"IK-L4", 14, -0.5235987755982988, 0.5235987755982988, 0.0017453292519943296, true, 0},  // psi_l1
-    {"IK-R1", 9, 1.8, 4.3, 0.01, false, 1},  // x_Fr
-    {"IK-R2", 10, 0.5, -3.5, 0.01, false, 1},  // y_Fr
-    {"IK-R3", 11, -0.5, 3.5, 0.01, false, 1},  // z_Fr
-    {"IK-R4", 15, -0.5235987755982988, 0.5235987755982988, 0.0017453292519943296, true, 1},  // psi_r1
-    {"IK-WL1", 12, 0.9, -0.7, 0.01, false, 2},  // z_Wl
-    {"IK-WL2", 16, -0.6981317007977318, 0.2617993877991494, 0.0017453292519943296, true, 2},  // theta_l5
-    {"IK-WR1", 13, 0.9, -0.7, 0.01, false, 3},  // z_Wr
-    {"IK-WR2", 17, -0.6981317007977318, 0.2617993877991494, 0.0017453292519943296, true, 3},  // theta_r5
-}};
-
-// The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).
-inline constexpr std::array<double, 18> kNominalInputs{{0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 3.5, 1.5, 0.0, 3.5, -1.5, 0.0, 0.0, 0.05, 0.0, 0.0, 0.0, 0.0}};
-// Where Newton's method starts for the dependent joints when no earlier solution is at hand (the
-// model file's `nominal` and the limbs' `start`; 0 where neither gives one), in coord:: order from
-// the first dependent joint.
-inline constexpr std::array<double, 14> kDependentStart{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
 
 inline constexpr bool kHasClearance = true;
 

@@ -22,6 +22,7 @@
 
 #include "ik.hpp"
 #include "params.hpp"
+#include "settings.hpp"
 #include "structure.hpp"
 #include "types.hpp"
 #include "kinematics.hpp"

@@ -94,12 +94,7 @@ inline constexpr int kDynamicsPair = 0;  // A
 inline constexpr std::array<int, 8> kActuated{{18, 19, 20, 21, 22, 23, 27, 31}};
 inline constexpr std::array<int, 8> kActuatedWheels{{-1, -1, -1, -1, -1, -1, -1, -1}};
 inline constexpr std::array<std::string_view, 8> kActuatorNames{{"abduct_l", "lift_l", "knee_l", "abduct_r", "lift_r", "knee_r", "swing_l", "swing_r"}};
-inline constexpr std::array<double, 8> kDefaultWeights{{1.0, 0.01, 0.1, 1.0, 0.01, 0.1, 0.01, 0.01}};
 inline constexpr double Params::*kGravity = &Params::gravity;
-// The actuators' torque limits (|tau_i| <= limit, N m; the model file's dynamics.torque_limits),
-// respected by the contact-keeping torque distribution; kHasTorqueLimits false: unlimited (zeros).
-inline constexpr bool kHasTorqueLimits = false;
-inline constexpr std::array<double, 8> kTorqueLimits{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
 
 // The rate basis T (s' = T u, one column per commanded speed): whether a coordinate's rate can
 // depend on a commanded speed. The closure's and the wheels' rows split the dependent rates into
@@ -204,19 +199,17 @@ struct ContactInfo {
   std::array<int, 3> point_rows;  // the closure rows of the origin's K0 x, y, z (-1: none)
   std::array<int, 3> level_rows;  // the closure rows keeping the frame's x, y, z axis level (-1: none)
   bool supports;
-  double friction;  // Coulomb coefficient (the model file's contacts.friction)
 };
 inline constexpr int kContactCount = 4;
 inline constexpr std::array<ContactInfo, 4> kContacts{{
-    {"footl", ContactKind::foot, 3, -1, {{0, 1, 2}}, {{-1, -1, -1}}, true, 0.5},  // foot_l
-    {"footr", ContactKind::foot, 6, -1, {{3, 4, 5}}, {{-1, -1, -1}}, true, 0.5},  // foot_r
-    {"contactl", ContactKind::wheel, 9, 0, {{-1, -1, 6}}, {{7, 8, -1}}, true, 0.5},  // contact_l
-    {"contactr", ContactKind::wheel, 12, 1, {{-1, -1, 10}}, {{11, 12, -1}}, true, 0.5},  // contact_r
+    {"footl", ContactKind::foot, 3, -1, {{0, 1, 2}}, {{-1, -1, -1}}, true},  // foot_l
+    {"footr", ContactKind::foot, 6, -1, {{3, 4, 5}}, {{-1, -1, -1}}, true},  // foot_r
+    {"contactl", ContactKind::wheel, 9, 0, {{-1, -1, 6}}, {{7, 8, -1}}, true},  // contact_l
+    {"contactr", ContactKind::wheel, 12, 1, {{-1, -1, 10}}, {{11, 12, -1}}, true},  // contact_r
 }};
 
 // The IK verification: each sweep moves one input over [from, to] in steps (SI units), from the
-// inputs kSweepStart, and checks one limb.
-inline constexpr std::array<double, 18> kSweepStart{{0.0, 0.0, 1.8, 0.0, 0.0, 0.0, 3.2, 1.4, 0.0, 3.2, -1.4, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
+// inputs kSweepStart, and checks one limb (the sweeps: settings.hpp or model.json).
 struct SweepInfo {
   std::string_view id;
   int input;
@@ -224,25 +217,6 @@ struct SweepInfo {
   bool degrees;  // quoted in degrees
   int limb;
 };
-inline constexpr std::array<SweepInfo, 10> kIkSweeps{{
-    {"WK-L1", 6, 2.0, 4.0, 0.01, false, 0},  // foot_x_l
-    {"WK-L2", 8, -0.5, 1.5, 0.01, false, 0},  // foot_z_l
-    {"WK-L3", 14, -0.3490658503988659, 0.3490658503988659, 0.0017453292519943296, true, 0},  // slew_l
-    {"WK-R1", 9, 2.0, 4.0, 0.01, false, 1},  // foot_x_r
-    {"WK-R2", 11, -0.5, 1.5, 0.01, false, 1},  // foot_z_r
-    {"WK-R3", 15, -0.3490658503988659, 0.3490658503988659, 0.0017453292519943296, true, 1},  // slew_r
-    {"WK-WL1", 12, 0.6, -0.6, 0.01, false, 2},  // ground_l
-    {"WK-WL2", 16, -0.5235987755982988, 0.5235987755982988, 0.0017453292519943296, true, 2},  // steer_l
-    {"WK-WR1", 13, 0.6, -0.6, 0.01, false, 3},  // ground_r
-    {"WK-WR2", 17, -0.5235987755982988, 0.5235987755982988, 0.0017453292519943296, true, 3},  // steer_r
-}};
-
-// The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).
-inline constexpr std::array<double, 18> kNominalInputs{{0.0, 0.0, 1.8, 0.0, 0.0, 0.0, 3.2, 1.4, 0.0, 3.2, -1.4, 0.0, 0.0, 0.05, 0.0, 0.0, 0.0, 0.0}};
-// Where Newton's method starts for the dependent joints when no earlier solution is at hand (the
-// model file's `nominal` and the limbs' `start`; 0 where neither gives one), in coord:: order from
-// the first dependent joint.
-inline constexpr std::array<double, 14> kDependentStart{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
 
 inline constexpr bool kHasClearance = true;
 

@@ -96,12 +96,7 @@ inline constexpr int kDynamicsPair = 0;  // lateral
 inline constexpr std::array<int, 16> kActuated{{18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 28, 29, -1, -1, -1, -1}};
 inline constexpr std::array<int, 16> kActuatedWheels{{-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 1, 2, 3}};
 inline constexpr std::array<std::string_view, 16> kActuatorNames{{"haa_lf", "hfe_lf", "kfe_lf", "haa_rf", "hfe_rf", "kfe_rf", "haa_lh", "hfe_lh", "kfe_lh", "haa_rh", "hfe_rh", "kfe_rh", "wheel_joint_lf", "wheel_joint_rf", "wheel_joint_lh", "wheel_joint_rh"}};
-inline constexpr std::array<double, 16> kDefaultWeights{{1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0}};
 inline constexpr double Params::*kGravity = &Params::g;
-// The actuators' torque limits (|tau_i| <= limit, N m; the model file's dynamics.torque_limits),
-// respected by the contact-keeping torque distribution; kHasTorqueLimits false: unlimited (zeros).
-inline constexpr bool kHasTorqueLimits = false;
-inline constexpr std::array<double, 16> kTorqueLimits{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
 
 // The rate basis T (s' = T u, one column per commanded speed): whether a coordinate's rate can
 // depend on a commanded speed. The closure's and the wheels' rows split the dependent rates into
@@ -214,19 +209,17 @@ struct ContactInfo {
   std::array<int, 3> point_rows;  // the closure rows of the origin's K0 x, y, z (-1: none)
   std::array<int, 3> level_rows;  // the closure rows keeping the frame's x, y, z axis level (-1: none)
   bool supports;
-  double friction;  // Coulomb coefficient (the model file's contacts.friction)
 };
 inline constexpr int kContactCount = 4;
 inline constexpr std::array<ContactInfo, 4> kContacts{{
-    {"contactlf", ContactKind::wheel, 21, 0, {{0, 1, 2}}, {{-1, -1, -1}}, true, 0.5},  // contact_lf
-    {"contactrf", ContactKind::wheel, 22, 1, {{3, 4, 5}}, {{-1, -1, -1}}, true, 0.5},  // contact_rf
-    {"contactlh", ContactKind::wheel, 23, 2, {{6, 7, 8}}, {{-1, -1, -1}}, true, 0.5},  // contact_lh
-    {"contactrh", ContactKind::wheel, 24, 3, {{9, 10, 11}}, {{-1, -1, -1}}, true, 0.5},  // contact_rh
+    {"contactlf", ContactKind::wheel, 21, 0, {{0, 1, 2}}, {{-1, -1, -1}}, true},  // contact_lf
+    {"contactrf", ContactKind::wheel, 22, 1, {{3, 4, 5}}, {{-1, -1, -1}}, true},  // contact_rf
+    {"contactlh", ContactKind::wheel, 23, 2, {{6, 7, 8}}, {{-1, -1, -1}}, true},  // contact_lh
+    {"contactrh", ContactKind::wheel, 24, 3, {{9, 10, 11}}, {{-1, -1, -1}}, true},  // contact_rh
 }};
 
 // The IK verification: each sweep moves one input over [from, to] in steps (SI units), from the
-// inputs kSweepStart, and checks one limb.
-inline constexpr std::array<double, 18> kSweepStart{{0.0, 0.0, 0.58, 0.0, 0.0, 0.0, 0.37, 0.35, 0.0, 0.37, -0.35, 0.0, -0.33, 0.35, 0.0, -0.33, -0.35, 0.0}};
+// inputs kSweepStart, and checks one limb (the sweeps: settings.hpp or model.json).
 struct SweepInfo {
   std::string_view id;
   int input;
@@ -234,23 +227,6 @@ struct SweepInfo {
   bool degrees;  // quoted in degrees
   int limb;
 };
-inline constexpr std::array<SweepInfo, 8> kIkSweeps{{
-    {"W-lf-x", 6, 0.25, 0.45, 0.005, false, 0},  // x_lf
-    {"W-lf-ground", 8, -0.05, 0.1, 0.005, false, 0},  // ground_lf
-    {"W-rf-x", 9, 0.25, 0.45, 0.005, false, 1},  // x_rf
-    {"W-rf-ground", 11, -0.05, 0.1, 0.005, false, 1},  // ground_rf
-    {"W-lh-x", 12, -0.25, -0.45, 0.005, false, 2},  // x_lh
-    {"W-lh-ground", 14, -0.05, 0.1, 0.005, false, 2},  // ground_lh
-    {"W-rh-x", 15, -0.25, -0.45, 0.005, false, 3},  // x_rh
-    {"W-rh-ground", 17, -0.05, 0.1, 0.005, false, 3},  // ground_rh
-}};
-
-// The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).
-inline constexpr std::array<double, 18> kNominalInputs{{0.0, 0.0, 0.58, 0.0, 0.0, 0.0, 0.37, 0.35, 0.0, 0.37, -0.35, 0.0, -0.33, 0.35, 0.0, -0.33, -0.35, 0.0}};
-// Where Newton's method starts for the dependent joints when no earlier solution is at hand (the
-// model file's `nominal` and the limbs' `start`; 0 where neither gives one), in coord:: order from
-// the first dependent joint.
-inline constexpr std::array<double, 12> kDependentStart{{0.0, 0.5, -1.0, 0.0, 0.5, -1.0, 0.0, 0.5, -1.0, 0.0, 0.5, -1.0}};
 
 inline constexpr bool kHasClearance = true;
 

@@ -1,0 +1,130 @@
+// model.json: the model as data, beside the generated code (emit.hpp, emit_description()).
+#include "emit.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <sstream>
+
+namespace wlx::codegen {
+
+namespace {
+
+using Json = nlohmann::ordered_json;  // keys in the order written: the file is byte-identical run to run
+
+// FNV-1a over the files' names and texts, twice with different offsets (128 bits): a fingerprint of
+// the code, the key a plugin's cache is found by. Not a signature: it names, it does not protect.
+std::string code_fingerprint(const std::vector<EmittedFile>& code) {
+  std::uint64_t a = 14695981039346656037ull, b = 1099511628211ull * 31 + 7;
+  const auto add = [&](const std::string& text) {
+    for (const unsigned char c : text) {
+      a = (a ^ c) * 1099511628211ull;
+      b = (b ^ c) * 1099511628211ull + 0x9e3779b97f4a7c15ull;
+    }
+    a = (a ^ 0xff) * 1099511628211ull;  // a separator: ("ab", "c") and ("a", "bc") differ
+  };
+  for (const auto& f : code) {
+    add(f.path);
+    add(f.text);
+  }
+  return fmt::format("{:016x}{:016x}", a, b);
+}
+
+const char* axis_name(Axis a) { return a == Axis::X ? "x" : a == Axis::Y ? "y" : "z"; }
+
+}  // namespace
+
+EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::vector<EmittedFile>& code) {
+  const auto coordinate = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
+  Json d;
+  d["format"] = "wlx model description 1";
+  d["model"] = m.name;
+  d["description"] = m.description;
+  d["generated_by"] = "wlx-gen " + opt.generator_version;
+  d["source"] = m.source;
+  d["code_key"] = code_fingerprint(code);
+  d["data_at_run_time"] = opt.data_at_run_time;
+
+  // Structure: names and what refers to what (the code's indices, by name).
+  Json params = Json::array();
+  for (std::size_t k = 0; k < m.parameters.size(); ++k) {
+    const auto& p = m.parameters[k];
+    params.push_back({{"name", p.name}, {"value", p.default_value}, {"unit", p.unit}, {"kind", kind_name(m.parameter_kinds[k])},
+                      {"meaning", p.meaning}});
+  }
+  d["parameters"] = params;
+  Json coordinates = Json::array();
+  for (const auto& c : m.coordinates)
+    coordinates.push_back({{"name", c.name}, {"unit", c.unit}, {"input", c.index < m.input_count}, {"meaning", c.meaning}});
+  d["coordinates"] = coordinates;
+  Json frames = Json::array();
+  for (const auto& f : m.frames) frames.push_back({{"name", f.name}, {"parent", f.parent}, {"meaning", f.meaning}});
+  d["frames"] = frames;
+  Json bodies = Json::array();
+  for (const auto& b : m.bodies)
+    bodies.push_back({{"name", b.name}, {"frame", b.frame}, {"mass", b.mass}, {"inertia", b.inertia}, {"meaning", b.meaning}});
+  d["bodies"] = bodies;
+  Json wheels = Json::array();
+  for (const auto& w : m.wheels)
+    wheels.push_back({{"name", w.name}, {"contact", w.contact}, {"hub", w.hub}, {"radius", w.radius}, {"axle", axis_name(w.axle)},
+                      {"ground", w.ground >= 0 ? coordinate(w.ground) : ""}});
+  d["wheels"] = wheels;
+  Json limbs = Json::array();
+  for (const auto& l : m.limbs) {
+    Json joints = Json::array(), rows = Json::array();
+    for (int j : l.joints) joints.push_back(coordinate(j));
+    for (int r : l.rows) rows.push_back(m.closure[static_cast<std::size_t>(r)].name);
+    limbs.push_back({{"name", l.name}, {"title", l.title}, {"joints", joints}, {"closure", rows}});
+  }
+  d["limbs"] = limbs;
+  const std::vector<GroundContact> contacts = ground_contacts(m);
+  Json contact_list = Json::array();
+  for (const auto& c : contacts)
+    contact_list.push_back({{"name", c.name}, {"frame", m.frames[static_cast<std::size_t>(c.frame)].name},
+                            {"kind", c.wheel >= 0 ? "wheel" : "foot"}, {"supports", c.point[2] >= 0}});
+  d["contacts"] = contact_list;
+  Json actuators = Json::array(), commanded = Json::array();
+  if (m.dynamics) {
+    for (const auto& a : m.dynamics->actuated) actuators.push_back(a.name);
+    for (int k : m.dynamics->commanded) commanded.push_back(coordinate(k));
+  }
+  d["actuators"] = actuators;
+  d["commanded"] = commanded;
+  if (m.clearance) {
+    Json size = Json::array();
+    for (const auto& e : m.clearance->size) {
+      std::ostringstream text;
+      text << e;
+      size.push_back(text.str());
+    }
+    d["clearance"] = {{"frame", m.clearance->frame}, {"size", size}};
+  } else {
+    d["clearance"] = nullptr;
+  }
+
+  // Settings: the model file's numbers that no generated function holds (with the parameters'
+  // values above). A plugin's runtime reads them from here; settings.hpp compiles them in.
+  Json settings;
+  Json nominal = Json::object(), start = Json::object(), sweep_start = Json::object();
+  for (int k = 0; k < static_cast<int>(m.nominal.size()); ++k)
+    (k < m.input_count ? nominal : start)[coordinate(k)] = m.nominal[static_cast<std::size_t>(k)];
+  for (int k = 0; k < static_cast<int>(m.sweep_start.size()); ++k) sweep_start[coordinate(k)] = m.sweep_start[static_cast<std::size_t>(k)];
+  settings["nominal"] = nominal;
+  settings["dependent_start"] = start;
+  settings["sweep_start"] = sweep_start;
+  Json sweeps = Json::array();
+  for (const auto& sw : m.sweeps)
+    sweeps.push_back({{"id", sw.id}, {"input", coordinate(sw.input)}, {"from", sw.from}, {"to", sw.to}, {"step", sw.step},
+                      {"degrees", sw.degrees}, {"limb", m.limbs[static_cast<std::size_t>(sw.limb)].name}});
+  settings["ik_sweeps"] = sweeps;
+  settings["weights"] = m.dynamics ? Json(m.dynamics->weights) : Json::array();
+  settings["torque_limits"] = m.dynamics && !m.dynamics->torque_limits.empty() ? Json(m.dynamics->torque_limits) : Json(nullptr);
+  Json friction = Json::array();
+  for (const auto& c : contacts) friction.push_back(c.friction);
+  settings["friction"] = friction;
+  d["settings"] = settings;
+  return {"wlx/gen/model.json", d.dump(1) + "\n"};
+}
+
+}  // namespace wlx::codegen

@@ -1,0 +1,54 @@
+// The model file's run-time settings: every number of the model file that no generated function
+// holds (the parameters' values, the nominal state, Newton's starts, the IK sweeps, the actuators'
+// weights and torque limits, the contacts' friction). They are data, not code: a model compiled in
+// (a built-in model, an embedding) takes them from its generated settings.hpp; a model file's
+// plugin, whose headers have none (wlx-gen --data-at-run-time), is handed them from its model.json
+// when it is loaded, so that editing them recompiles nothing. The runtime reads them only here.
+#pragma once
+
+#include "wlx/model_namespace.hpp"
+
+#include <wlx/gen/all.hpp>
+
+#include <array>
+#include <string>
+#include <vector>
+
+WLX_MODEL_NAMESPACE_BEGIN
+
+// One sweep of the IK verification (ik_verification.hpp): one input moved over [from, to] in steps,
+// one limb checked.
+struct IkSweep {
+  std::string id;      // "IK-L1", ...
+  std::string input;   // the swept input's name
+  double from = 0, to = 0, step = 0;  // SI units (radians for angles)
+  bool degrees = false;               // quoted in degrees
+  int limb = 0;                       // gen::kLimbs' index
+  // Number of points, both ends included.
+  int points() const;
+  double value(int k) const;
+};
+
+struct Settings {
+  gen::Params params;                                               // the parameters' values
+  std::array<double, gen::kInputCount> nominal_inputs{};            // the nominal state's inputs
+  std::array<double, gen::kDependentCount> dependent_start{};       // Newton's start (nominal and limbs' start)
+  std::array<double, gen::kInputCount> sweep_start{};               // the IK sweeps' start inputs
+  std::vector<IkSweep> ik_sweeps;
+  std::array<double, gen::kActuated.size()> weights{};              // the actuators' default weights
+  bool has_torque_limits = false;                                   // false: unlimited
+  std::array<double, gen::kActuated.size()> torque_limits{};        // N m, each > 0 when given
+  std::array<double, gen::kContactCount> friction{};                // Coulomb coefficient per contact (kContacts)
+};
+
+// The settings in use. A model compiled with its settings.hpp has them from the start; a plugin's
+// runtime throws wlx::Error until set_settings() has been given its model.json's.
+const Settings& settings();
+// Whether settings() has anything to give (always, where settings.hpp is compiled in).
+bool has_settings() noexcept;
+// Replaces the settings (a plugin's loader, once, before any evaluation: not thread-safe against
+// readers). Checks every number (finite; weights, limits positive; sweeps' indices in range) and
+// throws wlx::Error naming the first bad one, leaving the settings as they were.
+void set_settings(const Settings& settings);
+
+WLX_MODEL_NAMESPACE_END
