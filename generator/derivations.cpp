@@ -1170,7 +1170,11 @@ FunctionSpec derive_clearance(const Model& m) {
   ex depth = 0;
   for (int j = 0; j < 3; ++j) depth += GiNaC::abs(f.R(2, j)) * m.clearance->size[static_cast<std::size_t>(j)] / 2;
   low.elements.emplace_back("*{}", f.r[2] - depth);
-  fn.outputs = {low};
+  // The box itself (its frame is kClearanceFrame, structure.hpp): what a drawing of it needs.
+  OutputSpec half{"half_extents", "Vector3", "the box's half sizes along the frame's x, y, z axes, m (parameters only)", "", {}};
+  for (int j = 0; j < 3; ++j)
+    half.elements.emplace_back(at(j), m.clearance->size[static_cast<std::size_t>(j)] / 2);
+  fn.outputs = {low, half};
   return fn;
 }
 

@@ -202,7 +202,8 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
       "template <typename Scalar> using WheelVectorOf = Eigen::Matrix<Scalar, {3}, 1>;\n"
       "template <typename Scalar> using BodyVectorsOf = Eigen::Matrix<Scalar, 3, {4}>;\n"
       "template <typename Scalar> using BodyRotationsOf = std::array<Eigen::Matrix<Scalar, 3, 3>, {4}>;\n"
-      "template <typename Scalar> using BodyJacobiansOf = std::array<Eigen::Matrix<Scalar, 3, {0}>, {4}>;\n\n"
+      "template <typename Scalar> using BodyJacobiansOf = std::array<Eigen::Matrix<Scalar, 3, {0}>, {4}>;\n"
+      "template <typename Scalar> using Vector3Of = Eigen::Matrix<Scalar, 3, 1>;\n\n"
       "// The double ones: what the runtime uses.\n"
       "using Coordinates = CoordinatesOf<double>;\n"
       "using FramePositions = FramePositionsOf<double>;\n"
@@ -213,7 +214,8 @@ std::vector<EmittedFile> emit_model_headers(const Model& m, const EmitOptions& o
       "using WheelVector = WheelVectorOf<double>;\n"
       "using BodyVectors = BodyVectorsOf<double>;\n"
       "using BodyRotations = BodyRotationsOf<double>;\n"
-      "using BodyJacobians = BodyJacobiansOf<double>;\n\n"
+      "using BodyJacobians = BodyJacobiansOf<double>;\n"
+      "using Vector3 = Vector3Of<double>;\n\n"
       "{5}"
       "namespace detail {{\n"
       "// T, but not deduced: the scalar type of a generated function comes from its coordinates, so an\n"
@@ -1045,7 +1047,10 @@ std::vector<EmittedFile> emit_structure_header(const Model& m, const EmitOptions
                           "// the first dependent joint.\n"
                           "inline constexpr std::array<double, {}> kDependentStart{{{{{}}}}};\n\n",
                           m.input_count, nominal, m.nominal.size() - static_cast<std::size_t>(m.input_count), dependent_start);
-  t += fmt::format("inline constexpr bool kHasClearance = {};\n\n", m.clearance ? "true" : "false");
+  t += fmt::format("inline constexpr bool kHasClearance = {};\n"
+                   "// The frame the clearance box moves with (frame::; -1: none); its size: clearance()'s half_extents.\n"
+                   "inline constexpr int kClearanceFrame = {};\n\n",
+                   m.clearance ? "true" : "false", m.clearance ? m.frame_index(m.clearance->frame) : -1);
   t += namespace_close(opt);
   std::vector<EmittedFile> out{{"wlx/gen/structure.hpp", t}};
   if (!opt.data_at_run_time) {

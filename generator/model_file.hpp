@@ -28,6 +28,7 @@ struct ModelFileError : std::runtime_error {
 inline constexpr std::size_t kMaxModelFileBytes = std::size_t{1} << 20;  // 1 MiB
 inline constexpr std::size_t kMaxExpandedEntries = 4096;  // list entries after `for:` repetition, in all lists
 inline constexpr std::size_t kMaxFrames = 512;
+inline constexpr std::size_t kMaxUrdfElements = 65536;  // XML elements of a URDF (kMaxFrames links need a few thousand)
 inline constexpr std::size_t kMaxChainDepth = 64;      // frames between any frame and K0
 inline constexpr std::size_t kMaxCoordinates = 512;    // coordinates (joints and inputs)
 inline constexpr std::size_t kMaxExpressionBytes = 1024;

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <set>
@@ -119,9 +120,17 @@ UrdfRobot read_urdf(const std::string& path, const std::string& shown_name) {
   const Checker check(shown_name);
 
   // TinyXML parses nested elements recursively: bound the depth before it sees the text (a URDF
-  // nests five levels; comments, declarations and quoted attribute values are skipped).
+  // nests five levels; comments, declarations and quoted attribute values are skipped). The same
+  // pass counts the elements, and the links and joints among them, so that a file past the limits
+  // is refused with the line where it passes them, before anything is built from it (a 64 MB file
+  // of empty elements would otherwise take gigabytes in TinyXML's tree).
   {
     int depth = 0, line = 1;
+    std::size_t elements = 0, links = 0, joints = 0;
+    const auto tag_is = [&](std::size_t at, const char* tag) {
+      const std::size_t n = std::strlen(tag);
+      return text.compare(at, n, tag) == 0 && at + n < text.size() && std::strchr(" \t\r\n/>", text[at + n]) != nullptr;
+    };
     for (std::size_t i = 0; i < text.size(); ++i) {
       if (text[i] == '\n') ++line;
       if (text[i] != '<') continue;
@@ -135,6 +144,12 @@ UrdfRobot read_urdf(const std::string& path, const std::string& shown_name) {
       else if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) skip_to(">");
       else if (text.compare(i, 2, "</") == 0) depth = std::max(0, depth - 1);
       else {
+        if (++elements > kMaxUrdfElements)
+          check.fail(line, "XML", fmt::format("more than {} elements: a URDF of at most {} links is read", kMaxUrdfElements, kMaxFrames));
+        if (depth == 1 && tag_is(i + 1, "link") && ++links > kMaxFrames)
+          check.fail(line, "link", fmt::format("more than {} links (wlx's limit of frames)", kMaxFrames));
+        if (depth == 1 && tag_is(i + 1, "joint") && ++joints > kMaxFrames)
+          check.fail(line, "joint", fmt::format("more than {} joints (wlx's limit of frames)", kMaxFrames));
         char quote = 0;
         std::size_t j = i + 1;
         for (; j < text.size() && (quote || text[j] != '>'); ++j) {
@@ -241,9 +256,8 @@ UrdfRobot read_urdf(const std::string& path, const std::string& shown_name) {
   for (std::size_t k = 0; k < joint_entries.size(); ++k) {
     const JointEntry& j = joint_entries[k];
     const std::string element = element_name("joint", j.name);
-    std::vector<std::string> names(link_order.begin(), link_order.end());
     for (const std::string* link : {&j.parent, &j.child})
-      if (!link_entries.count(*link)) check.fail(j.line, element, fmt::format("no link '{}'{}", shown(*link), did_you_mean(*link, names)));
+      if (!link_entries.count(*link)) check.fail(j.line, element, fmt::format("no link '{}'{}", shown(*link), did_you_mean(*link, link_order)));
     if (j.parent == j.child) check.fail(j.line, element, "its parent and child are the same link");
     if (parent_of.count(j.child))
       check.fail(j.line, element,
@@ -258,6 +272,31 @@ UrdfRobot read_urdf(const std::string& path, const std::string& shown_name) {
     if (roots.empty()) check.fail(robot->Row(), "robot", "every link has a parent joint: the joints form a loop");
     check.fail(link_entries[roots[1]].line, element_name("link", roots[1]),
                fmt::format("a second root: no joint connects it to the tree of '{}' (a URDF has one root link)", roots[0]));
+  }
+  // Every link hangs from the root. Links on a loop of joints apart from the tree each have a
+  // parent, so the root count above cannot see them; unchecked, they and their mass would vanish.
+  {
+    std::map<std::string, std::vector<std::string>> children_of;
+    for (const auto& j : joint_entries) children_of[j.parent].push_back(j.child);
+    std::set<std::string> reached{roots[0]};
+    for (std::vector<std::string> todo{roots[0]}; !todo.empty();) {
+      const std::string link = todo.back();
+      todo.pop_back();
+      for (const auto& child : children_of[link])
+        if (reached.insert(child).second) todo.push_back(child);
+    }
+    std::vector<std::string> lost;
+    for (const auto& n : link_order)
+      if (!reached.count(n)) lost.push_back(n);
+    if (!lost.empty()) {
+      std::string names;
+      for (std::size_t k = 0; k < lost.size() && k < 5; ++k) names += fmt::format("{}'{}'", k ? ", " : "", shown(lost[k]));
+      if (lost.size() > 5) names += fmt::format(" and {} more", lost.size() - 5);
+      check.fail(link_entries[lost[0]].line, element_name("link", lost[0]),
+                 fmt::format("the root link '{}' does not reach it: {} hang on a loop of joints apart from the tree (a URDF "
+                             "is one tree from its root; close loops with closure conditions in the YAML file)",
+                             shown(roots[0]), lost.size() == 1 ? "it" : names));
+    }
   }
 
   // urdfdom reads the accepted file: the values come from it.

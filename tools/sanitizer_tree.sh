@@ -54,22 +54,38 @@ case "$what" in
     seconds=${2:-60}
     cmake --build "$tree" --parallel "$(nproc)" --target "${fuzz_targets[@]/#/fuzz_}"
     # Crashers stop the run and are copied to tests/fuzz/regressions/<target>/ (commit them:
-    # every test run replays that folder); new interesting inputs stay in the tree.
-    status=0
-    for target in "${fuzz_targets[@]}"; do
-      work=$tree/corpus-$target artifacts=$tree/artifacts-$target
+    # every test run replays that folder); new interesting inputs stay in the tree. Each fuzzer is
+    # one process on one core: as many run at once as there are cores (on CI's two, the five take
+    # three rounds of SECONDS instead of five).
+    fuzz_one() {
+      local target=$1 work=$tree/corpus-$1 artifacts=$tree/artifacts-$1
       mkdir -p "$work" "$artifacts" "tests/fuzz/regressions/$target"
-      echo "fuzz_$target: ${seconds} s"
-      seeds=("tests/fuzz/corpus/$target" "tests/fuzz/regressions/$target")
+      local seeds=("tests/fuzz/corpus/$target" "tests/fuzz/regressions/$target")
       [ "$target" = model_file ] && seeds+=(models)
       [ "$target" = report_file ] && seeds+=(scenarios/excavator)  # as the replay test (tests/CMakeLists.txt)
-      if ! ASAN_OPTIONS=detect_leaks=1 "$tree/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -max_len=4096 \
-          -timeout=10 -artifact_prefix="$artifacts/" "$work" "${seeds[@]}" > "$tree/fuzz-$target.log" 2>&1; then
-        status=1
-        cp "$artifacts"/* "tests/fuzz/regressions/$target/" 2>/dev/null || true
-        tail -40 "$tree/fuzz-$target.log"
-      fi
-      grep -E "^#[0-9]+.*DONE|Done [0-9]+ runs" "$tree/fuzz-$target.log" | tail -1 || true
+      ASAN_OPTIONS=detect_leaks=1 "$tree/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -max_len=4096 \
+          -timeout=10 -artifact_prefix="$artifacts/" "$work" "${seeds[@]}" > "$tree/fuzz-$target.log" 2>&1
+    }
+    status=0
+    cores=$(nproc)
+    for ((first = 0; first < ${#fuzz_targets[@]}; first += cores)); do
+      round=("${fuzz_targets[@]:first:cores}")
+      pids=()
+      for target in "${round[@]}"; do
+        echo "fuzz_$target: ${seconds} s"
+        fuzz_one "$target" &
+        pids+=($!)
+      done
+      for k in "${!round[@]}"; do
+        target=${round[$k]}
+        if ! wait "${pids[$k]}"; then
+          status=1
+          cp "$tree/artifacts-$target"/* "tests/fuzz/regressions/$target/" 2>/dev/null || true
+          echo "fuzz_$target failed:"
+          tail -40 "$tree/fuzz-$target.log"
+        fi
+        echo "fuzz_$target: $(grep -E "^#[0-9]+.*DONE|Done [0-9]+ runs" "$tree/fuzz-$target.log" | tail -1 || true)"
+      done
     done
     exit $status
     ;;

@@ -205,6 +205,27 @@ std::string manifest_value(const std::string& manifest, const std::string& key) 
   return {};
 }
 
+// What the cache holds runs inside wlx (a plugin is dlopen()ed), so only what is the user's and
+// what nobody else may write is trusted: the cache folder (followed if it is a link) and each
+// entry's folder, plugin and manifest (never links). Anything else is an error naming it, never
+// used and never removed (it is not ours to remove); the README says how to mend it.
+void check_private(const fs::path& path, const char* what, bool follow) {
+  struct stat st {};
+  if ((follow ? ::stat(path.c_str(), &st) : ::lstat(path.c_str(), &st)) != 0) return;  // absent: nothing to trust yet
+  if (!follow && S_ISLNK(st.st_mode))
+    throw Error("--model-file", fmt::format("the cache's {} {} is a symbolic link: a cache entry is never followed elsewhere; "
+                                            "remove it",
+                                            what, path.string()));
+  if (st.st_uid != ::geteuid())
+    throw Error("--model-file", fmt::format("the cache's {} {} belongs to another user (uid {}): code in it would run inside wlx; "
+                                            "set WLX_CACHE_DIR to a folder of your own",
+                                            what, path.string(), st.st_uid));
+  if ((st.st_mode & (S_IWGRP | S_IWOTH)) != 0)
+    throw Error("--model-file", fmt::format("the cache's {} {} may be written by others (mode {:04o}): code planted in it would run "
+                                            "inside wlx; chmod go-w {}, or set WLX_CACHE_DIR to a folder of your own",
+                                            what, path.string(), st.st_mode & 07777, path.string()));
+}
+
 // The settings of each plugin loaded in this process, by library: a second description of the same
 // code (the same model with other numbers, in one Python process) gets a copy of the library of its
 // own, since a library's settings are its globals and dlopen() returns the same handle for one file.
@@ -235,6 +256,9 @@ const ModelCommands* try_load(const fs::path& entry, const std::string& key, con
     why = "not built yet";
     return nullptr;
   }
+  check_private(entry, "entry", false);
+  check_private(entry / "manifest", "manifest", false);
+  check_private(entry / "plugin.so", "plugin", false);
   const std::string manifest = read_small(entry / "manifest", 1 << 16);
   std::uintmax_t size = 0;
   const fs::path library = entry / "plugin.so";
@@ -293,6 +317,24 @@ class FileLock {
  private:
   int fd_ = -1;
 };
+
+// Build folders of processes that died while compiling (kill -9): <stem>.build-<pid> whose pid no
+// longer runs. Removed before building again, so that nothing of them is left for good.
+void remove_abandoned_builds(const fs::path& cache, const std::string& stem) {
+  std::error_code ec;
+  const std::string prefix = stem + ".build-";
+  for (fs::directory_iterator it(cache, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    char* rest = nullptr;
+    const long pid = std::strtol(name.c_str() + prefix.size(), &rest, 10);
+    if (pid <= 0 || rest == nullptr || *rest != '\0' || pid == ::getpid()) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+      std::error_code removed;
+      fs::remove_all(it->path(), removed);
+    }
+  }
+}
 
 // A folder removed when the object goes, unless kept.
 struct TemporaryFolder {
@@ -579,9 +621,12 @@ std::string model_cache_dir() {
   else if (const char* home = std::getenv("HOME"); home != nullptr && *home == '/') dir = fs::path(home) / ".cache" / "wlx";
   else throw Error("--model-file", "no cache folder: set WLX_CACHE_DIR (or HOME)");
   std::error_code ec;
+  const bool existed = fs::exists(dir, ec);
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir, ec))
     throw Error("--model-file", fmt::format("the cache folder {} cannot be created ({})", dir.string(), ec.message()));
+  if (!existed) ::chmod(dir.c_str(), 0700);  // made here: the user's alone
+  check_private(dir, "folder", true);
   return dir.string();
 }
 
@@ -626,6 +671,7 @@ const ModelCommands& load_model_file(const std::string& model_file, const std::s
     wlx::diagnose("wlx: the cached plugin {} cannot be used ({}): building it again\n", entry.string(), why);
     fs::remove_all(entry, ec);
   }
+  remove_abandoned_builds(cache, stem);
   TemporaryFolder building{cache / (stem + ".build-" + std::to_string(::getpid()))};
   fs::remove_all(building.path, ec);
   fs::create_directories(building.path, ec);

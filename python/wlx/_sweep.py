@@ -16,7 +16,9 @@ import json
 import math
 import os
 import re
+import reprlib
 import signal
+import stat
 import sys
 import time
 
@@ -30,6 +32,13 @@ MAX_ROWS = 20_000_000  # 10^6 variants x 12 runs and a margin; `wlx sweep` strea
 MAX_BATCH = 10_000
 MAX_WORKERS = 256
 MAX_SPEC_BYTES = 1 << 20
+MAX_SPEC_DEPTH = 100  # nesting of the spec's lists and mappings (a scenario inline is a few deep)
+# A batch file is read (on resume) only up to its header and this much a row: a row as written
+# is at most about 6 KB (a run's name of 200 characters and a reason of 500, quoted, in UTF-8)
+# and 25 bytes a number.
+MAX_ROW_BYTES, MAX_CELL_BYTES = 8192, 32
+# Text from the input in an error message: at most this many characters of it.
+MAX_EXCERPT = 60
 # A batch should take about this long on a worker: hundreds of times a task's overhead (a few ms
 # through a local scheduler and back, README.md's scaling table), so scheduling costs well under
 # 1%; a 10^6-variant sweep stays at tens of thousands of tasks and batch files; a kill loses at
@@ -64,31 +73,51 @@ def _error(field, reason):
     raise Error(f"{field}: {reason}") from None
 
 
+_REPR = reprlib.Repr()  # bounded work on any value: a deep or shared structure is not written out whole
+_REPR.maxlevel, _REPR.maxstring, _REPR.maxother = 3, MAX_EXCERPT, MAX_EXCERPT
+
+
 def _excerpt(value):
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+    try:
+        text = _REPR.repr(value)
+    except Exception:  # noqa: BLE001 - a value without a repr (an int of more than 4300 digits)
+        text = f"a {type(value).__name__}"
+    return text if len(text) <= MAX_EXCERPT else text[:MAX_EXCERPT - 3] + "..."
+
+
+def _key(name):
+    """A key or name from the input as it goes into an error's field: as given when it is a short
+    printable name, else its excerpt (quoted, escaped and cut: no control characters reach the
+    terminal, no megabyte of key the message)."""
+    return name if isinstance(name, str) and 0 < len(name) <= MAX_EXCERPT and name.isprintable() else _excerpt(name)
 
 
 def _nearest(name, names):
     import difflib
 
-    close = difflib.get_close_matches(str(name), list(names), n=1, cutoff=0.6)
+    if not isinstance(name, str) or len(name) > 200:  # no "did you mean" for a value that is not a short name
+        return ""
+    close = difflib.get_close_matches(name, list(names), n=1, cutoff=0.6)
     return f"; did you mean {close[0]!r}?" if close else ""
 
 
 def _number(value, field):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         _error(field, f"expected a number, got {_excerpt(value)}")
-    if not math.isfinite(value):
-        _error(field, f"must be a finite number, got {value}")
-    return float(value)
+    try:
+        number = float(value)
+    except OverflowError:  # an int beyond a double's range
+        number = math.inf
+    if not math.isfinite(number):
+        _error(field, f"must be a finite number, got {_excerpt(value)}")
+    return number
 
 
 def _count(value, field, low, high):
     if isinstance(value, bool) or not isinstance(value, int):
         _error(field, f"expected a whole number, got {_excerpt(value)}")
     if not low <= value <= high:
-        _error(field, f"must be between {low} and {high}, got {value}")
+        _error(field, f"must be between {low} and {high}, got {_excerpt(value)}")
     return value
 
 
@@ -97,7 +126,7 @@ def _keys(mapping, field, allowed, required=()):
         _error(field, f"expected a mapping, got {_excerpt(mapping)}")
     for k in mapping:
         if k not in allowed:
-            _error(f"{field}.{k}" if field else str(k), f"unknown key{_nearest(k, allowed)} (known: {', '.join(allowed)})")
+            _error(f"{field}.{_key(k)}" if field else _key(k), f"unknown key{_nearest(k, allowed)} (known: {', '.join(allowed)})")
     for k in required:
         if k not in mapping:
             _error(f"{field}.{k}" if field else k, "missing")
@@ -147,7 +176,7 @@ def _parameter_values(model, parameters):
             _error(field, "expected a mapping {parameter: values} with at least one parameter")
         names, axes = [], []
         for name, axis in spec.items():
-            where = f"{field}.{name}"
+            where = f"{field}.{_key(name)}"
             check_name(name, where)
             if isinstance(axis, list):
                 if not axis:
@@ -180,7 +209,7 @@ def _parameter_values(model, parameters):
             _error(f"{field}[0]", f"expected a mapping {{parameter: value}}, got {_excerpt(spec[0])}")
         names = list(spec[0])
         for name in names:
-            check_name(name, f"{field}[0].{name}")
+            check_name(name, f"{field}[0].{_key(name)}")
         rows = []
         for k, variant in enumerate(spec):
             if not isinstance(variant, dict):
@@ -188,7 +217,7 @@ def _parameter_values(model, parameters):
             if sorted(variant) != sorted(names):
                 missing, extra = sorted(set(names) - set(variant)), sorted(set(variant) - set(names))
                 _error(f"{field}[{k}]", "every variant sets the same parameters as the first"
-                       + (f"; missing {', '.join(missing)}" if missing else "") + (f"; not in the first: {', '.join(map(str, extra))}" if extra else ""))
+                       + (f"; missing {', '.join(missing)}" if missing else "") + (f"; not in the first: {', '.join(map(_key, extra))}" if extra else ""))
             rows.append([_number(variant[n], f"{field}[{k}].{n}") for n in names])
         values = np.array(rows, dtype=float)
     else:
@@ -203,13 +232,13 @@ def _parameter_values(model, parameters):
         rng = np.random.Generator(np.random.PCG64(seed))
         names, columns = [], []
         for name, dist in dists.items():
-            where = f"{field}.distributions.{name}"
+            where = f"{field}.distributions.{_key(name)}"
             check_name(name, where)
             if not isinstance(dist, dict) or len(dist) != 1:
                 _error(where, "expected one of {uniform: [low, high]} or {normal: [mean, sd]}")
             kind, args = next(iter(dist.items()))
             if kind not in ("uniform", "normal"):
-                _error(f"{where}.{kind}", f"unknown distribution{_nearest(kind, ('uniform', 'normal'))} (known: uniform, normal)")
+                _error(f"{where}.{_key(kind)}", f"unknown distribution{_nearest(kind, ('uniform', 'normal'))} (known: uniform, normal)")
             if not isinstance(args, list) or len(args) != 2:
                 _error(f"{where}.{kind}", f"expected two numbers, got {_excerpt(args)}")
             a, b = (_number(v, f"{where}.{kind}[{k}]") for k, v in enumerate(args))
@@ -231,7 +260,7 @@ def _parameter_values(model, parameters):
     if not isinstance(given, dict):
         _error("parameters.units", f"expected a mapping {{parameter: unit}}, got {_excerpt(given)}")
     for name, unit in given.items():
-        where = f"parameters.units.{name}"
+        where = f"parameters.units.{_key(name)}"
         if name not in names:
             _error(where, f"not a swept parameter{_nearest(name, names)}")
         if unit == units[name]:
@@ -239,7 +268,7 @@ def _parameter_values(model, parameters):
         if unit == "deg" and units[name] == "rad":  # angles may be given in degrees, as in scenario files
             values[:, names.index(name)] = np.radians(values[:, names.index(name)])
             continue
-        _error(where, f"{model.name}'s {name} is in {units[name]!r}, not {unit!r}" + (" (or 'deg')" if units[name] == "rad" else ""))
+        _error(where, f"{model.name}'s {name} is in {units[name]!r}, not {_excerpt(unit)}" + (" (or 'deg')" if units[name] == "rad" else ""))
     return names, units, values, mode, shape
 
 
@@ -261,7 +290,7 @@ def _runs(model, runs, base_dir):
             elif os.path.isfile(path):
                 label, source = os.path.splitext(os.path.basename(run))[0], os.path.abspath(path)
             else:
-                _error(where, f"{run!r} is neither a scenario id of {model.name} nor a file{_nearest(run, model.scenarios)}")
+                _error(where, f"{_excerpt(run)} is neither a scenario id of {model.name} nor a file{_nearest(run, model.scenarios)}")
         elif isinstance(run, dict):
             label = run.get("id", f"run{k + 1}")
             if not isinstance(label, str):
@@ -387,9 +416,9 @@ def _failed(metrics, actuators, reason):
     return out
 
 
-def _one_line(text):
+def _one_line(text, limit=500):
     text = " ".join(str(text).split())
-    return text if len(text) <= 500 else text[:497] + "..."
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def run_batch(reference, names, runs, metrics, indices, values):
@@ -450,7 +479,7 @@ def _csv_text(header, rows):
 def _atomic_output(path):
     """A text file written under a temporary name beside `path`, synced and renamed to it when the
     block ends: a file under its own name is never cut. A failed write removes the temporary and
-    raises OutputError naming `path`."""
+    raises OutputError naming `path`; any other error in the block removes it too."""
     temp = os.path.join(os.path.dirname(path), f".{os.path.basename(path)}.{os.getpid()}.tmp")
     try:
         with open(temp, "w", encoding="utf-8", newline="") as f:
@@ -458,12 +487,12 @@ def _atomic_output(path):
             f.flush()
             os.fsync(f.fileno())
         os.replace(temp, path)
-    except OSError as e:
-        try:
+    except BaseException as e:
+        with contextlib.suppress(OSError):
             os.unlink(temp)
-        except OSError:
-            pass
-        raise OutputError(f"{path}: writing failed: {e.strerror or e}") from None
+        if isinstance(e, OSError):
+            raise OutputError(f"{path}: writing failed: {e.strerror or e}") from None
+        raise
 
 
 def _write_atomically(path, text):
@@ -473,6 +502,23 @@ def _write_atomically(path, text):
 
 class OutputError(OSError):
     """An output that could not be written (full disk, no permission): exit 74 on the command line."""
+
+
+def _remove(path):
+    try:
+        os.unlink(path)
+    except FileNotFoundError:
+        pass
+    except OSError as e:
+        raise OutputError(f"{path}: cannot remove it: {e.strerror or e}") from None
+
+
+def _say(text):
+    try:
+        sys.stderr.write(text)
+        sys.stderr.flush()
+    except (OSError, AttributeError, ValueError):  # a closed stderr never stops a sweep
+        pass
 
 
 # A batch's file: its variants are first..last, every one of them (batches never span a gap).
@@ -489,11 +535,130 @@ def _parse_cell(text, column):
     return float(text) if text != "" else None
 
 
-def _read_rows(path):
-    with open(path, newline="", encoding="utf-8") as f:
-        reader = csv.reader(f)
-        header = next(reader)
-        return header, [[_parse_cell(c, h) for c, h in zip(row, header)] for row in reader]
+class _Refused(Exception):
+    """An input file that is not read, or not taken: the reason."""
+
+
+def _kind(mode):
+    for test, name in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return "of another kind"
+
+
+def _open_regular(path, limit=None):
+    """`path` opened for reading (binary) if it is a regular file (through links) of at most
+    `limit` bytes, else _Refused with the reason. A FIFO, a device (/dev/zero) or a folder is
+    refused before anything is read from it, so nothing waits for a writer or reads without end:
+    checked by stat, then opened non-blocking and checked again (it may have been swapped)."""
+    try:
+        if not stat.S_ISREG(mode := os.stat(path).st_mode):
+            raise _Refused(f"not a regular file ({_kind(mode)})")
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError as e:
+        raise _Refused(f"cannot read: {e.strerror or e}") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise _Refused(f"not a regular file ({_kind(st.st_mode)})")
+        if limit is not None and st.st_size > limit:
+            raise _Refused(f"larger than {limit} bytes")
+        os.set_blocking(fd, True)
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def _read_bounded(path, limit):
+    """A regular file's bytes, at most `limit` (_Refused beyond, also when it grows while read)."""
+    with _open_regular(path, limit) as f:
+        data = f.read(limit + 1)
+    if len(data) > limit:
+        raise _Refused(f"larger than {limit} bytes")
+    return data
+
+
+def _csv_rows(f, limit):
+    """A CSV file's rows (UTF-8), read line by line and at most `limit` bytes in all (_Refused
+    beyond: a line without end is not read whole). UnicodeDecodeError and csv.Error as they come."""
+
+    def lines():
+        left = limit
+        while line := f.readline(left + 1):
+            left -= len(line)
+            if left < 0:
+                raise _Refused(f"larger than {limit} bytes")
+            yield line.decode("utf-8")  # a line ends at b"\n", never inside a UTF-8 sequence
+
+    return csv.reader(lines())
+
+
+def _batch_limit(header, rows):
+    return len(_csv_text(header, [])) + rows * (MAX_ROW_BYTES + MAX_CELL_BYTES * len(header))
+
+
+def _is_number(text):
+    """A finite number in its round-trip form (Python's repr), as the sweep writes one."""
+    try:
+        value = float(text)
+    except ValueError:
+        return False
+    return math.isfinite(value) and repr(value) == text
+
+
+def _check_batch(path, first, last, plan, header, keep):
+    """A batch file found on resume, checked against what this sweep writes there: the header, one
+    row per variant first..last and run in that order, each row's variant id and parameter values
+    to the bit and its run's name, `complete` true or false (a complete row stopped for no
+    reason), a reason of one line, every number finite and round-trip exact, reach_failure 0 or 1,
+    and no row more. Returns the rows, parsed (keep), else None; _Refused with the first problem.
+    (A number edited to another finite one in its exact form is not found: the file has no
+    checksum.)"""
+    variants = plan.values[first:last + 1].tolist()
+    rows = (last - first + 1) * len(plan.runs)
+    p = len(plan.names)
+    kept = [] if keep else None
+    count = 0
+    try:
+        with _open_regular(path, _batch_limit(header, rows)) as f:
+            reader = _csv_rows(f, _batch_limit(header, rows))
+            if next(reader, None) != header:
+                raise _Refused("its header is not this sweep's columns" if f.tell() else "empty")
+            for k, row in enumerate(reader):
+                count = k + 1
+                where = f"row {k + 1}"
+                if k >= rows:
+                    raise _Refused(f"more than its {rows} rows ({last - first + 1} variants x {len(plan.runs)} runs)")
+                if len(row) != len(header):
+                    raise _Refused(f"{where}: {len(row)} cells, not {len(header)}")
+                v, r = divmod(k, len(plan.runs))
+                expected = [str(first + v), *map(_cell, variants[v]), plan.runs[r][0]]
+                for column, (cell, want) in enumerate(zip(row, expected)):
+                    if cell != want:
+                        raise _Refused(f"{where}, {header[column]}: {_excerpt(cell)} where this sweep has {_excerpt(want)}")
+                complete, stopped = row[p + 2], row[p + 3]
+                if complete not in ("true", "false") or (complete == "true" and stopped) or len(stopped) > 500:
+                    raise _Refused(f"{where}: complete {_excerpt(complete)}, stopped {_excerpt(stopped)} is not a row "
+                                   "the sweep writes")
+                for column in range(p + 4, len(header)):
+                    cell = row[column]
+                    if header[column] == "reach_failure":
+                        good = cell in ("0", "1")
+                    else:
+                        good = _is_number(cell) or (cell == "" and column > p + 4)  # t_end is always there
+                    if not good:
+                        raise _Refused(f"{where}, {header[column]}: {_excerpt(cell)} is not a finite number as the sweep writes one")
+                if keep:
+                    kept.append([_parse_cell(c, h) for c, h in zip(row, header)])
+    except UnicodeDecodeError:
+        raise _Refused("not UTF-8 text") from None
+    except csv.Error as e:
+        raise _Refused(f"not CSV as the sweep writes it ({_one_line(e, 200)})") from None
+    if count < rows:
+        raise _Refused(f"{count} rows, not its {rows} ({last - first + 1} variants x {len(plan.runs)} runs)")
+    return kept
 
 
 # ---------------------------------------------------------------- progress
@@ -571,7 +736,11 @@ def _client_for(client, scheduler, workers):
             return Client(scheduler, timeout="10s"), None
         except (OSError, TimeoutError) as e:
             _error("scheduler", f"cannot reach {scheduler}: {e}")
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+    # Every server of a local cluster (the scheduler, its HTTP routes, each worker and its nanny)
+    # listens on the loopback address only: dashboard_address=None alone leaves the scheduler's
+    # HTTP server (/info, /json, /metrics) on 0.0.0.0:8787.
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                           dashboard_address="127.0.0.1:0", worker_dashboard_address="127.0.0.1:0",
                            silence_logs=logging.ERROR)
     return Client(cluster), cluster
 
@@ -639,31 +808,45 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
             raise OutputError(f"{out}: cannot create the folder: {e.strerror or e}") from None
         identity = json.dumps(plan.identity(), sort_keys=True)
         identity_path = os.path.join(out, "spec.json")
-        if os.path.exists(identity_path):
-            with open(identity_path, encoding="utf-8") as f:
-                if f.read() != identity:
-                    _error("out", f"{out} holds the rows of another sweep (another model, parameters, runs or metrics): "
-                                  "remove it or give another folder")
+        if os.path.lexists(identity_path):
+            try:  # read no more than this sweep's own identity and a byte: more is another sweep's
+                with _open_regular(identity_path) as f:
+                    same = f.read(len(identity.encode()) + 1) == identity.encode()
+            except _Refused as e:
+                _error("out", f"{identity_path}: {e}")
+            if not same:
+                _error("out", f"{out} holds the rows of another sweep (another model, parameters, runs or metrics): "
+                              "remove it or give another folder")
         else:
             _write_atomically(identity_path, identity)
         for name in sorted(os.listdir(batches_dir)):
             path = os.path.join(batches_dir, name)
             m = _BATCH_FILE.match(name)
             if name.startswith(".") and name.endswith(".tmp"):
-                os.unlink(path)  # a batch being written when the sweep was killed: it runs again
+                _remove(path)  # a batch being written when the sweep was killed: it runs again
             elif m:
                 first, last = int(m[1]), int(m[2])
                 if not 0 <= first <= last < n or done[first:last + 1].any():
                     _error("out", f"{path}: not a batch of this sweep (variants {first}..{last} of {n})")
+                # Not a file the sweep wrote there (a FIFO, a device, a folder): not read, and not
+                # removed either: someone put it there.
+                try:
+                    mode = os.stat(path).st_mode
+                except OSError as e:
+                    _error("out", f"{path}: cannot read: {e.strerror or e}")
+                if not stat.S_ISREG(mode):
+                    _error("out", f"{path}: not a regular file ({_kind(mode)}): remove it and run the same sweep again")
+                # Its rows are taken only as this sweep would write them; a file cut, edited or
+                # holding a row more runs again (README.md, "Killed, then resumed").
+                try:
+                    rows = _check_batch(path, first, last, plan, header, keep)
+                except _Refused as e:
+                    _say(f"sweep: {path}: {e}; its variants {first}..{last} run again\n")
+                    _remove(path)
+                    continue
                 if keep:
-                    file_header, rows = _read_rows(path)
                     for row in rows:
                         kept.setdefault(row[0], []).append(row)
-                else:
-                    with open(path, newline="", encoding="utf-8") as f:
-                        file_header = next(csv.reader(f), None)
-                if file_header != header:
-                    _error("out", f"{path}: its columns are not this sweep's")
                 done[first:last + 1] = True
                 files.append((first, last, path))
     pending = np.flatnonzero(~done).tolist()
@@ -672,10 +855,7 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
     workers_n = workers or _default_workers()
     bar = _Progress(n, n - len(pending), "variants", progress)
     if progress and len(pending) < n:
-        try:
-            sys.stderr.write(f"sweep: resuming: {n - len(pending)} of {n} variants already written in {batches_dir}\n")
-        except OSError:
-            pass
+        _say(f"sweep: resuming: {n - len(pending)} of {n} variants already written in {batches_dir}\n")
     order = {label: k for k, (label, _) in enumerate(plan.runs)}
     try:
         if pending:
@@ -724,7 +904,7 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
             cluster.close()
     if out is not None:
         results = os.path.join(out, "results.csv")
-        complete_rows, total_rows = _concatenate(sorted(files), header, results)
+        complete_rows, total_rows = _concatenate(sorted(files), header, results, len(plan.runs))
         manifest = {"model": model.name, "mode": plan.mode, "parameters": plan.names, "units": plan.units,
                     "grid_shape": list(plan.shape) if plan.shape else None, "runs": [label for label, _ in plan.runs],
                     "metrics": {m: METRICS[m][0] for m in plan.metrics}, "variants": n, "rows": total_rows,
@@ -732,12 +912,12 @@ def _sweep(model, parameters, runs, metrics, out, client, scheduler, workers, ba
         _write_atomically(os.path.join(out, "sweep.json"), json.dumps(manifest, indent=1) + "\n")
         _plots(out, plan, header, results)
     if not keep:
-        return None
+        return manifest if out is not None else None
     table = [row for i in range(n) for row in kept[i]]
     return {name: [row[k] for row in table] for k, name in enumerate(header)}
 
 
-def _concatenate(files, header, path):
+def _concatenate(files, header, path, runs):
     """results.csv: the batch files' rows in variant order (each file holds one range, in order),
     streamed to a temporary name and renamed. Returns (rows that completed, rows)."""
     complete_column = header.index("complete")
@@ -745,14 +925,17 @@ def _concatenate(files, header, path):
     with _atomic_output(path) as out:
         writer = csv.writer(out, lineterminator="\n")
         writer.writerow(header)
-        for _, _, batch in files:
-            with open(batch, newline="", encoding="utf-8") as f:
-                reader = csv.reader(f)
-                next(reader)
-                for row in reader:
-                    writer.writerow(row)
-                    total += 1
-                    complete += row[complete_column] == "true"
+        for first, last, batch in files:  # each checked on resume, or written by this sweep
+            try:
+                with _open_regular(batch) as f:
+                    reader = _csv_rows(f, _batch_limit(header, (last - first + 1) * runs))
+                    next(reader)
+                    for row in reader:
+                        writer.writerow(row)
+                        total += 1
+                        complete += row[complete_column] == "true"
+            except _Refused as e:
+                _error("out", f"{batch}: {e}")
     return complete, total
 
 
@@ -761,6 +944,14 @@ def _concatenate(files, header, path):
 
 def _label(name, unit):
     return f"{name} ({unit})" if unit and unit != "1" else name
+
+
+def _plain(text):
+    """Text from a spec or a model file (a run's id, a parameter's name or unit) as matplotlib
+    draws it literally: an even number of '$' would make it mathtext (an id such as a$x^2$b drawn
+    as math, or a$\\frac$b an error naming neither the run nor the field). Each '$' escaped is a
+    dollar sign again, and outside mathtext a backslash is one."""
+    return str(text).replace("$", r"\$")
 
 
 def _sensitivities(x, y):
@@ -810,6 +1001,11 @@ def _plots(out, plan, header, results):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    with plt.rc_context({"text.usetex": False}):  # a matplotlibrc's LaTeX would read the text as TeX
+        return _draw(out, plan, header, results, plt)
+
+
+def _draw(out, plan, header, results, plt):
     plots = os.path.join(out, "plots")
     os.makedirs(plots, exist_ok=True)
     p = len(plan.names)
@@ -825,7 +1021,7 @@ def _plots(out, plan, header, results):
         written.append(path)
 
     def axis_label(k):
-        return _label(plan.names[k], plan.units[plan.names[k]])
+        return _plain(_label(plan.names[k], plan.units[plan.names[k]]))
 
     sensitivity_rows = []
     for metric in plan.metrics:
@@ -840,7 +1036,7 @@ def _plots(out, plan, header, results):
                     order = np.argsort(x[keep], kind="stable")
                     left_out = data[label]["left_out"]
                     ax.plot(x[keep][order], y[keep][order], "o-",
-                            label=label + (f" ({left_out} variants did not complete)" if left_out else ""))
+                            label=_plain(label) + (f" ({left_out} variants did not complete)" if left_out else ""))
                     drawn = True
             if drawn:
                 ax.set_xlabel(axis_label(0))
@@ -870,16 +1066,16 @@ def _plots(out, plan, header, results):
                 fig.colorbar(mesh, ax=ax, label=_label(metric, unit))
                 ax.set_xlabel(axis_label(1))
                 ax.set_ylabel(axis_label(0))
-                ax.set_title(f"{metric}, run {label}{note}", fontsize=9)
+                ax.set_title(f"{metric}, run {_plain(label)}{note}", fontsize=9)
                 save(fig, f"{metric}-{safe}-heatmap.png")
             else:
                 coefficients = _sensitivities(x, y)
                 sensitivity_rows += [[metric, label, name, float(v)] for name, v in zip(plan.names, coefficients)]
                 fig, ax = plt.subplots(figsize=(max(4, 0.8 * p + 2), 3.5))
-                ax.bar(plan.names, coefficients, color=["tab:blue" if v >= 0 else "tab:red" for v in coefficients])
+                ax.bar([_plain(n) for n in plan.names], coefficients, color=["tab:blue" if v >= 0 else "tab:red" for v in coefficients])
                 ax.axhline(0, color="black", linewidth=0.5)
                 ax.set_ylabel(f"standardized effect on {metric}")
-                ax.set_title(f"{metric}, run {label}: linear fit over {len(y)} variants{note}", fontsize=9)
+                ax.set_title(f"{metric}, run {_plain(label)}: linear fit over {len(y)} variants{note}", fontsize=9)
                 fig.tight_layout()
                 save(fig, f"{metric}-{safe}-sensitivity.png")
     if sensitivity_rows:
@@ -900,11 +1096,42 @@ def _edges(centres):
 # ---------------------------------------------------------------- the spec file and the command line
 
 
+# Numbers as YAML 1.2 (its core schema) reads them, as model files do (yaml-cpp): 1e-3, 15e-1,
+# .5 and -2.5E+3 are floats (YAML 1.1, PyYAML's, wants a dot and a signed exponent: 1e-3 would be
+# a string), 010 is ten (not octal eight), 1:30 a string (not ninety). Whole numbers stay ints.
+_YAML12_INT = re.compile(r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$")
+_YAML12_FLOAT = re.compile(r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+                           r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$")
+
+
 def _yaml_loader():
     import yaml
 
+    int_tag, float_tag = "tag:yaml.org,2002:int", "tag:yaml.org,2002:float"
+
     class Loader(yaml.SafeLoader):
-        """YAML with a key given twice in one mapping an error (PyYAML would keep the last)."""
+        """YAML with a key given twice in one mapping an error (PyYAML would keep the last), no
+        aliases (*name: a 1 KB file of aliases of aliases is a structure of billions of nodes to
+        whatever walks it), at most MAX_SPEC_DEPTH deep, and YAML 1.2's numbers."""
+
+        depth = 0
+
+        def compose_node(self, parent, index):
+            if self.check_event(yaml.events.AliasEvent):
+                raise yaml.composer.ComposerError(None, None, "an alias (*name) is not allowed in a sweep spec: write the value out",
+                                                  self.peek_event().start_mark)
+            self.depth += 1
+            try:
+                if self.depth > MAX_SPEC_DEPTH:
+                    raise yaml.composer.ComposerError(None, None, f"nested more than {MAX_SPEC_DEPTH} deep", self.peek_event().start_mark)
+                return super().compose_node(parent, index)
+            finally:
+                self.depth -= 1
+
+    Loader.yaml_implicit_resolvers = {first: [(tag, rx) for tag, rx in resolvers if tag not in (int_tag, float_tag)]
+                                      for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+    Loader.add_implicit_resolver(int_tag, _YAML12_INT, list("-+0123456789"))
+    Loader.add_implicit_resolver(float_tag, _YAML12_FLOAT, list("-+0123456789."))
 
     def construct_mapping(loader, node, deep=False):
         seen = set()
@@ -913,30 +1140,35 @@ def _yaml_loader():
             if not isinstance(key, (str, int, float)):
                 raise yaml.constructor.ConstructorError(None, None, "a key must be a name", key_node.start_mark)
             if key in seen:
-                raise yaml.constructor.ConstructorError(None, None, f"{key}: given twice in one mapping", key_node.start_mark)
+                raise yaml.constructor.ConstructorError(None, None, f"{_key(key)}: given twice in one mapping", key_node.start_mark)
             seen.add(key)
         return yaml.SafeLoader.construct_mapping(loader, node, deep=deep)
 
+    def construct_number(loader, node):
+        text = loader.construct_scalar(node)
+        try:
+            if node.tag == int_tag:
+                return int(text, 0) if text[:2] in ("0o", "0x") else int(text)  # "010": ten
+            special = {".inf": math.inf, "+.inf": math.inf, "-.inf": -math.inf, ".nan": math.nan}
+            return special[text.lower()] if text.lower() in special else float(text)
+        except (ValueError, TypeError):  # an explicit !!int or !!float on other text; more than 4300 digits
+            reason = "more than 4300 digits" if len(text) > 4300 else f"not a number as {node.tag[18:]}: {_excerpt(text)}"
+            raise yaml.constructor.ConstructorError(None, None, reason, node.start_mark) from None
+
     Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, construct_mapping)
+    Loader.add_constructor(int_tag, construct_number)
+    Loader.add_constructor(float_tag, construct_number)
     return Loader
 
 
 def read_spec(path):
-    """The spec file as a mapping (bounded, a regular file only, keys given once)."""
-    import stat
-
+    """The spec file as a mapping (bounded, a regular file only, keys given once, no aliases)."""
     import yaml
 
     try:
-        st = os.stat(path)
-    except OSError as e:
-        _error(path, f"cannot read: {e.strerror}")
-    if not stat.S_ISREG(st.st_mode):
-        _error(path, "not a regular file")
-    if st.st_size > MAX_SPEC_BYTES:
-        _error(path, f"larger than {MAX_SPEC_BYTES} bytes")
-    with open(path, "rb") as f:
-        data = f.read(MAX_SPEC_BYTES + 1)
+        data = _read_bounded(path, MAX_SPEC_BYTES)
+    except _Refused as e:
+        _error(path, str(e))
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as e:
@@ -946,7 +1178,7 @@ def read_spec(path):
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
         where = f"{path}:{mark.line + 1}" if mark is not None else path
-        _error(where, _one_line(getattr(e, "problem", None) or e))
+        _error(where, _one_line(getattr(e, "problem", None) or e, 200))
     if not isinstance(spec, dict):
         _error(path, "a sweep spec is a mapping (model, parameters, runs, metrics, out, batch_size)")
     _keys(spec, "", ("model", "parameters", "runs", "metrics", "out", "batch_size"), ("parameters", "runs", "metrics"))
@@ -960,27 +1192,26 @@ def run_spec(path, out=None, scheduler=None, workers=None, batch_size=None, prog
     spec = read_spec(path)
     base = os.path.dirname(os.path.abspath(path))
     model_name = spec.get("model", wlx.models()[0])  # the default model, as the command line's
-    if not isinstance(model_name, str) or not model_name:
+    if not isinstance(model_name, str) or not model_name or not model_name.isprintable():
         _error("model", f"expected a built-in model's name or a model file, got {_excerpt(model_name)}")
     if model_name in wlx.models():
         model = wlx.model(model_name)
     else:
         file = model_name if os.path.isabs(model_name) else os.path.join(base, model_name)
         if not os.path.isfile(file):
-            _error("model", f"{model_name!r} is neither a built-in model ({', '.join(wlx.models())}) nor a file"
+            _error("model", f"{_excerpt(model_name)} is neither a built-in model ({', '.join(wlx.models())}) nor a file"
                             f"{_nearest(model_name, wlx.models())}")
         model = wlx.load(file)
     if out is None:
         given = spec.get("out", "sweep")
-        if not isinstance(given, str) or not given:
-            _error("out", f"expected a folder name, got {_excerpt(given)}")
+        if not isinstance(given, str) or not given or not given.isprintable():  # it is named in messages
+            _error("out", f"expected a folder name (one printable line), got {_excerpt(given)}")
         out = given if os.path.isabs(given) else os.path.join(base, given)
     if batch_size is None and "batch_size" in spec:
         batch_size = spec["batch_size"]
-    _sweep(model, spec["parameters"], spec["runs"], spec["metrics"], out, None, scheduler, workers, batch_size,
-           progress, base_dir=base, keep=False)
-    with open(os.path.join(out, "sweep.json"), encoding="utf-8") as f:
-        return json.load(f), out
+    manifest = _sweep(model, spec["parameters"], spec["runs"], spec["metrics"], out, None, scheduler, workers, batch_size,
+                      progress, base_dir=base, keep=False)
+    return manifest, out
 
 
 _interrupted = []  # the signals that asked the command line to stop (main)
@@ -1025,14 +1256,34 @@ def main(argv=None):
     except KeyboardInterrupt as e:
         signum = _interrupted[0] if _interrupted else (e.args[0] if e.args else None)
         code = {signal.SIGTERM: 143, signal.SIGHUP: 129}.get(signum, 130)
-        sys.stderr.write("\nwlx sweep: interrupted: the batches written are complete; run the same command again to resume\n")
+        _say("\nwlx sweep: interrupted: the batches written are complete; run the same command again to resume\n")
         return code
     except OutputError as e:
-        sys.stderr.write(f"wlx sweep: error: {e}\n")
+        _say(f"wlx sweep: error: {e}\n")
         return 74
     except ValueError as e:  # wlx.Error and the spec's errors: they name the field
-        sys.stderr.write(f"wlx sweep: error: {e}\n")
+        _say(f"wlx sweep: error: {e}\n")
         return 2
     stopped = manifest["rows"] - manifest["complete_rows"]
-    print(f"{manifest['rows']} rows ({stopped} did not complete) in {os.path.join(out, 'results.csv')}")
-    return 0
+    return _print(f"{manifest['rows']} rows ({stopped} did not complete) in {os.path.join(out, 'results.csv')}\n")
+
+
+def _print(text):
+    """`text` to stdout, flushed: 0, or 74 with the reason when it cannot be written (a full disk,
+    a closed pipe: Python ignores SIGPIPE, so the write fails with EPIPE instead of killing the
+    process without a word), as the C++ commands end (cli/shell/output_checks.cpp)."""
+    import errno
+
+    try:
+        if sys.stdout is None:  # started with stdout closed
+            raise OSError(errno.EBADF, os.strerror(errno.EBADF))
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        return 0
+    except OSError as e:
+        _say(f"wlx sweep: error: stdout: writing the output failed ({e.strerror or e}); the output is incomplete\n")
+    # What stays in stdout's buffer would fail again when Python exits (a second message and exit
+    # 120): it goes to /dev/null instead.
+    with contextlib.suppress(OSError, AttributeError, ValueError):
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    return 74

@@ -21,6 +21,8 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -226,6 +228,9 @@ TEST_CASE("--model-file: a corrupt cache entry is never loaded but rebuilt, and 
     for (std::size_t k = bytes.size() / 2; k < bytes.size() / 2 + 64; ++k) bytes[k] = static_cast<char>(~bytes[k]);
     write(plugin, bytes);
   }
+  // The build folder a killed first use left behind (its pid runs no more): removed when building.
+  const fs::path abandoned = s.cache / (entries().front().filename().string() + ".build-2147483000");
+  fs::create_directories(abandoned / "generated");
   auto a = wlx_test::start({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose});
   auto b = wlx_test::start({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose});
   const auto ra = wlx_test::finish(a), rb = wlx_test::finish(b);
@@ -238,6 +243,7 @@ TEST_CASE("--model-file: a corrupt cache entry is never loaded but rebuilt, and 
   CHECK(count(ra.err + rb.err, "wlx: compiled model excavator") == 1);  // one compiled, the other waited or found it built
   CHECK(count(ra.err + rb.err, "cannot be used (plugin.so is missing or does not match its manifest") == 1);
   CHECK(entries().size() == 1);
+  CHECK(!fs::exists(abandoned));
   // (A plugin of another key in an entry's place: the last case.)
 }
 
@@ -302,6 +308,38 @@ print("ok")
   CHECK(entries() == before);
 }
 #endif
+
+TEST_CASE("--model-file: a cache that others may write, or another user's, is refused before anything in it is loaded (exit 2)") {
+  const Setup& s = setup();
+  const fs::path open_cache = wlx_test::work_dir() / "open-cache";
+  fs::create_directories(open_cache);
+  fs::permissions(open_cache, fs::perms::all);  // 0777: anyone could plant a plugin.so
+  ::setenv("WLX_CACHE_DIR", open_cache.c_str(), 1);
+  auto r = run({"--model-file", s.model.string(), "fk"}, {.input = "{}"});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("the cache's folder " + open_cache.string() + " may be written by others (mode 0777)") != std::string::npos);
+  CHECK(r.err.find("chmod go-w") != std::string::npos);
+  // A private cache whose entry was made writable by others: that entry is refused by name.
+  ::setenv("WLX_CACHE_DIR", s.cache.c_str(), 1);
+  REQUIRE(run({"--model-file", s.model.string(), "fk"}, {.input = "{}"}).code == 0);
+  REQUIRE(!entries().empty());
+  const fs::path plugin = entries().front() / "plugin.so";
+  const fs::perms before = fs::status(plugin).permissions();
+  fs::permissions(plugin, fs::perms::others_write, fs::perm_options::add);
+  r = run({"--model-file", s.model.string(), "fk"}, {.input = "{}"});
+  fs::permissions(plugin, before);
+  CHECK(r.code == 2);
+  CHECK(r.err.find("the cache's plugin " + plugin.string() + " may be written by others") != std::string::npos);
+  if (::geteuid() == 0) {  // root can give a folder away: another user's cache
+    fs::permissions(open_cache, fs::perms::owner_all);
+    REQUIRE(::chown(open_cache.c_str(), 65534, 65534) == 0);
+    ::setenv("WLX_CACHE_DIR", open_cache.c_str(), 1);
+    r = run({"--model-file", s.model.string(), "fk"}, {.input = "{}"});
+    CHECK(r.code == 2);
+    CHECK(r.err.find("belongs to another user (uid 65534)") != std::string::npos);
+  }
+  ::setenv("WLX_CACHE_DIR", s.cache.c_str(), 1);
+}
 
 TEST_CASE("--model-file: a mistake in the model file is reported as wlx-gen reports it, before any compiling (exit 2)") {
   const Setup& s = setup();

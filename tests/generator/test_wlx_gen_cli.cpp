@@ -159,6 +159,51 @@ TEST_CASE("wlx-gen --data-at-run-time: files that differ only in numbers give by
   CHECK(baked.err.find("--data-at-run-time reads every parameter's value at run time") != std::string::npos);
 }
 
+#ifdef WLX_HAVE_URDF_TESTS
+TEST_CASE("wlx-gen --describe: quoted keys and a URDF's geometry are what wlx-gen parsed: the name as written, and a moved knee is another description") {
+  // A model file whose keys are quoted (`"model": ...`, `urdf: "..."`): whatever reads the
+  // description (the plugin cache's key) gets the name and the URDF that wlx-gen read.
+  const std::filesystem::path dir = wlx_test::work_dir() / "quoted-keys";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::string yaml = wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.yaml");
+  const auto replace = [](std::string t, const std::string& from, const std::string& to) {
+    const auto at = t.find(from);
+    REQUIRE_MESSAGE(at != std::string::npos, from);
+    return t.replace(at, from.size(), to);
+  };
+  yaml = replace(yaml, "\nmodel: wheeled_quadruped\n", "\n\"model\": \"my_quadruped\"\n");
+  yaml = replace(yaml, "\nurdf: wheeled_quadruped.urdf\n", "\nurdf: \"robot.urdf\"\n");
+  wlx_test::write(dir / "robot.yaml", yaml);
+  const std::string urdf = wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.urdf");
+  wlx_test::write(dir / "robot.urdf", urdf);
+  const auto before = wlx_test::run({(dir / "robot.yaml").string(), "--data-at-run-time", "--describe"});
+  CAPTURE(before.err);
+  REQUIRE(before.code == 0);
+  const nlohmann::json a = nlohmann::json::parse(before.out);
+  CHECK(a["model"] == "my_quadruped");
+  // The left front knee 10 cm further down its thigh. The URDF's offsets are imported as parameters,
+  // so the move is data: the same code (one plugin), and the description carries the new length,
+  // which the loaded plugin computes with (never the old geometry from a stale cache).
+  wlx_test::write(dir / "robot.urdf", replace(urdf, "<origin xyz=\"0 0.1 -0.285\" rpy=\"0 0 0\"/>", "<origin xyz=\"0 0.1 -0.385\" rpy=\"0 0 0\"/>"));
+  const auto after = wlx_test::run({(dir / "robot.yaml").string(), "--data-at-run-time", "--describe"});
+  REQUIRE(after.code == 0);
+  const nlohmann::json b = nlohmann::json::parse(after.out);
+  CHECK(b["model"] == "my_quadruped");
+  CHECK(a["code_key"] == b["code_key"]);
+  int moved = 0;
+  REQUIRE(a["parameters"].size() == b["parameters"].size());
+  for (std::size_t k = 0; k < a["parameters"].size(); ++k)
+    if (a["parameters"][k]["value"] != b["parameters"][k]["value"]) {
+      CAPTURE(a["parameters"][k]["name"].get<std::string>());
+      CHECK(a["parameters"][k]["value"] == -0.285);
+      CHECK(b["parameters"][k]["value"] == -0.385);
+      ++moved;
+    }
+  CHECK(moved >= 1);
+}
+#endif
+
 TEST_CASE("wlx-gen: a baked value that makes an output infinite at the nominal state exits 2 naming the function and output") {
   const std::filesystem::path dir = wlx_test::work_dir() / "baked-pole", out = dir / "out";
   std::filesystem::create_directories(dir);
@@ -543,6 +588,26 @@ int line_of(const std::string& text, const std::string& needle) {
 
 }  // namespace
 
+TEST_CASE("wlx-gen: a URDF past the limits is refused where it passes them, before anything is built from it") {
+  const std::filesystem::path dir = wlx_test::work_dir() / "urdf_limits";
+  std::filesystem::create_directories(dir);
+  wlx_test::write(dir / "robot.yaml", "model: big\nurdf: robot.urdf\nparameters:\n  - {name: g, value: 9.81, unit: m/s^2, kind: gravity}\n");
+  // 513 links (one more than the frames a model may have): refused at the 513th, with its line.
+  std::string links = "<robot name=\"big\">\n";
+  for (int k = 0; k < 513; ++k) links += "  <link name=\"l" + std::to_string(k) + "\"/>\n";
+  wlx_test::write(dir / "robot.urdf", links + "</robot>\n");
+  auto r = wlx_test::run({(dir / "robot.yaml").string(), "--describe"});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("robot.urdf:514: link: more than 512 links") != std::string::npos);
+  // Empty elements by the hundred thousand (small on disk, large in a parsed tree).
+  std::string empty = "<robot name=\"big\">\n<link name=\"base\">\n";
+  for (int k = 0; k < 70000; ++k) empty += "<visual/>";
+  wlx_test::write(dir / "robot.urdf", empty + "\n</link>\n</robot>\n");
+  r = wlx_test::run({(dir / "robot.yaml").string(), "--describe"});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("robot.urdf:3: XML: more than 65536 elements") != std::string::npos);
+}
+
 TEST_CASE("wlx-gen: a bad URDF or a bad URDF model file exits 2 with file:line: element: reason") {
   const std::string urdf = wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.urdf");
   const std::string yaml = wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.yaml");
@@ -568,6 +633,14 @@ TEST_CASE("wlx-gen: a bad URDF or a bad URDF model file exits 2 with file:line: 
        {"link 'wheel_lf' inertial: the principal moments of inertia are 0, 0, 0", "every one positive"}},
       {"a second root", false, "</robot>", "  <link name=\"spare_part\"/>\n</robot>", "spare_part",
        {"link 'spare_part': a second root", "tree of 'base'"}},
+      // Two heavy links on a loop of their own: each has a parent, so no second root; unreached, they
+      // would vanish from frames and bodies with their 1000 kg.
+      {"a loop apart from the tree", false, "</robot>",
+       "  <link name=\"ring_a\"><inertial><mass value=\"500\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n"
+       "  <link name=\"ring_b\"><inertial><mass value=\"500\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n"
+       "  <joint name=\"ring_ab\" type=\"fixed\"><parent link=\"ring_a\"/><child link=\"ring_b\"/></joint>\n"
+       "  <joint name=\"ring_ba\" type=\"fixed\"><parent link=\"ring_b\"/><child link=\"ring_a\"/></joint>\n</robot>",
+       "<link name=\"ring_a\"", {"link 'ring_a': the root link 'base' does not reach it: 'ring_a', 'ring_b' hang on a loop of joints apart from the tree"}},
       {"a link twice", false, "</robot>", "  <link name=\"hip_lf\"/>\n</robot>", "<link name=\"hip_lf\"/>", {"link 'hip_lf': defined twice"}},
       {"a link with two parents", false, "<child link=\"thigh_lf\"/>", "<child link=\"base_inertia\"/>", "<joint name=\"hfe_lf\"",
        {"joint 'hfe_lf': link 'base_inertia' is already the child of joint 'base_to_base_inertia'", "closure conditions"}},

@@ -5,9 +5,11 @@ package, WLX_BINARY the built `wlx`). Small sweeps on 1-2 local workers: the spe
 tools/sweep_scaling.py's, not a test's."""
 
 import csv
+import io
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -35,13 +37,64 @@ def robot():
 
 @pytest.fixture(scope="module")
 def client():
-    # One local cluster for the in-process tests: two single-threaded worker processes, as the
-    # default cluster is made (the runs hold the GIL).
-    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
-    c = distributed.Client(cluster)
+    # One local cluster for the in-process tests, made as a sweep makes its own: two single-threaded
+    # worker processes (the runs hold the GIL), every server on the loopback address.
+    c, cluster = _sweep._client_for(None, None, 2)
     yield c
     c.close()
     cluster.close()
+
+
+def listening_addresses(pids):
+    """The local addresses of the TCP sockets in LISTEN state that these processes hold (from /proc:
+    each socket's inode, found among the processes' open files, in /proc/net/tcp and tcp6)."""
+    inodes = set()
+    for pid in pids:
+        try:
+            fds = os.listdir(f"/proc/{pid}/fd")
+        except OSError:
+            continue
+        for fd in fds:
+            try:
+                link = os.readlink(f"/proc/{pid}/fd/{fd}")
+            except OSError:
+                continue
+            if link.startswith("socket:["):
+                inodes.add(link[len("socket:["):-1])
+    found = []
+    for table in ("tcp", "tcp6"):
+        with open(f"/proc/net/{table}") as f:
+            for line in f.read().splitlines()[1:]:
+                fields = line.split()
+                if fields[3] == "0A" and fields[9] in inodes:  # 0A: LISTEN
+                    found.append(fields[1].split(":")[0])
+    return found
+
+
+def descendants(pid):
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as f:
+                    ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+            children.setdefault(ppid, []).append(int(entry))
+    out, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        out.append(p)
+        todo += children.get(p, [])
+    return out
+
+
+def test_a_local_cluster_listens_on_the_loopback_address_only(client):
+    addresses = listening_addresses(descendants(os.getpid()))
+    # The scheduler, its HTTP routes, two workers and their nannies: each at least one socket.
+    assert len(addresses) >= 5, addresses
+    loopback = {"0100007F", "00000000000000000000000001000000"}  # 127.0.0.1 and ::1, as /proc/net writes them
+    assert set(addresses) <= loopback, addresses
 
 
 def peak_tau(run):
@@ -456,3 +509,246 @@ def test_python_arguments_are_checked(robot):
         wlx.sweep(robot, {"list": [{"legD": 1.5}]}, ["ID-1"], client=object(), workers=2)
     with pytest.raises(wlx.Error, match=r"^runs\[0\]\.id: must be a string"):
         wlx.sweep(robot, {"list": [{"legD": 1.5}]}, [{"id": 3}])
+
+
+# ---------------------------------------------------------------- hostile input: batch files, spec files, stdout, plots
+
+
+# 4 variants x 2 runs in batches of 2 variants: rows-0000000-0000001.csv and rows-0000002-0000003.csv.
+SMALL = {"parameters": {"grid": {"legD": [1.4, 1.5, 1.6, 1.7]}},
+         "runs": [{**ID1, "duration": 0.05}, {**ID1, "id": "ID-1b", "duration": 0.1}],
+         "metrics": ["peak_tau", "reach_failure"]}
+FIRST, SECOND = "rows-0000000-0000001.csv", "rows-0000002-0000003.csv"
+
+
+@pytest.fixture(scope="module")
+def small_reference(robot, client, tmp_path_factory):
+    """The uninterrupted sweep's folder and table."""
+    folder = tmp_path_factory.mktemp("small") / "reference"
+    table = wlx.sweep(robot, SMALL["parameters"], SMALL["runs"], SMALL["metrics"], out=folder, client=client, batch_size=2,
+                      progress=False)
+    assert sorted(f.name for f in (folder / "batches").iterdir()) == [FIRST, SECOND]
+    return folder, table
+
+
+def copy_of(reference, folder):
+    shutil.copytree(reference, folder)
+    (folder / "results.csv").unlink()  # the resumed sweep writes its own
+    return folder
+
+
+def edit_cell(path, row, column, text):
+    rows = list(csv.reader(path.open(newline="")))
+    rows[row][rows[0].index(column)] = text
+    with path.open("w", newline="") as f:
+        csv.writer(f, lineterminator="\n").writerows(rows)
+
+
+def duplicate_last_row(path):
+    lines = path.read_text().splitlines(keepends=True)
+    path.write_text("".join(lines) + lines[-1])
+
+
+# (batch file, how it is spoilt, what the message says)
+SPOILT_BATCHES = {
+    "a NaN edited in": (SECOND, lambda f: edit_cell(f, 2, "peak_tau", "nan"),
+                        r"row 2, peak_tau: 'nan' is not a finite number as the sweep writes one"),
+    "an infinite t_end": (FIRST, lambda f: edit_cell(f, 1, "t_end", "inf"),
+                          r"row 1, t_end: 'inf' is not a finite number as the sweep writes one"),
+    "emptied": (FIRST, lambda f: f.write_bytes(b""), r"empty"),
+    "a row duplicated": (SECOND, duplicate_last_row, r"more than its 4 rows \(2 variants x 2 runs\)"),
+    "only its header": (FIRST, lambda f: f.write_text(f.read_text().splitlines(keepends=True)[0]),
+                        r"0 rows, not its 4 \(2 variants x 2 runs\)"),
+    "a row of another variant": (SECOND, lambda f: edit_cell(f, 3, "variant", "2"), r"row 3, variant: '2' where this sweep has '3'"),
+    "another variant's value": (FIRST, lambda f: edit_cell(f, 1, "legD", "1.5"), r"row 1, legD: '1.5' where this sweep has '1.4'"),
+    "grown to a gigabyte": (FIRST, lambda f: os.truncate(f, 1 << 30), r"larger than \d+ bytes"),
+}
+
+
+@pytest.mark.parametrize("case", list(SPOILT_BATCHES))
+def test_a_resume_runs_a_spoilt_batch_again_and_ends_with_the_uninterrupted_table(robot, client, small_reference, case,
+                                                                                  tmp_path, capsys):
+    reference, reference_table = small_reference
+    name, spoil, reason = SPOILT_BATCHES[case]
+    work = copy_of(reference, tmp_path / "work")
+    spoil(work / "batches" / name)
+    table = wlx.sweep(robot, SMALL["parameters"], SMALL["runs"], SMALL["metrics"], out=work, client=client, batch_size=2,
+                      progress=False)
+    err = capsys.readouterr().err
+    first, last = (0, 1) if name == FIRST else (2, 3)
+    assert re.search("^" + re.escape(f"sweep: {work / 'batches' / name}: ") + reason +
+                     re.escape(f"; its variants {first}..{last} run again") + "$", err, re.M), err
+    assert (work / "results.csv").read_bytes() == (reference / "results.csv").read_bytes()
+    assert (work / "batches" / name).read_bytes() == (reference / "batches" / name).read_bytes()
+    assert table == reference_table
+
+
+def test_the_command_line_runs_a_batch_with_a_nan_again(small_reference, tmp_path):
+    reference, _ = small_reference
+    copy_of(reference, tmp_path / "out")
+    edit_cell(tmp_path / "out" / "batches" / SECOND, 4, "peak_tau_psi_l2", "NaN")
+    spec = write_spec(tmp_path / "s.yaml", {"model": "excavator", **SMALL, "out": "out"})
+    done = sweep_cli([str(spec), "--workers", "1", "--batch-size", "2"], timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert f"{tmp_path / 'out' / 'batches' / SECOND}: row 4, peak_tau_psi_l2: 'NaN' is not a finite number" in done.stderr
+    assert "resuming: 2 of 4 variants already written" in done.stderr
+    assert (tmp_path / "out" / "results.csv").read_bytes() == (reference / "results.csv").read_bytes()
+
+
+def fifo(path):
+    os.mkfifo(path)
+
+
+def dev_zero(path):
+    path.symlink_to("/dev/zero")
+
+
+@pytest.mark.parametrize("target", [f"batches/{FIRST}", "spec.json"])
+@pytest.mark.parametrize("make, kind", [(fifo, "a FIFO"), (dev_zero, "a character device")])
+def test_a_batch_or_identity_file_that_is_not_a_regular_file_is_refused_at_once(robot, small_reference, target, make, kind, tmp_path):
+    reference, _ = small_reference
+    copy_of(reference, tmp_path / "out")
+    path = tmp_path / "out" / target
+    path.unlink()
+    make(path)
+    spec = write_spec(tmp_path / "s.yaml", {"model": "excavator", **SMALL, "out": "out"})
+    started = time.monotonic()
+    done = sweep_cli([str(spec), "--workers", "1", "--batch-size", "2"], timeout=120)  # a hang or a read without end: the timeout
+    assert done.returncode == 2, done.stderr
+    assert f"out: {path}: not a regular file ({kind})" in done.stderr and "Traceback" not in done.stderr
+    assert time.monotonic() - started < 60  # refused before any cluster starts: seconds
+    assert path.is_symlink() or path.is_fifo()  # not removed: the sweep did not put it there
+    with pytest.raises(wlx.Error, match=re.escape(f"out: {path}: not a regular file ({kind})")):
+        wlx.sweep(robot, SMALL["parameters"], SMALL["runs"], SMALL["metrics"], out=tmp_path / "out", batch_size=2, progress=False)
+
+
+@pytest.mark.parametrize("make, kind", [(fifo, "a FIFO"), (dev_zero, "a character device")])
+def test_a_spec_that_is_a_fifo_or_a_device_is_refused_at_once(make, kind, tmp_path):
+    spec = tmp_path / "s.yaml"
+    make(spec)
+    done = sweep_cli([str(spec)], timeout=60)
+    assert done.returncode == 2
+    assert done.stderr == f"wlx sweep: error: {spec}: not a regular file ({kind})\n"
+
+
+def test_aliases_in_a_spec_are_refused_quickly_with_a_short_message(tmp_path):
+    # "Billion laughs": 9 nested lists of 9 aliases each, 9^9 strings to whatever walks the result.
+    lines = ["parameters: {list: [{legD: 1.5}]}", "metrics: [peak_tau]", "runs:", "  - - &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
+    lines += [f"    - &a{k} [" + ", ".join([f"*a{k - 1}"] * 9) + "]" for k in range(1, 9)]
+    spec = tmp_path / "laughs.yaml"
+    spec.write_text("\n".join(lines) + "\n")
+    assert spec.stat().st_size < 1024
+    started = time.monotonic()
+    done = sweep_cli([str(spec)], timeout=60)
+    assert done.returncode == 2
+    assert done.stderr == f"wlx sweep: error: {spec}:5: an alias (*name) is not allowed in a sweep spec: write the value out\n"
+    assert time.monotonic() - started < 30
+    # Nested without end: refused at its depth, not a Python RecursionError.
+    deep = tmp_path / "deep.yaml"
+    deep.write_text("runs: " + "[" * 5000 + "\n")
+    done = sweep_cli([str(deep)], timeout=60)
+    assert done.returncode == 2 and re.fullmatch(r"wlx sweep: error: .*deep\.yaml:1: nested more than 100 deep\n", done.stderr), done.stderr
+
+
+def test_error_messages_quote_and_cut_the_inputs_text(robot):
+    # From Python a structure may share its parts (as aliases would): 9^9 leaves, not written out.
+    laughs = ["lol"] * 9
+    for _ in range(8):
+        laughs = [laughs] * 9
+    started = time.monotonic()
+    with pytest.raises(wlx.Error) as e:
+        wlx.sweep(robot, {"list": [{"legD": 1.5}]}, [laughs], progress=False)
+    assert time.monotonic() - started < 5
+    assert str(e.value).startswith("runs[0]: expected a scenario id, a file or a scenario mapping, got [[[")
+    assert len(str(e.value)) < 150
+    # A name with a terminal's escape sequence and a megabyte of name: quoted, escaped and cut.
+    with pytest.raises(wlx.Error) as e:
+        wlx.sweep(robot, {"grid": {"\x1b[2Jleg": [1.5]}}, ["ID-1"], progress=False)
+    assert str(e.value).startswith(r"parameters.grid.'\x1b[2Jleg': not a parameter of excavator")
+    with pytest.raises(wlx.Error) as e:
+        wlx.sweep(robot, {"grid": {"legD": [1.5]}}, ["x" * 1_000_000], progress=False)
+    assert re.fullmatch(r"runs\[0\]: 'x+\.\.\.x+' is neither a scenario id of excavator nor a file", str(e.value))
+    assert len(str(e.value)) < 150
+    with pytest.raises(wlx.Error, match=r"^parameters\.list\[0\]\.legD: must be a finite number, got 1000000000000"):
+        wlx.sweep(robot, {"list": [{"legD": 10 ** 400}]}, ["ID-1"], progress=False)
+
+
+def test_spec_numbers_are_read_as_yaml_1_2_reads_them():
+    import yaml
+
+    values = yaml.load("[1e-3, 15e-1, .5, -2.5E+3, +7, 3, '1e-3', 010, 0x1f, 0o17, 1:30, 2.]", Loader=_sweep._yaml_loader())
+    assert values == [0.001, 1.5, 0.5, -2500.0, 7, 3, "1e-3", 10, 31, 15, "1:30", 2.0]
+    assert [type(v) for v in values] == [float, float, float, float, int, int, str, int, int, int, str, float]
+
+
+def test_a_spec_with_exponents_sweeps_those_numbers(robot, tmp_path):
+    spec = tmp_path / "e.yaml"
+    spec.write_text("parameters: {grid: {legD: [15e-1, 16E-1, .17e1], m_M1: [54e2]}}\n"
+                    "runs: [{id: ID-1, rates: {x_C: 3e0}, dependent: [y_C, yaw], duration: 5e-2, weighting: 1}]\n"
+                    "metrics: [peak_tau]\n")
+    done = sweep_cli([str(spec), "--workers", "1"], timeout=300)
+    assert done.returncode == 0, done.stderr
+    rows = read_csv(tmp_path / "sweep" / "results.csv")
+    assert [(r["legD"], r["m_M1"]) for r in rows] == [("1.5", "5400.0"), ("1.6", "5400.0"), ("1.7", "5400.0")]
+    run = {**ID1, "duration": 0.05}
+    assert float(rows[1]["peak_tau"]) == peak_tau(robot.simulate(run, params={"legD": 1.6, "m_M1": 5400.0}))
+
+
+def one_variant_spec(tmp_path):
+    return write_spec(tmp_path / "s.yaml", {"parameters": {"list": [{"legD": 1.5}]}, "runs": [{**ID1, "duration": 0.05}],
+                                            "metrics": ["peak_tau"]})
+
+
+def test_a_full_stdout_exits_74_naming_stdout(tmp_path):
+    spec = one_variant_spec(tmp_path)
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([WLX, "sweep", str(spec), "--workers", "1"], stdout=full, stderr=subprocess.PIPE, text=True,
+                              timeout=300, check=False)
+    assert done.returncode == 74, done.stderr
+    assert done.stderr.endswith("\nwlx sweep: error: stdout: writing the output failed (No space left on device); "
+                                "the output is incomplete\n"), done.stderr
+    assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr
+    assert len(read_csv(tmp_path / "sweep" / "results.csv")) == 1  # the files are written; only stdout failed
+
+
+def test_a_closed_pipe_on_stdout_exits_74_naming_stdout(tmp_path):
+    # `wlx sweep SPEC | head -c1` where head is gone before the sweep's one line: the reading end
+    # is closed at once (the line comes at the end, so a reader of one byte would get it whole).
+    spec = one_variant_spec(tmp_path)
+    read, write = os.pipe()
+    p = subprocess.Popen([WLX, "sweep", str(spec), "--workers", "1"], stdout=write, stderr=subprocess.PIPE, text=True)
+    os.close(write)
+    os.close(read)
+    _, err = p.communicate(timeout=300)
+    assert p.returncode == 74, err  # not -SIGPIPE: killed without a word
+    assert err.endswith("\nwlx sweep: error: stdout: writing the output failed (Broken pipe); the output is incomplete\n"), err
+    assert "Traceback" not in err and "Exception ignored" not in err
+
+
+def test_run_ids_reach_the_plots_as_plain_text(robot, client, tmp_path, monkeypatch):
+    # Each figure is also written as SVG with its text as text: the ids must be there as given
+    # (mathtext would draw a$x^2$b as "ab" and a superscript, and c\$d$e without its backslash).
+    import matplotlib.figure
+
+    svgs = []
+    savefig = matplotlib.figure.Figure.savefig
+
+    def also_svg(fig, fname, **kwargs):
+        savefig(fig, fname, **kwargs)
+        text = io.StringIO()
+        with matplotlib.rc_context({"svg.fonttype": "none"}):
+            savefig(fig, text, format="svg")
+        svgs.append(text.getvalue())
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", also_svg)
+    ids = ["a$x^2$b", "c\\$d$e"]
+    runs = [{**ID1, "id": i, "duration": 0.05} for i in ids]
+    wlx.sweep(robot, {"list": [{"legD": 1.5}, {"legD": 1.6}]}, runs, ["peak_tau"], out=tmp_path / "line", client=client,
+              progress=False)
+    assert (tmp_path / "line" / "plots" / "peak_tau-vs-legD.png").stat().st_size > 10000
+    assert len(svgs) == 1 and all(f">{i}</text>" in svgs[0] for i in ids)  # the legend's entries
+    wlx.sweep(robot, {"grid": {"legD": [1.5, 1.6], "m_M1": [5000.0, 6000.0]}}, runs, ["peak_tau"], out=tmp_path / "heat",
+              client=client, progress=False)
+    for safe, i in zip(("a_x_2_b", "c__d_e"), ids):
+        assert (tmp_path / "heat" / "plots" / f"peak_tau-{safe}-heatmap.png").stat().st_size > 5000
+    assert len(svgs) == 3 and [f">peak_tau, run {i}</text>" in svg for svg, i in zip(svgs[1:], ids)] == [True, True]

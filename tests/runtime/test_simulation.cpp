@@ -116,6 +116,11 @@ TEST_CASE("simulation: cabin clearance of the 3 x 3 x 0.5 m block") {
   CHECK(lowest_clearance(p, s) == doctest::Approx(2.0 - 0.25));
   s(c::roll) = 0.1;
   CHECK(lowest_clearance(p, s) == doctest::Approx(2.0 - (std::sin(0.1) * 1.5 + std::cos(0.1) * 0.25)));
+  // The box itself, for drawings (the viewer): the cabin frame and half the model file's sizes.
+  CHECK(gen::kClearanceFrame == gen::frame::C);
+  Eigen::Vector3d half;
+  gen::clearance(s, p, {.half_extents = &half});
+  CHECK(half == Eigen::Vector3d(p.cxd / 2, p.cyd / 2, p.cabin_height / 2));
 }
 
 TEST_CASE("simulation: a run that meets a singular J_beta midway stops there with the reason") {

@@ -15,7 +15,6 @@
 #include <wlx/model.hpp>
 
 #include <Eigen/Geometry>  // AngleAxisd
-#include <Eigen/QR>
 #include <emscripten/emscripten.h>
 
 #include <algorithm>
@@ -77,51 +76,21 @@ std::string array(const Range& range, Print print) {
 std::string integer(int v) { return std::to_string(v); }
 
 // The box of the generated clearance function (the model file's `clearance`: a frame and a size):
-// clearance(s) = z_f - sum_i h_i |R_f(2, i)| for the box's frame f and half extents h. The tables
-// do not name the frame, so it is found here: for each frame, h is fitted to the clearance at a few
-// poses of the base (each solved by the IK) and checked against all of them; the first frame the
-// formula fits to 1e-9 m is the box's. The model file's parameter names never appear here.
+// The clearance box as the model file gives it: its frame (structure.hpp) and its half sizes, which
+// the generated clearance() evaluates from the parameters.
 struct ClearanceBox {
   int frame = -1;
   Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();
 };
 
 ClearanceBox clearance_box() {
-  const std::array<std::array<double, 3>, 6> turns{{{0.3, 0.1, 0.2}, {-0.2, 0.25, -0.4}, {0.1, -0.3, 0.7},
-                                                   {0.35, 0.2, -0.1}, {-0.15, -0.1, 0.3}, {0.05, 0.02, 0.0}}};
-  std::vector<Coordinates> poses;
-  std::vector<double> lowest;
-  // The turns, and a quarter of them where a smaller machine's legs cannot follow the larger ones
-  // (the wheeled quadruped's reach ends before 0.4 rad of pitch).
-  for (double scale : {1.0, 0.25})
-  for (const auto& [pitch, roll, yaw] : turns) {
-    if (scale < 1 && poses.size() >= 4) break;
-    Coordinates s = nominal_inputs();
-    s(3) += scale * yaw, s(4) += scale * pitch, s(5) += scale * roll;
-    try {
-      solve_ik_closed_form(model(), s);
-    } catch (const Error&) {
-      continue;  // out of reach at this pose: the others decide
-    }
-    double value = 0;
-    gen::clearance(s, model().params(), {.lowest = &value});
-    poses.push_back(s);
-    lowest.push_back(value);
-  }
-  const int n = static_cast<int>(poses.size());
-  if (n < 4) return {};
-  for (int f = 0; f < gen::kFrameCount; ++f) {
-    Eigen::MatrixXd A(n, 3);
-    Eigen::VectorXd b(n);
-    for (int k = 0; k < n; ++k) {
-      forward_kinematics(model(), data(), poses[static_cast<std::size_t>(k)]);
-      A.row(k) = frame_rotation(data(), f).row(2).cwiseAbs();
-      b(k) = frame_position(data(), f).z() - lowest[static_cast<std::size_t>(k)];
-    }
-    const Eigen::Vector3d h = A.colPivHouseholderQr().solve(b);
-    if ((A * h - b).cwiseAbs().maxCoeff() < 1e-9 && (h.array() >= 0).all() && h.maxCoeff() > 0) return {f, h};
-  }
+#if __has_include(<wlx/gen/clearance.hpp>)
+  ClearanceBox box{gen::kClearanceFrame, Eigen::Vector3d::Zero()};
+  gen::clearance(nominal_inputs(), model().params(), {.half_extents = &box.half_extents});
+  return box;
+#else
   return {};
+#endif
 }
 
 // Whether the first six inputs are the pose of frame 0 as position and Rz(yaw) Ry(pitch) Rx(roll)

@@ -16,8 +16,8 @@
 //   dynamics_update              150         37306          1043
 //   reduced_dynamics             484        145199          6505
 //   generalized_forces           110          7426          2377
-//   clearance                      0            19            20
-//   total                                   420190         17426
+//   clearance                      0            22            23
+//   total                                   420193         17429
 #pragma once
 
 #include "ik.hpp"

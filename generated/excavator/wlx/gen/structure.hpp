@@ -219,6 +219,8 @@ struct SweepInfo {
 };
 
 inline constexpr bool kHasClearance = true;
+// The frame the clearance box moves with (frame::; -1: none); its size: clearance()'s half_extents.
+inline constexpr int kClearanceFrame = 0;
 
 }  // namespace gen
 }  // namespace excavator

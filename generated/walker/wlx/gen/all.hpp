@@ -16,8 +16,8 @@
 //   dynamics_update              183         47698           988
 //   reduced_dynamics             601        151284          6482
 //   generalized_forces           122          7864          2412
-//   clearance                      0            19            20
-//   total                                   477874         17763
+//   clearance                      0            22            23
+//   total                                   477877         17766
 #pragma once
 
 #include "ik.hpp"

@@ -16,8 +16,8 @@
 //   dynamics_update              361        102428          1916
 //   reduced_dynamics            1130        371844         18793
 //   generalized_forces           236         16742          4979
-//   clearance                      0            19            19
-//   total                                  1111764         39857
+//   clearance                      0            22            22
+//   total                                  1111767         39860
 #pragma once
 
 #include "ik.hpp"

@@ -22,17 +22,19 @@ namespace gen {
 // Outputs, members of ClearanceOutputsOf<Scalar> (ClearanceOutputs for double), each computed only when its
 // pointer is set (C++20: clearance(..., {.lowest = &x})):
 //   lowest             height of the lowest corner above the ground, m (own operations: 15, nonzero entries: 1)
+//   half_extents       the box's half sizes along the frame's x, y, z axes, m (parameters only) (own operations: 3, nonzero entries: 3)
 // Intermediate terms: 0; shared by several outputs: 4 operations (sin and cos of all angles
 // included: they are computed up front, whichever outputs are requested).
-// Operations with every output requested: 19 (adds 4, muls 8, divs 0, calls 7).
-// The same outputs as expression trees, before CSE: 19 (adds 3, muls 8, divs 0, calls 8).
+// Operations with every output requested: 22 (adds 4, muls 11, divs 0, calls 7).
+// The same outputs as expression trees, before CSE: 22 (adds 3, muls 11, divs 0, calls 8).
 // Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by
 // argument-dependent lookup; deduced from s. The parameters stay double.
 // Where clearance() writes: set the outputs you want; a null pointer skips that output and the
 // work only it needs.
 template <typename Scalar>
 struct ClearanceOutputsOf {
-  Scalar* lowest = nullptr;  // height of the lowest corner above the ground, m
+  Scalar* lowest = nullptr;                   // height of the lowest corner above the ground, m
+  Vector3Of<Scalar>* half_extents = nullptr;  // the box's half sizes along the frame's x, y, z axes, m (parameters only)
 };
 using ClearanceOutputs = ClearanceOutputsOf<double>;
 
@@ -41,6 +43,7 @@ inline void clearance(const CoordinatesOf<Scalar>& s, const Params& p, const det
   static_cast<void>(s);
   static_cast<void>(p);
   const auto lowest = out.lowest;
+  const auto half_extents = out.half_extents;
   using std::abs;
   const Scalar z_B = s(2);
   const Scalar pitch = s(4);
@@ -58,6 +61,11 @@ inline void clearance(const CoordinatesOf<Scalar>& s, const Params& p, const det
   const Scalar sin_roll = sin_angle[1];
   if (lowest != nullptr) {
     *lowest = z_B - Scalar(0.5)*abs(sin_roll*cos_pitch)*base_width - Scalar(0.5)*base_length*abs(-sin_pitch) - Scalar(0.5)*abs(cos_roll*cos_pitch)*base_height;
+  }
+  if (half_extents != nullptr) {
+    (*half_extents)(0) = Scalar(0.5)*base_length;
+    (*half_extents)(1) = Scalar(0.5)*base_width;
+    (*half_extents)(2) = Scalar(0.5)*base_height;
   }
 }
 
@@ -93,7 +101,7 @@ WLX_GEN_DOUBLE_INLINE void clearance(const Coordinates& s, const Params& p, cons
 
 namespace operations {
 // Operations clearance() evaluates with every output requested (adds, muls, divs, calls).
-inline constexpr long clearance = 19;
+inline constexpr long clearance = 22;
 }  // namespace operations
 
 }  // namespace gen
