@@ -38,7 +38,9 @@ int UrdfRobot::joint_index(const std::string& n) const {
 
 bool urdf_import_available() { return false; }
 
-UrdfRobot read_urdf(const std::string&, const std::string& shown_name) {
+UrdfRobot read_urdf(const std::string& path, const std::string& shown_name) { return read_urdf_text(path, shown_name); }
+
+UrdfRobot read_urdf_text(const std::string&, const std::string& shown_name) {
   throw ModelFileError(fmt::format("{}: URDF import is unavailable: this wlx-gen was built without liburdfdom (install "
                                    "Debian's liburdfdom-dev and configure again), or write the model file by hand "
                                    "(docs/model-format.md)",
@@ -115,7 +117,10 @@ UrdfRobot read_urdf(const std::string& path, const std::string& shown_name) {
   if (!in) throw ModelFileError(fmt::format("{}: cannot open the URDF file", shown_name));
   std::ostringstream buffer;
   buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  return read_urdf_text(buffer.str(), shown_name);
+}
+
+UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name) {
   if (text.size() > (64u << 20)) throw ModelFileError(fmt::format("{}: a URDF of more than 64 MB is not read", shown_name));
   const Checker check(shown_name);
 

@@ -62,5 +62,7 @@ bool urdf_import_available();
 
 // Reads and checks the URDF at `path`; messages call it `shown_name`. Throws ModelFileError.
 UrdfRobot read_urdf(const std::string& path, const std::string& shown_name);
+// The same for a URDF's text (the fuzz target's way in).
+UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name);
 
 }  // namespace wlx::codegen

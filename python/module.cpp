@@ -161,6 +161,11 @@ PYBIND11_MODULE(_wlx, m) {
             sink.row = [&](long row, const std::vector<double>& values) {
               for (std::size_t c = 0; c < values.size() && c < columns.size(); ++c) columns[c].mutable_at(row) = values[c];
             };
+            // Ctrl-C during a long run: Python's handler runs here (the GIL is held), and its
+            // KeyboardInterrupt ends the run at the next sample, microseconds later.
+            sink.poll = [] {
+              if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+            };
             const wlx::cli::SimulationOutcome run = h.api->simulate(scenario_json, params_json, every, std::move(function), sink);
             py::dict out_columns;
             for (std::size_t c = 0; c < columns.size(); ++c) {

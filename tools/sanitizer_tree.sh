@@ -39,7 +39,7 @@ export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktra
 # CLN and GiNaC keep memory until exit (tools/lsan.supp). print_suppressions=0: the tests compare
 # the exact standard error of the programs they run, which must not gain LeakSanitizer's summary.
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tools/lsan.supp:print_suppressions=0}
-fuzz_targets=(ik_numbers json_input model_file command_line report_file)
+fuzz_targets=(ik_numbers json_input model_file command_line report_file urdf)
 
 case "$what" in
   test)
@@ -61,7 +61,7 @@ case "$what" in
       local target=$1 work=$tree/corpus-$1 artifacts=$tree/artifacts-$1
       mkdir -p "$work" "$artifacts" "tests/fuzz/regressions/$target"
       local seeds=("tests/fuzz/corpus/$target" "tests/fuzz/regressions/$target")
-      [ "$target" = model_file ] && seeds+=(models)
+      [ "$target" = model_file ] || [ "$target" = urdf ] && seeds+=(models)
       [ "$target" = report_file ] && seeds+=(scenarios/excavator)  # as the replay test (tests/CMakeLists.txt)
       ASAN_OPTIONS=detect_leaks=1 "$tree/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -max_len=4096 \
           -timeout=10 -artifact_prefix="$artifacts/" "$work" "${seeds[@]}" > "$tree/fuzz-$target.log" 2>&1

@@ -24,6 +24,7 @@ inline constexpr double kMaxAngularRate = 100;    // rad/s (about 16 turns per s
 inline constexpr double kMaxWeightRatio = 1e12;   // largest / smallest diagonal torque weight
 inline constexpr double kMaxTorque = 1e9;         // N m (or N): any actuator, in a torque table
 inline constexpr std::size_t kMaxTorqueRows = 1'000'000;  // rows of a torque table: 1000 s at 1 ms, ~0.1 GB
+inline constexpr double kMinTorqueRowGap = 1e-9;  // s (relative beyond 1 s): consecutive rows of a torque table
 
 // Whether a coordinate is an angle (unit rad): only angles may be given as {"deg": x}.
 bool is_angle(int coordinate);

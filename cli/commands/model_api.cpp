@@ -240,6 +240,12 @@ SimulationOutcome api_simulate(const std::string& scenario_json, const std::stri
       if (tau.size() != kActuatedCount)
         throw Error("torques", "the function returned " + std::to_string(tau.size()) + " numbers; the model has " +
                                    std::to_string(kActuatedCount) + " actuators");
+      // Within a torque table's bound (a 1e300 overflowed the step into NaN, and the run stopped for
+      // another cause); a non-finite torque the run itself names.
+      for (int k = 0; k < kActuatedCount; ++k)
+        if (std::isfinite(tau(k)) && std::abs(tau(k)) > kMaxTorque)
+          throw Error("torques." + std::string(kActuatorNames[static_cast<std::size_t>(k)]),
+                      fmt::format("the function gave {:g} at t = {:.6f} s, beyond the bound of {:g} (N m or N)", tau(k), t, kMaxTorque));
       return tau;
     };
   // The overrides win over the scenario's own "params" (an id's, a file's or an object's), key by
@@ -254,6 +260,7 @@ SimulationOutcome api_simulate(const std::string& scenario_json, const std::stri
   sink.begin(header, kept);
   long index = 0, rows = 0;
   const Trajectory run = simulate_each(sc, [&](const Sample& smp) {
+    if (sink.poll) sink.poll();
     if (index++ % every != 0 || rows >= kept) return;
     sink.row(rows++, trajectory_row(smp, sc));
   });

@@ -176,6 +176,15 @@ TorqueTable torque_table(const std::map<std::string, std::vector<double>>& colum
   const std::vector<double>& times = columns.at("t");
   if (times.size() > kMaxTorqueRows)
     throw Error(key, fmt::format("{} rows, more than the limit of {}", times.size(), kMaxTorqueRows));
+  // Rows closer than an integrator step can resolve: a cubic's slopes divide by the gap, so two
+  // rows 1e-300 s apart made an infinite torque a run stopped on far from the table.
+  for (std::size_t r = 1; r < times.size(); ++r) {
+    const double gap = times[r] - times[r - 1];
+    if (gap > 0 && gap < kMinTorqueRowGap * std::max(1.0, std::abs(times[r])))
+      throw Error(key + ".t", fmt::format("rows {} and {} are {:g} s apart: a table's rows must be at least {:g} s apart (relative "
+                                          "to t beyond 1 s), which an integrator step can resolve",
+                                          r - 1, r, gap, kMinTorqueRowGap));
+  }
   std::vector<TorqueVector> rows(times.size());
   for (int a = 0; a < kActuatedCount; ++a) {
     const std::string name = "tau_" + std::string(kActuatorNames[static_cast<std::size_t>(a)]);

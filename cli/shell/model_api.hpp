@@ -35,6 +35,9 @@ using TorqueFunction = std::function<Eigen::VectorXd(double t, const Eigen::Vect
 struct SimulationSink {
   std::function<void(const std::vector<std::string>& header, long kept)> begin;
   std::function<void(long row, const std::vector<double>& values)> row;
+  // Called at every sample, kept or not: a host checks its signals there (Python's Ctrl-C) and may
+  // throw to end the run. Empty: nothing to check.
+  std::function<void()> poll;
 };
 struct SimulationOutcome {
   std::string id;

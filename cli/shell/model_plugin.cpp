@@ -3,6 +3,7 @@
 #include "bounded_input.hpp"
 #include "interrupt.hpp"
 #include "process.hpp"
+#include "sha256.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -184,9 +185,10 @@ std::vector<std::string> optimization_flags(bool commands = false) {
   return out;
 }
 
+// A file's SHA-256 and size: what a plugin must still be when it is loaded.
 std::string file_checksum(const fs::path& path, std::uintmax_t& size) {
   std::ifstream in(path, std::ios::binary);
-  Hash h;
+  Sha256 h;
   size = 0;
   std::vector<char> buffer(1 << 16);
   while (in) {
@@ -224,6 +226,20 @@ void check_private(const fs::path& path, const char* what, bool follow) {
     throw Error("--model-file", fmt::format("the cache's {} {} may be written by others (mode {:04o}): code planted in it would run "
                                             "inside wlx; chmod go-w {}, or set WLX_CACHE_DIR to a folder of your own",
                                             what, path.string(), st.st_mode & 07777, path.string()));
+}
+
+// The cache's index: the SHA-256 of every plugin this cache built, one "<entry> <digest>" line
+// each, in the cache folder (which only its user may write: check_private). A plugin is
+// dlopen()ed only when its bytes have the digest recorded here when it was built, so an entry
+// whose plugin.so and manifest were replaced together, or copied in from elsewhere, is never run.
+fs::path index_path(const fs::path& cache) { return cache / "index"; }
+
+std::string indexed_digest(const fs::path& cache, const std::string& stem) {
+  check_private(index_path(cache), "index", false);
+  std::istringstream in(read_small(index_path(cache), std::size_t{16} << 20));
+  for (std::string line; std::getline(in, line);)
+    if (line.size() == stem.size() + 65 && line.compare(0, stem.size(), stem) == 0 && line[stem.size()] == ' ') return line.substr(stem.size() + 1);
+  return {};
 }
 
 // The settings of each plugin loaded in this process, by library: a second description of the same
@@ -269,6 +285,10 @@ const ModelCommands* try_load(const fs::path& entry, const std::string& key, con
   const std::string checksum = fs::is_regular_file(library, ec) ? file_checksum(library, size) : std::string();
   if (checksum.empty() || checksum != manifest_value(manifest, "checksum") || std::to_string(size) != manifest_value(manifest, "size")) {
     why = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
+    return nullptr;
+  }
+  if (checksum != indexed_digest(entry.parent_path(), entry.filename().string())) {
+    why = fmt::format("plugin.so is not one this cache built (its SHA-256 is not the one {} recorded)", index_path(entry.parent_path()).string());
     return nullptr;
   }
   fs::path load = library;
@@ -367,6 +387,18 @@ std::string include_line(const fs::path& path) {
   return "#include \"" + p + "\"\n";
 }
 
+// A compiler's command line that dies with wlx: util-linux's setpriv (Debian's essential set) sets
+// its parent-death signal, then runs it, so a wlx killed (kill -9) during a first use leaves no
+// compiler running. (GCC's driver dies so; the cc1plus it started finishes its file into the build
+// folder, which the next first use removes. Clang compiles in its driver's process.)
+std::vector<std::string> dying_with_wlx(const std::vector<std::string>& argv) {
+  static const bool setpriv = ::access("/usr/bin/setpriv", X_OK) == 0;
+  if (!setpriv) return argv;
+  std::vector<std::string> out{"/usr/bin/setpriv", "--pdeathsig", "KILL", "--"};
+  out.insert(out.end(), argv.begin(), argv.end());
+  return out;
+}
+
 struct Job {
   std::string name;
   std::vector<std::string> argv;
@@ -392,7 +424,7 @@ Timings run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path
   while (next < jobs.size() || !running.empty()) {
     while (next < jobs.size() && running.size() < parallel) {
       const Job& job = jobs[next++];
-      const int pid = start_program(job.argv, {}, job.log.string());
+      const int pid = start_program(dying_with_wlx(job.argv), {}, job.log.string());
       if (pid < 0) {
         stop_all();
         throw Error("--model-file", fmt::format("cannot run '{}' for the {}{}", job.argv.front(), job.name,
@@ -421,6 +453,11 @@ Timings run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path
     if (interrupt_signal() != 0) {
       stop_all();
       throw_if_interrupted();
+    }
+    if (!r.started) {  // setpriv ran, the compiler did not (exit 127)
+      stop_all();
+      throw Error("--model-file", fmt::format("cannot run '{}' for the {}{}", job->argv.front(), job->name,
+                                              job->argv.front() == compiler() ? " (set CXX to a C++ compiler)" : ""));
     }
     if (!r.ok()) {
       stop_all();
@@ -598,6 +635,18 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   wlx::diagnose("wlx: compiled model {} in {:.1f} s\n", name, seconds);
 }
 
+// Records a plugin's SHA-256 in the cache's index (under its own lock: entries of other models are
+// built at the same time), replacing the entry's earlier line.
+void record_digest(const fs::path& cache, const std::string& stem, const std::string& digest) {
+  const FileLock lock(cache / "index.lock", "wlx: waiting for another wlx writing the cache's index");
+  check_private(index_path(cache), "index", false);
+  std::istringstream in(read_small(index_path(cache), std::size_t{16} << 20));
+  std::string kept;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line.rfind(stem + " ", 0) != 0) kept += line + "\n";
+  write_file_atomically(index_path(cache).string(), kept + stem + " " + digest + "\n");
+}
+
 // The cache entry of the model file loaded last (load_model_file), for its viewer module.
 struct LoadedEntry {
   fs::path cache, entry;
@@ -677,6 +726,7 @@ const ModelCommands& load_model_file(const std::string& model_file, const std::s
   fs::create_directories(building.path, ec);
   if (ec) throw Error("--model-file", fmt::format("cannot create {} ({})", building.path.string(), ec.message()));
   build_plugin(model_file, description, key, building.path, cache / (stem + ".failed"));
+  record_digest(cache, stem, manifest_value(read_small(building.path / "manifest", 1 << 16), "checksum"));
   fs::rename(building.path, entry, ec);
   if (ec) throw Error("--model-file", fmt::format("cannot put the plugin in place at {} ({})", entry.string(), ec.message()));
   building.keep = true;

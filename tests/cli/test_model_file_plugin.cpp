@@ -217,19 +217,47 @@ TEST_CASE("--model-file: editing only the file's numbers compiles nothing (the c
   CHECK(code.err.find("wlx: compiling model excavator for first use") != std::string::npos);
 }
 
-TEST_CASE("--model-file: a corrupt cache entry is never loaded but rebuilt, and two processes that find it so compile once") {
+// The SHA-256 of a file by coreutils' sha256sum: an implementation other than wlx's.
+std::string sha256sum(const fs::path& file) {
+  const auto r = run({file.string()}, {.program = "/usr/bin/sha256sum"});
+  REQUIRE(r.code == 0);
+  return r.out.substr(0, 64);
+}
+
+TEST_CASE("--model-file: a corrupt or replaced cache entry is never loaded but rebuilt, and two processes that find it so compile once") {
   const Setup& s = setup();
   REQUIRE(run({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose}).code == 0);  // built (by the case above)
   REQUIRE(entries().size() == 1);
-  const fs::path plugin = entries().front() / "plugin.so";
+  const fs::path entry = entries().front(), plugin = entry / "plugin.so";
   const std::string expected = run({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose}).out;
-  {  // the same size, other bytes: only the checksum can tell
-    std::string bytes = slurp(plugin);
-    for (std::size_t k = bytes.size() / 2; k < bytes.size() / 2 + 64; ++k) bytes[k] = static_cast<char>(~bytes[k]);
-    write(plugin, bytes);
-  }
+  const std::string good_plugin = slurp(plugin), good_manifest = slurp(entry / "manifest");
+  // The manifest and the cache's index hold the plugin's SHA-256, as sha256sum computes it.
+  CHECK(good_manifest.find("checksum " + sha256sum(plugin) + "\n") != std::string::npos);
+  CHECK(slurp(s.cache / "index").find(entry.filename().string() + " " + sha256sum(plugin) + "\n") != std::string::npos);
+  std::string spoilt = good_plugin;  // the same size, other bytes: only a digest can tell
+  for (std::size_t k = spoilt.size() / 2; k < spoilt.size() / 2 + 64; ++k) spoilt[k] = static_cast<char>(~spoilt[k]);
+
+  // Corrupt: the bytes no longer match the manifest. Found before dlopen; the rebuild that follows
+  // fails here at once (CXX=/bin/false), which shows it was not loaded.
+  write(plugin, spoilt);
+  ::setenv("CXX", "/bin/false", 1);
+  const auto corrupt = run({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose});
+  ::unsetenv("CXX");
+  CHECK(corrupt.code == 1);
+  CHECK(corrupt.err.find("cannot be used (plugin.so is missing or does not match its manifest") != std::string::npos);
+
+  // Replaced with a manifest to match: only the index, which the entry cannot rewrite, can tell.
+  fs::create_directories(entry);
+  write(plugin, spoilt);
+  const fs::path spoilt_copy = wlx_test::work_dir() / "spoilt.so";
+  write(spoilt_copy, spoilt);
+  std::string manifest = good_manifest;
+  const auto at = manifest.find("checksum ");
+  REQUIRE(at != std::string::npos);
+  manifest.replace(at + 9, 64, sha256sum(spoilt_copy));
+  write(entry / "manifest", manifest);
   // The build folder a killed first use left behind (its pid runs no more): removed when building.
-  const fs::path abandoned = s.cache / (entries().front().filename().string() + ".build-2147483000");
+  const fs::path abandoned = s.cache / (entry.filename().string() + ".build-2147483000");
   fs::create_directories(abandoned / "generated");
   auto a = wlx_test::start({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose});
   auto b = wlx_test::start({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose});
@@ -241,9 +269,10 @@ TEST_CASE("--model-file: a corrupt cache entry is never loaded but rebuilt, and 
   CHECK(ra.out == expected);
   CHECK(rb.out == expected);
   CHECK(count(ra.err + rb.err, "wlx: compiled model excavator") == 1);  // one compiled, the other waited or found it built
-  CHECK(count(ra.err + rb.err, "cannot be used (plugin.so is missing or does not match its manifest") == 1);
+  CHECK(count(ra.err + rb.err, "cannot be used (plugin.so is not one this cache built (its SHA-256 is not the one") == 1);
   CHECK(entries().size() == 1);
   CHECK(!fs::exists(abandoned));
+  CHECK(slurp(s.cache / "index").find(entry.filename().string() + " " + sha256sum(plugin) + "\n") != std::string::npos);
   // (A plugin of another key in an entry's place: the last case.)
 }
 
@@ -424,6 +453,48 @@ TEST_CASE("--model-file: SIGINT, SIGTERM or SIGHUP while compiling: stopped at o
     }
   }
   CHECK(entries().size() == 1);  // only the entry of the other cases
+}
+
+// The processes (other than this one) whose command line holds `text`.
+std::vector<int> processes_with(const std::string& text) {
+  std::vector<int> out;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos || std::stoi(name) == ::getpid()) continue;
+    std::string cmdline = slurp(e.path() / "cmdline");
+    for (char& c : cmdline)
+      if (c == '\0') c = ' ';
+    if (cmdline.find(text) != std::string::npos) out.push_back(std::stoi(name));
+  }
+  return out;
+}
+
+TEST_CASE("--model-file: kill -9 while compiling leaves no compiler running; the next first use removes its build folder") {
+  const Setup& s = setup();
+  ::setenv("WLX_PLUGIN_CXXFLAGS", "-O0 -DWLX_KILL_TEST", 1);  // a key with no entry yet: this run compiles
+  const auto started = std::chrono::steady_clock::now();
+  auto p = wlx_test::start({"--model-file", s.model.string(), "fk"}, {.input = "{}"});
+  const std::string build_folder = ".build-" + std::to_string(p.pid);
+  while (processes_with(build_folder).empty() && std::chrono::steady_clock::now() - started < std::chrono::seconds(30))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  REQUIRE_MESSAGE(!processes_with(build_folder).empty(), "no compiler of wlx's build folder ever ran");
+  ::kill(p.pid, SIGKILL);
+  const auto r = wlx_test::finish(p);
+  CHECK(r.signal == SIGKILL);
+  // The compilers had their parent-death signal: gone within moments (2 s: a loaded machine's slack).
+  const auto killed = std::chrono::steady_clock::now();
+  while (!processes_with(build_folder).empty() && std::chrono::steady_clock::now() - killed < std::chrono::seconds(2))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  CHECK(processes_with(build_folder).empty());
+  bool left = false;
+  for (const auto& e : fs::directory_iterator(s.cache)) left = left || e.path().filename().string().find(build_folder) != std::string::npos;
+  CHECK(left);  // nothing could remove it: wlx was killed
+  // The next first use of that key removes it before building (here with a compiler that fails at once).
+  ::setenv("CXX", "/bin/false", 1);
+  CHECK(run({"--model-file", s.model.string(), "fk"}, {.input = "{}"}).code == 1);
+  ::unsetenv("CXX");
+  ::setenv("WLX_PLUGIN_CXXFLAGS", "-O0", 1);
+  for (const auto& e : fs::directory_iterator(s.cache)) CHECK(e.path().filename().string().find(build_folder) == std::string::npos);
 }
 
 TEST_CASE("--model-file with --scenarios: a user's runs in every command; a run written for another model is refused") {

@@ -8,8 +8,10 @@ import json
 import math
 import os
 import re
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -255,6 +257,43 @@ def test_simulate_torque_function_errors():
     # A non-finite torque stops the run (its samples up to then are kept) and says why.
     run = robot.simulate({"duration": 0.01}, torques=lambda t, s, u: np.full(8, np.nan if t > 0.005 else 0.0))
     assert not run["complete"] and "non-finite torque" in run["stopped"] and run["t"][-1] <= 0.005 + 1e-12
+    # A torque beyond a table's bound of 1e9 stops it the same way, naming the actuator, the value and
+    # the bound (1e300 used to overflow the step and stop it with "-nan" for another cause).
+    run = robot.simulate({"duration": 0.01}, torques=lambda t, s, u: np.full(8, 1e300 if t > 0.005 else 0.0))
+    assert not run["complete"] and run["t"][-1] <= 0.005 + 1e-12, run["stopped"]
+    assert "torques.psi_l2: the function gave 1e+300 at t = 0.00" in run["stopped"], run["stopped"]
+    assert "beyond the bound of 1e+09" in run["stopped"] and "nan" not in run["stopped"], run["stopped"]
+
+
+def test_a_torque_table_whose_rows_are_closer_than_a_step_can_resolve_is_an_error_naming_it():
+    robot = wlx.model("excavator")
+    table = {"t": [0.0, 1e-300, 0.005, 0.01], "interpolation": "cubic",
+             **{"tau_" + a: [0.0, 1.0, 2.0, 0.0] for a in robot.actuators}}
+    with pytest.raises(wlx.Error, match=r"^torques\.t: rows 0 and 1 are 1e-300 s apart: a table's rows must be at least 1e-09 s apart"):
+        robot.simulate({"duration": 0.01, "torques": table})
+
+
+def test_ctrl_c_stops_a_long_run_at_once():
+    # A run of 2 x 10^6 steps (about 20 s); SIGINT a second in: Python's KeyboardInterrupt ends it
+    # within a fraction of a second, not when the C++ loop would have finished.
+    script = ("import time, wlx\n"
+              "robot = wlx.model('excavator')\n"
+              "print('running', flush=True)\n"
+              "start = time.monotonic()\n"
+              "try:\n"
+              "    robot.simulate({'rates': {'x_C': 0.0}, 'dependent': ['y_C', 'yaw'], 'duration': 2000.0, 'dt': 0.001}, every=100000)\n"
+              "except KeyboardInterrupt:\n"
+              "    print('interrupted', flush=True)\n")
+    env = dict(os.environ)
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
+    assert child.stdout.readline() == "running\n"
+    time.sleep(1.0)
+    child.send_signal(signal.SIGINT)
+    sent = time.monotonic()
+    out, _ = child.communicate(timeout=30)
+    stopped_after = time.monotonic() - sent
+    assert out == "interrupted\n", out
+    assert stopped_after < 1.0, stopped_after  # the run had about 19 s to go
 
 
 BAD_IK = [
