@@ -50,8 +50,9 @@ EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::
   Json params = Json::array();
   for (std::size_t k = 0; k < m.parameters.size(); ++k) {
     const auto& p = m.parameters[k];
-    params.push_back({{"name", p.name}, {"value", p.default_value}, {"unit", p.unit}, {"kind", kind_name(m.parameter_kinds[k])},
-                      {"meaning", p.meaning}});
+    const auto baked = opt.baked.find(p.name);  // a baked value is the one the code uses
+    params.push_back({{"name", p.name}, {"value", baked == opt.baked.end() ? p.default_value : baked->second}, {"unit", p.unit},
+                      {"kind", kind_name(m.parameter_kinds[k])}, {"meaning", p.meaning}});
   }
   d["parameters"] = params;
   Json coordinates = Json::array();

@@ -372,11 +372,12 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   // The axes meet when the offset between the joints lies in the plane of the two axes.
   const int a1 = static_cast<int>(j1.axis), a2 = static_cast<int>(j2.axis), across = 3 - a1 - a2;
   if (!identically_zero(between.offset[across])) {
-    const double gap = at_defaults(m, between.offset[across]);
+    // No value at the defaults in the reason: it reaches ik.hpp's comments, whose text must not
+    // depend on the parameters' values (wlx-gen --data-at-run-time: numbers are data).
     throw Unsolvable{fmt::format("point3: the axes of {} and {} do not meet: the offset between the joints ({}) has a {} "
-                                 "component ({:.4g} m at the defaults), across both axes; point3 needs it along the two axes (an offset "
+                                 "component across both axes; point3 needs it along the two axes (an offset "
                                  "across them that belongs further down the limb goes after the second joint)",
-                                 n1, n2, describe(m, c.fixed[1]), axis_name(static_cast<Axis>(across)), gap)};
+                                 n1, n2, describe(m, c.fixed[1]), axis_name(static_cast<Axis>(across)))};
   }
   // The meeting point P: on the first axis at the offset's component along it; from the second
   // joint's frame it lies back along the second axis by the offset's component along that one.

@@ -345,6 +345,9 @@ class Parser {
                          "bodies", "closure", "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "contacts",
                          "nominal", "ik_sweeps"});
     if (auto r = f.optional("repeat")) repeats(*r);
+    // The inputs are the YAML file's to name (the URDF's moving joints become the dependent ones):
+    // missing, they are said to be here, where the file is, not in the document made from it.
+    static_cast<void>(Fields(f["coordinates"], {"inputs", "dependent"})["inputs"]);
     const std::optional<Item> urdf_item = f.optional("urdf");
     const Item& where = urdf_item ? *urdf_item : top;
     std::string path = urdf_override_;

@@ -146,6 +146,7 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
         i = stop;
       };
       if (text.compare(i, 4, "<!--") == 0) skip_to("-->");
+      else if (text.compare(i, 9, "<![CDATA[") == 0) skip_to("]]>");  // text, whatever its brackets
       else if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) skip_to(">");
       else if (text.compare(i, 2, "</") == 0) depth = std::max(0, depth - 1);
       else {

@@ -23,9 +23,11 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <map>
+#include <mutex>
 #include <fstream>
 #include <sstream>
 #include <sys/file.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <thread>
 #include <unistd.h>
@@ -211,6 +213,8 @@ std::string manifest_value(const std::string& manifest, const std::string& key) 
 // what nobody else may write is trusted: the cache folder (followed if it is a link) and each
 // entry's folder, plugin and manifest (never links). Anything else is an error naming it, never
 // used and never removed (it is not ours to remove); the README says how to mend it.
+void check_private_stat(const struct stat& st, const fs::path& path, const char* what);
+
 void check_private(const fs::path& path, const char* what, bool follow) {
   struct stat st {};
   if ((follow ? ::stat(path.c_str(), &st) : ::lstat(path.c_str(), &st)) != 0) return;  // absent: nothing to trust yet
@@ -218,14 +222,23 @@ void check_private(const fs::path& path, const char* what, bool follow) {
     throw Error("--model-file", fmt::format("the cache's {} {} is a symbolic link: a cache entry is never followed elsewhere; "
                                             "remove it",
                                             what, path.string()));
+  check_private_stat(st, path, what);
+}
+
+// The owner and mode of what `st` describes (the cache's `what` at `path`).
+void check_private_stat(const struct stat& st, const fs::path& path, const char* what) {
+  // A sticky folder others may write (/tmp) or a folder of another user cannot be made private by
+  // its user: only another cache folder helps.
+  const bool only_elsewhere = (st.st_mode & S_ISVTX) != 0 || st.st_uid != ::geteuid();
   if (st.st_uid != ::geteuid())
     throw Error("--model-file", fmt::format("the cache's {} {} belongs to another user (uid {}): code in it would run inside wlx; "
                                             "set WLX_CACHE_DIR to a folder of your own",
                                             what, path.string(), st.st_uid));
   if ((st.st_mode & (S_IWGRP | S_IWOTH)) != 0)
     throw Error("--model-file", fmt::format("the cache's {} {} may be written by others (mode {:04o}): code planted in it would run "
-                                            "inside wlx; chmod go-w {}, or set WLX_CACHE_DIR to a folder of your own",
-                                            what, path.string(), st.st_mode & 07777, path.string()));
+                                            "inside wlx; {}set WLX_CACHE_DIR to a folder of your own",
+                                            what, path.string(), st.st_mode & 07777,
+                                            only_elsewhere ? std::string() : fmt::format("chmod go-w {}, or ", path.string())));
 }
 
 // The cache's index: the SHA-256 of every plugin this cache built, one "<entry> <digest>" line
@@ -234,33 +247,79 @@ void check_private(const fs::path& path, const char* what, bool follow) {
 // whose plugin.so and manifest were replaced together, or copied in from elsewhere, is never run.
 fs::path index_path(const fs::path& cache) { return cache / "index"; }
 
+// The index's text: absent is empty; anything but a private regular file within its bound is an
+// error naming it, before any entry is judged by it (a damaged index must not cost good plugins).
+constexpr std::uintmax_t kMaxIndexBytes = std::uintmax_t{16} << 20;
+std::string index_text(const fs::path& cache) {
+  const fs::path index = index_path(cache);
+  check_private(index, "index", false);
+  struct stat st {};
+  if (::lstat(index.c_str(), &st) != 0) return {};
+  if (!S_ISREG(st.st_mode))
+    throw Error("--model-file", fmt::format("the cache's index {} is not a regular file: remove it (every plugin of the cache is "
+                                            "then built again on its next use)",
+                                            index.string()));
+  if (static_cast<std::uintmax_t>(st.st_size) > kMaxIndexBytes)
+    throw Error("--model-file", fmt::format("the cache's index {} is larger than {} bytes: remove it (every plugin of the cache is "
+                                            "then built again on its next use)",
+                                            index.string(), kMaxIndexBytes));
+  const BoundedRead r = read_bounded_file(index.string(), kMaxIndexBytes);
+  if (!r.ok()) throw Error("--model-file", fmt::format("the cache's index {} cannot be read ({})", index.string(), r.error));
+  return r.text;
+}
+
 std::string indexed_digest(const fs::path& cache, const std::string& stem) {
-  check_private(index_path(cache), "index", false);
-  std::istringstream in(read_small(index_path(cache), std::size_t{16} << 20));
+  std::istringstream in(index_text(cache));
   for (std::string line; std::getline(in, line);)
     if (line.size() == stem.size() + 65 && line.compare(0, stem.size(), stem) == 0 && line[stem.size()] == ' ') return line.substr(stem.size() + 1);
   return {};
 }
 
-// The settings of each plugin loaded in this process, by library: a second description of the same
-// code (the same model with other numbers, in one Python process) gets a copy of the library of its
-// own, since a library's settings are its globals and dlopen() returns the same handle for one file.
-std::map<std::string, std::string>& loaded_descriptions() {
-  static std::map<std::string, std::string> loaded;
+// The plugins loaded in this process, by library and description: the same model with the same
+// numbers is that plugin again; a second description of the same code (the same model with other
+// numbers, in one Python process) gets a copy of the library of its own, since a library's
+// settings are its globals and dlopen() returns the same handle for one file. A copy costs its
+// library's size in memory for the process's life (a few MB), once per distinct set of numbers.
+std::map<std::pair<std::string, std::string>, const ModelCommands*>& loaded_commands() {
+  static std::map<std::pair<std::string, std::string>, const ModelCommands*> loaded;
   return loaded;
 }
 
-// A private copy of `library` for a second description, checked against the manifest as copied.
-fs::path private_copy(const fs::path& library, const std::string& checksum, const std::string& description) {
-  Hash h;
-  h.add(description);
-  const fs::path copy = library.parent_path() / ("instance-" + h.hex().substr(0, 16) + "-" + std::to_string(::getpid()) + ".so");
-  std::error_code ec;
-  fs::remove(copy, ec);
-  if (!fs::copy_file(library, copy, ec) || ec)
-    throw Error("--model-file", fmt::format("cannot copy {} for a second set of numbers of the same model ({})", library.string(), ec.message()));
+// A file's SHA-256 and size, read from a descriptor from its start.
+std::string fd_checksum(int fd, std::uintmax_t& size) {
+  Sha256 h;
+  size = 0;
+  std::vector<char> buffer(1 << 16);
+  for (;;) {
+    const ssize_t n = ::pread(fd, buffer.data(), buffer.size(), static_cast<off_t>(size));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return n == 0 ? h.hex() : std::string();
+    h.add(std::string_view(buffer.data(), static_cast<std::size_t>(n)));
+    size += static_cast<std::uintmax_t>(n);
+  }
+}
+
+// An anonymous copy (memfd) of the library open at `fd`, for a second description, checked
+// against the digest the original was checked against. Nothing is written to the cache.
+int private_copy(int fd, const std::string& checksum) {
+  const int copy = ::memfd_create("wlx-plugin", MFD_CLOEXEC);
+  if (copy < 0) throw Error("--model-file", fmt::format("cannot make a copy of a plugin for a second set of numbers ({})", std::strerror(errno)));
+  std::vector<char> buffer(1 << 16);
+  for (off_t at = 0;;) {
+    const ssize_t n = ::pread(fd, buffer.data(), buffer.size(), at);
+    if (n < 0 && errno == EINTR) continue;
+    if (n == 0) break;
+    if (n < 0 || ::write(copy, buffer.data(), static_cast<std::size_t>(n)) != n) {
+      ::close(copy);
+      throw Error("--model-file", fmt::format("cannot make a copy of a plugin for a second set of numbers ({})", std::strerror(errno)));
+    }
+    at += n;
+  }
   std::uintmax_t size = 0;
-  if (file_checksum(copy, size) != checksum) throw Error("--model-file", fmt::format("the copy {} does not match its manifest", copy.string()));
+  if (fd_checksum(copy, size) != checksum) {
+    ::close(copy);
+    throw Error("--model-file", "the copy of a plugin for a second set of numbers does not match its manifest");
+  }
   return copy;
 }
 
@@ -268,21 +327,46 @@ fs::path private_copy(const fs::path& library, const std::string& checksum, cons
 // given the model's settings from `description` (model.json's text); a refusal is an error.
 const ModelCommands* try_load(const fs::path& entry, const std::string& key, const std::string& description, std::string& why) {
   std::error_code ec;
-  if (!fs::exists(entry, ec)) {
+  // The same plugin with the same numbers, loaded before in this process: that one.
+  const fs::path library = entry / "plugin.so";
+  if (const auto it = loaded_commands().find({library.string(), description}); it != loaded_commands().end()) return it->second;
+  if (!fs::exists(fs::symlink_status(entry, ec))) {  // a dangling link is there, and refused below
     why = "not built yet";
     return nullptr;
   }
   check_private(entry, "entry", false);
   check_private(entry / "manifest", "manifest", false);
-  check_private(entry / "plugin.so", "plugin", false);
   const std::string manifest = read_small(entry / "manifest", 1 << 16);
-  std::uintmax_t size = 0;
-  const fs::path library = entry / "plugin.so";
   if (manifest_value(manifest, "key") != key) {
     why = "its manifest is missing or names another key";
     return nullptr;
   }
-  const std::string checksum = fs::is_regular_file(library, ec) ? file_checksum(library, size) : std::string();
+  // The file that is checked is the file that is loaded: opened once (never through a link), its
+  // owner and mode and its bytes' SHA-256 checked on that descriptor, and dlopen()ed by it, so no
+  // swap of the path between the check and the load can run other code.
+  const int fd = ::open(library.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) {
+    if (errno == ELOOP) check_private(library, "plugin", false);  // a link: refused, naming it
+    why = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
+    return nullptr;
+  }
+  // Kept open once loaded: dlopen() knows a library by the name it was given, and a reused
+  // /proc/self/fd/N would name another plugin by an earlier one's name.
+  struct CloseFd {
+    int fd;
+    bool keep = false;
+    ~CloseFd() {
+      if (!keep) ::close(fd);
+    }
+  } closing{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    why = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
+    return nullptr;
+  }
+  check_private_stat(st, library, "plugin");
+  std::uintmax_t size = 0;
+  const std::string checksum = fd_checksum(fd, size);
   if (checksum.empty() || checksum != manifest_value(manifest, "checksum") || std::to_string(size) != manifest_value(manifest, "size")) {
     why = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
     return nullptr;
@@ -291,11 +375,13 @@ const ModelCommands* try_load(const fs::path& entry, const std::string& key, con
     why = fmt::format("plugin.so is not one this cache built (its SHA-256 is not the one {} recorded)", index_path(entry.parent_path()).string());
     return nullptr;
   }
-  fs::path load = library;
-  if (const auto it = loaded_descriptions().find(library.string()); it != loaded_descriptions().end() && it->second != description)
-    load = private_copy(library, checksum, description);
+  // Another description of this code is loaded already: this one gets a copy of its own (its
+  // settings are the library's globals). The copy is checked as the original was.
+  bool other_numbers = false;
+  for (const auto& [loaded, commands] : loaded_commands()) other_numbers = other_numbers || loaded.first == library.string();
+  CloseFd copy{other_numbers ? private_copy(fd, checksum) : -1, !other_numbers};
+  const std::string load = fmt::format("/proc/self/fd/{}", other_numbers ? copy.fd : fd);
   void* handle = ::dlopen(load.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (load != library) fs::remove(load, ec);  // mapped: the name is no longer needed
   if (handle == nullptr) {
     why = fmt::format("dlopen refused it ({})", ::dlerror());
     return nullptr;
@@ -311,7 +397,8 @@ const ModelCommands* try_load(const fs::path& entry, const std::string& key, con
   }
   if (const char* refused = settings(description.c_str()); refused != nullptr)
     throw PluginBuildError(fmt::format("the plugin for model {} refused its description: {}", manifest_value(manifest, "model"), refused));
-  loaded_descriptions().emplace(library.string(), description);
+  loaded_commands().emplace(std::pair{library.string(), description}, commands);
+  (other_numbers ? copy : closing).keep = true;
   return commands;  // never closed: its code and strings are in use until exit
 }
 
@@ -338,22 +425,18 @@ class FileLock {
   int fd_ = -1;
 };
 
-// Build folders of processes that died while compiling (kill -9): <stem>.build-<pid> whose pid no
-// longer runs. Removed before building again, so that nothing of them is left for good.
+// Build folders of processes that died while compiling (kill -9): <stem>.build-*. Called with the
+// entry's lock held, which every build of that entry holds for its whole length, so none of them
+// belongs to a build that still runs (whatever pid namespace it ran in). Removed before building
+// again, so that nothing of them is left for good.
 void remove_abandoned_builds(const fs::path& cache, const std::string& stem) {
   std::error_code ec;
   const std::string prefix = stem + ".build-";
-  for (fs::directory_iterator it(cache, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name.rfind(prefix, 0) != 0) continue;
-    char* rest = nullptr;
-    const long pid = std::strtol(name.c_str() + prefix.size(), &rest, 10);
-    if (pid <= 0 || rest == nullptr || *rest != '\0' || pid == ::getpid()) continue;
-    if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+  for (fs::directory_iterator it(cache, ec), end; !ec && it != end; it.increment(ec))
+    if (it->path().filename().string().rfind(prefix, 0) == 0) {
       std::error_code removed;
       fs::remove_all(it->path(), removed);
     }
-  }
 }
 
 // A folder removed when the object goes, unless kept.
@@ -519,20 +602,18 @@ Description description_of(const std::string& text, const std::string& where) {
 // wlx-gen --data-at-run-time --describe: the model file checked and derived (tens of milliseconds),
 // nothing written; its mistakes are reported as wlx-gen reports them.
 Description describe(const fs::path& model_file, const fs::path& scratch) {
-  const std::string tag = std::to_string(::getpid());
-  struct Scratch {
-    fs::path out, log;
-    ~Scratch() {
-      std::error_code ec;
-      fs::remove(out, ec);
-      fs::remove(log, ec);
-    }
-  } files{scratch / (".describe-" + tag + ".json"), scratch / (".describe-" + tag + ".log")};
+  // A folder of its own (mkdtemp): two loads at once (Python threads, processes of other pid
+  // namespaces sharing the cache) never read each other's description.
+  std::string pattern = (scratch / ".describe-XXXXXX").string();
+  if (::mkdtemp(pattern.data()) == nullptr)
+    throw Error("--model-file", fmt::format("cannot create a scratch folder in {} ({})", scratch.string(), std::strerror(errno)));
+  const TemporaryFolder folder{pattern};
+  const fs::path out = folder.path / "model.json", log = folder.path / "wlx-gen.log";
   const ProgramRun run = run_program(
       {generator_program().string(), fs::absolute(model_file).string(), "--data-at-run-time", "--describe", "--quiet"}, {},
-      files.out.string(), files.log.string());
-  check_generator_run(run, files.log, model_file);
-  return description_of(read_small(files.out, kMaxFileBytes), "wlx-gen --describe");
+      out.string(), log.string());
+  check_generator_run(run, log, model_file);
+  return description_of(read_small(out, kMaxFileBytes), "wlx-gen --describe");
 }
 
 // Generates the model's headers and compiles its plugin into `dir`.
@@ -639,12 +720,12 @@ void build_plugin(const fs::path& model_file, const Description& description, co
 // built at the same time), replacing the entry's earlier line.
 void record_digest(const fs::path& cache, const std::string& stem, const std::string& digest) {
   const FileLock lock(cache / "index.lock", "wlx: waiting for another wlx writing the cache's index");
-  check_private(index_path(cache), "index", false);
-  std::istringstream in(read_small(index_path(cache), std::size_t{16} << 20));
+  std::istringstream in(index_text(cache));
   std::string kept;
   for (std::string line; std::getline(in, line);)
     if (!line.empty() && line.rfind(stem + " ", 0) != 0) kept += line + "\n";
   write_file_atomically(index_path(cache).string(), kept + stem + " " + digest + "\n");
+  ::chmod(index_path(cache).c_str(), 0600);  // whatever the umask: the index is the user's alone
 }
 
 // The cache entry of the model file loaded last (load_model_file), for its viewer module.
@@ -680,6 +761,10 @@ std::string model_cache_dir() {
 }
 
 const ModelCommands& load_model_file(const std::string& model_file, const std::string& version) {
+  // One load at a time in a process (Python threads): the loaded plugins' table, the settings a
+  // plugin is handed and the cache's files are not shared mid-way.
+  static std::mutex loading;
+  const std::lock_guard<std::mutex> one_at_a_time(loading);
   const BoundedRead file = read_bounded_file(model_file, kMaxFileBytes);
   if (!file.ok()) throw Error("--model-file", fmt::format("{}: {}", excerpt(model_file), file.error));
   const fs::path cache = model_cache_dir();
@@ -726,6 +811,10 @@ const ModelCommands& load_model_file(const std::string& model_file, const std::s
   fs::create_directories(building.path, ec);
   if (ec) throw Error("--model-file", fmt::format("cannot create {} ({})", building.path.string(), ec.message()));
   build_plugin(model_file, description, key, building.path, cache / (stem + ".failed"));
+  // Whatever the umask (002 is common): the entry is the user's alone, as the next load checks.
+  for (fs::recursive_directory_iterator it(building.path, ec), end; !ec && it != end; it.increment(ec))
+    if (!it->is_symlink(ec)) fs::permissions(it->path(), fs::perms::group_write | fs::perms::others_write, fs::perm_options::remove, ec);
+  ::chmod(building.path.c_str(), 0700);
   record_digest(cache, stem, manifest_value(read_small(building.path / "manifest", 1 << 16), "checksum"));
   fs::rename(building.path, entry, ec);
   if (ec) throw Error("--model-file", fmt::format("cannot put the plugin in place at {} ({})", entry.string(), ec.message()));
@@ -796,7 +885,9 @@ std::string model_file_viewer_module() {
   // The numbers compiled in must be those the loaded plugin was given (the file may have changed since).
   const auto numbers = [](const std::string& text) {
     const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-    return j.is_object() ? nlohmann::json{j.value("parameters", nlohmann::json()), j.value("settings", nlohmann::json())} : nlohmann::json();
+    return j.is_object() ? nlohmann::json{j.value("source", nlohmann::json()), j.value("parameters", nlohmann::json()),
+                                          j.value("settings", nlohmann::json())}
+                         : nlohmann::json();
   };
   if (numbers(read_small(building.path / "generated" / "wlx" / "gen" / "model.json", kMaxFileBytes)) != numbers(loaded.description))
     throw Error("viewer", fmt::format("{} changed while wlx was reading it: run the command again", loaded.model_file.string()));

@@ -214,7 +214,10 @@ def _parameter_values(model, parameters):
         for k, variant in enumerate(spec):
             if not isinstance(variant, dict):
                 _error(f"{field}[{k}]", f"expected a mapping {{parameter: value}}, got {_excerpt(variant)}")
-            if sorted(variant) != sorted(names):
+            for name in variant:
+                if not isinstance(name, str):  # a number or null as a key: named before any comparison of keys
+                    _error(f"{field}[{k}].{_key(name)}", "a parameter's name is text")
+            if set(variant) != set(names):
                 missing, extra = sorted(set(names) - set(variant)), sorted(set(variant) - set(names))
                 _error(f"{field}[{k}]", "every variant sets the same parameters as the first"
                        + (f"; missing {', '.join(missing)}" if missing else "") + (f"; not in the first: {', '.join(map(_key, extra))}" if extra else ""))
@@ -316,7 +319,7 @@ def _metrics(metrics):
         _error("metrics", f"expected a non-empty list of metric names ({', '.join(METRICS)})")
     out = []
     for k, m in enumerate(metrics):
-        if m not in METRICS:
+        if not isinstance(m, str) or m not in METRICS:  # a mapping or list is not hashable: never `in` a tuple of names
             _error(f"metrics[{k}]", f"unknown metric {_excerpt(m)}{_nearest(m, METRICS)} (known: {', '.join(METRICS)})")
         if m in out:
             _error(f"metrics[{k}]", f"{m} given twice")

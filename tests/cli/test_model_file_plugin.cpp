@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace {
@@ -36,6 +37,9 @@ struct Setup {
   fs::path model = wlx_test::work_dir() / "longer_thighs.yaml";
   fs::path params = wlx_test::work_dir() / "longer_thighs.json";
   Setup() {
+    // A umask that leaves new files group-writable (Ubuntu's default for users): the entries wlx
+    // makes must be private all the same, or its own next load would refuse them.
+    ::umask(002);
     ::setenv("WLX_CACHE_DIR", cache.c_str(), 1);
     ::setenv("WLX_PLUGIN_CXXFLAGS", "-O0", 1);
     ::setenv("WLX_PLUGIN_EMCCFLAGS", "-O0", 1);  // the viewer's module likewise (its IK is checked, not timed)
@@ -247,8 +251,11 @@ TEST_CASE("--model-file: a corrupt or replaced cache entry is never loaded but r
   CHECK(corrupt.err.find("cannot be used (plugin.so is missing or does not match its manifest") != std::string::npos);
 
   // Replaced with a manifest to match: only the index, which the entry cannot rewrite, can tell.
+  // (Made as wlx makes its entries, the user's alone: what others may write is refused before this.)
   fs::create_directories(entry);
+  fs::permissions(entry, fs::perms::owner_all);
   write(plugin, spoilt);
+  fs::permissions(plugin, fs::perms::owner_read | fs::perms::owner_write);
   const fs::path spoilt_copy = wlx_test::work_dir() / "spoilt.so";
   write(spoilt_copy, spoilt);
   std::string manifest = good_manifest;
@@ -256,6 +263,7 @@ TEST_CASE("--model-file: a corrupt or replaced cache entry is never loaded but r
   REQUIRE(at != std::string::npos);
   manifest.replace(at + 9, 64, sha256sum(spoilt_copy));
   write(entry / "manifest", manifest);
+  fs::permissions(entry / "manifest", fs::perms::owner_read | fs::perms::owner_write);
   // The build folder a killed first use left behind (its pid runs no more): removed when building.
   const fs::path abandoned = s.cache / (entry.filename().string() + ".build-2147483000");
   fs::create_directories(abandoned / "generated");
@@ -289,6 +297,17 @@ TEST_CASE("wlx.load in Python: the plugin `wlx --model-file` built, from the sam
   const std::string script = R"py(
 import sys, numpy as np, wlx
 mine, builtin = wlx.load(sys.argv[1]), wlx.model("excavator")
+# Two threads loading two sets of numbers of this code at once, five times over: each load gets
+# its own description (no shared scratch file) and keeps its own numbers.
+import threading
+thighs = {}
+def load(path, key):
+    thighs.setdefault(key, []).append(wlx.load(path).params["thighD"])
+for _ in range(5):
+    threads = [threading.Thread(target=load, args=(sys.argv[1], "mine")), threading.Thread(target=load, args=(sys.argv[3], "variant"))]
+    for t in threads: t.start()
+    for t in threads: t.join()
+assert thighs == {"mine": [2.3] * 5, "variant": [2.4] * 5}, thighs
 assert repr(mine) == f"wlx.load({sys.argv[1]!r})" and mine.name == "excavator" and mine.params["thighD"] == 2.3, mine.params
 assert builtin.params["thighD"] == 2.0
 pose = {"z_C": 1.8, "x_Fl": 2.4}
@@ -329,7 +348,9 @@ print("ok")
 )py";
   const fs::path bad = wlx_test::work_dir() / "bad.yaml";
   write(bad, "model: broken\n");
-  const auto r = run({"-c", script, s.model.string(), bad.string()}, {.program = WLX_PYTHON});
+  const fs::path variant = wlx_test::work_dir() / "variant_thighs.yaml";
+  write(variant, replaced(slurp(s.model), "{name: thighD, value: 2.3,", "{name: thighD, value: 2.4,"));
+  const auto r = run({"-c", script, s.model.string(), bad.string(), variant.string()}, {.program = WLX_PYTHON});
   INFO(r.err);
   CHECK(r.code == 0);
   CHECK(r.out == "ok\n");
@@ -359,6 +380,26 @@ TEST_CASE("--model-file: a cache that others may write, or another user's, is re
   fs::permissions(plugin, before);
   CHECK(r.code == 2);
   CHECK(r.err.find("the cache's plugin " + plugin.string() + " may be written by others") != std::string::npos);
+  // A damaged index (here a folder) is an error naming it, and costs no good plugin.
+  fs::rename(s.cache / "index", s.cache / "index.kept");
+  fs::create_directory(s.cache / "index");
+  fs::permissions(s.cache / "index", fs::perms::owner_all);  // the user's own: only its kind is wrong
+  r = run({"--model-file", s.model.string(), "fk"}, {.input = "{}"});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("the cache's index " + (s.cache / "index").string() + " is not a regular file") != std::string::npos);
+  CHECK(fs::exists(plugin));
+  fs::remove(s.cache / "index");
+  fs::rename(s.cache / "index.kept", s.cache / "index");
+  // An entry that is a link, even one to nothing: refused by name, never compiled over.
+  const fs::path entry = plugin.parent_path(), kept = entry.string() + ".kept";
+  fs::rename(entry, kept);
+  fs::create_symlink("/nonexistent", entry);
+  r = run({"--model-file", s.model.string(), "fk"}, {.input = "{}"});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("the cache's entry " + entry.string() + " is a symbolic link") != std::string::npos);
+  fs::remove(entry);
+  fs::rename(kept, entry);
+  REQUIRE(run({"--model-file", s.model.string(), "fk"}, {.input = "{}"}).code == 0);
   if (::geteuid() == 0) {  // root can give a folder away: another user's cache
     fs::permissions(open_cache, fs::perms::owner_all);
     REQUIRE(::chown(open_cache.c_str(), 65534, 65534) == 0);

@@ -591,7 +591,8 @@ int line_of(const std::string& text, const std::string& needle) {
 TEST_CASE("wlx-gen: a URDF past the limits is refused where it passes them, before anything is built from it") {
   const std::filesystem::path dir = wlx_test::work_dir() / "urdf_limits";
   std::filesystem::create_directories(dir);
-  wlx_test::write(dir / "robot.yaml", "model: big\nurdf: robot.urdf\nparameters:\n  - {name: g, value: 9.81, unit: m/s^2, kind: gravity}\n");
+  wlx_test::write(dir / "robot.yaml", "model: big\nurdf: robot.urdf\nparameters:\n  - {name: g, value: 9.81, unit: m/s^2, kind: gravity}\n"
+                                      "coordinates:\n  inputs:\n    - {name: x, unit: m}\n");
   // 513 links (one more than the frames a model may have): refused at the 513th, with its line.
   std::string links = "<robot name=\"big\">\n";
   for (int k = 0; k < 513; ++k) links += "  <link name=\"l" + std::to_string(k) + "\"/>\n";
@@ -606,6 +607,11 @@ TEST_CASE("wlx-gen: a URDF past the limits is refused where it passes them, befo
   r = wlx_test::run({(dir / "robot.yaml").string(), "--describe"});
   CHECK(r.code == 2);
   CHECK(r.err.find("robot.urdf:3: XML: more than 65536 elements") != std::string::npos);
+  // A URDF's YAML file without its inputs: the field, where the file is (was yaml-cpp's "invalid node", exit 1).
+  wlx_test::write(dir / "robot.yaml", "model: big\ndescription: no inputs\nurdf: robot.urdf\n");
+  r = wlx_test::run({(dir / "robot.yaml").string(), "--describe"});
+  CHECK(r.code == 2);
+  CHECK(r.err == "wlx-gen: error: robot.yaml:1:1: missing field 'coordinates'\n");
 }
 
 TEST_CASE("wlx-gen: a bad URDF or a bad URDF model file exits 2 with file:line: element: reason") {

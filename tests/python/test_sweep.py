@@ -473,6 +473,47 @@ def test_spec_files_are_read_strictly(tmp_path):
     assert done.returncode == 2 and "SPEC: missing" in done.stderr
 
 
+# The spec reader as a fuzz target (no libFuzzer for Python here): seeded random mutations of
+# valid specs, each read and planned as `wlx sweep` would before any run. Every text is either a
+# plan or a wlx.Error naming its field; any other exception, or a message of more than a few
+# lines, fails. 3000 mutants in a few seconds; the seed fixes them, so a failure replays.
+SPEC_SEEDS = [
+    "model: excavator\nparameters: {grid: {legD: [1.4, 1.6], thighD: {from: 1.8, to: 2.2, count: 3}}}\n"
+    "runs: [NH-1, {id: T, rates: {x_C: 0.2}, dependent: [y_C, yaw], duration: 0.1}]\nmetrics: [peak_tau, min_clearance]\n",
+    "parameters:\n  list:\n    - {legD: 1.5e0, cxd: 3}\n    - {legD: 15e-1, cxd: 3.1}\nruns: [ID-1]\nmetrics: [peak_cond_J_beta]\nbatch_size: 4\n",
+    "parameters: {random: {samples: 5, seed: 7, distributions: {legD: {uniform: [1.4, 1.6]}, m_M1: {normal: [5400, 270]}}}}\n"
+    "runs: [NH-2]\nmetrics: [peak_tau]\nout: here\n",
+]
+MUTATIONS = [":", "-", "[", "]", "{", "}", ",", "#", "&a", "*a", "!!int ", "!!float ", "'", '"', "\n", "  ", "1e308", "-0",
+             ".nan", ".inf", "~", "null", "?", "|", ">", "%", "@", "\t", "\x00", "\u2028", "1" * 40, "legD", "runs"]
+
+
+def test_the_spec_reader_takes_any_text_to_a_plan_or_an_error_naming_its_field(robot, tmp_path):
+    import random
+
+    rng = random.Random(20261205)
+    path = tmp_path / "spec.yaml"
+    outcomes = {"plan": 0, "error": 0}
+    for k in range(3000):
+        text = rng.choice(SPEC_SEEDS)
+        for _ in range(rng.randint(1, 4)):
+            at = rng.randrange(len(text) + 1)
+            cut = rng.choice([0, 0, 1, rng.randint(1, 12)])
+            text = text[:at] + (rng.choice(MUTATIONS) if rng.random() < 0.8 else "") + text[at + cut:]
+        path.write_text(text, encoding="utf-8", errors="surrogatepass")
+        try:
+            spec = _sweep.read_spec(str(path))
+            _sweep._plan(robot, spec["parameters"], spec["runs"], spec["metrics"], str(tmp_path))
+            outcomes["plan"] += 1
+        except wlx.Error as e:
+            message = str(e)
+            assert message and message.count("\n") <= 2 and len(message) <= 2000, (k, text, message)
+            outcomes["error"] += 1
+        except Exception as e:  # noqa: BLE001 - the point: nothing else may escape
+            raise AssertionError(f"mutant {k}: {type(e).__name__}: {e}\n--- spec ---\n{text}") from e
+    assert outcomes["plan"] > 100 and outcomes["error"] > 1000, outcomes  # both paths taken, often
+
+
 def test_a_worker_that_cannot_load_the_model_stops_the_sweep_resumably(client, tmp_path):
     # As when a model file is not at the same path on the workers: the task fails, not a variant.
     # The sweep stops with the reason (exit 2 on the command line); nothing is written as a row.
