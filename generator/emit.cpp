@@ -746,7 +746,7 @@ std::vector<GroundContact> ground_contacts(const Model& m) {
   return contacts;
 }
 
-std::vector<EmittedFile> emit_structure_header(const Model& m, const EmitOptions& opt) {
+EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
   const auto name_of = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
   std::string t = banner(m, opt, "Model structure: limbs, wheels, dependent pairs, inverse dynamics, nominal state.");
   t += "//\n// Everything the generic runtime needs to know about this model's structure, so that it never\n"
@@ -754,8 +754,6 @@ std::vector<EmittedFile> emit_structure_header(const Model& m, const EmitOptions
        "// the closure rows (kClosureNames) and the bodies (body::).\n";
   t += "#pragma once\n\n#include <array>\n#include <string_view>\n\n#include \"params.hpp\"\n#include \"types.hpp\"\n\n" +
        namespace_open(opt) + "\n";
-  // The model file's numbers that no function holds: settings.hpp (compiled in), or model.json alone.
-  std::string settings;
 
   // Frames: parents, so that a drawing can connect them.
   t += "// Parent of each frame of interest (-1: the ground frame K0), in frame:: order.\n";
@@ -859,7 +857,7 @@ std::vector<EmittedFile> emit_structure_header(const Model& m, const EmitOptions
     int pair = 0;
     for (std::size_t k = 0; k < pairs.size(); ++k)
       if (pairs[k].name == d.pair) pair = static_cast<int>(k);
-    std::string commanded, actuated, weights;
+    std::string commanded, actuated;
     std::vector<int> joints, wheels;
     std::vector<std::string> names;
     for (int k : d.commanded) commanded += (commanded.empty() ? "" : ", ") + name_of(k);
@@ -869,10 +867,6 @@ std::vector<EmittedFile> emit_structure_header(const Model& m, const EmitOptions
       wheels.push_back(a.wheel);
       names.push_back(quoted(a.name));
     }
-    for (double w : d.weights) weights += (weights.empty() ? "" : ", ") + literal(w);
-    std::string limits;
-    for (std::size_t a = 0; a < d.actuated.size(); ++a)
-      limits += (limits.empty() ? "" : ", ") + literal(d.torque_limits.empty() ? 0.0 : d.torque_limits[a]);
     t += fmt::format(
         "// Inverse dynamics: the commanded speeds u ({}), the dependent pair, the actuators\n"
         "// ({}), their default weights, and gravity (along -z of K0).\n"
@@ -889,14 +883,6 @@ std::vector<EmittedFile> emit_structure_header(const Model& m, const EmitOptions
         d.commanded.size(), int_list(d.commanded), pair, m.dynamics ? d.pair : "none", joints.size(), int_list(joints),
         wheels.size(), int_list(wheels), names.size(), fmt::join(names, ", "),
         m.dynamics ? "&Params::" + d.gravity : "nullptr");
-    settings += fmt::format(
-        "// The actuators' default weights (the model file's dynamics.weights).\n"
-        "inline constexpr std::array<double, {}> kDefaultWeights{{{{{}}}}};\n"
-        "// The actuators' torque limits (|tau_i| <= limit, N m; the model file's dynamics.torque_limits),\n"
-        "// respected by the contact-keeping torque distribution; kHasTorqueLimits false: unlimited (zeros).\n"
-        "inline constexpr bool kHasTorqueLimits = {};\n"
-        "inline constexpr std::array<double, {}> kTorqueLimits{{{{{}}}}};\n\n",
-        d.weights.size(), weights, d.torque_limits.empty() ? "false" : "true", d.actuated.size(), limits);
   }
 
   // The rate basis' structure.
@@ -1003,67 +989,79 @@ std::vector<EmittedFile> emit_structure_header(const Model& m, const EmitOptions
          "  bool supports;\n};\n";
     t += fmt::format("inline constexpr int kContactCount = {};\n", contacts.size());
     t += fmt::format("inline constexpr std::array<ContactInfo, {}> kContacts{{{{\n", contacts.size());
-    std::string friction;
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       const auto& c = contacts[k];
       t += fmt::format("    {{\"{}\", ContactKind::{}, {}, {}, {{{{{}}}}}, {{{{{}}}}}, {}}},  // {}\n", c.name,
                        c.wheel >= 0 ? "wheel" : "foot", c.frame, c.wheel, int_list(std::vector<int>(c.point.begin(), c.point.end())),
                        int_list(std::vector<int>(c.level.begin(), c.level.end())), c.point[2] >= 0 ? "true" : "false",
                        m.frames[static_cast<std::size_t>(c.frame)].name);
-      friction += (friction.empty() ? "" : ", ") + literal(c.friction);
     }
     t += "}};\n\n";
-    settings += fmt::format("// Each contact's Coulomb coefficient (kContacts' order; the model file's contacts.friction).\n"
-                            "inline constexpr std::array<double, {}> kContactFriction{{{{{}}}}};\n\n",
-                            contacts.size(), friction);
   }
 
-  // IK verification sweeps.
-  std::string start;
-  for (double v : m.sweep_start) start += (start.empty() ? "" : ", ") + literal(v);
   t += "// The IK verification: each sweep moves one input over [from, to] in steps (SI units), from the\n"
        "// inputs kSweepStart, and checks one limb (the sweeps: settings.hpp or model.json).\n"
        "struct SweepInfo {\n  std::string_view id;\n  int input;\n  double from, to, step;\n"
        "  bool degrees;  // quoted in degrees\n  int limb;\n};\n\n";
-  settings += fmt::format("// The IK verification's start inputs (the model file's nominal state with ik_sweeps.start) and sweeps.\n"
-                          "inline constexpr std::array<double, {}> kSweepStart{{{{{}}}}};\n",
-                          m.sweep_start.size(), start);
-  settings += fmt::format("inline constexpr std::array<SweepInfo, {}> kIkSweeps{{{{\n", m.sweeps.size());
-  for (const auto& sw : m.sweeps)
-    settings += fmt::format("    {{{}, {}, {}, {}, {}, {}, {}}},  // {}\n", quoted(sw.id), sw.input, literal(sw.from), literal(sw.to),
-                            literal(sw.step), sw.degrees ? "true" : "false", sw.limb, name_of(sw.input));
-  settings += "}};\n\n";
-
-  // Nominal state.
-  std::string nominal, dependent_start;
-  for (int k = 0; k < static_cast<int>(m.nominal.size()); ++k) {
-    std::string& list = k < m.input_count ? nominal : dependent_start;
-    list += fmt::format("{}{}", list.empty() ? "" : ", ", literal(m.nominal[static_cast<std::size_t>(k)]));
-  }
-  settings += fmt::format("// The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).\n"
-                          "inline constexpr std::array<double, {}> kNominalInputs{{{{{}}}}};\n"
-                          "// Where Newton's method starts for the dependent joints when no earlier solution is at hand (the\n"
-                          "// model file's `nominal` and the limbs' `start`; 0 where neither gives one), in coord:: order from\n"
-                          "// the first dependent joint.\n"
-                          "inline constexpr std::array<double, {}> kDependentStart{{{{{}}}}};\n\n",
-                          m.input_count, nominal, m.nominal.size() - static_cast<std::size_t>(m.input_count), dependent_start);
   t += fmt::format("inline constexpr bool kHasClearance = {};\n"
                    "// The frame the clearance box moves with (frame::; -1: none); its size: clearance()'s half_extents.\n"
                    "inline constexpr int kClearanceFrame = {};\n\n",
                    m.clearance ? "true" : "false", m.clearance ? m.frame_index(m.clearance->frame) : -1);
   t += namespace_close(opt);
-  std::vector<EmittedFile> out{{"wlx/gen/structure.hpp", t}};
-  if (!opt.data_at_run_time) {
-    std::string h = banner(m, opt, "Model settings: the model file's numbers that no generated function holds, compiled in.");
-    h += "//\n// The nominal state, Newton's starts, the IK sweeps, the actuators' weights and torque limits and\n"
-         "// the contacts' friction, as the model file gives them. The runtime reads them through its\n"
-         "// settings() (wlx/settings.hpp), which a plugin fills from model.json instead: a plugin's headers\n"
-         "// have no settings.hpp, so that editing these numbers recompiles nothing.\n";
-    h += "#pragma once\n\n#include <array>\n#include <string_view>\n\n#include \"structure.hpp\"\n\n" + namespace_open(opt) + "\n" +
-         settings + namespace_close(opt);
-    out.push_back({"wlx/gen/settings.hpp", h});
-  }
-  return out;
+  return {"wlx/gen/structure.hpp", t};
+}
+
+EmittedFile emit_settings_header(const Model& m, const EmitOptions& opt) {
+  const auto list = [](const auto& values, const auto& text) {
+    std::string out;
+    for (const auto& v : values) out += (out.empty() ? "" : ", ") + text(v);
+    return out;
+  };
+  std::string h = banner(m, opt, "Model settings: the model file's numbers that no generated function holds, compiled in.");
+  h += "//\n// The nominal state, Newton's starts, the IK sweeps, the actuators' weights and torque limits and\n"
+       "// the contacts' friction, as the model file gives them. The runtime reads them through its\n"
+       "// settings() (wlx/settings.hpp), which a plugin fills from model.json instead: a plugin's headers\n"
+       "// have no settings.hpp, so that editing these numbers recompiles nothing.\n";
+  h += "#pragma once\n\n#include <array>\n#include <string_view>\n\n#include \"structure.hpp\"\n\n" + namespace_open(opt) + "\n";
+
+  // Inverse dynamics (empty without a dynamics section, as structure.hpp's kActuated).
+  const Dynamics none{};
+  const Dynamics& d = m.dynamics ? *m.dynamics : none;
+  std::vector<double> limits(d.actuated.size(), 0.0);
+  if (!d.torque_limits.empty()) limits = d.torque_limits;
+  h += fmt::format("// The actuators' default weights (the model file's dynamics.weights).\n"
+                   "inline constexpr std::array<double, {}> kDefaultWeights{{{{{}}}}};\n"
+                   "// The actuators' torque limits (|tau_i| <= limit, N m; the model file's dynamics.torque_limits),\n"
+                   "// respected by the contact-keeping torque distribution; kHasTorqueLimits false: unlimited (zeros).\n"
+                   "inline constexpr bool kHasTorqueLimits = {};\n"
+                   "inline constexpr std::array<double, {}> kTorqueLimits{{{{{}}}}};\n\n",
+                   d.weights.size(), list(d.weights, literal), d.torque_limits.empty() ? "false" : "true", limits.size(),
+                   list(limits, literal));
+
+  const std::vector<GroundContact> contacts = ground_contacts(m);
+  h += fmt::format("// Each contact's Coulomb coefficient (kContacts' order; the model file's contacts.friction).\n"
+                   "inline constexpr std::array<double, {}> kContactFriction{{{{{}}}}};\n\n",
+                   contacts.size(), list(contacts, [](const GroundContact& c) { return literal(c.friction); }));
+
+  h += fmt::format("// The IK verification's start inputs (the model file's nominal state with ik_sweeps.start) and sweeps.\n"
+                   "inline constexpr std::array<double, {}> kSweepStart{{{{{}}}}};\n",
+                   m.sweep_start.size(), list(m.sweep_start, literal));
+  h += fmt::format("inline constexpr std::array<SweepInfo, {}> kIkSweeps{{{{\n", m.sweeps.size());
+  for (const auto& sw : m.sweeps)
+    h += fmt::format("    {{{}, {}, {}, {}, {}, {}, {}}},  // {}\n", quoted(sw.id), sw.input, literal(sw.from), literal(sw.to),
+                     literal(sw.step), sw.degrees ? "true" : "false", sw.limb, m.coordinates[static_cast<std::size_t>(sw.input)].name);
+  h += "}};\n\n";
+
+  const auto inputs = static_cast<std::ptrdiff_t>(m.input_count);
+  const std::vector<double> nominal(m.nominal.begin(), m.nominal.begin() + inputs), start(m.nominal.begin() + inputs, m.nominal.end());
+  h += fmt::format("// The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).\n"
+                   "inline constexpr std::array<double, {}> kNominalInputs{{{{{}}}}};\n"
+                   "// Where Newton's method starts for the dependent joints when no earlier solution is at hand (the\n"
+                   "// model file's `nominal` and the limbs' `start`; 0 where neither gives one), in coord:: order from\n"
+                   "// the first dependent joint.\n"
+                   "inline constexpr std::array<double, {}> kDependentStart{{{{{}}}}};\n\n",
+                   nominal.size(), list(nominal, literal), start.size(), list(start, literal));
+  return {"wlx/gen/settings.hpp", h + namespace_close(opt)};
 }
 
 }  // namespace wlx::codegen

@@ -67,10 +67,12 @@ struct GroundContact {
 std::vector<GroundContact> ground_contacts(const Model& m);
 
 // structure.hpp: every fact about the model's structure the runtime needs, as constexpr tables
-// (limbs, wheels, dependent pairs, inverse-dynamics set-up, body Jacobian columns, contacts); and,
-// unless opt.data_at_run_time, settings.hpp: the model file's run-time settings compiled in
-// (nominal state, Newton's starts, IK sweeps, weights, torque limits, friction).
-std::vector<EmittedFile> emit_structure_header(const Model& m, const EmitOptions& opt);
+// (limbs, wheels, dependent pairs, inverse-dynamics set-up, body Jacobian columns, contacts).
+EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt);
+// settings.hpp: the model file's run-time settings compiled in (nominal state, Newton's starts, IK
+// sweeps, weights, torque limits, friction); written unless opt.data_at_run_time (then model.json
+// alone holds them).
+EmittedFile emit_settings_header(const Model& m, const EmitOptions& opt);
 // model.json: the description of the model as data (docs/model-format.md, "The description"):
 // its names and structure, and every number of the model file that no generated function holds
 // (parameters' values, nominal state, starts, sweeps, weights, torque limits, friction), with

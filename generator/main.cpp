@@ -341,7 +341,8 @@ int main(int argc, char** argv) {
 
     std::vector<EmittedFile> files = emit_model_headers(model, opt);
     files.push_back(emit_trig_header(model, opt));
-    for (auto& f : emit_structure_header(model, opt)) files.push_back(std::move(f));
+    files.push_back(emit_structure_header(model, opt));
+    if (!opt.data_at_run_time) files.push_back(emit_settings_header(model, opt));
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<FunctionSpec> fns;
     std::vector<FunctionStats> stats;

@@ -112,6 +112,56 @@ Matrix3Rows rotation_of(const urdf::Rotation& q) {
 
 }  // namespace
 
+namespace {
+
+// TinyXML parses nested elements recursively: bound the depth before it sees the text (a URDF
+// nests five levels; comments, declarations and quoted attribute values are skipped). The same
+// pass counts the elements, and the links and joints among them, so that a file past the limits
+// is refused with the line where it passes them, before anything is built from it (a 64 MB file
+// of empty elements would otherwise take gigabytes in TinyXML's tree).
+void check_xml_bounds(const std::string& text, const Checker& check) {
+  int depth = 0, line = 1;
+  std::size_t elements = 0, links = 0, joints = 0;
+  const auto tag_is = [&](std::size_t at, const char* tag) {
+    const std::size_t n = std::strlen(tag);
+    return text.compare(at, n, tag) == 0 && at + n < text.size() && std::strchr(" \t\r\n/>", text[at + n]) != nullptr;
+  };
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\n') ++line;
+    if (text[i] != '<') continue;
+    const auto skip_to = [&](const char* end) {
+      const std::size_t at = text.find(end, i);
+      const std::size_t stop = at == std::string::npos ? text.size() : at;
+      line += static_cast<int>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i), text.begin() + static_cast<std::ptrdiff_t>(stop), '\n'));
+      i = stop;
+    };
+    if (text.compare(i, 4, "<!--") == 0) skip_to("-->");
+    else if (text.compare(i, 9, "<![CDATA[") == 0) skip_to("]]>");  // text, whatever its brackets
+    else if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) skip_to(">");
+    else if (text.compare(i, 2, "</") == 0) depth = std::max(0, depth - 1);
+    else {
+      if (++elements > kMaxUrdfElements)
+        check.fail(line, "XML", fmt::format("more than {} elements: a URDF of at most {} links is read", kMaxUrdfElements, kMaxFrames));
+      if (depth == 1 && tag_is(i + 1, "link") && ++links > kMaxFrames)
+        check.fail(line, "link", fmt::format("more than {} links (wlx's limit of frames)", kMaxFrames));
+      if (depth == 1 && tag_is(i + 1, "joint") && ++joints > kMaxFrames)
+        check.fail(line, "joint", fmt::format("more than {} joints (wlx's limit of frames)", kMaxFrames));
+      char quote = 0;
+      std::size_t j = i + 1;
+      for (; j < text.size() && (quote || text[j] != '>'); ++j) {
+        if (text[j] == '\n') ++line;
+        if (quote && text[j] == quote) quote = 0;
+        else if (!quote && (text[j] == '"' || text[j] == '\'')) quote = text[j];
+      }
+      if (j < text.size() && text[j - 1] != '/' && ++depth > 64)
+        check.fail(line, "XML", "elements nest more than 64 levels deep");
+      i = j;
+    }
+  }
+}
+
+}  // namespace
+
 UrdfRobot read_urdf(const std::string& path, const std::string& shown_name) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ModelFileError(fmt::format("{}: cannot open the URDF file", shown_name));
@@ -124,51 +174,7 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
   if (text.size() > (64u << 20)) throw ModelFileError(fmt::format("{}: a URDF of more than 64 MB is not read", shown_name));
   const Checker check(shown_name);
 
-  // TinyXML parses nested elements recursively: bound the depth before it sees the text (a URDF
-  // nests five levels; comments, declarations and quoted attribute values are skipped). The same
-  // pass counts the elements, and the links and joints among them, so that a file past the limits
-  // is refused with the line where it passes them, before anything is built from it (a 64 MB file
-  // of empty elements would otherwise take gigabytes in TinyXML's tree).
-  {
-    int depth = 0, line = 1;
-    std::size_t elements = 0, links = 0, joints = 0;
-    const auto tag_is = [&](std::size_t at, const char* tag) {
-      const std::size_t n = std::strlen(tag);
-      return text.compare(at, n, tag) == 0 && at + n < text.size() && std::strchr(" \t\r\n/>", text[at + n]) != nullptr;
-    };
-    for (std::size_t i = 0; i < text.size(); ++i) {
-      if (text[i] == '\n') ++line;
-      if (text[i] != '<') continue;
-      const auto skip_to = [&](const char* end) {
-        const std::size_t at = text.find(end, i);
-        const std::size_t stop = at == std::string::npos ? text.size() : at;
-        line += static_cast<int>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i), text.begin() + static_cast<std::ptrdiff_t>(stop), '\n'));
-        i = stop;
-      };
-      if (text.compare(i, 4, "<!--") == 0) skip_to("-->");
-      else if (text.compare(i, 9, "<![CDATA[") == 0) skip_to("]]>");  // text, whatever its brackets
-      else if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) skip_to(">");
-      else if (text.compare(i, 2, "</") == 0) depth = std::max(0, depth - 1);
-      else {
-        if (++elements > kMaxUrdfElements)
-          check.fail(line, "XML", fmt::format("more than {} elements: a URDF of at most {} links is read", kMaxUrdfElements, kMaxFrames));
-        if (depth == 1 && tag_is(i + 1, "link") && ++links > kMaxFrames)
-          check.fail(line, "link", fmt::format("more than {} links (wlx's limit of frames)", kMaxFrames));
-        if (depth == 1 && tag_is(i + 1, "joint") && ++joints > kMaxFrames)
-          check.fail(line, "joint", fmt::format("more than {} joints (wlx's limit of frames)", kMaxFrames));
-        char quote = 0;
-        std::size_t j = i + 1;
-        for (; j < text.size() && (quote || text[j] != '>'); ++j) {
-          if (text[j] == '\n') ++line;
-          if (quote && text[j] == quote) quote = 0;
-          else if (!quote && (text[j] == '"' || text[j] == '\'')) quote = text[j];
-        }
-        if (j < text.size() && text[j - 1] != '/' && ++depth > 64)
-          check.fail(line, "XML", "elements nest more than 64 levels deep");
-        i = j;
-      }
-    }
-  }
+  check_xml_bounds(text, check);
   TiXmlDocument doc;
   doc.Parse(text.c_str(), nullptr, TIXML_ENCODING_UTF8);
   if (doc.Error()) check.fail(doc.ErrorRow() > 0 ? doc.ErrorRow() : 1, "XML", doc.ErrorDesc());

@@ -187,21 +187,6 @@ std::vector<std::string> optimization_flags(bool commands = false) {
   return out;
 }
 
-// A file's SHA-256 and size: what a plugin must still be when it is loaded.
-std::string file_checksum(const fs::path& path, std::uintmax_t& size) {
-  std::ifstream in(path, std::ios::binary);
-  Sha256 h;
-  size = 0;
-  std::vector<char> buffer(1 << 16);
-  while (in) {
-    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-    const auto n = static_cast<std::size_t>(in.gcount());
-    h.add(std::string_view(buffer.data(), n));
-    size += n;
-  }
-  return h.hex();
-}
-
 std::string manifest_value(const std::string& manifest, const std::string& key) {
   std::istringstream in(manifest);
   for (std::string l; std::getline(in, l);)
@@ -299,6 +284,16 @@ std::string fd_checksum(int fd, std::uintmax_t& size) {
   }
 }
 
+// A file's SHA-256 and size (the plugin just built, for its manifest and the index): by its descriptor.
+std::string file_checksum(const fs::path& path, std::uintmax_t& size) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  size = 0;
+  if (fd < 0) return {};
+  const std::string digest = fd_checksum(fd, size);
+  ::close(fd);
+  return digest;
+}
+
 // An anonymous copy (memfd) of the library open at `fd`, for a second description, checked
 // against the digest the original was checked against. Nothing is written to the cache.
 int private_copy(int fd, const std::string& checksum) {
@@ -325,6 +320,8 @@ int private_copy(int fd, const std::string& checksum) {
 
 // The plugin of a complete entry, or null with the reason it cannot be used. Once loaded, it is
 // given the model's settings from `description` (model.json's text); a refusal is an error.
+constexpr const char* kNotAsBuilt = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
+
 const ModelCommands* try_load(const fs::path& entry, const std::string& key, const std::string& description, std::string& why) {
   std::error_code ec;
   // The same plugin with the same numbers, loaded before in this process: that one.
@@ -347,7 +344,7 @@ const ModelCommands* try_load(const fs::path& entry, const std::string& key, con
   const int fd = ::open(library.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) {
     if (errno == ELOOP) check_private(library, "plugin", false);  // a link: refused, naming it
-    why = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
+    why = kNotAsBuilt;
     return nullptr;
   }
   // Kept open once loaded: dlopen() knows a library by the name it was given, and a reused
@@ -361,14 +358,14 @@ const ModelCommands* try_load(const fs::path& entry, const std::string& key, con
   } closing{fd};
   struct stat st {};
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    why = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
+    why = kNotAsBuilt;
     return nullptr;
   }
   check_private_stat(st, library, "plugin");
   std::uintmax_t size = 0;
   const std::string checksum = fd_checksum(fd, size);
   if (checksum.empty() || checksum != manifest_value(manifest, "checksum") || std::to_string(size) != manifest_value(manifest, "size")) {
-    why = "plugin.so is missing or does not match its manifest (corrupt or replaced)";
+    why = kNotAsBuilt;
     return nullptr;
   }
   if (checksum != indexed_digest(entry.parent_path(), entry.filename().string())) {
