@@ -6,6 +6,7 @@
 #include <wlx/text.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cctype>
 #include <chrono>
 #include <functional>
@@ -1022,7 +1023,27 @@ EmittedFile emit_settings_header(const Model& m, const EmitOptions& opt) {
        "// the contacts' friction, as the model file gives them. The runtime reads them through its\n"
        "// settings() (wlx/settings.hpp), which a plugin fills from model.json instead: a plugin's headers\n"
        "// have no settings.hpp, so that editing these numbers recompiles nothing.\n";
-  h += "#pragma once\n\n#include <array>\n#include <string_view>\n\n#include \"structure.hpp\"\n\n" + namespace_open(opt) + "\n";
+  h += "#pragma once\n\n#include <array>\n#include <limits>\n#include <string_view>\n\n#include \"structure.hpp\"\n\n" +
+       namespace_open(opt) + "\n";
+
+  // The joints' limits and the limbs' default branches.
+  const auto bound = [](double v) {
+    return std::isinf(v) ? std::string(v < 0 ? "-kNoLimit" : "kNoLimit") : literal(v);
+  };
+  std::vector<int> branches;
+  for (const auto& l : m.limbs) branches.push_back(l.branch);
+  h += fmt::format("inline constexpr double kNoLimit = std::numeric_limits<double>::infinity();\n"
+                   "// The joints' ranges, in coord:: order (the model file's `limits` and a URDF's <limit>s; -kNoLimit and\n"
+                   "// kNoLimit: none). The IK prefers the branch within them; verify ik and simulate check them.\n"
+                   "inline constexpr std::array<double, {0}> kJointLower{{{{{1}}}}};\n"
+                   "inline constexpr std::array<double, {0}> kJointUpper{{{{{2}}}}};\n"
+                   "// The joints' largest speeds (rad/s or m/s; 0: none), in coord:: order.\n"
+                   "inline constexpr std::array<double, {0}> kJointVelocityLimit{{{{{3}}}}};\n"
+                   "// Each limb's default branch of its closed form (the model file's limbs[].branch; -1: none given, the\n"
+                   "// runtime takes the first branch from 0 whose joints are within their ranges).\n"
+                   "inline constexpr std::array<int, {4}> kDefaultBranches{{{{{5}}}}};\n\n",
+                   m.coordinates.size(), list(m.lower, bound), list(m.upper, bound), list(m.velocity, literal), m.limbs.size(),
+                   list(branches, [](int b) { return std::to_string(b); }));
 
   // Inverse dynamics (empty without a dynamics section, as structure.hpp's kActuated).
   const Dynamics none{};

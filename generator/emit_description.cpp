@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <sstream>
 
@@ -124,6 +125,23 @@ EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::
   Json friction = Json::array();
   for (const auto& c : contacts) friction.push_back(c.friction);
   settings["friction"] = friction;
+  // The joints' limits (only those with one; JSON has no infinity): range, effort, speed.
+  Json limits = Json::array();
+  for (int k = 0; k < static_cast<int>(m.coordinates.size()); ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    if (std::isinf(m.lower[kk]) && m.effort[kk] == 0 && m.velocity[kk] == 0) continue;
+    Json l = {{"coordinate", coordinate(k)}};
+    l["lower"] = std::isinf(m.lower[kk]) ? Json(nullptr) : Json(m.lower[kk]);
+    l["upper"] = std::isinf(m.upper[kk]) ? Json(nullptr) : Json(m.upper[kk]);
+    l["effort"] = m.effort[kk] > 0 ? Json(m.effort[kk]) : Json(nullptr);
+    l["velocity"] = m.velocity[kk] > 0 ? Json(m.velocity[kk]) : Json(nullptr);
+    limits.push_back(l);
+  }
+  settings["limits"] = limits;
+  Json branches = Json::object();
+  for (const auto& l : m.limbs)
+    if (l.branch >= 0) branches[l.name] = l.branch;
+  settings["branches"] = branches;
   d["settings"] = settings;
   return {"wlx/gen/model.json", d.dump(1) + "\n"};
 }

@@ -31,6 +31,7 @@
 // returned as a solution.
 #include "derivations.hpp"
 #include "emit.hpp"
+#include "model_file.hpp"
 #include "printer.hpp"
 
 #include <fmt/format.h>
@@ -1162,6 +1163,12 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
         reasons.push_back(u.reason);
       }
     }
+    // A default branch the closed form does not have is the model file's mistake, named there.
+    const int branches = solve ? solve->branches : 1;
+    if (limb.branch >= branches)
+      throw ModelFileError(fmt::format("{}: limb '{}' has {} (0 to {}), not {}{}", limb.branch_place, limb.name,
+                                       branches == 1 ? "one branch" : fmt::format("{} branches", branches), branches - 1, limb.branch,
+                                       solve ? "" : ": wlx-gen found no closed form for it, and Newton's method has no branches"));
     if (!solve) {
       report.push_back(fmt::format("{}: no closed form ({}); Newton's method at run time", limb.name, fmt::join(reasons, "; ")));
       entries.push_back(fmt::format("    {{nullptr, 0, \"none\", {{}}, {{}}}},  // {}: {}", limb.name, comment(fmt::format("{}", fmt::join(reasons, "; ")))));

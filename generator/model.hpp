@@ -86,6 +86,8 @@ struct Limb {
   std::string title;  // for messages: "left leg"
   std::vector<int> rows;
   std::vector<int> joints;
+  int branch = -1;           // the model file's default branch of its closed form, or -1: none given
+  std::string branch_place;  // where the file gives it (file:line:column: field), for messages
 };
 
 // The input rates, one per wheel, that the wheels' rolling rows determine.
@@ -109,6 +111,7 @@ struct Dynamics {
   std::vector<Actuator> actuated;
   std::vector<double> weights;  // default weighting, one per actuator
   std::vector<double> torque_limits;  // the largest |torque| of each actuator (N m), or empty: unlimited
+  bool torque_limits_from_efforts = false;  // torque_limits are the joints' and drives' efforts (`limits`, URDF)
 };
 
 // A box attached to a frame (centred on its origin, along its axes) whose lowest corner must
@@ -157,6 +160,9 @@ struct Model {
                                 // joints' start values for Newton's method (0 where none is given)
   std::vector<double> sweep_start;  // the IK sweeps' initial inputs (nominal with overrides)
   std::vector<IkSweep> sweeps;
+  // The joints' limits, one entry per coordinate (the `limits` section and a URDF's <limit>s):
+  // the range [lower, upper] (-inf, inf: none), the largest effort and speed (0: none).
+  std::vector<double> lower, upper, effort, velocity;
 
   const Parameter& parameter(const std::string& name) const;
   const Coordinate& coordinate(const std::string& name) const;

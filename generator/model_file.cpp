@@ -304,7 +304,8 @@ class Parser {
     const YAML::Node root = with_urdf(file_root);
     const Item top(src_, root, "", {});
     const Fields f(top, {"model", "description", "repeat", "parameters", "coordinates", "frames", "bodies", "closure",
-                         "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "contacts", "nominal", "ik_sweeps"});
+                         "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "contacts", "nominal", "ik_sweeps",
+                         "limits"});
     m_.name = f["model"].name();
     if (const std::string why = model_name_problem(m_.name); !why.empty())
       f["model"].fail(fmt::format("'{}' cannot be the model's name: {}", m_.name, why));
@@ -320,6 +321,7 @@ class Parser {
     if (auto c = f.optional("closure")) closure(*c);
     limbs(f.optional("limbs"), top);
     nonholonomic(f.optional("nonholonomic"), top);
+    limits(f.optional("limits"));
     if (auto d = f.optional("dynamics")) dynamics(*d);
     if (auto c = f.optional("clearance")) clearance(*c);
     if (auto c = f.optional("contacts")) contacts(*c);
@@ -343,7 +345,7 @@ class Parser {
     const Item top(src_, root, "", {});
     const Fields f(top, {"model", "description", "urdf", "rename", "base", "repeat", "parameters", "coordinates", "frames",
                          "bodies", "closure", "limbs", "wheels", "nonholonomic", "dynamics", "clearance", "contacts",
-                         "nominal", "ik_sweeps"});
+                         "nominal", "ik_sweeps", "limits"});
     if (auto r = f.optional("repeat")) repeats(*r);
     // The inputs are the YAML file's to name (the URDF's moving joints become the dependent ones):
     // missing, they are said to be here, where the file is, not in the document made from it.
@@ -513,6 +515,12 @@ class Parser {
       if (file_parameters.count(j.name))
         urdf_fail(j.line, element, fmt::format("'{}' is also the name of a parameter in {}: {}", j.name, src_.name, rename_hint(j.name, "_joint")));
     }
+
+    // The joints' <limit>s, by their (renamed) names: the `limits` section reads them, and the file's
+    // own entries take precedence (limits() below); a wheel's continuous joint gives its drive's effort.
+    for (const UrdfJoint& j : robot.joints)
+      if (j.type != UrdfJoint::Type::Fixed && (j.lower || j.effort || j.velocity))
+        urdf_limits_[j.name] = {j.lower, j.upper, j.effort, j.velocity, fmt::format("{}:{}", shown, j.limit_line)};
 
     // Rigid groups: a link and the links fixed to it (fixed joints collapse). Each moving joint's
     // child (and the root) starts a group; its body carries the group's mass.
@@ -743,7 +751,7 @@ class Parser {
     merged["frames"] = frames;
     if (bodies.size() > 0) merged["bodies"] = bodies;
     for (const char* key : {"wheels", "closure", "limbs", "nonholonomic", "dynamics", "clearance", "contacts", "nominal",
-                            "ik_sweeps"})
+                            "ik_sweeps", "limits"})
       if (root[key].IsDefined()) merged[key] = root[key];
     return merged;
   }
@@ -1305,8 +1313,17 @@ class Parser {
     }
     std::map<int, std::string> row_owner, joint_owner;
     each(*list, [&](const Item& it) {
-      const Fields f(it, {"name", "title", "closure", "joints", "start"});
+      const Fields f(it, {"name", "title", "closure", "joints", "start", "branch"});
       Limb limb;
+      // The branch of its closed form every command takes unless told otherwise (checked against
+      // the branches wlx-gen finds, which come later: emit_ik.cpp).
+      if (auto b = f.optional("branch")) {
+        const double v = b->number();
+        if (!(v >= 0 && v <= 1023 && v == std::floor(v))) b->fail(fmt::format("a branch is a whole number from 0, got {}", v));
+        limb.branch = static_cast<int>(v);
+        const YAML::Mark mark = b->mark();
+        limb.branch_place = fmt::format("{}:{}:{}: {}", src_.name, mark.line + 1, mark.column + 1, b->path());
+      }
       limb.name = f["name"].name();
       for (const auto& l : m_.limbs)
         if (l.name == limb.name) f["name"].fail(fmt::format("limb '{}' is defined twice", limb.name));
@@ -1549,6 +1566,24 @@ class Parser {
       }
       if (d.torque_limits.size() != d.actuated.size())
         l->fail(fmt::format("one limit per actuator: {} needed", d.actuated.size()));
+    } else {
+      // Without torque_limits, the joints' efforts (`limits`, a URDF's <limit effort>) and the
+      // drives' (their wheel joint's <limit effort>), when every actuator has one.
+      std::vector<double> efforts;
+      for (const Actuator& a : d.actuated) {
+        double e = 0;
+        if (a.coordinate >= 0) {
+          e = m_.effort[static_cast<std::size_t>(a.coordinate)];
+        } else if (const auto u = urdf_axle_.find(m_.wheels[static_cast<std::size_t>(a.wheel)].hub); u != urdf_axle_.end()) {
+          if (const auto l = urdf_limits_.find(u->second.joint); l != urdf_limits_.end() && l->second.effort) e = *l->second.effort;
+        }
+        if (!(e > 0)) break;
+        efforts.push_back(e);
+      }
+      if (efforts.size() == d.actuated.size()) {
+        d.torque_limits = std::move(efforts);
+        d.torque_limits_from_efforts = true;
+      }
     }
     m_.dynamics = std::move(d);
   }
@@ -1580,6 +1615,53 @@ class Parser {
 
   // The inputs' nominal values, and for dependent joints the start of Newton's method (a limb's
   // own `start` takes precedence).
+  // The joints' limits: the URDF's <limit>s, then the file's `limits` entries, which replace what
+  // they give field by field. A range is checked against nothing else here: the nominal state
+  // may lie outside it (the runtime then says so), and Newton's starts are starts.
+  void limits(const std::optional<Item>& section) {
+    const std::size_t n = m_.coordinates.size();
+    const double inf = std::numeric_limits<double>::infinity();
+    m_.lower.assign(n, -inf);
+    m_.upper.assign(n, inf);
+    m_.effort.assign(n, 0.0);
+    m_.velocity.assign(n, 0.0);
+    for (const auto& entry : urdf_limits_) {
+      const std::string& joint = entry.first;
+      const UrdfLimit& l = entry.second;
+      const auto c = std::find_if(m_.coordinates.begin(), m_.coordinates.end(), [&](const Coordinate& x) { return x.name == joint; });
+      if (c == m_.coordinates.end()) continue;  // a wheel's spin: its effort is its drive's (dynamics)
+      const auto k = static_cast<std::size_t>(c - m_.coordinates.begin());
+      if (l.lower) m_.lower[k] = *l.lower, m_.upper[k] = *l.upper;
+      if (l.effort && *l.effort > 0) m_.effort[k] = *l.effort;
+      if (l.velocity && *l.velocity > 0) m_.velocity[k] = *l.velocity;
+    }
+    if (!section) return;
+    std::set<int> given;
+    each(*section, [&](const Item& it) {
+      const Fields f(it, {"joint", "lower", "upper", "effort", "velocity"});
+      const int k = coordinate_index(f["joint"]);
+      const auto kk = static_cast<std::size_t>(k);
+      if (!given.insert(k).second) f["joint"].fail(fmt::format("'{}' has limits already: give them once", m_.coordinates[kk].name));
+      const auto lower = f.optional("lower"), upper = f.optional("upper");
+      if (lower.has_value() != upper.has_value())
+        (lower ? *lower : *upper).fail("a range needs both `lower` and `upper`");
+      if (lower) {
+        const double lo = lower->number(true), hi = upper->number(true);
+        for (const auto& [item, v] : {std::pair{&*lower, lo}, std::pair{&*upper, hi}})
+          if (!(std::abs(v) <= 1e6)) item->fail(fmt::format("must be within [-1e6, 1e6], got {}", v));
+        if (!(lo < hi)) lower->fail(fmt::format("lower ({}) must be below upper ({})", lo, hi));
+        m_.lower[kk] = lo;
+        m_.upper[kk] = hi;
+      }
+      for (const auto& [key, out] : {std::pair{"effort", &m_.effort}, std::pair{"velocity", &m_.velocity}})
+        if (auto x = f.optional(key)) {
+          const double v = x->number(true);
+          if (!(v > 0 && v <= 1e9)) x->fail(fmt::format("must be in (0, 1e9], got {}", v));
+          (*out)[kk] = v;
+        }
+    });
+  }
+
   void nominal(const std::optional<Item>& section) {
     m_.nominal.assign(m_.coordinates.size(), 0.0);
     if (section) {
@@ -1646,6 +1728,11 @@ class Parser {
     std::string place, joint;
   };
   std::map<std::string, UrdfAxle> urdf_axle_;  // a wheel's hub link -> its URDF joint's axis
+  struct UrdfLimit {
+    std::optional<double> lower, upper, effort, velocity;
+    std::string place;  // file:line of the <limit>
+  };
+  std::map<std::string, UrdfLimit> urdf_limits_;  // a URDF joint's name -> its <limit>
   Model m_;
   GiNaC::symtab params_, coordinates_;
   GiNaC::exmap param_defaults_;  // each parameter's symbol -> its default, for check_at_defaults
@@ -1763,6 +1850,31 @@ std::string print_model_file(const std::string& path, const std::string& urdf_pa
     }
     actuated.SetStyle(YAML::EmitterStyle::Flow);
     merged["dynamics"]["actuated"] = actuated;
+    // The drives' efforts come from the URDF's wheel joints, which the printed file does not have.
+    if (model.dynamics->torque_limits_from_efforts) {
+      YAML::Node limits(YAML::NodeType::Sequence);
+      for (double v : model.dynamics->torque_limits) limits.push_back(v);
+      limits.SetStyle(YAML::EmitterStyle::Flow);
+      merged["dynamics"]["torque_limits"] = limits;
+    }
+  }
+  // The joints' limits as the model has them (the URDF's <limit>s with the file's entries).
+  if (!parser.urdf_fingerprint().empty()) {
+    YAML::Node limits(YAML::NodeType::Sequence);
+    for (std::size_t k = 0; k < model.coordinates.size(); ++k) {
+      YAML::Node l(YAML::NodeType::Map);
+      l.SetStyle(YAML::EmitterStyle::Flow);
+      if (!std::isinf(model.lower[k])) l["lower"] = model.lower[k], l["upper"] = model.upper[k];
+      if (model.effort[k] > 0) l["effort"] = model.effort[k];
+      if (model.velocity[k] > 0) l["velocity"] = model.velocity[k];
+      if (l.size() == 0) continue;
+      YAML::Node entry(YAML::NodeType::Map);
+      entry.SetStyle(YAML::EmitterStyle::Flow);
+      entry["joint"] = model.coordinates[k].name;
+      for (const auto& kv : l) entry[kv.first] = kv.second;
+      limits.push_back(entry);
+    }
+    if (limits.size() > 0) merged["limits"] = limits;
   }
   YAML::Emitter out;
   out << merged;

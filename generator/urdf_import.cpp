@@ -190,6 +190,8 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
   struct JointEntry {
     std::string name, type, parent, child;
     int line;
+    std::optional<double> lower, upper, effort, velocity;
+    int limit_line = 0;
   };
   std::map<std::string, LinkEntry> link_entries;
   std::vector<std::string> link_order;
@@ -241,7 +243,7 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
         check.fail(mimic->Row(), element + " mimic",
                    "mimic joints are not supported: wlx's joints are independent coordinates; drive the joint with its "
                    "own coordinate and couple it with a closure condition in the YAML file");
-      JointEntry j{name, t, "", "", e->Row()};
+      JointEntry j{name, t, "", "", e->Row(), {}, {}, {}, {}, 0};
       for (const char* role : {"parent", "child"}) {
         const TiXmlElement* r = e->FirstChildElement(role);
         const char* link = r ? r->Attribute("link") : nullptr;
@@ -256,8 +258,30 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
         const auto a = check.numbers(axis, "xyz", 3, element + " axis", {1, 0, 0});
         if (std::hypot(a[0], a[1], a[2]) < 1e-9) check.fail(axis->Row(), element + " axis", "the axis is zero: give its direction");
       }
-      if ((t == "revolute" || t == "prismatic") && e->FirstChildElement("limit") == nullptr)
-        check.fail(e->Row(), element, fmt::format("URDF requires <limit effort=... velocity=.../> for a {} joint (wlx does not use the limits)", t));
+      const TiXmlElement* limit = e->FirstChildElement("limit");
+      if ((t == "revolute" || t == "prismatic") && limit == nullptr)
+        check.fail(e->Row(), element, fmt::format("URDF requires <limit effort=... velocity=.../> for a {} joint", t));
+      if (limit != nullptr && t != "fixed") {
+        j.limit_line = limit->Row();
+        const auto one = [&](const char* attribute) -> std::optional<double> {
+          const auto v = check.numbers(limit, attribute, 1, element + " limit", {});
+          return v.empty() ? std::nullopt : std::optional<double>(v[0]);
+        };
+        j.effort = one("effort");
+        j.velocity = one("velocity");
+        for (const auto& [name, v] : {std::pair{"effort", j.effort}, std::pair{"velocity", j.velocity}})
+          if (v && !(*v >= 0 && *v <= 1e9))
+            check.fail(limit->Row(), element + " limit", fmt::format("{}=\"{}\" must be in [0, 1e9]", name, *v));
+        // A continuous joint has no range (URDF ignores its lower and upper); neither has a range of
+        // zero width, which is what URDF's defaults give when both are left out.
+        if (t != "continuous") {
+          const auto lower = one("lower"), upper = one("upper");
+          const double lo = lower.value_or(0), hi = upper.value_or(0);
+          if (lo > hi)
+            check.fail(limit->Row(), element + " limit", fmt::format("lower=\"{}\" is above upper=\"{}\"", lo, hi));
+          if (lo < hi) j.lower = lo, j.upper = hi;
+        }
+      }
       joint_entries.push_back(std::move(j));
     }
   }
@@ -378,6 +402,11 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
                                             : UrdfJoint::Type::Fixed;
       joint.parent = e.parent;
       joint.child = e.child;
+      joint.lower = e.lower;
+      joint.upper = e.upper;
+      joint.effort = e.effort;
+      joint.velocity = e.velocity;
+      joint.limit_line = e.limit_line;
       const auto& pose = j->parent_to_joint_origin_transform;
       joint.origin.translation = {pose.position.x, pose.position.y, pose.position.z};
       joint.origin.rotation = rotation_of(pose.rotation);

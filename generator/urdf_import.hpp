@@ -4,8 +4,8 @@
 // inputs, wheels, closures, limbs, dynamics), into the same Model a model file gives.
 //
 // The subset read: joints of type revolute, continuous, prismatic and fixed; <origin xyz rpy>;
-// <axis>; link <inertial> (mass, origin with rpy, the six inertia values). Visuals, collisions,
-// limits, dynamics, materials, transmissions and gazebo tags are read past. Anything that changes
+// <axis>; <limit> (lower, upper, effort, velocity); link <inertial> (mass, origin with rpy, the six
+// inertia values). Visuals, collisions, dynamics, materials, transmissions and gazebo tags are read past. Anything that changes
 // the kinematics and wlx cannot represent (mimic joints, floating and planar joints, xacro that was
 // not expanded) is an error that says so: `file:line: element: reason`.
 #pragma once
@@ -46,6 +46,11 @@ struct UrdfJoint {
   std::string parent, child;  // link names
   RigidPose origin;           // the joint frame in the parent link's frame
   std::array<double, 3> axis{1, 0, 0};  // unit, in the joint frame (moving joints)
+  // <limit>: the joint's range (revolute and prismatic joints whose lower and upper differ: URDF's
+  // defaults for absent attributes are 0 and 0, which would lock the joint, so a range of zero
+  // width counts as none), the largest effort (N m or N) and speed (rad/s or m/s); absent: none.
+  std::optional<double> lower, upper, effort, velocity;
+  int limit_line = 0;
 };
 
 struct UrdfRobot {

@@ -4,6 +4,10 @@
 #include <nlohmann/json.hpp>
 #include <wlx/error.hpp>
 
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+
 WLX_COMMANDS_BEGIN
 
 namespace {
@@ -89,6 +93,28 @@ Settings settings_of_description(const std::string& json_text) {
   s.has_torque_limits = !section["torque_limits"].is_null();
   if (s.has_torque_limits) numbers(section["torque_limits"], s.torque_limits, "settings.torque_limits");
   numbers(member(section, "friction", Json::value_t::array, "settings"), s.friction, "settings.friction");
+  for (const Json& l : member(section, "limits", Json::value_t::array, "settings")) {
+    const std::string name = member(l, "coordinate", Json::value_t::string, "settings.limits[]").get<std::string>();
+    const std::string where = "settings.limits." + name;
+    std::size_t k = 0;
+    while (k < gen::kCoordinateNames.size() && gen::kCoordinateNames[k] != name) ++k;
+    if (k == gen::kCoordinateNames.size()) mismatch(fmt::format("{}: the code has no coordinate '{}'", where, name));
+    const auto optional_number = [&](const char* key, double absent) {
+      if (!l.contains(key)) mismatch(fmt::format("{} has no '{}'", where, key));
+      return l[key].is_null() ? absent : number(l, key, where);
+    };
+    s.lower[k] = optional_number("lower", -std::numeric_limits<double>::infinity());
+    s.upper[k] = optional_number("upper", std::numeric_limits<double>::infinity());
+    s.velocity_limit[k] = optional_number("velocity", 0);
+  }
+  const Json& branches = member(section, "branches", Json::value_t::object, "settings");
+  for (const auto& [limb, value] : branches.items()) {
+    std::size_t l = 0;
+    while (l < gen::kLimbs.size() && gen::kLimbs[l].name != limb) ++l;
+    if (l == gen::kLimbs.size()) mismatch(fmt::format("settings.branches: the code has no limb '{}'", limb));
+    if (!value.is_number_integer()) mismatch(fmt::format("settings.branches.{} is not a whole number", limb));
+    s.default_branch[l] = static_cast<int>(std::clamp<std::int64_t>(value.get<std::int64_t>(), -2, 1 << 20));
+  }
   return s;
 }
 

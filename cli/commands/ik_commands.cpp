@@ -68,6 +68,15 @@ nlohmann::ordered_json solve_ik_request(const IkRequest& r, Coordinates* warm, C
   const auto name = [](Limb limb) { return std::string(gen::kLimbs[static_cast<std::size_t>(limb)].name); };
   for (Limb limb : kLimbs) branches[name(limb)] = classify_branch(model, limb, s);
   out["branch"] = branches;
+  // The joints' limits (the model file's `limits`, a URDF's <limit>s): said, not enforced, for a
+  // solution asked for on a branch, or on none within them.
+  if (const int k = first_outside_limits(s); k >= 0) {
+    out["within_limits"] = false;
+    out["outside_limits"] = describe_outside_limits(s, k);
+  } else {
+    out["within_limits"] = true;
+    out["outside_limits"] = nullptr;
+  }
   if (r.method == IkMethod::newton) {
     nlohmann::ordered_json it;
     int total = 0;
@@ -88,7 +97,7 @@ void write_ik_sweep_csv(const std::string& path, const IkSweepResult& r) {
     for (const char* axis : {"x_", "y_"}) header.push_back(axis + contact_column_stem(w));
   for (const char* h :
        {"check_error_closed_form", "check_error_newton", "level_error_closed_form", "level_error_newton",
-        "newton_minus_closed_form", "newton_iterations", "newton_branch", "cold_start_branch"})
+        "newton_minus_closed_form", "newton_iterations", "newton_branch", "cold_start_branch", "within_limits"})
     header.emplace_back(h);
   CsvWriter csv(path, header);
   for (const auto& p : r.points) {
@@ -98,7 +107,7 @@ void write_ik_sweep_csv(const std::string& path, const IkSweepResult& r) {
     row.insert(row.end(), {p.check_closed_form.position_error, p.check_newton.position_error,
                            p.check_closed_form.level_error, p.check_newton.level_error, p.newton_difference,
                            static_cast<double>(p.newton_iterations), static_cast<double>(p.newton_branch),
-                           static_cast<double>(p.cold_newton_branch)});
+                           static_cast<double>(p.cold_newton_branch), p.within_limits ? 1.0 : 0.0});
     csv.row(row);
   }
   csv.commit();
@@ -171,17 +180,24 @@ int run_verify_ik(const ModelOptions& model_options, const std::string& out_dir,
     const IkSweepResult r = run_ik_sweep(model, data, sweep);
     write_ik_sweep_csv((std::filesystem::path(out_dir) / (sweep.id + ".csv")).string(), r);
     const bool pass = r.max_check_closed_form <= kLimit && r.max_check_newton <= kLimit && r.max_level_error <= kLimit &&
-                      r.newton_branch_changes == 0;
+                      r.newton_branch_changes == 0 && r.outside_limits == 0;
     ok = ok && pass;
     fmt::print("{:<7} {:<9} {:>6} {:>12.2e} {:>12.2e} {:>11.2e} {:>12.2e} {:>11.2f} {:>8} {:>11}{}\n", sweep.id,
                sweep.input, r.points.size(), r.max_check_closed_form, r.max_check_newton, r.max_level_error,
                r.max_newton_difference, r.mean_newton_iterations, r.max_newton_iterations,
                fmt::format("{} off", r.cold_start_off_default),
-               pass ? "" : (r.newton_branch_changes ? "  FAIL (Newton changed branch)" : "  FAIL"));
+               pass                       ? ""
+               : r.newton_branch_changes ? "  FAIL (Newton changed branch)"
+               : r.outside_limits        ? "  FAIL (outside the joints' limits)"
+                                         : "  FAIL");
+    if (r.outside_limits > 0)
+      fmt::print("        {} of {} points leave a joint's range on branch {}, first {}\n", r.outside_limits, r.points.size(),
+                 r.branch, r.first_outside);
   }
   fmt::print("\n'check' is |target - FK(solution)| with the generated forward kinematics \n"
              "Newton is warm-started along the sweep; 'cold start' counts points where Newton started from the\n"
-             "sweep's start pose lands off the default branch. CSV files: {}/\n"
+             "sweep's start pose lands off the sweep's branch (the model's choice at that pose, within the\n"
+             "joints' limits where a branch is). CSV files: {}/\n"
              "{}\n",
              out_dir, ok ? "all sweeps pass (every error <= 1e-10 m)" : "SOME SWEEPS FAIL");
   return ok ? 0 : 1;

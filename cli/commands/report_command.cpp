@@ -149,12 +149,14 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
   std::vector<report::Section> out;
   if (!runner_.sweeps().empty()) {
     report::Table t{{"sweep", "input", "points", "max check, closed form (m)", "max check, Newton (m)", "max |closed form - Newton| (rad)",
-                     "Newton iterations (mean / max)", "CSV"},
+                     "Newton iterations (mean / max)", "joints' limits (branch)", "CSV"},
                     {}};
     for (const auto& s : runner_.sweeps())
       t.rows.push_back({{s.sweep.id}, {s.sweep.input}, {std::to_string(s.points.size())}, {fmt::format("{:.2e}", s.max_check_closed_form)},
                         {fmt::format("{:.2e}", s.max_check_newton)}, {fmt::format("{:.2e}", s.max_newton_difference)},
                         {fmt::format("{:.2f} / {}", s.mean_newton_iterations, s.max_newton_iterations)},
+                        {s.outside_limits == 0 ? fmt::format("within ({})", s.branch)
+                                               : fmt::format("{} points outside ({}), first {}", s.outside_limits, s.branch, s.first_outside)},
                         {s.sweep.id + ".csv", "data/" + s.sweep.id + ".csv"}});
     out.push_back({"ik", title("ik", "Inverse kinematics sweeps"), "", {t}, figures.ik, {}});
   }

@@ -295,7 +295,7 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::
   if (!j.is_object()) throw Error("", fmt::format("a scenario is a JSON object, got {}", j.type_name()));
   reject_unknown_keys(j, {"id", "model", "description", "observation", "verify", "initial", "params", "rates", "dependent", "duration",
                           "dt", "integrator", "tolerance", "branch", "max_condition", "weighting", "torques",
-                          "on_contact_loss"},
+                          "on_contact_loss", "on_limit"},
                       "");
   // "model": the model the run was written for. Names alone may match another machine's (two
   // models with an x_C), so a run says whose it is, and running it on another is an error.
@@ -386,6 +386,12 @@ Scenario parse_scenario(const nlohmann::json& j, const Params& base, const std::
       throw Error("max_condition", fmt::format("must be above 1, got {}", sc.nonholonomic.max_condition));
   }
   if (j.contains("weighting")) sc.weighting = parse_weighting(j.at("weighting"), "weighting");
+  if (j.contains("on_limit")) {
+    const nlohmann::json& v = j.at("on_limit");
+    if (!(v == "stop" || v == "continue"))
+      throw Error("on_limit", fmt::format("must be \"stop\" or \"continue\", got {}", excerpt(v)));
+    sc.stop_on_limit = v == "stop";
+  }
   if (j.contains("on_contact_loss")) {
     const nlohmann::json& v = j.at("on_contact_loss");
     if (!(v == "stop" || v == "continue"))

@@ -142,6 +142,7 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
                  summary.energy.residual());
   }
   fmt::print("wrote {}\n", path);
+  if (!tr.limit_warning.empty()) wlx::diagnose("wlx: warning: a joint left its limits {} (\"on_limit\": \"continue\")\n", tr.limit_warning);
   if (interrupted) {
     wlx::diagnose("wlx: {} at t = {:.4f} s: the run is partial; {} holds the {} samples computed before\n",
                interrupted->what(), summary.last_t, path, summary.samples);

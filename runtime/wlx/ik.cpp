@@ -114,7 +114,79 @@ void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinat
   if (status != gen::IkStatus::ok) throw_failure(limb, branch, status, why);
 }
 
-void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches) {
+namespace {
+bool limb_has_limits(Limb limb) {
+  const LimbBlock block = limb_block(limb);
+  for (int j = 0; j < block.size; ++j) {
+    const auto k = static_cast<std::size_t>(block.joints[static_cast<std::size_t>(j)]);
+    if (std::isfinite(settings().lower[k]) || std::isfinite(settings().upper[k])) return true;
+  }
+  return false;
+}
+bool limb_within_limits(Limb limb, const Coordinates& s) {
+  const LimbBlock block = limb_block(limb);
+  for (int j = 0; j < block.size; ++j) {
+    const auto k = static_cast<std::size_t>(block.joints[static_cast<std::size_t>(j)]);
+    if (!(s(static_cast<Eigen::Index>(k)) >= settings().lower[k] && s(static_cast<Eigen::Index>(k)) <= settings().upper[k])) return false;
+  }
+  return true;
+}
+}  // namespace
+
+int first_outside_limits(const Coordinates& s) noexcept {
+  for (int k = 0; k < kCoordinateCount; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    if (!(s(k) >= settings().lower[kk] && s(k) <= settings().upper[kk])) return k;
+  }
+  return -1;
+}
+
+std::string describe_outside_limits(const Coordinates& s, int k) {
+  const auto kk = static_cast<std::size_t>(k);
+  return fmt::format("{} = {:.6g} is outside its range [{:.6g}, {:.6g}]", gen::kCoordinateNames[kk], s(k),
+                     settings().lower[kk], settings().upper[kk]);
+}
+
+Branches resolve_branches(const Model& model, const Coordinates& s, const Branches& requested, std::array<bool, kLimbCount>* outside) {
+  Branches out = requested;
+  for (Limb limb : kLimbs) {
+    const auto l = static_cast<std::size_t>(limb);
+    const int preferred = std::max(settings().default_branch[l], 0);
+    bool leaves = false;
+    if (out.limb[l] == kModelsChoice) {
+      out.limb[l] = preferred;
+      if (limb_has_limits(limb)) {
+        leaves = true;
+        // The default branch first, then the others in order: the first within the ranges wins.
+        for (int k = -1; k < branch_count(limb) && leaves; ++k) {
+          const int b = k < 0 ? preferred : k;
+          if (k == preferred) continue;
+          Coordinates candidate = s;
+          try {
+            solve_limb_closed_form(model, limb, b, candidate);
+          } catch (const Error&) {
+            continue;
+          }
+          if (limb_within_limits(limb, candidate)) out.limb[l] = b, leaves = false;
+        }
+      }
+    } else if (outside != nullptr && limb_has_limits(limb)) {
+      Coordinates candidate = s;
+      try {
+        solve_limb_closed_form(model, limb, out.limb[l], candidate);
+        leaves = !limb_within_limits(limb, candidate);
+      } catch (const Error&) {
+      }
+    }
+    if (outside != nullptr) (*outside)[l] = leaves;
+  }
+  return out;
+}
+
+void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& requested) {
+  bool choose = false;
+  for (int b : requested.limb) choose = choose || b == kModelsChoice;
+  const Branches branches = choose ? resolve_branches(model, s, requested) : requested;
   // Every limb with a closed form in one generated pass (the body's pose and the sines and cosines
   // computed once); the limbs without one (gen::kHasFusedIk false) then by Newton's method from
   // the dependent joints in s.

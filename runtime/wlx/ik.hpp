@@ -11,6 +11,7 @@
 #include "wlx/model.hpp"
 
 #include <array>
+#include <string>
 #include <string_view>
 
 WLX_MODEL_NAMESPACE_BEGIN
@@ -38,15 +39,35 @@ struct LimbBlock {
 };
 LimbBlock limb_block(Limb limb) noexcept;
 
+// Which branch each limb's closed form takes, indexed by Limb; kModelsChoice leaves it to the
+// model (resolve_branches). Default-constructed: every limb the model's choice.
+inline constexpr int kModelsChoice = -1;
 struct Branches {
-  std::array<int, kLimbCount> limb{};  // indexed by Limb
+  std::array<int, kLimbCount> limb = [] {
+    std::array<int, kLimbCount> all{};
+    all.fill(kModelsChoice);
+    return all;
+  }();
 };
+
+// The model's choice of branch for a limb at the inputs in s: its default branch (the model
+// file's limbs[].branch, else 0) when that solution keeps the limb's joints within their ranges
+// (settings().lower, upper), else the first branch from 0 that does, else (none does, or none
+// solves) the default branch. A limb whose joints have no ranges takes its default branch
+// without solving anything. Every branch given in `requested` stays as it is. `outside[limb]`,
+// when given, says whether the limb's chosen solution leaves a range.
+Branches resolve_branches(const Model& model, const Coordinates& s, const Branches& requested = {},
+                          std::array<bool, kLimbCount>* outside = nullptr);
+// The first of s's coordinates outside its range (settings().lower, upper), or -1.
+int first_outside_limits(const Coordinates& s) noexcept;
+// "kfe_rf = 1.15 rad is outside its range [-2.8, -0.4]": what first_outside_limits found.
+std::string describe_outside_limits(const Coordinates& s, int coordinate);
 
 // Solves one limb's dependent joints in s from its inputs in s. Throws wlx::Error when the target
 // is out of reach (naming the limb, what the target asks and what the limb reaches), an input is
 // not finite, or the branch does not exist.
 void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinates& s);
-// All limbs.
+// All limbs, each on its branch in `branches` (the model's choice where kModelsChoice: resolve_branches).
 void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches = {});
 
 // Which branch of the closed form a solution lies on (the branch whose solution is nearest).

@@ -3,6 +3,8 @@
 #include "wlx/error.hpp"
 #include "wlx/kinematics.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -58,14 +60,18 @@ LimbCheck analytic_check(const Model& model, Data& data, Limb limb, const Coordi
 }
 
 IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep) {
-  IkSweepResult result{sweep, {}, 0, 0, 0, 0, 0, 0, 0, 0};
+  IkSweepResult result{sweep, {}, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, {}};
   const int input = coordinate_index(sweep.input);
   const auto joints = limb_joints(sweep.limb);
   Coordinates start = ik_sweep_inputs();
-  solve_ik_closed_form(model, start);  // the assembled start pose, as in MOBILE
+  // One branch per limb all along: the model's choice at the start pose (within the joints' ranges
+  // where a branch is), so that the closed form and Newton's continuation follow the same one.
+  const Branches branches = resolve_branches(model, start);
+  solve_ik_closed_form(model, start, branches);  // the assembled start pose, as in MOBILE
   Coordinates warm = start, previous = start;
   long iterations = 0;
-  int previous_branch = 0;
+  result.branch = branches.limb[static_cast<std::size_t>(sweep.limb)];
+  int previous_branch = result.branch;
   for (int k = 0; k < sweep.points(); ++k) {
     IkSweepPoint pt;
     pt.value = sweep.value(k);
@@ -73,9 +79,16 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
     // point's solution (continuation).
     Coordinates s = previous;
     s(input) = pt.value;
-    solve_ik_closed_form(model, s);
+    solve_ik_closed_form(model, s, branches);
     previous = s;
     pt.closed_form = s;
+    for (int j : joints)
+      if (!(s(j) >= settings().lower[static_cast<std::size_t>(j)] && s(j) <= settings().upper[static_cast<std::size_t>(j)])) {
+        if (pt.within_limits && result.first_outside.empty())
+          result.first_outside = fmt::format("at {} = {:.6g}: {}", sweep.input, pt.value, describe_outside_limits(s, j));
+        pt.within_limits = false;
+      }
+    if (!pt.within_limits) ++result.outside_limits;
     pt.check_closed_form = analytic_check(model, data, sweep.limb, s);
     for (int w = 0; w < kWheelCount; ++w)  // element by element: compiles for no wheels too
       for (int i = 0; i < 2; ++i) pt.contacts(2 * w + i) = data.frame_positions(i, gen::kWheels[static_cast<std::size_t>(w)].contact_frame);
@@ -111,7 +124,7 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
     iterations += pt.newton_iterations;
     if (k > 0 && pt.newton_branch != previous_branch) ++result.newton_branch_changes;
     previous_branch = pt.newton_branch;
-    if (pt.cold_newton_branch != 0) ++result.cold_start_off_default;
+    if (pt.cold_newton_branch != result.branch) ++result.cold_start_off_default;
     result.points.push_back(pt);
   }
   result.mean_newton_iterations = static_cast<double>(iterations) / static_cast<double>(result.points.size());

@@ -37,6 +37,7 @@ struct IkSweepPoint {
   int newton_iterations = 0;
   int newton_branch = 0;            // branch of the continued Newton result
   int cold_newton_branch = -1;      // branch Newton reaches from the sweep's start pose (-1: no convergence)
+  bool within_limits = true;        // the limb's joints within their ranges (closed form)
 };
 
 struct IkSweepResult {
@@ -46,7 +47,10 @@ struct IkSweepResult {
   double mean_newton_iterations = 0;
   int max_newton_iterations = 0;
   int newton_branch_changes = 0;       // along the continued path
-  int cold_start_off_default = 0;      // points where a cold start lands off the default branch
+  int cold_start_off_default = 0;      // points where a cold start lands off the sweep's branch
+  int branch = 0;                      // the limb's branch along the sweep: the model's choice at its start pose
+  int outside_limits = 0;              // points where a joint of the limb leaves its range
+  std::string first_outside;           // the first of them, in words (describe_outside_limits), or ""
 };
 
 IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep);

@@ -25,6 +25,10 @@ Settings compiled_settings() {
   s.has_torque_limits = gen::kHasTorqueLimits;
   s.torque_limits = gen::kTorqueLimits;
   s.friction = gen::kContactFriction;
+  s.lower = gen::kJointLower;
+  s.upper = gen::kJointUpper;
+  s.velocity_limit = gen::kJointVelocityLimit;
+  s.default_branch = gen::kDefaultBranches;
   return s;
 }
 std::optional<Settings>& current() {
@@ -82,6 +86,22 @@ void set_settings(const Settings& s) {
   for (std::size_t c = 0; c < s.friction.size(); ++c)
     if (!(std::isfinite(s.friction[c]) && s.friction[c] >= 0))
       throw Error(fmt::format("contacts.friction ({})", gen::kContacts[c].name), fmt::format("must be non-negative, got {}", s.friction[c]));
+  for (int k = 0; k < gen::kCoordinateCount; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    const std::string field = fmt::format("limits.{}", gen::kCoordinateNames[kk]);
+    if (std::isnan(s.lower[kk]) || std::isnan(s.upper[kk]) || !(s.lower[kk] < s.upper[kk]))
+      throw Error(field, fmt::format("lower ({}) must be below upper ({})", s.lower[kk], s.upper[kk]));
+    if (!(std::isfinite(s.velocity_limit[kk]) && s.velocity_limit[kk] >= 0))
+      throw Error(field + ".velocity", fmt::format("must be positive (0: none), got {}", s.velocity_limit[kk]));
+  }
+  for (int l = 0; l < gen::kLimbCount; ++l) {
+    const int b = s.default_branch[static_cast<std::size_t>(l)];
+    const gen::ClosedFormInfo& cf = gen::kClosedForm[static_cast<std::size_t>(l)];
+    const int count = cf.solve == nullptr ? 1 : cf.branches;
+    if (b < -1 || b >= count)
+      throw Error(fmt::format("limbs.{}.branch", gen::kLimbs[static_cast<std::size_t>(l)].name),
+                  fmt::format("the limb has branches 0 to {}, got {}", count - 1, b));
+  }
 #if !__has_include(<wlx/gen/settings.hpp>)
   // The generated Params' defaults read these (params.hpp, --data-at-run-time): Params{} is the file's.
   for (std::size_t k = 0; k < gen::kParamInfo.size(); ++k) gen::detail::param_defaults()[k] = s.params.*gen::kParamInfo[k].member;

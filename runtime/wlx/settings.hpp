@@ -11,6 +11,7 @@
 #include <wlx/gen/all.hpp>
 
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,23 @@ struct Settings {
   bool has_torque_limits = false;                                   // false: unlimited
   std::array<double, gen::kActuated.size()> torque_limits{};        // N m, each > 0 when given
   std::array<double, gen::kContactCount> friction{};                // Coulomb coefficient per contact (kContacts)
+  // The joints' ranges, in coordinate order (-inf, inf: none): the IK prefers the branch within
+  // them, verify ik and simulate check them. And their largest speeds (0: none).
+  std::array<double, gen::kCoordinateCount> lower = unlimited(-1), upper = unlimited(1);
+  std::array<double, gen::kCoordinateCount> velocity_limit{};
+  // Each limb's default branch (the model file's limbs[].branch), or -1: none given.
+  std::array<int, gen::kLimbCount> default_branch = no_default_branches();
+
+  static constexpr std::array<double, gen::kCoordinateCount> unlimited(int sign) {
+    std::array<double, gen::kCoordinateCount> a{};
+    a.fill(sign * std::numeric_limits<double>::infinity());
+    return a;
+  }
+  static constexpr std::array<int, gen::kLimbCount> no_default_branches() {
+    std::array<int, gen::kLimbCount> b{};
+    b.fill(-1);
+    return b;
+  }
 };
 
 // The settings in use. A model compiled with its settings.hpp has them from the start; a plugin's

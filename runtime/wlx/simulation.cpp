@@ -21,13 +21,14 @@ struct KinematicRates {
   const Scenario& sc;
   const Model& model;
   Data& data;
+  Branches branches;  // the run's, chosen at its start (resolve_branches): one branch all along
   Coordinates s = Coordinates::Zero(), sdot = Coordinates::Zero();
   long evaluations = 0;
 
   InputVector operator()(double /*t: the commanded rates are constant*/, const InputVector& q) {
     ++evaluations;
     s.head<kInputCount>() = q;
-    solve_ik_closed_form(model, s, sc.branches);
+    solve_ik_closed_form(model, s, branches);
     sdot.head<kInputCount>() = sc.rates;
     solve_dependent_rates(model, data, s, sdot, sc.pair, sc.nonholonomic);
     return sdot.head<kInputCount>();
@@ -43,6 +44,7 @@ struct TorqueRates {
   const Scenario& sc;
   const Model& model;
   Data& data;
+  Branches branches;  // as KinematicRates'
   Coordinates s = Coordinates::Zero();
   CommandVector u = CommandVector::Zero(), u_dot = CommandVector::Zero();
   TorqueVector tau = TorqueVector::Zero();
@@ -53,7 +55,7 @@ struct TorqueRates {
     ++evaluations;
     s.head<kInputCount>() = x.head<kInputCount>();
     u = x.tail<kCommandedCount>();
-    solve_ik_closed_form(model, s, sc.branches);
+    solve_ik_closed_form(model, s, branches);
     tau = sc.torques(t, s, u);
     if (!tau.allFinite()) throw Error("torques", fmt::format("the torque source gave a non-finite torque at t = {:.6f} s", t));
     forward_dynamics(model, data, s, u, tau, u_dot, terms, sc.nonholonomic);
@@ -176,6 +178,19 @@ void check_finite(const Sample& smp, const Scenario& sc) {
     if (!std::isfinite(smp.tau(k))) fail("tau_" + std::string(kActuatorNames[static_cast<std::size_t>(k)]), smp.tau(k));
   for (int k = 0; k < kCommandedCount; ++k)
     if (!std::isfinite(smp.Qstar(k))) fail("Qstar_" + name(kCommandedSpeeds[static_cast<std::size_t>(k)]), smp.Qstar(k));
+}
+
+// What in a sample leaves the joints' limits (the first range, else the first speed), or "".
+std::string limit_violation(const Sample& smp) {
+  if (const int k = first_outside_limits(smp.s); k >= 0) return describe_outside_limits(smp.s, k);
+  const auto& limit = settings().velocity_limit;
+  for (int k = 0; k < kCoordinateCount; ++k) {
+    const double v = limit[static_cast<std::size_t>(k)];
+    if (v > 0 && !(std::abs(smp.sdot(k)) <= v))
+      return fmt::format("{}'s rate {:.6g} is above its largest speed {:.6g}", gen::kCoordinateNames[static_cast<std::size_t>(k)],
+                         smp.sdot(k), v);
+  }
+  return {};
 }
 
 }  // namespace
@@ -343,6 +358,10 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
         smp.t = t;
         fill(smp);
         check_finite(smp, sc);
+        if (const std::string why = limit_violation(smp); !why.empty()) {
+          if (sc.stop_on_limit) throw Error("limits", why + " (\"on_limit\": \"continue\" goes on)");
+          if (out.limit_warning.empty()) out.limit_warning = fmt::format("at t = {:.4f} s: {}", t, why);
+        }
         on_sample(smp);
         if (progress) progress(k + 1, n);
         if (k + 1 == n) break;
@@ -374,7 +393,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
   const auto coordinate = [](int i) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(i)]); };
 
   if (sc.driven_by_torques()) {
-    TorqueRates f{sc, model, data};
+    TorqueRates f{sc, model, data, resolve_branches(model, sc.initial, sc.branches)};
     TorqueState x;
     x << sc.initial.head<kInputCount>(), sc.commanded_speeds();
     f.s = sc.initial;
@@ -402,7 +421,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       return i < kInputCount ? coordinate(i) : "u." + coordinate(kCommandedSpeeds[static_cast<std::size_t>(i - kInputCount)]);
     });
   } else {
-    KinematicRates f{sc, model, data};
+    KinematicRates f{sc, model, data, resolve_branches(model, sc.initial, sc.branches)};
     f.s = sc.initial;
     const CommandVector u = sc.commanded_speeds();
     DynamicsTerms terms;

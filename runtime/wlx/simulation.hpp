@@ -59,6 +59,10 @@ struct Scenario {
   // false (the scenario's "on_contact_loss": "continue") reports those samples in the columns and
   // the summary and goes on, as the thesis' bilateral contacts do.
   bool stop_on_contact_loss = true;
+  // Stop where a joint leaves its range or exceeds its largest speed (settings().lower, upper,
+  // velocity_limit), naming the joint, its value and the time; false (the scenario's "on_limit":
+  // "continue") goes on and says in Trajectory::limit_warning where it first happened.
+  bool stop_on_limit = true;
 
   bool driven_by_torques() const { return static_cast<bool>(torques); }
   // The commanded speeds u at t = 0: the commanded inputs' rates.
@@ -98,6 +102,7 @@ struct Trajectory {
   std::vector<Sample> samples;
   bool complete = true;
   std::string error;  // why the run stopped early (with its time), when !complete
+  std::string limit_warning;  // with stop_on_limit false: where a joint first left its limits, else empty
   // Integration work: accepted steps, rejected steps (dopri5 only), right-hand-side evaluations
   // (each one an IK of every limb plus a dependent-rate solve).
   long steps = 0, rejected_steps = 0, evaluations = 0;

@@ -233,6 +233,36 @@ TEST_CASE("cli: wlx simulate ID-1 --weighting 2 adds the torque and Q* columns")
 }
 
 #ifdef WLX_BUILT_MODEL_wheeled_quadruped  // not in the sanitized tree
+TEST_CASE("cli: wlx ik keeps the wheeled quadruped's knees within its URDF's limits, and says so of a branch that leaves them") {
+  // The URDF's knees bend backwards only: [-2.8, -0.4] rad about y on the left, [0.4, 2.8] about -y
+  // on the right (models/wheeled_quadruped.urdf). No branch given: every knee within its range.
+  Run r = run_wlx("--model wheeled_quadruped ik", "{}");
+  REQUIRE(r.code == 0);
+  auto j = nlohmann::json::parse(r.out);
+  CHECK(j.at("within_limits") == true);
+  for (const char* knee : {"kfe_lf", "kfe_lh"}) {
+    CAPTURE(knee);
+    CHECK(j.at(knee).get<double>() >= -2.8);
+    CHECK(j.at(knee).get<double>() <= -0.4);
+  }
+  for (const char* knee : {"kfe_rf", "kfe_rh"}) {
+    CAPTURE(knee);
+    CHECK(j.at(knee).get<double>() >= 0.4);
+    CHECK(j.at(knee).get<double>() <= 2.8);
+  }
+  // Branch 2 of the right front leg (its knee's other root) is taken when asked for, and said to
+  // leave the knee's range.
+  r = run_wlx("--model wheeled_quadruped ik", R"({"branch": {"leg_rf": 2}})");
+  REQUIRE(r.code == 0);
+  j = nlohmann::json::parse(r.out);
+  CHECK(j.at("kfe_rf").get<double>() < 0);
+  CHECK(j.at("within_limits") == false);
+  CHECK(j.at("outside_limits").get<std::string>().rfind("kfe_rf = -", 0) == 0);
+  CHECK(j.at("outside_limits").get<std::string>().find("is outside its range [0.4, 2.8]") != std::string::npos);
+}
+#endif
+
+#ifdef WLX_BUILT_MODEL_wheeled_quadruped  // not in the sanitized tree
 TEST_CASE("cli: the wheeled quadruped's inverse dynamics has a column per actuator, drives too, and weightings of its size") {
   const fs::path dir = fs::temp_directory_path() / "wlx_cli_test" / "quadruped";
   fs::remove_all(dir);

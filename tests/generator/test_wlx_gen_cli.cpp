@@ -7,6 +7,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <sys/mount.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
@@ -202,6 +203,100 @@ TEST_CASE("wlx-gen --describe: quoted keys and a URDF's geometry are what wlx-ge
     }
   CHECK(moved >= 1);
 }
+TEST_CASE("wlx-gen: joint limits from the URDF and a `limits` section, field by field; a default branch; both are data, in model.json") {
+  const std::filesystem::path dir = wlx_test::work_dir() / "limits";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string yaml = wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.yaml");
+  wlx_test::write(dir / "wheeled_quadruped.urdf", wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.urdf"));
+  wlx_test::write(dir / "robot.yaml", yaml);
+  const auto plain = wlx_test::run({(dir / "robot.yaml").string(), "--data-at-run-time", "--describe"});
+  REQUIRE(plain.code == 0);
+  const nlohmann::json a = nlohmann::json::parse(plain.out);
+  // The URDF's <limit>s: ranges and speeds of the revolute joints (the wheels' continuous joints are
+  // spins, no coordinates), and every actuator's effort as its torque limit (dynamics gives none).
+  std::map<std::string, nlohmann::json> limits;
+  for (const auto& l : a["settings"]["limits"]) limits[l["coordinate"].get<std::string>()] = l;
+  REQUIRE(limits.size() == 12);
+  CHECK(limits["haa_rf"]["lower"] == -0.72);
+  CHECK(limits["haa_rf"]["upper"] == 0.49);
+  CHECK(limits["kfe_lh"]["lower"] == -2.8);
+  CHECK(limits["kfe_lh"]["upper"] == -0.4);
+  CHECK(limits["kfe_lh"]["velocity"] == 7.5);
+  CHECK(limits["kfe_lh"]["effort"] == 80.0);
+  const std::vector<double> efforts{80, 80, 80, 80, 80, 80, 80, 80, 80, 80, 80, 80, 40, 40, 40, 40};
+  CHECK(a["settings"]["torque_limits"].get<std::vector<double>>() == efforts);
+  CHECK(a["settings"]["branches"].empty());
+  // The file's own `limits` replace the URDF's field by field (the knees' range; their effort and
+  // speed stay), and a limb's default branch: data both, so the code key stays.
+  std::string edited = yaml;
+  const std::string start = "    start: {haa_<leg>: 0, hfe_<leg>: 0.5, kfe_<leg>: -1.0}\n";
+  REQUIRE(edited.find(start) != std::string::npos);
+  edited.replace(edited.find(start), start.size(), start + "    branch: 2\n");
+  edited += "\nlimits:\n  - for: leg\n    items:\n      - {joint: kfe_<leg>, lower: -2.5, upper: -0.5}\n";
+  wlx_test::write(dir / "robot.yaml", edited);
+  const auto limited = wlx_test::run({(dir / "robot.yaml").string(), "--data-at-run-time", "--describe"});
+  CAPTURE(limited.err);
+  REQUIRE(limited.code == 0);
+  const nlohmann::json b = nlohmann::json::parse(limited.out);
+  CHECK(a["code_key"] == b["code_key"]);
+  limits.clear();
+  for (const auto& l : b["settings"]["limits"]) limits[l["coordinate"].get<std::string>()] = l;
+  CHECK(limits["kfe_rf"]["lower"] == -2.5);
+  CHECK(limits["kfe_rf"]["upper"] == -0.5);
+  CHECK(limits["kfe_rf"]["effort"] == 80.0);
+  CHECK(limits["hfe_rf"]["lower"] == -9.42);
+  CHECK(b["settings"]["branches"]["leg_rh"] == 2);
+  // Mistakes, named where they are: a branch the limb's closed form does not have, an empty range,
+  // half a range, an effort that is no effort, a joint given twice, a name that is no coordinate.
+  const std::pair<std::string, std::string> cases[] = {
+      {"    branch: 4\n", "has 4 branches (0 to 3), not 4"},
+      {"    branch: 1.5\n", "a branch is a whole number from 0, got 1.5"},
+  };
+  for (const auto& c : cases) {
+    const std::string& line = c.first;
+    const std::string& message = c.second;
+    std::string bad = yaml;
+    bad.replace(bad.find(start), start.size(), start + line);
+    wlx_test::write(dir / "robot.yaml", bad);
+    const auto r = wlx_test::run({(dir / "robot.yaml").string(), "--describe"});
+    CAPTURE(r.err);
+    CHECK(r.code == 2);
+    CHECK(r.err.find("robot.yaml:") != std::string::npos);
+    CHECK(r.err.find(message) != std::string::npos);
+  }
+  const std::pair<std::string, std::string> entries[] = {
+      {"{joint: kfe_lf, lower: -0.4, upper: -0.4}", "lower (-0.4) must be below upper (-0.4)"},
+      {"{joint: kfe_lf, lower: -0.4}", "a range needs both `lower` and `upper`"},
+      {"{joint: kfe_lf, effort: -3}", "must be in (0, 1e9], got -3"},
+      {"{joint: kfe_lf, lower: -1e7, upper: 0}", "must be within [-1e6, 1e6], got -10000000"},
+      {"{joint: kfe_lf, velocity: 2}\n  - {joint: kfe_lf, effort: 2}", "'kfe_lf' has limits already: give them once"},
+      {"{joint: knee_lf, velocity: 2}", "knee_lf"},
+  };
+  for (const auto& e : entries) {
+    // Not a structured binding: clang 14 cannot capture one in CAPTURE's lambda.
+    const std::string& entry = e.first;
+    const std::string& message = e.second;
+    wlx_test::write(dir / "robot.yaml", yaml + "\nlimits:\n  - " + entry + "\n");
+    const auto r = wlx_test::run({(dir / "robot.yaml").string(), "--describe"});
+    CAPTURE(entry);
+    CAPTURE(r.err);
+    CHECK(r.code == 2);
+    CHECK(r.err.find("robot.yaml:") != std::string::npos);
+    CHECK(r.err.find("limits") != std::string::npos);
+    CHECK(r.err.find(message) != std::string::npos);
+  }
+  // A URDF range upside down is the URDF's mistake, named at its line.
+  const std::string urdf = wlx_test::slurp(WLX_SOURCE_DIR "/models/wheeled_quadruped.urdf");
+  const std::string range = "<limit lower=\"-0.72\" upper=\"0.49\"";
+  REQUIRE(urdf.find(range) != std::string::npos);
+  wlx_test::write(dir / "wheeled_quadruped.urdf", std::string(urdf).replace(urdf.find(range), range.size(), "<limit lower=\"0.72\" upper=\"0.49\""));
+  wlx_test::write(dir / "robot.yaml", yaml);
+  const auto r = wlx_test::run({(dir / "robot.yaml").string(), "--describe"});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("wheeled_quadruped.urdf:84: joint 'haa_lf' limit: lower=\"0.72\" is above upper=\"0.49\"") != std::string::npos);
+}
+
 #endif
 
 TEST_CASE("wlx-gen: a baked value that makes an output infinite at the nominal state exits 2 naming the function and output") {

@@ -21,11 +21,13 @@
 #include <wlx/ik_verification.hpp>
 #include <wlx/kinematics.hpp>
 #include <wlx/nonholonomic.hpp>
+#include <wlx/settings.hpp>
 #include <wlx/simulation.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -195,6 +197,131 @@ TEST_CASE(titled("the IK from the nominal state, and the model's sweeps: closure
     CHECK(r.max_level_error <= 1e-12);
     CHECK(r.max_newton_difference <= 1e-9);  // Newton's own stop, |Phi| <= 1e-13, over the limb's conditioning
   }
+}
+
+// The joints' limits and the limbs' default branches are settings (data): each case below sets
+// them for this model and puts the model's own back afterwards.
+struct SettingsRestorer {
+  Settings saved = settings();
+  ~SettingsRestorer() { set_settings(saved); }
+};
+
+TEST_CASE(titled("limits: the IK takes the branch within the joints' ranges, else the default branch, and says when none is")) {
+  const SettingsRestorer restore;
+  const Model model;
+  const Coordinates base = nominal_inputs();
+  bool tried = false;
+  for (Limb limb : kLimbs) {
+    if (branch_count(limb) < 2) continue;
+    const LimbBlock block = limb_block(limb);
+    // Branch 0's solution, and the last branch whose solution differs from it on some joint.
+    Coordinates first = base;
+    try {
+      solve_limb_closed_form(model, limb, 0, first);
+    } catch (const Error&) {
+      continue;
+    }
+    int other = -1;
+    Coordinates target = base;
+    for (int b = branch_count(limb) - 1; b > 0 && other < 0; --b) {
+      Coordinates c = base;
+      try {
+        solve_limb_closed_form(model, limb, b, c);
+      } catch (const Error&) {
+        continue;
+      }
+      double gap = 0;
+      for (int j = 0; j < block.size; ++j) gap = std::max(gap, std::abs(c(block.joints[static_cast<std::size_t>(j)]) - first(block.joints[static_cast<std::size_t>(j)])));
+      if (gap > 1e-3) other = b, target = c;
+    }
+    if (other < 0) continue;
+    tried = true;
+    CAPTURE(limb_name(limb));
+    CAPTURE(other);
+    const auto same_as = [&](const Coordinates& got, const Coordinates& want) {
+      double worst = 0;
+      for (int j = 0; j < block.size; ++j) {
+        const int k = block.joints[static_cast<std::size_t>(j)];
+        worst = std::max(worst, std::abs(got(k) - want(k)));
+      }
+      return worst;
+    };
+    // Ranges of +-1e-3 around that branch's joints: only it lies within them, and the IK with no
+    // branch given takes it; a branch given is taken as it is, and said to be outside.
+    Settings s = restore.saved;
+    for (int j = 0; j < block.size; ++j) {
+      const auto k = static_cast<std::size_t>(block.joints[static_cast<std::size_t>(j)]);
+      s.lower[k] = target(static_cast<Eigen::Index>(k)) - 1e-3;
+      s.upper[k] = target(static_cast<Eigen::Index>(k)) + 1e-3;
+    }
+    set_settings(s);
+    Coordinates got = base;
+    solve_ik_closed_form(model, got);
+    CHECK(same_as(got, target) <= 1e-12);
+    std::array<bool, kLimbCount> outside{};
+    const Branches chosen = resolve_branches(model, base, {}, &outside);
+    CHECK(chosen.limb[static_cast<std::size_t>(limb)] == other);
+    CHECK_FALSE(outside[static_cast<std::size_t>(limb)]);
+    Branches zero;
+    zero.limb[static_cast<std::size_t>(limb)] = 0;
+    got = base;
+    solve_ik_closed_form(model, got, zero);
+    CHECK(same_as(got, first) <= 1e-12);
+    resolve_branches(model, base, zero, &outside);
+    CHECK(outside[static_cast<std::size_t>(limb)]);
+    const int k = first_outside_limits(got);
+    REQUIRE(k >= 0);
+    CHECK(describe_outside_limits(got, k).find(std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]) + " = ") == 0);
+
+    // No ranges on the limb's joints (a model's own may have some), a default branch: the IK takes it.
+    s = restore.saved;
+    for (int j = 0; j < block.size; ++j) {
+      const auto k = static_cast<std::size_t>(block.joints[static_cast<std::size_t>(j)]);
+      s.lower[k] = -std::numeric_limits<double>::infinity();
+      s.upper[k] = std::numeric_limits<double>::infinity();
+    }
+    s.default_branch[static_cast<std::size_t>(limb)] = other;
+    set_settings(s);
+    got = base;
+    solve_ik_closed_form(model, got);
+    CHECK(same_as(got, target) <= 1e-12);
+
+    // A range no branch meets: the default branch, said to be outside.
+    const auto j0 = static_cast<std::size_t>(block.joints[0]);
+    s.lower[j0] = 1e5;
+    s.upper[j0] = 1e5 + 1;
+    set_settings(s);
+    got = base;
+    solve_ik_closed_form(model, got);
+    CHECK(same_as(got, target) <= 1e-12);
+    resolve_branches(model, base, {}, &outside);
+    CHECK(outside[static_cast<std::size_t>(limb)]);
+    CHECK(first_outside_limits(got) == static_cast<int>(j0));
+
+    // A run from there stops at once, naming the joint; with "on_limit": "continue" it goes on and says where.
+    Scenario sc;
+    sc.duration = 0.004;
+    const Trajectory stopped = simulate(sc);
+    CHECK_FALSE(stopped.complete);
+    CHECK(stopped.error.find("stopped at t = 0.0000 s") != std::string::npos);
+    CHECK(stopped.error.find(std::string(gen::kCoordinateNames[j0]) + " = ") != std::string::npos);
+    CHECK(stopped.error.find("is outside its range [100000, 100001]") != std::string::npos);
+    sc.stop_on_limit = false;
+    const Trajectory went_on = simulate(sc);
+    CHECK(went_on.complete);
+    CHECK(went_on.samples.size() == 5);
+    CHECK(went_on.limit_warning.find("at t = 0.0000 s: " + std::string(gen::kCoordinateNames[j0])) == 0);
+
+    // set_settings refuses an empty range and a branch the limb does not have, naming the field.
+    Settings bad = restore.saved;
+    bad.lower[j0] = bad.upper[j0] = 1;
+    CHECK_THROWS_WITH_AS(set_settings(bad), doctest::Contains(("limits." + std::string(gen::kCoordinateNames[j0])).c_str()), Error);
+    bad = restore.saved;
+    bad.default_branch[static_cast<std::size_t>(limb)] = branch_count(limb);
+    CHECK_THROWS_WITH_AS(set_settings(bad), doctest::Contains(".branch: the limb has branches 0 to"), Error);
+    break;  // one limb of several branches is enough: the code is the same for every limb
+  }
+  if (!tried) MESSAGE(kName << ": no limb with two distinct closed-form branches at the nominal inputs");
 }
 
 TEST_CASE(titled("dependent rates and accelerations keep the wheels rolling and the closure, as a run's differences")) {
@@ -517,8 +644,10 @@ TEST_CASE(titled("forward dynamics: inverts the inverse dynamics; no torque and 
       sc.duration = duration, sc.dt = dt, sc.integrator = integrator, sc.tolerance = tolerance;
       sc.torques = std::move(torques);
       // These runs test the dynamics, not whether the machine stays on the ground (weightless, or
-      // driven by torques of another model, it need not): they go on where a contact lifts.
+      // driven by torques of another model, it need not) or within its joints' limits: they go on
+      // where a contact lifts or a joint leaves its range.
       sc.stop_on_contact_loss = false;
+      sc.stop_on_limit = false;
       return sc;
     };
 

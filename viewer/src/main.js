@@ -418,6 +418,7 @@ function buildPanel(info) {
     label.style.display = 'block';
     const select = document.createElement('select');
     for (let b = 0; b < limb.branches; ++b) select.add(new Option(String(b), String(b)));
+    select.value = String(app.branches[k]);
     select.onchange = () => {
       const previous = app.branches[k];
       app.branches[k] = Number(select.value);
@@ -685,7 +686,8 @@ const ready = (async () => {
                     'wlx viewer --model-file FILE writes a model file\'s own module)');
   });
   app.info = app.model.info;
-  app.branches = new Int32Array(app.info.limbs.length);
+  // The model's branches (its file's default, else within the joints' ranges), as `wlx ik` takes them.
+  app.branches = Int32Array.from(app.info.limbs, (limb) => limb.defaultBranch);
   // The nominal pose first, so that a run that fails to load still leaves a machine on screen, and
   // the view and the drawn parts sized to it.
   const nominal = app.model.solve(Float64Array.from(app.info.nominalInputs), app.branches);

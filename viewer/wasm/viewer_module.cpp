@@ -121,12 +121,16 @@ std::string build_info_json() {
          const auto i = static_cast<std::size_t>(k++);
          return "{\"name\":" + quoted(gen::kFrameNames[i]) + ",\"parent\":" + integer(gen::kFrameParent[i]) + "}";
        });
-  j += ",\"limbs\":" + array(gen::kLimbs, [](const gen::LimbInfo& l) {
+  // Each limb's branch where none is chosen: the model's at the nominal inputs (its file's
+  // default, else the first within the joints' ranges), as `wlx ik` takes it.
+  const Branches model_choice = resolve_branches(model(), nominal_inputs());
+  j += ",\"limbs\":" + array(gen::kLimbs, [&](const gen::LimbInfo& l) {
          std::string s = "{\"name\":" + quoted(l.name) + ",\"title\":" + quoted(l.title);
          s += ",\"joints\":" + array(std::vector<int>(l.joints.begin(), l.joints.begin() + l.size), integer);
          s += ",\"inputs\":" + array(std::vector<int>(l.inputs.begin(), l.inputs.begin() + l.input_count), integer);
          const int limb = static_cast<int>(&l - gen::kLimbs.data());
-         return s + ",\"branches\":" + integer(branch_count(limb)) + "}";
+         return s + ",\"branches\":" + integer(branch_count(limb)) +
+                ",\"defaultBranch\":" + integer(model_choice.limb[static_cast<std::size_t>(limb)]) + "}";
        });
   j += ",\"wheels\":" + array(gen::kWheels, [&](const gen::WheelInfo& w) {
          return "{\"name\":" + quoted(w.name) + ",\"contactFrame\":" + integer(w.contact_frame) +

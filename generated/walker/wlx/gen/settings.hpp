@@ -12,6 +12,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string_view>
 
 #include "structure.hpp"
@@ -19,6 +20,17 @@
 namespace wlx {
 inline namespace walker {
 namespace gen {
+
+inline constexpr double kNoLimit = std::numeric_limits<double>::infinity();
+// The joints' ranges, in coord:: order (the model file's `limits` and a URDF's <limit>s; -kNoLimit and
+// kNoLimit: none). The IK prefers the branch within them; verify ik and simulate check them.
+inline constexpr std::array<double, 32> kJointLower{{-kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit}};
+inline constexpr std::array<double, 32> kJointUpper{{kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit}};
+// The joints' largest speeds (rad/s or m/s; 0: none), in coord:: order.
+inline constexpr std::array<double, 32> kJointVelocityLimit{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
+// Each limb's default branch of its closed form (the model file's limbs[].branch; -1: none given, the
+// runtime takes the first branch from 0 whose joints are within their ranges).
+inline constexpr std::array<int, 4> kDefaultBranches{{-1, -1, -1, -1}};
 
 // The actuators' default weights (the model file's dynamics.weights).
 inline constexpr std::array<double, 8> kDefaultWeights{{1.0, 0.01, 0.1, 1.0, 0.01, 0.1, 0.01, 0.01}};
