@@ -14,7 +14,8 @@ WLX_COMMANDS_BEGIN
 void write_ik_sweep_csv(const std::string& path, const IkSweepResult& result);
 
 // t, the coordinates, per wheel x_/y_<contact> (x_Wl, y_Wl, ...), nh_residual_<wheel>, spin_rate_<wheel>,
-// the input rates (<name>_dot), cond_J_beta, clearance, the contact velocities vx_/vy_/vz_<contact>, and for
+// the input rates (<name>_dot), cond_J_beta, clearance (only for a model with a clearance box:
+// gen::kHasClearance), the contact velocities vx_/vy_/vz_<contact>, and for
 // dynamics runs tau_<joint> and Qstar_<speed>, and for runs driven by torques the commanded speeds'
 // accelerations <name>_ddot, the kinetic and potential energy (J) and the actuators' power (W); for
 // dynamics runs of a model with contacts, per contact (gen::kContacts' names) the ground's force

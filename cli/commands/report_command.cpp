@@ -120,6 +120,12 @@ void Report::evaluate_claims(report::Document& d) {
         measured = false;
         break;
       }
+      if (!m->stopped.empty()) {  // a run it depends on stopped: no value, and a check fails
+        row.measured.push_back("not measured: " + m->stopped);
+        if (t.criterion) row.criteria.push_back(t.criterion->describe(m->unit));
+        pass = false;
+        continue;
+      }
       row.measured.push_back(format_value(*m, t.criterion));
       if (t.criterion) {
         row.criteria.push_back(t.criterion->describe(m->unit));
@@ -160,10 +166,11 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
                         {s.sweep.id + ".csv", "data/" + s.sweep.id + ".csv"}});
     out.push_back({"ik", title("ik", "Inverse kinematics sweeps"), "", {t}, figures.ik, {}});
   }
+  // A model without a clearance box (structure.hpp's kHasClearance) has no clearance column.
   const auto runs_table = [&](auto keep) {
-    report::Table t{{"run", "description", "samples", "max |v_W . n_W| (m/s)", "max cond(J_beta)", "min clearance (m)", "CSV",
-                     "3D"},
-                    {}};
+    report::Table t{{"run", "description", "samples", "result", "max |v_W . n_W| (m/s)", "max cond(J_beta)"}, {}};
+    if (gen::kHasClearance) t.header.emplace_back("min clearance (m)");
+    t.header.insert(t.header.end(), {"CSV", "3D"});
     for (const auto& r : runner_.runs()) {
       if (!keep(r)) continue;
       double res = 0, cond = 0, clear = 1e300;
@@ -172,9 +179,14 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
         cond = std::max(cond, smp.cond_J_beta);
         clear = std::min(clear, smp.clearance);
       }
-      t.rows.push_back({{r.id}, {r.scenario.description}, {std::to_string(r.trajectory.samples.size())}, {fmt::format("{:.2e}", res)},
-                        {fmt::format("{:.3g}", cond)}, {fmt::format("{:.4f}", clear)}, {r.csv, "data/" + r.csv},
-                        viewer_missing_.empty() ? report::Cell{"animate", viewer_link(r.id)} : report::Cell{"-"}});
+      const bool any = !r.trajectory.samples.empty();  // a run stopped at its first step has no maxima
+      std::vector<report::Cell> row{{r.id}, {r.scenario.description}, {std::to_string(r.trajectory.samples.size())},
+                                    {r.stopped ? r.stopped->describe() : "complete"}, {any ? fmt::format("{:.2e}", res) : "-"},
+                                    {any ? fmt::format("{:.3g}", cond) : "-"}};
+      if (gen::kHasClearance) row.push_back({any ? fmt::format("{:.4f}", clear) : "-"});
+      row.push_back({r.csv, "data/" + r.csv});
+      row.push_back(viewer_missing_.empty() && any ? report::Cell{"animate", viewer_link(r.id)} : report::Cell{"-"});
+      t.rows.push_back(row);
     }
     return t;
   };
@@ -255,16 +267,25 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
                    {t}, {}, {}});
   }
   if (!runner_.forward().empty()) {
-    report::Table trips{{"run", "samples", "evaluations", "max |s_forward - s_inverse| (m or rad)", "max |E - E0 - W| (J)",
+    report::Table trips{{"run", "result", "samples", "evaluations", "max |s_forward - s_inverse| (m or rad)", "max |E - E0 - W| (J)",
                          "relative to max |W|", "CSV"},
                         {}};
-    report::Table loops{{"run", "tracking error at t = 0 (m or rad)", "max tracking error, second half (m or rad)", "CSV"}, {}};
+    report::Table loops{{"run", "result", "tracking error at t = 0 (m or rad)", "max tracking error, second half (m or rad)", "CSV"}, {}};
     for (const auto& r : runner_.forward()) {
-      trips.rows.push_back({{r.id}, {std::to_string(r.samples)}, {std::to_string(r.evaluations)}, {fmt::format("{:.2e}", r.round_trip)},
-                            {fmt::format("{:.2e}", r.energy_balance)}, {fmt::format("{:.1e}", r.energy_balance / std::max(r.work, 1.0))},
-                            {r.csv, "data/" + r.csv}});
-      loops.rows.push_back({{r.id}, {fmt::format("{:.2e}", r.start_error)},
-                            {r.closed_loop_complete ? fmt::format("{:.2e}", r.late_error) : "stopped " + r.closed_loop_stopped},
+      if (r.not_run) {  // its inverse-dynamics run stopped: neither simulation has a motion to follow
+        const std::string why = fmt::format("not run: {} {}", r.id, r.not_run->describe());
+        trips.rows.push_back({{r.id}, {why}, {"-"}, {"-"}, {"-"}, {"-"}, {"-"}, {"-"}});
+        loops.rows.push_back({{r.id}, {why}, {"-"}, {"-"}, {"-"}});
+        continue;
+      }
+      const bool trip = r.samples > 0, loop = r.closed_loop_samples > 0;  // no sample: no maxima
+      trips.rows.push_back({{r.id}, {r.round_trip_stopped ? r.round_trip_stopped->describe() : "complete"}, {std::to_string(r.samples)},
+                            {std::to_string(r.evaluations)}, {trip ? fmt::format("{:.2e}", r.round_trip) : "-"},
+                            {trip ? fmt::format("{:.2e}", r.energy_balance) : "-"},
+                            {trip ? fmt::format("{:.1e}", r.energy_balance / std::max(r.work, 1.0)) : "-"}, {r.csv, "data/" + r.csv}});
+      loops.rows.push_back({{r.id}, {r.closed_loop_stopped ? r.closed_loop_stopped->describe() : "complete"},
+                            {loop ? fmt::format("{:.2e}", r.start_error) : "-"},
+                            {r.closed_loop_stopped ? std::string("-") : fmt::format("{:.2e}", r.late_error)},
                             {r.closed_loop_csv, "data/" + r.closed_loop_csv}});
     }
     report::Section s{"forward", title("forward", "Forward dynamics"),
@@ -313,6 +334,9 @@ report::Document Report::document(const ReportFigures& figures) {
     d.parameters.rows.push_back({{std::string(info.name)}, {fmt::format("{:.10g}", p.*(info.member))}, {std::string(info.unit)},
                                  {std::string(info.meaning)}});
   evaluate_claims(d);
+  d.stopped_runs.header = {"run", "stopped at t (s)", "reason"};
+  for (const StoppedRun& r : runner_.stopped())
+    d.stopped_runs.rows.push_back({{r.label()}, {fmt::format("{:.4f}", r.stop.time)}, {r.stop.reason}});
   d.sections = sections(figures);
   return d;
 }
@@ -333,6 +357,7 @@ void Report::write_viewer() {
     return;
   }
   for (const auto& r : runner_.runs()) {
+    if (r.trajectory.samples.empty()) continue;  // stopped at its first step: nothing to animate (its "3D" cell says "-")
     const std::string weighting = r.scenario.weighting ? " (" + r.scenario.weighting->label() + ")" : "";
     write_viewer_run(dir, r.scenario, r.trajectory, r.id, r.scenario.description + weighting);
   }
@@ -359,23 +384,28 @@ int Report::run() {
   progress("measuring the claims and drawing the figures");
   const ReportFigures figures = make_figures(runner_, spec_, (root_ / "data").string());
   report::Document doc = document(figures);
-  std::vector<report::FigureSpec> all;
+  std::vector<report::FigureSpec> all;  // the figures drawn; an omitted one is a sentence in the page
   for (const auto* group : {&figures.ik, &figures.nonholonomic, &figures.kinematic, &figures.dynamics, &figures.forward,
                             &figures.closed_loop, &figures.poses})
-    all.insert(all.end(), group->begin(), group->end());
+    for (const auto& f : *group)
+      if (!f.omitted()) all.push_back(f);
   progress(fmt::format("rendering {} figures with gnuplot (PNG and SVG)", all.size()));
   report::render(root_.string(), all);
   // Last of all the files: its presence says the report is complete.
   write_file_atomically((root_ / "index.html").string(), report::render_html(doc));
   std::size_t failed = 0;
   for (const auto& c : doc.checks) failed += c.result != ClaimRow::Result::pass;
+  const auto& stopped = runner_.stopped();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  fmt::print("\n{} of {} checks pass ({} inputs, {} observations shown apart); {} figures; {:.1f} s\nopen {}\n",
-             doc.checks.size() - failed, doc.checks.size(), doc.inputs.size(), doc.observations.size(), all.size(), seconds,
-             fs::absolute(root_ / "index.html").string());
+  fmt::print("\n{} of {} checks pass ({} inputs, {} observations shown apart); stopped simulations: {}; {} figures; {:.1f} s\nopen {}\n",
+             doc.checks.size() - failed, doc.checks.size(), doc.inputs.size(), doc.observations.size(), stopped.size(), all.size(),
+             seconds, fs::absolute(root_ / "index.html").string());
+  for (const StoppedRun& r : stopped)
+    wlx::diagnose("wlx: run stopped: {} at t = {:.4f} s: {}\n", r.label(), r.stop.time, r.stop.reason);
   for (const auto& c : doc.checks)
     if (c.result != ClaimRow::Result::pass) wlx::diagnose("wlx: check failed: {}: {}\n", c.id, c.claim);
-  return failed == 0 ? 0 : 1;
+  // A stopped run fails the report as a failed check does: the report stands, the result does not.
+  return failed == 0 && stopped.empty() ? 0 : 1;
 }
 
 }  // namespace

@@ -35,7 +35,9 @@ std::vector<std::string> trajectory_header(const Scenario& sc) {
     for (const gen::WheelInfo& wheel : gen::kWheels) h.push_back(quantity + std::string(wheel.name));
   for (int k = 0; k < kInputCount; ++k) h.push_back(name(k) + "_dot");
   h.emplace_back("cond_J_beta");
-  h.emplace_back("clearance");
+  // Only a model with a clearance box has the column (its sample's clearance is +infinity without
+  // one, which no CSV holds): readers look for the column, as for the dynamics columns.
+  if (gen::kHasClearance) h.emplace_back("clearance");
   for (int w = 0; w < kWheelCount; ++w)
     for (const char* axis : {"vx_", "vy_", "vz_"}) h.push_back(axis + contact_column_stem(w));
   if (dynamics) {
@@ -72,7 +74,7 @@ std::vector<double> trajectory_row(const Sample& smp, const Scenario& sc) {
   for (int w = 0; w < kWheelCount; ++w) row.push_back(smp.spin_rate(w));
   for (int k = 0; k < kInputCount; ++k) row.push_back(smp.sdot(k));
   row.push_back(smp.cond_J_beta);
-  row.push_back(smp.clearance);
+  if (gen::kHasClearance) row.push_back(smp.clearance);
   for (int w = 0; w < kWheelCount; ++w)
     for (int i = 0; i < 3; ++i) row.push_back(smp.contact_velocity(i, w));
   if (dynamics) {

@@ -116,8 +116,8 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
   if (summary.samples == 0) {
     fmt::print("no sample was computed\n");
   } else {
-    fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, min clearance = {:.4f} m\n",
-               summary.worst_residual, summary.worst_cond, summary.min_clearance);
+    fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, {}\n", summary.worst_residual, summary.worst_cond,
+               gen::kHasClearance ? fmt::format("min clearance = {:.4f} m", summary.min_clearance) : std::string("no clearance box"));
     if (sc.weighting) fmt::print("inverse dynamics with {}: largest |tau| = {:.4g} N m\n", sc.weighting->label(), summary.peak_tau);
     if ((sc.weighting || sc.driven_by_torques()) && summary.normal.contact >= 0) {
       const auto& st = summary;

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 WLX_COMMANDS_BEGIN
@@ -47,6 +48,27 @@ std::vector<std::string> legend_titles(const std::vector<std::string>& names, co
 
 // A dash pattern per curve index, so that coinciding curves stay distinguishable.
 int dash(std::size_t k) { return static_cast<int>(k % 5) + 1; }
+
+// A curve needs two samples: a run that stopped before its second has none (and gnuplot refuses a
+// plot whose data are empty). Why `what` of a simulation with `samples` samples is not drawn, or
+// "" when it is.
+std::string not_drawn(const std::string& what, std::size_t samples, const std::optional<Stop>& stopped) {
+  if (samples >= 2) return "";
+  if (!stopped) return what + " has fewer than two samples: nothing to draw";  // a complete run has two at least
+  return fmt::format("{} stopped at t = {:.4f} s {} (it never left its start), with nothing to draw: {}", what, stopped->time,
+                     samples == 0 ? "before its first sample" : "after its first sample", stopped->reason);
+}
+std::string not_drawn(const ReportRun& r) { return not_drawn(r.id, r.trajectory.samples.size(), r.stopped); }
+
+// ". Left out: <why>; <why>" to end a caption, or "".
+std::string left_out(const std::vector<std::string>& why) {
+  return why.empty() ? "" : fmt::format(". Left out: {}", fmt::join(why, "; "));
+}
+
+// A figure not drawn: its sentence stands in its place in the page (FigureSpec::omitted).
+FigureSpec omitted(const std::string& name, const std::string& what, const std::vector<std::string>& why) {
+  return {name, fmt::format("No figure of {}: {}.", what, fmt::join(why, "; ")), "", ""};
+}
 
 struct Bounds {
   double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300, z0 = 0, z1 = -1e300;
@@ -119,7 +141,7 @@ class Figures {
   // body frame's path.
   void write_poses() {
     for (const auto& r : runner_.runs()) {
-      if (duplicate_motion(r)) continue;
+      if (duplicate_motion(r) || r.trajectory.samples.empty()) continue;  // no pose: poses() says so
       std::ostringstream out;
       for (const Sample* smp : {&r.trajectory.samples.front(), &r.trajectory.samples.back()}) {
         const Pose p = pose_at(smp->s);
@@ -206,9 +228,17 @@ class Figures {
 
   void nonholonomic(std::vector<FigureSpec>& out) {
     std::vector<const ReportRun*> runs;
-    for (const auto& r : runner_.runs())
-      if (r.nonholonomic_verification) runs.push_back(&r);
-    if (runs.empty()) return;
+    std::vector<std::string> why;
+    for (const auto& r : runner_.runs()) {
+      if (!r.nonholonomic_verification) continue;
+      const std::string reason = not_drawn(r);
+      if (reason.empty()) runs.push_back(&r);
+      else why.push_back(reason);
+    }
+    if (runs.empty()) {
+      if (!why.empty()) out.push_back(omitted("nh-residuals", "the wheel constraint residuals", why));
+      return;
+    }
     std::string b = fmt::format("set multiplot layout {},1\nset logscale y\nset format y '1e%L'\nset yrange [1e-19:1e-3]\n"
                                 "set key outside right top\n",
                                 runs.size());
@@ -222,15 +252,25 @@ class Figures {
       b += reference_line("wheel_residual") + "\n";
     }
     b += "unset multiplot\n";
-    out.push_back({"nh-residuals", "Wheel constraint residual per wheel (zeros drawn at 1e-19)", fmt::format("1000,{}", 260 * runs.size()), b});
+    out.push_back({"nh-residuals", "Wheel constraint residual per wheel (zeros drawn at 1e-19)" + left_out(why),
+                   fmt::format("1000,{}", 260 * runs.size()), b});
   }
 
   void runs(std::vector<FigureSpec>& out) {
     for (const auto& g : spec_.run_figures) {
       std::vector<const ReportRun*> runs;
-      for (const auto& id : g.runs)
-        if (const ReportRun* r = runner_.find_run(id)) runs.push_back(r);
-      if (runs.empty()) continue;
+      std::vector<std::string> why;
+      for (const auto& id : g.runs) {
+        const ReportRun* r = runner_.find_run(id);
+        if (!r) continue;  // not in this report (--quick)
+        const std::string reason = not_drawn(*r);
+        if (reason.empty()) runs.push_back(r);
+        else why.push_back(reason);
+      }
+      if (runs.empty()) {
+        if (!why.empty()) out.push_back(omitted("run-" + g.id, g.id, why));
+        continue;
+      }
       const int x = coordinate_index(g.x);
       std::string b = fmt::format("set multiplot layout 1,{}\nset key outside right top\n", g.y.size());
       for (const auto& name : g.y) {
@@ -245,7 +285,7 @@ class Figures {
       b += "unset multiplot\n";
       std::string caption = fmt::format("{}: {} over the driving input {}", g.id, fmt::format("{}", fmt::join(g.y, " and ")), g.x);
       if (!g.thesis.empty()) caption += "; cf. thesis " + g.thesis;
-      out.push_back({"run-" + g.id, caption, "1100,450", b});
+      out.push_back({"run-" + g.id, caption + left_out(why), "1100,450", b});
       out.push_back(top_view(g.id, runs));
     }
   }
@@ -293,6 +333,10 @@ class Figures {
     }
     for (const auto& r : runner_.runs()) {
       if (!r.scenario.weighting) continue;
+      if (const std::string why = not_drawn(r); !why.empty()) {
+        out.push_back(omitted("id-" + r.id, "the torques of " + r.id, {why}));
+        continue;
+      }
       const int weighting = weighting_number(*r.scenario.weighting);
       const report::TorqueReference* reference = nullptr;
       for (const auto& ref : spec_.torque_references)
@@ -332,16 +376,43 @@ class Figures {
   void forward(std::vector<FigureSpec>& trips, std::vector<FigureSpec>& loops) {
     const auto& rows = runner_.forward();
     if (rows.empty()) return;
-    std::string t = "set xlabel 't (s)'\nset ylabel 'max |s_forward - s_inverse| (m or rad)'\nset logscale y\nset format y '1e%L'\n"
-                    "set key outside right top\nset title 'round trips: the torques of each inverse-dynamics run fed back'\nplot ";
-    for (std::size_t k = 0; k < rows.size(); ++k)
-      t += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(data_path(rows[k].csv)), column("t"),
-                       log_column("round_trip_deviation"), dash(k), q(rows[k].id));
-    trips.push_back({"forward-round-trips", "Round trips: the largest deviation of the forward-dynamics run from the inverse-dynamics "
-                                            "run whose torques drive it, over time", "1100,500", t + "\n"});
+    // Why a row's round trip or closed loop has no curve: its inverse-dynamics run stopped, or it
+    // stopped itself before its second sample; "" when it has one.
+    const auto why_not = [](const ForwardRow& r, bool loop) {
+      if (r.not_run) return fmt::format("{} {}, so it has no {}", r.id, r.not_run->describe(), loop ? "closed loop" : "round trip");
+      return loop ? not_drawn("the closed loop of " + r.id, static_cast<std::size_t>(r.closed_loop_samples), r.closed_loop_stopped)
+                  : not_drawn("the round trip of " + r.id, static_cast<std::size_t>(r.samples), r.round_trip_stopped);
+    };
+    std::vector<const ForwardRow*> drawn;
+    std::vector<std::string> why;
+    for (const auto& r : rows) {
+      const std::string reason = why_not(r, false);
+      if (reason.empty()) drawn.push_back(&r);
+      else why.push_back(reason);
+    }
+    if (drawn.empty()) {
+      trips.push_back(omitted("forward-round-trips", "the round trips", why));
+    } else {
+      std::string t = "set xlabel 't (s)'\nset ylabel 'max |s_forward - s_inverse| (m or rad)'\nset logscale y\nset format y '1e%L'\n"
+                      "set key outside right top\nset title 'round trips: the torques of each inverse-dynamics run fed back'\nplot ";
+      for (std::size_t k = 0; k < drawn.size(); ++k)
+        t += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(data_path(drawn[k]->csv)), column("t"),
+                         log_column("round_trip_deviation"), dash(k), q(drawn[k]->id));
+      trips.push_back({"forward-round-trips", "Round trips: the largest deviation of the forward-dynamics run from the inverse-dynamics "
+                                              "run whose torques drive it, over time" + left_out(why), "1100,500", t + "\n"});
+    }
     std::vector<const ForwardRow*> shown;
-    for (const auto& r : rows)
-      if (r.id.size() < 3 || r.id.substr(r.id.size() - 3) != "-w2") shown.push_back(&r);
+    std::vector<std::string> loops_why;
+    for (const auto& r : rows) {
+      if (r.id.size() >= 3 && r.id.substr(r.id.size() - 3) == "-w2") continue;
+      const std::string reason = why_not(r, true);
+      if (reason.empty()) shown.push_back(&r);
+      else loops_why.push_back(reason);
+    }
+    if (shown.empty()) {
+      if (!loops_why.empty()) loops.push_back(omitted("forward-closed-loop", "the closed loops' tracking errors", loops_why));
+      return;
+    }
     std::string l = fmt::format("set multiplot layout {},1\nset xlabel 't (s)'\nset ylabel 'q_ref - q (mm or deg)'\n"
                                 "set key outside right top\n",
                                 shown.size());
@@ -358,13 +429,18 @@ class Figures {
     }
     l += "unset multiplot\n";
     loops.push_back({"forward-closed-loop", "A controller in the loop: the tracking error of computed torque with PD feedback on a "
-                                            "plant 10% heavier than its model, from a perturbed start, per commanded coordinate",
+                                            "plant 10% heavier than its model, from a perturbed start, per commanded coordinate" +
+                                                left_out(loops_why),
                      fmt::format("1100,{}", 330 * shown.size()), l});
   }
 
   void poses(std::vector<FigureSpec>& out) {
     for (const auto& r : runner_.runs()) {
       if (duplicate_motion(r)) continue;
+      if (r.trajectory.samples.empty()) {  // one sample still shows where it stood
+        out.push_back(omitted("pose-" + title_of(r), "the poses of " + r.id, {not_drawn(r)}));
+        continue;
+      }
       const std::string dat = data_path(r.id + "-pose.dat");
       const Bounds& bounds = bounds_[r.id];
       const std::string title = title_of(r);

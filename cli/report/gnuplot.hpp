@@ -12,6 +12,9 @@ struct FigureSpec {
   std::string caption;  // for the HTML
   std::string size;     // gnuplot canvas size, "900,600"
   std::string body;     // plot commands, emitted once per terminal; data files named as data_path() gives them
+  // An omitted figure: no body, and its caption says why (a run stopped before it had anything to
+  // draw). The page shows the sentence in its place; nothing is rendered.
+  bool omitted() const { return body.empty(); }
 };
 
 // A data file as the scripts name it: relative to plots/, where the scripts run (so the user's

@@ -55,7 +55,10 @@ void section(std::string& h, const Section& s, int level) {
   if (!s.intro.empty()) h += "<p>" + escape(s.intro) + "</p>\n";
   for (const auto& t : s.tables) h += table(t);
   for (const auto& f : s.figures)
-    h += fmt::format("<figure id=\"fig-{0}\"><a href=\"fig/{0}.svg\"><img src=\"fig/{0}.png\" alt=\"{1}\" /></a>"
+    if (f.omitted())  // said in words where the figure would be
+      h += fmt::format("<p id=\"fig-{}\" class=\"omitted\">{}</p>\n", escape(f.name), escape(f.caption));
+    else
+      h += fmt::format("<figure id=\"fig-{0}\"><a href=\"fig/{0}.svg\"><img src=\"fig/{0}.png\" alt=\"{1}\" /></a>"
                      "<figcaption>{1} (<a href=\"plots/{0}.gp\">script</a>)</figcaption></figure>\n",
                      escape(f.name), escape(f.caption));
   for (const auto& sub : s.subsections) section(h, sub, level + 1);
@@ -82,6 +85,7 @@ std::string render_html(const Document& d) {
        "th{background:#eee}.pass{color:#176b17;font-weight:bold}.fail{color:#b00;font-weight:bold}\n"
        "td.why{color:#555;font-size:90%;max-width:24em}td.wlx,td.criterion{white-space:nowrap}\n"
        "figure{margin:1.5em 0}figure img{max-width:100%;border:1px solid #ddd}figcaption{color:#555}\n"
+       "p.omitted{color:#555;font-style:italic;border-left:3px solid #bbb;padding-left:0.6em}\n"
        "nav{background:#f6f6f6;padding:0.5em 1em;border:1px solid #ddd}\n"
        "code{background:#f4f4f4;padding:1px 3px}\n</style>\n</head>\n<body>\n";
   h += fmt::format("<h1>wlx report: {}</h1>\n", escape(d.title));
@@ -92,6 +96,7 @@ std::string render_html(const Document& d) {
        "<code>data/</code>, the scripts in <code>plots/</code> (run <code>gnuplot NAME.gp</code> in that folder).</p>\n";
 
   std::vector<Section> toc;
+  if (!d.stopped_runs.rows.empty()) toc.push_back({"stopped", "Stopped runs", "", {}, {}, {}});
   toc.push_back({"checks", "Checks", "", {}, {}, {}});
   toc.push_back({"inputs", "Inputs and set-up (not checks)", "", {}, {}, {}});
   toc.push_back({"observations", "Observations: where wlx differs from its sources", "", {}, {}, {}});
@@ -101,6 +106,13 @@ std::string render_html(const Document& d) {
   contents(h, toc);
   h += "</nav>\n";
 
+  if (!d.stopped_runs.rows.empty()) {
+    h += fmt::format("<h2 id=\"stopped\">Stopped runs</h2>\n<p class=\"fail\">{} of the report's simulations stopped before their "
+                     "end. Each is shown with what it computed up to there (its CSV, its figures where it has at least two "
+                     "samples); a check that depends on one fails with its reason, and the report exits with 1.</p>\n",
+                     d.stopped_runs.rows.size());
+    h += table(d.stopped_runs);
+  }
   std::size_t failed = 0;
   for (const auto& c : d.checks) failed += c.result != ClaimRow::Result::pass;
   h += "<h2 id=\"checks\">Checks</h2>\n";

@@ -44,6 +44,7 @@ struct Document {
   std::vector<std::pair<std::string, std::string>> about;  // version, model, date, command line, ...
   Table parameters;
   std::vector<ClaimRow> checks, inputs, observations;
+  Table stopped_runs;  // the simulations that ended before their duration: run, time, reason (no rows: none)
   std::map<std::string, std::string> sources;  // "thesis", "spec": what a row's source names
   std::string claims_source;  // where the claims come from (a file), or empty: the model has none
   int skipped_claims = 0;     // claims about runs this report did not make (--quick)

@@ -40,6 +40,8 @@ void stop_on_signal(long, long) { throw_if_interrupted(); }
 
 }  // namespace
 
+std::string Stop::describe() const { return fmt::format("stopped at t = {:.4f} s: {}", time, reason); }
+
 std::string display_unit(int c) { return gen::kCoordinateUnits[static_cast<std::size_t>(c)] == "rad" ? "deg" : std::string(gen::kCoordinateUnits[static_cast<std::size_t>(c)]); }
 double display_scale(int c) { return gen::kCoordinateUnits[static_cast<std::size_t>(c)] == "rad" ? kDegPerRad : 1; }
 
@@ -105,6 +107,11 @@ void ReportRunner::validate() const {
       check(m.params, params, m.line, path + ".params", "a parameter");
       if (!m.sweep.empty()) check({m.sweep}, sweeps, m.line, path + ".sweep", "an IK sweep");
       if (!m.integrator.empty()) check({m.integrator}, integrators, m.line, path + ".integrator", "an integrator");
+      // Measured from the clearance box (structure.hpp's kHasClearance): a model without one has no such time.
+      if (m.quantity == "ground_contact_time" && !gen::kHasClearance)
+        throw Error(report::where(spec_, m.line, path + ".quantity"),
+                    fmt::format("ground_contact_time needs a clearance box, and model {} has none (its model file has no "
+                                "'clearance')", gen::kModelName));
       if (m.quantity == "integrator_deviation") {
         for (const auto& r : m.runs)
           if (std::find(spec_.integrator_scenarios.begin(), spec_.integrator_scenarios.end(), r) == spec_.integrator_scenarios.end())
@@ -171,8 +178,10 @@ void ReportRunner::run_all(const std::string& data_dir) {
       // its contacts table, not the end of the report.
       if (weighting) sc.stop_on_contact_loss = false;
       progress_(fmt::format("simulating {}{}: {}", id, weighting ? " (" + weighting->label() + ")" : "", sc.description));
-      ReportRun r{id, scenario_id, sc, simulate(sc, stop_on_signal), id + ".csv", verify};
-      if (!r.trajectory.complete) throw Error(id, r.trajectory.error);
+      ReportRun r{id, scenario_id, sc, simulate(sc, stop_on_signal), id + ".csv", verify, std::nullopt};
+      // A run that stops is one row of the report, with what it computed up to there: the
+      // others still run, and the report says where and why.
+      if (!r.trajectory.complete) r.stopped = record_stop(id, "", r.trajectory);
       write_trajectory(data_file(r.csv), r.trajectory, sc);
       runs_.push_back(std::move(r));
     }
@@ -181,6 +190,16 @@ void ReportRunner::run_all(const std::string& data_dir) {
   for (std::size_t k = 0; k < inverse_runs; ++k) {
     // Forward dynamics for weightings 1 and 2 (weighting 3's torques retrace the same motion).
     if (!runs_[k].scenario.weighting || runs_[k].scenario.weighting->kind == Weighting::Kind::contacts) continue;
+    if (runs_[k].stopped) {
+      // Both follow the run's whole motion (its torques from 0 to its duration, its path as the
+      // reference): a stopped run has neither.
+      progress_(fmt::format("forward dynamics of {}: not run ({} stopped)", runs_[k].id, runs_[k].id));
+      ForwardRow row;
+      row.id = runs_[k].id;
+      row.not_run = runs_[k].stopped;
+      forward_.push_back(row);
+      continue;
+    }
     progress_(fmt::format("forward dynamics of {}: its torques fed back, and a controller tracking it on a heavier plant", runs_[k].id));
     forward_.push_back(forward_dynamics_of(runs_[k], data_dir));
   }
@@ -194,14 +213,22 @@ void ReportRunner::run_all(const std::string& data_dir) {
 void ReportRunner::compare_integrators(const std::string& data_dir) {
   const double step = spec_.reference_step;
   for (const auto& id : spec_.integrator_scenarios) {
+    // A run that stopped at its own step stops in the comparison too: its row says so already.
+    if (first_stop({id})) continue;
     Scenario sc = parse_scenario(model_scenario_json(id), model_.params(), model_scenario_directory());
     Scenario ref_sc = sc;
     ref_sc.dt = step;
     const Trajectory ref = simulate(ref_sc, stop_on_signal);
-    if (!ref.complete) throw Error(id, ref.error);
+    if (!ref.complete) {
+      record_stop(id, fmt::format("reference, RK4 at {:g} s", step), ref);
+      continue;
+    }
     const auto compare = [&](const std::string& setting, const Scenario& run) {
       const Trajectory tr = simulate(run, stop_on_signal);
-      if (!tr.complete) throw Error(id, tr.error);
+      if (!tr.complete) {
+        record_stop(id, fmt::format("{}, {}", integrator_name(run.integrator), setting), tr);
+        return;
+      }
       IntegratorRow row{id, run.integrator, setting, static_cast<long>(tr.samples.size()), tr.evaluations, 0,
                         std::vector<double>(compared_.size(), 0.0)};
       for (const auto& smp : tr.samples) {
@@ -251,7 +278,7 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
   trip.tolerance = kRoundTripTolerance;
   trip.torques = TorqueTable(times, torques, TorqueTable::Interpolation::cubic);
   const Trajectory forward = simulate(trip, stop_on_signal);
-  if (!forward.complete) throw Error(run.id, "its torques fed back: " + forward.error);
+  if (!forward.complete) row.round_trip_stopped = record_stop(run.id, "round trip", forward);
   row.samples = static_cast<long>(forward.samples.size());
   row.evaluations = forward.evaluations;
 
@@ -292,8 +319,8 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
     return distribute_torques(terms.J_beta, terms.Qstar, weighting);
   };
   const Trajectory loop = simulate(plant, stop_on_signal);
-  row.closed_loop_complete = loop.complete;
-  row.closed_loop_stopped = loop.error;
+  if (!loop.complete) row.closed_loop_stopped = record_stop(run.id, "closed loop", loop);
+  row.closed_loop_samples = static_cast<long>(loop.samples.size());
 
   CsvWriter csv(data_dir + "/" + row.csv, {"t", "round_trip_deviation", "energy_balance"});
   EnergyBalance energy;
@@ -327,8 +354,19 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
     tracking.row(values);
   }
   tracking.commit();
-  if (!loop.complete) row.late_error = NAN;
   return row;
+}
+
+Stop ReportRunner::record_stop(const std::string& run, const std::string& part, const Trajectory& trajectory) {
+  const Stop stop{trajectory.stop_time, trajectory.stop_reason};
+  stopped_.push_back({run, part, stop});
+  return stop;
+}
+
+const StoppedRun* ReportRunner::first_stop(const std::vector<std::string>& runs, const std::vector<std::string>& parts) const {
+  for (const auto& s : stopped_)
+    if (std::count(runs.begin(), runs.end(), s.run) && (parts.empty() || std::count(parts.begin(), parts.end(), s.part))) return &s;
+  return nullptr;
 }
 
 const ReportRun* ReportRunner::find_run(const std::string& id) const {
@@ -342,6 +380,10 @@ const ReportRun* ReportRunner::find_run(const std::string& id) const {
 std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
   const std::string& q = m.quantity;
   const int c = m.coordinates.empty() ? -1 : coordinate_index(m.coordinates.front());
+  // A claim about a run that stopped is not measured: it fails, saying which run stopped where.
+  const auto stopped = [](const StoppedRun& s, const std::string& unit) {
+    return Measured{NAN, unit, fmt::format("{} {}", s.label(), s.stop.describe())};
+  };
   if (q == "total_mass") return Measured{model_.total_mass(), "kg"};
   if (q == "param_product") {
     Params p = model_.params();
@@ -373,16 +415,22 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
   }
   if (q == "max_wheel_residual") {
     if (runs_.empty()) return std::nullopt;
+    std::vector<std::string> all_runs;  // every sample of every run: a stopped one's are not all there
+    for (const auto& r : runs_) all_runs.push_back(r.id);
+    if (const StoppedRun* s = first_stop(all_runs)) return stopped(*s, "m/s");
     double worst = 0;
     for (const auto& r : runs_)
       for (const auto& smp : r.trajectory.samples) worst = std::max(worst, smp.nh_residual.cwiseAbs().maxCoeff());
     return Measured{worst, "m/s"};
   }
   if (q == "integrator_deviation") {
-    if (integrators_.empty()) return std::nullopt;
+    if (quick_ || spec_.integrator_scenarios.empty()) return std::nullopt;  // not compared (run_all)
     const Integrator integrator = *integrator_from_name(m.integrator);
     double worst = 0;
     std::string unit = "m or rad";
+    // A compared run stopped, at its own step or in a comparison: its deviation is not known.
+    if (const StoppedRun* s = first_stop(m.runs.empty() ? spec_.integrator_scenarios : m.runs, {}))
+      return stopped(*s, m.coordinates.empty() ? unit : display_unit(coordinate_index(m.coordinates.front())));
     for (const auto& r : integrators_) {
       if (r.integrator != integrator || (!m.runs.empty() && std::find(m.runs.begin(), m.runs.end(), r.id) == m.runs.end())) continue;
       if (m.coordinates.empty()) {
@@ -413,9 +461,11 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
   }
   if (q == "peak_torque") {
     double worst = 0;
+    for (const auto& id : m.runs)
+      if (!find_run(id)) return std::nullopt;
+    if (const StoppedRun* s = first_stop(m.runs)) return stopped(*s, "N m");
     for (const auto& id : m.runs) {
       const ReportRun* r = find_run(id);
-      if (!r) return std::nullopt;
       for (const auto& smp : r->trajectory.samples) worst = std::max(worst, smp.tau.cwiseAbs().maxCoeff());
     }
     return Measured{worst, "N m"};
@@ -423,27 +473,29 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
   if (q == "round_trip_deviation" || q == "energy_balance" || q == "closed_loop_error") {
     double worst = 0;
     bool any = false;
+    const std::string unit = q == "energy_balance" ? "" : "m or rad";
     for (const ForwardRow& r : forward_) {
       if (!m.runs.empty() && std::find(m.runs.begin(), m.runs.end(), r.id) == m.runs.end()) continue;
       any = true;
+      // The inverse-dynamics run, or the simulation this quantity comes from, stopped: not measured.
+      const std::string part = q == "closed_loop_error" ? "closed loop" : "round trip";
+      if (const StoppedRun* s = first_stop({r.id}, {"", part})) return stopped(*s, unit);
       if (q == "round_trip_deviation") worst = std::max(worst, r.round_trip);
       else if (q == "energy_balance") worst = std::max(worst, r.energy_balance / std::max(r.work, 1.0));
-      else worst = r.closed_loop_complete ? std::max(worst, r.late_error) : NAN;  // a stopped loop fails every criterion
-      if (std::isnan(worst)) break;
+      else worst = std::max(worst, r.late_error);
     }
     if (!any) return std::nullopt;
-    return Measured{worst, q == "energy_balance" ? "" : "m or rad"};
+    return Measured{worst, unit};
   }
   // The rest concern one run.
   const ReportRun* run = find_run(m.run);
   if (!run) return std::nullopt;
   const auto& samples = run->trajectory.samples;
+  const std::string unit = q == "end_value" ? display_unit(c) : q == "peak_condition_time" || q == "ground_contact_time" ? "s" : "";
+  if (q == "end_ratio" && !find_run(m.of_run)) return std::nullopt;
+  if (const StoppedRun* s = first_stop({m.run, m.of_run})) return stopped(*s, unit);
   if (q == "end_value") return Measured{samples.back().s(c) * display_scale(c), display_unit(c)};
-  if (q == "end_ratio") {
-    const ReportRun* of = find_run(m.of_run);
-    if (!of) return std::nullopt;
-    return Measured{samples.back().s(c) / of->trajectory.samples.back().s(c), ""};
-  }
+  if (q == "end_ratio") return Measured{samples.back().s(c) / find_run(m.of_run)->trajectory.samples.back().s(c), ""};
   if (q == "peak_condition" || q == "peak_condition_time") {
     std::size_t peak = 0;
     for (std::size_t k = 0; k < samples.size(); ++k)

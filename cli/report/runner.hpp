@@ -25,13 +25,31 @@ inline std::string coordinate_name(int coordinate) {
   return std::string(gen::kCoordinateNames[static_cast<std::size_t>(coordinate)]);
 }
 
+// Where and why a simulation ended before its duration: the report shows it and goes on.
+struct Stop {
+  double time = 0;     // s, the step that stopped it; its samples end before
+  std::string reason;  // the runtime's, naming the field or the limit
+  // "stopped at t = 0.1230 s: <reason>"
+  std::string describe() const;
+};
+
+// Every simulation of the report that stopped, in the order they ran: a scenario's run (`part`
+// empty), or one made from it ("round trip", "closed loop", an integrator compared).
+struct StoppedRun {
+  std::string run;   // the report run's id ("<id>-w1", ...) or the scenario's
+  std::string part;  // empty: the run itself
+  Stop stop;
+  std::string label() const { return part.empty() ? run : run + " (" + part + ")"; }
+};
+
 struct ReportRun {
   std::string id;           // the scenario's id, "<id>-w1"/"<id>-w2" for inverse dynamics
   std::string scenario_id;  // the scenario file's id
   Scenario scenario;
-  Trajectory trajectory;
+  Trajectory trajectory;  // what it computed, up to where it stopped
   std::string csv;  // file name in data/
   bool nonholonomic_verification = false;  // the scenario is marked "verify": "nonholonomic"
+  std::optional<Stop> stopped;  // set: the run ended before its duration
 };
 
 // One run integrated one way, against RK4 at the reference step.
@@ -50,14 +68,17 @@ struct IntegratorRow {
 // closed loop). Generic: the plant, the start and the gains are the same for every model.
 struct ForwardRow {
   std::string id;   // the inverse-dynamics run's
+  // Set: neither the round trip nor the closed loop ran, because the inverse-dynamics run stopped
+  // (they follow its whole motion); its CSV files are not written.
+  std::optional<Stop> not_run;
   std::string csv;             // data/<id>-forward.csv: t, round_trip_deviation, energy_balance
   std::string closed_loop_csv;  // data/<id>-closed-loop.csv: t, tracking_error, error_<commanded coordinate> ...
   long samples = 0, evaluations = 0;  // the round trip's
   double round_trip = 0;      // max |s_forward - s_inverse| over the samples and coordinates, m or rad
   double energy_balance = 0;  // max |E(t) - E(0) - W(t)| over the samples, J (W: the actuators' work, trapezoid rule)
   double work = 0;            // max |W(t)|, J: the scale of energy_balance
-  bool closed_loop_complete = false;
-  std::string closed_loop_stopped;    // why the closed loop ended early
+  std::optional<Stop> round_trip_stopped, closed_loop_stopped;  // set: that simulation ended early
+  long closed_loop_samples = 0;
   double start_error = 0, late_error = 0;  // max |q_ref - q| over the commanded coordinates (m or rad): at t = 0, and over the second half
 };
 // The closed loop's plant and controller (ForwardRow).
@@ -69,8 +90,13 @@ inline constexpr double kRoundTripTolerance = 1e-12;  // dopri5's, for the round
 
 // A measured value in the unit the report shows it in.
 struct Measured {
+  Measured(double value_in, std::string unit_in, std::string stopped_in = {})
+      : value(value_in), unit(std::move(unit_in)), stopped(std::move(stopped_in)) {}
   double value = 0;
   std::string unit;
+  // Not empty: the value could not be measured because a run it depends on stopped (this says
+  // which, where and why); the value is then NaN, which no criterion passes.
+  std::string stopped;
 };
 
 class ReportRunner {
@@ -93,6 +119,8 @@ class ReportRunner {
   const std::vector<IntegratorRow>& integrators() const { return integrators_; }
   const std::vector<ForwardRow>& forward() const { return forward_; }
   const std::vector<int>& compared_coordinates() const { return compared_; }
+  // Every simulation that stopped, in the order they ran.
+  const std::vector<StoppedRun>& stopped() const { return stopped_; }
   const Model& model() const { return model_; }
   Data& data() { return data_; }
   const ReportRun* find_run(const std::string& id) const;
@@ -102,6 +130,11 @@ class ReportRunner {
   std::vector<std::string> selected_scenarios() const;
   void compare_integrators(const std::string& data_dir);
   ForwardRow forward_dynamics_of(const ReportRun& run, const std::string& data_dir);
+  // Records a stopped simulation; returns its Stop.
+  Stop record_stop(const std::string& run, const std::string& part, const Trajectory& trajectory);
+  // The first stop of one of these runs' simulations named in `parts` ("": the run itself; no
+  // parts: any of them), or null.
+  const StoppedRun* first_stop(const std::vector<std::string>& runs, const std::vector<std::string>& parts = {""}) const;
 
   const report::ReportSpec& spec_;
   bool quick_;
@@ -113,6 +146,7 @@ class ReportRunner {
   std::vector<ReportRun> runs_;
   std::vector<IntegratorRow> integrators_;
   std::vector<ForwardRow> forward_;
+  std::vector<StoppedRun> stopped_;
 };
 
 // The unit a coordinate is shown in ("deg" for angles, "m") and the factor from SI to it.

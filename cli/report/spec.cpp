@@ -29,7 +29,8 @@ struct QuantityRule {
 // always does. max_wheel_residual: |v_W . n_W| over every sample
 // of every run (m/s). end_value: `coordinate` at the end of `run`. end_ratio: that over the same
 // of `of_run`. peak_condition(_time): the largest cond(J_beta) of `run` (and when). ground_contact_time:
-// when the cabin's lowest corner, extrapolated from `run`'s last two samples, reaches z = 0.
+// when the clearance box's lowest corner, extrapolated from `run`'s last two samples, reaches z = 0
+// (a model without a clearance box has none: an error naming the claim).
 // integrator_deviation: the largest deviation of `integrator` from the reference over `runs` (default:
 // all compared) in `coordinates` (default: every input). static_torque: the largest |tau| of `joints`
 // at the nominal pose at rest with `weighting`. peak_torque: the largest |tau| over `runs`.

@@ -385,6 +385,8 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       } catch (const Error& e) {
         out.complete = false;
         out.error = fmt::format("stopped at t = {:.4f} s (step {} of {}): {}", t, k, n - 1, e.what());
+        out.stop_time = t;
+        out.stop_reason = e.what();
         break;
       }
     }

@@ -83,7 +83,7 @@ struct Sample {
   WheelVector nh_residual;                                 // v_W . n_W per wheel (should be 0)
   WheelVector spin_rate;                                   // wheel spin rates, rad/s
   double cond_J_beta = 0;
-  double clearance = 0;  // the clearance box's lowest corner above z = 0, m (+infinity without a box)
+  double clearance = 0;  // the clearance box's lowest corner above z = 0, m (+infinity without a box: gen::kHasClearance)
   // Inverse- and forward-dynamics runs only:
   TorqueVector tau = TorqueVector::Zero();      // actuator torques, order of kActuatedJoints
   CommandVector Qstar = CommandVector::Zero();  // generalized forces on u (J_beta^T tau)
@@ -103,6 +103,10 @@ struct Trajectory {
   bool complete = true;
   std::string error;  // why the run stopped early (with its time), when !complete
   std::string limit_warning;  // with stop_on_limit false: where a joint first left its limits, else empty
+  // The same apart, when !complete: the time of the step that stopped the run (its samples end
+  // before it) and the reason alone, for a caller that lists stopped runs in a table.
+  double stop_time = 0;
+  std::string stop_reason;
   // Integration work: accepted steps, rejected steps (dopri5 only), right-hand-side evaluations
   // (each one an IK of every limb plus a dependent-rate solve).
   long steps = 0, rejected_steps = 0, evaluations = 0;

@@ -673,3 +673,59 @@ factory().then((m) => {
 
 }
 #endif
+
+// Issue 43, item 5: a model file without `clearance` (the test model newton_leg: one leg, one
+// wheel, no clearance box). Its runs have no clearance to write (the runtime's is +infinity), so
+// the trajectory has no clearance column, and every command that writes or reads one copes.
+TEST_CASE("--model-file without a clearance box: simulate, report and the viewer's runs have no clearance column") {
+  setup();
+  const fs::path model = fs::path(WLX_SOURCE_DIR) / "tests" / "models" / "newton_leg.yaml";
+  REQUIRE(slurp(model).find("\nclearance:") == std::string::npos);  // the premise
+  const fs::path runs = wlx_test::work_dir() / "newton_leg_runs";
+  fs::create_directories(runs);
+  write(runs / "roll.json", R"({"description": "the base forward at 0.2 m/s, the wheel rolling", "rates": {"x_B": 0.2},
+    "dependent": ["y_B"], "duration": 0.2, "dt": 0.01})");
+
+  const fs::path out = wlx_test::work_dir() / "newton_leg_sim";
+  const auto sim = run({"--model-file", model.string(), "--scenarios", runs.string(), "simulate", "roll", "--out", out.string()});
+  INFO(sim.out);
+  INFO(sim.err);
+  REQUIRE(sim.code == 0);
+  const auto [header, rows] = read_csv(out / "trajectory.csv");
+  CHECK(rows.size() == 21);
+  CHECK(header.find("cond_J_beta") != std::string::npos);
+  CHECK(header.find("clearance") == std::string::npos);
+  CHECK(slurp(out / "trajectory.csv").find("inf") == std::string::npos);
+  CHECK(sim.out.find("no clearance box") != std::string::npos);
+  CHECK(sim.out.find("min clearance") == std::string::npos);
+
+  const fs::path report = wlx_test::work_dir() / "newton_leg_report";
+  const auto rep = run({"--model-file", model.string(), "--scenarios", runs.string(), "report", "--out", report.string()});
+  INFO(rep.out);
+  INFO(rep.err);
+  CHECK(rep.code == 0);
+  const std::string html = slurp(report / "index.html");
+  CHECK(html.find("the base forward at 0.2 m/s") != std::string::npos);
+  CHECK(html.find("min clearance") == std::string::npos);
+  CHECK(html.find("<img src=\"fig/pose-roll.png\"") != std::string::npos);
+  const std::string data = slurp(report / "data" / "roll.csv");
+  CHECK(!data.empty());
+  CHECK(data.find("clearance") == std::string::npos);
+  CHECK(data.find("inf") == std::string::npos);
+#ifdef WLX_VIEWER_DIST  // the viewer's copy of the run: the same columns, no infinity
+  const std::string viewer_run = slurp(report / "viewer" / "runs" / "roll.js");
+  CHECK(!viewer_run.empty());
+  CHECK(viewer_run.find("clearance") == std::string::npos);
+  CHECK(viewer_run.find("nf") == std::string::npos);  // neither inf nor Infinity
+#endif
+
+  // A claim measured from the clearance box is a bad input for this model: named, exit 2, no report.
+  write(runs / "report.yaml", "claims:\n  - {id: touch, kind: check, claim: the body touches down, source: {spec: a test}, spec: 1 s, "
+                              "measure: {quantity: ground_contact_time, run: roll}, criterion: {at_least: 0}, why: a test}\n");
+  const fs::path bad = wlx_test::work_dir() / "newton_leg_bad_report";
+  const auto refused = run({"--model-file", model.string(), "--scenarios", runs.string(), "report", "--out", bad.string()});
+  CHECK(refused.code == 2);
+  CHECK(refused.err.find("report.yaml:2: claims.touch.measure.quantity: ground_contact_time needs a clearance box, and model "
+                         "newton_leg has none") != std::string::npos);
+  CHECK(!fs::exists(bad / "index.html"));
+}

@@ -1,6 +1,7 @@
 // `wlx report` end to end: every run, every figure, a checks table without failures, valid HTML.
 #include <doctest/doctest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <unistd.h>
 #include <filesystem>
@@ -261,3 +262,164 @@ TEST_CASE("report: the wheeled quadruped (four wheels, sixteen actuators) gets a
   CHECK(loops == 4);
 }
 #endif
+
+namespace {
+
+// The rows of a CSV file of numbers after its header.
+std::vector<std::vector<double>> csv_rows(const fs::path& path) {
+  std::istringstream in(slurp(path));
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// The index of a column in a CSV file's header, or -1.
+int csv_column(const fs::path& path, const std::string& name) {
+  std::istringstream in(slurp(path));
+  std::string header, cell;
+  std::getline(in, header);
+  std::istringstream cells(header);
+  for (int k = 0; std::getline(cells, cell, ','); ++k)
+    if (cell == name) return k;
+  return -1;
+}
+
+}  // namespace
+
+// Issue 43, item 4: runs of a user's folder that stop, each in its own way, in one report. UP
+// raises the body at 1 m/s until a leg cannot reach its foot (it stops part way); OUT starts with
+// the body too high to reach at all (its three inverse-dynamics runs stop before their first
+// sample, so neither forward simulation runs); HIGH starts just below the reach and moves down,
+// so its runs complete, but the closed loop's plant, started 2 cm higher, is out of reach at once
+// (an empty closed loop, which made gnuplot fail with "x range is invalid").
+TEST_CASE("report: runs that stop are rows of the report, which is written all the same and exits 1 listing them") {
+  const fs::path dir = temp_dir("wlx_report_stopped_runs");
+  fs::remove_all(dir);
+  fs::create_directories(dir / "runs");
+  write(dir / "runs" / "UP.json", R"({"description": "the body raised until a leg cannot reach", "rates": {"z_C": 1.0},
+    "dependent": ["y_C", "yaw"], "duration": 3, "dt": 0.01})");
+  write(dir / "runs" / "OUT.json", R"({"description": "inverse dynamics from a start out of reach", "initial": {"z_C": 3.2},
+    "rates": {"z_C": -0.5}, "dependent": ["y_C", "yaw"], "duration": 0.1, "dt": 0.001, "weighting": 1})");
+  write(dir / "runs" / "HIGH.json", R"({"description": "inverse dynamics down from just below the reach", "initial": {"z_C": 2.87},
+    "rates": {"z_C": -0.5}, "dependent": ["y_C", "yaw"], "duration": 0.2, "dt": 0.001, "weighting": 1})");
+  // Checks on each kind of stop, one on none (the mass) and one on a round trip that completes.
+  const auto check = [](const std::string& id, const std::string& measure, const std::string& criterion) {
+    return "  - {id: " + id + ", kind: check, claim: " + id + ", source: {spec: a test}, spec: the test's, measure: " + measure + ", criterion: " +
+           criterion + ", why: a test}\n";
+  };
+  write(dir / "runs" / "report.yaml",
+        "quick: {sweeps: [IK-L3], scenarios: [UP, OUT, HIGH]}\n"
+        "integrator_comparison: {scenarios: [UP], coordinates: [y_C]}\n"
+        "claims:\n" +
+            check("mass", "{quantity: total_mass}", "{at_least: 1}") +
+            check("up-end", "{quantity: end_value, run: UP, coordinate: z_C}", "{at_least: 2.5}") +
+            check("out-trip", "{quantity: round_trip_deviation, runs: [OUT-w1]}", "{at_most: 1.0e-8}") +
+            // Near the legs' reach the round trip is looser than the built-in runs' 1e-8 (2e-5 m here).
+            check("high-trip", "{quantity: round_trip_deviation, runs: [HIGH-w1]}", "{at_most: 1.0e-3}") +
+            check("high-loop", "{quantity: closed_loop_error, runs: [HIGH-w1]}", "{at_most: 0.01}") +
+            check("up-euler", "{quantity: integrator_deviation, integrator: euler, runs: [UP]}", "{at_most: 1}"));
+  for (const bool quick : {true, false}) {
+    CAPTURE(quick);
+    const fs::path out = dir / (quick ? "quick" : "full");
+    const int code = run(std::string(WLX_BINARY) + " --scenarios " + (dir / "runs").string() + " report " + (quick ? "--quick " : "") +
+                             "--out " + out.string(),
+                         dir / "log");
+    const std::string log = slurp(dir / "log");
+    INFO(log);
+    CHECK(code == 1);
+    const std::string html = slurp(out / "index.html");
+    REQUIRE(!html.empty());
+    CHECK(markup_problem(html).empty());
+    // Every file the page names is there: no figure of a stopped run is referenced without its image.
+    const std::regex ref("(src|href)=\"([^\"#?]+)[^\"]*\"");
+    for (auto it = std::sregex_iterator(html.begin(), html.end(), ref); it != std::sregex_iterator(); ++it) {
+      CAPTURE((*it)[2].str());
+      CHECK(fs::exists(out / (*it)[2].str()));
+    }
+    for (const auto& e : fs::directory_iterator(out / "data")) {
+      const std::string text = slurp(e.path());
+      CHECK(text.find("nan") == std::string::npos);
+      CHECK(text.find("inf") == std::string::npos);
+    }
+
+    // UP: its samples up to where it stopped, in its CSV and its row, with the time and the reason;
+    // its pose figure is drawn from them.
+    const auto up = csv_rows(out / "data" / "UP.csv");
+    REQUIRE(up.size() >= 2);
+    CHECK(up.size() < 301);  // 3 s at 0.01 s: it did not finish
+    const int z_C = csv_column(out / "data" / "UP.csv", "z_C");
+    REQUIRE(z_C > 0);
+    CHECK(up.back()[static_cast<std::size_t>(z_C)] == doctest::Approx(2.0 + up.back()[0]).epsilon(1e-9));  // it rose as asked
+    // It stopped in the step from its last sample: the time the report gives is that sample's.
+    char up_time_text[32];
+    std::snprintf(up_time_text, sizeof up_time_text, "%.4f", up.back()[0]);
+    const std::string up_time = up_time_text;
+    const std::string up_stop = "stopped at t = " + up_time + " s: left leg: F_l out of reach";
+    CHECK(html.find("<td>UP</td><td>the body raised until a leg cannot reach</td><td>" + std::to_string(up.size()) + "</td><td>" +
+                    up_stop) != std::string::npos);
+    CHECK(log.find("wlx: run stopped: UP at t = " + up_time + " s: left leg: F_l out of reach") != std::string::npos);
+    CHECK(html.find("<img src=\"fig/pose-UP.png\"") != std::string::npos);
+
+    // OUT: no sample at all; said in words, no figure, no forward simulation; its row has no maxima.
+    for (const char* id : {"OUT-w1", "OUT-w2", "OUT-w3"}) {
+      CAPTURE(id);
+      CHECK(csv_rows(out / "data" / (std::string(id) + ".csv")).empty());
+      CHECK(log.find(std::string("wlx: run stopped: ") + id + " at t = 0.0000 s: ") != std::string::npos);
+      CHECK(html.find(std::string("<td>") + id + "</td><td>inverse dynamics from a start out of reach</td><td>0</td><td>stopped at t = "
+                      "0.0000 s: ") != std::string::npos);
+      CHECK(html.find(std::string("id=\"fig-id-") + id + "\" class=\"omitted\">No figure of the torques of " + id + ": " + id +
+                      " stopped at t = 0.0000 s before its first sample") != std::string::npos);
+      CHECK(!fs::exists(out / "fig" / ("id-" + std::string(id) + ".png")));
+    }
+    CHECK(html.find("id=\"fig-pose-OUT\" class=\"omitted\"") != std::string::npos);
+    CHECK(html.find("<td>OUT-w1</td><td>not run: OUT-w1 stopped at t = 0.0000 s: ") != std::string::npos);
+    CHECK(!fs::exists(out / "data" / "OUT-w1-forward.csv"));
+
+    // HIGH: the runs and their round trips complete (drawn); the closed loop never left its start:
+    // an empty CSV, a sentence instead of its figure.
+    CHECK(csv_rows(out / "data" / "HIGH-w1.csv").size() == 201);
+    CHECK(csv_rows(out / "data" / "HIGH-w1-forward.csv").size() == 201);
+    CHECK(csv_rows(out / "data" / "HIGH-w1-closed-loop.csv").empty());
+    CHECK(log.find("wlx: run stopped: HIGH-w1 (closed loop) at t = 0.0000 s: ") != std::string::npos);
+    CHECK(log.find("wlx: run stopped: HIGH-w1 at") == std::string::npos);
+    CHECK(html.find("<img src=\"fig/forward-round-trips.png\"") != std::string::npos);
+    CHECK(html.find("fig/forward-closed-loop.png") == std::string::npos);
+    CHECK(html.find("No figure of the closed loops&#39; tracking errors: the closed loop of HIGH-w1 stopped at t = 0.0000 s before its "
+                    "first sample (it never left its start)") != std::string::npos);
+    CHECK(html.find("id=\"stopped\">Stopped runs</h2>") != std::string::npos);
+
+    // Checks on a stopped run fail with its reason; the others are measured as usual.
+    CHECK(log.find("check failed: up-end") != std::string::npos);
+    CHECK(log.find("check failed: out-trip") != std::string::npos);
+    CHECK(log.find("check failed: high-loop") != std::string::npos);
+    CHECK(log.find("check failed: mass") == std::string::npos);
+    CHECK(log.find("check failed: high-trip") == std::string::npos);
+    CHECK(html.find("not measured: UP " + up_stop) != std::string::npos);
+    CHECK(html.find("not measured: HIGH-w1 (closed loop) stopped at t = 0.0000 s: ") != std::string::npos);
+    CHECK(html.find("not measured: OUT-w1 stopped at t = 0.0000 s: ") != std::string::npos);
+    CHECK(std::regex_search(html, std::regex("claim-high-trip\">.*<td class=\"wlx\">[0-9.e+-]+ m or rad</td>.*class=\"pass\"")));
+    // The integrators are compared in the full report only; UP stopped, so its deviation is not known.
+    if (quick) {
+      CHECK(log.find("check failed: up-euler") == std::string::npos);
+      CHECK(html.find("<tr id=\"claim-up-euler\">") == std::string::npos);
+    } else {
+      CHECK(log.find("check failed: up-euler") != std::string::npos);
+    }
+  }
+
+  // Bad input stays bad input: a name that is not a run of the folder, exit 2 and no report.
+  write(dir / "claims.yaml", "claims:\n" + check("x", "{quantity: end_value, run: UPP, coordinate: z_C}", "{at_least: 1}"));
+  const fs::path out = dir / "bad";
+  CHECK(run(std::string(WLX_BINARY) + " --scenarios " + (dir / "runs").string() + " report --quick --claims " +
+                (dir / "claims.yaml").string() + " --out " + out.string(),
+            dir / "log") == 2);
+  CHECK(slurp(dir / "log").find("'UPP' is not a run of model excavator (did you mean 'UP'?)") != std::string::npos);
+  CHECK(!fs::exists(out / "index.html"));
+}
