@@ -103,6 +103,30 @@ function(wlx_generate)
   endif()
 endfunction()
 
+# Writes FILE, the Python package's _built_for.py: the interpreter its compiled module (_wlx) is
+# built for, which python/wlx/__init__.py names when another interpreter imports the package and
+# cannot load it (the python3 first on PATH may be another one, without this one's NumPy, or of
+# another version). No file when CMake knows no interpreter (the package then says nothing more).
+function(wlx_write_python_built_for file)
+  set(python "${Python3_EXECUTABLE}")
+  set(version "${Python3_VERSION_MAJOR}.${Python3_VERSION_MINOR}")
+  if(NOT python AND PYTHON_EXECUTABLE)  # pybind11 found it the older way (FindPythonInterp)
+    set(python "${PYTHON_EXECUTABLE}")
+    set(version "${PYTHON_VERSION_MAJOR}.${PYTHON_VERSION_MINOR}")
+  endif()
+  if(NOT python)
+    file(REMOVE "${file}")
+    return()
+  endif()
+  # Python string literals: backslashes and quotes escaped.
+  string(REPLACE "\\" "\\\\" python "${python}")
+  string(REPLACE "\"" "\\\"" python "${python}")
+  file(CONFIGURE OUTPUT "${file}" CONTENT [=[# Written by CMake: the interpreter wlx's compiled module (_wlx) was built for. Do not edit.
+executable = "@python@"
+version = "@version@"
+]=] @ONLY)
+endfunction()
+
 # The Python package for one model: its commands (the command line's parsing and solving, which
 # Python's API calls, cli/shell/model_api.hpp) compiled for it, and python/module.cpp with a
 # registry that lists it, linked with the shell (wlx::cli_common).
@@ -157,4 +181,5 @@ const std::vector<ModelCommands>& models() {
   foreach(file __init__.py _sweep.py __main__.py)  # the package's Python files (the sweep engine too)
     configure_file("${WLX_PYTHON_SOURCE_DIR}/wlx/${file}" "${dir}/wlx/${file}" COPYONLY)
   endforeach()
+  wlx_write_python_built_for("${dir}/wlx/_built_for.py")
 endfunction()

@@ -1356,7 +1356,7 @@ class Parser {
           const int k = coordinate_index(key, false, true);
           if (std::find(limb.joints.begin(), limb.joints.end(), k) == limb.joints.end())
             key.fail(fmt::format("'{}' is not one of limb '{}''s joints", m_.coordinates[static_cast<std::size_t>(k)].name, limb.name));
-          limb_start_[k] = start->child(kv.first.Scalar()).number();
+          limb_start_[k] = start->child(kv.first.Scalar()).number(true);  // <sign>*0.6 too, as in ik_sweeps
         }
       }
       if (limb.rows.size() != limb.joints.size() || limb.rows.empty())
@@ -1672,7 +1672,7 @@ class Parser {
         if (limb_start_.count(k))
           key.fail(fmt::format("'{}' has a start value in its limb's `start` already: give it once",
                                m_.coordinates[static_cast<std::size_t>(k)].name));
-        m_.nominal[static_cast<std::size_t>(k)] = section->child(kv.first.Scalar()).number();
+        m_.nominal[static_cast<std::size_t>(k)] = section->child(kv.first.Scalar()).number(true);
       }
     }
     for (const auto& [k, value] : limb_start_) m_.nominal[static_cast<std::size_t>(k)] = value;
@@ -1686,7 +1686,8 @@ class Parser {
       if (!start->is_map()) start->fail("must map input names to values");
       for (const auto& kv : start->node()) {
         const Item key(src_, kv.first, start->path(), {});
-        m_.sweep_start[static_cast<std::size_t>(coordinate_index(key, true))] = start->child(kv.first.Scalar()).number();
+        m_.sweep_start[static_cast<std::size_t>(coordinate_index(key, true))] =
+            start->child(kv.first.Scalar()).number(true);
       }
     }
     each(f["sweeps"], [&](const Item& it) {

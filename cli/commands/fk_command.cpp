@@ -48,8 +48,8 @@ Params load_params(const ModelOptions& model) {
 }
 
 // `wlx fk`: a pose from stdin (any of the coordinates; missing inputs take the nominal state,
-// missing dependent joints are solved by the closed-form IK when none is given), its dependent
-// joints and the forward kinematics of every frame.
+// missing dependent joints are solved by the IK when none is given: the closed form, Newton's
+// method for a limb without one), its dependent joints and the forward kinematics of every frame.
 int run_fk(const ModelOptions& model_options, bool as_json) {
   const Model model(load_params(model_options));
   const std::string text = read_all_capped(std::cin, "stdin", kMaxLineBytes);
@@ -59,6 +59,14 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
   if (!j.is_object()) throw Error("stdin", fmt::format("expected a JSON object of coordinates, e.g. {{\"{}\": 1.8}}", gen::kCoordinateNames[0]));
   std::vector<std::string> names;
   for (const auto& n : gen::kCoordinateNames) names.emplace_back(n);
+  // A branch picks one of the IK's solutions: fk solves for none of its own choosing, so a branch
+  // is a question for `wlx ik`, whose answer's joints fk then takes.
+  if (j.contains("branch"))
+    throw Error(
+        "branch",
+        fmt::format("unknown key: branches apply to the IK (`wlx ik` takes \"branch\"), not to fk, which takes all "
+                    "joint values: give fk the {} dependent joints of the branch you want (from `wlx ik`'s answer)",
+                    kDependentCount));
   reject_unknown_keys(j, names, "");
   Coordinates s = nominal_inputs();
   int dependents_given = 0;
@@ -68,10 +76,13 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
     s(k) = si_value(j.at(name), name, quantity_of(is_angle(k)));  // one grammar with ik and scenarios: SI or {"deg": x}
     dependents_given += k >= kInputCount;
   }
+  // How the dependent joints are found when none is given: the closed form where wlx-gen derived
+  // one, Newton's method for the other limbs (limb_methods).
+  const auto methods = limb_methods(IkMethod::closed_form);
   if (dependents_given == 0) solve_ik_closed_form(model, s, {});
   else if (dependents_given != kDependentCount)
-    throw Error("stdin", fmt::format("give all {} dependent joints or none (then the closed-form IK solves them); {} given",
-                                     kDependentCount, dependents_given));
+    throw Error("stdin", fmt::format("give all {} dependent joints or none, {} given; with none, fk solves them by {}",
+                                     kDependentCount, dependents_given, methods_in_words(methods)));
   Data data;
   forward_kinematics(model, data, s);
   closure(model, data, s, false);
@@ -86,11 +97,18 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
       fr["rotation"] = {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
     }
     out["closure_residual"] = residual;
+    // Per limb how its dependent joints were found: "given", or the method that solved them.
+    nlohmann::ordered_json solved = nlohmann::ordered_json::object();
+    for (Limb limb : kLimbs)
+      solved[std::string(gen::kLimbs[static_cast<std::size_t>(limb)].name)] =
+          dependents_given ? "given" : method_name(methods[static_cast<std::size_t>(limb)]);
+    out["limb_methods"] = solved;
     std::cout << out.dump(2) << "\n";
     return 0;
   }
   // SI like every other input and output (rad); degrees beside them only for reading.
-  fmt::print("{} pose, dependent joints{}:\n", gen::kModelName, dependents_given ? " as given" : " by the closed-form IK");
+  fmt::print("{} pose, dependent joints {}:\n", gen::kModelName,
+             dependents_given ? "as given" : "by " + methods_in_words(methods));
   for (int k = kInputCount; k < kCoordinateCount; ++k) {
     const std::string_view unit = gen::kCoordinateUnits[static_cast<std::size_t>(k)];
     fmt::print("  {:<12} {:>10.6f} {:<3}", gen::kCoordinateNames[k], tidy(s(k)), unit);

@@ -6,6 +6,7 @@
 #include "scenario_io.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <wlx/error.hpp>
 
 #include <algorithm>
@@ -31,6 +32,37 @@ bool is_angle_param(const std::string& name) {
 }
 
 }  // namespace
+
+const char* method_name(IkMethod method) { return method == IkMethod::closed_form ? "closed-form" : "newton"; }
+
+std::array<IkMethod, kLimbCount> limb_methods(IkMethod requested) {
+  std::array<IkMethod, kLimbCount> methods{};
+  for (Limb limb : kLimbs)
+    methods[static_cast<std::size_t>(limb)] =
+        requested == IkMethod::closed_form && has_closed_form(limb) ? IkMethod::closed_form : IkMethod::newton;
+  return methods;
+}
+
+std::string overall_method(const std::array<IkMethod, kLimbCount>& methods, IkMethod requested) {
+  if (methods.empty()) return method_name(requested);
+  for (IkMethod m : methods)
+    if (m != methods.front()) return "mixed";
+  return method_name(methods.front());
+}
+
+std::string methods_in_words(const std::array<IkMethod, kLimbCount>& methods) {
+  std::vector<std::string> by_newton;
+  for (Limb limb : kLimbs)
+    if (methods[static_cast<std::size_t>(limb)] == IkMethod::newton) by_newton.emplace_back(limb_name(limb));
+  if (by_newton.empty()) return "the closed-form IK";
+  if (by_newton.size() == methods.size()) {
+    for (Limb limb : kLimbs)
+      if (has_closed_form(limb)) return "Newton's method";  // asked for: the closed form was there
+    return "Newton's method (wlx-gen derived no closed form for any limb)";
+  }
+  return fmt::format("the closed-form IK, and Newton's method for the limbs without a closed form ({})",
+                     fmt::join(by_newton, ", "));
+}
 
 Params parse_params(const nlohmann::json& object, Params params) {
   if (!object.is_object()) throw Error("params", fmt::format("must be an object, got {}", type_name(object)));

@@ -6,6 +6,7 @@
 #include <wlx/ik.hpp>
 #include <wlx/model.hpp>
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +17,19 @@ WLX_COMMANDS_BEGIN
 Params parse_params(const nlohmann::json& object, Params params = settings().params);
 
 enum class IkMethod { closed_form, newton };
+
+// The methods by name, as requests and answers spell them: "closed-form", "newton".
+const char* method_name(IkMethod method);
+// The method that solves each limb (kLimbs order) for a request of `requested`: the closed form
+// where it is asked for and wlx-gen derived one (has_closed_form), else Newton's method.
+std::array<IkMethod, kLimbCount> limb_methods(IkMethod requested);
+// What solved every limb, by name ("closed-form", "newton"), or "mixed" where the limbs differ;
+// for a model without limbs (nothing to solve) the requested method's name.
+std::string overall_method(const std::array<IkMethod, kLimbCount>& methods, IkMethod requested);
+// In words, for text: "the closed-form IK", "Newton's method (wlx-gen derived no closed form for
+// any limb)", or "the closed-form IK, and Newton's method for the limbs without a closed form
+// (wheel arm)"; "Newton's method" where it was asked for.
+std::string methods_in_words(const std::array<IkMethod, kLimbCount>& methods);
 
 struct IkRequest {
   Params params = settings().params;

@@ -157,9 +157,17 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
     report::Table t{{"sweep", "input", "points", "max check, closed form (m)", "max check, Newton (m)", "max |closed form - Newton| (rad)",
                      "Newton iterations (mean / max)", "joints' limits (branch)", "CSV"},
                     {}};
+    // A limb without a closed form: Newton's method alone, nothing to check or compare (ik_verification.hpp).
+    const auto closed_form_cell = [](const IkSweepResult& s, double v) {
+      return s.closed_form ? fmt::format("{:.2e}", v) : std::string("no closed form");
+    };
     for (const auto& s : runner_.sweeps())
-      t.rows.push_back({{s.sweep.id}, {s.sweep.input}, {std::to_string(s.points.size())}, {fmt::format("{:.2e}", s.max_check_closed_form)},
-                        {fmt::format("{:.2e}", s.max_check_newton)}, {fmt::format("{:.2e}", s.max_newton_difference)},
+      t.rows.push_back({{s.sweep.id},
+                        {s.sweep.input},
+                        {std::to_string(s.points.size())},
+                        {closed_form_cell(s, s.max_check_closed_form)},
+                        {fmt::format("{:.2e}", s.max_check_newton)},
+                        {closed_form_cell(s, s.max_newton_difference)},
                         {fmt::format("{:.2f} / {}", s.mean_newton_iterations, s.max_newton_iterations)},
                         {s.outside_limits == 0 ? fmt::format("within ({})", s.branch)
                                                : fmt::format("{} points outside ({}), first {}", s.outside_limits, s.branch, s.first_outside)},

@@ -203,7 +203,7 @@ class Figures {
         const int c = block.joints[static_cast<std::size_t>(j)];
         joints.push_back(coordinate_name(c));
         curves.emplace_back();
-        for (const auto& p : s.points) curves.back().push_back(p.closed_form(c));
+        for (const auto& p : s.points) curves.back().push_back(s.solution(p)(c));
       }
       const auto titles = legend_titles(joints, curves, 1e-9);
       const double xs = s.sweep.degrees ? kDegPerRad : 1;
@@ -211,18 +211,28 @@ class Figures {
       std::string b = "set multiplot layout 2,1\nset key outside right top\n";
       b += fmt::format("set xlabel {}\nset ylabel 'joint angle (deg)'\nset title {}\nplot ",
                        q(fmt::format("{} ({})", s.sweep.input, s.sweep.degrees ? "deg" : "m")),
-                       q(s.sweep.id + ": dependent joints (closed form)"));
+                       q(s.sweep.id + (s.closed_form ? ": dependent joints (closed form)"
+                                                     : ": dependent joints (Newton; no closed form)")));
       for (std::size_t k = 0; k < joints.size(); ++k)
         b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(file), column(s.sweep.input, xs),
                          column(joints[k], kDegPerRad), dash(k), q(titles[k]));
       b += "\nset logscale y\nset format y '1e%L'\nset yrange [1e-18:1e-3]\nset ylabel 'analytic check error (m)'\n";
       b += fmt::format("set title {}\n", q(s.sweep.id + ": |target - FK(solution)| (zeros drawn at 1e-18)"));
-      b += fmt::format("plot {0} using {1}:{2} with lines lw 2 title 'closed form', {0} using {1}:{3} with points pt 7 ps 0.4 "
-                       "title 'Newton'{4}\n",
-                       q(file), column(s.sweep.input, xs), log_column("check_error_closed_form"), log_column("check_error_newton"),
-                       reference_line("ik_check_error"));
+      if (s.closed_form)
+        b += fmt::format(
+            "plot {0} using {1}:{2} with lines lw 2 title 'closed form', {0} using {1}:{3} with points pt 7 ps 0.4 "
+            "title 'Newton'{4}\n",
+            q(file), column(s.sweep.input, xs), log_column("check_error_closed_form"), log_column("check_error_newton"),
+            reference_line("ik_check_error"));
+      else  // no closed form: Newton's alone (the CSV has no closed-form column)
+        b += fmt::format("plot {0} using {1}:{2} with points pt 7 ps 0.4 title 'Newton'{3}\n", q(file),
+                         column(s.sweep.input, xs), log_column("check_error_newton"), reference_line("ik_check_error"));
       b += "unset multiplot\n";
-      out.push_back({"ik-" + s.sweep.id, fmt::format("{}: {} swept; closed form and Newton", s.sweep.id, s.sweep.input), "1000,800", b});
+      out.push_back(
+          {"ik-" + s.sweep.id,
+           fmt::format("{}: {} swept; {}", s.sweep.id, s.sweep.input,
+                       s.closed_form ? "closed form and Newton" : "Newton's method (the limb has no closed form)"),
+           "1000,800", b});
     }
   }
 

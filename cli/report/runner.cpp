@@ -392,10 +392,16 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
     return Measured{v, m.unit};
   }
   if (q == "max_ik_check_error" || q == "max_ik_method_difference") {
-    if (sweeps_.empty()) return std::nullopt;
+    // The method difference over the sweeps that have both methods: a limb without a closed form
+    // has nothing to compare, and with none such the claim cannot be measured (skipped).
     double worst = 0;
-    for (const auto& s : sweeps_)
+    bool any = false;
+    for (const auto& s : sweeps_) {
+      if (q == "max_ik_method_difference" && !s.closed_form) continue;
+      any = true;
       worst = std::max(worst, q == "max_ik_check_error" ? std::max(s.max_check_closed_form, s.max_check_newton) : s.max_newton_difference);
+    }
+    if (!any) return std::nullopt;
     return Measured{worst, q == "max_ik_check_error" ? "m" : "rad"};
   }
   if (q == "newton_branch_switch" || q == "newton_branch_settled") {

@@ -24,7 +24,8 @@ struct QuantityRule {
   std::vector<std::string> required, optional;
 };
 // total_mass: the model's mass (kg). max_ik_check_error, max_ik_method_difference: over every
-// sweep run (m, rad). newton_branch_switch: the first value of `sweep`'s input where Newton from
+// sweep run (m, rad; the difference over the sweeps of limbs with a closed form).
+// newton_branch_switch: the first value of `sweep`'s input where Newton from
 // the start pose lands off the default branch; newton_branch_settled: the value from which it
 // always does. max_wheel_residual: |v_W . n_W| over every sample
 // of every run (m/s). end_value: `coordinate` at the end of `run`. end_ratio: that over the same

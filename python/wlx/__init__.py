@@ -14,10 +14,42 @@ Errors raise wlx.Error (a ValueError) with the command line's message, which nam
 
 import json as _json
 
-import numpy as _np
 
-from . import _wlx
-from ._wlx import Error
+def _import_failure(error):
+    """Why the package cannot load here, when this interpreter is not the one it was built for: the
+    python3 first on PATH may be another (a pyenv or virtual environment's, without the build's NumPy,
+    or of another version, which cannot load the compiled module: "No module named 'wlx._wlx'").
+    None when it is that interpreter (the original error says it all) or the build did not say."""
+    import os
+    import sys
+
+    try:
+        from ._built_for import executable, version  # written by CMake at configure time
+    except ImportError:
+        return None
+    running = sys.executable or "this interpreter"
+    this_version = "%d.%d" % sys.version_info[:2]
+    in_venv = sys.prefix != sys.base_prefix
+    if os.path.realpath(running) == os.path.realpath(executable) and this_version == version and not in_venv:
+        return None
+    where = f"{running} (Python {sys.version.split()[0]}{', a virtual environment' if in_venv else ''})"
+    return ImportError(
+        f"wlx: this package was built for the Python at {executable} (Python {version}), with that "
+        f"interpreter's NumPy; it is imported by {where}, where it cannot load: {error}. Run it with "
+        f"{executable}, or build wlx for this interpreter (cmake -DPython3_EXECUTABLE={running}, with "
+        f"NumPy and pybind11 installed for it).")
+
+
+try:
+    import numpy as _np
+
+    from . import _wlx
+    from ._wlx import Error
+except ImportError as _error:
+    _explained = _import_failure(_error)
+    if _explained is None:
+        raise
+    raise _explained from _error
 
 __all__ = ["Error", "Model", "load", "model", "models", "sweep"]
 

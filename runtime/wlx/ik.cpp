@@ -59,6 +59,8 @@ LimbBlock limb_block(Limb limb) noexcept {
 
 std::string_view limb_name(Limb limb) noexcept { return info(limb).title; }
 
+bool has_closed_form(Limb limb) noexcept { return gen::kClosedForm[static_cast<std::size_t>(limb)].solve != nullptr; }
+
 int branch_count(Limb limb) noexcept {
   const gen::ClosedFormInfo& cf = gen::kClosedForm[static_cast<std::size_t>(limb)];
   return cf.solve == nullptr ? 1 : cf.branches;
@@ -183,7 +185,7 @@ Branches resolve_branches(const Model& model, const Coordinates& s, const Branch
   return out;
 }
 
-void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& requested) {
+void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& requested, NewtonReport* newton_report) {
   bool choose = false;
   for (int b : requested.limb) choose = choose || b == kModelsChoice;
   const Branches branches = choose ? resolve_branches(model, s, requested) : requested;
@@ -199,11 +201,13 @@ void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& re
   gen::IkDiagnostics why;
   const gen::IkStatus status = gen::ik_all(s, model.params(), branches.limb, s, failed, why);
   if (status != gen::IkStatus::ok) throw_failure(failed, branches.limb[static_cast<std::size_t>(failed)], status, why);
+  if (newton_report != nullptr) *newton_report = NewtonReport{};
   if constexpr (!gen::kHasFusedIk) {
     std::array<bool, kLimbCount> newton{};
-    for (Limb limb : kLimbs) newton[static_cast<std::size_t>(limb)] = gen::kClosedForm[static_cast<std::size_t>(limb)].solve == nullptr;
+    for (Limb limb : kLimbs) newton[static_cast<std::size_t>(limb)] = !has_closed_form(limb);
     Data data;
-    solve_newton_limbs(model, data, newton, s, {});
+    const NewtonReport report = solve_newton_limbs(model, data, newton, s, {});
+    if (newton_report != nullptr) *newton_report = report;
   }
 }
 

@@ -26,6 +26,11 @@ inline constexpr std::array<Limb, kLimbCount> kLimbs = [] {
 }();
 std::string_view limb_name(Limb limb) noexcept;  // the model file's title: "left leg", ...
 
+// Whether wlx-gen derived a closed form for the limb (the generated gen::kClosedForm[limb].solve).
+// A limb without one is solved by Newton's method wherever the closed form is asked for (below),
+// so what a command reports as the method that ran comes from here, not from what was asked.
+bool has_closed_form(Limb limb) noexcept;
+
 // The branches of a limb's closed form (1 without one). What each bit selects is in the
 // generated gen::kClosedForm[limb].bits; branch 0 takes, in every equation, the root nearest the
 // joint's zero.
@@ -38,6 +43,8 @@ struct LimbBlock {
   std::array<int, gen::kMaxLimbSize> joints{};
 };
 LimbBlock limb_block(Limb limb) noexcept;
+
+struct NewtonReport;
 
 // Which branch each limb's closed form takes, indexed by Limb; kModelsChoice leaves it to the
 // model (resolve_branches). Default-constructed: every limb the model's choice.
@@ -67,8 +74,12 @@ std::string describe_outside_limits(const Coordinates& s, int coordinate);
 // is out of reach (naming the limb, what the target asks and what the limb reaches), an input is
 // not finite, or the branch does not exist.
 void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinates& s);
-// All limbs, each on its branch in `branches` (the model's choice where kModelsChoice: resolve_branches).
-void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches = {});
+// All limbs, each on its branch in `branches` (the model's choice where kModelsChoice:
+// resolve_branches); those without a closed form by Newton's method from the dependent joints in s
+// (then from the model file's start values), whose report goes to `newton` when given (zero
+// iterations for the limbs solved in closed form).
+void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches = {},
+                          NewtonReport* newton = nullptr);
 
 // Which branch of the closed form a solution lies on (the branch whose solution is nearest).
 int classify_branch(const Model& model, Limb limb, const Coordinates& s);

@@ -60,7 +60,11 @@ LimbCheck analytic_check(const Model& model, Data& data, Limb limb, const Coordi
 }
 
 IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep) {
-  IkSweepResult result{sweep, {}, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, {}};
+  IkSweepResult result;
+  result.sweep = sweep;
+  // Without a closed form, the "closed form" below would be Newton's method again (solve_ik_closed_form
+  // falls back to it): comparing the two would prove nothing, so only Newton's result is measured.
+  result.closed_form = has_closed_form(sweep.limb);
   const int input = coordinate_index(sweep.input);
   const auto joints = limb_joints(sweep.limb);
   Coordinates start = ik_sweep_inputs();
@@ -75,23 +79,16 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
   for (int k = 0; k < sweep.points(); ++k) {
     IkSweepPoint pt;
     pt.value = sweep.value(k);
-    // The closed form reads only the inputs; a limb without one starts Newton from the previous
-    // point's solution (continuation).
+    // The closed form reads only the inputs; other limbs without one start Newton from the
+    // previous point's solution (continuation).
     Coordinates s = previous;
     s(input) = pt.value;
-    solve_ik_closed_form(model, s, branches);
-    previous = s;
-    pt.closed_form = s;
-    for (int j : joints)
-      if (!(s(j) >= settings().lower[static_cast<std::size_t>(j)] && s(j) <= settings().upper[static_cast<std::size_t>(j)])) {
-        if (pt.within_limits && result.first_outside.empty())
-          result.first_outside = fmt::format("at {} = {:.6g}: {}", sweep.input, pt.value, describe_outside_limits(s, j));
-        pt.within_limits = false;
-      }
-    if (!pt.within_limits) ++result.outside_limits;
-    pt.check_closed_form = analytic_check(model, data, sweep.limb, s);
-    for (int w = 0; w < kWheelCount; ++w)  // element by element: compiles for no wheels too
-      for (int i = 0; i < 2; ++i) pt.contacts(2 * w + i) = data.frame_positions(i, gen::kWheels[static_cast<std::size_t>(w)].contact_frame);
+    if (result.closed_form) {
+      solve_ik_closed_form(model, s, branches);
+      previous = s;
+      pt.closed_form = s;
+      pt.check_closed_form = analytic_check(model, data, sweep.limb, s);
+    }
 
     Coordinates n = warm;  // continuation: start from the previous point's Newton solution
     n(input) = pt.value;
@@ -100,9 +97,23 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
     pt.newton_iterations = report.iterations[static_cast<std::size_t>(sweep.limb)];
     pt.newton_branch = classify_branch(model, sweep.limb, n);
     pt.check_newton = analytic_check(model, data, sweep.limb, n);
-    for (int j : joints)
-      pt.newton_difference = std::max(pt.newton_difference, std::abs(std::remainder(s(j) - n(j), 2 * std::numbers::pi)));
+    if (result.closed_form)
+      for (int j : joints)
+        pt.newton_difference =
+            std::max(pt.newton_difference, std::abs(std::remainder(s(j) - n(j), 2 * std::numbers::pi)));
     warm = n;
+    const Coordinates& solution = result.solution(pt);
+    for (int j : joints)
+      if (!(solution(j) >= settings().lower[static_cast<std::size_t>(j)] && solution(j) <= settings().upper[static_cast<std::size_t>(j)])) {
+        if (pt.within_limits && result.first_outside.empty())
+          result.first_outside = fmt::format("at {} = {:.6g}: {}", sweep.input, pt.value, describe_outside_limits(solution, j));
+        pt.within_limits = false;
+      }
+    if (!pt.within_limits) ++result.outside_limits;
+    forward_kinematics(model, data, solution);
+    for (int w = 0; w < kWheelCount; ++w)  // element by element: compiles for no wheels too
+      for (int i = 0; i < 2; ++i)
+        pt.contacts(2 * w + i) = data.frame_positions(i, gen::kWheels[static_cast<std::size_t>(w)].contact_frame);
 
     Coordinates cold = start;  // the thesis' way: every point from the same start pose
     cold(input) = pt.value;

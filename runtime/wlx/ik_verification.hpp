@@ -1,7 +1,8 @@
 // The verification of the inverse kinematics (the thesis' method, thesis 3.4): sweep one input,
 // solve the dependent joints, put them back into the forward kinematics and measure the distance
-// to the target; here with both the closed form and Newton's method. The sweeps are the model
-// file's (settings().ik_sweeps).
+// to the target; here with both the closed form and Newton's method, or with Newton's method
+// alone for a limb that has no closed form (has_closed_form). The sweeps are the model file's
+// (settings().ik_sweeps).
 #pragma once
 
 #include "wlx/ik.hpp"
@@ -27,11 +28,14 @@ struct LimbCheck {
 };
 LimbCheck analytic_check(const Model& model, Data& data, Limb limb, const Coordinates& s);
 
+// The closed-form fields of a point (closed_form, check_closed_form, newton_difference) hold
+// nothing for a limb without a closed form (IkSweepResult::closed_form false): zeros; the point's
+// solution (IkSweepResult::solution) is then Newton's.
 struct IkSweepPoint {
   double value = 0;                 // the swept input
-  Coordinates closed_form;          // all 32 coordinates
+  Coordinates closed_form = Coordinates::Zero();  // all coordinates
   Coordinates newton;               // Newton, warm-started from the previous point (continuation)
-  Eigen::Matrix<double, 2 * kWheelCount, 1> contacts;  // per wheel x, y of its contact point (closed form)
+  Eigen::Matrix<double, 2 * kWheelCount, 1> contacts;  // per wheel x, y of its contact point (at solution())
   LimbCheck check_closed_form, check_newton;
   double newton_difference = 0;     // max |closed form - Newton| over the limb's joints (rad)
   int newton_iterations = 0;
@@ -42,7 +46,10 @@ struct IkSweepPoint {
 
 struct IkSweepResult {
   IkSweep sweep;
+  bool closed_form = true;  // the swept limb has a closed form; false: Newton's method alone, nothing compared
   std::vector<IkSweepPoint> points;
+  // The solution a point shows: the closed form's, or Newton's where the limb has no closed form.
+  const Coordinates& solution(const IkSweepPoint& p) const { return closed_form ? p.closed_form : p.newton; }
   double max_check_closed_form = 0, max_check_newton = 0, max_level_error = 0, max_newton_difference = 0;
   double mean_newton_iterations = 0;
   int max_newton_iterations = 0;

@@ -1,8 +1,11 @@
 // The wlx command line, run as a user would: exit codes, stdout, stderr, files.
 #include <doctest/doctest.h>
+#include <input.hpp>
 #include <nlohmann/json.hpp>
+#include <wlx/gen/ik.hpp>
 #include <wlx/gen/kinematics.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -95,6 +98,84 @@ TEST_CASE("cli: Newton agrees with the closed form and reports its iterations") 
   CHECK(!a.contains("iterations"));
 }
 
+// Issue 43: the labels say what ran. Every limb of the excavator has a closed form (the generated
+// ik.hpp's kClosedForm, checked here first); a model whose limbs have none is run through
+// --model-file in test_model_file_plugin.cpp.
+TEST_CASE("cli: wlx ik's method and limb_methods say what solved each limb; Newton's iterations only where it ran") {
+  for (const auto& info : wlx::gen::kClosedForm) {
+    const bool has_closed_form = info.solve != nullptr;
+    REQUIRE(has_closed_form);
+  }
+  const Run cf = run_wlx("ik", R"({"z_C": 1.7})");
+  const Run nt = run_wlx("ik", R"({"z_C": 1.7, "method": "newton"})");
+  REQUIRE(cf.code == 0);
+  REQUIRE(nt.code == 0);
+  const auto a = nlohmann::json::parse(cf.out), b = nlohmann::json::parse(nt.out);
+  CHECK(a.at("method") == "closed-form");
+  CHECK(b.at("method") == "newton");
+  REQUIRE(a.at("limb_methods").size() == wlx::gen::kLimbs.size());
+  REQUIRE(b.at("limb_methods").size() == wlx::gen::kLimbs.size());
+  for (const auto& limb : wlx::gen::kLimbs) {
+    const std::string name(limb.name);
+    CHECK(a.at("limb_methods").at(name) == "closed-form");
+    CHECK(b.at("limb_methods").at(name) == "newton");
+    CHECK(b.at("iterations").contains(name));
+  }
+  CHECK(!a.contains("iterations"));
+  CHECK(!a.contains("iterations_total"));
+}
+
+TEST_CASE("cli: the method in words and by name for limbs that differ (a model whose limbs are solved two ways)") {
+  // The excavator's limbs all have a closed form, so the mixed case is built here: what ik and fk
+  // print for a model where the second limb has none.
+  using namespace wlx::excavator::commands;
+  std::array<IkMethod, wlx::kLimbCount> methods{};
+  methods.fill(IkMethod::closed_form);
+  CHECK(overall_method(methods, IkMethod::closed_form) == "closed-form");
+  CHECK(methods_in_words(methods) == "the closed-form IK");
+  methods[1] = IkMethod::newton;
+  CHECK(overall_method(methods, IkMethod::closed_form) == "mixed");
+  CHECK(methods_in_words(methods) == "the closed-form IK, and Newton's method for the limbs without a closed form (" +
+                                         std::string(wlx::gen::kLimbs[1].title) + ")");
+  methods.fill(IkMethod::newton);
+  CHECK(overall_method(methods, IkMethod::closed_form) == "newton");
+  CHECK(methods_in_words(methods) == "Newton's method");  // asked for: this model's limbs do have closed forms
+  // What a request asks and the model has: every limb in closed form, or Newton's when asked.
+  for (const IkMethod m : limb_methods(IkMethod::closed_form)) CHECK(m == IkMethod::closed_form);
+  for (const IkMethod m : limb_methods(IkMethod::newton)) CHECK(m == IkMethod::newton);
+}
+
+TEST_CASE("cli: wlx fk says how it found the dependent joints, and a branch is a question for wlx ik") {
+  Run r = run_wlx("fk", "{}");
+  REQUIRE(r.code == 0);
+  CHECK(r.out.rfind("excavator pose, dependent joints by the closed-form IK:\n", 0) == 0);
+  r = run_wlx("fk --json", "{}");
+  REQUIRE(r.code == 0);
+  auto j = nlohmann::json::parse(r.out);
+  for (const auto& limb : wlx::gen::kLimbs) CHECK(j.at("limb_methods").at(std::string(limb.name)) == "closed-form");
+  // All the dependent joints given: nothing was solved.
+  nlohmann::json pose = nlohmann::json::object();
+  for (const auto& [name, value] : j.at("coordinates").items()) pose[name] = value;
+  r = run_wlx("fk --json", pose.dump());
+  REQUIRE(r.code == 0);
+  j = nlohmann::json::parse(r.out);
+  for (const auto& limb : wlx::gen::kLimbs) CHECK(j.at("limb_methods").at(std::string(limb.name)) == "given");
+  CHECK(run_wlx("fk", pose.dump()).out.rfind("excavator pose, dependent joints as given:\n", 0) == 0);
+  r = run_wlx("fk", R"({"psi_l2": 0.1})");
+  CHECK(r.code == 2);
+  CHECK(r.err ==
+        "wlx: error: stdin: give all 14 dependent joints or none, 1 given; with none, fk solves them by the "
+        "closed-form IK\n");
+  r = run_wlx("fk", R"({"z_C": 1.8, "branch": {"leg_l": 1}})");
+  CHECK(r.code == 2);
+  CHECK(r.out.empty());
+  CHECK(r.err.rfind("wlx: error: branch: unknown key: branches apply to the IK (`wlx ik` takes \"branch\"), not to fk, "
+                    "which takes "
+                    "all joint values",
+                    0) == 0);
+  CHECK(r.err.find("the 14 dependent joints") != std::string::npos);
+}
+
 TEST_CASE("cli: bad input gets a message naming the field and exit code 2") {
   Run r = run_wlx("ik", R"({"x_Fll": 7})");
   CHECK(r.code == 2);
@@ -168,8 +249,14 @@ TEST_CASE("cli: wlx verify ik writes one CSV per sweep and passes") {
   const Run r = run_wlx("verify ik --sweep IK-L1 --sweep IK-WR2 --out " + dir.string());
   CHECK(r.code == 0);
   CHECK(r.out.find("all sweeps pass") != std::string::npos);
+  // Both limbs have a closed form: its columns, and no word of a limb without one.
+  CHECK(r.out.find("check CF (m)") != std::string::npos);
+  CHECK(r.out.find("|CF-N| (rad)") != std::string::npos);
+  CHECK(r.out.find("No closed form") == std::string::npos);
   const std::string csv = slurp(dir / "IK-L1.csv");
   CHECK(csv.rfind("x_Fl,psi_l2,psi_l3,psi_l4,", 0) == 0);
+  CHECK(csv.find(",check_error_closed_form,check_error_newton,level_error_closed_form,level_error_newton,newton_minus_"
+                 "closed_form,") != std::string::npos);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 251);
   CHECK(csv.find("nan") == std::string::npos);
   CHECK(fs::exists(dir / "IK-WR2.csv"));

@@ -699,8 +699,13 @@ TEST_CASE("--model-file without a clearance box: simulate, report and the viewer
   CHECK(sim.out.find("no clearance box") != std::string::npos);
   CHECK(sim.out.find("min clearance") == std::string::npos);
 
+  // The report (--params with the defaults: the report then leaves out the 3D viewer, whose module
+  // this model would compile first, 20 s of CI for a run file the CSV's columns also make).
+  const fs::path defaults = wlx_test::work_dir() / "newton_leg_clearance_defaults.json";
+  write(defaults, "{}");
   const fs::path report = wlx_test::work_dir() / "newton_leg_report";
-  const auto rep = run({"--model-file", model.string(), "--scenarios", runs.string(), "report", "--out", report.string()});
+  const auto rep = run({"--model-file", model.string(), "--params", defaults.string(), "--scenarios", runs.string(), "report",
+                        "--out", report.string()});
   INFO(rep.out);
   INFO(rep.err);
   CHECK(rep.code == 0);
@@ -712,12 +717,6 @@ TEST_CASE("--model-file without a clearance box: simulate, report and the viewer
   CHECK(!data.empty());
   CHECK(data.find("clearance") == std::string::npos);
   CHECK(data.find("inf") == std::string::npos);
-#ifdef WLX_VIEWER_DIST  // the viewer's copy of the run: the same columns, no infinity
-  const std::string viewer_run = slurp(report / "viewer" / "runs" / "roll.js");
-  CHECK(!viewer_run.empty());
-  CHECK(viewer_run.find("clearance") == std::string::npos);
-  CHECK(viewer_run.find("nf") == std::string::npos);  // neither inf nor Infinity
-#endif
 
   // A claim measured from the clearance box is a bad input for this model: named, exit 2, no report.
   write(runs / "report.yaml", "claims:\n  - {id: touch, kind: check, claim: the body touches down, source: {spec: a test}, spec: 1 s, "
@@ -728,4 +727,96 @@ TEST_CASE("--model-file without a clearance box: simulate, report and the viewer
   CHECK(refused.err.find("report.yaml:2: claims.touch.measure.quantity: ground_contact_time needs a clearance box, and model "
                          "newton_leg has none") != std::string::npos);
   CHECK(!fs::exists(bad / "index.html"));
+}
+
+// Issue 43: the labels say what ran. tests/models/newton_leg.yaml is a model whose limbs no
+// closed-form pattern solves (its generated ik.hpp, read from the plugin's cache entry, is checked
+// first): every command must say Newton's method solved them, and nothing may claim, check or
+// compare a closed form. (tests/cli/test_cli.cpp checks the excavator, whose limbs all have one.)
+TEST_CASE(
+    "--model-file: a model whose limbs have no closed form: ik, fk, verify ik and report say Newton's method, never "
+    "the closed form") {
+  setup();
+  const fs::path model = fs::path(WLX_SOURCE_DIR) / "tests" / "models" / "newton_leg.yaml";
+  const auto ik = run({"--model-file", model.string(), "ik"}, {.input = "{}"});
+  INFO(ik.err);
+  REQUIRE(ik.code == 0);
+  // What wlx-gen emitted for the model: no closed form for either limb (kClosedForm's solve nullptr).
+  std::string emitted;
+  for (const auto& e : fs::directory_iterator(setup().cache))
+    if (e.is_directory() && e.path().filename().string().rfind("newton_leg-", 0) == 0 &&
+        e.path().filename().string().find('.') == std::string::npos)
+      emitted = slurp(e.path() / "generated" / "wlx" / "gen" / "ik.hpp");
+  REQUIRE(!emitted.empty());
+  REQUIRE(count(emitted, "{nullptr, 0, \"none\", {}, {}},  // leg:") == 1);
+  REQUIRE(count(emitted, "{nullptr, 0, \"none\", {}, {}},  // wheel_arm:") == 1);
+
+  // wlx ik, the closed form asked for (the default) and Newton's method asked for: Newton's both times.
+  for (const std::string request : {"{}", R"({"method": "closed-form", "foot_x": 0.6})", R"({"method": "newton"})"}) {
+    CAPTURE(request);
+    const auto r = run({"--model-file", model.string(), "ik"}, {.input = request});
+    REQUIRE(r.code == 0);
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    CHECK(j["method"] == "newton");
+    CHECK(j["limb_methods"] == nlohmann::json({{"leg", "newton"}, {"wheel_arm", "newton"}}));
+    CHECK(j["iterations"].size() == 2);
+    CHECK(j["closure_residual"].get<double>() <= 1e-12);
+  }
+  // From the nominal dependent joints (the model's start values), Newton's method took steps.
+  CHECK(nlohmann::json::parse(ik.out)["iterations_total"].get<int>() > 0);
+
+  // wlx fk: the table's heading, the JSON's limb_methods, the message for a partial pose.
+  const auto fk = run({"--model-file", model.string(), "fk"}, {.input = "{}"});
+  REQUIRE(fk.code == 0);
+  CHECK(fk.out.rfind(
+            "newton_leg pose, dependent joints by Newton's method (wlx-gen derived no closed form for any limb):\n",
+            0) == 0);
+  CHECK(fk.out.find("closed-form IK") == std::string::npos);
+  const auto fk_json = run({"--model-file", model.string(), "fk", "--json"}, {.input = "{}"});
+  REQUIRE(fk_json.code == 0);
+  CHECK(nlohmann::json::parse(fk_json.out)["limb_methods"] ==
+        nlohmann::json({{"leg", "newton"}, {"wheel_arm", "newton"}}));
+  const auto partial = run({"--model-file", model.string(), "fk"}, {.input = R"({"knee": -1.2})"});
+  CHECK(partial.code == 2);
+  CHECK(partial.err ==
+        "wlx: error: stdin: give all 4 dependent joints or none, 1 given; with none, fk solves them by Newton's method "
+        "(wlx-gen "
+        "derived no closed form for any limb)\n");
+
+  // wlx verify ik: no closed-form column, no comparison; the words instead; CSVs without them.
+  const fs::path out = wlx_test::work_dir() / "verify-newton-leg";
+  const auto verify = run({"--model-file", model.string(), "verify", "ik", "--out", out.string()});
+  INFO(verify.out);
+  CHECK(verify.code == 0);
+  CHECK(verify.out.find("CF") == std::string::npos);
+  CHECK(verify.out.find("check N (m)") != std::string::npos);
+  CHECK(verify.out.find("No closed form for leg (N-foot-x), wheel arm (N-ground): wlx-gen derived none.\n") !=
+        std::string::npos);
+  CHECK(verify.out.find("all sweeps pass") != std::string::npos);
+  for (const char* sweep : {"N-foot-x", "N-ground"}) {
+    const auto csv = read_csv(out / (std::string(sweep) + ".csv"));
+    const std::string& header = csv.first;
+    CAPTURE(header);
+    CHECK(header.find("closed_form") == std::string::npos);
+    CHECK(header.find(",check_error_newton,level_error_newton,newton_iterations,") != std::string::npos);
+    CHECK(csv.second.size() > 10);
+  }
+  // Only one of the two limbs swept: the other is not named.
+  const auto one = run({"--model-file", model.string(), "verify", "ik", "--sweep", "N-ground", "--out", out.string()});
+  CHECK(one.code == 0);
+  CHECK(one.out.find("No closed form for wheel arm (N-ground): wlx-gen derived none.\n") != std::string::npos);
+
+  // wlx report: the sweeps' table and figures say so too (--params with the defaults: the report
+  // then leaves out the 3D viewer, whose module this model would compile first).
+  const fs::path defaults = wlx_test::work_dir() / "newton_leg_defaults.json";
+  write(defaults, "{}");
+  const fs::path report = wlx_test::work_dir() / "report-newton-leg";
+  const auto rep = run(
+      {"--model-file", model.string(), "--params", defaults.string(), "report", "--quick", "--out", report.string()});
+  INFO(rep.err);
+  REQUIRE(rep.code == 0);
+  const std::string page = slurp(report / "index.html");
+  CHECK(count(page, "<td>no closed form</td>") == 4);  // two sweeps: the check and the difference each
+  CHECK(page.find("N-foot-x: foot_x swept; Newton&#39;s method (the limb has no closed form)") != std::string::npos);
+  CHECK(page.find("closed form and Newton") == std::string::npos);
 }

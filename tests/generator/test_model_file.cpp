@@ -421,3 +421,57 @@ TEST_CASE("model file: a wheel on a hub may be driven; the drive's name and its 
   CHECK(with("{wheel: lf, name: 3x}, {wheel: rf}").find("'3x' is not a name") != std::string::npos);
   CHECK(with("{name: motor_lf}, {wheel: rf}").find("missing field 'wheel'") != std::string::npos);
 }
+
+// Issue 43: a limb's `start`, `nominal` and `ik_sweeps.start` take the constant expressions that
+// ik_sweeps' from/to/step take (a repeated limb's <sign>*0.6), not only plain numbers.
+TEST_CASE(
+    "model file: start values, nominal values and the sweeps' start take expressions of numbers, as the sweeps' ends "
+    "do") {
+  std::ifstream in(WLX_SOURCE_DIR "/models/walker.yaml");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  const std::string good = buffer.str();
+  const std::string anchor = "    joints: [abduct_<side>, lift_<side>, knee_<side>]\n";
+  REQUIRE(good.find(anchor) != std::string::npos);
+  const auto with_start = [&](const std::string& start) {
+    std::string text = good;
+    text.replace(text.find(anchor), anchor.size(), anchor + "    start: " + start + "\n");
+    return text;
+  };
+  const auto index = [](const Model& m, const std::string& name) {
+    for (std::size_t k = 0; k < m.coordinates.size(); ++k)
+      if (m.coordinates[k].name == name) return k;
+    FAIL("no coordinate " << name);
+    return std::size_t{0};
+  };
+  // The left side's sign is 1, the right side's -1 (walker.yaml's repeat table): the values are
+  // worked out here from the text, not read back from the reader.
+  const Model m = parse_model(with_start("{abduct_<side>: <sign>*0.1, knee_<side>: 1*<sign>*-0.6}"), "walker.yaml");
+  CHECK(m.nominal[index(m, "abduct_l")] == doctest::Approx(0.1).epsilon(1e-15));
+  CHECK(m.nominal[index(m, "abduct_r")] == doctest::Approx(-0.1).epsilon(1e-15));
+  CHECK(m.nominal[index(m, "knee_l")] == doctest::Approx(-0.6).epsilon(1e-15));
+  CHECK(m.nominal[index(m, "knee_r")] == doctest::Approx(0.6).epsilon(1e-15));
+  // A plain number reads as before; what is not a number of numbers is still an error naming the field.
+  const Model plain = parse_model(with_start("{knee_<side>: -0.6}"), "walker.yaml");
+  CHECK(plain.nominal[index(plain, "knee_r")] == -0.6);
+  std::string message;
+  try {
+    parse_model(with_start("{knee_<side>: <sign>*thigh}"), "walker.yaml");
+  } catch (const ModelFileError& e) {
+    message = e.what();
+  }
+  CAPTURE(message);
+  CHECK(message.find("limbs[0]{side=l}.start.knee_<side>") != std::string::npos);
+  CHECK(message.find("'1*thigh' is not a number") != std::string::npos);
+
+  // `nominal` and `ik_sweeps.start` the same way (the excavator's file: z_Wr in both).
+  std::string excavator = excavator_text();
+  const std::string nominal = "  z_Wr: 0.05", sweep_start = "start: {z_Wr: 0.0}";
+  REQUIRE(excavator.find(nominal) != std::string::npos);
+  REQUIRE(excavator.find(sweep_start) != std::string::npos);
+  excavator.replace(excavator.find(nominal), nominal.size(), "  z_Wr: 0.1/2");
+  excavator.replace(excavator.find(sweep_start), sweep_start.size(), "start: {z_Wr: -2*0.01}");
+  const Model e = parse_model(excavator, "excavator.yaml");
+  CHECK(e.nominal[index(e, "z_Wr")] == doctest::Approx(0.05).epsilon(1e-15));
+  CHECK(e.sweep_start[index(e, "z_Wr")] == doctest::Approx(-0.02).epsilon(1e-15));
+}

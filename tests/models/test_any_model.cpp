@@ -168,9 +168,22 @@ TEST_CASE(titled("the IK from the nominal state, and the model's sweeps: closure
   const Model model;
   Data data;
   Coordinates s = nominal_inputs();
-  REQUIRE_NOTHROW(solve_ik_closed_form(model, s));
+  NewtonReport fallback;
+  REQUIRE_NOTHROW(solve_ik_closed_form(model, s, {}, &fallback));
   closure(model, data, s, false);
   CHECK(data.Phi.cwiseAbs().maxCoeff() <= 1e-12);
+  // Newton's iterations are reported for the limbs without a closed form (the generated
+  // kClosedForm's solve nullptr), which it solves from the model's start values (not a solution:
+  // at least one step), and none for the others (what `wlx ik` reports as each limb's method).
+  for (Limb limb : kLimbs) {
+    CAPTURE(limb_name(limb));
+    const bool generated = gen::kClosedForm[static_cast<std::size_t>(limb)].solve != nullptr;
+    CHECK(has_closed_form(limb) == generated);
+    if (generated)
+      CHECK(fallback.iterations[static_cast<std::size_t>(limb)] == 0);
+    else
+      CHECK(fallback.iterations[static_cast<std::size_t>(limb)] > 0);
+  }
   // Newton's method from the model file's start values (a straight leg would be singular).
   Coordinates n = dependent_start(nominal_inputs());
   REQUIRE_NOTHROW(solve_ik_newton(model, data, n));
@@ -192,6 +205,15 @@ TEST_CASE(titled("the IK from the nominal state, and the model's sweeps: closure
     const IkSweepResult r = run_ik_sweep(model, data, sweep);
     MESSAGE(kName << " " << sweep.id << ": " << r.points.size() << " points, check " << r.max_check_closed_form
                   << " m, |closed form - Newton| " << r.max_newton_difference);
+    // A limb without a closed form is checked by Newton's method alone: nothing is measured as the
+    // closed form's (which would be Newton's again), and the point's solution is Newton's.
+    CHECK(r.closed_form == (gen::kClosedForm[static_cast<std::size_t>(sweep.limb)].solve != nullptr));
+    if (!r.closed_form)
+      for (const IkSweepPoint& p : r.points) {
+        CHECK(p.check_closed_form.position_error == 0);
+        CHECK(p.newton_difference == 0);
+        CHECK(r.solution(p) == p.newton);
+      }
     CHECK(r.max_check_closed_form <= 1e-12);
     CHECK(r.max_check_newton <= 1e-12);
     CHECK(r.max_level_error <= 1e-12);

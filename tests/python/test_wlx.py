@@ -448,3 +448,28 @@ def test_simulate_columns_name_the_contacts():
         assert (run["f_n_" + c] > 0).all()
     assert (run["momentum_residual"] <= 1e-9).all()
     assert (run["margin_tip"] > 0).all()
+
+
+def test_another_interpreter_is_told_which_one_the_package_was_built_for(tmp_path):
+    """The python3 first on a user's PATH may not be the interpreter the build used (a pyenv or a
+    virtual environment's, without its NumPy; issue 43): import wlx there fails with an ImportError
+    that names the build's interpreter (ctest runs this file with it: sys.executable) and this one,
+    not only NumPy's or the compiled module's obscure error."""
+    package_dir = str(Path(wlx.__file__).resolve().parents[1])
+    venv = tmp_path / "venv"  # another interpreter, without the system's site-packages (so no NumPy)
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True, capture_output=True)
+    other = venv / "bin" / "python3"
+    env = {**os.environ, "PYTHONPATH": package_dir}
+    done = subprocess.run([str(other), "-c", "import wlx"], capture_output=True, text=True, env=env, check=False)
+    assert done.returncode != 0
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("ImportError: wlx: this package was built for the Python at "), done.stderr
+    assert f"built for the Python at {sys.executable} (Python {sys.version_info[0]}.{sys.version_info[1]})" in last
+    assert str(other) in last and "a virtual environment" in last
+    assert "No module named 'numpy'" in last  # the original error is kept, after the explanation
+    # The build's own interpreter, NumPy made unimportable: the original error, nothing claimed
+    # about another interpreter.
+    done = subprocess.run([sys.executable, "-c", "import sys; sys.modules['numpy'] = None; import wlx"],
+                          capture_output=True, text=True, env=env, check=False)
+    assert done.returncode != 0
+    assert "built for" not in done.stderr and "numpy" in done.stderr.splitlines()[-1]
