@@ -1003,7 +1003,7 @@ EmittedFile emit_structure_header(const Model& m, const EmitOptions& opt) {
   t += "// The IK verification: each sweep moves one input over [from, to] in steps (SI units), from the\n"
        "// inputs kSweepStart, and checks one limb (the sweeps: settings.hpp or model.json).\n"
        "struct SweepInfo {\n  std::string_view id;\n  int input;\n  double from, to, step;\n"
-       "  bool degrees;  // quoted in degrees\n  int limb;\n};\n\n";
+       "  bool degrees;  // quoted in degrees\n  int limb;\n  int branch;  // the limb's branch along the sweep; -1: the model's choice\n};\n\n";
   t += fmt::format("inline constexpr bool kHasClearance = {};\n"
                    "// The frame the clearance box moves with (frame::; -1: none); its size: clearance()'s half_extents.\n"
                    "inline constexpr int kClearanceFrame = {};\n\n",
@@ -1069,8 +1069,9 @@ EmittedFile emit_settings_header(const Model& m, const EmitOptions& opt) {
                    m.sweep_start.size(), list(m.sweep_start, literal));
   h += fmt::format("inline constexpr std::array<SweepInfo, {}> kIkSweeps{{{{\n", m.sweeps.size());
   for (const auto& sw : m.sweeps)
-    h += fmt::format("    {{{}, {}, {}, {}, {}, {}, {}}},  // {}\n", quoted(sw.id), sw.input, literal(sw.from), literal(sw.to),
-                     literal(sw.step), sw.degrees ? "true" : "false", sw.limb, m.coordinates[static_cast<std::size_t>(sw.input)].name);
+    h += fmt::format("    {{{}, {}, {}, {}, {}, {}, {}, {}}},  // {}\n", quoted(sw.id), sw.input, literal(sw.from), literal(sw.to),
+                     literal(sw.step), sw.degrees ? "true" : "false", sw.limb, sw.branch,
+                     m.coordinates[static_cast<std::size_t>(sw.input)].name);
   h += "}};\n\n";
 
   const auto inputs = static_cast<std::ptrdiff_t>(m.input_count);

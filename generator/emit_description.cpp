@@ -69,7 +69,8 @@ EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::
   d["bodies"] = bodies;
   Json wheels = Json::array();
   for (const auto& w : m.wheels)
-    wheels.push_back({{"name", w.name}, {"contact", w.contact}, {"hub", w.hub}, {"radius", w.radius}, {"axle", axis_name(w.axle)},
+    wheels.push_back({{"name", w.name}, {"contact", w.contact}, {"hub", w.hub}, {"radius", w.radius},
+                      {"offset", w.offset.empty() ? Json(nullptr) : Json(w.offset)}, {"axle", axis_name(w.axle)},
                       {"ground", w.ground >= 0 ? coordinate(w.ground) : ""}});
   d["wheels"] = wheels;
   Json limbs = Json::array();
@@ -118,7 +119,8 @@ EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::
   Json sweeps = Json::array();
   for (const auto& sw : m.sweeps)
     sweeps.push_back({{"id", sw.id}, {"input", coordinate(sw.input)}, {"from", sw.from}, {"to", sw.to}, {"step", sw.step},
-                      {"degrees", sw.degrees}, {"limb", m.limbs[static_cast<std::size_t>(sw.limb)].name}});
+                      {"degrees", sw.degrees}, {"limb", m.limbs[static_cast<std::size_t>(sw.limb)].name},
+                      {"branch", sw.branch >= 0 ? Json(sw.branch) : Json(nullptr)}});
   settings["ik_sweeps"] = sweeps;
   settings["weights"] = m.dynamics ? Json(m.dynamics->weights) : Json::array();
   settings["torque_limits"] = m.dynamics && !m.dynamics->torque_limits.empty() ? Json(m.dynamics->torque_limits) : Json(nullptr);

@@ -78,6 +78,7 @@ struct NonholonomicWheel {
   int ground = -1;     // the input holding the ground level under the wheel
   std::string hub;     // the hub frame (wheel centre, not spinning), or empty
   Axis axle = Axis::Y;  // the hub frame's axis the wheel turns about
+  std::string offset;   // parameter name of the rolling plane's place along the axle from the hub, or empty: 0
 };
 
 // Closure rows and the dependent joints they determine: a square diagonal block of dPhi/ds.
@@ -128,6 +129,7 @@ struct IkSweep {
   double from = 0, to = 0, step = 0;  // SI (radians for angles)
   bool degrees = false;               // quoted in degrees
   int limb = -1;
+  int branch = -1;  // the limb's branch along the sweep, or -1: the model's choice at the start pose
 };
 
 // Coulomb friction coefficients of the contacts with the ground, per kind of contact (the model

@@ -413,6 +413,7 @@ class Parser {
     // the hubs of its wheels (a wheel's continuous joint is its spin, not a coordinate).
     std::set<std::string> file_parameters, file_inputs;
     std::map<std::string, Item> hubs;
+    std::set<std::string> hubs_with_radius;  // the wheels that give their radius themselves
     if (auto list = f.optional("parameters"))
       each(*list, [&](const Item& it) { if (it.has("name")) file_parameters.insert(it.child("name").text()); });
     if (auto c = f.optional("coordinates")) {
@@ -423,7 +424,11 @@ class Parser {
       each(cf["inputs"], [&](const Item& it) { if (it.has("name")) file_inputs.insert(it.child("name").text()); });
     }
     if (auto w = f.optional("wheels"))
-      each(*w, [&](const Item& it) { if (it.has("hub")) hubs.emplace(it.child("hub").text(), it.child("hub")); });
+      each(*w, [&](const Item& it) {
+        if (!it.has("hub")) return;
+        hubs.emplace(it.child("hub").text(), it.child("hub"));
+        if (it.has("radius")) hubs_with_radius.insert(it.child("hub").text());
+      });
 
     // The shortest decimal within two units in the last place: an angle that went through
     // urdfdom's quaternion (0.2 comes back as 0.20000000000000004) or a diagonalised moment reads
@@ -649,6 +654,34 @@ class Parser {
       }
       frame["chain"] = flow(chain);
       frames.push_back(frame);
+    }
+
+    // A wheel without `radius` rolls on its hub link's collision cylinder (about the axle) or sphere:
+    // parameters <hub>_radius and <hub>_offset (the centre's place along the axle, which moves the
+    // rolling plane), which the wheel then takes (wheels() below).
+    for (const auto& [hub, item] : hubs) {
+      const auto l = link_of.find(hub);
+      if (l == link_of.end() || hubs_with_radius.count(hub)) continue;
+      const UrdfLink& link = robot.links[static_cast<std::size_t>(l->second)];
+      const UrdfAxle& axle = urdf_axle_.at(hub);
+      if (!link.round_shape)
+        item.fail(fmt::format("the wheel on '{}' has no `radius`, and the URDF's link '{}' has no collision cylinder or sphere to "
+                              "read one from (a mesh has none): give `radius: PARAMETER`",
+                              hub, hub));
+      const UrdfRoundShape& shape = *link.round_shape;
+      const auto a = static_cast<std::size_t>(axle.axis);
+      if (shape.cylinder && !(std::abs(shape.axis[a]) >= 1 - 1e-9))
+        urdf_fail(shape.line, fmt::format("link '{}' collision", hub),
+                  fmt::format("the cylinder's axis ({:.6g}, {:.6g}, {:.6g}) is not the wheel's axle ({} of the link): it gives no "
+                              "rolling radius; turn its <origin rpy>, or give the wheel a `radius`",
+                              shape.axis[0], shape.axis[1], shape.axis[2], "xyz"[a]));
+      const std::string place = fmt::format("{}:{}", shown, shape.line);
+      add_parameter(shape.line, "link", hub, hub + "_radius", shape.radius, "length", "m",
+                    fmt::format("rolling radius of the wheel on {} (its collision {}, {})", hub, shape.cylinder ? "cylinder" : "sphere", place));
+      add_parameter(shape.line, "link", hub, hub + "_offset", shape.center[a], "offset", "m",
+                    fmt::format("the wheel's rolling plane along the axle {} of {} (its collision {}'s centre, {})", "xyz"[a], hub,
+                                shape.cylinder ? "cylinder" : "sphere", place));
+      urdf_wheel_shape_[hub] = {hub + "_radius", hub + "_offset"};
     }
 
     // Bodies: each group's mass, centre of mass and inertia (the parallel-axis theorem moves every
@@ -1385,13 +1418,18 @@ class Parser {
   void wheels(const Item& list) {
     each(list, [&](const Item& it) {
       const bool on_hub = it.is_map() && it.has("hub");
-      const Fields f(it, on_hub ? std::vector<std::string>{"name", "hub", "axle", "radius", "ground", "contact"}
+      const Fields f(it, on_hub ? std::vector<std::string>{"name", "hub", "axle", "radius", "offset", "ground", "contact"}
                                 : std::vector<std::string>{"name", "contact", "forward", "lateral", "radius", "ground"});
       NonholonomicWheel w;
       w.name = f["name"].name();
       for (const auto& other : m_.wheels)
         if (other.name == w.name) f["name"].fail(fmt::format("wheel '{}' is defined twice", w.name));
-      w.radius = parameter(f["radius"], ParameterKind::length).name;
+      // On a hub, a URDF's collision cylinder or sphere may give the radius and the offset (with_urdf).
+      const auto shape = on_hub ? urdf_wheel_shape_.find(it.child("hub").text()) : urdf_wheel_shape_.end();
+      w.radius = f.optional("radius") || shape == urdf_wheel_shape_.end() ? parameter(f["radius"], ParameterKind::length).name
+                                                                          : shape->second.radius;
+      if (auto o = f.optional("offset")) w.offset = parameter(*o, ParameterKind::offset).name;
+      else if (shape != urdf_wheel_shape_.end() && !f.optional("radius")) w.offset = shape->second.offset;
       w.ground = coordinate_index(f["ground"], true);
       if (m_.coordinates[static_cast<std::size_t>(w.ground)].unit != "m")
         f["ground"].fail(fmt::format("'{}' is an angle; the ground level is a height (m)", m_.coordinates[static_cast<std::size_t>(w.ground)].name));
@@ -1420,7 +1458,8 @@ class Parser {
       contact.name = w.contact;
       contact.meaning = fmt::format("contact point of wheel {} (derived: the rim point nearest the ground)", w.name);
       contact.parent = hub.name;
-      contact.frame = wheel_contact_frame(hub.frame, w.axle, m_.parameter(w.radius).symbol, m_.coordinates);
+      contact.frame = wheel_contact_frame(hub.frame, w.axle, m_.parameter(w.radius).symbol,
+                                          w.offset.empty() ? ex(0) : ex(m_.parameter(w.offset).symbol), m_.coordinates);
       contact.derived_from_wheel = static_cast<int>(m_.wheels.size());
       m_.frames.push_back(std::move(contact));
       m_.wheels.push_back(std::move(w));
@@ -1691,7 +1730,7 @@ class Parser {
       }
     }
     each(f["sweeps"], [&](const Item& it) {
-      const Fields s(it, {"id", "input", "from", "to", "step", "unit", "limb"});
+      const Fields s(it, {"id", "input", "from", "to", "step", "unit", "limb", "branch"});
       IkSweep sw;
       sw.id = s["id"].text();
       for (const auto& other : m_.sweeps)
@@ -1718,6 +1757,13 @@ class Parser {
       for (std::size_t k = 0; k < m_.limbs.size(); ++k)
         if (m_.limbs[k].name == limb) sw.limb = static_cast<int>(k);
       if (sw.limb < 0) s["limb"].fail(fmt::format("no limb '{}'", limb));
+      // The branch the sweep checks (checked against the closed form's branches at run time, as
+      // every branch a file or a request gives: settings).
+      if (auto b = s.optional("branch")) {
+        const double v = b->number();
+        if (!(v >= 0 && v <= 1023 && v == std::floor(v))) b->fail(fmt::format("a branch is a whole number from 0, got {}", v));
+        sw.branch = static_cast<int>(v);
+      }
       m_.sweeps.push_back(std::move(sw));
     });
   }
@@ -1734,6 +1780,10 @@ class Parser {
     std::string place;  // file:line of the <limit>
   };
   std::map<std::string, UrdfLimit> urdf_limits_;  // a URDF joint's name -> its <limit>
+  struct UrdfWheelShape {
+    std::string radius, offset;  // the parameters with_urdf made from the hub's collision shape
+  };
+  std::map<std::string, UrdfWheelShape> urdf_wheel_shape_;  // a hub link -> its wheel's radius and offset
   Model m_;
   GiNaC::symtab params_, coordinates_;
   GiNaC::exmap param_defaults_;  // each parameter's symbol -> its default, for check_at_defaults
@@ -1858,6 +1908,31 @@ std::string print_model_file(const std::string& path, const std::string& urdf_pa
       limits.SetStyle(YAML::EmitterStyle::Flow);
       merged["dynamics"]["torque_limits"] = limits;
     }
+  }
+  // The wheels as the model has them: a radius and an offset read from the URDF's collision shapes
+  // are parameters of the printed file, which the wheels name.
+  if (!parser.urdf_fingerprint().empty() && !model.wheels.empty()) {
+    YAML::Node wheels(YAML::NodeType::Sequence);
+    for (const NonholonomicWheel& w : model.wheels) {
+      YAML::Node e(YAML::NodeType::Map);
+      e.SetStyle(YAML::EmitterStyle::Flow);
+      e["name"] = w.name;
+      const char* axes = "xyz";
+      if (!w.hub.empty()) {
+        e["hub"] = w.hub;
+        e["axle"] = std::string(1, axes[static_cast<int>(w.axle)]);
+        if (w.contact != "contact_" + w.name) e["contact"] = w.contact;
+      } else {
+        e["contact"] = w.contact;
+        e["forward"] = std::string(1, axes[static_cast<int>(w.forward)]);
+        e["lateral"] = std::string(1, axes[static_cast<int>(w.lateral)]);
+      }
+      e["radius"] = w.radius;
+      if (!w.offset.empty()) e["offset"] = w.offset;
+      e["ground"] = model.coordinates[static_cast<std::size_t>(w.ground)].name;
+      wheels.push_back(e);
+    }
+    merged["wheels"] = wheels;
   }
   // The joints' limits as the model has them (the URDF's <limit>s with the file's entries).
   if (!parser.urdf_fingerprint().empty()) {

@@ -186,6 +186,7 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
   struct LinkEntry {
     int line;
     const TiXmlElement* element;
+    std::optional<UrdfRoundShape> round_shape;
   };
   struct JointEntry {
     std::string name, type, parent, child;
@@ -205,7 +206,7 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
       const char* name = e->Attribute("name");
       if (name == nullptr || !*name) check.fail(e->Row(), "link", "has no name");
       if (link_entries.count(name)) check.fail(e->Row(), element_name("link", name), fmt::format("defined twice (first at line {})", link_entries[name].line));
-      link_entries[name] = {e->Row(), e};
+      link_entries[name] = {e->Row(), e, std::nullopt};
       link_order.push_back(name);
       const std::string element = element_name("link", name);
       if (const TiXmlElement* inertial = e->FirstChildElement("inertial")) {
@@ -221,6 +222,35 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
         for (const char* a : {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"})
           if (check.numbers(inertia, a, 1, element + " inertial inertia", {}).empty())
             check.fail(inertia->Row(), element + " inertial inertia", fmt::format("has no {} attribute", a));
+      }
+      // The first collision cylinder or sphere: a wheel's rolling radius (and its plane's offset).
+      for (const TiXmlElement* c = e->FirstChildElement("collision"); c != nullptr && !link_entries[name].round_shape;
+           c = c->NextSiblingElement("collision")) {
+        const TiXmlElement* geometry = c->FirstChildElement("geometry");
+        const TiXmlElement* shape = nullptr;
+        bool cylinder = false;
+        if (geometry != nullptr) {
+          if ((shape = geometry->FirstChildElement("cylinder")) != nullptr) cylinder = true;
+          else shape = geometry->FirstChildElement("sphere");
+        }
+        if (shape == nullptr) continue;
+        const std::string where = element + " collision";
+        const auto r = check.numbers(shape, "radius", 1, where, {});
+        if (r.empty()) check.fail(shape->Row(), where, fmt::format("<{}> has no radius", cylinder ? "cylinder" : "sphere"));
+        if (!(r[0] > 0 && r[0] <= 1e3)) check.fail(shape->Row(), where, fmt::format("radius=\"{}\" must be in (0, 1000] m", r[0]));
+        const TiXmlElement* origin = c->FirstChildElement("origin");
+        const auto xyz = check.numbers(origin, "xyz", 3, where + " origin", {0, 0, 0});
+        const auto rpy = check.numbers(origin, "rpy", 3, where + " origin", {0, 0, 0});
+        UrdfRoundShape round;
+        round.cylinder = cylinder;
+        round.radius = r[0];
+        round.center = {xyz[0], xyz[1], xyz[2]};
+        // z of R = Rz(yaw) Ry(pitch) Rx(roll): the cylinder's axis in the link's axes.
+        const double cr = std::cos(rpy[0]), sr = std::sin(rpy[0]), cp = std::cos(rpy[1]), sp = std::sin(rpy[1]);
+        const double cy = std::cos(rpy[2]), sy = std::sin(rpy[2]);
+        round.axis = {cy * sp * cr + sy * sr, sy * sp * cr - cy * sr, cp * cr};
+        round.line = c->Row();
+        link_entries[name].round_shape = round;
       }
     } else if (tag == "joint") {
       const char* name = e->Attribute("name");
@@ -369,6 +399,7 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
     UrdfLink link;
     link.name = name;
     link.line = link_entries[name].line;
+    link.round_shape = link_entries[name].round_shape;
     link.parent_joint = parent_joint;
     const urdf::LinkConstSharedPtr l = model->getLink(name);
     if (l && l->inertial) {

@@ -5,7 +5,8 @@
 //
 // The subset read: joints of type revolute, continuous, prismatic and fixed; <origin xyz rpy>;
 // <axis>; <limit> (lower, upper, effort, velocity); link <inertial> (mass, origin with rpy, the six
-// inertia values). Visuals, collisions, dynamics, materials, transmissions and gazebo tags are read past. Anything that changes
+// inertia values) and the first <collision> cylinder or sphere (a wheel's radius). Visuals, other
+// collisions, dynamics, materials, transmissions and gazebo tags are read past. Anything that changes
 // the kinematics and wlx cannot represent (mimic joints, floating and planar joints, xacro that was
 // not expanded) is an error that says so: `file:line: element: reason`.
 #pragma once
@@ -31,10 +32,21 @@ struct UrdfInertial {
   Matrix3Rows inertia{};               // about the centre of mass, in the link's axes
 };
 
+// The first <collision> cylinder or sphere of a link, in the link's axes: what a wheel's rolling
+// radius and the offset of its rolling plane along the axle are read from.
+struct UrdfRoundShape {
+  bool cylinder = true;                   // else a sphere
+  double radius = 0;                      // m
+  std::array<double, 3> center{0, 0, 0};  // the shape's centre (its <origin xyz>)
+  std::array<double, 3> axis{0, 0, 1};    // a cylinder's axis (z of its <origin rpy>)
+  int line = 0;                           // of its <collision>
+};
+
 struct UrdfLink {
   std::string name;
   int line = 0;
   std::optional<UrdfInertial> inertial;
+  std::optional<UrdfRoundShape> round_shape;
   int parent_joint = -1;  // index into UrdfRobot::joints; -1 for the root
 };
 

@@ -130,7 +130,7 @@ Moving root(const Moving& a) {
 
 }  // namespace
 
-Frame wheel_contact_frame(const Frame& hub, Axis axle, const ex& radius, const std::vector<Coordinate>& coordinates) {
+Frame wheel_contact_frame(const Frame& hub, Axis axle, const ex& radius, const ex& offset, const std::vector<Coordinate>& coordinates) {
   const std::size_t n = coordinates.size();
   // The axle a is fixed in the hub: a' = omega x a (column k: axis_k x a for a revolute joint k),
   // a''_bias = alpha_bias x a + omega x (omega x a).
@@ -152,16 +152,18 @@ Frame wheel_contact_frame(const Frame& hub, Axis axle, const ex& radius, const s
   const Moving nx = A[0] * inv, ny = A[1] * inv;
   // c = h - r u with u = (-a_z n_x, -a_z n_y, sigma).
   const Moving r{radius, 0, 0, std::vector<ex>(n, 0)};
-  const std::array<Moving, 3> offset = {r * A[2] * nx, r * A[2] * ny, -(r * sigma)};
+  // c = h + d a - r u: d moves the rolling plane along the axle (its terms vanish for d = 0).
+  const Moving d{offset, 0, 0, std::vector<ex>(n, 0)};
+  const std::array<Moving, 3> offset_of_contact = {d * A[0] + r * A[2] * nx, d * A[1] + r * A[2] * ny, d * A[2] + -(r * sigma)};
   Frame f;
   f.joints = hub.joints;  // the coordinates that move it
   f.linear_columns.assign(n, Vec3());
   for (int i = 0; i < 3; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    f.r[i] = hub.r[i] + offset[k].value;
-    f.v[i] = hub.v[i] + offset[k].rate;
-    f.a_bias[i] = hub.a_bias[i] + offset[k].bias;
-    for (std::size_t c = 0; c < n; ++c) f.linear_columns[c][i] = hub_columns[c][i] + offset[k].columns[c];
+    f.r[i] = hub.r[i] + offset_of_contact[k].value;
+    f.v[i] = hub.v[i] + offset_of_contact[k].rate;
+    f.a_bias[i] = hub.a_bias[i] + offset_of_contact[k].bias;
+    for (std::size_t c = 0; c < n; ++c) f.linear_columns[c][i] = hub_columns[c][i] + offset_of_contact[k].columns[c];
   }
   f.R(0, 0) = ny.value, f.R(1, 0) = -nx.value, f.R(2, 0) = 0;  // forward t
   f.R(0, 1) = nx.value, f.R(1, 1) = ny.value, f.R(2, 1) = 0;   // lateral n

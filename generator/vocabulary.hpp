@@ -111,7 +111,9 @@ class Frame {
 // The point slides round the rim as the hub tilts, so its velocity Jacobian (one column per
 // coordinate of `coordinates`) is carried explicitly; omega is the heading's rate about e_z.
 // Undefined (division by zero) when the axle is vertical.
-Frame wheel_contact_frame(const Frame& hub, Axis axle, const ex& radius, const std::vector<Coordinate>& coordinates);
+// `offset` moves the rolling plane along the axle (c = h + offset a - r u): a wheel whose rim is
+// not centred on the hub frame's origin.
+Frame wheel_contact_frame(const Frame& hub, Axis axle, const ex& radius, const ex& offset, const std::vector<Coordinate>& coordinates);
 
 // Jacobian columns of the frame origin's velocity, one per coordinate (n in all).
 std::vector<Vec3> linear_jacobian(const Frame& f, int n);

@@ -86,6 +86,11 @@ Settings settings_of_description(const std::string& json_text) {
     for (std::size_t l = 0; l < gen::kLimbs.size(); ++l)
       if (gen::kLimbs[l].name == limb) sweep.limb = static_cast<int>(l);
     if (sweep.limb < 0) mismatch(fmt::format("{}: the code has no limb '{}'", where, limb));
+    if (!sw.contains("branch")) mismatch(fmt::format("{} has no 'branch'", where));
+    if (!sw["branch"].is_null()) {
+      if (!sw["branch"].is_number_integer()) mismatch(fmt::format("{}.branch is not a whole number", where));
+      sweep.branch = static_cast<int>(std::clamp<std::int64_t>(sw["branch"].get<std::int64_t>(), -2, 1 << 20));
+    }
     s.ik_sweeps.push_back(sweep);
   }
   numbers(member(section, "weights", Json::value_t::array, "settings"), s.weights, "settings.weights");

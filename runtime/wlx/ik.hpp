@@ -52,7 +52,7 @@ inline constexpr int kModelsChoice = -1;
 struct Branches {
   std::array<int, kLimbCount> limb = [] {
     std::array<int, kLimbCount> all{};
-    all.fill(kModelsChoice);
+    for (int& b : all) b = kModelsChoice;
     return all;
   }();
 };

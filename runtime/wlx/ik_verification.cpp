@@ -70,7 +70,9 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
   Coordinates start = ik_sweep_inputs();
   // One branch per limb all along: the model's choice at the start pose (within the joints' ranges
   // where a branch is), so that the closed form and Newton's continuation follow the same one.
-  const Branches branches = resolve_branches(model, start);
+  Branches requested;  // the sweep's own branch for its limb, if it names one
+  if (sweep.branch >= 0) requested.limb[static_cast<std::size_t>(sweep.limb)] = sweep.branch;
+  const Branches branches = resolve_branches(model, start, requested);
   solve_ik_closed_form(model, start, branches);  // the assembled start pose, as in MOBILE
   Coordinates warm = start, previous = start;
   long iterations = 0;

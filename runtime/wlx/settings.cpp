@@ -20,7 +20,7 @@ Settings compiled_settings() {
   s.sweep_start = gen::kSweepStart;
   for (const auto& sw : gen::kIkSweeps)
     s.ik_sweeps.push_back({std::string(sw.id), std::string(gen::kCoordinateNames[static_cast<std::size_t>(sw.input)]), sw.from, sw.to,
-                           sw.step, sw.degrees, sw.limb});
+                           sw.step, sw.degrees, sw.limb, sw.branch});
   s.weights = gen::kDefaultWeights;
   s.has_torque_limits = gen::kHasTorqueLimits;
   s.torque_limits = gen::kTorqueLimits;
@@ -72,6 +72,13 @@ void set_settings(const Settings& s) {
     for (int k = 0; k < gen::kInputCount; ++k) input = input || gen::kCoordinateNames[static_cast<std::size_t>(k)] == sw.input;
     if (!input) throw Error(field, fmt::format("its input '{}' is not one of the model's inputs", sw.input));
     if (sw.limb < 0 || sw.limb >= gen::kLimbCount) throw Error(field, "its limb is not one of the model's limbs");
+    {
+      const gen::ClosedFormInfo& cf = gen::kClosedForm[static_cast<std::size_t>(sw.limb)];
+      const int count = cf.solve == nullptr ? 1 : cf.branches;
+      if (sw.branch < -1 || sw.branch >= count)
+        throw Error(field + ".branch", fmt::format("limb {} has branches 0 to {}, got {}", gen::kLimbs[static_cast<std::size_t>(sw.limb)].name,
+                                                   count - 1, sw.branch));
+    }
     check_finite(field + ".from", sw.from);
     check_finite(field + ".to", sw.to);
     if (!(std::isfinite(sw.step) && sw.step > 0)) throw Error(field + ".step", fmt::format("must be positive, got {}", sw.step));

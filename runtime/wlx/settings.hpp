@@ -25,6 +25,7 @@ struct IkSweep {
   double from = 0, to = 0, step = 0;  // SI units (radians for angles)
   bool degrees = false;               // quoted in degrees
   int limb = 0;                       // gen::kLimbs' index
+  int branch = -1;                    // the limb's branch along the sweep; -1: the model's choice at its start
   // Number of points, both ends included.
   int points() const;
   double value(int k) const;
@@ -47,14 +48,16 @@ struct Settings {
   // Each limb's default branch (the model file's limbs[].branch), or -1: none given.
   std::array<int, gen::kLimbCount> default_branch = no_default_branches();
 
+  // Loops, not std::array::fill, which is constexpr only from C++20 (a project embedding the
+  // runtime may compile it as C++17).
   static constexpr std::array<double, gen::kCoordinateCount> unlimited(int sign) {
     std::array<double, gen::kCoordinateCount> a{};
-    a.fill(sign * std::numeric_limits<double>::infinity());
+    for (auto& v : a) v = sign * std::numeric_limits<double>::infinity();
     return a;
   }
   static constexpr std::array<int, gen::kLimbCount> no_default_branches() {
     std::array<int, gen::kLimbCount> b{};
-    b.fill(-1);
+    for (auto& v : b) v = -1;
     return b;
   }
 };

@@ -301,6 +301,88 @@ dynamics: {gravity: g, commanded: [slide, tilt], actuated: [slide, tilt]}
   CHECK(m.bodies.size() == 3);
 }
 
+
+TEST_CASE("URDF import: a wheel without `radius` rolls on its hub's collision cylinder, its plane where the cylinder's centre is") {
+  const fs::path dir = scratch() / "wheel_shapes";
+  fs::create_directories(dir);
+  std::ifstream yaml_in(kModels + "/wheeled_quadruped.yaml"), urdf_in(kModels + "/wheeled_quadruped.urdf");
+  std::stringstream yaml_text, urdf_text;
+  yaml_text << yaml_in.rdbuf();
+  urdf_text << urdf_in.rdbuf();
+  std::string yaml = yaml_text.str(), urdf = urdf_text.str();
+  const std::string with_radius = "axle: y, radius: wheel_radius, ground:";
+  REQUIRE(yaml.find(with_radius) != std::string::npos);
+  yaml.replace(yaml.find(with_radius), with_radius.size(), "axle: y, ground:");
+  // The left front wheel's cylinder 6 cm out along its axle (y of the hub), as real wheels sit.
+  const std::string centred = "<origin xyz=\"0 0 0\" rpy=\"1.5707963267948966 0 0\"/>";
+  REQUIRE(urdf.find(centred) != std::string::npos);
+  std::string moved = urdf;
+  moved.replace(moved.find(centred), centred.size(), "<origin xyz=\"0 0.06 0\" rpy=\"1.5707963267948966 0 0\"/>");
+  std::ofstream(dir / "robot.yaml") << yaml;
+  std::ofstream(dir / "robot.urdf") << moved;
+  const Model m = load_model_file((dir / "robot.yaml").string(), (dir / "robot.urdf").string());
+  REQUIRE(m.wheels.size() == 4);
+  CHECK(m.wheels[0].radius == "wheel_lf_radius");
+  CHECK(m.wheels[0].offset == "wheel_lf_offset");
+  CHECK(m.parameter("wheel_lf_radius").default_value == 0.1);
+  CHECK(m.parameter("wheel_lf_offset").default_value == 0.06);
+  CHECK(m.parameter("wheel_rf_offset").default_value == 0);
+  // At a pose with tilted legs, the contact point is the hub's centre, moved along the axle a by the
+  // offset, then down the wheel's plane by the radius: c = h + d a - r u (u: up in the wheel's plane).
+  const Evaluator e(m, {{"z_B", 0.5}, {"roll", 0.2}, {"haa_lf", 0.1}, {"hfe_lf", 0.4}, {"kfe_lf", -0.9}});
+  for (const auto& [wheel, d] : {std::pair{0, 0.06}, std::pair{1, 0.0}}) {
+    const NonholonomicWheel& w = m.wheels[static_cast<std::size_t>(wheel)];
+    CAPTURE(w.name);
+    const Frame& hub = m.frames[static_cast<std::size_t>(m.frame_index(w.hub))].frame;
+    const Frame& contact = m.frames[static_cast<std::size_t>(m.frame_index(w.contact))].frame;
+    const Eigen::Vector3d h = e.vec(hub.r), a = e.mat(hub.R).col(1);
+    const Eigen::Vector3d up = (Eigen::Vector3d::UnitZ() - a.z() * a).normalized();
+    CHECK((e.vec(contact.r) - (h + d * a - 0.1 * up)).cwiseAbs().maxCoeff() < 1e-14);
+  }
+  // A cylinder across the axle gives no radius; a wheel link with a mesh only has none: named, with what to do.
+  std::string across = urdf;
+  across.replace(across.find(centred), centred.size(), "<origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>");
+  std::ofstream(dir / "robot.urdf") << across;
+  CHECK_THROWS_WITH_AS(load_model_file((dir / "robot.yaml").string(), (dir / "robot.urdf").string()),
+                       doctest::Contains("robot.urdf:151: link 'wheel_lf' collision: the cylinder's axis (0, 0, 1) is not the wheel's axle (y of the link)"),
+                       ModelFileError);
+  std::string mesh_only = urdf;
+  const auto at = mesh_only.find("<collision>", mesh_only.find("<link name=\"wheel_lf\">"));
+  mesh_only.replace(at, mesh_only.find("</collision>", at) + 12 - at, "");
+  std::ofstream(dir / "robot.urdf") << mesh_only;
+  CHECK_THROWS_WITH_AS(load_model_file((dir / "robot.yaml").string(), (dir / "robot.urdf").string()),
+                       doctest::Contains("the wheel on 'wheel_lf' has no `radius`, and the URDF's link 'wheel_lf' has no collision cylinder or "
+                                         "sphere to read one from (a mesh has none): give `radius: PARAMETER`"),
+                       ModelFileError);
+  // A wheel's own `radius` and `offset` (any model file, with or without a URDF): the shape then unused.
+  std::string own = yaml;
+  own.replace(own.find("axle: y, ground:"), 16, "axle: y, radius: wheel_radius, offset: hub_shift, ground:");
+  const std::string g = "  - {name: g,";
+  REQUIRE(own.find(g) != std::string::npos);
+  own.replace(own.find(g), 0, "  - {name: hub_shift, value: -0.05, unit: m, kind: offset, meaning: the rolling plane inwards}\n");
+  std::ofstream(dir / "own.yaml") << own;
+  std::ofstream(dir / "robot.urdf") << moved;
+  const Model m2 = load_model_file((dir / "own.yaml").string(), (dir / "robot.urdf").string());
+  CHECK(m2.wheels[0].radius == "wheel_radius");
+  CHECK(m2.wheels[0].offset == "hub_shift");
+  CHECK_THROWS(m2.parameter("wheel_lf_offset"));
+  {
+    const Evaluator e2(m2, {{"z_B", 0.5}, {"roll", 0.2}, {"haa_lf", 0.1}, {"hfe_lf", 0.4}, {"kfe_lf", -0.9}});
+    const NonholonomicWheel& w = m2.wheels[0];
+    const Frame& hub = m2.frames[static_cast<std::size_t>(m2.frame_index(w.hub))].frame;
+    const Frame& contact = m2.frames[static_cast<std::size_t>(m2.frame_index(w.contact))].frame;
+    const Eigen::Vector3d h = e2.vec(hub.r), a = e2.mat(hub.R).col(1);
+    const Eigen::Vector3d up = (Eigen::Vector3d::UnitZ() - a.z() * a).normalized();
+    CHECK((e2.vec(contact.r) - (h - 0.05 * a - 0.1 * up)).cwiseAbs().maxCoeff() < 1e-14);
+  }
+  // --print-model writes the read radius and offset as parameters the wheels name: it reads alone.
+  std::ofstream(dir / "robot.urdf") << moved;
+  std::ofstream(dir / "printed.yaml") << print_model_file((dir / "robot.yaml").string(), (dir / "robot.urdf").string());
+  const Model printed = load_model_file((dir / "printed.yaml").string());
+  CHECK(printed.wheels[0].offset == "wheel_lf_offset");
+  CHECK(printed.parameter("wheel_lf_offset").default_value == 0.06);
+}
+
 #else
 
 TEST_CASE("URDF import: without liburdfdom a URDF is refused with a message that says so") {

@@ -234,6 +234,9 @@ TEST_CASE("wlx-gen: joint limits from the URDF and a `limits` section, field by 
   REQUIRE(edited.find(start) != std::string::npos);
   edited.replace(edited.find(start), start.size(), start + "    branch: 2\n");
   edited += "\nlimits:\n  - for: leg\n    items:\n      - {joint: kfe_<leg>, lower: -2.5, upper: -0.5}\n";
+  const std::string x_sweep = "step: 0.005, limb: leg_<leg>}";
+  REQUIRE(edited.find(x_sweep) != std::string::npos);
+  edited.replace(edited.find(x_sweep), x_sweep.size(), "step: 0.005, limb: leg_<leg>, branch: 1}");
   wlx_test::write(dir / "robot.yaml", edited);
   const auto limited = wlx_test::run({(dir / "robot.yaml").string(), "--data-at-run-time", "--describe"});
   CAPTURE(limited.err);
@@ -247,6 +250,11 @@ TEST_CASE("wlx-gen: joint limits from the URDF and a `limits` section, field by 
   CHECK(limits["kfe_rf"]["effort"] == 80.0);
   CHECK(limits["hfe_rf"]["lower"] == -9.42);
   CHECK(b["settings"]["branches"]["leg_rh"] == 2);
+  for (const auto& sweep : b["settings"]["ik_sweeps"]) {
+    CAPTURE(sweep.dump());
+    const bool along_x = sweep["id"].get<std::string>().find("-x") != std::string::npos;
+    CHECK(sweep["branch"] == (along_x ? nlohmann::json(1) : nlohmann::json(nullptr)));
+  }
   // Mistakes, named where they are: a branch the limb's closed form does not have, an empty range,
   // half a range, an effort that is no effort, a joint given twice, a name that is no coordinate.
   const std::pair<std::string, std::string> cases[] = {

@@ -295,6 +295,24 @@ TEST_CASE(titled("limits: the IK takes the branch within the joints' ranges, els
     REQUIRE(k >= 0);
     CHECK(describe_outside_limits(got, k).find(std::string(gen::kCoordinateNames[static_cast<std::size_t>(k)]) + " = ") == 0);
 
+    // A sweep of this limb that names that branch follows it (ik_sweeps' `branch`), whatever the ranges.
+    for (IkSweep sweep : model_ik_sweeps()) {
+      if (sweep.limb != limb || !has_closed_form(limb)) continue;
+      sweep.branch = other;
+      sweep.to = sweep.from + 2 * sweep.step;  // three points are enough to see the branch
+      Data sweep_data;
+      try {
+        const IkSweepResult r = run_ik_sweep(model, sweep_data, sweep);
+        CHECK(r.branch == other);
+        Coordinates on_branch = r.points.front().closed_form;
+        solve_limb_closed_form(model, limb, other, on_branch);
+        CHECK(same_as(r.points.front().closed_form, on_branch) <= 1e-12);
+      } catch (const Error& e) {
+        MESSAGE(kName << ": sweep " << sweep.id << " does not reach on branch " << other << ": " << e.what());
+      }
+      break;
+    }
+
     // No ranges on the limb's joints (a model's own may have some), a default branch: the IK takes it.
     s = restore.saved;
     for (int j = 0; j < block.size; ++j) {

@@ -45,16 +45,16 @@ inline constexpr std::array<double, 4> kContactFriction{{0.5, 0.5, 0.5, 0.5}};
 // The IK verification's start inputs (the model file's nominal state with ik_sweeps.start) and sweeps.
 inline constexpr std::array<double, 18> kSweepStart{{0.0, 0.0, 1.8, 0.0, 0.0, 0.0, 3.2, 1.4, 0.0, 3.2, -1.4, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
 inline constexpr std::array<SweepInfo, 10> kIkSweeps{{
-    {"WK-L1", 6, 2.0, 4.0, 0.01, false, 0},  // foot_x_l
-    {"WK-L2", 8, -0.5, 1.5, 0.01, false, 0},  // foot_z_l
-    {"WK-L3", 14, -0.3490658503988659, 0.3490658503988659, 0.0017453292519943296, true, 0},  // slew_l
-    {"WK-R1", 9, 2.0, 4.0, 0.01, false, 1},  // foot_x_r
-    {"WK-R2", 11, -0.5, 1.5, 0.01, false, 1},  // foot_z_r
-    {"WK-R3", 15, -0.3490658503988659, 0.3490658503988659, 0.0017453292519943296, true, 1},  // slew_r
-    {"WK-WL1", 12, 0.6, -0.6, 0.01, false, 2},  // ground_l
-    {"WK-WL2", 16, -0.5235987755982988, 0.5235987755982988, 0.0017453292519943296, true, 2},  // steer_l
-    {"WK-WR1", 13, 0.6, -0.6, 0.01, false, 3},  // ground_r
-    {"WK-WR2", 17, -0.5235987755982988, 0.5235987755982988, 0.0017453292519943296, true, 3},  // steer_r
+    {"WK-L1", 6, 2.0, 4.0, 0.01, false, 0, -1},  // foot_x_l
+    {"WK-L2", 8, -0.5, 1.5, 0.01, false, 0, -1},  // foot_z_l
+    {"WK-L3", 14, -0.3490658503988659, 0.3490658503988659, 0.0017453292519943296, true, 0, -1},  // slew_l
+    {"WK-R1", 9, 2.0, 4.0, 0.01, false, 1, -1},  // foot_x_r
+    {"WK-R2", 11, -0.5, 1.5, 0.01, false, 1, -1},  // foot_z_r
+    {"WK-R3", 15, -0.3490658503988659, 0.3490658503988659, 0.0017453292519943296, true, 1, -1},  // slew_r
+    {"WK-WL1", 12, 0.6, -0.6, 0.01, false, 2, -1},  // ground_l
+    {"WK-WL2", 16, -0.5235987755982988, 0.5235987755982988, 0.0017453292519943296, true, 2, -1},  // steer_l
+    {"WK-WR1", 13, 0.6, -0.6, 0.01, false, 3, -1},  // ground_r
+    {"WK-WR2", 17, -0.5235987755982988, 0.5235987755982988, 0.0017453292519943296, true, 3, -1},  // steer_r
 }};
 
 // The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).

@@ -45,14 +45,14 @@ inline constexpr std::array<double, 4> kContactFriction{{0.5, 0.5, 0.5, 0.5}};
 // The IK verification's start inputs (the model file's nominal state with ik_sweeps.start) and sweeps.
 inline constexpr std::array<double, 18> kSweepStart{{0.0, 0.0, 0.58, 0.0, 0.0, 0.0, 0.37, 0.35, 0.0, 0.37, -0.35, 0.0, -0.33, 0.35, 0.0, -0.33, -0.35, 0.0}};
 inline constexpr std::array<SweepInfo, 8> kIkSweeps{{
-    {"W-lf-x", 6, 0.25, 0.45, 0.005, false, 0},  // x_lf
-    {"W-lf-ground", 8, -0.05, 0.1, 0.005, false, 0},  // ground_lf
-    {"W-rf-x", 9, 0.25, 0.45, 0.005, false, 1},  // x_rf
-    {"W-rf-ground", 11, -0.05, 0.1, 0.005, false, 1},  // ground_rf
-    {"W-lh-x", 12, -0.25, -0.45, 0.005, false, 2},  // x_lh
-    {"W-lh-ground", 14, -0.05, 0.1, 0.005, false, 2},  // ground_lh
-    {"W-rh-x", 15, -0.25, -0.45, 0.005, false, 3},  // x_rh
-    {"W-rh-ground", 17, -0.05, 0.1, 0.005, false, 3},  // ground_rh
+    {"W-lf-x", 6, 0.25, 0.45, 0.005, false, 0, -1},  // x_lf
+    {"W-lf-ground", 8, -0.05, 0.1, 0.005, false, 0, -1},  // ground_lf
+    {"W-rf-x", 9, 0.25, 0.45, 0.005, false, 1, -1},  // x_rf
+    {"W-rf-ground", 11, -0.05, 0.1, 0.005, false, 1, -1},  // ground_rf
+    {"W-lh-x", 12, -0.25, -0.45, 0.005, false, 2, -1},  // x_lh
+    {"W-lh-ground", 14, -0.05, 0.1, 0.005, false, 2, -1},  // ground_lh
+    {"W-rh-x", 15, -0.25, -0.45, 0.005, false, 3, -1},  // x_rh
+    {"W-rh-ground", 17, -0.05, 0.1, 0.005, false, 3, -1},  // ground_rh
 }};
 
 // The nominal inputs (the model file's `nominal`; the dependent joints follow from the IK).

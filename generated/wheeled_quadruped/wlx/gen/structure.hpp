@@ -226,6 +226,7 @@ struct SweepInfo {
   double from, to, step;
   bool degrees;  // quoted in degrees
   int limb;
+  int branch;  // the limb's branch along the sweep; -1: the model's choice
 };
 
 inline constexpr bool kHasClearance = true;
