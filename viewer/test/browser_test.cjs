@@ -267,6 +267,18 @@ function cliIk(inputs) {
     const quadrupedCoordinates = Object.keys(await api(quadruped, () => wlxViewer.api.coordinates()));
     check(quadrupedCoordinates.includes('kfe_rh') && quadrupedCoordinates.includes('x_B'),
           'the wheeled quadruped\'s page shows its coordinates', quadrupedCoordinates.join(' '));
+    // The page opens on the model's branches: its URDF's knees bend backwards only ([-2.8, -0.4] rad on
+    // the left, [0.4, 2.8] about the mirrored axis on the right), as `wlx ik` solves them.
+    const knees = await api(quadruped, () => wlxViewer.api.coordinates());
+    check(knees.kfe_lf >= -2.8 && knees.kfe_lf <= -0.4 && knees.kfe_lh >= -2.8 && knees.kfe_lh <= -0.4 &&
+          knees.kfe_rf >= 0.4 && knees.kfe_rf <= 2.8 && knees.kfe_rh >= 0.4 && knees.kfe_rh <= 2.8,
+          'the wheeled quadruped opens with its knees within its joint limits',
+          ['kfe_lf', 'kfe_rf', 'kfe_lh', 'kfe_rh'].map((k) => `${k} ${knees[k]}`).join(' '));
+    const cliQuadruped = spawnSync(wlx, ['--model', 'wheeled_quadruped', 'ik'], { input: '{}', encoding: 'utf8' });
+    const cliBranches = cliQuadruped.status === 0 ? JSON.parse(cliQuadruped.stdout).branch : null;
+    const pageBranches = Object.fromEntries((await api(quadruped, () => wlxViewer.api.info())).limbs.map((l) => [l.name, l.defaultBranch]));
+    check(cliBranches && JSON.stringify(pageBranches) === JSON.stringify(cliBranches),
+          'the page\'s branches are the ones `wlx ik` takes with none given', `${JSON.stringify(pageBranches)} ${JSON.stringify(cliBranches)}`);
     const quadrupedBox = (await api(quadruped, () => wlxViewer.api.info())).clearanceBox;
     check(quadrupedBox && Math.abs(quadrupedBox.halfExtents[0] - 0.35) < 1e-9, 'the wheeled quadruped\'s base box is found',
           JSON.stringify(quadrupedBox));
