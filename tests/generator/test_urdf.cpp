@@ -11,6 +11,7 @@
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -381,6 +382,22 @@ TEST_CASE("URDF import: a wheel without `radius` rolls on its hub's collision cy
   const Model printed = load_model_file((dir / "printed.yaml").string());
   CHECK(printed.wheels[0].offset == "wheel_lf_offset");
   CHECK(printed.parameter("wheel_lf_offset").default_value == 0.06);
+  // ... and the joints' limits and the actuators' torque limits the URDF gave (the drives' efforts
+  // are its wheel joints', which the printed file does not have).
+  REQUIRE(printed.lower.size() == m.lower.size());
+  for (std::size_t k = 0; k < m.lower.size(); ++k) {
+    CAPTURE(m.coordinates[k].name);
+    CHECK(printed.lower[k] == m.lower[k]);
+    CHECK(printed.upper[k] == m.upper[k]);
+    CHECK(printed.effort[k] == m.effort[k]);
+    CHECK(printed.velocity[k] == m.velocity[k]);
+  }
+  const std::size_t kfe_lf = static_cast<std::size_t>(std::find_if(m.coordinates.begin(), m.coordinates.end(),
+                                                                     [](const auto& c) { return c.name == "kfe_lf"; }) - m.coordinates.begin());
+  CHECK(printed.lower[kfe_lf] == -2.8);
+  REQUIRE(printed.dynamics);
+  CHECK(printed.dynamics->torque_limits == m.dynamics->torque_limits);
+  CHECK(printed.dynamics->torque_limits.back() == 40);
 }
 
 #else
