@@ -172,7 +172,8 @@ const std::vector<ModelCommands>& models() {
   # Link only: the model's WLX_MODEL must not reach module.cpp, which names no model. The shell
   # whole: a model file's plugin (wlx.load) calls its functions from this module.
   target_link_libraries(${target}_python PRIVATE $<LINK_ONLY:${target}_commands> wlx::cli_common Eigen3::Eigen)
-  target_link_options(${target}_python PRIVATE "LINKER:--whole-archive" "$<TARGET_FILE:wlx::cli_common>" "LINKER:--no-whole-archive")
+  target_link_options(${target}_python PRIVATE "LINKER:--whole-archive" "$<TARGET_FILE:wlx::cli_common>" "$<TARGET_FILE:wlx::numerics>"
+                      "LINKER:--no-whole-archive")
   target_compile_features(${target}_python PRIVATE cxx_std_20)
   # wlx.load() runs wlx-gen: the package's own.
   target_compile_definitions(${target}_python PRIVATE WLX_VERSION="${wlx_VERSION}" WLX_BIN_FROM_PYTHON_MODULE="wlx-gen-is-not-here"

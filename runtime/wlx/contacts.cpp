@@ -1,11 +1,10 @@
 #include "wlx/contacts.hpp"
 
-#include "wlx/dense_qp.hpp"
 #include "wlx/error.hpp"
 #include "wlx/kinematics.hpp"
+#include "wlx/numerics.hpp"
 
 #include <Eigen/Geometry>
-#include <Eigen/QR>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -336,9 +335,7 @@ ContactDistribution distribute_torques_on_contacts(const Model& model, Data& d, 
     // tau = tau_1 + scale N z: weighting 1's torques plus the null space of J_beta^T (the last
     // columns of a full QR of J_beta), scaled so z is of order one.
     const TorqueVector tau_1 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::model_weights());
-    const Eigen::HouseholderQR<Eigen::Matrix<double, kA, kU>> qr(terms.J_beta);
-    const Eigen::Matrix<double, kA, kA> Q = qr.householderQ();
-    const Eigen::Matrix<double, kA, kK> N = Q.template rightCols<kK>();
+    const Eigen::Matrix<double, kA, kK> N = numerics::left_null_space(terms.J_beta);
     const double scale = std::max(tau_1.cwiseAbs().maxCoeff(), weight * 1e-3);
     ContactForceMap map;
     contact_force_map(model, d, s, terms, map);

@@ -107,7 +107,7 @@ double smallest_contact_margin(const Model& model, const ContactForces& forces);
 // actuators' limits (gen::kTorqueLimits), ties broken by the least change from weighting 1's
 // torques (a penalty of `regularization` times that change squared, in units of the largest of
 // those torques). The friction cones enter as tangent planes added where the solution leaves them
-// (a cutting-plane loop of small quadratic programmes, dense_qp.hpp) until every cone holds to
+// (a cutting-plane loop of small quadratic programmes, numerics.hpp) until every cone holds to
 // `tolerance` (relative to the weight). Throws wlx::Error when no torques within the limits
 // produce Q*. Allocates (dynamic-size matrices of a few hundred entries).
 struct ContactDistribution {

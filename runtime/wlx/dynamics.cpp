@@ -1,9 +1,9 @@
 #include "wlx/dynamics.hpp"
 
+#include "wlx/numerics.hpp"
+
 #include "wlx/error.hpp"
 
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/QR>
 #include <fmt/format.h>
@@ -173,14 +173,17 @@ Weighting Weighting::matrix_of(const TorqueMatrix& W) {
   if (!W.allFinite()) throw Error("weighting", "the weight matrix has a non-finite entry");
   if ((W - W.transpose()).cwiseAbs().maxCoeff() > 1e-12 * W.cwiseAbs().maxCoeff())
     throw Error("weighting", "the weight matrix must be symmetric");
-  // Scaled to a largest entry of 1 first: entries near 1e308 would overflow in the factorization.
+  // S = L^-T of W = L L^T, once here rather than at every step. W is scaled to a largest entry of 1
+  // first: entries near 1e308 would overflow in the factorization, and a uniform scale of W leaves
+  // the minimum-norm torques as they are.
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(kActuatedCount, kActuatedCount);
 #if __has_include(<wlx/gen/reduced_dynamics.hpp>)  // (no actuated joints without: nothing to factorize)
-  if ((W / W.cwiseAbs().maxCoeff()).llt().info() != Eigen::Success)
+  if (!numerics::inverse_cholesky_factor(W / W.cwiseAbs().maxCoeff(), S))
     throw Error("weighting", "the weight matrix must be positive definite");
 #endif
   Weighting out;
   out.kind = Kind::matrix;
-  out.matrix = std::make_shared<const TorqueMatrix>(W);
+  out.matrix = std::make_shared<const TorqueMatrix>(S);
   return out;
 }
 
@@ -443,8 +446,7 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
 // freely give one where they all point the same way: the whole machine rolls along them and no
 // actuated joint moves.)
 [[gnu::noinline, gnu::cold]] std::string unactuated_motion(const ActuatorJacobian& At) {
-  const Eigen::SelfAdjointEigenSolver<CommandMatrix> eigen(At.transpose() * At);
-  CommandVector n = eigen.eigenvectors().col(0);
+  CommandVector n = numerics::smallest_eigenvector(At.transpose() * At);
   Eigen::Index largest = 0;
   n.cwiseAbs().maxCoeff(&largest);
   n /= n(largest);
@@ -493,12 +495,10 @@ TorqueVector min_norm_solve(const ActuatorJacobian& At, const CommandVector& Qst
   return x;
 }
 
-// A full weight matrix: S = L^-T from W = L L^T (scaled to a largest entry of 1, as above).
+// A full weight matrix: tau = S x with S = L^-T of W = L L^T, which matrix_of factorized.
 [[gnu::noinline]] TorqueVector distribute_torques_weight_matrix(const ActuatorJacobian& J_beta, const CommandVector& Qstar,
                                                                 const Weighting& weighting) {
-  const TorqueMatrix& W = *weighting.matrix;
-  const TorqueMatrix L = (W / W.cwiseAbs().maxCoeff()).llt().matrixL();
-  const TorqueMatrix S = L.transpose().triangularView<Eigen::Upper>().solve(TorqueMatrix::Identity());
+  const TorqueMatrix& S = *weighting.matrix;
   return S.lazyProduct(min_norm_solve(S.transpose().lazyProduct(J_beta), Qstar, weighting));
 }
 

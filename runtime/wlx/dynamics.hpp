@@ -89,8 +89,9 @@ struct Weighting {
   enum class Kind { model_weights, contribution, diagonal, matrix, contacts };
   Kind kind = Kind::model_weights;
   TorqueVector diagonal = TorqueVector::Ones();  // W for Kind::diagonal
-  // W for Kind::matrix, else null: shared, so that a Weighting made at every step (model_weights())
-  // costs nothing, where a matrix member would write kActuatedCount^2 numbers each time.
+  // For Kind::matrix, S = L^-T of the weight matrix W = L L^T (scaled to a largest entry of 1), which
+  // matrix_of factorizes once; else null. Shared, so that a Weighting made at every step
+  // (model_weights()) costs nothing, where a matrix member would write kActuatedCount^2 numbers each time.
   std::shared_ptr<const TorqueMatrix> matrix;
   std::string label() const;
 

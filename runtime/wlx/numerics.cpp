@@ -1,35 +1,17 @@
-// A small dense convex quadratic programme, min 1/2 x^T H x + c^T x subject to A x >= b, by a
-// primal-dual interior-point method with Mehrotra's predictor-corrector (Nocedal and Wright,
-// Numerical Optimization, 2nd ed., algorithm 16.4). For the contact-keeping torque distribution:
-// a handful of variables and up to a few hundred constraints per step, where a factorization of
-// the n x n normal matrix per iteration costs microseconds. H is positive semidefinite, and
-// H + A^T D A positive definite for positive D (every variable bounded by the constraints or
-// penalized by H). Debian has no small dense QP solver library (OSQP, qpOASES and quadprog are not
-// packaged for C++); docs/architecture.md says why this one.
-#pragma once
+// The model-independent numerics (numerics.hpp), compiled once for every model.
+#include "wlx/numerics.hpp"
 
 #include <Eigen/Cholesky>
-#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace wlx::qp {
 
-struct Result {
-  Eigen::VectorXd x;       // the solution
-  Eigen::VectorXd lambda;  // the constraints' multipliers (>= 0)
-  int iterations = 0;
-  bool converged = false;
-  double gap = 0;        // the mean complementarity s . lambda / m at the end
-  double residual = 0;   // the largest relative primal or dual residual at the end
-};
-
-// Converged when the complementarity and the residuals, relative to the data's scale, are below
-// `tolerance`. A problem without a solution (infeasible constraints) ends with converged false.
-inline Result solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& c, const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
-                    double tolerance = 1e-11, int max_iterations = 120) {
+Result solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& c, const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+             double tolerance, int max_iterations) {
   const Eigen::Index n = H.rows(), m = A.rows();
   Result out;
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
@@ -88,3 +70,26 @@ inline Result solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& c, const Ei
 }
 
 }  // namespace wlx::qp
+
+namespace wlx::numerics {
+
+Eigen::VectorXd smallest_eigenvector(const Eigen::Ref<const Eigen::MatrixXd>& S) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(S);  // eigenvalues in increasing order
+  return eigen.eigenvectors().col(0);
+}
+
+Eigen::MatrixXd left_null_space(const Eigen::Ref<const Eigen::MatrixXd>& A) {
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(A);
+  const Eigen::MatrixXd Q = qr.householderQ();
+  return Q.rightCols(A.rows() - A.cols());
+}
+
+bool inverse_cholesky_factor(const Eigen::Ref<const Eigen::MatrixXd>& W, Eigen::MatrixXd& S) {
+  const Eigen::LLT<Eigen::MatrixXd> llt(W);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd L = llt.matrixL();
+  S = L.transpose().triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(W.rows(), W.cols()));
+  return true;
+}
+
+}  // namespace wlx::numerics
