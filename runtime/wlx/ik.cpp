@@ -129,17 +129,20 @@ bool limb_within_limits(Limb limb, const Coordinates& s) {
   const LimbBlock block = limb_block(limb);
   for (int j = 0; j < block.size; ++j) {
     const auto k = static_cast<std::size_t>(block.joints[static_cast<std::size_t>(j)]);
-    if (!(s(static_cast<Eigen::Index>(k)) >= settings().lower[k] && s(static_cast<Eigen::Index>(k)) <= settings().upper[k])) return false;
+    if (!within_range(s, static_cast<int>(k))) return false;
   }
   return true;
 }
 }  // namespace
 
+bool within_range(const Coordinates& s, int k) noexcept {
+  const auto kk = static_cast<std::size_t>(k);
+  return s(k) >= settings().lower[kk] && s(k) <= settings().upper[kk];  // false for NaN too
+}
+
 int first_outside_limits(const Coordinates& s) noexcept {
-  for (int k = 0; k < kCoordinateCount; ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    if (!(s(k) >= settings().lower[kk] && s(k) <= settings().upper[kk])) return k;
-  }
+  for (int k = 0; k < kCoordinateCount; ++k)
+    if (!within_range(s, k)) return k;
   return -1;
 }
 

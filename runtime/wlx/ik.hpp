@@ -65,6 +65,9 @@ struct Branches {
 // when given, says whether the limb's chosen solution leaves a range.
 Branches resolve_branches(const Model& model, const Coordinates& s, const Branches& requested = {},
                           std::array<bool, kLimbCount>* outside = nullptr);
+// Whether coordinate k of s lies within its range (settings().lower, upper, bounds included); a
+// NaN lies within none. The one range test of the IK, the sweeps and the runs.
+bool within_range(const Coordinates& s, int k) noexcept;
 // The first of s's coordinates outside its range (settings().lower, upper), or -1.
 int first_outside_limits(const Coordinates& s) noexcept;
 // "kfe_rf = 1.15 rad is outside its range [-2.8, -0.4]": what first_outside_limits found.

@@ -106,7 +106,7 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
     warm = n;
     const Coordinates& solution = result.solution(pt);
     for (int j : joints)
-      if (!(solution(j) >= settings().lower[static_cast<std::size_t>(j)] && solution(j) <= settings().upper[static_cast<std::size_t>(j)])) {
+      if (!within_range(solution, j)) {
         if (pt.within_limits && result.first_outside.empty())
           result.first_outside = fmt::format("at {} = {:.6g}: {}", sweep.input, pt.value, describe_outside_limits(solution, j));
         pt.within_limits = false;

@@ -5,6 +5,7 @@
 // computes when given the same parameters (--params). The plugins are compiled at -O0
 // (WLX_PLUGIN_CXXFLAGS, part of the cache key): these tests check the mechanism, and -O0 halves
 // their compile time; users get -O2.
+#include "../support/csv.hpp"
 #include "../support/run_wlx.hpp"
 
 #include <doctest/doctest.h>
@@ -73,20 +74,7 @@ std::vector<fs::path> entries() {
   return out;
 }
 
-// A CSV of numbers: its header line and its rows.
-std::pair<std::string, std::vector<std::vector<double>>> read_csv(const fs::path& path) {
-  std::istringstream in(slurp(path));
-  std::string header, line;
-  std::getline(in, header);
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::istringstream cells(line);
-    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
-  return {header, rows};
-}
+using wlx_test::read_csv;
 
 const std::string kPose = R"({"z_C": 1.8, "x_Fl": 2.4})";
 

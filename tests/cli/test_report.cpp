@@ -1,4 +1,6 @@
 // `wlx report` end to end: every run, every figure, a checks table without failures, valid HTML.
+#include "../support/csv.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cstdio>
@@ -266,20 +268,6 @@ TEST_CASE("report: the wheeled quadruped (four wheels, sixteen actuators) gets a
 namespace {
 
 // The rows of a CSV file of numbers after its header.
-std::vector<std::vector<double>> csv_rows(const fs::path& path) {
-  std::istringstream in(slurp(path));
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::istringstream cells(line);
-    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
-  return rows;
-}
-
 // The index of a column in a CSV file's header, or -1.
 int csv_column(const fs::path& path, const std::string& name) {
   std::istringstream in(slurp(path));
@@ -351,7 +339,7 @@ TEST_CASE("report: runs that stop are rows of the report, which is written all t
 
     // UP: its samples up to where it stopped, in its CSV and its row, with the time and the reason;
     // its pose figure is drawn from them.
-    const auto up = csv_rows(out / "data" / "UP.csv");
+    const auto up = wlx_test::read_csv(out / "data" / "UP.csv").second;
     REQUIRE(up.size() >= 2);
     CHECK(up.size() < 301);  // 3 s at 0.01 s: it did not finish
     const int z_C = csv_column(out / "data" / "UP.csv", "z_C");
@@ -370,7 +358,7 @@ TEST_CASE("report: runs that stop are rows of the report, which is written all t
     // OUT: no sample at all; said in words, no figure, no forward simulation; its row has no maxima.
     for (const char* id : {"OUT-w1", "OUT-w2", "OUT-w3"}) {
       CAPTURE(id);
-      CHECK(csv_rows(out / "data" / (std::string(id) + ".csv")).empty());
+      CHECK(wlx_test::read_csv(out / "data" / (std::string(id) + ".csv")).second.empty());
       CHECK(log.find(std::string("wlx: run stopped: ") + id + " at t = 0.0000 s: ") != std::string::npos);
       CHECK(html.find(std::string("<td>") + id + "</td><td>inverse dynamics from a start out of reach</td><td>0</td><td>stopped at t = "
                       "0.0000 s: ") != std::string::npos);
@@ -384,9 +372,9 @@ TEST_CASE("report: runs that stop are rows of the report, which is written all t
 
     // HIGH: the runs and their round trips complete (drawn); the closed loop never left its start:
     // an empty CSV, a sentence instead of its figure.
-    CHECK(csv_rows(out / "data" / "HIGH-w1.csv").size() == 201);
-    CHECK(csv_rows(out / "data" / "HIGH-w1-forward.csv").size() == 201);
-    CHECK(csv_rows(out / "data" / "HIGH-w1-closed-loop.csv").empty());
+    CHECK(wlx_test::read_csv(out / "data" / "HIGH-w1.csv").second.size() == 201);
+    CHECK(wlx_test::read_csv(out / "data" / "HIGH-w1-forward.csv").second.size() == 201);
+    CHECK(wlx_test::read_csv(out / "data" / "HIGH-w1-closed-loop.csv").second.empty());
     CHECK(log.find("wlx: run stopped: HIGH-w1 (closed loop) at t = 0.0000 s: ") != std::string::npos);
     CHECK(log.find("wlx: run stopped: HIGH-w1 at") == std::string::npos);
     CHECK(html.find("<img src=\"fig/forward-round-trips.png\"") != std::string::npos);
