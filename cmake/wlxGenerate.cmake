@@ -81,9 +81,6 @@ function(wlx_generate)
     target_link_libraries(${arg_TARGET} INTERFACE Eigen3::Eigen)
   else()
     file(GLOB runtime_sources "${WLX_RUNTIME_SOURCE_DIR}/*.cpp")
-    # limb_steps.cpp is there for a model file's viewer module (emscripten); here wlx::numerics,
-    # which wlx::runtime links, holds it compiled.
-    list(FILTER runtime_sources EXCLUDE REGEX "/limb_steps\\.cpp$")
     add_library(${arg_TARGET} STATIC ${runtime_sources})
     # The runtime's sources in one translation unit (they share their Eigen templates: half the
     # compile time); the generated functions' files apart, each defines WLX_GEN_DEFINE_DOUBLE.

@@ -2,7 +2,6 @@
 
 #include "expr_graph.hpp"
 #include "urdf_import.hpp"
-#include "wlx/numerics.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
@@ -1393,11 +1392,6 @@ class Parser {
           limb_start_[k] = start->child(kv.first.Scalar()).number(true);  // <sign>*0.6 too, as in ik_sweeps
         }
       }
-      if (limb.joints.size() > static_cast<std::size_t>(wlx::numerics::kMaxLimbJoints))
-        it.fail(fmt::format("limb '{}' has {} dependent joints, more than the {} one limb may have (the runtime's Newton "
-                            "steps work on matrices of at most that size): split it into limbs whose closure conditions "
-                            "each involve only their own joints",
-                            limb.name, limb.joints.size(), wlx::numerics::kMaxLimbJoints));
       if (limb.rows.size() != limb.joints.size() || limb.rows.empty())
         it.fail(fmt::format("limb '{}' has {} closure conditions and {} joints: a limb's block of dPhi/ds must be square and "
                             "non-empty",

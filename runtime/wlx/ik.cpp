@@ -3,8 +3,9 @@
 #include "wlx/error.hpp"
 
 #include "wlx/kinematics.hpp"
-#include "wlx/numerics.hpp"
 
+#include <Eigen/LU>
+#include <Eigen/QR>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -19,7 +20,6 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 using LimbMatrix = Eigen::Matrix<double, gen::kMaxLimbSize, gen::kMaxLimbSize>;
 using LimbVector = Eigen::Matrix<double, gen::kMaxLimbSize, 1>;
-static_assert(gen::kMaxLimbSize <= numerics::kMaxLimbJoints, "a limb larger than Newton's steps take: wlx-gen refuses such a model");
 
 double wrap(double a) {
   if (a > -kPi && a <= kPi) return a;  // the usual case, without the slow remainder
@@ -299,7 +299,13 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
         r(i) = data.Phi(row);
         for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
       }
-      numerics::newton_step(J, r, step[l]);  // (a Levenberg-Marquardt step at a singular pose)
+      const Eigen::FullPivLU<LimbMatrix> lu(J);
+      if (lu.rcond() > 1e-12) {
+        step[l] = -lu.solve(r);
+      } else {  // at a singular pose (straight leg, lever at 90 deg): Levenberg-Marquardt step
+        const double mu = 1e-8 * std::max(1.0, J.squaredNorm());
+        step[l] = -(J.transpose() * J + mu * LimbMatrix::Identity()).ldlt().solve(J.transpose() * r);
+      }
       ++report.iterations[l];
     }
     if (all_done) break;
@@ -364,7 +370,13 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       }
       gradient[l] = J.transpose() * r;
       if (mu[l] == 0) mu[l] = 1e-9 * std::max(1.0, J.colwise().squaredNorm().maxCoeff());  // nearly Newton's step first
-      numerics::damped_least_squares_step(J, r, mu[l], step[l]);
+      // As the least-squares problem [J; sqrt(mu) I] dx = [-r; 0], by QR: the normal equations would
+      // square J's condition number (1e6 at the thesis' worst poses).
+      Eigen::Matrix<double, 2 * gen::kMaxLimbSize, gen::kMaxLimbSize> stacked;
+      stacked << J, std::sqrt(mu[l]) * LimbMatrix::Identity();
+      Eigen::Matrix<double, 2 * gen::kMaxLimbSize, 1> rhs;
+      rhs << -r, LimbVector::Zero();
+      step[l] = stacked.householderQr().solve(rhs);
       before[l] = half_square(data.Phi, idx);
       ++report.iterations[l];
     }

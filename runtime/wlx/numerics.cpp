@@ -1,6 +1,4 @@
-// The model-independent numerics (numerics.hpp), compiled once for every model: the QP and the
-// decompositions off the hot paths. (Newton's limb steps are in limb_steps.cpp, which the viewer's
-// WebAssembly module compiles in too.)
+// The model-independent numerics (numerics.hpp), compiled once for every model.
 #include "wlx/numerics.hpp"
 
 #include <Eigen/Cholesky>

@@ -1,11 +1,10 @@
 // Model-independent numerics, compiled once (the library wlx::numerics) rather than once per model:
-// the small dense QP of the contact-keeping torque distribution, the decompositions that run off
-// the hot paths (building a message, the null space of a distribution that then solves QPs), and
-// Newton's IK steps. Every function takes dynamic-size matrices, so one compiled copy serves every
-// model's sizes. Newton's steps work on bounded-size matrices (at most kMaxLimbJoints) and allocate
-// nothing; the others allocate. The hot paths of a step (the fused update, the dependent rates,
-// the inverse-dynamics step, forward dynamics) keep their fixed-size decompositions in the
-// per-model runtime: there sizes known at compile time are the speed.
+// the small dense QP of the contact-keeping torque distribution and the decompositions that run off
+// the hot paths (building a message, the null space of a distribution that then solves QPs). Every
+// function takes dynamic-size matrices, so one compiled copy serves every model's sizes. The hot
+// paths (the fused update, the dependent rates, the inverse-dynamics step, forward dynamics, Newton's
+// IK steps) keep their fixed-size decompositions in the per-model runtime: there sizes known at
+// compile time are the speed, and they allocate nothing; these functions allocate.
 #pragma once
 
 #include <Eigen/Core>
@@ -38,23 +37,6 @@ Result solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& c, const Eigen::Ma
 }  // namespace wlx::qp
 
 namespace wlx::numerics {
-
-// The most dependent joints one limb may have (wlx-gen refuses a larger limb): the bound of the
-// bounded-size matrices Newton's IK steps use below, which therefore allocate nothing.
-inline constexpr int kMaxLimbJoints = 16;
-
-// One Newton step of a limb's closure, J step = -r, for a square J of at most kMaxLimbJoints rows:
-// by LU with full pivoting where J's reciprocal condition estimate exceeds 1e-12, else (a singular
-// pose: a straight leg, a lever at 90 degrees) the Levenberg-Marquardt step
-// -(J^T J + mu I)^-1 J^T r with mu = 1e-8 max(1, |J|_F^2). Allocates nothing.
-void newton_step(const Eigen::Ref<const Eigen::MatrixXd>& J, const Eigen::Ref<const Eigen::VectorXd>& r,
-                 Eigen::Ref<Eigen::VectorXd> step) noexcept;
-
-// The damped least-squares step argmin |J step + r|^2 + mu |step|^2, as the least-squares problem
-// [J; sqrt(mu) I] step = [-r; 0] by QR (the normal equations would square J's condition number,
-// 1e6 at the thesis' worst poses). J square, at most kMaxLimbJoints rows. Allocates nothing.
-void damped_least_squares_step(const Eigen::Ref<const Eigen::MatrixXd>& J, const Eigen::Ref<const Eigen::VectorXd>& r, double mu,
-                               Eigen::Ref<Eigen::VectorXd> step) noexcept;
 
 // The eigenvector of the symmetric matrix `S` for its smallest eigenvalue (unit length; its sign
 // as the eigensolver leaves it).

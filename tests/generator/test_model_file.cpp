@@ -194,27 +194,6 @@ TEST_CASE("model file: the tiny model the hostile cases start from reads") {
   CHECK(error_of(tiny_model("  - {name: base, parent: K0, chain: [rz: q]}\n")) == "");
 }
 
-// A limb of n dependent joints d0..d(n-1), each held by a sum row d_i + q = 0 and turning a frame.
-std::string limb_of(int n) {
-  std::string dependent = "  dependent:\n", frames, closure = "closure:\n", names, rows;
-  for (int i = 0; i < n; ++i) {
-    dependent += fmt::format("    - {{name: d{}, unit: rad, meaning: a joint}}\n", i);
-    frames += fmt::format("  - {{name: f{}, parent: {}, chain: [rz: d{}]}}\n", i, i == 0 ? "base" : fmt::format("f{}", i - 1), i);
-    closure += fmt::format("  - {{name: c{}, type: sum, coordinates: [d{}, q]}}\n", i, i);
-    names += fmt::format("{}d{}", i ? ", " : "", i);
-    rows += fmt::format("{}c{}", i ? ", " : "", i);
-  }
-  return tiny_model("  - {name: base, parent: K0, chain: [rz: q]}\n" + frames, dependent) + closure +
-         "limbs:\n  - {name: chain, closure: [" + rows + "], joints: [" + names + "]}\n";
-}
-
-TEST_CASE("model file: a limb of more dependent joints than Newton's bounded steps take is refused, naming it; one at the bound reads") {
-  CHECK(error_of(limb_of(16)) == "");
-  const std::string error = error_of(limb_of(17));
-  CHECK(error.find("limb 'chain' has 17 dependent joints, more than the 16 one limb may have") != std::string::npos);
-  CHECK(error.find("hostile.yaml:") == 0);
-}
-
 TEST_CASE("model file: a key given twice, or a key that is a list or a map, is reported with its place") {
   const std::string frames = "  - {name: base, parent: K0, chain: [rz: q]}\n";
   // (the file, the whole message): the places are counted in the text here (tiny_model: 8 lines).
