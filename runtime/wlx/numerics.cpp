@@ -43,7 +43,6 @@ Result solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& c, const Eigen::Ma
     const double mu = m ? s.dot(lambda) / static_cast<double>(m) : 0.0;
     out.gap = mu;
     out.residual = std::max(rd.cwiseAbs().maxCoeff(), m ? rp.cwiseAbs().maxCoeff() : 0.0) / scale;
-    out.iterations = it;
     if (mu <= tolerance * scale && out.residual <= tolerance) {
       out.converged = true;
       break;
@@ -55,13 +54,17 @@ Result solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& c, const Eigen::Ma
     // Predictor (affine scaling), then the corrector with Mehrotra's centring.
     step(s.cwiseProduct(lambda));
     const double a_aff = std::min(max_step(s, ds), max_step(lambda, dl));
-    const double mu_aff = (s + a_aff * ds).dot(lambda + a_aff * dl) / static_cast<double>(m);
-    const double sigma = std::pow(mu_aff / mu, 3);
+    // Without constraints (m = 0) there is no complementarity to centre: mu and mu_aff are 0.
+    const double mu_aff = m ? (s + a_aff * ds).dot(lambda + a_aff * dl) / static_cast<double>(m) : 0.0;
+    const double sigma = mu > 0 ? std::pow(mu_aff / mu, 3) : 0.0;
     step(s.cwiseProduct(lambda) + ds.cwiseProduct(dl) - Eigen::VectorXd::Constant(m, sigma * mu));
-    const double alpha = 0.995 * std::min(max_step(s, ds), max_step(lambda, dl));
+    // 0.995 of the way to the boundary keeps s and lambda positive; without constraints the
+    // Newton step of a quadratic is exact, and the whole of it is taken.
+    const double alpha = m ? 0.995 * std::min(max_step(s, ds), max_step(lambda, dl)) : 1.0;
     x += alpha * dx;
     s += alpha * ds;
     lambda += alpha * dl;
+    ++out.iterations;  // the steps taken, whether or not the next test converges
     if (!(x.allFinite() && s.allFinite() && lambda.allFinite())) break;
   }
   out.x = x;

@@ -14,7 +14,7 @@ namespace wlx::qp {
 struct Result {
   Eigen::VectorXd x;       // the solution
   Eigen::VectorXd lambda;  // the constraints' multipliers (>= 0)
-  int iterations = 0;
+  int iterations = 0;      // the interior-point steps taken
   bool converged = false;
   double gap = 0;        // the mean complementarity s . lambda / m at the end
   double residual = 0;   // the largest relative primal or dual residual at the end

@@ -1,0 +1,74 @@
+// The model-independent numerics (runtime/wlx/numerics.hpp), compiled once for every model: the
+// QP against problems solved by hand (KKT conditions), and each decomposition against the
+// property that defines it.
+#include "wlx/numerics.hpp"
+
+#include <doctest/doctest.h>
+
+#include <Eigen/Dense>
+
+TEST_CASE("qp::solve: an unconstrained problem (no rows) is solved in one exact step; x = -H^-1 c") {
+  Eigen::MatrixXd H(2, 2);
+  H << 4, 1, 1, 3;
+  const Eigen::VectorXd c = Eigen::Vector2d(1, -2);
+  const wlx::qp::Result r = wlx::qp::solve(H, c, Eigen::MatrixXd(0, 2), Eigen::VectorXd(0));
+  REQUIRE(r.converged);
+  CHECK(r.iterations == 1);
+  // x = -H^-1 c = -(1/11) [3 -1; -1 4] [1; -2] = [-5/11; 9/11], to rounding (H's condition is 2).
+  CHECK((r.x - Eigen::Vector2d(-5.0 / 11, 9.0 / 11)).norm() <= 1e-14);
+  CHECK(r.lambda.size() == 0);
+}
+
+TEST_CASE("qp::solve: an active row: min 1/2 |x|^2 - x1 - x2 with x1 + x2 <= 1 gives x = (1/2, 1/2), multiplier 1/2") {
+  // KKT: x - (1, 1) - A^T lambda = 0 with A = [-1 -1] (the row -x1 - x2 >= -1), active:
+  // x_i = 1 - lambda and x1 + x2 = 1, so lambda = 1/2.
+  const Eigen::MatrixXd H = Eigen::MatrixXd::Identity(2, 2);
+  const Eigen::VectorXd c = Eigen::Vector2d(-1, -1);
+  Eigen::MatrixXd A(2, 2);
+  A << -1, -1, 1, 0;  // and x1 >= -5, which stays inactive (multiplier 0)
+  const Eigen::VectorXd b = Eigen::Vector2d(-1, -5);
+  const wlx::qp::Result r = wlx::qp::solve(H, c, A, b);
+  REQUIRE(r.converged);
+  // The interior-point method stops at a complementarity gap of 1e-11 of the data's scale (2):
+  // the solution and the multipliers are that close to the exact ones.
+  CHECK((r.x - Eigen::Vector2d(0.5, 0.5)).norm() <= 1e-9);
+  CHECK(std::abs(r.lambda(0) - 0.5) <= 1e-9);
+  CHECK(std::abs(r.lambda(1)) <= 1e-9);
+  CHECK(r.iterations >= 1);
+  CHECK(r.iterations < 120);
+}
+
+TEST_CASE("qp::solve: rows no x satisfies (x >= 1 and x <= 0) end without converging") {
+  const Eigen::MatrixXd H = Eigen::MatrixXd::Constant(1, 1, 1.0);
+  Eigen::MatrixXd A(2, 1);
+  A << 1, -1;
+  const wlx::qp::Result r = wlx::qp::solve(H, Eigen::VectorXd::Zero(1), A, Eigen::Vector2d(1, 0), 1e-11, 60);
+  CHECK_FALSE(r.converged);
+  CHECK(r.iterations <= 60);
+}
+
+TEST_CASE("numerics: the smallest eigenvector, the left null space and the inverse Cholesky factor, by what defines them") {
+  Eigen::MatrixXd S = Eigen::Vector3d(3, 1, 2).asDiagonal();
+  const Eigen::VectorXd v = wlx::numerics::smallest_eigenvector(S);
+  CHECK(std::abs(std::abs(v(1)) - 1) <= 1e-15);
+  CHECK(std::abs(v(0)) + std::abs(v(2)) <= 1e-15);
+
+  Eigen::MatrixXd A(4, 2);
+  A << 1, 2, 0, 1, 3, -1, 2, 0.5;
+  const Eigen::MatrixXd N = wlx::numerics::left_null_space(A);
+  REQUIRE(N.rows() == 4);
+  REQUIRE(N.cols() == 2);
+  CHECK((A.transpose() * N).norm() <= 1e-14);                                // in the null space of A^T
+  CHECK((N.transpose() * N - Eigen::Matrix2d::Identity()).norm() <= 1e-14);  // orthonormal
+
+  Eigen::MatrixXd W(3, 3);
+  W << 4, 1, 0.5, 1, 3, 0.2, 0.5, 0.2, 2;
+  Eigen::MatrixXd F;
+  REQUIRE(wlx::numerics::inverse_cholesky_factor(W, F));
+  CHECK((F * F.transpose() - W.inverse()).norm() <= 1e-14);  // S S^T = W^-1
+  CHECK((F.transpose() * W * F - Eigen::Matrix3d::Identity()).norm() <= 1e-14);
+  W(2, 2) = -1;  // indefinite
+  Eigen::MatrixXd untouched = Eigen::MatrixXd::Constant(1, 1, 7.0);
+  CHECK_FALSE(wlx::numerics::inverse_cholesky_factor(W, untouched));
+  CHECK(untouched(0, 0) == 7.0);
+}
