@@ -1,8 +1,7 @@
 #include "wlx/dynamics.hpp"
 
-#include "wlx/numerics.hpp"
-
 #include "wlx/error.hpp"
+#include "wlx/numerics.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/QR>

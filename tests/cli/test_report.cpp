@@ -267,7 +267,6 @@ TEST_CASE("report: the wheeled quadruped (four wheels, sixteen actuators) gets a
 
 namespace {
 
-// The rows of a CSV file of numbers after its header.
 // The index of a column in a CSV file's header, or -1.
 int csv_column(const fs::path& path, const std::string& name) {
   std::istringstream in(slurp(path));

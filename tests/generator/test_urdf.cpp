@@ -392,8 +392,7 @@ TEST_CASE("URDF import: a wheel without `radius` rolls on its hub's collision cy
     CHECK(printed.effort[k] == m.effort[k]);
     CHECK(printed.velocity[k] == m.velocity[k]);
   }
-  const std::size_t kfe_lf = static_cast<std::size_t>(std::find_if(m.coordinates.begin(), m.coordinates.end(),
-                                                                     [](const auto& c) { return c.name == "kfe_lf"; }) - m.coordinates.begin());
+  const auto kfe_lf = static_cast<std::size_t>(&m.coordinate("kfe_lf") - m.coordinates.data());
   CHECK(printed.lower[kfe_lf] == -2.8);
   REQUIRE(printed.dynamics);
   CHECK(printed.dynamics->torque_limits == m.dynamics->torque_limits);
