@@ -424,6 +424,12 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
     for (auto it = mine.rbegin(); it != mine.rend(); ++it) {
       const JointEntry& e = joint_entries[*it];
       const urdf::JointConstSharedPtr j = model->getJoint(e.name);
+      // urdfdom reads names through its own XML layer: a name it reads otherwise than the first
+      // pass (bytes that are not UTF-8, say) is not found under that pass's name.
+      if (!j)
+        check.fail(e.line, "joint", fmt::format("name {}: the URDF parser reads this name differently (a byte that is not "
+                                                "UTF-8, or an entity): write joint names in plain ASCII",
+                                                shown(e.name)));
       UrdfJoint joint;
       joint.name = e.name;
       joint.line = e.line;
