@@ -119,6 +119,27 @@ namespace {
 // pass counts the elements, and the links and joints among them, so that a file past the limits
 // is refused with the line where it passes them, before anything is built from it (a 64 MB file
 // of empty elements would otherwise take gigabytes in TinyXML's tree).
+// TinyXML (the pre-pass's and urdfdom's XML layer) steps over a UTF-8 lead byte by the length
+// it announces without looking for the end of the text: a sequence cut short by the end of the
+// file makes it read past the buffer (found by fuzz_urdf). XML's text is well-formed UTF-8 in
+// any case, and a NUL would end TinyXML's reading early and drop the rest of the file unseen.
+void check_encoding(const std::string& text, const Checker& check) {
+  int line = 1;
+  std::size_t line_start = 0;
+  for (std::size_t k = 0; k < text.size();) {
+    const std::size_t length = text::utf8_length(text, k);
+    if (length == 0 || text[k] == '\0')
+      check.fail(line, "XML",
+                 fmt::format("{} at byte {} of the line: a URDF is UTF-8 text (save it as UTF-8)",
+                             length == 0 ? "bytes that are not UTF-8" : "a NUL byte", k - line_start + 1));
+    if (text[k] == '\n') {
+      ++line;
+      line_start = k + 1;
+    }
+    k += length;
+  }
+}
+
 void check_xml_bounds(const std::string& text, const Checker& check) {
   int depth = 0, line = 1;
   std::size_t elements = 0, links = 0, joints = 0;
@@ -174,6 +195,7 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
   if (text.size() > (64u << 20)) throw ModelFileError(fmt::format("{}: a URDF of more than 64 MB is not read", shown_name));
   const Checker check(shown_name);
 
+  check_encoding(text, check);
   check_xml_bounds(text, check);
   TiXmlDocument doc;
   doc.Parse(text.c_str(), nullptr, TIXML_ENCODING_UTF8);
@@ -424,12 +446,12 @@ UrdfRobot read_urdf_text(const std::string& text, const std::string& shown_name)
     for (auto it = mine.rbegin(); it != mine.rend(); ++it) {
       const JointEntry& e = joint_entries[*it];
       const urdf::JointConstSharedPtr j = model->getJoint(e.name);
-      // urdfdom reads names through its own XML layer: a name it reads otherwise than the first
-      // pass (bytes that are not UTF-8, say) is not found under that pass's name.
+      // urdfdom reads names through its own pass over the XML: should it ever read a name
+      // otherwise than the first pass did (it once did for bytes that were not UTF-8, which
+      // check_encoding now refuses first), the joint is an error at its line, not a null pointer.
       if (!j)
-        check.fail(e.line, "joint", fmt::format("name {}: the URDF parser reads this name differently (a byte that is not "
-                                                "UTF-8, or an entity): write joint names in plain ASCII",
-                                                shown(e.name)));
+        check.fail(e.line, "joint", fmt::format("name {}: the URDF parser does not find a joint of this name: write joint "
+                                                "names in plain ASCII", shown(e.name)));
       UrdfJoint joint;
       joint.name = e.name;
       joint.line = e.line;

@@ -82,7 +82,10 @@ case "$what" in
           status=1
           cp "$tree/artifacts-$target"/* "tests/fuzz/regressions/$target/" 2>/dev/null || true
           echo "fuzz_$target failed:"
-          tail -40 "$tree/fuzz-$target.log"
+          # The finding's stack first (a tail alone cut it off), then the input that caused it.
+          grep -m1 -A 24 -E "ERROR: |runtime error: |==[0-9]+== ?ERROR" "$tree/fuzz-$target.log" || true
+          echo "..."
+          tail -6 "$tree/fuzz-$target.log"
         fi
         echo "fuzz_$target: $(grep -E "^#[0-9]+.*DONE|Done [0-9]+ runs" "$tree/fuzz-$target.log" | tail -1 || true)"
       done

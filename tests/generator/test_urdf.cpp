@@ -399,6 +399,24 @@ TEST_CASE("URDF import: a wheel without `radius` rolls on its hub's collision cy
   CHECK(printed.dynamics->torque_limits.back() == 40);
 }
 
+TEST_CASE("URDF import: text that is not UTF-8 is refused at its line before an XML parser reads it") {
+  const std::string head = "<robot name=\"r\">\n  <link name=\"base\"/>\n";
+  // A multi-byte sequence cut short by the end of the file: TinyXML would step past the buffer's
+  // end (fuzz_urdf's finding); a byte no UTF-8 has; a NUL, which would end TinyXML's reading early.
+  const std::pair<std::string, std::string> cases[] = {
+      {head + "</robot>\n<!-- \xE2", "r.urdf:4: XML: bytes that are not UTF-8 at byte 6 of the line"},
+      {head + "  <link name=\"b\xFF\"/>\n</robot>\n", "r.urdf:3: XML: bytes that are not UTF-8 at byte 16 of the line"},
+      {head + std::string("</robot>\0<robot/>", 18), "r.urdf:3: XML: a NUL byte at byte 9 of the line"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.second);
+    CHECK_THROWS_WITH_AS(read_urdf_text(c.first, "r.urdf"), doctest::Contains(c.second.c_str()), ModelFileError);
+  }
+  // Well-formed UTF-8 beyond ASCII (a comment, a robot name) reads.
+  const UrdfRobot robot = read_urdf_text("<robot name=\"r\xC3\xB6\">\n  <!-- \xE2\x86\x92 -->\n  <link name=\"base\"/>\n</robot>\n", "r.urdf");
+  CHECK(robot.links.size() == 1);
+}
+
 #else
 
 TEST_CASE("URDF import: without liburdfdom a URDF is refused with a message that says so") {
