@@ -1,10 +1,12 @@
-# wlx_generate(TARGET <name> MODEL <file> [NAMESPACE <ns>] [BAKE <name=value>...] [PYTHON])
+# wlx_generate(TARGET <name> MODEL <file> [NAME <model>] [NAMESPACE <ns>] [BAKE <name=value>...] [PYTHON])
 #
-# Runs wlx-gen on a model file at build time (again only when the file or wlx-gen changes) into
+# Runs wlx-gen on a model file at build time (again only when the file, the URDF it names or
+# wlx-gen changes) into
 # <build>/wlx_generated/<name>/wlx/gen/ and defines the target <name> to link:
 #   - without NAMESPACE: a static library, the wlx runtime compiled for this model (Model, Data,
 #     IK, dependent rates, inverse dynamics, simulation in namespace wlx::<model>, where <model> is
-#     the file's `model:` name), with the generated headers on its include path;
+#     NAME, else the file's name without .yaml; wlx-gen checks that the file's `model:` is that
+#     name), with the generated headers on its include path;
 #   - with NAMESPACE: the generated headers alone (INTERFACE), in that namespace (the runtime needs
 #     the default one).
 # BAKE name=value bakes parameters in as constants (wlx-gen --bake).
@@ -13,32 +15,49 @@
 # then `import wlx; wlx.model("<model>")`: the same API as the installed package's models, with
 # this one built in). Needs pybind11 and Python's headers.
 # Used by the installed package (lib/cmake/wlx) and, the same way, inside the source tree.
-# What CMake needs of a model file before wlx-gen runs: its model's name (the runtime's namespace;
-# wlx-gen checks the rest) into NAME_VAR, and the files it is generated from (itself and the URDF
-# it names, `urdf: robot.urdf` relative to it) into INPUTS_VAR. Both are read at configure time,
-# so the file becomes a configure dependency (a renamed model, another URDF). WHO names the caller
-# in errors.
-function(wlx_read_model_file file name_var inputs_var who)
-  file(STRINGS "${file}" name_line REGEX "^model:[ \t]*[A-Za-z_][A-Za-z0-9_]*[ \t]*(#.*)?$" LIMIT_COUNT 1)
-  if(NOT name_line)
-    message(FATAL_ERROR "${who}: ${file}: no line 'model: <name>' (a C++ identifier) found")
+# The model's name (the runtime's namespace wlx::<model>, the Python module's wlx.model("<model>")),
+# which CMake needs before wlx-gen runs: NAME if given, else the file's name without its extension.
+# CMake never reads the model file (only wlx-gen does: a second reader could read it otherwise);
+# wlx-gen checks that the file's `model:` is this name (--expect-model) and lists the files the
+# model was read from (the URDF it names) in a depfile, so that editing any of them regenerates.
+# WHO names the caller in errors.
+function(wlx_model_name file given name_var who)
+  if(given)
+    set(name "${given}")
+  else()
+    get_filename_component(name "${file}" NAME_WLE)
   endif()
-  string(REGEX REPLACE "^model:[ \t]*([A-Za-z_][A-Za-z0-9_]*).*$" "\\1" name "${name_line}")
-  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${file}")
-  set(inputs "${file}")
-  file(STRINGS "${file}" urdf_line REGEX "^urdf:[ \t]*[^ \t#]+" LIMIT_COUNT 1)
-  if(urdf_line)
-    string(REGEX REPLACE "^urdf:[ \t]*([^ \t#]+).*$" "\\1" urdf "${urdf_line}")
-    get_filename_component(folder "${file}" DIRECTORY)
-    get_filename_component(urdf "${urdf}" ABSOLUTE BASE_DIR "${folder}")
-    list(APPEND inputs "${urdf}")
+  if(NOT name MATCHES "^[A-Za-z_][A-Za-z0-9_]*$")
+    message(FATAL_ERROR "${who}: ${file}: the model's name '${name}' (NAME, else the file's name) is not a C++ identifier: "
+                        "rename the file or give NAME (the file's `model:`)")
   endif()
   set(${name_var} ${name} PARENT_SCOPE)
-  set(${inputs_var} ${inputs} PARENT_SCOPE)
+endfunction()
+
+# The command that runs wlx-gen on FILE into OUT, touching STAMP, again whenever wlx-gen, FILE or a
+# file it read (the URDF) changes. ARGN: further options of wlx-gen.
+function(wlx_add_generation stamp file out expected_model comment)
+  # CMP0116 NEW (whatever the caller's policies): Ninja is given the depfile's paths relative to the
+  # build folder, as it names the stamp; else it would see another target and regenerate every build.
+  cmake_policy(PUSH)
+  cmake_policy(SET CMP0116 NEW)
+  add_custom_command(
+    OUTPUT "${stamp}"
+    # wlx-gen rewrites all.hpp whenever any header changes: named here, Ninja recompiles what
+    # includes it after an edit of the model file (else objects built from the old headers stay).
+    BYPRODUCTS "${out}/wlx/gen/all.hpp"
+    COMMAND wlx::wlx-gen "${file}" --out "${out}" --expect-model "${expected_model}" --depfile "${stamp}.d"
+            --depfile-target "${stamp}" ${ARGN}
+    COMMAND "${CMAKE_COMMAND}" -E touch "${stamp}"
+    DEPENDS "${file}" "$<TARGET_FILE:wlx::wlx-gen>"
+    DEPFILE "${stamp}.d"
+    COMMENT "${comment}"
+    VERBATIM)
+  cmake_policy(POP)
 endfunction()
 
 function(wlx_generate)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "PYTHON" "TARGET;MODEL;NAMESPACE" "BAKE")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "PYTHON" "TARGET;MODEL;NAMESPACE;NAME" "BAKE")
   if(arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "wlx_generate: unknown arguments: ${arg_UNPARSED_ARGUMENTS}")
   endif()
@@ -52,7 +71,7 @@ function(wlx_generate)
   if(NOT EXISTS "${model_file}")
     message(FATAL_ERROR "wlx_generate: MODEL ${model_file}: no such file")
   endif()
-  wlx_read_model_file("${model_file}" model_name model_inputs "wlx_generate")
+  wlx_model_name("${model_file}" "${arg_NAME}" model_name "wlx_generate")
 
   set(out "${CMAKE_CURRENT_BINARY_DIR}/wlx_generated/${arg_TARGET}")
   set(stamp "${CMAKE_CURRENT_BINARY_DIR}/wlx_generated/${arg_TARGET}.stamp")
@@ -63,16 +82,7 @@ function(wlx_generate)
   if(arg_NAMESPACE)
     list(APPEND options --namespace "${arg_NAMESPACE}")
   endif()
-  add_custom_command(
-    OUTPUT "${stamp}"
-    # wlx-gen rewrites all.hpp whenever any header changes: named here, Ninja recompiles what
-    # includes it after an edit of the model file (else objects built from the old headers stay).
-    BYPRODUCTS "${out}/wlx/gen/all.hpp"
-    COMMAND wlx::wlx-gen "${model_file}" --out "${out}" ${options}
-    COMMAND "${CMAKE_COMMAND}" -E touch "${stamp}"
-    DEPENDS ${model_inputs} "$<TARGET_FILE:wlx::wlx-gen>"
-    COMMENT "wlx-gen: ${arg_MODEL} -> ${out}/wlx/gen/"
-    VERBATIM)
+  wlx_add_generation("${stamp}" "${model_file}" "${out}" ${model_name} "wlx-gen: ${arg_MODEL} -> ${out}/wlx/gen/" ${options})
   add_custom_target(${arg_TARGET}_wlx_gen DEPENDS "${stamp}")
 
   if(arg_NAMESPACE)
@@ -80,13 +90,14 @@ function(wlx_generate)
     target_include_directories(${arg_TARGET} INTERFACE "${out}")
     target_link_libraries(${arg_TARGET} INTERFACE Eigen3::Eigen)
   else()
-    file(GLOB runtime_sources "${WLX_RUNTIME_SOURCE_DIR}/*.cpp")
-    add_library(${arg_TARGET} STATIC ${runtime_sources})
+    set(runtime_sources ${WLX_RUNTIME_FILES})
+    set(generated_function_sources ${WLX_GENERATED_FUNCTION_FILES})
+    list(TRANSFORM runtime_sources PREPEND "${WLX_RUNTIME_SOURCE_DIR}/")
+    list(TRANSFORM generated_function_sources PREPEND "${WLX_RUNTIME_SOURCE_DIR}/")
+    add_library(${arg_TARGET} STATIC ${runtime_sources} ${generated_function_sources})
     # The runtime's sources in one translation unit (they share their Eigen templates: half the
     # compile time); the generated functions' files apart, each defines WLX_GEN_DEFINE_DOUBLE.
     set_target_properties(${arg_TARGET} PROPERTIES UNITY_BUILD ON)
-    set(generated_function_sources "${runtime_sources}")
-    list(FILTER generated_function_sources INCLUDE REGEX "/generated_[a-z_]*\\.cpp$")
     set_source_files_properties(${generated_function_sources} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
     target_include_directories(${arg_TARGET} PUBLIC "${out}")
     # The generated functions' double versions are compiled once, here (generated_*.cpp).

@@ -212,6 +212,27 @@ int remove_stale(const fs::path& dir, const std::vector<EmittedFile>& files) {
   return removed;
 }
 
+// A Makefile-style depfile, "TARGET: INPUT...", which Ninja and Make read (CMake's add_custom_command
+// DEPFILE): absolute paths, with Make's escapes for spaces, '#' and '$'. A path with a newline
+// cannot be written in one, so it is an error rather than a depfile that names another file.
+std::string depfile_path(const std::string& path) {
+  const std::string absolute = fs::absolute(path).lexically_normal().string();
+  std::string out;
+  for (const char c : absolute) {
+    if (c == '\n' || c == '\r') throw ModelFileError(fmt::format("--depfile: the path {} holds a line break", absolute.substr(0, 200)));
+    if (c == ' ' || c == '#') out += '\\';
+    if (c == '$') out += '$';
+    out += c;
+  }
+  return out;
+}
+
+void write_depfile(const std::string& depfile, const std::string& target, const std::vector<std::string>& inputs) {
+  std::string text = depfile_path(target) + ":";
+  for (const auto& input : inputs) text += " \\\n  " + depfile_path(input);
+  wlx::write_file_atomically(depfile, text + "\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -239,6 +260,13 @@ int main(int argc, char** argv) {
   app.add_flag("--bake-defaults", bake_defaults, "bake every geometry parameter (kinds length, offset, angle) in at its default");
   app.add_option("--namespace", opt.name_space,
                  "C++ namespace of the emitted code (default: wlx::<model>::gen, <model> inline)");
+  std::string depfile, depfile_target, expected_model;
+  app.add_option("--depfile", depfile,
+                 "also write a Makefile-style depfile: the files the headers were derived from (the model file and "
+                 "the URDF it names), so that a build system reruns wlx-gen when any of them changes");
+  app.add_option("--depfile-target", depfile_target, "the depfile's target (default: OUT/wlx/gen/all.hpp)");
+  app.add_option("--expect-model", expected_model,
+                 "the model's name the build was told (CMake's wlx_generate): a model file whose `model:` differs is an error");
   app.add_flag("--quiet", quiet, "print nothing on success");
   app.add_flag("--stats", stats_only, "print the operation-count table (always printed unless --quiet)");
   app.set_version_flag("--version", WLX_VERSION, "print the version and exit");
@@ -297,7 +325,12 @@ int main(int argc, char** argv) {
     if (out_dir.empty() && !describe) throw ModelFileError("--out is required (the output root; headers go to OUT/wlx/gen/)");
     if (opt.data_at_run_time && (bake_defaults || !bake_args.empty()))
       throw ModelFileError("--data-at-run-time reads every parameter's value at run time: it cannot bake any (--bake, --bake-defaults)");
+    if (!depfile.empty() && out_dir.empty()) throw ModelFileError("--depfile lists what --out's headers depend on: give --out");
     const Model model = load_model_file(model_path, urdf_path);
+    if (!expected_model.empty() && expected_model != model.name)
+      throw ModelFileError(fmt::format("{}: `model: {}`, where the build expects the model '{}' (wlx_generate's NAME, else the "
+                                       "file's name without .yaml): rename the model or the file, or give NAME",
+                                       model_path.substr(0, 200), model.name, expected_model.substr(0, 60)));
     opt.model_name = model.name;
     if (bake_defaults)
       for (std::size_t k = 0; k < model.parameters.size(); ++k) {
@@ -368,6 +401,9 @@ int main(int argc, char** argv) {
     const int removed = remove_stale(out_dir, files);
     writing = 0;
     if (const int signal = received_signal) throw Interrupted{signal};  // the new set is whole; still stop as asked
+    if (!depfile.empty())
+      write_depfile(depfile, depfile_target.empty() ? (fs::path(out_dir) / "wlx" / "gen" / "all.hpp").string() : depfile_target,
+                    model.input_files);
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!quiet || stats_only) {
       std::string report;

@@ -143,6 +143,9 @@ struct Model {
   std::string name;
   std::string description;
   std::string source;  // where the description lives, for the banner
+  // The files it was read from (the model file, then the URDF it names): wlx-gen --depfile lists them,
+  // so that a build knows its inputs without reading the model file itself.
+  std::vector<std::string> input_files;
   std::vector<Parameter> parameters;
   std::vector<ParameterKind> parameter_kinds;  // one per parameter
   std::vector<Coordinate> coordinates;

@@ -367,6 +367,7 @@ class Parser {
       where.fail(fmt::format("cannot open the URDF file '{}'", excerpt(path)));
     if (std::filesystem::file_size(path, error) > (64u << 20)) where.fail(fmt::format("'{}' is larger than 64 MB", excerpt(path)));
     UrdfRobot robot = read_urdf(path, shown);
+    urdf_file_ = path;
     {
       std::ifstream in(path, std::ios::binary);
       std::ostringstream text;
@@ -790,6 +791,8 @@ class Parser {
   }
 
   const std::string& urdf_fingerprint() const { return urdf_fingerprint_; }
+  // The URDF's path as opened (empty without one).
+  const std::string& urdf_file() const { return urdf_file_; }
 
  private:
   // ---- repetition ----
@@ -1769,7 +1772,7 @@ class Parser {
   }
 
   Source src_;
-  std::string directory_, urdf_override_, urdf_fingerprint_;
+  std::string directory_, urdf_override_, urdf_fingerprint_, urdf_file_;
   struct UrdfAxle {
     Axis axis;
     std::string place, joint;
@@ -1871,11 +1874,14 @@ Model parse_model(const std::string& text, const std::string& source_name, const
   Model m = parser.parse(root);
   m.source = fmt::format("{}, fingerprint {:016x}", source_name, fingerprint(text));
   if (!parser.urdf_fingerprint().empty()) m.source += "; " + parser.urdf_fingerprint();
+  if (!parser.urdf_file().empty()) m.input_files.push_back(parser.urdf_file());
   return m;
 }
 
 Model load_model_file(const std::string& path, const std::string& urdf_path) {
-  return parse_model(read_text(path), shown_name(path), directory_of(path), urdf_path);
+  Model m = parse_model(read_text(path), shown_name(path), directory_of(path), urdf_path);
+  m.input_files.insert(m.input_files.begin(), path);
+  return m;
 }
 
 std::string print_model_file(const std::string& path, const std::string& urdf_path) {

@@ -108,6 +108,25 @@ else:
     raise AssertionError("a run of another model ran")
 print("wlx_generate(PYTHON): wlx.model(\"python_check\") from", wlx.__file__)' "$work/fk.json" "$work/runs/forward.json"
 
+# wlx-gen tells the build what the model was read from (a depfile): built, nothing is dirty; an
+# edit of the model file makes its generation dirty, without CMake having read the file.
+if ! ninja -C "$work/python" -n | grep -q "no work to do"; then
+  ninja -C "$work/python" -n -d explain >&2; echo "wlx_generate: a build after a build is not empty" >&2; exit 1; fi
+touch "$work/python_check.yaml"
+ninja -C "$work/python" -n my_robot_wlx_gen | grep -q "wlx-gen: .*python_check.yaml" || {
+  echo "wlx_generate: an edit of the model file does not run wlx-gen" >&2; exit 1; }
+# The model's name is NAME, else the file's name: a file named otherwise than its model is an
+# error of the build that names both (CMake never reads the model file).
+cp "$work/python_check.yaml" "$work/renamed.yaml"
+cmake -S tests/package/python -B "$work/renamed" -G Ninja -DCMAKE_PREFIX_PATH="$PWD/build/install" -DMODEL="$work/renamed.yaml" \
+      > "$work/renamed-configure.log" || { cat "$work/renamed-configure.log" >&2; exit 1; }
+if cmake --build "$work/renamed" --target my_robot_wlx_gen > "$work/renamed-build.log" 2>&1 ||
+   ! grep -q "renamed.yaml: \`model: python_check\`, where the build expects the model 'renamed' (wlx_generate's NAME" \
+     "$work/renamed-build.log"; then
+  cat "$work/renamed-build.log" >&2; echo "wlx_generate: a model file named otherwise than its model was not refused" >&2; exit 1
+fi
+echo "wlx_generate: regenerates on an edit of the model file (wlx-gen's depfile); a file named otherwise than its model is refused"
+
 echo "-- add_subdirectory(), runtime only"
 # -O0: this checks what add_subdirectory() configures and that it builds and links; the runtime's
 # optimised build is the embedding recipe's above (GCC at -O3 twice cost CI a minute of CPU).

@@ -46,6 +46,8 @@ TEST_CASE("wlx-gen: every bad option or value exits 2 with the reason, and write
       {"code in the namespace", {"--namespace", "x { } int evil(){return 1;} namespace y"}, "is not a C++ qualified name"},
       {"namespace starting with a digit", {"--namespace", "1bad"}, "is not a C++ qualified name"},
       {"unknown option", {"--bogus"}, "--bogus"},
+      {"another model's name expected (wlx_generate's NAME, or the file's name)", {"--expect-model", "digger"},
+       "excavator.yaml: `model: excavator`, where the build expects the model 'digger'"},
   };
   for (const Case& c : cases) {
     CAPTURE(c.what);
@@ -809,6 +811,34 @@ TEST_CASE("wlx-gen: a bad URDF or a bad URDF model file exits 2 with file:line: 
   CHECK(r.code == 2);
   const int robot_line = line_of(urdf, "</robot>");
   CHECK(r.err == "wlx-gen: error: wheeled_quadruped.urdf:" + std::to_string(robot_line + 63) + ": XML: elements nest more than 64 levels deep\n");
+}
+
+TEST_CASE("wlx-gen --depfile: the model file and the URDF it names, for the build to regenerate when either changes") {
+  // A folder whose name needs Make's escapes (a space, a '#'), with a copy of the quadruped's files.
+  const std::filesystem::path dir = wlx_test::work_dir() / "dep files #1";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(WLX_SOURCE_DIR "/models/wheeled_quadruped.yaml", dir / "wheeled_quadruped.yaml");
+  std::filesystem::copy_file(WLX_SOURCE_DIR "/models/wheeled_quadruped.urdf", dir / "wheeled_quadruped.urdf");
+  const std::string escaped = std::string(std::filesystem::absolute(dir).lexically_normal()).replace(
+      std::string(std::filesystem::absolute(dir).lexically_normal()).find("dep files #1"), 12, "dep\\ files\\ \\#1");
+  const auto r = wlx_test::run({(dir / "wheeled_quadruped.yaml").string(), "--out", (dir / "out").string(), "--quiet", "--depfile",
+                                (dir / "gen.d").string(), "--depfile-target", (dir / "gen.stamp").string(), "--expect-model",
+                                "wheeled_quadruped"});
+  CAPTURE(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(wlx_test::slurp(dir / "gen.d") == escaped + "/gen.stamp: \\\n  " + escaped + "/wheeled_quadruped.yaml \\\n  " + escaped +
+                                               "/wheeled_quadruped.urdf\n");
+  // Without --depfile-target, the target is the header every other one is included through.
+  const auto plain = wlx_test::run({WLX_MODEL_FILE, "--out", (dir / "exc").string(), "--quiet", "--depfile", (dir / "exc.d").string()});
+  REQUIRE(plain.code == 0);
+  CHECK(wlx_test::slurp(dir / "exc.d") == escaped + "/exc/wlx/gen/all.hpp: \\\n  " +
+                                               std::string(std::filesystem::absolute(WLX_MODEL_FILE).lexically_normal()) + "\n");
+  // It lists what the headers depend on: without --out there are none.
+  const auto no_out = wlx_test::run({WLX_MODEL_FILE, "--describe", "--depfile", (dir / "x.d").string()});
+  CHECK(no_out.code == 2);
+  CHECK(no_out.err.find("--depfile lists what --out's headers depend on: give --out") != std::string::npos);
+  CHECK(!std::filesystem::exists(dir / "x.d"));
 }
 
 TEST_CASE("wlx-gen: robot.urdf --with robot.yaml, and --print-model") {
