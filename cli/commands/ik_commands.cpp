@@ -29,7 +29,19 @@ nlohmann::ordered_json solve_ik_request(const IkRequest& r, Coordinates* warm, C
   nlohmann::ordered_json out;
   NewtonReport report;  // the limbs Newton's method solved
   if (r.method == IkMethod::closed_form) {
+    // The limbs without a closed form by Newton's method: in a batch from the previous answer (each
+    // line's solution then follows the last, as with "method": "newton", instead of starting again
+    // from the model's start values, which may find another of the limb's solutions), then from
+    // the request's start.
+    if (warm != nullptr && warm->allFinite())
+      for (Limb limb : kLimbs) {
+        if (has_closed_form(limb)) continue;
+        const LimbBlock block = limb_block(limb);
+        for (int j = 0; j < block.size; ++j) s(block.joints[static_cast<std::size_t>(j)]) = (*warm)(block.joints[static_cast<std::size_t>(j)]);
+      }
+    for (const auto& [index, value] : r.start) s(index) = value;
     solve_ik_closed_form(model, s, r.branches, &report);  // Newton for the limbs without a closed form
+    if (warm != nullptr) *warm = s;
   } else {
     // Start: the previous solution in a batch, else the assembled nominal pose (as MOBILE does).
     Coordinates start = nominal_inputs();

@@ -132,9 +132,18 @@ IkRequest parse_ik_request(const nlohmann::json& j, const Params& base) {
     for (const auto& [key, value] : st.items()) {
       const int k = coordinate_index(key);
       r.start.emplace_back(k, si_value(value, "start." + key, quantity_of(is_angle(k))));
+      // Newton's starting guess: for every limb with "method": "newton", else for the limbs that
+      // have no closed form (which Newton's method solves whatever the method asked).
+      if (r.method == IkMethod::newton) continue;
+      for (Limb limb : kLimbs) {
+        const LimbBlock block = limb_block(limb);
+        if (has_closed_form(limb) && std::find(block.joints.begin(), block.joints.begin() + block.size, k) != block.joints.begin() + block.size)
+          throw Error("start." + key,
+                      fmt::format("is Newton's starting guess, and {} is solved by its closed form, which takes none: give "
+                                  "\"method\": \"newton\" to solve it by Newton's method from this start",
+                                  limb_name(limb)));
+      }
     }
-    if (r.method != IkMethod::newton)
-      throw Error("start", "is Newton's starting guess: it needs \"method\": \"newton\" (the closed form takes no start)");
   }
   return r;
 }

@@ -188,7 +188,8 @@ Branches resolve_branches(const Model& model, const Coordinates& s, const Branch
   return out;
 }
 
-void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& requested, NewtonReport* newton_report) {
+void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& requested, NewtonReport* newton_report,
+                          const NewtonOptions* newton_options) {
   bool choose = false;
   for (int b : requested.limb) choose = choose || b == kModelsChoice;
   const Branches branches = choose ? resolve_branches(model, s, requested) : requested;
@@ -209,7 +210,7 @@ void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& re
     std::array<bool, kLimbCount> newton{};
     for (Limb limb : kLimbs) newton[static_cast<std::size_t>(limb)] = !has_closed_form(limb);
     Data data;
-    const NewtonReport report = solve_newton_limbs(model, data, newton, s, {});
+    const NewtonReport report = solve_newton_limbs(model, data, newton, s, newton_options ? *newton_options : NewtonOptions{});
     if (newton_report != nullptr) *newton_report = report;
   }
 }
@@ -469,23 +470,58 @@ NewtonReport solve_newton_limbs(const Model& model, Data& data, const std::array
       const auto idx = indices(limb);
       for (int j = 0; j < idx.count; ++j) usable = usable && std::isfinite(s(idx.dep[static_cast<std::size_t>(j)]));
     }
+  const Coordinates previous = s;
+  // Continuation follows one solution: a result whose joints moved further than options.max_jump
+  // from the previous solution is another root (angles compared on the circle: results are wrapped).
+  const auto check_jump = [&](const Coordinates& result, bool restarted) {
+    if (!usable || !(options.max_jump < std::numeric_limits<double>::infinity())) return;
+    for (Limb limb : kLimbs) {
+      if (!limbs[static_cast<std::size_t>(limb)]) continue;
+      const auto idx = indices(limb);
+      for (int j = 0; j < idx.count; ++j) {
+        const int k = idx.dep[static_cast<std::size_t>(j)];
+        const std::string_view unit = gen::kCoordinateUnits[static_cast<std::size_t>(k)];
+        const double move = unit == "rad" ? std::abs(std::remainder(result(k) - previous(k), 2 * std::numbers::pi))
+                                          : std::abs(result(k) - previous(k));
+        if (!(move <= options.max_jump))
+          throw Error(std::string(limb_name(limb)),
+                      fmt::format("Newton's method {} another solution: {} moved from {:.6g} to {:.6g} {} between two "
+                                  "evaluations, more than a continuation step's bound of {} {} (the limb passes near a "
+                                  "singular pose, where two solutions meet, or the steps are too long)",
+                                  restarted ? "lost the solution it followed and, from the start values, found"
+                                            : "jumped to",
+                                  gen::kCoordinateNames[static_cast<std::size_t>(k)], previous(k), result(k), unit,
+                                  options.max_jump, unit));
+      }
+    }
+  };
   if (usable) {
     Coordinates warm = s;
+    bool converged = false;
+    NewtonReport report;
     try {
-      const NewtonReport report = newton(model, limbs, warm, data, options);
-      s = warm;
-      return report;
+      report = newton(model, limbs, warm, data, options);
+      converged = true;
     } catch (const Error&) {
       // fall through to the model's start values, whose error is the one reported
     }
+    if (converged) {
+      check_jump(warm, false);
+      s = warm;
+      return report;
+    }
   }
   const Coordinates fresh = dependent_start(s);
+  Coordinates cold = s;  // s stays the previous solution when this one is refused
   for (Limb limb : kLimbs)
     if (limbs[static_cast<std::size_t>(limb)]) {
       const auto idx = indices(limb);
-      for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = fresh(idx.dep[static_cast<std::size_t>(j)]);
+      for (int j = 0; j < idx.count; ++j) cold(idx.dep[static_cast<std::size_t>(j)]) = fresh(idx.dep[static_cast<std::size_t>(j)]);
     }
-  return newton(model, limbs, s, data, options);
+  const NewtonReport report = newton(model, limbs, cold, data, options);
+  check_jump(cold, true);
+  s = cold;
+  return report;
 }
 
 NewtonReport solve_ik_newton(const Model& model, Data& data, Coordinates& s, const NewtonOptions& options) {

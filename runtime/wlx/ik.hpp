@@ -11,6 +11,7 @@
 #include "wlx/model.hpp"
 
 #include <array>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -45,6 +46,7 @@ struct LimbBlock {
 LimbBlock limb_block(Limb limb) noexcept;
 
 struct NewtonReport;
+struct NewtonOptions;
 
 // Which branch each limb's closed form takes, indexed by Limb; kModelsChoice leaves it to the
 // model (resolve_branches). Default-constructed: every limb the model's choice.
@@ -80,9 +82,10 @@ void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinat
 // All limbs, each on its branch in `branches` (the model's choice where kModelsChoice:
 // resolve_branches); those without a closed form by Newton's method from the dependent joints in s
 // (then from the model file's start values), whose report goes to `newton` when given (zero
-// iterations for the limbs solved in closed form).
+// iterations for the limbs solved in closed form), with `newton_options` when given (a run's
+// continuation bound).
 void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& branches = {},
-                          NewtonReport* newton = nullptr);
+                          NewtonReport* newton = nullptr, const NewtonOptions* newton_options = nullptr);
 
 // Which branch of the closed form a solution lies on (the branch whose solution is nearest).
 int classify_branch(const Model& model, Limb limb, const Coordinates& s);
@@ -100,7 +103,16 @@ struct NewtonOptions {
   // thesis' method, whose basins of attraction its cold starts show (docs/excavator.md section 4).
   enum class Method { levenberg_marquardt, backtracking };
   Method method = Method::levenberg_marquardt;
+  // Continuation (solve_newton_limbs from the previous solution): the largest move of a dependent
+  // joint (rad or m) that still counts as following the same solution. A larger one is an error
+  // naming the limb, never a silent switch to another root. Infinite: no check (a one-off solve).
+  double max_jump = std::numeric_limits<double>::infinity();
 };
+
+// The bound of a run's continuation (simulate, the report's runs): between two evaluations of the
+// integrator no dependent joint of a limb solved by Newton's method moves more than half a radian
+// (or half a metre). A run's evaluations lie a step apart; a move that large is another root.
+inline constexpr double kContinuationJump = 0.5;
 
 struct NewtonReport {
   std::array<int, kLimbCount> iterations{};  // per limb
@@ -115,6 +127,8 @@ struct NewtonReport {
 NewtonReport solve_ik_newton(const Model& model, Data& data, Coordinates& s, const NewtonOptions& options = {});
 // The same for the limbs marked in `limbs`, first from the joints in s (continuation along a sweep
 // or a run), then, if that fails, from the model file's start values (settings().dependent_start).
+// With a finite options.max_jump, a result whose joints moved further than that from the joints in
+// s (on either path) is an error naming the limb and the joint.
 NewtonReport solve_newton_limbs(const Model& model, Data& data, const std::array<bool, kLimbCount>& limbs, Coordinates& s,
                                 const NewtonOptions& options = {});
 // s with its dependent joints at the model file's start values for Newton's method.

@@ -16,19 +16,33 @@ namespace {
 
 using InputVector = Eigen::Matrix<double, kInputCount, 1>;
 
+// The solution a run's continuation starts from: the dependent joints at the initial inputs, from
+// the start values of Newton's method (nominal_inputs). A failure is left to the first evaluation,
+// which reports it as the run's stop at t = 0.
+void start_continuation(const Model& model, Coordinates& s, const Branches& branches) {
+  Coordinates solved = s;
+  try {
+    solve_ik_closed_form(model, solved, branches);
+    s = solved;
+  } catch (const Error&) {
+  }
+}
+
 // A kinematic run's right-hand side: the input rates at the inputs q (dependents re-solved first).
 struct KinematicRates {
   const Scenario& sc;
   const Model& model;
   Data& data;
   Branches branches;  // the run's, chosen at its start (resolve_branches): one branch all along
+  // Newton's limbs follow one solution from evaluation to evaluation (kContinuationJump).
+  NewtonOptions continuation{.max_jump = kContinuationJump};
   Coordinates s = Coordinates::Zero(), sdot = Coordinates::Zero();
   long evaluations = 0;
 
   InputVector operator()(double /*t: the commanded rates are constant*/, const InputVector& q) {
     ++evaluations;
     s.head<kInputCount>() = q;
-    solve_ik_closed_form(model, s, branches);
+    solve_ik_closed_form(model, s, branches, nullptr, &continuation);
     sdot.head<kInputCount>() = sc.rates;
     solve_dependent_rates(model, data, s, sdot, sc.pair, sc.nonholonomic);
     return sdot.head<kInputCount>();
@@ -45,6 +59,7 @@ struct TorqueRates {
   const Model& model;
   Data& data;
   Branches branches;  // as KinematicRates'
+  NewtonOptions continuation{.max_jump = kContinuationJump};
   Coordinates s = Coordinates::Zero();
   CommandVector u = CommandVector::Zero(), u_dot = CommandVector::Zero();
   TorqueVector tau = TorqueVector::Zero();
@@ -55,7 +70,7 @@ struct TorqueRates {
     ++evaluations;
     s.head<kInputCount>() = x.head<kInputCount>();
     u = x.tail<kCommandedCount>();
-    solve_ik_closed_form(model, s, branches);
+    solve_ik_closed_form(model, s, branches, nullptr, &continuation);
     tau = sc.torques(t, s, u);
     if (!tau.allFinite()) throw Error("torques", fmt::format("the torque source gave a non-finite torque at t = {:.6f} s", t));
     forward_dynamics(model, data, s, u, tau, u_dot, terms, sc.nonholonomic);
@@ -399,6 +414,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
     TorqueState x;
     x << sc.initial.head<kInputCount>(), sc.commanded_speeds();
     f.s = sc.initial;
+    start_continuation(model, f.s, f.branches);
     const auto fill = [&](Sample& smp) {
       kinematic_sample(smp, f.s, f.terms.sdot);
       smp.tau = f.tau;
@@ -425,6 +441,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
   } else {
     KinematicRates f{sc, model, data, resolve_branches(model, sc.initial, sc.branches)};
     f.s = sc.initial;
+    start_continuation(model, f.s, f.branches);
     const CommandVector u = sc.commanded_speeds();
     DynamicsTerms terms;
     const auto fill = [&](Sample& smp) {

@@ -218,7 +218,9 @@ TEST_CASE("cli: wlx ik reads the scenario files' value grammar: {\"deg\": x} for
   CHECK(r.err == "wlx: error: roll: expected a number or {\"deg\": x}, got {\"deg/s\":3}\n");
   r = run_wlx("ik", R"({"start": {"psi_l2": 0.1}})");
   CHECK(r.code == 2);
-  CHECK(r.err == "wlx: error: start: is Newton's starting guess: it needs \"method\": \"newton\" (the closed form takes no start)\n");
+  // psi_l2 is the left leg's, which its closed form solves: a start there asks for Newton's method.
+  CHECK(r.err == "wlx: error: start.psi_l2: is Newton's starting guess, and left leg is solved by its closed form, which "
+                 "takes none: give \"method\": \"newton\" to solve it by Newton's method from this start\n");
   const Run started = run_wlx("ik", R"({"method": "newton", "start": {"psi_l2": {"deg": 14}}})");
   const Run plain = run_wlx("ik", R"({"method": "closed-form"})");
   REQUIRE(started.code == 0);

@@ -752,6 +752,31 @@ TEST_CASE(
   }
   // From the nominal dependent joints (the model's start values), Newton's method took steps.
   CHECK(nlohmann::json::parse(ik.out)["iterations_total"].get<int>() > 0);
+  // A start for the limbs Newton's method solves is taken without "method": "newton" (the knee
+  // bent the other way: the leg's other solution). In a batch, each line's Newton limbs continue
+  // from the previous answer: the lines after it stay on that solution, where each on its own goes
+  // back to the model's start values' one.
+  const double knee_default = nlohmann::json::parse(ik.out)["knee"].get<double>();
+  const auto other = run({"--model-file", model.string(), "ik"}, {.input = R"({"start": {"knee": 0.6}})"});
+  INFO(other.err);
+  REQUIRE(other.code == 0);
+  const double knee_other = nlohmann::json::parse(other.out)["knee"].get<double>();
+  REQUIRE(knee_default * knee_other < 0);
+  const auto batch = run({"--model-file", model.string(), "ik", "--batch"},
+                         {.input = "{\"start\": {\"knee\": 0.6}}\n{\"foot_x\": 0.56}\n{\"foot_x\": 0.57}\n"});
+  REQUIRE(batch.code == 0);
+  std::istringstream lines(batch.out);
+  int answers = 0;
+  for (std::string line; std::getline(lines, line); ++answers) {
+    CAPTURE(line);
+    const nlohmann::json a = nlohmann::json::parse(line);
+    CHECK(a["knee"].get<double>() * knee_other > 0);
+    CHECK(a["closure_residual"].get<double>() <= 1e-12);
+  }
+  CHECK(answers == 3);
+  const auto alone = run({"--model-file", model.string(), "ik"}, {.input = R"({"foot_x": 0.56})"});
+  REQUIRE(alone.code == 0);
+  CHECK(nlohmann::json::parse(alone.out)["knee"].get<double>() * knee_default > 0);
 
   // wlx fk: the table's heading, the JSON's limb_methods, the message for a partial pose.
   const auto fk = run({"--model-file", model.string(), "fk"}, {.input = "{}"});

@@ -221,6 +221,68 @@ TEST_CASE(titled("the IK from the nominal state, and the model's sweeps: closure
   }
 }
 
+TEST_CASE(titled("Newton's continuation follows one solution: a result further than max_jump from the previous one is an error naming the limb")) {
+  const Model model;
+  Data data;
+  Coordinates s = nominal_inputs();
+  REQUIRE_NOTHROW(solve_ik_closed_form(model, s));
+  int jumps = 0, follows = 0;
+  for (Limb limb : kLimbs) {
+    if (has_closed_form(limb)) continue;  // continuation is Newton's: the closed form has none
+    CAPTURE(limb_name(limb));
+    std::array<bool, kLimbCount> only{};
+    only[static_cast<std::size_t>(limb)] = true;
+    NewtonOptions bounded;
+    bounded.max_jump = kContinuationJump;
+    // A step of the inputs a run's evaluations are apart: the same solution, moved a little.
+    Coordinates next = s;
+    for (int k = 0; k < kInputCount; ++k) next(k) += 1e-3;
+    REQUIRE_NOTHROW(solve_newton_limbs(model, data, only, next, bounded));
+    const LimbBlock block = limb_block(limb);
+    for (int j = 0; j < block.size; ++j) {
+      const int k = block.joints[static_cast<std::size_t>(j)];
+      CHECK(std::abs(next(k) - s(k)) <= 0.05);
+    }
+    ++follows;
+    // A previous solution one joint 1.2 (rad or m) away from where Newton's method then converges:
+    // without the bound it lands more than kContinuationJump from it (a jump), or within it.
+    for (int j = 0; j < block.size; ++j) {
+      const int k = block.joints[static_cast<std::size_t>(j)];
+      Coordinates previous = s;
+      previous(k) += 1.2;
+      Coordinates unbounded = previous;
+      try {
+        solve_newton_limbs(model, data, only, unbounded);
+      } catch (const Error&) {
+        continue;  // no solution from there: nothing to jump to
+      }
+      double move = 0;
+      for (int i = 0; i < block.size; ++i) {
+        const int c = block.joints[static_cast<std::size_t>(i)];
+        move = std::max(move, is_angle(c) ? std::abs(std::remainder(unbounded(c) - previous(c), 2 * std::numbers::pi))
+                                          : std::abs(unbounded(c) - previous(c)));
+      }
+      Coordinates followed = previous;
+      if (move > kContinuationJump) {
+        ++jumps;
+        try {
+          solve_newton_limbs(model, data, only, followed, bounded);
+          FAIL("a jump of " << move << " passed the bound");
+        } catch (const Error& e) {
+          CHECK(e.field() == std::string(limb_name(limb)));
+          CHECK(std::string(e.reason()).find("more than a continuation step's bound of 0.5") != std::string::npos);
+          CHECK(followed == previous);  // the previous solution stays where a jump is refused
+        }
+      } else {
+        CHECK_NOTHROW(solve_newton_limbs(model, data, only, followed, bounded));
+        CHECK(followed == unbounded);
+      }
+    }
+  }
+  if (follows > 0) CHECK(jumps > 0);  // the refusal was taken, not only the passing path
+  MESSAGE(kName << ": " << follows << " limbs by Newton's method, " << jumps << " jumps refused");
+}
+
 // The joints' limits and the limbs' default branches are settings (data): each case below sets
 // them for this model and puts the model's own back afterwards.
 struct SettingsRestorer {
