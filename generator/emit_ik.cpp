@@ -300,7 +300,14 @@ std::string describe(const Model& m, const Rigid& r) {
 
 // The limb's three point rows: the frame they place and the input targets of its x, y and z.
 std::pair<std::string, std::array<int, 3>> point_rows(const Model& m, const Limb& limb, const std::string& pattern) {
-  if (limb.rows.size() != 3) throw Unsolvable{pattern + " needs three point rows (x, y and z of one frame)"};
+  if (limb.rows.size() != 3) {
+    // Say which rows the limb has: one with x, y and z and a fourth row (a joint sum, a level
+    // row) has "those three", and the message must name what is extra.
+    std::vector<std::string> rows;
+    for (int r : limb.rows) rows.push_back(m.closure[static_cast<std::size_t>(r)].name);
+    throw Unsolvable{fmt::format("{} solves exactly three point rows (x, y and z of one frame); this limb has {}: {}", pattern,
+                                 limb.rows.size(), fmt::join(rows, ", "))};
+  }
   std::string frame;
   std::array<int, 3> target{-1, -1, -1};
   for (int r : limb.rows) {

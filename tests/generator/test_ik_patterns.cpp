@@ -133,4 +133,13 @@ TEST_CASE("IK patterns: point3 tests whether the axes meet, whatever separates t
   const std::string tilted = replaced(original, "chain: [translate: [0, 0, -drop], ry: flex]", "chain: [rz: skew, ry: flex]");
   const std::string tilted_line = ik_line(parse_model(tilted, "tilted.yaml"), "leg");
   CHECK(tilted_line.find("point3: between abduct and flex the chain turns (rz: skew)") != std::string::npos);
+  // A limb with a row beyond a frame's x, y and z (the wheel arm's row joined to the leg): the
+  // report names the rows the limb has, so that the extra one is seen.
+  std::string joined = replaced(original, "closure: [foot_at_x, foot_at_y, foot_at_z], joints: [abduct, flex, knee]",
+                                "closure: [foot_at_x, foot_at_y, foot_at_z, on_ground], joints: [abduct, flex, knee, swing]");
+  joined = replaced(joined, "  - {name: wheel_arm, title: wheel arm, closure: [on_ground], joints: [swing]}\n", "");
+  joined = replaced(joined, "limb: wheel_arm}", "limb: leg}");
+  const std::string four = ik_line(parse_model(joined, "joined.yaml"), "leg");
+  CHECK(four.find("point3 solves exactly three point rows (x, y and z of one frame); this limb has 4: foot_at_x, foot_at_y, "
+                  "foot_at_z, on_ground") != std::string::npos);
 }
