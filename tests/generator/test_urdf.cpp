@@ -417,6 +417,39 @@ TEST_CASE("URDF import: text that is not UTF-8 is refused at its line before an 
   CHECK(robot.links.size() == 1);
 }
 
+// tests/models/big_wheeled: an outside-style robot of CENTAURO's kind (written apart from the
+// importer: four legs of six joints and a wheel, a torso yaw, two arms of seven; 43 moving
+// joints, 115 kg), the size issue "Edit your robot and see the result in seconds" measures first
+// use on. Its URDF read here by a plain scan of the text, independently of urdfdom and the importer.
+TEST_CASE("URDF import: a 43-joint wheeled-legged robot: every moving joint a coordinate, every kilogram a body's") {
+  std::ifstream in(kTestModels + "/big_wheeled/big_wheeled.urdf");
+  std::ostringstream text;
+  text << in.rdbuf();
+  const std::string urdf = text.str();
+  REQUIRE(!urdf.empty());
+  int moving = 0, wheels = 0;
+  double mass = 0;
+  for (std::size_t at = 0; (at = urdf.find("<joint name=", at)) != std::string::npos; ++at) {
+    const std::string tag = urdf.substr(at, urdf.find('>', at) - at);
+    moving += tag.find("type=\"revolute\"") != std::string::npos || tag.find("type=\"continuous\"") != std::string::npos;
+    wheels += tag.find("type=\"continuous\"") != std::string::npos;
+  }
+  for (std::size_t at = 0; (at = urdf.find("<mass value=\"", at)) != std::string::npos; ++at) mass += std::stod(urdf.substr(at + 13));
+  REQUIRE(moving == 43);
+  REQUIRE(wheels == 4);
+  const Model m = load_model_file(kTestModels + "/big_wheeled/big_wheeled.yaml");
+  // The floating base's six coordinates and the contact targets are the file's own inputs; every
+  // moving joint but the wheels' (whose spins are no coordinates) is one coordinate.
+  const int base_and_targets = 6 + 4 * 3;
+  CHECK(static_cast<int>(m.coordinates.size()) == base_and_targets + moving - wheels);
+  CHECK(m.wheels.size() == 4);
+  CHECK(m.limbs.size() == 4);
+  double bodies = 0;
+  for (const Body& b : m.bodies) bodies += m.parameter(b.mass).default_value;
+  CHECK(std::abs(bodies - mass) <= 1e-12 * mass);
+  CHECK(std::abs(mass - 115.0) <= 1e-9);
+}
+
 #else
 
 TEST_CASE("URDF import: without liburdfdom a URDF is refused with a message that says so") {
