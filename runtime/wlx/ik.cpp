@@ -1,11 +1,9 @@
 #include "wlx/ik.hpp"
 
 #include "wlx/error.hpp"
-
 #include "wlx/kinematics.hpp"
+#include "wlx/limb_steps.hpp"
 
-#include <Eigen/LU>
-#include <Eigen/QR>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -300,12 +298,10 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
         r(i) = data.Phi(row);
         for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
       }
-      const Eigen::FullPivLU<LimbMatrix> lu(J);
-      if (lu.rcond() > 1e-12) {
-        step[l] = -lu.solve(r);
-      } else {  // at a singular pose (straight leg, lever at 90 deg): Levenberg-Marquardt step
+      if (!limb_steps::newton_step<gen::kMaxLimbSize>(J, r, step[l])) {
+        // At a singular pose (straight leg, lever at 90 deg): Levenberg-Marquardt's step.
         const double mu = 1e-8 * std::max(1.0, J.squaredNorm());
-        step[l] = -(J.transpose() * J + mu * LimbMatrix::Identity()).ldlt().solve(J.transpose() * r);
+        step[l] = limb_steps::regularized_step<gen::kMaxLimbSize>(J, r, mu);
       }
       ++report.iterations[l];
     }
@@ -371,13 +367,8 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
       }
       gradient[l] = J.transpose() * r;
       if (mu[l] == 0) mu[l] = 1e-9 * std::max(1.0, J.colwise().squaredNorm().maxCoeff());  // nearly Newton's step first
-      // As the least-squares problem [J; sqrt(mu) I] dx = [-r; 0], by QR: the normal equations would
-      // square J's condition number (1e6 at the thesis' worst poses).
-      Eigen::Matrix<double, 2 * gen::kMaxLimbSize, gen::kMaxLimbSize> stacked;
-      stacked << J, std::sqrt(mu[l]) * LimbMatrix::Identity();
-      Eigen::Matrix<double, 2 * gen::kMaxLimbSize, 1> rhs;
-      rhs << -r, LimbVector::Zero();
-      step[l] = stacked.householderQr().solve(rhs);
+      // As the least-squares problem [J; sqrt(mu) I] dx = [-r; 0], by QR (limb_steps.hpp).
+      step[l] = limb_steps::damped_step<gen::kMaxLimbSize>(J, r, mu[l]);
       before[l] = half_square(data.Phi, idx);
       ++report.iterations[l];
     }
