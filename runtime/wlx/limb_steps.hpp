@@ -29,8 +29,8 @@ using Column = Eigen::Matrix<double, N, 1>;
 // The largest N compiled once (the limbs of the built-in models have 1 to 4 joints; a leg of six).
 inline constexpr int kPrecompiledLimbSize = 8;
 
-// The Newton step -J^-1 r into `step` when J's reciprocal condition estimate is above 1e-12, by a
-// full-pivoting LU; false (step untouched) for a J that singular.
+// The Newton step -J^-1 r into `step` when J has full rank and its reciprocal condition estimate
+// is above 1e-12, by a full-pivoting LU; false (step untouched) otherwise.
 template <int N>
 bool newton_step(const Square<N>& J, const Column<N>& r, Column<N>& step);
 
@@ -47,7 +47,9 @@ Column<N> damped_step(const Square<N>& J, const Column<N>& r, double mu);
 template <int N>
 bool newton_step(const Square<N>& J, const Column<N>& r, Column<N>& step) {
   const Eigen::FullPivLU<Square<N>> lu(J);
-  if (!(lu.rcond() > 1e-12)) return false;
+  // Both tests: the condition estimate solves with the LU, which for a J of lower rank leaves the
+  // null directions at zero and so estimates a moderate inverse; the rank test sees that J.
+  if (!lu.isInvertible() || !(lu.rcond() > 1e-12)) return false;
   step = -lu.solve(r);
   return true;
 }

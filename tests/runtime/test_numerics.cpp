@@ -1,6 +1,7 @@
 // The model-independent numerics (runtime/wlx/numerics.hpp), compiled once for every model: the
 // QP against problems solved by hand (KKT conditions), and each decomposition against the
 // property that defines it.
+#include "wlx/limb_steps.hpp"
 #include "wlx/numerics.hpp"
 
 #include <doctest/doctest.h>
@@ -71,4 +72,38 @@ TEST_CASE("numerics: the smallest eigenvector, the left null space and the inver
   Eigen::MatrixXd untouched = Eigen::MatrixXd::Constant(1, 1, 7.0);
   CHECK_FALSE(wlx::numerics::inverse_cholesky_factor(W, untouched));
   CHECK(untouched(0, 0) == 7.0);
+}
+
+// Newton's limb steps by what defines them, at a size compiled once into wlx::numerics (3) and at
+// one beyond kPrecompiledLimbSize (9), which this file compiles itself: both link and agree with
+// the definitions (J step = -r; the normal equations of the damped problems).
+template <int N>
+void check_limb_steps() {
+  CAPTURE(N);
+  using namespace wlx::limb_steps;
+  Square<N> J;
+  Column<N> r;
+  for (int i = 0; i < N; ++i) {
+    r(i) = std::cos(1.0 + i);
+    for (int j = 0; j < N; ++j) J(i, j) = (i == j ? 3.0 : 0.0) + std::sin(1.0 + 2 * i + 3 * j);
+  }
+  Column<N> step = Column<N>::Zero();
+  REQUIRE(newton_step<N>(J, r, step));
+  CHECK((J * step + r).cwiseAbs().maxCoeff() <= 1e-13);
+  const double mu = 0.25;
+  const Column<N> damped = damped_step<N>(J, r, mu), regularized = regularized_step<N>(J, r, mu);
+  const Square<N> normal = J.transpose() * J + mu * Square<N>::Identity();
+  CHECK((normal * damped + J.transpose() * r).cwiseAbs().maxCoeff() <= 1e-12);
+  CHECK((normal * regularized + J.transpose() * r).cwiseAbs().maxCoeff() <= 1e-12);
+  // A singular J (two equal rows) has no Newton step: the step is left as it was.
+  Square<N> singular = J;
+  singular.row(1) = singular.row(0);
+  Column<N> untouched = Column<N>::Constant(7.0);
+  CHECK(!newton_step<N>(singular, r, untouched));
+  CHECK(untouched == Column<N>::Constant(7.0));
+}
+
+TEST_CASE("limb_steps: Newton's and the damped steps at a precompiled size and beyond it") {
+  check_limb_steps<3>();
+  check_limb_steps<9>();
 }
