@@ -5,7 +5,7 @@
 // Why here and not in ik.cpp: the decompositions they take (a full-pivoting LU with its condition
 // estimate, an LDLT, a Householder QR of a 2N x N matrix) were a seventh of each model's runtime
 // compile, once per model although they depend on nothing but N. They are defined below for every
-// N, and compiled once, into wlx::numerics, for N = 1 to kPrecompiledLimbSize (numerics.cpp); the
+// N, and compiled once, into wlx::numerics, for N = 1 to kPrecompiledLimbSize (limb_steps.cpp); the
 // extern declarations keep every model's runtime from compiling them again. Each model calls them
 // at its own fixed size, so Newton's method keeps its fixed-size speed and allocates nothing (on
 // dynamic-size matrices instead it was 40% slower). A limb of more joints compiles them where it
@@ -26,8 +26,9 @@ using Square = Eigen::Matrix<double, N, N>;
 template <int N>
 using Column = Eigen::Matrix<double, N, 1>;
 
-// The largest N compiled once (the limbs of the built-in models have 1 to 4 joints; a leg of six).
-inline constexpr int kPrecompiledLimbSize = 8;
+// The largest N compiled once: legs of three to six joints, levers of one or two (each size
+// costs wlx's own build about 6 s of CPU at -O3, and saves each model's runtime as much).
+inline constexpr int kPrecompiledLimbSize = 6;
 
 // The Newton step -J^-1 r into `step` when J has full rank and its reciprocal condition estimate
 // is above 1e-12, by a full-pivoting LU; false (step untouched) otherwise.
@@ -68,7 +69,7 @@ Column<N> damped_step(const Square<N>& J, const Column<N>& r, double mu) {
   return stacked.householderQr().solve(rhs);
 }
 
-// Compiled once, in numerics.cpp, for N = 1 to kPrecompiledLimbSize; where nothing links
+// Compiled once, in limb_steps.cpp, for N = 1 to kPrecompiledLimbSize; where nothing links
 // wlx::numerics (the viewer's WebAssembly module defines WLX_LIMB_STEPS_HERE), where they are used.
 #ifndef WLX_LIMB_STEPS_HERE
 #define WLX_LIMB_STEPS_EXTERN(N)                                                                      \
@@ -81,8 +82,6 @@ WLX_LIMB_STEPS_EXTERN(3)
 WLX_LIMB_STEPS_EXTERN(4)
 WLX_LIMB_STEPS_EXTERN(5)
 WLX_LIMB_STEPS_EXTERN(6)
-WLX_LIMB_STEPS_EXTERN(7)
-WLX_LIMB_STEPS_EXTERN(8)
 #undef WLX_LIMB_STEPS_EXTERN
 #endif
 

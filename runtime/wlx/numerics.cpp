@@ -1,7 +1,5 @@
-// The model-independent numerics (numerics.hpp), compiled once for every model, and Newton's limb
-// steps (limb_steps.hpp) at each limb size up to kPrecompiledLimbSize.
+// The model-independent numerics (numerics.hpp), compiled once for every model.
 #include "wlx/numerics.hpp"
-#include "wlx/limb_steps.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -98,22 +96,3 @@ bool inverse_cholesky_factor(const Eigen::Ref<const Eigen::MatrixXd>& W, Eigen::
 }
 
 }  // namespace wlx::numerics
-
-namespace wlx::limb_steps {
-
-#define WLX_LIMB_STEPS_INSTANTIATE(N)                                                   \
-  template bool newton_step<N>(const Square<N>&, const Column<N>&, Column<N>&);         \
-  template Column<N> regularized_step<N>(const Square<N>&, const Column<N>&, double);   \
-  template Column<N> damped_step<N>(const Square<N>&, const Column<N>&, double);
-WLX_LIMB_STEPS_INSTANTIATE(1)
-WLX_LIMB_STEPS_INSTANTIATE(2)
-WLX_LIMB_STEPS_INSTANTIATE(3)
-WLX_LIMB_STEPS_INSTANTIATE(4)
-WLX_LIMB_STEPS_INSTANTIATE(5)
-WLX_LIMB_STEPS_INSTANTIATE(6)
-WLX_LIMB_STEPS_INSTANTIATE(7)
-WLX_LIMB_STEPS_INSTANTIATE(8)
-#undef WLX_LIMB_STEPS_INSTANTIATE
-static_assert(kPrecompiledLimbSize == 8, "instantiate every size up to kPrecompiledLimbSize above");
-
-}  // namespace wlx::limb_steps
