@@ -114,11 +114,6 @@ Matrix3Rows rotation_of(const urdf::Rotation& q) {
 
 namespace {
 
-// TinyXML parses nested elements recursively: bound the depth before it sees the text (a URDF
-// nests five levels; comments, declarations and quoted attribute values are skipped). The same
-// pass counts the elements, and the links and joints among them, so that a file past the limits
-// is refused with the line where it passes them, before anything is built from it (a 64 MB file
-// of empty elements would otherwise take gigabytes in TinyXML's tree).
 // TinyXML (the pre-pass's and urdfdom's XML layer) steps over a UTF-8 lead byte by the length
 // it announces without looking for the end of the text: a sequence cut short by the end of the
 // file makes it read past the buffer (found by fuzz_urdf). XML's text is well-formed UTF-8 in
@@ -140,6 +135,11 @@ void check_encoding(const std::string& text, const Checker& check) {
   }
 }
 
+// TinyXML parses nested elements recursively: bound the depth before it sees the text (a URDF
+// nests five levels; comments, declarations and quoted attribute values are skipped). The same
+// pass counts the elements, and the links and joints among them, so that a file past the limits
+// is refused with the line where it passes them, before anything is built from it (a 64 MB file
+// of empty elements would otherwise take gigabytes in TinyXML's tree).
 void check_xml_bounds(const std::string& text, const Checker& check) {
   int depth = 0, line = 1;
   std::size_t elements = 0, links = 0, joints = 0;

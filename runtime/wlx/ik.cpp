@@ -472,8 +472,7 @@ NewtonReport solve_newton_limbs(const Model& model, Data& data, const std::array
       for (int j = 0; j < idx.count; ++j) {
         const int k = idx.dep[static_cast<std::size_t>(j)];
         const std::string_view unit = gen::kCoordinateUnits[static_cast<std::size_t>(k)];
-        const double move = unit == "rad" ? std::abs(std::remainder(result(k) - previous(k), 2 * std::numbers::pi))
-                                          : std::abs(result(k) - previous(k));
+        const double move = std::abs(unit == "rad" ? wrap(result(k) - previous(k)) : result(k) - previous(k));
         if (!(move <= options.max_jump))
           throw Error(std::string(limb_name(limb)),
                       fmt::format("Newton's method {} another solution: {} moved from {:.6g} to {:.6g} {} between two "
