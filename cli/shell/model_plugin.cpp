@@ -889,7 +889,6 @@ std::string model_file_viewer_module() {
   if (numbers(read_small(building.path / "generated" / "wlx" / "gen" / "model.json", kMaxFileBytes)) != numbers(loaded.description))
     throw Error("viewer", fmt::format("{} changed while wlx was reading it: run the command again", loaded.model_file.string()));
   std::string unity = "// The viewer module's sources in one translation unit (viewer/CMakeLists.txt's lists).\n";
-  unity += "#define WLX_LIMB_STEPS_HERE 1\n";  // no wlx::numerics to link: Newton's limb steps compile here
   for (const auto& f : split_list(WLX_VIEWER_RUNTIME_SOURCES)) unity += include_line(src.runtime_sources / f);
   for (const auto& f : split_list(WLX_VIEWER_CLI_SOURCES)) unity += include_line(src.cli / f);
   unity += include_line(src.viewer_module / "viewer_module.cpp");

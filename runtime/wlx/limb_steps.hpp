@@ -2,22 +2,19 @@
 // dependent joints) and residual r, at the limb's fixed size N (gen::kMaxLimbSize: smaller limbs
 // are padded with a unit diagonal).
 //
-// Why here and not in ik.cpp: the decompositions they take (a full-pivoting LU with its condition
-// estimate, an LDLT, a Householder QR of a 2N x N matrix) were a seventh of each model's runtime
-// compile, once per model although they depend on nothing but N. They are defined below for every
-// N, and compiled once, into wlx::numerics, for N = 1 to kPrecompiledLimbSize (limb_steps.cpp); the
-// extern declarations keep every model's runtime from compiling them again. Each model calls them
-// at its own fixed size, so Newton's method keeps its fixed-size speed and allocates nothing (on
-// dynamic-size matrices instead it was 40% slower). A limb of more joints compiles them where it
-// is used, as before.
+// Written out as loops on the coefficients, not as Eigen's decompositions: at sizes of one to six
+// Eigen unrolls its FullPivLU, LDLT and Householder QR into code that cost about 6 s of CPU per
+// size to compile (36 s for sizes 1 to 6 at -O3, 73 s under the sanitizers), for a few dozen
+// multiply-adds. These loops compile in a fraction of a second for any N, so every model's
+// runtime compiles its own size where it calls them; nothing is precompiled. The steps keep their
+// fixed size and allocate nothing.
 #pragma once
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <Eigen/LU>
-#include <Eigen/QR>
 
 #include <cmath>
+#include <limits>
+#include <utility>
 
 namespace wlx::limb_steps {
 
@@ -26,63 +23,168 @@ using Square = Eigen::Matrix<double, N, N>;
 template <int N>
 using Column = Eigen::Matrix<double, N, 1>;
 
-// The largest N compiled once: legs of three to six joints, levers of one or two (each size
-// costs wlx's own build about 6 s of CPU at -O3, and saves each model's runtime as much).
-inline constexpr int kPrecompiledLimbSize = 6;
-
-// The Newton step -J^-1 r into `step` when J has full rank and its reciprocal condition estimate
-// is above 1e-12, by a full-pivoting LU; false (step untouched) otherwise.
+// An LU factorization with complete pivoting, P J Q = L U (L unit lower triangular), in place.
 template <int N>
-bool newton_step(const Square<N>& J, const Column<N>& r, Column<N>& step);
+struct FullPivotLu {
+  double lu[N][N];
+  int row[N];     // row[k]: J's row at position k
+  int column[N];  // column[k]: J's column at position k
+  bool full_rank = true;
 
-// The step of the regularized normal equations (J^T J + mu I) dx = -J^T r, by LDLT: the
-// backtracking method's step at a singular pose.
-template <int N>
-Column<N> regularized_step(const Square<N>& J, const Column<N>& r, double mu);
+  // Full rank as Eigen's FullPivLU::isInvertible() decides it: every pivot above N machine
+  // epsilons of the first (the largest coefficient of J).
+  explicit FullPivotLu(const Square<N>& J) {
+    for (int i = 0; i < N; ++i) {
+      row[i] = column[i] = i;
+      for (int j = 0; j < N; ++j) lu[i][j] = J(i, j);
+    }
+    double largest = 0;
+    for (int k = 0; k < N; ++k) {
+      int p = k, q = k;
+      for (int i = k; i < N; ++i)
+        for (int j = k; j < N; ++j)
+          if (std::abs(lu[i][j]) > std::abs(lu[p][q])) p = i, q = j;
+      const double pivot = std::abs(lu[p][q]);
+      if (k == 0) largest = pivot;
+      // Not `<=` alone: a NaN pivot is not full rank either.
+      if (!(pivot > N * std::numeric_limits<double>::epsilon() * largest) || largest == 0) {
+        full_rank = false;
+        return;
+      }
+      if (p != k) {
+        std::swap(row[p], row[k]);
+        for (int j = 0; j < N; ++j) std::swap(lu[p][j], lu[k][j]);
+      }
+      if (q != k) {
+        std::swap(column[q], column[k]);
+        for (int i = 0; i < N; ++i) std::swap(lu[i][q], lu[i][k]);
+      }
+      for (int i = k + 1; i < N; ++i) {
+        lu[i][k] /= lu[k][k];
+        for (int j = k + 1; j < N; ++j) lu[i][j] -= lu[i][k] * lu[k][j];
+      }
+    }
+  }
 
-// Levenberg-Marquardt's step: the least-squares solution of [J; sqrt(mu) I] dx = [-r; 0], by QR
-// (the normal equations would square J's condition number, 1e6 at the thesis' worst poses).
-template <int N>
-Column<N> damped_step(const Square<N>& J, const Column<N>& r, double mu);
+  // x = J^-1 b (full rank only).
+  void solve(const double (&b)[N], double (&x)[N]) const {
+    double y[N];
+    for (int i = 0; i < N; ++i) {
+      y[i] = b[row[i]];
+      for (int j = 0; j < i; ++j) y[i] -= lu[i][j] * y[j];
+    }
+    for (int i = N - 1; i >= 0; --i) {
+      for (int j = i + 1; j < N; ++j) y[i] -= lu[i][j] * y[j];
+      y[i] /= lu[i][i];
+    }
+    for (int k = 0; k < N; ++k) x[column[k]] = y[k];
+  }
+};
 
+// The Newton step -J^-1 r into `step` when J has full rank and its reciprocal condition number in
+// the 1-norm is above 1e-12, by an LU with complete pivoting; false (step untouched) otherwise.
+// The condition number is exact (||J||_1 ||J^-1||_1 from J's inverse, N solves), where Eigen's
+// rcond() estimates it from below: the test is, if anything, the stricter.
 template <int N>
 bool newton_step(const Square<N>& J, const Column<N>& r, Column<N>& step) {
-  const Eigen::FullPivLU<Square<N>> lu(J);
-  // Both tests: the condition estimate solves with the LU, which for a J of lower rank leaves the
-  // null directions at zero and so estimates a moderate inverse; the rank test sees that J.
-  if (!lu.isInvertible() || !(lu.rcond() > 1e-12)) return false;
-  step = -lu.solve(r);
+  const FullPivotLu<N> lu(J);
+  if (!lu.full_rank) return false;
+  double norm = 0, inverse_norm = 0;
+  for (int j = 0; j < N; ++j) {
+    double e[N] = {}, column[N];
+    e[j] = 1;
+    lu.solve(e, column);
+    double sum = 0, inverse_sum = 0;
+    for (int i = 0; i < N; ++i) {
+      sum += std::abs(J(i, j));
+      inverse_sum += std::abs(column[i]);
+    }
+    norm = std::max(norm, sum);
+    inverse_norm = std::max(inverse_norm, inverse_sum);
+  }
+  if (!(1.0 / (norm * inverse_norm) > 1e-12)) return false;
+  double b[N], x[N];
+  for (int i = 0; i < N; ++i) b[i] = -r(i);
+  lu.solve(b, x);
+  for (int i = 0; i < N; ++i) step(i) = x[i];
   return true;
 }
 
+// The step of the regularized normal equations (J^T J + mu I) dx = -J^T r, mu > 0, by Cholesky's
+// factorization (the matrix is positive definite): the backtracking method's step at a singular
+// pose.
 template <int N>
 Column<N> regularized_step(const Square<N>& J, const Column<N>& r, double mu) {
-  return -(J.transpose() * J + mu * Square<N>::Identity()).ldlt().solve(J.transpose() * r);
+  double L[N][N] = {}, b[N];
+  for (int i = 0; i < N; ++i) {
+    b[i] = 0;
+    for (int k = 0; k < N; ++k) b[i] -= J(k, i) * r(k);
+  }
+  // A = J^T J + mu I, its lower triangle factorized as L L^T column by column.
+  for (int j = 0; j < N; ++j) {
+    for (int i = j; i < N; ++i) {
+      double a = i == j ? mu : 0;
+      for (int k = 0; k < N; ++k) a += J(k, i) * J(k, j);
+      for (int k = 0; k < j; ++k) a -= L[i][k] * L[j][k];
+      L[i][j] = i == j ? std::sqrt(a) : a / L[j][j];
+    }
+  }
+  Column<N> x;
+  for (int i = 0; i < N; ++i) {
+    for (int k = 0; k < i; ++k) b[i] -= L[i][k] * b[k];
+    b[i] /= L[i][i];
+  }
+  for (int i = N - 1; i >= 0; --i) {
+    for (int k = i + 1; k < N; ++k) b[i] -= L[k][i] * b[k];
+    b[i] /= L[i][i];
+    x(i) = b[i];
+  }
+  return x;
 }
 
+// Levenberg-Marquardt's step: the least-squares solution of [J; sqrt(mu) I] dx = [-r; 0], mu > 0,
+// by Householder's QR of the 2N x N stack (the normal equations would square J's condition
+// number, 1e6 at the thesis' worst poses).
 template <int N>
 Column<N> damped_step(const Square<N>& J, const Column<N>& r, double mu) {
-  Eigen::Matrix<double, 2 * N, N> stacked;
-  stacked << J, std::sqrt(mu) * Square<N>::Identity();
-  Eigen::Matrix<double, 2 * N, 1> rhs;
-  rhs << -r, Column<N>::Zero();
-  return stacked.householderQr().solve(rhs);
+  constexpr int M = 2 * N;
+  double a[M][N] = {}, b[M] = {};
+  const double root_mu = std::sqrt(mu);
+  for (int i = 0; i < N; ++i) {
+    for (int j = 0; j < N; ++j) a[i][j] = J(i, j);
+    a[N + i][i] = root_mu;
+    b[i] = -r(i);
+  }
+  for (int k = 0; k < N; ++k) {
+    // The reflection I - 2 v v^T / (v^T v) that maps column k below the diagonal onto its first entry.
+    double norm = 0;
+    for (int i = k; i < M; ++i) norm += a[i][k] * a[i][k];
+    norm = std::sqrt(norm);
+    if (norm == 0) continue;
+    const double alpha = a[k][k] > 0 ? -norm : norm;
+    double v[M];
+    for (int i = k; i < M; ++i) v[i] = a[i][k];
+    v[k] -= alpha;
+    double vv = 0;
+    for (int i = k; i < M; ++i) vv += v[i] * v[i];
+    for (int j = k; j < N; ++j) {
+      double dot = 0;
+      for (int i = k; i < M; ++i) dot += v[i] * a[i][j];
+      const double f = 2 * dot / vv;
+      for (int i = k; i < M; ++i) a[i][j] -= f * v[i];
+    }
+    double dot = 0;
+    for (int i = k; i < M; ++i) dot += v[i] * b[i];
+    const double f = 2 * dot / vv;
+    for (int i = k; i < M; ++i) b[i] -= f * v[i];
+  }
+  Column<N> x;
+  for (int i = N - 1; i >= 0; --i) {
+    for (int j = i + 1; j < N; ++j) b[i] -= a[i][j] * b[j];
+    b[i] /= a[i][i];
+    x(i) = b[i];
+  }
+  return x;
 }
-
-// Compiled once, in limb_steps.cpp, for N = 1 to kPrecompiledLimbSize; where nothing links
-// wlx::numerics (the viewer's WebAssembly module defines WLX_LIMB_STEPS_HERE), where they are used.
-#ifndef WLX_LIMB_STEPS_HERE
-#define WLX_LIMB_STEPS_EXTERN(N)                                                                      \
-  extern template bool newton_step<N>(const Square<N>&, const Column<N>&, Column<N>&);               \
-  extern template Column<N> regularized_step<N>(const Square<N>&, const Column<N>&, double);          \
-  extern template Column<N> damped_step<N>(const Square<N>&, const Column<N>&, double);
-WLX_LIMB_STEPS_EXTERN(1)
-WLX_LIMB_STEPS_EXTERN(2)
-WLX_LIMB_STEPS_EXTERN(3)
-WLX_LIMB_STEPS_EXTERN(4)
-WLX_LIMB_STEPS_EXTERN(5)
-WLX_LIMB_STEPS_EXTERN(6)
-#undef WLX_LIMB_STEPS_EXTERN
-#endif
 
 }  // namespace wlx::limb_steps

@@ -74,9 +74,8 @@ TEST_CASE("numerics: the smallest eigenvector, the left null space and the inver
   CHECK(untouched(0, 0) == 7.0);
 }
 
-// Newton's limb steps by what defines them, at a size compiled once into wlx::numerics (3) and at
-// one beyond kPrecompiledLimbSize (9), which this file compiles itself: both link and agree with
-// the definitions (J step = -r; the normal equations of the damped problems).
+// Newton's limb steps by what defines them, at a limb size (3) and at one beyond any built-in
+// model's (9): J step = -r; the normal equations of the damped problems; no step for a singular J.
 template <int N>
 void check_limb_steps() {
   CAPTURE(N);
@@ -101,9 +100,17 @@ void check_limb_steps() {
   Column<N> untouched = Column<N>::Constant(7.0);
   CHECK(!newton_step<N>(singular, r, untouched));
   CHECK(untouched == Column<N>::Constant(7.0));
+  // Full rank but conditioned past the 1e-12 bound (1-norm condition 1e13): no Newton step either;
+  // at 1e11 the step is taken, and solves the system.
+  Square<N> ill = Square<N>::Identity();
+  ill(1, 1) = 1e-13;
+  CHECK(!newton_step<N>(ill, r, untouched));
+  ill(1, 1) = 1e-11;
+  REQUIRE(newton_step<N>(ill, r, step));
+  CHECK(std::abs(step(1) + r(1) * 1e11) <= 1e-14 * std::abs(r(1)) * 1e11);  // a diagonal solve: a rounding or two
 }
 
-TEST_CASE("limb_steps: Newton's and the damped steps at a precompiled size and beyond it") {
+TEST_CASE("limb_steps: Newton's and the damped steps at a limb's size and beyond it") {
   check_limb_steps<3>();
   check_limb_steps<9>();
 }
