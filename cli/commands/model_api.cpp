@@ -9,6 +9,7 @@
 #include "outputs.hpp"
 #include "scenario_io.hpp"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <wlx/contacts.hpp>
 #include <wlx/dynamics.hpp>
