@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -32,22 +33,19 @@ struct FullPivotLu {
   bool full_rank = true;
 
   // Full rank as Eigen's FullPivLU::isInvertible() decides it: every pivot above N machine
-  // epsilons of the first (the largest coefficient of J).
+  // epsilons of the largest pivot, judged once all are known (a later pivot may be the largest).
   explicit FullPivotLu(const Square<N>& J) {
     for (int i = 0; i < N; ++i) {
       row[i] = column[i] = i;
       for (int j = 0; j < N; ++j) lu[i][j] = J(i, j);
     }
-    double largest = 0;
     for (int k = 0; k < N; ++k) {
       int p = k, q = k;
       for (int i = k; i < N; ++i)
         for (int j = k; j < N; ++j)
           if (std::abs(lu[i][j]) > std::abs(lu[p][q])) p = i, q = j;
-      const double pivot = std::abs(lu[p][q]);
-      if (k == 0) largest = pivot;
-      // Not `<=` alone: a NaN pivot is not full rank either.
-      if (!(pivot > N * std::numeric_limits<double>::epsilon() * largest) || largest == 0) {
+      // A zero pivot ends the elimination (nothing to divide by); so does a NaN (`!(x > 0)`).
+      if (!(std::abs(lu[p][q]) > 0) || !std::isfinite(lu[p][q])) {
         full_rank = false;
         return;
       }
@@ -64,6 +62,10 @@ struct FullPivotLu {
         for (int j = k + 1; j < N; ++j) lu[i][j] -= lu[i][k] * lu[k][j];
       }
     }
+    double largest = 0;
+    for (int k = 0; k < N; ++k) largest = std::max(largest, std::abs(lu[k][k]));
+    for (int k = 0; k < N; ++k)
+      if (!(std::abs(lu[k][k]) > N * std::numeric_limits<double>::epsilon() * largest)) full_rank = false;
   }
 
   // x = J^-1 b (full rank only).
@@ -110,9 +112,10 @@ bool newton_step(const Square<N>& J, const Column<N>& r, Column<N>& step) {
   return true;
 }
 
-// The step of the regularized normal equations (J^T J + mu I) dx = -J^T r, mu > 0, by Cholesky's
-// factorization (the matrix is positive definite): the backtracking method's step at a singular
-// pose.
+// The step of the regularized normal equations (J^T J + mu I) dx = -J^T r by Cholesky's
+// factorization: the backtracking method's step at a singular pose. The matrix must be positive
+// definite in floating point, so mu well above N eps ||J||_F^2 (ik.cpp passes 1e-8 max(1, ||J||_F^2),
+// about 1e7 times that): at a mu lost in rounding a pivot of a singular J^T J may come out negative.
 template <int N>
 Column<N> regularized_step(const Square<N>& J, const Column<N>& r, double mu) {
   double L[N][N] = {}, b[N];
@@ -144,7 +147,8 @@ Column<N> regularized_step(const Square<N>& J, const Column<N>& r, double mu) {
 
 // Levenberg-Marquardt's step: the least-squares solution of [J; sqrt(mu) I] dx = [-r; 0], mu > 0,
 // by Householder's QR of the 2N x N stack (the normal equations would square J's condition
-// number, 1e6 at the thesis' worst poses).
+// number, 1e6 at the excavator's worst poses). Row N + k keeps its sqrt(mu) until column k is
+// reduced, so every column's norm is at least sqrt(mu) and R's diagonal has no zero.
 template <int N>
 Column<N> damped_step(const Square<N>& J, const Column<N>& r, double mu) {
   constexpr int M = 2 * N;
@@ -160,7 +164,6 @@ Column<N> damped_step(const Square<N>& J, const Column<N>& r, double mu) {
     double norm = 0;
     for (int i = k; i < M; ++i) norm += a[i][k] * a[i][k];
     norm = std::sqrt(norm);
-    if (norm == 0) continue;
     const double alpha = a[k][k] > 0 ? -norm : norm;
     double v[M];
     for (int i = k; i < M; ++i) v[i] = a[i][k];

@@ -1,6 +1,7 @@
 // The model-independent numerics (runtime/wlx/numerics.hpp), compiled once for every model: the
 // QP against problems solved by hand (KKT conditions), and each decomposition against the
-// property that defines it.
+// property that defines it; and Newton's limb steps (runtime/wlx/limb_steps.hpp), which each
+// model compiles at its own limb size, likewise.
 #include "wlx/limb_steps.hpp"
 #include "wlx/numerics.hpp"
 
@@ -74,8 +75,11 @@ TEST_CASE("numerics: the smallest eigenvector, the left null space and the inver
   CHECK(untouched(0, 0) == 7.0);
 }
 
-// Newton's limb steps by what defines them, at a limb size (3) and at one beyond any built-in
-// model's (9): J step = -r; the normal equations of the damped problems; no step for a singular J.
+// Newton's limb steps by what defines them, at one joint (a lever), at a leg's three and at nine
+// (beyond any built-in model): J step = -r; the normal equations of the damped problems; no step
+// for a singular or too badly conditioned J, and the step then left as it was. The residual bounds
+// are about a hundred times N eps ||J||^2 ||step|| (J's entries are at most 4, the steps O(1)):
+// they pass the rounding of any backward-stable solve and fail a wrong sign, pivot or scale.
 template <int N>
 void check_limb_steps() {
   CAPTURE(N);
@@ -89,28 +93,44 @@ void check_limb_steps() {
   Column<N> step = Column<N>::Zero();
   REQUIRE(newton_step<N>(J, r, step));
   CHECK((J * step + r).cwiseAbs().maxCoeff() <= 1e-13);
-  const double mu = 0.25;
-  const Column<N> damped = damped_step<N>(J, r, mu), regularized = regularized_step<N>(J, r, mu);
-  const Square<N> normal = J.transpose() * J + mu * Square<N>::Identity();
-  CHECK((normal * damped + J.transpose() * r).cwiseAbs().maxCoeff() <= 1e-12);
-  CHECK((normal * regularized + J.transpose() * r).cwiseAbs().maxCoeff() <= 1e-12);
-  // A singular J (two equal rows) has no Newton step: the step is left as it was.
-  Square<N> singular = J;
-  singular.row(1) = singular.row(0);
+  const auto check_damped = [&](const Square<N>& A, const char* what) {
+    INFO(what);
+    const double mu = 0.25;
+    const Column<N> damped = damped_step<N>(A, r, mu), regularized = regularized_step<N>(A, r, mu);
+    const Square<N> normal = A.transpose() * A + mu * Square<N>::Identity();
+    CHECK((normal * damped + A.transpose() * r).cwiseAbs().maxCoeff() <= 1e-12);
+    CHECK((normal * regularized + A.transpose() * r).cwiseAbs().maxCoeff() <= 1e-12);
+  };
+  check_damped(J, "a regular J");
   Column<N> untouched = Column<N>::Constant(7.0);
-  CHECK(!newton_step<N>(singular, r, untouched));
-  CHECK(untouched == Column<N>::Constant(7.0));
-  // Full rank but conditioned past the 1e-12 bound (1-norm condition 1e13): no Newton step either;
-  // at 1e11 the step is taken, and solves the system.
-  Square<N> ill = Square<N>::Identity();
-  ill(1, 1) = 1e-13;
-  CHECK(!newton_step<N>(ill, r, untouched));
-  ill(1, 1) = 1e-11;
-  REQUIRE(newton_step<N>(ill, r, step));
-  CHECK(std::abs(step(1) + r(1) * 1e11) <= 1e-14 * std::abs(r(1)) * 1e11);  // a diagonal solve: a rounding or two
+  if constexpr (N >= 2) {
+    // A singular J (two equal rows) has no Newton step: the step is left as it was. The damped
+    // steps, there for such a J, still solve their normal equations.
+    Square<N> singular = J;
+    singular.row(1) = singular.row(0);
+    CHECK(!newton_step<N>(singular, r, untouched));
+    CHECK(untouched == Column<N>::Constant(7.0));
+    check_damped(singular, "a singular J");
+    // Full rank but conditioned past the 1e-12 bound (1-norm condition 1e13): no Newton step
+    // either; at 1e11 the step is taken, and solves the system.
+    Square<N> ill = Square<N>::Identity();
+    ill(1, 1) = 1e-13;
+    CHECK(!newton_step<N>(ill, r, untouched));
+    CHECK(untouched == Column<N>::Constant(7.0));
+    ill(1, 1) = 1e-11;
+    REQUIRE(newton_step<N>(ill, r, step));
+    CHECK(std::abs(step(1) + r(1) * 1e11) <= 1e-14 * std::abs(r(1)) * 1e11);  // a diagonal solve: a rounding or two
+    CHECK((ill * step + r).cwiseAbs().maxCoeff() <= 1e-15);
+  } else {
+    // One joint: a zero derivative has no Newton step.
+    CHECK(!newton_step<N>(Square<N>::Zero(), r, untouched));
+    CHECK(untouched == Column<N>::Constant(7.0));
+    check_damped(Square<N>::Zero(), "a zero J");
+  }
 }
 
 TEST_CASE("limb_steps: Newton's and the damped steps at a limb's size and beyond it") {
+  check_limb_steps<1>();
   check_limb_steps<3>();
   check_limb_steps<9>();
 }
