@@ -19,12 +19,8 @@ namespace {
 
 std::size_t at(int i) { return static_cast<std::size_t>(i); }
 
-// Templates on the factorization's and the rows' types, so that for a model without wheels (no
-// factorization, 0-row matrices whose rows Eigen refuses at compile time) nothing is compiled.
-template <typename LU>
-void solve_transposed(const LU& factors, const WheelVector& rhs, WheelVector& x) {
-  if constexpr (!std::is_same_v<LU, char>) x = factors.transpose().solve(rhs);
-}
+// A template on the rows' type, so that for a model without wheels (0-row matrices, whose rows
+// Eigen refuses at compile time) nothing is compiled.
 template <typename Rows>
 void subtract_row(const Rows& rows, int w, double scale, Coordinates& r) {
   if constexpr (Rows::RowsAtCompileTime > 0) r.noalias() -= rows.row(w).transpose() * scale;
@@ -54,7 +50,7 @@ void multipliers(const Data& d, const Coordinates& r, gen::ClosureVector& lambda
       const int k = pair.index[at(w)];
       rhs(w) = r(k) - d.dPhi_ds.col(k).dot(lambda);
     }
-    solve_transposed(d.J_beta_lu, rhs, mu);
+    d.J_beta_lu.solve_transposed(rhs, mu);
     lambda.noalias() -= d.wheel_adjoint * mu;
   } else {
     static_cast<void>(mu);

@@ -4,7 +4,6 @@
 #include "wlx/numerics.hpp"
 
 #include <Eigen/Geometry>
-#include <Eigen/QR>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -462,28 +461,24 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
                      combination);
 }
 
-// The same with column pivoting and a rank test: for poses where the fast path declines. Kept out
-// of line: inlined, its dynamic-size blocks cost the fast path a 2 KB stack frame.
+// The same with column pivoting and a rank test, for poses where the fast path declines: compiled
+// once, at run-time sizes (numerics.hpp), being off the hot path. Kept out of line and cold, so
+// that the fast path's frame stays small.
 [[gnu::noinline, gnu::cold]] TorqueVector min_norm_solve_pivoted(const ActuatorJacobian& At, const CommandVector& Qstar, const Weighting& weighting) {
   constexpr int kU = kCommandedCount;
   // From A^T P = Q R (column-pivoted, rank-revealing QR), x = Q [R^-T P^T Q*; 0].
   if (!At.allFinite())  // no rank to speak of, and no combination to name
     throw Error("J_beta", "the actuator Jacobian has a non-finite entry: the pose or the parameters are outside the model's domain");
-  Eigen::ColPivHouseholderQR<ActuatorJacobian> qr;
-  qr.setThreshold(1e-13);  // relative to the largest pivot: only a real rank loss, not ID-3's 1e6 conditioning
-  qr.compute(At);
-  if (qr.rank() < kU) {
+  // 1e-13 relative to the largest pivot: only a real rank loss, not ID-3's 1e6 conditioning.
+  TorqueVector x;
+  const int rank = numerics::min_norm_solve_pivoted(At, Qstar, 1e-13, x);
+  if (rank < kU) {
     std::string u;
     for (int k : kCommandedSpeeds) u += fmt::format("{}{}'", u.empty() ? "" : ", ", gen::kCoordinateNames[static_cast<std::size_t>(k)]);
     throw Error("J_beta", fmt::format("the actuator Jacobian has rank {} < {} with {}: the {} actuators cannot produce "
                                       "every generalized force on u = [{}] in this pose: {}",
-                                      qr.rank(), kU, weighting.label(), kActuatedCount, u, unactuated_motion(At)));
+                                      rank, kU, weighting.label(), kActuatedCount, u, unactuated_motion(At)));
   }
-  const CommandMatrix R = qr.matrixR().template topLeftCorner<kU, kU>().template triangularView<Eigen::Upper>();
-  const CommandVector y = R.transpose().template triangularView<Eigen::Lower>().solve(qr.colsPermutation().transpose() * Qstar);
-  TorqueVector x = TorqueVector::Zero();
-  x.template head<kU>() = y;
-  x.applyOnTheLeft(qr.householderQ());
   return x;
 }
 

@@ -8,7 +8,9 @@
 
 #include <wlx/gen/all.hpp>
 
-#include <Eigen/LU>  // Matrix4d::inverse, PartialPivLU
+#include "wlx/small_dense.hpp"
+
+#include <Eigen/LU>  // Matrix4d::inverse
 
 #include <string_view>
 #include <type_traits>
@@ -79,9 +81,7 @@ struct Data {
   Eigen::Matrix<double, gen::kDependentCount, gen::kWheelCount> wheel_adjoint;
   Eigen::Matrix<double, gen::kWheelCount, gen::kWheelCount> J_beta;
   // J_beta's LU factorization (partial pivoting), once per step: every solve with J_beta uses it.
-  // (A model without wheels has nothing to factorize, and Eigen no 0 x 0 LU.)
-  std::conditional_t<(gen::kWheelCount > 0), Eigen::PartialPivLU<Eigen::Matrix<double, gen::kWheelCount, gen::kWheelCount>>, char>
-      J_beta_lu;
+  small::PartialPivotLu<gen::kWheelCount> J_beta_lu;
   double cond_J_beta = 0;
 };
 

@@ -3,7 +3,6 @@
 #include "wlx/error.hpp"
 #include "wlx/ik.hpp"
 
-#include <Eigen/SVD>
 #include <fmt/format.h>
 
 #include <cmath>
@@ -72,33 +71,6 @@ void reduce(Data& d) {
   });
 }
 
-// B := J_beta^-1 B from the step's LU factors, all columns at once: the permutation, then the
-// unit lower and the upper triangle row by row, the operations of Eigen's solve (so its backward
-// stability: the rolling rows hold to rounding even where J_beta is badly conditioned) without its
-// per-column calls or its GEMM kernel for a matrix right-hand side.
-// (Templates on the factorization's type, so that for a model without wheels, whose Data holds
-// none, nothing here is compiled.)
-template <typename LU>
-void factorize_J_beta(LU& factors, const WheelMatrix& J_beta) {
-  if constexpr (!std::is_same_v<LU, char>) factors.compute(J_beta);
-}
-
-template <int N, typename LU>
-void solve_with_J_beta(const LU& factors, Eigen::Matrix<double, kWheelCount, N>& B) {
-  if constexpr (!std::is_same_v<LU, char>) {
-    const WheelMatrix& lu = factors.matrixLU();
-    B = factors.permutationP() * B;
-    for (int i = 1; i < kWheelCount; ++i)
-      for (int j = 0; j < i; ++j) B.row(i) -= lu(i, j) * B.row(j);
-    for (int i = kWheelCount - 1; i >= 0; --i) {
-      for (int j = i + 1; j < kWheelCount; ++j) B.row(i) -= lu(i, j) * B.row(j);
-      B.row(i) /= lu(i, i);
-    }
-  } else {
-    static_cast<void>(factors), static_cast<void>(B);
-  }
-}
-
 // The dependent joints' part of s'' or s' for a closure right-hand side: Phi_dep x = -v.
 void solve_closure(const Data& d, const gen::ClosureVector& v, Coordinates& out) {
   for_each_limb([&](auto L) {
@@ -129,7 +101,7 @@ void solve_pair_and_closure(const Data& d, const DependentPair& pair, const gen:
   }
   if constexpr (kWheelCount > 0) {
     WheelVector pair_rate = d.wheel_adjoint.transpose().lazyProduct(closure) - wheels;
-    solve_with_J_beta(d.J_beta_lu, pair_rate);
+    d.J_beta_lu.solve_in_place(pair_rate);
     for (int w = 0; w < kWheelCount; ++w) {
       const int k = pair.index[static_cast<std::size_t>(w)];
       out(k) = pair_rate(w);
@@ -160,10 +132,7 @@ double condition_number(const WheelMatrix& J) {
     const double smax = 0.5 * (std::sqrt(p) + std::sqrt(q));
     return smax * smax / D;
   } else {
-    if (!J.allFinite()) return kInfinity;
-    const Eigen::JacobiSVD<WheelMatrix> svd(J);
-    const double smin = svd.singularValues().minCoeff();
-    return smin > 0 ? svd.singularValues().maxCoeff() / smin : kInfinity;
+    return small::condition_number<kWheelCount>(J);
   }
 }
 
@@ -227,7 +196,7 @@ void factorize_dependent_rates(Data& d, const DependentPair& pair, const Nonholo
   reduce(d);
   for (int k = 0; k < kWheelCount; ++k) d.J_beta.col(k) = reduced_column(d, pair.index[k]);
   d.cond_J_beta = condition_number(d.J_beta);
-  factorize_J_beta(d.J_beta_lu, d.J_beta);  // once: the rate basis and the accelerations use it
+  d.J_beta_lu.compute(d.J_beta);  // once: the rate basis and the accelerations use it
   if (!(d.cond_J_beta <= options.max_condition))
     throw Error(
         "dependent",
@@ -266,7 +235,7 @@ void rate_basis(const Data& d, const std::array<int, N>& commanded, const Depend
   Eigen::Matrix<double, kWheelCount, kU> pair_rates;
   if constexpr (kWheelCount > 0) {
     pair_rates = -ch;
-    solve_with_J_beta(d.J_beta_lu, pair_rates);
+    d.J_beta_lu.solve_in_place(pair_rates);
   }
   T.setZero();
   for (int k = 0; k < kU; ++k) {

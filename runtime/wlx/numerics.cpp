@@ -95,4 +95,21 @@ bool inverse_cholesky_factor(const Eigen::Ref<const Eigen::MatrixXd>& W, Eigen::
   return true;
 }
 
+int min_norm_solve_pivoted(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eigen::Ref<const Eigen::VectorXd>& b,
+                           double threshold, Eigen::Ref<Eigen::VectorXd> x) {
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr;
+  qr.setThreshold(threshold);
+  qr.compute(M);
+  const Eigen::Index n = M.cols();
+  const int rank = static_cast<int>(qr.rank());
+  if (rank < n) return rank;
+  const Eigen::MatrixXd R = qr.matrixR().topLeftCorner(n, n).triangularView<Eigen::Upper>();
+  const Eigen::VectorXd y = R.transpose().triangularView<Eigen::Lower>().solve(qr.colsPermutation().transpose() * b);
+  Eigen::VectorXd full = Eigen::VectorXd::Zero(M.rows());
+  full.head(n) = y;
+  full.applyOnTheLeft(qr.householderQ());
+  x = full;
+  return rank;
+}
+
 }  // namespace wlx::numerics

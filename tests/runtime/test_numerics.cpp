@@ -1,13 +1,19 @@
 // The model-independent numerics (runtime/wlx/numerics.hpp), compiled once for every model: the
 // QP against problems solved by hand (KKT conditions), and each decomposition against the
 // property that defines it; and Newton's limb steps (runtime/wlx/limb_steps.hpp), which each
-// model compiles at its own limb size, likewise.
+// model compiles at its own limb size, likewise; and the wheels' LU and condition number
+// (runtime/wlx/small_dense.hpp) against Eigen's decompositions.
 #include "wlx/limb_steps.hpp"
 #include "wlx/numerics.hpp"
+#include "wlx/small_dense.hpp"
 
 #include <doctest/doctest.h>
 
 #include <Eigen/Dense>
+
+#include <cmath>
+#include <limits>
+#include <random>
 
 TEST_CASE("qp::solve: an unconstrained problem (no rows) is solved in one exact step; x = -H^-1 c") {
   Eigen::MatrixXd H(2, 2);
@@ -133,4 +139,90 @@ TEST_CASE("limb_steps: Newton's and the damped steps at a limb's size and beyond
   check_limb_steps<1>();
   check_limb_steps<3>();
   check_limb_steps<9>();
+}
+
+TEST_CASE("numerics::min_norm_solve_pivoted: the minimum-norm solution of M^T x = b, and the rank where M loses it") {
+  // M 6 x 3 of full rank: x solves M^T x = b and lies in M's column space (so it has the least
+  // norm of all solutions: any other differs by a null-space vector of M^T, orthogonal to it).
+  Eigen::MatrixXd M(6, 3);
+  M << 1, 2, 0, 0, 1, 1, 3, 0, 1, 1, 1, 1, 0, 2, 5, 4, 0, 1;
+  const Eigen::VectorXd b = Eigen::Vector3d(1, -2, 0.5);
+  Eigen::VectorXd x(6);
+  REQUIRE(wlx::numerics::min_norm_solve_pivoted(M, b, 1e-13, x) == 3);
+  // M's entries are at most 5 and its condition number is about 5: residuals at rounding level.
+  CHECK((M.transpose() * x - b).norm() <= 1e-13);
+  const Eigen::MatrixXd P = M * (M.transpose() * M).inverse() * M.transpose();  // projector onto range(M)
+  CHECK((P * x - x).norm() <= 1e-13);
+  // A third column that is the sum of the first two: rank 2, and x is left as it was.
+  M.col(2) = M.col(0) + M.col(1);
+  Eigen::VectorXd untouched = Eigen::VectorXd::Constant(6, 7.0);
+  CHECK(wlx::numerics::min_norm_solve_pivoted(M, b, 1e-13, untouched) == 2);
+  CHECK(untouched == Eigen::VectorXd::Constant(6, 7.0));
+}
+
+namespace {
+
+// The LU's solves and the condition number at size N against Eigen's PartialPivLU and JacobiSVD, on
+// random matrices with singular values from 1 down to 10^-k (U diag V^T with random orthogonal U, V).
+template <int N>
+void check_small_dense(std::mt19937& random) {
+  using Square = Eigen::Matrix<double, N, N>;
+  using Column = Eigen::Matrix<double, N, 1>;
+  std::normal_distribution<double> normal;
+  const auto gaussian = [&] { return Square::NullaryExpr([&](Eigen::Index, Eigen::Index) { return normal(random); }); };
+  for (int trial = 0; trial < 200; ++trial) {
+    const int k = trial % 11;  // condition numbers 1 to 1e10
+    const Square U = Eigen::HouseholderQR<Square>(gaussian()).householderQ();
+    const Square V = Eigen::HouseholderQR<Square>(gaussian()).householderQ();
+    Column sigma;
+    for (int i = 0; i < N; ++i) sigma(i) = N == 1 ? 1.0 : std::pow(10.0, -k * double(i) / (N - 1));
+    const Square A = U * sigma.asDiagonal() * V.transpose();
+    const Column b = Column::NullaryExpr([&](Eigen::Index) { return normal(random); });
+
+    wlx::small::PartialPivotLu<N> lu;
+    lu.compute(A);
+    const Eigen::PartialPivLU<Square> eigen(A);
+    Eigen::Matrix<double, N, 2> B;
+    B << b, 2 * b;
+    lu.template solve_in_place<2>(B);
+    const Column x_eigen = eigen.solve(b), xt_eigen = eigen.transpose().solve(b);
+    Column xt;
+    lu.solve_transposed(b, xt);
+    // Both are backward stable and pivot the same way: the solutions agree to the condition
+    // number times rounding, and the residuals are at rounding relative to |A| |x|.
+    const double cond = sigma(0) / sigma(N - 1), scale = x_eigen.norm() + xt_eigen.norm();
+    CHECK((B.col(0) - x_eigen).norm() <= 1e-14 * cond * scale);
+    CHECK((B.col(1) - 2 * x_eigen).norm() <= 2e-14 * cond * scale);
+    CHECK((xt - xt_eigen).norm() <= 1e-14 * cond * scale);
+    CHECK((A * B.col(0) - b).norm() <= 1e-14 * N * (1 + A.norm() * B.col(0).norm()));
+    CHECK((A.transpose() * xt - b).norm() <= 1e-14 * N * (1 + A.norm() * xt.norm()));
+
+    // The condition number against Eigen's SVD of the same stored A: any backward-stable method
+    // finds sigma_min to about eps sigma_max, so the two agree to a relative 1e-14 cond (1e-4 at
+    // 1e10, 1e-14 at 1), and both to the construction's sigma (whose rounding is of that order too).
+    const Column sv = Eigen::JacobiSVD<Square>(A).singularValues();
+    const double mine = wlx::small::condition_number<N>(A), eigens = sv(0) / sv(N - 1);
+    CHECK(std::abs(mine - eigens) <= 1e-14 * cond * eigens);
+    CHECK(std::abs(mine - cond) <= 1e-14 * cond * cond);
+  }
+  // Singular and non-finite matrices have an infinite condition number.
+  Square singular = gaussian();
+  if constexpr (N > 1) singular.col(N - 1) = singular.col(0);
+  else singular.setZero();
+  CHECK(wlx::small::condition_number<N>(singular) >= 1e15);
+  Square nan = gaussian();
+  nan(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  CHECK(wlx::small::condition_number<N>(nan) == std::numeric_limits<double>::infinity());
+}
+
+}  // namespace
+
+TEST_CASE("small_dense: the wheels' LU and condition number agree with Eigen's at 1 to 6 wheels") {
+  std::mt19937 random(20261206);
+  check_small_dense<1>(random);
+  check_small_dense<2>(random);
+  check_small_dense<3>(random);
+  check_small_dense<4>(random);
+  check_small_dense<5>(random);
+  check_small_dense<6>(random);
 }

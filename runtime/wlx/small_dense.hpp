@@ -1,0 +1,113 @@
+// Dense decompositions of the wheels' square matrix J_beta (one row and column per wheel) at its
+// fixed size N, written out as loops on the coefficients: an LU factorization with partial pivoting
+// and the 2-norm condition number by one-sided Jacobi rotations.
+//
+// Why not Eigen's PartialPivLU and JacobiSVD: at fixed sizes Eigen unrolls them into code that cost
+// 1.5-2 s of CPU per model to compile (the quadruped's four wheels: the LU's factorization, solve
+// and transposed solve 1.7 s, the SVD 0.5 s more), for a few dozen multiply-adds a step. The LU does
+// Eigen's unblocked partial-pivoting elimination in Eigen's order (the largest entry of the column,
+// rows swapped whole, the column below divided by the pivot, the trailing block updated), so it
+// keeps its backward stability: the rolling rows hold to rounding where J_beta is badly
+// conditioned. Nothing here allocates.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace wlx::small {
+
+// P A = L U for a square A of size N (L unit lower triangular, below the diagonal of `lu`; U on
+// and above it). A zero column below the diagonal is left as it is, as Eigen does: a singular A
+// gets infinite or NaN solutions, which the callers' condition test refuses first.
+template <int N>
+struct PartialPivotLu {
+  Eigen::Matrix<double, N, N> lu;
+  int row[N > 0 ? N : 1] = {};  // row[k]: A's row at position k of P A
+
+  void compute(const Eigen::Matrix<double, N, N>& A) {
+    lu = A;
+    for (int i = 0; i < N; ++i) row[i] = i;
+    for (int k = 0; k < N; ++k) {
+      int p = k;
+      for (int i = k + 1; i < N; ++i)
+        if (std::abs(lu(i, k)) > std::abs(lu(p, k))) p = i;
+      if (lu(p, k) == 0) continue;  // nothing to eliminate with (Eigen records it and goes on)
+      if (p != k) {
+        lu.row(p).swap(lu.row(k));
+        std::swap(row[p], row[k]);
+      }
+      for (int i = k + 1; i < N; ++i) lu(i, k) /= lu(k, k);
+      for (int j = k + 1; j < N; ++j)
+        for (int i = k + 1; i < N; ++i) lu(i, j) -= lu(i, k) * lu(k, j);
+    }
+  }
+
+  // B := A^-1 B, all columns at once: the permutation, then L and U row by row.
+  template <int Cols>
+  void solve_in_place(Eigen::Matrix<double, N, Cols>& B) const {
+    Eigen::Matrix<double, N, Cols> permuted;
+    for (int i = 0; i < N; ++i) permuted.row(i) = B.row(row[i]);
+    B = permuted;
+    for (int i = 1; i < N; ++i)
+      for (int j = 0; j < i; ++j) B.row(i) -= lu(i, j) * B.row(j);
+    for (int i = N - 1; i >= 0; --i) {
+      for (int j = i + 1; j < N; ++j) B.row(i) -= lu(i, j) * B.row(j);
+      B.row(i) /= lu(i, i);
+    }
+  }
+
+  // x = A^-T b: A^T = U^T L^T P, so U^T z = b forwards, L^T w = z backwards, x = P^T w.
+  void solve_transposed(const Eigen::Matrix<double, N, 1>& b, Eigen::Matrix<double, N, 1>& x) const {
+    Eigen::Matrix<double, N, 1> w = b;
+    for (int i = 0; i < N; ++i) {
+      for (int j = 0; j < i; ++j) w(i) -= lu(j, i) * w(j);
+      w(i) /= lu(i, i);
+    }
+    for (int i = N - 1; i >= 0; --i)
+      for (int j = i + 1; j < N; ++j) w(i) -= lu(j, i) * w(j);
+    for (int i = 0; i < N; ++i) x(row[i]) = w(i);
+  }
+};
+
+// sigma_max / sigma_min of a square A, infinite for a singular or non-finite A. One-sided Jacobi
+// (Hestenes): plane rotations of column pairs until every pair is orthogonal to working precision;
+// the singular values are then the columns' norms, each to high relative accuracy, so a small
+// sigma_min is not swamped by the rounding of a large sigma_max (as it would be through A^T A's
+// eigenvalues, which square the condition number).
+template <int N>
+double condition_number(Eigen::Matrix<double, N, N> A) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  if (!A.allFinite()) return kInfinity;
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  // Each sweep squares the off-diagonal mass once it is small; 30 sweeps is far beyond what sizes
+  // like these need (6-8 in practice), and bounds the loop for any input.
+  for (int sweep = 0; sweep < 30; ++sweep) {
+    bool rotated = false;
+    for (int p = 0; p < N - 1; ++p)
+      for (int q = p + 1; q < N; ++q) {
+        const double alpha = A.col(p).squaredNorm(), beta = A.col(q).squaredNorm(), gamma = A.col(p).dot(A.col(q));
+        if (!(std::abs(gamma) > eps * std::sqrt(alpha * beta))) continue;  // orthogonal already (or a zero column)
+        rotated = true;
+        const double zeta = (beta - alpha) / (2 * gamma);
+        const double t = (zeta >= 0 ? 1.0 : -1.0) / (std::abs(zeta) + std::sqrt(1 + zeta * zeta));
+        const double c = 1 / std::sqrt(1 + t * t), s = c * t;
+        const Eigen::Matrix<double, N, 1> a_p = A.col(p);
+        A.col(p) = c * a_p - s * A.col(q);
+        A.col(q) = s * a_p + c * A.col(q);
+      }
+    if (!rotated) break;
+  }
+  double largest = 0, smallest = kInfinity;
+  for (int k = 0; k < N; ++k) {
+    const double sigma = A.col(k).norm();
+    largest = std::max(largest, sigma);
+    smallest = std::min(smallest, sigma);
+  }
+  return smallest > 0 ? largest / smallest : kInfinity;
+}
+
+}  // namespace wlx::small
