@@ -176,7 +176,10 @@ Weighting Weighting::matrix_of(const TorqueMatrix& W) {
   // the minimum-norm torques as they are.
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(kActuatedCount, kActuatedCount);
 #if __has_include(<wlx/gen/reduced_dynamics.hpp>)  // (no actuated joints without: nothing to factorize)
-  if (!numerics::inverse_cholesky_factor(W / W.cwiseAbs().maxCoeff(), S))
+  // (Scaled into a fixed-size matrix first: a product or quotient bound to numerics' dynamic-size
+  // Ref would compile Eigen's general kernels into every model.)
+  const TorqueMatrix scaled = W / W.cwiseAbs().maxCoeff();
+  if (!numerics::inverse_cholesky_factor(scaled, S))
     throw Error("weighting", "the weight matrix must be positive definite");
 #endif
   Weighting out;
@@ -252,6 +255,8 @@ bool householder_step(ActuatorJacobian& qr, Tail<k>& v, double& tau) {
 // (Householder), x = Q [R^-T Q*; 0]. Unpivoted, fixed-size and unrolled: a fraction of Eigen's
 // column-pivoted QR, whose inner loops run on dynamic-size blocks. Returns false, leaving the
 // answer to the pivoted QR, unless condition_bound(R) <= kConditionLimit.
+// (A template: compiled only where min_norm_solve_fast takes it.)
+template <int = 0>
 bool min_norm_solve_dense(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
   constexpr int kU = kCommandedCount;
   ActuatorJacobian qr = A;
@@ -373,7 +378,9 @@ inline constexpr bool kUseSparseQr = kSparseQr.feasible && 3 * kSparseQr.sparse_
 // min_norm_solve_dense's answer by the plan's sparse QR: the same reflectors on a row-permuted A,
 // skipping the structural zeros, with the same condition test. Loop bounds and row indices are
 // compile-time constants (kSparseQr), so the compiler unrolls every loop.
-[[maybe_unused]] bool min_norm_solve_sparse(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
+// (A template: compiled only where min_norm_solve_fast takes it.)
+template <int = 0>
+bool min_norm_solve_sparse(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
   constexpr int kU = kCommandedCount;
   constexpr const SparseQrPlan& plan = kSparseQr;
   ActuatorJacobian qr = A;
@@ -431,10 +438,58 @@ inline constexpr bool kUseSparseQr = kSparseQr.feasible && 3 * kSparseQr.sparse_
   return true;
 }
 
+// min_norm_solve_dense's answer as plain loops (the same reflectors, each stored below R's diagonal),
+// for a model whose hot path is the sparse plan: there the dense QR answers only a matrix a caller
+// built off J_beta's structure (a full weight matrix), and its unrolled form, one template per
+// column, cost 3.5 s of the wheeled quadruped's compile (ten columns of sixteen rows).
+// (A template: compiled only where min_norm_solve_fast takes it.)
+template <int = 0>
+bool min_norm_solve_dense_loops(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
+  constexpr int kU = kCommandedCount, kA = kActuatedCount;
+  ActuatorJacobian qr = A;
+  CommandVector tau;
+  for (int k = 0; k < kU; ++k) {
+    double norm2 = 0;
+    for (int i = k; i < kA; ++i) norm2 += qr(i, k) * qr(i, k);
+    const double alpha = qr(k, k), norm = std::sqrt(norm2);
+    if (!(norm > 0)) return false;  // a zero column (or NaN): the pivoted QR says what is wrong
+    const double beta = alpha >= 0 ? -norm : norm, scale = 1 / (alpha - beta);
+    for (int i = k + 1; i < kA; ++i) qr(i, k) *= scale;  // v, whose first entry is 1
+    tau(k) = (beta - alpha) / beta;
+    qr(k, k) = beta;
+    for (int j = k + 1; j < kU; ++j) {
+      double projection = qr(k, j);
+      for (int i = k + 1; i < kA; ++i) projection += qr(i, k) * qr(i, j);
+      projection *= tau(k);
+      qr(k, j) -= projection;
+      for (int i = k + 1; i < kA; ++i) qr(i, j) -= qr(i, k) * projection;
+    }
+  }
+  const CommandMatrix R = qr.template topRows<kU>().template triangularView<Eigen::Upper>();
+  if (!(condition_bound(R) <= kConditionLimit)) return false;
+  x.setZero();
+  for (int i = 0; i < kU; ++i) {
+    double sum = Qstar(i);
+    for (int l = 0; l < i; ++l) sum -= R(l, i) * x(l);
+    x(i) = sum / R(i, i);
+  }
+  for (int k = kU - 1; k >= 0; --k) {
+    double projection = x(k);
+    for (int i = k + 1; i < kA; ++i) projection += qr(i, k) * x(i);
+    projection *= tau(k);
+    x(k) -= projection;
+    for (int i = k + 1; i < kA; ++i) x(i) -= qr(i, k) * projection;
+  }
+  return true;
+}
+
 bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
-  if constexpr (kUseSparseQr)
-    if (!breaks_pattern(A)) return min_norm_solve_sparse(A, Qstar, x);
-  return min_norm_solve_dense(A, Qstar, x);
+  if constexpr (kUseSparseQr) {
+    if (!breaks_pattern(A)) return min_norm_solve_sparse<>(A, Qstar, x);
+    return min_norm_solve_dense_loops<>(A, Qstar, x);
+  } else {
+    return min_norm_solve_dense<>(A, Qstar, x);
+  }
 }
 
 // The motion no actuator acts on, for the message of a rank loss: the unit combination n of the
@@ -444,7 +499,8 @@ bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, 
 // freely give one where they all point the same way: the whole machine rolls along them and no
 // actuated joint moves.)
 [[gnu::noinline, gnu::cold]] std::string unactuated_motion(const ActuatorJacobian& At) {
-  CommandVector n = numerics::smallest_eigenvector(At.transpose() * At);
+  const CommandMatrix normal = At.transpose().lazyProduct(At);  // fixed size, as in matrix_of
+  CommandVector n = numerics::smallest_eigenvector(normal);
   Eigen::Index largest = 0;
   n.cwiseAbs().maxCoeff(&largest);
   n /= n(largest);

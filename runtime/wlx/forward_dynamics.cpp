@@ -1,8 +1,8 @@
 #include "wlx/forward_dynamics.hpp"
 
 #include "wlx/error.hpp"
+#include "wlx/small_dense.hpp"
 
-#include <Eigen/Cholesky>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -26,10 +26,8 @@ void forward_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   // Coefficient-based products (lazyProduct): at these fixed sizes Eigen's general
   // matrix-vector kernel costs more in set-up than in arithmetic.
   out.Qstar.noalias() = out.J_beta.transpose().lazyProduct(tau);
-  const Eigen::LLT<CommandMatrix> llt(out.M);
-  if (llt.info() != Eigen::Success)
+  if (!small::cholesky_solve<kCommandedCount>(out.M, out.Qstar - out.b + out.Q_gravity, u_dot))
     throw Error("M", "the mass matrix on the commanded speeds is not positive definite: some commanded speed moves no body");
-  u_dot = llt.solve(out.Qstar - out.b + out.Q_gravity);
   out.sddot.noalias() += out.T.lazyProduct(u_dot);
 #endif
 }

@@ -204,7 +204,27 @@ void check_small_dense(std::mt19937& random) {
     const double mine = wlx::small::condition_number<N>(A), eigens = sv(0) / sv(N - 1);
     CHECK(std::abs(mine - eigens) <= 1e-14 * cond * eigens);
     CHECK(std::abs(mine - cond) <= 1e-14 * cond * cond);
+
+    // The Cholesky solve of the symmetric positive definite A A^T (condition cond^2, up to 1e10)
+    // against Eigen's LLT, the same elimination: agreement to cond^2 times rounding.
+    if (k <= 5) {
+      const Square S = A * A.transpose();
+      Column y;
+      REQUIRE(wlx::small::cholesky_solve<N>(S, b, y));
+      const Column y_eigen = Eigen::LLT<Square>(S).solve(b);
+      CHECK((y - y_eigen).norm() <= 1e-14 * cond * cond * y_eigen.norm());
+      CHECK((S * y - b).norm() <= 1e-14 * N * (1 + S.norm() * y.norm()));
+    }
   }
+  // A matrix that is not positive definite (a negative or a zero pivot, or NaN) has no Cholesky
+  // factor: refused, with x untouched.
+  Column untouched = Column::Constant(3.0);
+  CHECK_FALSE(wlx::small::cholesky_solve<N>(Square(-Square::Identity()), Column::Ones(), untouched));
+  CHECK_FALSE(wlx::small::cholesky_solve<N>(Square(Square::Zero()), Column::Ones(), untouched));
+  Square nan_pivot = Square::Identity();
+  nan_pivot(N - 1, N - 1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(wlx::small::cholesky_solve<N>(nan_pivot, Column::Ones(), untouched));
+  CHECK(untouched == Column::Constant(3.0));
   // Singular and non-finite matrices have an infinite condition number.
   Square singular = gaussian();
   if constexpr (N > 1) singular.col(N - 1) = singular.col(0);
@@ -217,7 +237,7 @@ void check_small_dense(std::mt19937& random) {
 
 }  // namespace
 
-TEST_CASE("small_dense: the wheels' LU and condition number agree with Eigen's at 1 to 6 wheels") {
+TEST_CASE("small_dense: the LU, the condition number and the Cholesky solve agree with Eigen's at sizes 1 to 6") {
   std::mt19937 random(20261206);
   check_small_dense<1>(random);
   check_small_dense<2>(random);
