@@ -1,10 +1,12 @@
 // Model-independent numerics, compiled once (the library wlx::numerics) rather than once per model:
 // the small dense QP of the contact-keeping torque distribution and the decompositions that run off
-// the hot paths (building a message, the null space of a distribution that then solves QPs). Every
+// the hot paths (building a message, the null space of a distribution that then solves QPs, the
+// pivoted QR where the inverse dynamics' fixed-size fast path declines). Every
 // function takes dynamic-size matrices, so one compiled copy serves every model's sizes. The hot
 // paths (the fused update, the dependent rates, the inverse-dynamics step, forward dynamics, Newton's
-// IK steps) keep their fixed-size decompositions in the per-model runtime: there sizes known at
-// compile time are the speed, and they allocate nothing; these functions allocate.
+// IK steps) keep fixed sizes in the per-model runtime (as loops where Eigen's decompositions would
+// unroll: small_dense.hpp, limb_steps.hpp): there sizes known at compile time are the speed, and
+// they allocate nothing; these functions allocate.
 #pragma once
 
 #include <Eigen/Core>
