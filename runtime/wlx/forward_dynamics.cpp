@@ -26,6 +26,9 @@ void forward_dynamics(const Model& model, Data& d, const Coordinates& s, const C
   // Coefficient-based products (lazyProduct): at these fixed sizes Eigen's general
   // matrix-vector kernel costs more in set-up than in arithmetic.
   out.Qstar.noalias() = out.J_beta.transpose().lazyProduct(tau);
+  if (!out.M.allFinite())
+    throw Error("M", "the mass matrix on the commanded speeds is not finite in this state (the pose or the parameters are "
+                     "outside the model's domain)");
   if (!small::cholesky_solve<kCommandedCount>(out.M, out.Qstar - out.b + out.Q_gravity, u_dot))
     throw Error("M", "the mass matrix on the commanded speeds is not positive definite: some commanded speed moves no body");
   out.sddot.noalias() += out.T.lazyProduct(u_dot);

@@ -41,7 +41,7 @@ struct NonholonomicOptions {
 
 // The 2-norm condition number sigma_max / sigma_min of J_beta; infinity for a singular matrix. For two
 // wheels in closed form, accurate to a few ulp even where the singular values nearly agree; otherwise
-// from a Jacobi SVD.
+// by one-sided Jacobi rotations (small_dense.hpp).
 double condition_number(const WheelMatrix& J);
 
 // Velocity level. `s`: all coordinates, closure satisfied. `sdot`: the commanded input rates

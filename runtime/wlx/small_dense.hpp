@@ -75,18 +75,23 @@ struct PartialPivotLu {
   }
 };
 
-// sigma_max / sigma_min of a square A, infinite for a singular or non-finite A. One-sided Jacobi
-// (Hestenes): plane rotations of column pairs until every pair is orthogonal to working precision;
-// the singular values are then the columns' norms, each to high relative accuracy, so a small
-// sigma_min is not swamped by the rounding of a large sigma_max (as it would be through A^T A's
-// eigenvalues, which square the condition number).
+// sigma_max / sigma_min of a square A, infinite for a singular or non-finite A (1 for no wheels, as
+// for a model without them). One-sided Jacobi (Hestenes): plane rotations of column pairs until
+// every pair is orthogonal to working precision; the singular values are then the columns' norms.
+// Backward stable, so sigma_min is found to about eps sigma_max: the condition number to a relative
+// eps cond, without the squaring of the condition that A^T A's eigenvalues would bring. A is first
+// scaled to a largest entry of 1 (as Eigen's SVD does), so that no squared norm over- or underflows.
 template <int N>
 double condition_number(Eigen::Matrix<double, N, N> A) {
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  if constexpr (N == 0) return 1;
   if (!A.allFinite()) return kInfinity;
+  const double largest_entry = A.cwiseAbs().maxCoeff();
+  if (!(largest_entry > 0)) return kInfinity;
+  A /= largest_entry;
   constexpr double eps = std::numeric_limits<double>::epsilon();
   // Each sweep squares the off-diagonal mass once it is small; 30 sweeps is far beyond what sizes
-  // like these need (6-8 in practice), and bounds the loop for any input.
+  // like these need (3-8 in practice), and bounds the loop for any input.
   for (int sweep = 0; sweep < 30; ++sweep) {
     bool rotated = false;
     for (int p = 0; p < N - 1; ++p)
@@ -95,7 +100,10 @@ double condition_number(Eigen::Matrix<double, N, N> A) {
         if (!(std::abs(gamma) > eps * std::sqrt(alpha * beta))) continue;  // orthogonal already (or a zero column)
         rotated = true;
         const double zeta = (beta - alpha) / (2 * gamma);
-        const double t = (zeta >= 0 ? 1.0 : -1.0) / (std::abs(zeta) + std::sqrt(1 + zeta * zeta));
+        // t = sign(zeta) / (|zeta| + sqrt(1 + zeta^2)), the smaller root; 1 / (2 zeta) where zeta^2
+        // would overflow (the same to rounding there).
+        const double t = std::abs(zeta) > 1e150 ? 1 / (2 * zeta)
+                                                : (zeta >= 0 ? 1.0 : -1.0) / (std::abs(zeta) + std::sqrt(1 + zeta * zeta));
         const double c = 1 / std::sqrt(1 + t * t), s = c * t;
         const Eigen::Matrix<double, N, 1> a_p = A.col(p);
         A.col(p) = c * a_p - s * A.col(q);
@@ -113,8 +121,9 @@ double condition_number(Eigen::Matrix<double, N, N> A) {
 }
 
 // x = A^-1 b for a symmetric positive definite A, from A = L L^T (A's lower triangle is read), as
-// Eigen's LLT: false, x untouched, where a pivot is not positive (or NaN): A is not positive
-// definite to working precision.
+// Eigen's LLT computes it: false, x untouched, where a pivot is not positive, A not positive
+// definite to working precision. Unlike Eigen's LLT, a NaN pivot is refused too (Eigen's test,
+// x <= 0, lets it through into NaN results); callers check A's finiteness first to say so.
 template <int N>
 bool cholesky_solve(const Eigen::Matrix<double, N, N>& A, const Eigen::Matrix<double, N, 1>& b, Eigen::Matrix<double, N, 1>& x) {
   Eigen::Matrix<double, N, N> L = A;

@@ -149,7 +149,7 @@ TEST_CASE("numerics::min_norm_solve_pivoted: the minimum-norm solution of M^T x 
   const Eigen::VectorXd b = Eigen::Vector3d(1, -2, 0.5);
   Eigen::VectorXd x(6);
   REQUIRE(wlx::numerics::min_norm_solve_pivoted(M, b, 1e-13, x) == 3);
-  // M's entries are at most 5 and its condition number is about 5: residuals at rounding level.
+  // M's entries are at most 5 and its condition number is about 3: residuals at rounding level.
   CHECK((M.transpose() * x - b).norm() <= 1e-13);
   const Eigen::MatrixXd P = M * (M.transpose() * M).inverse() * M.transpose();  // projector onto range(M)
   CHECK((P * x - x).norm() <= 1e-13);
@@ -190,10 +190,17 @@ void check_small_dense(std::mt19937& random) {
     lu.solve_transposed(b, xt);
     // Both are backward stable and pivot the same way: the solutions agree to the condition
     // number times rounding, and the residuals are at rounding relative to |A| |x|.
-    const double cond = sigma(0) / sigma(N - 1), scale = x_eigen.norm() + xt_eigen.norm();
-    CHECK((B.col(0) - x_eigen).norm() <= 1e-14 * cond * scale);
-    CHECK((B.col(1) - 2 * x_eigen).norm() <= 2e-14 * cond * scale);
-    CHECK((xt - xt_eigen).norm() <= 1e-14 * cond * scale);
+    const double cond = sigma(0) / sigma(N - 1);
+    CHECK((B.col(0) - x_eigen).norm() <= 1e-14 * cond * x_eigen.norm());
+    CHECK((B.col(1) - 2 * x_eigen).norm() <= 2e-14 * cond * x_eigen.norm());
+    CHECK((xt - xt_eigen).norm() <= 1e-14 * cond * xt_eigen.norm());
+    // The same elimination in the same order: the same pivots, and factors equal to a few ulp of
+    // the largest entry (the compilers may contract a multiply-add differently).
+    const Square eigen_lu = eigen.matrixLU();
+    CHECK((lu.lu - eigen_lu).cwiseAbs().maxCoeff() <= 8 * std::numeric_limits<double>::epsilon() * eigen_lu.cwiseAbs().maxCoeff());
+    const Eigen::PermutationMatrix<N, N> eigen_inverse = eigen.permutationP().transpose();  // row k of P A is A's row [k]
+    const Eigen::Matrix<int, N, 1> eigen_rows = eigen_inverse.indices();
+    for (int i = 0; i < N; ++i) CHECK(lu.row[i] == eigen_rows(i));
     CHECK((A * B.col(0) - b).norm() <= 1e-14 * N * (1 + A.norm() * B.col(0).norm()));
     CHECK((A.transpose() * xt - b).norm() <= 1e-14 * N * (1 + A.norm() * xt.norm()));
 
@@ -216,8 +223,35 @@ void check_small_dense(std::mt19937& random) {
       CHECK((S * y - b).norm() <= 1e-14 * N * (1 + S.norm() * y.norm()));
     }
   }
-  // A matrix that is not positive definite (a negative or a zero pivot, or NaN) has no Cholesky
-  // factor: refused, with x untouched.
+  // A structured matrix: a zero leading entry (a row swap first) and an exactly zero pivot later
+  // (a singular A), factorized as Eigen does.
+  if constexpr (N >= 2) {
+    Square structured = Square::Identity();
+    structured(0, 0) = 0;
+    structured(1, 0) = 2;
+    structured.row(N - 1) = structured.row(0);  // with N = 2: rows (0 1), (0 1) after the swap: singular
+    wlx::small::PartialPivotLu<N> lu;
+    lu.compute(structured);
+    const Eigen::PartialPivLU<Square> eigen(structured);
+    const Square eigen_lu = eigen.matrixLU();
+    CHECK((lu.lu - eigen_lu).cwiseAbs().maxCoeff() == 0);
+    const Eigen::PermutationMatrix<N, N> eigen_inverse = eigen.permutationP().transpose();  // row k of P A is A's row [k]
+    const Eigen::Matrix<int, N, 1> eigen_rows = eigen_inverse.indices();
+    for (int i = 0; i < N; ++i) CHECK(lu.row[i] == eigen_rows(i));
+    CHECK(wlx::small::condition_number<N>(structured) >= 1e15);
+  }
+  // Scaled far from 1 (entries near 1e200 and 1e-200), the condition number is the same: no squared
+  // norm overflows or underflows.
+  {
+    Square A = Square::Identity();
+    if constexpr (N >= 2) A(0, 1) = 1;
+    const double reference = wlx::small::condition_number<N>(A);
+    CHECK(std::abs(wlx::small::condition_number<N>(Square(1e200 * A)) - reference) <= 1e-14 * reference);
+    CHECK(std::abs(wlx::small::condition_number<N>(Square(1e-200 * A)) - reference) <= 1e-14 * reference);
+  }
+  // A matrix that is not positive definite (a negative or a zero pivot) has no Cholesky factor:
+  // refused, with x untouched. So is a NaN pivot, which Eigen's LLT would let through (its test is
+  // pivot <= 0): forward dynamics checks M's finiteness first, to say so.
   Column untouched = Column::Constant(3.0);
   CHECK_FALSE(wlx::small::cholesky_solve<N>(Square(-Square::Identity()), Column::Ones(), untouched));
   CHECK_FALSE(wlx::small::cholesky_solve<N>(Square(Square::Zero()), Column::Ones(), untouched));
