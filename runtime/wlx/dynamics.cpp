@@ -251,6 +251,21 @@ bool householder_step(ActuatorJacobian& qr, Tail<k>& v, double& tau) {
   return true;
 }
 
+// The part of the dense QR's minimum-norm solve after the reflectors (qr's top rows hold R): the
+// condition test, then R^T y = Q* by forward substitution into x's head, the rest zero. False,
+// leaving the answer to the pivoted QR, unless condition_bound(R) <= kConditionLimit.
+bool solve_transposed_R(const ActuatorJacobian& qr, const CommandVector& Qstar, TorqueVector& x) {
+  const CommandMatrix R = qr.template topRows<kCommandedCount>().template triangularView<Eigen::Upper>();
+  if (!(condition_bound(R) <= kConditionLimit)) return false;
+  x.setZero();
+  for (int i = 0; i < kCommandedCount; ++i) {
+    double sum = Qstar(i);
+    for (int l = 0; l < i; ++l) sum -= R(l, i) * x(l);
+    x(i) = sum / R(i, i);
+  }
+  return true;
+}
+
 // The minimum-norm x with A^T x = Q*, A actuated x commanded with full column rank: from A = Q R
 // (Householder), x = Q [R^-T Q*; 0]. Unpivoted, fixed-size and unrolled: a fraction of Eigen's
 // column-pivoted QR, whose inner loops run on dynamic-size blocks. Returns false, leaving the
@@ -264,15 +279,8 @@ bool min_norm_solve_dense(const ActuatorJacobian& A, const CommandVector& Qstar,
   return [&]<int... k>(std::integer_sequence<int, k...>) {
     std::tuple<Tail<k>...> v;
     if (!(householder_step<k>(qr, std::get<k>(v), tau(k)) && ...)) return false;
-    const CommandMatrix R = qr.template topRows<kU>().template triangularView<Eigen::Upper>();
-    if (!(condition_bound(R) <= kConditionLimit)) return false;
-    // R^T y = Q* by forward substitution, then x = H_0 ... H_{n-1} [y; 0].
-    x.setZero();
-    for (int i = 0; i < kU; ++i) {
-      double sum = Qstar(i);
-      for (int l = 0; l < i; ++l) sum -= R(l, i) * x(l);
-      x(i) = sum / R(i, i);
-    }
+    // R^T y = Q*, then x = H_0 ... H_{n-1} [y; 0].
+    if (!solve_transposed_R(qr, Qstar, x)) return false;
     ((x.template tail<kActuatedCount - (kU - 1 - k)>() -=
       (tau(kU - 1 - k) * std::get<kU - 1 - k>(v).dot(x.template tail<kActuatedCount - (kU - 1 - k)>())) *
       std::get<kU - 1 - k>(v)),
@@ -465,14 +473,7 @@ bool min_norm_solve_dense_loops(const ActuatorJacobian& A, const CommandVector& 
       for (int i = k + 1; i < kA; ++i) qr(i, j) -= qr(i, k) * projection;
     }
   }
-  const CommandMatrix R = qr.template topRows<kU>().template triangularView<Eigen::Upper>();
-  if (!(condition_bound(R) <= kConditionLimit)) return false;
-  x.setZero();
-  for (int i = 0; i < kU; ++i) {
-    double sum = Qstar(i);
-    for (int l = 0; l < i; ++l) sum -= R(l, i) * x(l);
-    x(i) = sum / R(i, i);
-  }
+  if (!solve_transposed_R(qr, Qstar, x)) return false;
   for (int k = kU - 1; k >= 0; --k) {
     double projection = x(k);
     for (int i = k + 1; i < kA; ++i) projection += qr(i, k) * x(i);

@@ -10,6 +10,8 @@
 // fixed size and allocate nothing.
 #pragma once
 
+#include "wlx/small_dense.hpp"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -118,30 +120,20 @@ bool newton_step(const Square<N>& J, const Column<N>& r, Column<N>& step) {
 // about 1e7 times that): at a mu lost in rounding a pivot of a singular J^T J may come out negative.
 template <int N>
 Column<N> regularized_step(const Square<N>& J, const Column<N>& r, double mu) {
-  double L[N][N] = {}, b[N];
+  Square<N> A;
+  Column<N> b, x;
   for (int i = 0; i < N; ++i) {
-    b[i] = 0;
-    for (int k = 0; k < N; ++k) b[i] -= J(k, i) * r(k);
-  }
-  // A = J^T J + mu I, its lower triangle factorized as L L^T column by column.
-  for (int j = 0; j < N; ++j) {
-    for (int i = j; i < N; ++i) {
+    b(i) = 0;
+    for (int k = 0; k < N; ++k) b(i) -= J(k, i) * r(k);
+    for (int j = 0; j <= i; ++j) {  // the lower triangle, which the Cholesky solve reads
       double a = i == j ? mu : 0;
       for (int k = 0; k < N; ++k) a += J(k, i) * J(k, j);
-      for (int k = 0; k < j; ++k) a -= L[i][k] * L[j][k];
-      L[i][j] = i == j ? std::sqrt(a) : a / L[j][j];
+      A(i, j) = a;
     }
   }
-  Column<N> x;
-  for (int i = 0; i < N; ++i) {
-    for (int k = 0; k < i; ++k) b[i] -= L[i][k] * b[k];
-    b[i] /= L[i][i];
-  }
-  for (int i = N - 1; i >= 0; --i) {
-    for (int k = i + 1; k < N; ++k) b[i] -= L[k][i] * b[k];
-    b[i] /= L[i][i];
-    x(i) = b[i];
-  }
+  // A pivot that is not positive (a mu lost in rounding): no step, as NaN (the square root of a
+  // negative pivot gave NaN before; Newton's damping then takes no step either).
+  if (!small::cholesky_solve<N>(A, b, x)) x.setConstant(std::numeric_limits<double>::quiet_NaN());
   return x;
 }
 

@@ -13,7 +13,6 @@
 #include <Eigen/LU>  // Matrix4d::inverse
 
 #include <string_view>
-#include <type_traits>
 #include <vector>
 
 WLX_MODEL_NAMESPACE_BEGIN
