@@ -45,7 +45,7 @@ function(wlx_add_generation stamp file out expected_model comment)
     OUTPUT "${stamp}"
     # wlx-gen rewrites all.hpp whenever any header changes: named here, Ninja recompiles what
     # includes it after an edit of the model file (else objects built from the old headers stay).
-    BYPRODUCTS "${out}/wlx/gen/all.hpp"
+    BYPRODUCTS "${out}/wlx/gen/all.hpp" "${out}/wlx/gen/model.json"
     COMMAND wlx::wlx-gen "${file}" --out "${out}" --expect-model "${expected_model}" --depfile "${stamp}.d"
             --depfile-target "${stamp}" ${ARGN}
     COMMAND "${CMAKE_COMMAND}" -E touch "${stamp}"
@@ -160,6 +160,8 @@ extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios
 const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios = {};
 extern const char* const kEmbeddedReportFile;
 const char* const kEmbeddedReportFile = \"\";
+extern const char* const kEmbeddedDescription;
+const char* const kEmbeddedDescription = \"\";
 } } }
 ")
   file(CONFIGURE OUTPUT "${dir}/registry.cpp" CONTENT "// Written by wlx_generate(PYTHON). Do not edit.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <sstream>
+#include <stdexcept>
 
 namespace wlx::codegen {
 
@@ -34,6 +35,72 @@ std::string code_fingerprint(const std::vector<EmittedFile>& code) {
 
 const char* axis_name(Axis a) { return a == Axis::X ? "x" : a == Axis::Y ? "y" : "z"; }
 
+// An expression of parameters as the number it is at the description's parameter values (the code's
+// baked ones, else the defaults). The model file's reader has checked every such expression finite
+// at the defaults; one that is not a number here is a generator error, said as such.
+class Evaluator {
+ public:
+  Evaluator(const Model& m, const EmitOptions& opt) {
+    for (const auto& p : m.parameters) {
+      const auto baked = opt.baked.find(p.name);
+      values_[p.symbol] = baked == opt.baked.end() ? p.default_value : baked->second;
+    }
+  }
+  double operator()(const ex& e, const std::string& what) const {
+    const ex v = GiNaC::evalf(e.subs(values_));
+    if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real())
+      throw std::runtime_error(fmt::format("wlx-gen: {} is not a number at the parameters' values", what));
+    const double x = GiNaC::ex_to<GiNaC::numeric>(v).to_double();
+    if (!std::isfinite(x)) throw std::runtime_error(fmt::format("wlx-gen: {} is not finite at the parameters' values", what));
+    return x;
+  }
+  Json vector(const Vec3& v, const std::string& what) const {
+    return Json::array({(*this)(v.e[0], what), (*this)(v.e[1], what), (*this)(v.e[2], what)});
+  }
+
+ private:
+  GiNaC::exmap values_;
+};
+
+// A frame's chain as data: each step with its numbers at the parameters' values (docs/model-format.md,
+// "The description"): what a reader needs to build the tree (an MJCF export, a peer library) without
+// the generated functions.
+Json chain_of(const Model& m, const NamedFrame& f, const Evaluator& number) {
+  Json chain = Json::array();
+  const std::string where = "frame " + f.name;
+  for (const ChainStep& step : f.chain) {
+    switch (step.kind) {
+      case ChainStep::Kind::Translate: chain.push_back({{"translate", number.vector(step.offset, where)}}); break;
+      case ChainStep::Kind::Turn: chain.push_back({{"turn", axis_name(step.axis)}, {"angle", number(step.angle, where)}}); break;
+      case ChainStep::Kind::Rotate:
+      case ChainStep::Kind::Slide:
+        chain.push_back({{step.kind == ChainStep::Kind::Rotate ? "revolute" : "prismatic", axis_name(step.axis)},
+                         {"coordinate", m.coordinates[static_cast<std::size_t>(step.coordinate)].name},
+                         {"sign", step.sign}});
+        break;
+    }
+  }
+  return chain;
+}
+
+// The rotation from a body's frame axes to its principal axes (columns: the principal axes in the
+// frame's), from its fixed turns.
+Json principal_axes(const Body& b, const Evaluator& number) {
+  double R[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (const auto& [axis, angle] : b.principal_turns) {
+    const double a = number(angle, "body " + b.name + " rotation"), c = std::cos(a), s = std::sin(a);
+    const int i = (static_cast<int>(axis) + 1) % 3, j = (static_cast<int>(axis) + 2) % 3;  // the turn takes i towards j
+    for (auto& row : R) {
+      const double ri = row[i], rj = row[j];
+      row[i] = c * ri + s * rj;
+      row[j] = -s * ri + c * rj;
+    }
+  }
+  Json rows = Json::array();
+  for (const auto& row : R) rows.push_back(Json::array({row[0], row[1], row[2]}));
+  return rows;
+}
+
 }  // namespace
 
 EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::vector<EmittedFile>& code) {
@@ -60,17 +127,26 @@ EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::
   for (const auto& c : m.coordinates)
     coordinates.push_back({{"name", c.name}, {"unit", c.unit}, {"input", c.index < m.input_count}, {"meaning", c.meaning}});
   d["coordinates"] = coordinates;
+  const Evaluator number(m, opt);
   Json frames = Json::array();
-  for (const auto& f : m.frames) frames.push_back({{"name", f.name}, {"parent", f.parent}, {"meaning", f.meaning}});
+  for (const auto& f : m.frames) {
+    Json frame = {{"name", f.name}, {"parent", f.parent}, {"meaning", f.meaning}};
+    if (f.derived_from_wheel >= 0) frame["derived_from_wheel"] = m.wheels[static_cast<std::size_t>(f.derived_from_wheel)].name;
+    else frame["chain"] = chain_of(m, f, number);
+    frames.push_back(frame);
+  }
   d["frames"] = frames;
   Json bodies = Json::array();
   for (const auto& b : m.bodies)
-    bodies.push_back({{"name", b.name}, {"frame", b.frame}, {"mass", b.mass}, {"inertia", b.inertia}, {"meaning", b.meaning}});
+    bodies.push_back({{"name", b.name}, {"frame", b.frame}, {"mass", b.mass}, {"inertia", b.inertia},
+                      {"com", number.vector(b.com, "body " + b.name + " com")}, {"principal_axes", principal_axes(b, number)},
+                      {"meaning", b.meaning}});
   d["bodies"] = bodies;
   Json wheels = Json::array();
   for (const auto& w : m.wheels)
     wheels.push_back({{"name", w.name}, {"contact", w.contact}, {"hub", w.hub}, {"radius", w.radius},
                       {"offset", w.offset.empty() ? Json(nullptr) : Json(w.offset)}, {"axle", axis_name(w.axle)},
+                      {"forward", axis_name(w.forward)}, {"lateral", axis_name(w.lateral)},
                       {"ground", w.ground >= 0 ? coordinate(w.ground) : ""}});
   d["wheels"] = wheels;
   Json limbs = Json::array();
@@ -94,6 +170,30 @@ EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::
   }
   d["actuators"] = actuators;
   d["commanded"] = commanded;
+  // What each actuator drives (a joint's coordinate, or a wheel on a hub), and gravity's parameter
+  // (acting along -z of K0): for a reader that builds the machine elsewhere (wlx export mjcf).
+  Json actuated = Json::array();
+  if (m.dynamics)
+    for (const auto& a : m.dynamics->actuated)
+      actuated.push_back(a.wheel >= 0 ? Json{{"name", a.name}, {"wheel", m.wheels[static_cast<std::size_t>(a.wheel)].name}}
+                                      : Json{{"name", a.name}, {"coordinate", coordinate(a.coordinate)}});
+  d["actuated"] = actuated;
+  d["gravity"] = m.dynamics ? Json(m.dynamics->gravity) : Json(nullptr);
+  // The closure rows as the model file gives them.
+  Json closure = Json::array();
+  for (const auto& c : m.closure) {
+    using K = ClosureCondition::Kind;
+    if (c.kind == K::PointEqualsCoordinate)
+      closure.push_back({{"name", c.name}, {"type", "point"}, {"frame", c.frame}, {"component", axis_name(c.axis)}, {"equals", coordinate(c.target)}});
+    else if (c.kind == K::AttachedDirectionLevel)
+      closure.push_back({{"name", c.name}, {"type", "level"}, {"frame", c.frame}, {"axis", axis_name(c.axis)}});
+    else {
+      Json sum = Json::array();
+      for (int k : c.coordinates) sum.push_back(coordinate(k));
+      closure.push_back({{"name", c.name}, {"type", "sum"}, {"coordinates", sum}});
+    }
+  }
+  d["closure"] = closure;
   if (m.clearance) {
     Json size = Json::array();
     for (const auto& e : m.clearance->size) {

@@ -47,6 +47,10 @@ struct Body {
   std::string meaning;
   std::string frame;  // the frame it moves with
   Frame com_frame;
+  // The same, relative to `frame` (the description's data): the CoM in the frame's axes, and the
+  // fixed turns from the frame's axes to the principal axes, in order.
+  Vec3 com;
+  std::vector<std::pair<Axis, ex>> principal_turns;
   std::string mass;
   std::array<std::string, 3> inertia;  // principal moments about the CoM, in the body frame
 };

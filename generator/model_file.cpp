@@ -1257,7 +1257,8 @@ class Parser {
       b.meaning = f.optional("meaning") ? f["meaning"].text() : "";
       const int frame = frame_index(f["frame"]);
       b.frame = m_.frames[static_cast<std::size_t>(frame)].name;
-      b.com_frame = m_.frames[static_cast<std::size_t>(frame)].frame.translated(vector3(f["com"]));
+      b.com = vector3(f["com"]);
+      b.com_frame = m_.frames[static_cast<std::size_t>(frame)].frame.translated(b.com);
       // The principal axes, turned from the frame's (a URDF inertial's rpy, or the axes that
       // diagonalise its tensor): fixed turns of parameter expressions, applied in order.
       if (auto rotation = f.optional("rotation"))
@@ -1265,7 +1266,8 @@ class Parser {
           const std::string op = step.is_map() && step.size() == 1 ? step.node().begin()->first.Scalar() : "";
           if (op != "rx" && op != "ry" && op != "rz")
             step.fail("a rotation step is rx, ry or rz: <expression of parameters> (a fixed turn about the axes turned so far)");
-          b.com_frame = b.com_frame.turned(static_cast<Axis>(op[1] - 'x'), expression(step.child(op), false));
+          b.principal_turns.emplace_back(static_cast<Axis>(op[1] - 'x'), expression(step.child(op), false));
+          b.com_frame = b.com_frame.turned(b.principal_turns.back().first, b.principal_turns.back().second);
         }
       b.mass = parameter(f["mass"], ParameterKind::mass).name;
       const Item inertia = f["inertia"];

@@ -123,9 +123,12 @@ int run_fk(const ModelOptions& model_options, bool as_json) {
   return 0;
 }
 
+extern const char* const kEmbeddedDescription;  // the model's model.json, embedded by CMake
+
 const ModelCommands& entry() {
   static const ModelCommands commands{gen::kModelName, gen::kModelDescription, &run_fk, &run_ik, &run_verify_ik,
-                                      &run_verify_nonholonomic, &run_simulate, &run_report, &run_viewer, &api()};
+                                      &run_verify_nonholonomic, &run_simulate, &run_report, &run_viewer, &api(),
+                                      kEmbeddedDescription};
   return commands;
 }
 

@@ -61,6 +61,12 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
   inv.viewer->add_option("RUN", inv.viewer_options.runs, "scenario files or ids to simulate and show (wlx simulate --list shows the ids)");
   inv.viewer->add_option("--out", inv.viewer_options.out_dir, "output folder (viewer.html, viewer.js, wasm/, runs/)")->capture_default_str();
 
+  auto* exporter = app.add_subcommand("export", "the model in another tool's format, from its description (no compile)");
+  exporter->require_subcommand(1);
+  inv.export_mjcf = exporter->add_subcommand("mjcf", "the model as MuJoCo's MJCF: bodies, joints, inertias, wheels, contacts, motors "
+                                                     "(docs/export.md)");
+  inv.export_mjcf->add_option("--out", inv.export_out, "the MJCF file to write (default: out/mjcf/<model>.xml)");
+
   inv.sweep = app.add_subcommand("sweep", "a parameter sweep of a spec file (YAML: model, parameters, runs, metrics) on Dask, "
                                           "resumable; writes results.csv and plots (runs python3 -m wlx sweep)");
   inv.sweep->add_option("SPEC", inv.sweep_options.spec, "the sweep's spec file (README.md, \"Parameter sweeps\")");
@@ -70,7 +76,7 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
   inv.sweep->add_option("--workers", inv.sweep_options.workers, "the local cluster's worker processes (default: this machine's cores)");
   inv.sweep->add_option("--batch-size", inv.sweep_options.batch_size, "variants per Dask task (default: sized to about 2 s a task)");
 
-  for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report, inv.viewer}) add_model_options(a);
+  for (CLI::App* a : {inv.fk, inv.ik, inv.verify_ik, inv.verify_nh, inv.simulate, inv.report, inv.viewer, inv.export_mjcf}) add_model_options(a);
 }
 
 }  // namespace wlx::cli

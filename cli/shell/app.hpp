@@ -42,6 +42,8 @@ struct Invocation {
   ReportOptions report_options;
   CLI::App* viewer = nullptr;
   ViewerOptions viewer_options;
+  CLI::App* export_mjcf = nullptr;
+  std::string export_out;  // empty: out/mjcf/<model>.xml
   CLI::App* sweep = nullptr;
   SweepOptions sweep_options;
 };

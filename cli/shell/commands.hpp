@@ -52,6 +52,9 @@ struct ModelCommands {
   int (*report)(const ModelOptions& model, const ReportOptions& options);
   int (*viewer)(const ModelOptions& model, const ViewerOptions& options);
   const ModelApi* api;  // its computations for a binding that names no model (Python)
+  // Its description (model.json's text), embedded by CMake for a model built into wlx; empty for a
+  // model file's plugin, whose description wlx-gen gives at each load.
+  const char* description_json;
 };
 
 // The built-in models, the default (the thesis excavator) first.

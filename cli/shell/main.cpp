@@ -5,6 +5,7 @@
 #include "command_line.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "mjcf_export.hpp"
 #include "model_plugin.hpp"
 #include "output_checks.hpp"
 #include "scenario_folder.hpp"
@@ -67,6 +68,23 @@ int run_sweep(const wlx::cli::SweepOptions& o, bool model_options_given) {
 #endif
 }
 
+// `wlx export mjcf`: the model's MJCF, written atomically (cli/shell/mjcf_export.hpp).
+int run_export_mjcf(const std::string& description, std::string out, const wlx::cli::ModelOptions& options, const std::string& scenarios) {
+  if (!options.params_file.empty())
+    throw wlx::Error("--params", "the export writes the model at its description's parameter values: change them in the model file");
+  if (!scenarios.empty()) throw wlx::Error("--scenarios", "the export writes the model, not its runs");
+  if (description.empty()) throw wlx::Error("export", "this model has no description to export (rebuild wlx)");
+  const wlx::cli::MjcfExport mjcf = wlx::cli::mjcf_of_description(description);
+  if (out.empty()) out = "out/mjcf/" + mjcf.model + ".xml";
+  std::error_code ec;
+  const std::filesystem::path parent = std::filesystem::path(out).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  wlx::write_file_atomically(out, mjcf.xml);
+  if (!mjcf.placeholders.empty()) wlx::diagnose("wlx: export mjcf: {}", mjcf.placeholders);
+  wlx::diagnose("wlx: wrote {}\n", out);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -77,7 +95,7 @@ int main(int argc, char** argv) {
   Invocation inv;
   define_command_line(app, inv, names, WLX_VERSION);
   auto& [model_name, model_file, scenarios_dir, model_options, list_models, fk, fk_json, ik, batch, verify_ik, ik_out, sweep_ids, verify_nh, nh_out,
-         simulate, sim, report, report_options, viewer, viewer_options, sweep, sweep_options] = inv;
+         simulate, sim, report, report_options, viewer, viewer_options, export_mjcf, export_out, sweep, sweep_options] = inv;
   std::string model_names;
   for (const auto& n : names) model_names += (model_names.empty() ? "" : ", ") + n;
   install_interrupt_handlers();
@@ -102,6 +120,8 @@ int main(int argc, char** argv) {
     if (!model_file.empty()) {
       if (model_name != names.front())
         throw wlx::Error("--model-file", "give --model (a built-in model) or --model-file (your own), not both");
+      // An export reads the model as data: its description, and no compile.
+      if (export_mjcf->parsed()) return finish(run_export_mjcf(describe_model_file(model_file), export_out, model_options, scenarios_dir));
       if (!list_models->parsed()) model = &load_model_file(model_file, WLX_VERSION);
     }
     if (model == nullptr) {
@@ -120,6 +140,7 @@ int main(int argc, char** argv) {
         throw wlx::Error(command, fmt::format("not available for model '{}' yet", model->name));
       return function;
     };
+    if (export_mjcf->parsed()) return finish(run_export_mjcf(model->description_json, export_out, model_options, scenarios_dir));
     if (fk->parsed()) return finish(model->fk(model_options, fk_json));
     if (ik->parsed()) return finish(model->ik(model_options, batch));
     if (verify_ik->parsed()) return finish(model->verify_ik(model_options, ik_out, sweep_ids));

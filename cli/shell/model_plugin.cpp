@@ -651,6 +651,8 @@ void build_plugin(const fs::path& model_file, const Description& description, co
       "const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios = {{}};\n"
       "extern const char* const kEmbeddedReportFile;\n"
       "const char* const kEmbeddedReportFile = \"\";\n"
+      "extern const char* const kEmbeddedDescription;\n"
+      "const char* const kEmbeddedDescription = \"\";\n"
       "}} }} }}\n"
       "// The entry points wlx looks up with dlsym: the commands, and the key this plugin was built for;\n"
       "// and the model's settings, from its description (model.json), which its headers leave out.\n"
@@ -755,6 +757,12 @@ std::string model_cache_dir() {
   if (!existed) ::chmod(dir.c_str(), 0700);  // made here: the user's alone
   check_private(dir, "folder", true);
   return dir.string();
+}
+
+std::string describe_model_file(const std::string& model_file) {
+  const BoundedRead file = read_bounded_file(model_file, kMaxFileBytes);
+  if (!file.ok()) throw Error("--model-file", fmt::format("{}: {}", excerpt(model_file), file.error));
+  return describe(model_file, model_cache_dir()).text;
 }
 
 const ModelCommands& load_model_file(const std::string& model_file, const std::string& version) {

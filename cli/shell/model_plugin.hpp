@@ -44,6 +44,10 @@ class PluginBuildError : public Error {
 // failed compile (the compiler's first error and where the whole log is).
 const ModelCommands& load_model_file(const std::string& model_file, const std::string& version);
 
+// The description (model.json's text) of the model in `model_file`, as wlx-gen gives it: nothing
+// is compiled (`wlx export` reads the model as data). Errors as load_model_file's.
+std::string describe_model_file(const std::string& model_file);
+
 // Where wlx's programs (wlx-gen) and, beside them, its installed sources are, for a host other than
 // the wlx program (the Python module); by default, the running program's folder.
 void set_plugin_host_bin_dir(const std::string& bin_dir);

@@ -5,12 +5,14 @@
 #include <wlx/gen/ik.hpp>
 #include <wlx/gen/kinematics.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -436,4 +438,43 @@ TEST_CASE("cli: every validation rule names the field, the value and the rule, w
     const bool nan_only_when_quoted = r.err.find("nan") == std::string::npos || c.message.find("nan") != std::string::npos;
     CHECK(nan_only_when_quoted);
   }
+}
+
+TEST_CASE("cli: wlx export mjcf writes the model's MJCF atomically, the same for --model and --model-file, which compiles nothing") {
+  const fs::path dir = fs::temp_directory_path() / "wlx_cli_export";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "cache");
+  const Run built_in = run_wlx("export mjcf --model excavator --out " + (dir / "builtin.xml").string());
+  REQUIRE(built_in.code == 0);
+  const std::string xml = slurp(dir / "builtin.xml");
+  CHECK(xml.find("<mujoco model=\"excavator\">") != std::string::npos);
+  CHECK(xml.find("<freejoint name=\"C\"/>") != std::string::npos);
+  CHECK(xml.find("<joint name=\"guidance_l\" joint1=\"theta_l4\" joint2=\"theta_l5\"") != std::string::npos);
+  CHECK(xml.find("nan") == std::string::npos);
+  CHECK(xml.rfind("</mujoco>\n") == xml.size() - 10);
+  // The excavator's virtual joints carry no body: placeholders, said on stderr.
+  CHECK(built_in.err.find("frame W_l: moves but carries no body") != std::string::npos);
+  // A model file is described, never compiled: CXX=/bin/false would fail any compile.
+  const std::string env = "CXX=/bin/false WLX_CACHE_DIR=" + (dir / "cache").string() + " ";
+  const int status = std::system((env + WLX_BINARY + " export mjcf --model-file " + WLX_EXCAVATOR_MODEL_FILE + " --out " +
+                                  (dir / "file.xml").string() + " > /dev/null 2>&1").c_str());
+  REQUIRE(WEXITSTATUS(status) == 0);
+  CHECK(slurp(dir / "file.xml") == xml);
+  // Nothing left beside the files (they were written under temporary names and renamed).
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  CHECK(names == std::vector<std::string>{"builtin.xml", "cache", "file.xml"});
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cli: wlx export mjcf refuses --params and --scenarios with exit code 2, naming the option") {
+  const Run params = run_wlx("export mjcf --params /dev/null --out /tmp/wlx_cli_never.xml");
+  CHECK(params.code == 2);
+  CHECK(params.err.find("--params: the export writes the model at its description's parameter values") != std::string::npos);
+  const Run scenarios = run_wlx("export mjcf --scenarios /tmp --out /tmp/wlx_cli_never.xml");
+  CHECK(scenarios.code == 2);
+  CHECK(!fs::exists("/tmp/wlx_cli_never.xml"));
+  const Run missing = run_wlx("export");
+  CHECK(missing.code == 2);
 }

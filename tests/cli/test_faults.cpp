@@ -119,7 +119,7 @@ std::string e(const std::string& field) { return "wlx: error: " + field + ": "; 
 
 TEST_CASE("faults: the command line: every parse error exits 2 naming the option, with did-you-mean") {
   const std::vector<Case> cases = {
-      {"no subcommand", {}, "", "", 2, e("subcommand"), "fk, ik, verify, simulate, report, viewer or sweep"},
+      {"no subcommand", {}, "", "", 2, e("subcommand"), "fk, ik, verify, simulate, report, viewer, export or sweep"},
       {"unknown subcommand", {"simulat", "NH-1"}, "", "", 2, e("simulat"), "did you mean 'simulate'?"},
       {"unknown subcommand 2", {"reprot"}, "", "", 2, e("reprot"), "did you mean 'report'?"},
       {"unknown subcommand, no near name", {"zzzzzzzz"}, "", "", 2, e("zzzzzzzz"), "the subcommands are"},
