@@ -3,7 +3,10 @@
 // sizes are compared side by side in one run: the IK of every limb, the dependent rates, and one
 // inverse-dynamics step (IK, rates, the Newton-Euler pass, the torque split; and the same by Kane's
 // sums) and one forward-dynamics step, and what the contacts add to an inverse-dynamics step (the
-// forces, the margins, the momentum check, weighting 3), from the model's tables alone.
+// forces, the margins, the momentum check, weighting 3), from the model's tables alone. With MuJoCo
+// (WLX_HAVE_MUJOCO), the same machine exported by `wlx export mjcf` beside them: its kinematics,
+// open-tree inverse dynamics, mass matrix and one simulation step (tests/bench/test_mujoco_peer.cpp
+// checks that it computes the same values).
 #include <benchmark/benchmark.h>
 #include <wlx/contacts.hpp>
 #include <wlx/dynamics.hpp>
@@ -14,6 +17,15 @@
 
 #include <memory>
 #include <string>
+
+#ifdef WLX_HAVE_MUJOCO
+#include "mjcf_export.hpp"
+#include "mujoco_peer.hpp"
+#include "open_tree.hpp"
+
+#include <fstream>
+#include <sstream>
+#endif
 
 namespace {
 
@@ -141,6 +153,100 @@ void weighting_3_part(benchmark::State& st) {
   }
 }
 
+#ifdef WLX_HAVE_MUJOCO
+// The nominal pose in MuJoCo too: the exported model at the same coordinates, rates 0.1 and
+// accelerations 0.2 (per coordinate; what MuJoCo's free joint and wheel spins make of them).
+struct MujocoPose : Pose {
+  std::unique_ptr<mjModel, mujoco_peer::MjModelDeleter> m;
+  std::unique_ptr<mjData, mujoco_peer::MjDataDeleter> md;
+  Coordinates sdot = Coordinates::Constant(0.1), sddot = Coordinates::Constant(0.2);
+  std::vector<double> qpos, qvel;
+  MujocoPose() {
+    // The model's branches, within the joints' ranges (MuJoCo's joint limits would act otherwise).
+    solve_ik_closed_form(model, s);
+    std::ifstream in(WLX_DESCRIPTION_FILE);
+    std::stringstream text;
+    text << in.rdbuf();
+    m = mujoco_peer::load(cli::mjcf_of_description(text.str()).xml);
+    md.reset(mj_makeData(m.get()));
+    const mujoco_peer::Mapping map = mujoco_peer::map_state(m.get(), mujoco_peer::free_bases(text.str()), s, sdot);
+    const Eigen::VectorXd v = map.G * sdot, a = map.G * sddot + map.Gdot_sdot;
+    for (int i = 0; i < m->nq; ++i) md->qpos[i] = map.qpos(i);
+    for (int i = 0; i < m->nv; ++i) md->qvel[i] = v(i), md->qacc[i] = a(i);
+    qpos.assign(md->qpos, md->qpos + m->nq);
+    qvel.assign(md->qvel, md->qvel + m->nv);
+  }
+};
+
+void fk_all_frames(benchmark::State& st) {
+  auto x = std::make_unique<MujocoPose>();
+  gen::FramePositions positions;
+  gen::FrameRotations rotations;
+  for (auto _ : st) {
+    gen::kinematics(x->s, x->model.params(), {.positions = &positions, .rotations = &rotations});
+    benchmark::DoNotOptimize(positions.data());
+  }
+}
+void mujoco_kinematics(benchmark::State& st) {
+  auto x = std::make_unique<MujocoPose>();
+  for (auto _ : st) {
+    mj_kinematics(x->m.get(), x->md.get());
+    benchmark::DoNotOptimize(x->md->xpos);
+  }
+}
+void open_tree_inverse_dynamics(benchmark::State& st) {
+  auto x = std::make_unique<MujocoPose>();
+  open_tree::OpenTreeWorkspace w;
+  Coordinates Q;
+  for (auto _ : st) {
+    open_tree::open_tree_inverse_dynamics(x->model.params(), x->s, x->sdot, x->sddot, w, Q);
+    benchmark::DoNotOptimize(Q.data());
+  }
+}
+// What MuJoCo needs for the same torques from the state: positions, the bodies' inertias in the
+// CoM frames, velocities, then the recursive Newton-Euler pass.
+void mujoco_rne(benchmark::State& st) {
+  auto x = std::make_unique<MujocoPose>();
+  std::vector<mjtNum> tau(static_cast<std::size_t>(x->m->nv));
+  for (auto _ : st) {
+    mj_kinematics(x->m.get(), x->md.get());
+    mj_comPos(x->m.get(), x->md.get());
+    mj_comVel(x->m.get(), x->md.get());
+    mj_rne(x->m.get(), x->md.get(), 1, tau.data());
+    benchmark::DoNotOptimize(tau.data());
+  }
+}
+// wlx's M and b on the commanded speeds (the constrained machine) against MuJoCo's composite
+// rigid-body pass for the open tree's M.
+void equations_of_motion_step(benchmark::State& st) {
+  auto x = std::make_unique<MujocoPose>();
+  for (auto _ : st) {
+    equations_of_motion(x->model, x->d, x->s, x->u, x->terms);
+    benchmark::DoNotOptimize(x->terms.M.data());
+  }
+}
+void mujoco_crb(benchmark::State& st) {
+  auto x = std::make_unique<MujocoPose>();
+  for (auto _ : st) {
+    mj_kinematics(x->m.get(), x->md.get());
+    mj_comPos(x->m.get(), x->md.get());
+    mj_crb(x->m.get(), x->md.get());
+    benchmark::DoNotOptimize(x->md->qM);
+  }
+}
+// One MuJoCo step of 1 ms from the nominal pose on the ground (contacts, the constraint solver,
+// the integrator), beside wlx's forward-dynamics step (exact rolling and contacts, no integration).
+void mujoco_step(benchmark::State& st) {
+  auto x = std::make_unique<MujocoPose>();
+  for (auto _ : st) {
+    std::copy(x->qpos.begin(), x->qpos.end(), x->md->qpos);
+    std::copy(x->qvel.begin(), x->qvel.end(), x->md->qvel);
+    mj_step(x->m.get(), x->md.get());
+    benchmark::DoNotOptimize(x->md->qacc);
+  }
+}
+#endif
+
 const bool registered = [] {
   const std::string model(gen::kModelName);
   benchmark::RegisterBenchmark((model + "/ik_all_limbs").c_str(), ik);
@@ -156,6 +262,17 @@ const bool registered = [] {
       benchmark::RegisterBenchmark((model + "/weighting_3").c_str(), weighting_3_part);
     }
   }
+#ifdef WLX_HAVE_MUJOCO
+  benchmark::RegisterBenchmark((model + "/fk_all_frames").c_str(), fk_all_frames);
+  benchmark::RegisterBenchmark((model + "/mujoco_kinematics").c_str(), mujoco_kinematics);
+  if (gen::kHasDynamics) {
+    benchmark::RegisterBenchmark((model + "/open_tree_inverse_dynamics").c_str(), open_tree_inverse_dynamics);
+    benchmark::RegisterBenchmark((model + "/mujoco_rne").c_str(), mujoco_rne);
+    benchmark::RegisterBenchmark((model + "/equations_of_motion").c_str(), equations_of_motion_step);
+    benchmark::RegisterBenchmark((model + "/mujoco_crb").c_str(), mujoco_crb);
+    benchmark::RegisterBenchmark((model + "/mujoco_step").c_str(), mujoco_step);
+  }
+#endif
   return true;
 }();
 

@@ -33,6 +33,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace {
@@ -690,7 +691,7 @@ struct Row {
   const char* generated;  // benchmark name
   const char* baseline;   // benchmark name, or nullptr
   long ops;               // operations of the generated function, or 0
-  bool peer = false;      // the baseline is Orocos KDL (a peer library), not our numeric baseline
+  const char* peer = nullptr;  // the baseline's library (a peer: "Orocos KDL", "MuJoCo 2.2.2"), not our numeric baseline
   const char* group = nullptr;  // a heading for the rows from here on (JSON "group")
 };
 
@@ -721,16 +722,16 @@ int main(int argc, char** argv) {
   namespace ops = wlx::gen::operations;
   std::vector<Row> rows = {
       // Orocos KDL, the peer (built with KDL only): first, as the README's table shows them.
-      {"KDL peer: FK of all frames (KDL: chain FK to each end frame)", "BM_gen_kinematics_all", "BM_kdl_fk_chains", ops::kinematics, true},
-      {"KDL peer: bodies' CoM Jacobians Jv, Jw (KDL: tree Jacobians)", "BM_gen_body_jacobians", "BM_kdl_body_jacobians", 0, true},
-      {"KDL peer: end frames' Jacobians (wlx: their dPhi/ds rows)", "BM_gen_closure", "BM_kdl_end_frame_jacobians", ops::closure, true},
-      {"KDL peer: open-tree inverse dynamics (KDL: tree RNE)", "BM_gen_open_tree_inverse_dynamics", "BM_kdl_tree_rne", 0, true},
-      {"KDL peer: leg IK closed form vs KDL LMA, cold", "BM_ik_closed_form_leg", "BM_kdl_ik_lma_cold", 0, true},
-      {"KDL peer: leg IK closed form vs KDL LMA, warm", "BM_ik_closed_form_leg", "BM_kdl_ik_lma_warm", 0, true},
-      {"KDL peer: leg IK closed form vs KDL NR, cold", "BM_ik_closed_form_leg", "BM_kdl_ik_nr_cold", 0, true},
-      {"KDL peer: leg IK closed form vs KDL NR, warm", "BM_ik_closed_form_leg", "BM_kdl_ik_nr_warm", 0, true},
-      {"KDL peer: leg IK Newton vs KDL NR, cold", "BM_ik_newton_leg_cold", "BM_kdl_ik_nr_cold", 0, true},
-      {"KDL peer: leg IK Newton vs KDL NR, warm", "BM_ik_newton_leg_warm", "BM_kdl_ik_nr_warm", 0, true},
+      {"KDL peer: FK of all frames (KDL: chain FK to each end frame)", "BM_gen_kinematics_all", "BM_kdl_fk_chains", ops::kinematics, "Orocos KDL"},
+      {"KDL peer: bodies' CoM Jacobians Jv, Jw (KDL: tree Jacobians)", "BM_gen_body_jacobians", "BM_kdl_body_jacobians", 0, "Orocos KDL"},
+      {"KDL peer: end frames' Jacobians (wlx: their dPhi/ds rows)", "BM_gen_closure", "BM_kdl_end_frame_jacobians", ops::closure, "Orocos KDL"},
+      {"KDL peer: open-tree inverse dynamics (KDL: tree RNE)", "BM_gen_open_tree_inverse_dynamics", "BM_kdl_tree_rne", 0, "Orocos KDL"},
+      {"KDL peer: leg IK closed form vs KDL LMA, cold", "BM_ik_closed_form_leg", "BM_kdl_ik_lma_cold", 0, "Orocos KDL"},
+      {"KDL peer: leg IK closed form vs KDL LMA, warm", "BM_ik_closed_form_leg", "BM_kdl_ik_lma_warm", 0, "Orocos KDL"},
+      {"KDL peer: leg IK closed form vs KDL NR, cold", "BM_ik_closed_form_leg", "BM_kdl_ik_nr_cold", 0, "Orocos KDL"},
+      {"KDL peer: leg IK closed form vs KDL NR, warm", "BM_ik_closed_form_leg", "BM_kdl_ik_nr_warm", 0, "Orocos KDL"},
+      {"KDL peer: leg IK Newton vs KDL NR, cold", "BM_ik_newton_leg_cold", "BM_kdl_ik_nr_cold", 0, "Orocos KDL"},
+      {"KDL peer: leg IK Newton vs KDL NR, warm", "BM_ik_newton_leg_warm", "BM_kdl_ik_nr_warm", 0, "Orocos KDL"},
       {"FK of 13 frames (positions + rotations)", "BM_gen_kinematics_all", "BM_base_frames", ops::kinematics},
       {"FK positions only", "BM_gen_kinematics_positions", nullptr, 0},
       {"Phi + dPhi/ds (14 x 32)", "BM_gen_closure", "BM_base_closure_jacobian", ops::closure},
@@ -784,7 +785,7 @@ int main(int argc, char** argv) {
         const char* what = texts.emplace_back(fmt::format("{}: {}", model, suffix)).c_str();
         const char* generated = texts.emplace_back(name).c_str();
         const char* baseline = model == models.front() ? nullptr : texts.emplace_back(reference).c_str();
-        rows.push_back({what, generated, baseline, 0, false,
+        rows.push_back({what, generated, baseline, 0, nullptr,
                         first ? "every model, side by side (speedup: the first model's time over this one's)" : nullptr});
         first = false;
       }
@@ -796,11 +797,29 @@ int main(int argc, char** argv) {
       const std::string forward = model + "/forward_dynamics_step", inverse = model + "/inverse_dynamics_step";
       if (!collector.median_ns.count(forward) || !collector.median_ns.count(inverse)) continue;
       rows.push_back({texts.emplace_back(fmt::format("{}: forward_dynamics_step vs its inverse_dynamics_step", model)).c_str(),
-                      texts.emplace_back(forward).c_str(), texts.emplace_back(inverse).c_str(), 0, false,
+                      texts.emplace_back(forward).c_str(), texts.emplace_back(inverse).c_str(), 0, nullptr,
                       first_pair ? "each model's forward-dynamics step against its own inverse-dynamics step (speedup: inverse / forward)"
                                  : nullptr});
       first_pair = false;
     }
+    // MuJoCo (built with libmujoco-dev), on each model exported by `wlx export mjcf`: the same
+    // quantity in both, but for the mass matrix (wlx's on the commanded speeds, MuJoCo's on the
+    // open tree) and the step (wlx's constrained forward dynamics; MuJoCo's contacts, solver and
+    // integration of 1 ms).
+    bool first_mujoco = true;
+    for (const std::string& model : models)
+      for (const auto& [ours, theirs, what] :
+           {std::tuple<const char*, const char*, const char*>{"fk_all_frames", "mujoco_kinematics", "FK of all frames (MuJoCo: mj_kinematics)"},
+            {"open_tree_inverse_dynamics", "mujoco_rne", "open-tree inverse dynamics (MuJoCo: kinematics, com, velocities, mj_rne)"},
+            {"equations_of_motion", "mujoco_crb", "M, b on the commanded speeds (MuJoCo: open-tree M, mj_crb)"},
+            {"forward_dynamics_step", "mujoco_step", "forward-dynamics step (MuJoCo: mj_step of 1 ms on the ground)"}}) {
+        const std::string mine = model + "/" + ours, peer = model + "/" + theirs;
+        if (!collector.median_ns.count(mine) || !collector.median_ns.count(peer)) continue;
+        rows.push_back({texts.emplace_back(fmt::format("MuJoCo peer: {}: {}", model, what)).c_str(), texts.emplace_back(mine).c_str(),
+                        texts.emplace_back(peer).c_str(), 0, "MuJoCo 2.2.2",
+                        first_mujoco ? "MuJoCo on the same machine (`wlx export mjcf`; speedup: MuJoCo's time over wlx's)" : nullptr});
+        first_mujoco = false;
+      }
   }
   const auto get = [&](const char* name) {
     const auto it = collector.median_ns.find(name);
@@ -817,7 +836,7 @@ int main(int argc, char** argv) {
       if (r.group != nullptr) group = r.group;
       if (group != nullptr) out += fmt::format(", \"group\": \"{}\"", group);
       if (b > 0) out += fmt::format(", \"baseline\": \"{}\", \"baseline_ns\": {:.1f}, \"speedup\": {:.2f}", r.baseline, b, b / g);
-      if (r.peer) out += ", \"peer\": \"Orocos KDL\"";
+      if (r.peer) out += fmt::format(", \"peer\": \"{}\"", r.peer);
       if (r.ops > 0) out += fmt::format(", \"ops\": {}, \"ns_per_op\": {:.3f}", r.ops, g / static_cast<double>(r.ops));
       out += "}";
       first = false;
@@ -838,7 +857,7 @@ int main(int argc, char** argv) {
     fmt::print("{:<62} {:>11.1f} {:>34} {:>9} {:>7} {:>7}\n", r.what, g, base, b > 0 ? fmt::format("{:.1f}x", b / g) : "",
                r.ops > 0 ? std::to_string(r.ops) : "", r.ops > 0 ? fmt::format("{:.3f}", g / static_cast<double>(r.ops)) : "");
   }
-  fmt::print("\nmedians of 5 repetitions, one run; speedup = baseline (Orocos KDL in the \"KDL peer\" rows, else the numeric\n"
-             "baseline) / wlx, measured side by side\n");
+  fmt::print("\nmedians of 5 repetitions, one run; speedup = baseline (Orocos KDL in the \"KDL peer\" rows, MuJoCo in the\n"
+             "\"MuJoCo peer\" rows, else the numeric baseline) / wlx, measured side by side\n");
   return 0;
 }

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <wlx/error.hpp>
+#include <wlx/text.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -24,26 +25,12 @@ namespace {
 using Json = nlohmann::json;
 using Transform = Eigen::Isometry3d;
 
-// Text of the description quoted for an XML attribute.
-std::string xml(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default:
-        // A control character has no place in a name (XML 1.0 forbids most of them).
-        if (static_cast<unsigned char>(c) < 0x20) throw Error("model.json", "a name holds a control character");
-        out += c;
-    }
-  }
-  return out;
-}
+// Text of the description quoted for an XML attribute: HTML's rules are XML's (text.hpp; control
+// characters and ill-formed UTF-8 are dropped or replaced there).
+std::string xml(const std::string& text) { return ::wlx::text::html(text); }
 // Text for an XML comment ("--" may not appear in one).
-std::string comment(std::string text) {
+std::string comment(const std::string& raw) {
+  std::string text = ::wlx::text::html(raw);
   for (std::size_t at; (at = text.find("--")) != std::string::npos;) text.replace(at, 2, "- -");
   return text;
 }
@@ -267,6 +254,7 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
     if (a.contains("wheel")) drive_of_wheel[text(a, "wheel", "actuated")] = text(a, "name", "actuated");
   std::string placeholders;
   std::set<std::string> wheel_bodies;
+  std::vector<std::pair<std::string, std::string>> spin_joints;  // wheel, its spin joint's name
   for (const Json& w : member(d, "wheels", "model.json")) {
     const std::string name = text(w, "name", "wheels"), where = "wheels." + name;
     const double r = param(text(w, "radius", where), where + ".radius");
@@ -310,6 +298,7 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
                                   name, num(placeholder_mass));
     }
     const std::string joint = drive_of_wheel.count(name) ? drive_of_wheel[name] : "spin_" + name;
+    spin_joints.emplace_back(name, joint);
     const std::string body = "spin_" + name;
     if (!wheel_bodies.insert(body).second || frame_index.count(body)) throw Error(where, fmt::format("its spinning body's name '{}' is taken", body));
     h.extra += fmt::format(
@@ -373,6 +362,19 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
       throw Error("closure." + name, fmt::format("has type '{}', which the export does not know", type));
     }
   }
+
+  // MuJoCo's names are unique per kind: joints (coordinates, free bases, wheels' spins) and geoms.
+  std::set<std::string> joints_seen, geoms_seen{"ground"};
+  for (const auto& f : frames) {
+    if (f.free && !joints_seen.insert(f.name).second) throw Error("frames." + f.name, "names a free joint that another joint's name takes");
+    for (const auto& j : f.joints)
+      if (!joints_seen.insert(j.name).second) throw Error("frames." + f.name, fmt::format("joint '{}' is named twice", j.name));
+  }
+  for (const auto& [wheel, joint] : spin_joints)
+    if (!joints_seen.insert(joint).second) throw Error("wheels." + wheel, fmt::format("its spin joint's name '{}' is taken", joint));
+  for (const Json& c : contacts)
+    if (!geoms_seen.insert(text(c, "frame", "contacts")).second)
+      throw Error("contacts", fmt::format("two contact geoms would be named '{}'", text(c, "frame", "contacts")));
 
   // The tree, written from K0 down.
   std::string body_xml;

@@ -4,11 +4,8 @@
 // mass, the open tree's mass matrix (mj_fullM) and its inverse dynamics with gravity (mj_rne,
 // contacts off). Compiled once per built-in model.
 //
-// Coordinates: each hinge and slide joint is the coordinate of its name. A floating base is
-// MuJoCo's free joint: qpos = (x, y, z, quaternion of R = R_a1(q1) R_a2(q2) R_a3(q3)), qvel =
-// (world velocity, body-frame angular velocity) = G(s) s'. So M_wlx = G^T M_mj G, and
-// Q_wlx(s, s', s'') = G^T rne(q, G s', G s'' + G' s'). A wheel's spin (no coordinate of wlx's:
-// its rate follows from rolling) is held at 0.
+// Coordinates as bench/mujoco_peer.hpp maps them, qvel = G(s) s': so M_wlx = G^T M_mj G, and
+// Q_wlx(s, s', s'') = G^T rne(q, G s', G s'' + G' s').
 //
 // Tolerance: 1e-10 relative to the largest entry of the compared quantity. Both sides are exact
 // formulas in double precision (MuJoCo's recursive CRBA and RNE, wlx's Kane's sums) and differ by
@@ -19,6 +16,7 @@
 // axis, mass or inertia shows far above it: the second test changes one inertia by 1% and sees it
 // (5e-5 relative on the wheeled quadruped's mass matrix, 5e-3 on the excavator's).
 #include "../support/random.hpp"
+#include "mujoco_peer.hpp"
 #include "open_tree.hpp"
 #include "mjcf_export.hpp"
 
@@ -44,6 +42,7 @@
 #include <unistd.h>
 
 using namespace wlx;
+using namespace wlx::mujoco_peer;
 
 namespace {
 
@@ -56,103 +55,6 @@ std::string read_text(const std::string& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-// MuJoCo's model of an MJCF text (written to a temporary file: 2.2.2 loads XML from files).
-struct MjModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
-struct MjDataDeleter {
-  void operator()(mjData* d) const { mj_deleteData(d); }
-};
-std::unique_ptr<mjModel, MjModelDeleter> load(const std::string& xml) {
-  char path[] = "/tmp/wlx-mjcf-XXXXXX";
-  const int fd = mkstemp(path);
-  REQUIRE(fd >= 0);
-  REQUIRE(write(fd, xml.data(), xml.size()) == static_cast<ssize_t>(xml.size()));
-  close(fd);
-  char error[1000] = "";
-  mjModel* m = mj_loadXML(path, nullptr, error, sizeof error);
-  std::remove(path);
-  REQUIRE_MESSAGE(m != nullptr, "MuJoCo refuses the export: " << error);
-  return std::unique_ptr<mjModel, MjModelDeleter>(m);
-}
-
-int coordinate_index(const std::string& name) {
-  for (int k = 0; k < gen::kCoordinateCount; ++k)
-    if (gen::kCoordinateNames[static_cast<std::size_t>(k)] == name) return k;
-  return -1;
-}
-
-// The floating base: the free joint's frame and its six coordinates with the rotation axes.
-struct FreeBase {
-  std::string frame;
-  std::array<int, 3> position{}, angle{};
-  std::array<int, 3> axis{};
-};
-
-// G (MuJoCo's dofs x wlx's coordinates), its time derivative times s', and qpos, for a state.
-struct Mapping {
-  Eigen::MatrixXd G;
-  Eigen::VectorXd Gdot_sdot, qpos;
-};
-
-Eigen::Matrix3d axis_rotation(int axis, double angle) { return Eigen::AngleAxisd(angle, Eigen::Vector3d::Unit(axis)).toRotationMatrix(); }
-Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
-  Eigen::Matrix3d H;
-  H << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
-  return H;
-}
-
-Mapping map_state(const mjModel* m, const std::vector<FreeBase>& bases, const gen::Coordinates& s, const gen::Coordinates& sdot) {
-  Mapping out;
-  out.G = Eigen::MatrixXd::Zero(m->nv, gen::kCoordinateCount);
-  out.Gdot_sdot = Eigen::VectorXd::Zero(m->nv);
-  out.qpos = Eigen::VectorXd::Zero(m->nq);
-  for (int j = 0; j < m->njnt; ++j) {
-    const int qa = m->jnt_qposadr[j], va = m->jnt_dofadr[j];
-    const std::string name = mj_id2name(m, mjOBJ_JOINT, j);
-    if (m->jnt_type[j] == mjJNT_FREE) {
-      const auto base = std::find_if(bases.begin(), bases.end(), [&](const FreeBase& b) { return b.frame == name; });
-      REQUIRE_MESSAGE(base != bases.end(), "free joint " << name << " is no frame's floating base");
-      for (int i = 0; i < 3; ++i) {
-        out.qpos(qa + i) = s(base->position[static_cast<std::size_t>(i)]);
-        out.G(va + i, base->position[static_cast<std::size_t>(i)]) = 1;
-      }
-      std::array<Eigen::Matrix3d, 3> R;
-      for (int i = 0; i < 3; ++i) R[static_cast<std::size_t>(i)] = axis_rotation(base->axis[static_cast<std::size_t>(i)], s(base->angle[static_cast<std::size_t>(i)]));
-      const Eigen::Quaterniond q(R[0] * R[1] * R[2]);
-      out.qpos.segment<4>(qa + 3) << q.w(), q.x(), q.y(), q.z();
-      // omega_body = sum_i B_i e_i q_i', B_i = (R_{i+1} ... R_3)^T; B_i' from R_k' = R_k [e_k q_k']x.
-      for (int i = 0; i < 3; ++i) {
-        Eigen::Matrix3d B = Eigen::Matrix3d::Identity(), Bdot = Eigen::Matrix3d::Zero();
-        // B_i = R_3^T ... R_{i+1}^T, written as a product from R_3^T down.
-        std::vector<Eigen::Matrix3d> factors;  // R_3^T, R_2^T, ..., R_{i+1}^T
-        std::vector<Eigen::Matrix3d> derivatives;
-        for (int k = 2; k > i; --k) {
-          const Eigen::Vector3d w = Eigen::Vector3d::Unit(base->axis[static_cast<std::size_t>(k)]) * sdot(base->angle[static_cast<std::size_t>(k)]);
-          factors.push_back(R[static_cast<std::size_t>(k)].transpose());
-          derivatives.push_back(-hat(w) * R[static_cast<std::size_t>(k)].transpose());
-        }
-        for (const auto& f : factors) B = B * f;
-        for (std::size_t d = 0; d < factors.size(); ++d) {
-          Eigen::Matrix3d term = Eigen::Matrix3d::Identity();
-          for (std::size_t f = 0; f < factors.size(); ++f) term = term * (f == d ? derivatives[f] : factors[f]);
-          Bdot += term;
-        }
-        const Eigen::Vector3d e = Eigen::Vector3d::Unit(base->axis[static_cast<std::size_t>(i)]);
-        const int c = base->angle[static_cast<std::size_t>(i)];
-        out.G.block<3, 1>(va + 3, c) = B * e;
-        out.Gdot_sdot.segment<3>(va + 3) += Bdot * e * sdot(c);
-      }
-      continue;
-    }
-    const int c = coordinate_index(name);
-    if (c < 0) continue;  // a wheel's spin: held at 0
-    out.qpos(qa) = s(c);
-    out.G(va, c) = 1;
-  }
-  return out;
 }
 
 struct Worst {
@@ -172,30 +74,7 @@ Worst compare(const std::string& xml, const std::string& description, int states
   for (int b = 0; b < gen::kBodyCount; ++b) mass += p.*gen::kBodyMass[static_cast<std::size_t>(b)].mass;
   worst.mass = std::abs(mj_getTotalmass(m) - mass) / mass;
 
-  // The floating bases, from the description's chains.
-  const nlohmann::json desc = nlohmann::json::parse(description);
-  std::vector<FreeBase> bases;
-  for (const auto& f : desc["frames"]) {
-    if (!f.contains("chain") || f["parent"] != "K0" || f["chain"].size() != 6) continue;
-    FreeBase b;
-    b.frame = f["name"];
-    bool slides = true;
-    for (int i = 0; i < 3; ++i) {
-      const auto& step = f["chain"][static_cast<std::size_t>(i)];
-      slides = slides && step.contains("prismatic");
-      if (slides) b.position[static_cast<std::size_t>(i)] = coordinate_index(step["coordinate"]);
-    }
-    for (int i = 0; i < 3 && slides; ++i) {
-      const auto& step = f["chain"][static_cast<std::size_t>(i + 3)];
-      if (!step.contains("revolute")) slides = false;
-      else {
-        b.angle[static_cast<std::size_t>(i)] = coordinate_index(step["coordinate"]);
-        b.axis[static_cast<std::size_t>(i)] = std::string(step["revolute"]) == "x" ? 0 : std::string(step["revolute"]) == "y" ? 1 : 2;
-      }
-    }
-    if (slides) bases.push_back(b);
-  }
-
+  const std::vector<FreeBase> bases = free_bases(description);
   std::mt19937_64 rng(20261206);
   open_tree::OpenTreeWorkspace w;
   gen::FramePositions positions;
