@@ -14,6 +14,7 @@
 
 #include <dlfcn.h>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -32,8 +33,38 @@ using wlx::cli::ModelApi;
 struct ModelHandle {
   const ModelApi* api = nullptr;
   py::dict info;
-  long actuators = 0;
+  long actuators = 0, coordinates = 0, frames = 0, commanded = 0;
 };
+
+// The model at one set of parameters with its Data (ModelApi::new_workspace), for the calls
+// without JSON: made once per parameters by wlx.Model, freed with it.
+struct Workspace {
+  const ModelApi* api;
+  void* data;
+  Workspace(const ModelApi* a, void* d) : api(a), data(d) {}
+  Workspace(const Workspace&) = delete;
+  Workspace& operator=(const Workspace&) = delete;
+  ~Workspace() { api->delete_workspace(data); }
+};
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// The rows of a state array (one state, or count x n), checked against the model's n ("has 3
+// entries; the model has 32 coordinates", as the single-state calls say).
+long rows_of(const Array& a, long n, const char* field, const char* what) {
+  if (a.ndim() == 1 && a.shape(0) == n) return 1;
+  if (a.ndim() == 2 && a.shape(1) == n) return static_cast<long>(a.shape(0));
+  if (a.ndim() == 1)
+    throw Error(field, "has " + std::to_string(a.shape(0)) + " entries; the model has " + std::to_string(n) + " " + what);
+  if (a.ndim() == 2)
+    throw Error(field, "has rows of " + std::to_string(a.shape(1)) + " entries; the model has " + std::to_string(n) + " " + what);
+  throw Error(field, "must be one state or an array of rows, one state a row (" + std::to_string(a.ndim()) + " dimensions given)");
+}
+// An output of `rows` rows of `shape` (none but the shape for a single state).
+Array output(long rows, bool single, std::vector<py::ssize_t> shape) {
+  if (!single) shape.insert(shape.begin(), rows);
+  return Array(shape);
+}
 
 ModelHandle handle_of(const wlx::cli::ModelCommands& commands) {
   if (commands.api == nullptr) throw Error("model", std::string(commands.name) + " has no computations for Python");
@@ -41,6 +72,9 @@ ModelHandle handle_of(const wlx::cli::ModelCommands& commands) {
   h.api = commands.api;
   h.info = py::module_::import("json").attr("loads")(commands.api->info());
   h.actuators = static_cast<long>(py::len(h.info["actuators"]));
+  h.coordinates = static_cast<long>(py::len(h.info["coordinates"]));
+  h.frames = static_cast<long>(py::len(h.info["frames"]));
+  h.commanded = static_cast<long>(py::len(h.info["commanded"]));
   return h;
 }
 
@@ -83,7 +117,34 @@ PYBIND11_MODULE(_wlx, m) {
   m.doc() = "wlx's C++ core; use the package wlx";
   py::register_exception<Error>(m, "Error", PyExc_ValueError);
 
+  py::class_<Workspace>(m, "Workspace", "The model at one set of parameters, with its working memory (use wlx.Model)");
+
   py::class_<ModelHandle>(m, "ModelHandle", "One model's computations (use wlx.Model)")
+      .def("workspace",
+           [](const ModelHandle& h, const std::string& params_json) { return std::make_unique<Workspace>(h.api, h.api->new_workspace(params_json)); },
+           "workspace(params_json) -> the model at these parameters, for fk_many and inverse_dynamics_many")
+      .def("fk_many",
+           [](const ModelHandle& h, Workspace& w, const Array& s) {
+             const long rows = rows_of(s, h.coordinates, "s", "coordinates");
+             const bool single = s.ndim() == 1;
+             Array positions = output(rows, single, {h.frames, 3}), rotations = output(rows, single, {h.frames, 3, 3});
+             h.api->fk_many(w.data, s.data(), rows, positions.mutable_data(), rotations.mutable_data());
+             return py::make_tuple(positions, rotations);
+           },
+           "fk_many(workspace, s) -> (positions, rotations): s one state or rows of states; (frames x 3, frames x 3 x 3) per state")
+      .def("inverse_dynamics_many",
+           [](const ModelHandle& h, Workspace& w, const Array& s, const Array& u, const Array& u_dot, const std::string& weighting_json) {
+             const long rows = rows_of(s, h.coordinates, "s", "coordinates");
+             if (rows_of(u, h.commanded, "u", "commanded speeds") != rows || rows_of(u_dot, h.commanded, "u_dot", "commanded speeds") != rows ||
+                 u.ndim() != s.ndim() || u_dot.ndim() != s.ndim())
+               throw Error("u", "s, u and u_dot must have as many rows (one state a row)");
+             const bool single = s.ndim() == 1;
+             Array tau = output(rows, single, {h.actuators}), qstar = output(rows, single, {h.commanded});
+             h.api->inverse_dynamics_many(w.data, weighting_json, s.data(), u.data(), u_dot.data(), rows, tau.mutable_data(),
+                                          qstar.mutable_data());
+             return py::make_tuple(tau, qstar);
+           },
+           "inverse_dynamics_many(workspace, s, u, u_dot, weighting_json) -> (tau, Qstar), a row per state")
       .def_property_readonly("info", [](const ModelHandle& h) { return h.info; })
       .def("ik",
            [](const ModelHandle& h, const std::string& request_json) {

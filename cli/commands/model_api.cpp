@@ -268,11 +268,76 @@ SimulationOutcome api_simulate(const std::string& scenario_json, const std::stri
   return {sc.id, run.complete, run.error, run.evaluations, rows};
 }
 
+// The fast paths (model_api.hpp): a workspace, and states by the array.
+struct Workspace {
+  Model model;
+  Data data;
+  DynamicsTerms terms;
+  explicit Workspace(const Params& p) : model(p) {}
+};
+
+void* api_new_workspace(const std::string& params_json) { return new Workspace(params_of(params_json)); }
+void api_delete_workspace(void* workspace) { delete static_cast<Workspace*>(workspace); }
+
+// Row `row` of a caller's array as coordinates: the cheap test first, the named error of
+// coordinates_of only for a state that fails it ("s.<name>" for one state, "s[row].<name>" in a batch).
+Coordinates state_row(const double* s, long row, long count) {
+  const Eigen::Map<const Coordinates> state(s + row * kCoordinateCount);
+  // Within the smaller of the two bounds: within its own (no unit to look up); else the full check,
+  // which throws for a value beyond its unit's bound and lets the others through.
+  constexpr double kWithinEither = std::min(kMaxAngle, kMaxPosition);
+  for (int k = 0; k < kCoordinateCount; ++k)
+    if (!(std::abs(state(k)) <= kWithinEither)) {
+      const std::string field = count == 1 ? std::string("s") : "s[" + std::to_string(row) + "]";
+      coordinates_of(Eigen::VectorXd(state), field.c_str());
+      break;
+    }
+  return state;
+}
+
+void api_fk_many(void* workspace, const double* s, long count, double* positions, double* rotations) {
+  auto& w = *static_cast<Workspace*>(workspace);
+  for (long row = 0; row < count; ++row) {
+    forward_kinematics(w.model, w.data, state_row(s, row, count));
+    double* p = positions + row * 3 * gen::kFrameCount;
+    double* r = rotations + row * 9 * gen::kFrameCount;
+    for (int f = 0; f < gen::kFrameCount; ++f) {
+      Eigen::Map<Eigen::Vector3d>(p + 3 * f) = w.data.frame_positions.col(f);
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r + 9 * f) = w.data.frame_rotations[static_cast<std::size_t>(f)];
+    }
+  }
+}
+
+void api_inverse_dynamics_many(void* workspace, const std::string& weighting_json, const double* s, const double* u,
+                               const double* u_dot, long count, double* tau, double* Qstar) {
+  auto& w = *static_cast<Workspace*>(workspace);
+  const Weighting weighting = parse_weighting(parse_json(weighting_json, "weighting"), "weighting");
+  if (weighting.kind == Weighting::Kind::contacts)
+    throw Error("weighting", "the contacts' distribution solves an optimisation per state: call inverse_dynamics state by state");
+  for (long row = 0; row < count; ++row) {
+    const Coordinates state = state_row(s, row, count);
+    const CommandVector speeds = Eigen::Map<const CommandVector>(u + row * kCommandedCount);
+    const CommandVector rates = Eigen::Map<const CommandVector>(u_dot + row * kCommandedCount);
+    if (!speeds.allFinite() || !rates.allFinite() || speeds.cwiseAbs().maxCoeff() > std::min(kMaxLinearRate, kMaxAngularRate) ||
+        rates.cwiseAbs().maxCoeff() > 1e4) {  // the named errors of the state-by-state path
+      const std::string field = count == 1 ? std::string() : "[" + std::to_string(row) + "]";
+      speeds_of(Eigen::VectorXd(speeds), ("u" + field).c_str());
+      accelerations_of(Eigen::VectorXd(rates), ("u_dot" + field).c_str());
+    }
+    inverse_dynamics(w.model, w.data, state, speeds, rates, w.terms);
+    const TorqueVector t = distribute_torques(w.terms.J_beta, w.terms.Qstar, weighting);
+    if (!t.allFinite()) throw Error("tau[" + std::to_string(row) + "]", "is not finite at these inputs (a state the model does not compute)");
+    Eigen::Map<TorqueVector>(tau + row * kActuatedCount) = t;
+    Eigen::Map<CommandVector>(Qstar + row * kCommandedCount) = w.terms.Qstar;
+  }
+}
+
 }  // namespace
 
 const ModelApi& api() {
   static const ModelApi functions{&info_text,           &api_ik,           &api_fk, &api_dependent_rates, &api_inverse_dynamics,
-                                  &api_forward_dynamics, &api_simulate};
+                                  &api_forward_dynamics, &api_simulate, &api_new_workspace, &api_delete_workspace, &api_fk_many,
+                                  &api_inverse_dynamics_many};
   return functions;
 }
 

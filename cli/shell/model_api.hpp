@@ -67,6 +67,18 @@ struct ModelApi {
   // params_json (an object) overrides the scenario's own parameters (a sweep's variant over a run).
   SimulationOutcome (*simulate)(const std::string& scenario_json, const std::string& params_json, long every, TorqueFunction torques,
                                 const SimulationSink& sink);
+  // Without JSON per call, for a binding's hot loops: a workspace (the model at the parameters of
+  // params_json, with its Data, made once), then states by the array, row-major (count rows of
+  // the model's coordinates; outputs sized by the caller). Each state is checked as `s` above is
+  // (the first bad entry named "s[row].<coordinate>"); the results are finite, or an error.
+  void* (*new_workspace)(const std::string& params_json);
+  void (*delete_workspace)(void* workspace);
+  // positions: count x frames x 3; rotations: count x frames x 3 x 3 (each matrix row-major).
+  void (*fk_many)(void* workspace, const double* s, long count, double* positions, double* rotations);
+  // tau: count x actuators; Qstar: count x commanded speeds. u, u_dot: count x commanded speeds.
+  // weighting_json as inverse_dynamics' (all but the contacts' distribution, an optimisation per state).
+  void (*inverse_dynamics_many)(void* workspace, const std::string& weighting_json, const double* s, const double* u,
+                                const double* u_dot, long count, double* tau, double* Qstar);
 };
 
 }  // namespace wlx::cli

@@ -112,6 +112,21 @@ class Model:
         self.actuators = list(info["actuators"])  # tau's order: joints, and wheel drives (spin_<wheel>)
         # The contacts with the ground (contact_force's rows; f_n_<name> in simulate's columns).
         self.contacts = list(info.get("contacts", []))
+        # The model at its own parameters with its working memory, made once: fk() and a batch of
+        # inverse_dynamics() go through it without JSON; other parameters get theirs, a few kept.
+        self._workspace = handle.workspace("{}")
+        self._workspaces = {}
+
+    def _workspace_for(self, params):
+        if not params:
+            return self._workspace
+        key = _params_json(params)
+        w = self._workspaces.get(key)
+        if w is None:
+            if len(self._workspaces) >= 8:  # bounded: the oldest goes
+                self._workspaces.pop(next(iter(self._workspaces)))
+            w = self._workspaces[key] = self._m.workspace(key)
+        return w
 
     def __repr__(self):
         return f"wlx.load({self._path!r})" if self._path is not None else f"wlx.model({self.name!r})"
@@ -129,9 +144,11 @@ class Model:
 
     def fk(self, s, params=None):
         """Frame origins and orientations in K0 at coordinates s (all of them, e.g. ik()["s"]):
-        {"positions": (frames x 3), "rotations": (frames x 3 x 3), "frames": names}."""
-        positions, rotations = self._m.fk(_np.asarray(s, dtype=float), _params_json(params))
-        return {"positions": positions, "rotations": _np.array(rotations), "frames": self.frames}
+        {"positions": (frames x 3), "rotations": (frames x 3 x 3), "frames": names}. s may also be
+        an array of states, one a row (N x coordinates): then positions are N x frames x 3 and
+        rotations N x frames x 3 x 3, computed in one call."""
+        positions, rotations = self._m.fk_many(self._workspace_for(params), s)
+        return {"positions": positions, "rotations": rotations, "frames": self.frames}
 
     def dependent_rates(self, s, rates, dependent=None, params=None):
         """All coordinate rates s' from the input rates (a dict by name or an array of the inputs'
@@ -154,9 +171,19 @@ class Model:
         that keep the machine on its contacts, {"diag": [...]}, {"matrix": [[...]]}). For a model
         with contacts also "contact_force" and "contact_point" (one row per contact, in the order
         of `contacts`, K0, N and m), "friction_margin" (mu f_n - |f_t|, N) and "margins" (static
-        and zero-moment-point margins in m, the force-angle margin in rad)."""
+        and zero-moment-point margins in m, the force-angle margin in rad).
+
+        s, u and u_dot may also be arrays of rows, one state a row (N x coordinates, N x commanded):
+        then the result is {"tau": N x actuators, "Qstar": N x commanded}, computed in one call
+        (weighting 1, 2, {"diag": ...} or {"matrix": ...}; the contacts' weighting solves an
+        optimisation per state, so goes state by state)."""
+        s = _np.asarray(s, dtype=float)
         if u_dot is None:
-            u_dot = _np.zeros(len(self.commanded))
+            u_dot = _np.zeros(_np.shape(u))
+        if s.ndim == 2:
+            tau, qstar = self._m.inverse_dynamics_many(self._workspace_for(params), s, _np.asarray(u, dtype=float),
+                                                       _np.asarray(u_dot, dtype=float), _to_json(weighting, "weighting"))
+            return {"tau": tau, "Qstar": qstar}
         return self._m.inverse_dynamics(_np.asarray(s, dtype=float), _np.asarray(u, dtype=float),
                                         _np.asarray(u_dot, dtype=float), _params_json(params), _to_json(weighting, "weighting"))
 

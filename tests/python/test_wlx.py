@@ -331,6 +331,70 @@ def test_array_arguments_are_checked():
         wlx.model("tractor")
 
 
+@pytest.mark.parametrize("name", wlx.models())
+def test_arrays_of_states_give_what_one_state_at_a_time_gives(name):
+    # fk and inverse_dynamics over N x n arrays (one call, no JSON per state) against the same
+    # computations state by state (fk's one-state call goes through the same C++; inverse_dynamics'
+    # through the JSON path of the command line): equal to the last bit.
+    robot = wlx.model(name)
+    rng = np.random.default_rng(11)
+    s0 = robot.ik()["s"]
+    states = s0 + 1e-3 * rng.standard_normal((25, len(s0)))
+    batch = robot.fk(states)
+    assert batch["positions"].shape == (25, len(robot.frames), 3)
+    assert batch["rotations"].shape == (25, len(robot.frames), 3, 3)
+    for k in (0, 7, 24):
+        one = robot.fk(states[k])
+        np.testing.assert_array_equal(batch["positions"][k], one["positions"])
+        np.testing.assert_array_equal(batch["rotations"][k], one["rotations"])
+    if not robot.commanded:
+        return
+    # Poses the closure holds (the IK's), commanded speeds and their rates at random.
+    poses = np.array([robot.ik({robot.inputs[0]: s0[0] + 0.01 * k})["s"] for k in range(6)])
+    u = 0.2 * rng.standard_normal((6, len(robot.commanded)))
+    u_dot = 0.5 * rng.standard_normal((6, len(robot.commanded)))
+    for weighting in (1, 2):
+        many = robot.inverse_dynamics(poses, u, u_dot, weighting=weighting)
+        assert many["tau"].shape == (6, len(robot.actuators)) and many["Qstar"].shape == (6, len(robot.commanded))
+        for k in range(6):
+            one = robot.inverse_dynamics(poses[k], u[k], u_dot[k], weighting=weighting)
+            np.testing.assert_array_equal(many["tau"][k], one["tau"])
+            np.testing.assert_array_equal(many["Qstar"][k], one["Qstar"])
+
+
+def test_a_bad_row_of_an_array_of_states_is_named_by_its_row():
+    robot = wlx.model("excavator")
+    s0 = robot.ik()["s"]
+    states = np.tile(s0, (4, 1))
+    states[2, robot.coordinates.index("x_C")] = float("nan")
+    with pytest.raises(wlx.Error, match=r"^s\[2\]\.x_C: is not a finite number"):
+        robot.fk(states)
+    with pytest.raises(wlx.Error, match=r"^s: has rows of 3 entries; the model has 32 coordinates"):
+        robot.fk(np.zeros((4, 3)))
+    u = np.zeros((4, 4))
+    u[1, 1] = float("inf")
+    with pytest.raises(wlx.Error, match=r"^u\[1\]\.x_C: is not a finite number"):
+        robot.inverse_dynamics(np.tile(s0, (4, 1)), u)
+    with pytest.raises(wlx.Error, match=r"^weighting: the contacts' distribution solves an optimisation per state"):
+        robot.inverse_dynamics(np.tile(s0, (4, 1)), np.zeros((4, 4)), weighting="contacts")
+    with pytest.raises(wlx.Error, match=r"^u: s, u and u_dot must have as many rows"):
+        robot.inverse_dynamics(np.tile(s0, (4, 1)), np.zeros((3, 4)))
+
+
+def test_fk_with_parameters_gives_what_wlx_fk_gives_with_them(tmp_path):
+    # Another parameter set gets a workspace of its own (and the model's own stays as it was).
+    robot = wlx.model("excavator")
+    params = {"thighD": 2.4}
+    (tmp_path / "p.json").write_text(json.dumps(params))
+    expected = cli_json(["fk", "--json", "--params", str(tmp_path / "p.json")], {})
+    s = robot.ik({"params": params})["s"]
+    got = robot.fk(s, params=params)
+    for i, name in enumerate(robot.frames):
+        np.testing.assert_array_equal(got["positions"][i], expected["frames"][name]["position"])
+    default = robot.fk(s)
+    assert np.abs(default["positions"] - got["positions"]).max() > 0.1
+
+
 def readme_python_blocks():
     # The README's Python examples: each python block after "<!-- ci: python -->", as it stands.
     # The one through wlx.sweep is tests/python/test_sweep.py's.
