@@ -16,7 +16,9 @@
 #include <wlx/nonholonomic.hpp>
 
 #include <memory>
+#include <random>
 #include <string>
+#include <vector>
 
 #ifdef WLX_HAVE_MUJOCO
 #include "mjcf_export.hpp"
@@ -59,6 +61,26 @@ void ik(benchmark::State& st) {
   for (auto _ : st) {
     solve_ik_closed_form(x->model, x->s, x->branches);
     benchmark::DoNotOptimize(x->s.data());
+  }
+}
+
+// FK of all frames over 1000 states near the nominal pose (every coordinate off by 1 mm or 1 mrad
+// at random, seeded), each output kept: what one call over an array costs (Python's m.fk(S),
+// tools/python_speed.py), where the same state called again flatters the generated trigonometry.
+void fk_1000_states(benchmark::State& st) {
+  auto x = std::make_unique<Pose>();
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> noise(0.0, 1e-3);
+  std::vector<Coordinates> states(1000, x->s);
+  for (auto& s : states)
+    for (int k = 0; k < kCoordinateCount; ++k) s(k) += noise(rng);
+  std::vector<gen::FramePositions> positions(states.size());
+  std::vector<gen::FrameRotations> rotations(states.size());
+  for (auto _ : st) {
+    for (std::size_t i = 0; i < states.size(); ++i)
+      gen::kinematics(states[i], x->model.params(), {.positions = &positions[i], .rotations = &rotations[i]});
+    benchmark::DoNotOptimize(positions.data());
+    benchmark::ClobberMemory();
   }
 }
 
@@ -250,6 +272,7 @@ void mujoco_step(benchmark::State& st) {
 const bool registered = [] {
   const std::string model(gen::kModelName);
   benchmark::RegisterBenchmark((model + "/ik_all_limbs").c_str(), ik);
+  benchmark::RegisterBenchmark((model + "/fk_1000_states").c_str(), fk_1000_states);
   if (gen::kHasDynamics) {
     benchmark::RegisterBenchmark((model + "/dependent_rates").c_str(), dependent_rates);
     benchmark::RegisterBenchmark((model + "/inverse_dynamics_step").c_str(), inverse_dynamics_step);

@@ -774,7 +774,7 @@ int main(int argc, char** argv) {
       return (a == "excavator") != (b == "excavator") ? a == "excavator" : a < b;
     });
     bool first = true;
-    for (const std::string& suffix : {std::string("ik_all_limbs"), std::string("dependent_rates"),
+    for (const std::string& suffix : {std::string("ik_all_limbs"), std::string("fk_1000_states"), std::string("dependent_rates"),
                                       std::string("inverse_dynamics_step"), std::string("inverse_dynamics_step_by_kane"),
                                       std::string("forward_dynamics_step")}) {
       if (models.empty()) break;  // (a --benchmark_filter without them)

@@ -129,7 +129,8 @@ PYBIND11_MODULE(_wlx, m) {
              const bool single = s.ndim() == 1;
              Array positions = output(rows, single, {h.frames, 3}), rotations = output(rows, single, {h.frames, 3, 3});
              h.api->fk_many(w.data, s.data(), rows, positions.mutable_data(), rotations.mutable_data());
-             return py::make_tuple(positions, rotations);
+             // Each matrix was written by columns: the view with its last two axes swapped is it.
+             return py::make_tuple(positions, rotations.attr("swapaxes")(-1, -2));
            },
            "fk_many(workspace, s) -> (positions, rotations): s one state or rows of states; (frames x 3, frames x 3 x 3) per state")
       .def("inverse_dynamics_many",

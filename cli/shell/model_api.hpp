@@ -73,7 +73,8 @@ struct ModelApi {
   // (the first bad entry named "s[row].<coordinate>"); the results are finite, or an error.
   void* (*new_workspace)(const std::string& params_json);
   void (*delete_workspace)(void* workspace);
-  // positions: count x frames x 3; rotations: count x frames x 3 x 3 (each matrix row-major).
+  // positions: count x frames x 3; rotations: count x frames x 3 x 3, each matrix by columns (the
+  // binding presents the transpose of that layout: the matrices as they are).
   void (*fk_many)(void* workspace, const double* s, long count, double* positions, double* rotations);
   // tau: count x actuators; Qstar: count x commanded speeds. u, u_dot: count x commanded speeds.
   // weighting_json as inverse_dynamics' (all but the contacts' distribution, an optimisation per state).
