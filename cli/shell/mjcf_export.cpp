@@ -343,7 +343,7 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
   std::set<std::string> joint_names;
   for (const auto& f : frames)
     for (const auto& j : f.joints) joint_names.insert(j.name);
-  std::string equalities;
+  std::string equalities, tendons;
   for (const Json& c : member(d, "closure", "model.json")) {
     const std::string name = text(c, "name", "closure"), type = text(c, "type", "closure." + name);
     if (type == "point" || type == "level") {
@@ -352,12 +352,22 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
         throw Error("closure." + name, fmt::format("holds frame {} inside the machine ({} row), which the export cannot express", f, type));
     } else if (type == "sum") {
       const Json& cs = member(c, "coordinates", "closure." + name);
-      if (!cs.is_array() || cs.size() != 2)
-        throw Error("closure." + name, "is a sum of other than two coordinates, which the export cannot express");
-      const std::string a = cs[0].get<std::string>(), b = cs[1].get<std::string>();
-      if (!joint_names.count(a) || !joint_names.count(b))
-        throw Error("closure." + name, "sums a coordinate that is no joint of the tree, which the export cannot express");
-      equalities += fmt::format("    <joint name=\"{}\" joint1=\"{}\" joint2=\"{}\" polycoef=\"0 -1 0 0 0\"/>\n", xml(name), xml(a), xml(b));
+      if (!cs.is_array() || cs.size() < 2) throw Error("closure." + name, "is a sum of fewer than two coordinates");
+      std::vector<std::string> terms;
+      for (const Json& term : cs) {
+        if (!term.is_string() || !joint_names.count(term.get<std::string>()))
+          throw Error("closure." + name, "sums a coordinate that is no joint of the tree, which the export cannot express");
+        terms.push_back(term.get<std::string>());
+      }
+      if (terms.size() == 2) {  // q1 = -q2
+        equalities += fmt::format("    <joint name=\"{}\" joint1=\"{}\" joint2=\"{}\" polycoef=\"0 -1 0 0 0\"/>\n", xml(name), xml(terms[0]),
+                                  xml(terms[1]));
+      } else {  // more: a fixed tendon, the sum, held at its length at zero joint values (0)
+        tendons += fmt::format("    <fixed name=\"{}\">\n", xml(name));
+        for (const auto& term : terms) tendons += fmt::format("      <joint joint=\"{}\" coef=\"1\"/>\n", xml(term));
+        tendons += "    </fixed>\n";
+        equalities += fmt::format("    <tendon name=\"{}\" tendon1=\"{}\"/>\n", xml(name), xml(name));
+      }
     } else {
       throw Error("closure." + name, fmt::format("has type '{}', which the export does not know", type));
     }
@@ -435,9 +445,10 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
       "    <geom name=\"ground\" type=\"plane\" size=\"0 0 1\" friction=\"0 0 0\"/>\n"
       "{}"
       "  </worldbody>\n"
-      "{}{}"
+      "{}{}{}"
       "</mujoco>\n",
       comment(model), comment(text(d, "source", "model.json")), xml(model), num(-g), body_xml,
+      tendons.empty() ? "" : "  <tendon>\n" + tendons + "  </tendon>\n",
       equalities.empty() ? "" : "  <equality>\n" + equalities + "  </equality>\n",
       motors.empty() ? "" : "  <actuator>\n" + motors + "  </actuator>\n");
   return out;

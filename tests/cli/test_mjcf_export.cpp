@@ -42,14 +42,23 @@ TEST_CASE("mjcf export: a closure row it cannot express is an error naming the r
   d["closure"].push_back({{"name", "inner_x"}, {"type", "point"}, {"frame", "knee_l"}, {"component", "x"}, {"equals", "x_C"}});
   CHECK(refusal(d) == "closure.inner_x: holds frame knee_l inside the machine (point row), which the export cannot express");
   d = excavator();
-  d["closure"].push_back({{"name", "three"}, {"type", "sum"}, {"coordinates", {"psi_l1", "psi_l2", "psi_l3"}}});
-  CHECK(refusal(d) == "closure.three: is a sum of other than two coordinates, which the export cannot express");
+  d["closure"].push_back({{"name", "one"}, {"type", "sum"}, {"coordinates", {"psi_l1"}}});
+  CHECK(refusal(d) == "closure.one: is a sum of fewer than two coordinates");
   d = excavator();
   d["closure"].push_back({{"name", "of_input"}, {"type", "sum"}, {"coordinates", {"x_Fl", "psi_l2"}}});
   CHECK(refusal(d) == "closure.of_input: sums a coordinate that is no joint of the tree, which the export cannot express");
   d = excavator();
   d["closure"][0]["type"] = "angle";
   CHECK(refusal(d).find("has type 'angle', which the export does not know") != std::string::npos);
+}
+
+TEST_CASE("mjcf export: a sum of three coordinates is a fixed tendon held at zero") {
+  Json d = excavator();
+  d["closure"].push_back({{"name", "three"}, {"type", "sum"}, {"coordinates", {"psi_l2", "psi_l3", "psi_l4"}}});
+  const std::string xml = cli::mjcf_of_description(d.dump()).xml;
+  CHECK(xml.find("<fixed name=\"three\">\n      <joint joint=\"psi_l2\" coef=\"1\"/>\n      <joint joint=\"psi_l3\" coef=\"1\"/>\n"
+                 "      <joint joint=\"psi_l4\" coef=\"1\"/>\n    </fixed>") != std::string::npos);
+  CHECK(xml.find("<tendon name=\"three\" tendon1=\"three\"/>") != std::string::npos);
 }
 
 TEST_CASE("mjcf export: a description without the fields it reads, or with a bad one, names the field") {
