@@ -59,11 +59,8 @@ constexpr double kKp = 400, kKd = 40;  // 1/s^2, 1/s: critically damped at 20 ra
 constexpr double kSpeed = 0.5;                                // m/s, forward along the heading
 constexpr double kYawRate = 10 * std::numbers::pi / 180;      // rad/s
 
-// r(t): 0 to 1 over kRamp with zero slope at both ends; its integral and derivative.
+// r(t): 0 to 1 over kRamp with zero slope at both ends, and its derivative.
 double ramp(double t) { return t < kRamp ? 0.5 * (1 - std::cos(std::numbers::pi * t / kRamp)) : 1.0; }
-double ramp_integral(double t) {
-  return t < kRamp ? 0.5 * t - kRamp / (2 * std::numbers::pi) * std::sin(std::numbers::pi * t / kRamp) : 0.5 * kRamp + (t - kRamp);
-}
 double ramp_rate(double t) { return t < kRamp ? 0.5 * std::numbers::pi / kRamp * std::sin(std::numbers::pi * t / kRamp) : 0.0; }
 
 int coordinate(const std::string& name) {

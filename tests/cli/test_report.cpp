@@ -202,7 +202,7 @@ TEST_CASE("report: the gnuplot scripts run from their own folder") {
 namespace {
 // `wlx --model MODEL report` into a fresh folder: the folder, once the report exited 0 with a page
 // whose markup is sound and that shows no failed check.
-fs::path model_report(const std::string& model) {
+[[maybe_unused]] fs::path model_report(const std::string& model) {
   const fs::path dir = temp_dir("wlx_report_" + model);
   fs::remove_all(dir);
   const int code = run(std::string(WLX_BINARY) + " --model " + model + " report --out " + dir.string(), dir.string() + ".log");

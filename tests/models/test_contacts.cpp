@@ -28,7 +28,7 @@ const char* contact_titled(const char* what) {
 }
 
 // A reachable state near the nominal one, every input moved by up to `reach`.
-Coordinates reachable_state(std::mt19937_64& rng, const Model& model, double reach) {
+[[maybe_unused]] Coordinates reachable_state(std::mt19937_64& rng, const Model& model, double reach) {
   std::uniform_real_distribution<double> u(-1, 1);
   for (int attempt = 0; attempt < 1000; ++attempt) {
     Coordinates s = nominal_inputs();
@@ -43,11 +43,11 @@ Coordinates reachable_state(std::mt19937_64& rng, const Model& model, double rea
   return {};
 }
 
-bool info_supports_loaded(int c, const ContactForces& f) {
+[[maybe_unused]] bool info_supports_loaded(int c, const ContactForces& f) {
   return gen::kContacts[static_cast<std::size_t>(c)].supports && f.normal(c) > 0;
 }
 
-bool is_held(int k) {
+[[maybe_unused]] bool is_held(int k) {
   if (k >= kInputCount) return false;
   for (int c : kCommandedSpeeds)
     if (c == k) return false;
