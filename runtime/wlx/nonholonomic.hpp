@@ -5,8 +5,9 @@
 // With the dependent joints eliminated through the linearised closure
 // (beta_dep' = -Phi_dep^-1 Phi_q q'), the wheel rows reduce to C_hat q' = 0 (wheels x inputs). Splitting
 // q' into the chosen dependent pair and the commanded rest gives the thesis' eq. 4.9:
-// J_beta pair' + phi_hat = 0, J_beta square with one row and one column per wheel. ("Pair" is the
-// thesis' word for its two wheels; a model with n wheels has n dependent rates.)
+// J_beta pair' + phi_hat = 0, J_beta square with one row and one column per wheel. (The "pair" is
+// the set of input rates the wheels' rolling determines, one per wheel: two for a machine on two
+// wheels, n for n wheels; the rest of the inputs' rates are commanded.)
 #pragma once
 
 #include "wlx/model.hpp"

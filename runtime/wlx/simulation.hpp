@@ -44,8 +44,9 @@ struct Scenario {
   double tolerance = 1e-10;  // dopri5 only: local error per step, relative to 1 + |q| (m or rad)
   Branches branches;
   NonholonomicOptions nonholonomic;
-  // Set: an inverse-dynamics run (docs/excavator.md section 7): pair A, only u = [z_C', x_C', roll',
-  // pitch'] commanded (constant, so u' = 0), torques distributed with this weighting.
+  // Set: an inverse-dynamics run: the model's dynamics pair dependent, only the commanded speeds u
+  // of its dynamics section given (the scenario's rates, constant: u' = 0), torques distributed
+  // with this weighting.
   std::optional<Weighting> weighting;
   // Set: a forward-dynamics run. The state is the inputs and the commanded speeds u (their values
   // at t = 0 in `rates`, which may name only the commanded inputs); u' comes from forward_dynamics
