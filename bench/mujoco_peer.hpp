@@ -94,22 +94,16 @@ inline Mapping map_state(const mjModel* m, const std::vector<FreeBase>& bases, c
       for (int i = 0; i < 3; ++i) R[static_cast<std::size_t>(i)] = axis_rotation(base->axis[static_cast<std::size_t>(i)], s(base->angle[static_cast<std::size_t>(i)]));
       const Eigen::Quaterniond q(R[0] * R[1] * R[2]);
       out.qpos.segment<4>(qa + 3) << q.w(), q.x(), q.y(), q.z();
-      // omega_body = sum_i B_i e_i q_i', B_i = (R_{i+1} ... R_3)^T; B_i' from R_k' = R_k [e_k q_k']x.
-      for (int i = 0; i < 3; ++i) {
-        Eigen::Matrix3d B = Eigen::Matrix3d::Identity(), Bdot = Eigen::Matrix3d::Zero();
-        // B_i = R_3^T ... R_{i+1}^T, written as a product from R_3^T down.
-        std::vector<Eigen::Matrix3d> factors;  // R_3^T, R_2^T, ..., R_{i+1}^T
-        std::vector<Eigen::Matrix3d> derivatives;
-        for (int k = 2; k > i; --k) {
-          const Eigen::Vector3d w = Eigen::Vector3d::Unit(base->axis[static_cast<std::size_t>(k)]) * sdot(base->angle[static_cast<std::size_t>(k)]);
-          factors.push_back(R[static_cast<std::size_t>(k)].transpose());
-          derivatives.push_back(-hat(w) * R[static_cast<std::size_t>(k)].transpose());
-        }
-        for (const auto& f : factors) B = B * f;
-        for (std::size_t d = 0; d < factors.size(); ++d) {
-          Eigen::Matrix3d term = Eigen::Matrix3d::Identity();
-          for (std::size_t f = 0; f < factors.size(); ++f) term = term * (f == d ? derivatives[f] : factors[f]);
-          Bdot += term;
+      // omega_body = sum_i B_i e_i q_i' with B_i = (R_{i+1} ... R_3)^T, built from B_3 = I by
+      // B_i = B_{i+1} R_{i+1}^T; and B_i' likewise, R_k^T' = -[e_k q_k']x R_k^T.
+      Eigen::Matrix3d B = Eigen::Matrix3d::Identity(), Bdot = Eigen::Matrix3d::Zero();
+      for (int i = 2; i >= 0; --i) {
+        if (i < 2) {
+          const std::size_t k = static_cast<std::size_t>(i + 1);
+          const Eigen::Matrix3d Rt = R[k].transpose();
+          const Eigen::Matrix3d Rt_dot = -hat(Eigen::Vector3d::Unit(base->axis[k]) * sdot(base->angle[k])) * Rt;
+          Bdot = Bdot * Rt + B * Rt_dot;
+          B = B * Rt;
         }
         const Eigen::Vector3d e = Eigen::Vector3d::Unit(base->axis[static_cast<std::size_t>(i)]);
         const int c = base->angle[static_cast<std::size_t>(i)];

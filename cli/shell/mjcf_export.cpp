@@ -170,24 +170,32 @@ std::string inertial_xml(const Inertial& in) {
                      num(I(1, 1)), num(I(2, 2)), num(I(0, 1)), num(I(0, 2)), num(I(1, 2)));
 }
 
-}  // namespace
-
-MjcfExport mjcf_of_description(const std::string& description_json) {
-  const Json d = parse_json_bounded(description_json, "model.json");
-  const std::string model = text(d, "model", "model.json");
+// The machine as the description gives it: parameters, frames placed and linked to their
+// children, and each frame's bodies.
+struct Machine {
   std::map<std::string, double> params;
-  for (const Json& p : member(d, "parameters", "model.json")) params[text(p, "name", "parameters")] = number(member(p, "value", "parameters"), "parameters.value");
-  const auto param = [&](const std::string& name, const std::string& where) {
+  std::vector<Frame> frames;
+  std::map<std::string, std::size_t> frame_index;
+  std::map<std::string, std::vector<Inertial>> bodies_of;  // by frame
+  double total_mass = 0;
+
+  double param(const std::string& name, const std::string& where) const {
     const auto it = params.find(name);
     if (it == params.end()) throw Error(where, fmt::format("names no parameter ('{}')", name));
     return it->second;
-  };
-  std::map<std::string, bool> coordinate_is_angle;
-  for (const Json& c : member(d, "coordinates", "model.json")) coordinate_is_angle[text(c, "name", "coordinates")] = text(c, "unit", "coordinates") == "rad";
+  }
+  Frame& frame(const std::string& name, const std::string& where) {
+    const auto it = frame_index.find(name);
+    if (it == frame_index.end()) throw Error(where, fmt::format("names no frame ('{}')", name));
+    return frames[it->second];
+  }
+  const Frame& frame(const std::string& name, const std::string& where) const { return const_cast<Machine&>(*this).frame(name, where); }
+};
 
-  // Frames, placed; the tree by parent.
-  std::vector<Frame> frames;
-  std::map<std::string, std::size_t> frame_index;
+Machine read_machine(const Json& d) {
+  Machine m;
+  for (const Json& p : member(d, "parameters", "model.json"))
+    m.params[text(p, "name", "parameters")] = number(member(p, "value", "parameters"), "parameters.value");
   for (const Json& j : member(d, "frames", "model.json")) {
     Frame f;
     f.name = text(j, "name", "frames");
@@ -195,160 +203,160 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
     f.meaning = j.value("meaning", "");
     if (j.contains("derived_from_wheel")) f.derived = true;
     else place(f, member(j, "chain", "frames." + f.name), "frames." + f.name + ".chain");
-    if (!frame_index.emplace(f.name, frames.size()).second) throw Error("frames." + f.name, "is given twice");
-    frames.push_back(std::move(f));
+    if (!m.frame_index.emplace(f.name, m.frames.size()).second) throw Error("frames." + f.name, "is given twice");
+    m.frames.push_back(std::move(f));
   }
-  const auto frame = [&](const std::string& name, const std::string& where) -> Frame& {
-    const auto it = frame_index.find(name);
-    if (it == frame_index.end()) throw Error(where, fmt::format("names no frame ('{}')", name));
-    return frames[it->second];
-  };
-  for (auto& f : frames)
-    if (!f.derived && f.parent != "K0") frame(f.parent, "frames." + f.name + ".parent").children.push_back(f.name);
-
-  // Bodies, gathered per frame; the machine's mass.
-  double total_mass = 0;
-  std::map<std::string, std::vector<std::pair<std::string, Inertial>>> bodies_of;
+  for (auto& f : m.frames)
+    if (!f.derived && f.parent != "K0") m.frame(f.parent, "frames." + f.name + ".parent").children.push_back(f.name);
   for (const Json& b : member(d, "bodies", "model.json")) {
     const std::string name = text(b, "name", "bodies"), where = "bodies." + name;
     Inertial in;
-    in.mass = param(text(b, "mass", where), where + ".mass");
+    in.mass = m.param(text(b, "mass", where), where + ".mass");
     const Json& moments = member(b, "inertia", where);
     if (!moments.is_array() || moments.size() != 3) throw Error(where + ".inertia", "is not a list of 3 parameters");
     Eigen::Vector3d D;
-    for (int k = 0; k < 3; ++k) D(k) = param(moments[static_cast<std::size_t>(k)].get<std::string>(), where + ".inertia");
+    for (int k = 0; k < 3; ++k) D(k) = m.param(moments[static_cast<std::size_t>(k)].get<std::string>(), where + ".inertia");
     const Json& axes = member(b, "principal_axes", where);
     Eigen::Matrix3d R;
     if (!axes.is_array() || axes.size() != 3) throw Error(where + ".principal_axes", "is not a 3 x 3 matrix");
     for (int r = 0; r < 3; ++r) R.row(r) = vector3(axes[static_cast<std::size_t>(r)], where + ".principal_axes").transpose();
     in.com = vector3(member(b, "com", where), where + ".com");
     in.inertia = R * D.asDiagonal() * R.transpose();
-    total_mass += in.mass;
+    m.total_mass += in.mass;
     const std::string on = text(b, "frame", where);
-    if (frame(on, where + ".frame").derived) throw Error(where + ".frame", "is a derived contact frame, which is no rigid body's");
-    bodies_of[on].emplace_back(name, in);
+    if (m.frame(on, where + ".frame").derived) throw Error(where + ".frame", "is a derived contact frame, which is no rigid body's");
+    m.bodies_of[on].push_back(in);
   }
-  const double placeholder_mass = kPlaceholderMassRatio * std::max(total_mass, 1.0);
+  return m;
+}
 
-  // Contacts: geoms with their friction.
-  const Json& settings = member(d, "settings", "model.json");
-  const Json& friction = member(settings, "friction", "settings");
-  const Json& contacts = member(d, "contacts", "model.json");
-  if (!friction.is_array() || friction.size() != contacts.size()) throw Error("settings.friction", "does not list one coefficient per contact");
-  std::map<std::string, double> friction_of_frame;
-  std::set<std::string> contact_frames;
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
-    const std::string f = text(contacts[k], "frame", "contacts");
-    friction_of_frame[f] = number(friction[k], "settings.friction");
-    contact_frames.insert(f);
+// The contact geoms: named as their contact frames, with their friction.
+class ContactGeoms {
+ public:
+  explicit ContactGeoms(const Json& d) : contacts_(member(d, "contacts", "model.json")) {
+    const Json& friction = member(member(d, "settings", "model.json"), "friction", "settings");
+    if (!friction.is_array() || friction.size() != contacts_.size())
+      throw Error("settings.friction", "does not list one coefficient per contact");
+    for (std::size_t k = 0; k < contacts_.size(); ++k) friction_[text(contacts_[k], "frame", "contacts")] = number(friction[k], "settings.friction");
   }
-  const auto contact_geom = [&](const std::string& frame_name, const std::string& shape) {
-    const double mu = friction_of_frame.count(frame_name) ? friction_of_frame[frame_name] : 1.0;
+  const Json& contacts() const { return contacts_; }
+  bool is_contact(const std::string& frame) const { return friction_.count(frame) > 0; }
+  std::string geom(const std::string& frame, const std::string& shape) const {
+    const auto mu = friction_.find(frame);
     // mass 0: a geom adds no mass (the inertials hold the model's), whatever body it is on.
-    return fmt::format("<geom name=\"{}\" {} mass=\"0\" friction=\"{} 0.005 0.0001\"/>", xml(frame_name), shape, num(mu));
-  };
+    return fmt::format("<geom name=\"{}\" {} mass=\"0\" friction=\"{} 0.005 0.0001\"/>", xml(frame), shape,
+                       num(mu != friction_.end() ? mu->second : 1.0));
+  }
 
-  // Wheels: a spinning body on a hub, or a cylinder on the file's contact frame.
+ private:
+  const Json& contacts_;
+  std::map<std::string, double> friction_;
+};
+
+// A wheel on a hub spins with the hub's bodies where they are the wheel's alone: their CoM on the
+// axle through `centre` and their inertia the same about every axis across it (spinning moves
+// no mass then).
+bool spins_with_wheel(const Inertial& hub, const Eigen::Vector3d& a, const Eigen::Vector3d& centre, double r) {
+  if (hub.mass <= 0) return false;
+  const Eigen::Vector3d off_axle = (hub.com - centre) - a * a.dot(hub.com - centre);
+  const Eigen::Matrix3d& I = hub.inertia;
+  const Eigen::Vector3d Ia = I * a;
+  const Eigen::Matrix3d across = I - Ia * a.transpose() - a * Ia.transpose() + a.dot(Ia) * a * a.transpose();
+  const double scale = I.norm();
+  const Eigen::Matrix3d plane = Eigen::Matrix3d::Identity() - a * a.transpose();
+  const double symmetric = (across - 0.5 * across.trace() * plane).norm();
+  return off_axle.norm() <= 1e-12 * std::max(1.0, r) && (Ia - a.dot(Ia) * a).norm() <= 1e-12 * scale && symmetric <= 1e-12 * scale;
+}
+
+// The wheels: a spinning body on a hub, or a cylinder on the file's contact frame; the feet's
+// spheres. Returns each spinning wheel's joint (wheel, joint name); placeholders are said.
+std::vector<std::pair<std::string, std::string>> place_contacts(Machine& m, const Json& d, const ContactGeoms& geoms, double placeholder_mass,
+                                                                std::string& placeholders) {
   std::map<std::string, std::string> drive_of_wheel;
   for (const Json& a : member(d, "actuated", "model.json"))
     if (a.contains("wheel")) drive_of_wheel[text(a, "wheel", "actuated")] = text(a, "name", "actuated");
-  std::string placeholders;
   std::set<std::string> wheel_bodies;
-  std::vector<std::pair<std::string, std::string>> spin_joints;  // wheel, its spin joint's name
+  std::vector<std::pair<std::string, std::string>> spin_joints;
   for (const Json& w : member(d, "wheels", "model.json")) {
     const std::string name = text(w, "name", "wheels"), where = "wheels." + name;
-    const double r = param(text(w, "radius", where), where + ".radius");
+    const double r = m.param(text(w, "radius", where), where + ".radius");
     const Eigen::Vector3d a = unit(axis_index(text(w, "axle", where), where + ".axle"));
     const std::string hub = text(w, "hub", where), contact = text(w, "contact", where);
     if (hub.empty()) {  // the file's contact frame, on the rim's lowest point: the centre is r above it
       const Eigen::Vector3d forward = unit(axis_index(text(w, "forward", where), where + ".forward"));
       const Eigen::Vector3d lateral = unit(axis_index(text(w, "lateral", where), where + ".lateral"));
-      frame(contact, where + ".contact").geoms.push_back(contact_geom(
+      m.frame(contact, where + ".contact").geoms.push_back(geoms.geom(
           contact, fmt::format("type=\"cylinder\" size=\"{} {}\" pos=\"{}\" zaxis=\"{}\"", num(r), num(0.2 * r), vec(r * forward.cross(lateral)), vec(lateral))));
       continue;
     }
-    Frame& h = frame(hub, where + ".hub");
-    const double offset = w["offset"].is_string() ? param(w["offset"].get<std::string>(), where + ".offset") : 0.0;
+    Frame& h = m.frame(hub, where + ".hub");
+    const double offset = w["offset"].is_string() ? m.param(w["offset"].get<std::string>(), where + ".offset") : 0.0;
     const Eigen::Vector3d centre = offset * a;
-    // The hub's bodies spin with the wheel where they are the wheel: their CoM on the axle and
-    // their inertia the same about every axis across it (spinning moves no mass then).
-    Inertial hub_bodies;
-    for (const auto& [body, in] : bodies_of[hub]) hub_bodies.add(in.mass, in.com, in.inertia);
     Inertial spinning;
-    bool moved = false;
-    if (hub_bodies.mass > 0) {
-      const Eigen::Vector3d off_axle = (hub_bodies.com - centre) - a * a.dot(hub_bodies.com - centre);
-      const Eigen::Matrix3d& I = hub_bodies.inertia;
-      const Eigen::Vector3d Ia = I * a;
-      const Eigen::Matrix3d across = I - Ia * a.transpose() - a * Ia.transpose() + a.dot(Ia) * a * a.transpose();
-      const double scale = I.norm();
-      const Eigen::Matrix3d plane = Eigen::Matrix3d::Identity() - a * a.transpose();
-      const double symmetric = (across - 0.5 * across.trace() * plane).norm();
-      if (off_axle.norm() <= 1e-12 * std::max(1.0, r) && (Ia - a.dot(Ia) * a).norm() <= 1e-12 * scale && symmetric <= 1e-12 * scale) {
-        spinning = hub_bodies;
-        spinning.com -= centre;
-        bodies_of[hub].clear();
-        moved = true;
-      }
-    }
-    if (!moved) {
-      spinning.mass = placeholder_mass;
-      spinning.inertia = placeholder_mass * Eigen::Matrix3d::Identity();
+    for (const Inertial& in : m.bodies_of[hub]) spinning.add(in.mass, in.com, in.inertia);
+    if (spins_with_wheel(spinning, a, centre, r)) {
+      spinning.com -= centre;
+      m.bodies_of[hub].clear();
+    } else {
+      spinning = Inertial{placeholder_mass, Eigen::Vector3d::Zero(), placeholder_mass * Eigen::Matrix3d::Identity()};
       placeholders += fmt::format("wheel {}: its spinning body holds a placeholder of {} kg (the hub's bodies are not the wheel's alone)\n",
                                   name, num(placeholder_mass));
     }
     const std::string joint = drive_of_wheel.count(name) ? drive_of_wheel[name] : "spin_" + name;
     spin_joints.emplace_back(name, joint);
     const std::string body = "spin_" + name;
-    if (!wheel_bodies.insert(body).second || frame_index.count(body)) throw Error(where, fmt::format("its spinning body's name '{}' is taken", body));
+    if (!wheel_bodies.insert(body).second || m.frame_index.count(body))
+      throw Error(where, fmt::format("its spinning body's name '{}' is taken", body));
     h.extra += fmt::format(
         "<body name=\"{}\" pos=\"{}\">\n  <joint name=\"{}\" type=\"hinge\" axis=\"{}\"/>\n  {}\n  {}\n</body>\n", xml(body), vec(centre),
         xml(joint), vec(a), inertial_xml(spinning),
-        contact_geom(contact, fmt::format("type=\"cylinder\" size=\"{} {}\" zaxis=\"{}\"", num(r), num(0.2 * r), vec(a))));
+        geoms.geom(contact, fmt::format("type=\"cylinder\" size=\"{} {}\" zaxis=\"{}\"", num(r), num(0.2 * r), vec(a))));
   }
-  for (const Json& c : contacts)
+  for (const Json& c : geoms.contacts())
     if (text(c, "kind", "contacts") == "foot") {
       const std::string f = text(c, "frame", "contacts");
-      frame(f, "contacts.frame").geoms.push_back(contact_geom(f, "type=\"sphere\" size=\"0.02\""));
+      m.frame(f, "contacts.frame").geoms.push_back(geoms.geom(f, "type=\"sphere\" size=\"0.02\""));
     }
+  return spin_joints;
+}
 
-  // Each frame's inertial; a moving frame without mass in it or its welded children gets a placeholder.
-  for (auto& f : frames)
-    for (const auto& [body, in] : bodies_of[f.name]) f.inertial.add(in.mass, in.com, in.inertia);
-  std::map<std::string, double> welded_mass;  // a frame's mass with that of the frames welded to it
+// Each frame's inertial from its bodies; a moving frame without mass in it or in the frames
+// welded to it (MuJoCo refuses a moving body without mass) gets a placeholder, said.
+void gather_inertials(Machine& m, double placeholder_mass, std::string& placeholders) {
+  for (auto& f : m.frames)
+    for (const Inertial& in : m.bodies_of[f.name]) f.inertial.add(in.mass, in.com, in.inertia);
   std::function<double(const Frame&)> welded = [&](const Frame& f) {
-    double m = f.inertial.mass;
+    double mass = f.inertial.mass;
     for (const auto& c : f.children) {
-      const Frame& child = frame(c, "frames");
-      if (child.joints.empty() && !child.free) m += welded(child);
+      const Frame& child = m.frame(c, "frames");
+      if (child.joints.empty() && !child.free) mass += welded(child);
     }
-    return m;
+    return mass;
   };
-  for (auto& f : frames)
+  for (auto& f : m.frames)
     if (!f.derived && (f.free || !f.joints.empty()) && welded(f) <= 0) {
       f.inertial.mass = placeholder_mass;
       f.inertial.inertia = placeholder_mass * Eigen::Matrix3d::Identity();
       f.placeholder = true;
       placeholders += fmt::format("frame {}: moves but carries no body; a placeholder of {} kg\n", f.name, num(placeholder_mass));
     }
+}
 
-  // Joint limits.
-  std::map<std::string, std::pair<double, double>> range;
-  for (const Json& l : member(settings, "limits", "settings")) {
-    const Json &lo = member(l, "lower", "settings.limits"), &hi = member(l, "upper", "settings.limits");
-    if (lo.is_number() && hi.is_number()) range[text(l, "coordinate", "settings.limits")] = {lo.get<double>(), hi.get<double>()};
-  }
-
-  // The closure: contacts, or joint equalities, or an error.
+// The closure: rows on contacts are the contacts; sums become joint equalities (two coordinates)
+// or a fixed tendon held at zero (more); anything else is an error naming the row.
+struct Constraints {
+  std::string tendons, equalities;
+};
+Constraints closure_xml(const Json& d, const Machine& m, const ContactGeoms& geoms) {
   std::set<std::string> joint_names;
-  for (const auto& f : frames)
+  for (const auto& f : m.frames)
     for (const auto& j : f.joints) joint_names.insert(j.name);
-  std::string equalities, tendons;
+  Constraints out;
   for (const Json& c : member(d, "closure", "model.json")) {
     const std::string name = text(c, "name", "closure"), type = text(c, "type", "closure." + name);
     if (type == "point" || type == "level") {
       const std::string f = text(c, "frame", "closure." + name);
-      if (!contact_frames.count(f))
+      if (!geoms.is_contact(f))
         throw Error("closure." + name, fmt::format("holds frame {} inside the machine ({} row), which the export cannot express", f, type));
     } else if (type == "sum") {
       const Json& cs = member(c, "coordinates", "closure." + name);
@@ -360,65 +368,74 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
         terms.push_back(term.get<std::string>());
       }
       if (terms.size() == 2) {  // q1 = -q2
-        equalities += fmt::format("    <joint name=\"{}\" joint1=\"{}\" joint2=\"{}\" polycoef=\"0 -1 0 0 0\"/>\n", xml(name), xml(terms[0]),
-                                  xml(terms[1]));
+        out.equalities += fmt::format("    <joint name=\"{}\" joint1=\"{}\" joint2=\"{}\" polycoef=\"0 -1 0 0 0\"/>\n", xml(name),
+                                      xml(terms[0]), xml(terms[1]));
       } else {  // more: a fixed tendon, the sum, held at its length at zero joint values (0)
-        tendons += fmt::format("    <fixed name=\"{}\">\n", xml(name));
-        for (const auto& term : terms) tendons += fmt::format("      <joint joint=\"{}\" coef=\"1\"/>\n", xml(term));
-        tendons += "    </fixed>\n";
-        equalities += fmt::format("    <tendon name=\"{}\" tendon1=\"{}\"/>\n", xml(name), xml(name));
+        out.tendons += fmt::format("    <fixed name=\"{}\">\n", xml(name));
+        for (const auto& term : terms) out.tendons += fmt::format("      <joint joint=\"{}\" coef=\"1\"/>\n", xml(term));
+        out.tendons += "    </fixed>\n";
+        out.equalities += fmt::format("    <tendon name=\"{}\" tendon1=\"{}\"/>\n", xml(name), xml(name));
       }
     } else {
       throw Error("closure." + name, fmt::format("has type '{}', which the export does not know", type));
     }
   }
+  return out;
+}
 
-  // MuJoCo's names are unique per kind: joints (coordinates, free bases, wheels' spins) and geoms.
+// MuJoCo's names are unique per kind: joints (coordinates, free bases, wheels' spins) and geoms.
+void check_unique_names(const Machine& m, const std::vector<std::pair<std::string, std::string>>& spin_joints, const ContactGeoms& geoms) {
   std::set<std::string> joints_seen, geoms_seen{"ground"};
-  for (const auto& f : frames) {
+  for (const auto& f : m.frames) {
     if (f.free && !joints_seen.insert(f.name).second) throw Error("frames." + f.name, "names a free joint that another joint's name takes");
     for (const auto& j : f.joints)
       if (!joints_seen.insert(j.name).second) throw Error("frames." + f.name, fmt::format("joint '{}' is named twice", j.name));
   }
   for (const auto& [wheel, joint] : spin_joints)
     if (!joints_seen.insert(joint).second) throw Error("wheels." + wheel, fmt::format("its spin joint's name '{}' is taken", joint));
-  for (const Json& c : contacts)
+  for (const Json& c : geoms.contacts())
     if (!geoms_seen.insert(text(c, "frame", "contacts")).second)
       throw Error("contacts", fmt::format("two contact geoms would be named '{}'", text(c, "frame", "contacts")));
+}
 
-  // The tree, written from K0 down.
-  std::string body_xml;
+// The body tree, from K0 down, each joint with its limits where both bounds are given.
+std::string tree_xml(const Machine& m, const Json& settings) {
+  std::map<std::string, std::pair<double, double>> range;
+  for (const Json& l : member(settings, "limits", "settings")) {
+    const Json &lo = member(l, "lower", "settings.limits"), &hi = member(l, "upper", "settings.limits");
+    if (lo.is_number() && hi.is_number()) range[text(l, "coordinate", "settings.limits")] = {lo.get<double>(), hi.get<double>()};
+  }
+  std::string out;
   std::function<void(const Frame&, int)> write = [&](const Frame& f, int depth) {
     const std::string in(static_cast<std::size_t>(2 * depth), ' ');
-    if (!f.meaning.empty()) body_xml += in + "<!-- " + comment(f.meaning) + " -->\n";
-    body_xml += fmt::format("{}<body name=\"{}\" pos=\"{}\" quat=\"{}\">\n", in, xml(f.name), vec(f.placement.translation()),
-                            quat(f.placement.linear()));
-    if (f.free) body_xml += fmt::format("{}  <freejoint name=\"{}\"/>\n", in, xml(f.name));
+    if (!f.meaning.empty()) out += in + "<!-- " + comment(f.meaning) + " -->\n";
+    out += fmt::format("{}<body name=\"{}\" pos=\"{}\" quat=\"{}\">\n", in, xml(f.name), vec(f.placement.translation()), quat(f.placement.linear()));
+    if (f.free) out += fmt::format("{}  <freejoint name=\"{}\"/>\n", in, xml(f.name));
     for (const auto& j : f.joints) {
       std::string limits;
       if (const auto r = range.find(j.name); r != range.end())
         limits = fmt::format(" limited=\"true\" range=\"{} {}\"", num(r->second.first), num(r->second.second));
-      body_xml += fmt::format("{}  <joint name=\"{}\" type=\"{}\" axis=\"{}\" pos=\"{}\"{}/>\n", in, xml(j.name), j.revolute ? "hinge" : "slide",
-                              vec(j.axis), vec(j.anchor), limits);
+      out += fmt::format("{}  <joint name=\"{}\" type=\"{}\" axis=\"{}\" pos=\"{}\"{}/>\n", in, xml(j.name), j.revolute ? "hinge" : "slide",
+                         vec(j.axis), vec(j.anchor), limits);
     }
-    if (f.inertial.mass > 0) body_xml += in + "  " + inertial_xml(f.inertial) + (f.placeholder ? "  <!-- placeholder: no body -->" : "") + "\n";
-    for (const auto& g : f.geoms) body_xml += in + "  " + g + "\n";
-    if (!f.extra.empty()) {
-      std::string extra = f.extra;
-      for (std::size_t at = 0; at < extra.size();) {
-        const std::size_t end = extra.find('\n', at);
-        body_xml += in + "  " + extra.substr(at, end - at) + "\n";
-        at = end + 1;
-      }
+    if (f.inertial.mass > 0) out += in + "  " + inertial_xml(f.inertial) + (f.placeholder ? "  <!-- placeholder: no body -->" : "") + "\n";
+    for (const auto& g : f.geoms) out += in + "  " + g + "\n";
+    for (std::size_t at = 0; at < f.extra.size();) {  // the spinning wheels' lines, indented
+      const std::size_t end = f.extra.find('\n', at);
+      out += in + "  " + f.extra.substr(at, end - at) + "\n";
+      at = end + 1;
     }
-    for (const auto& c : f.children) write(frame(c, "frames"), depth + 1);
-    body_xml += in + "</body>\n";
+    for (const auto& c : f.children) write(m.frame(c, "frames"), depth + 1);
+    out += in + "</body>\n";
   };
-  for (const auto& f : frames)
+  for (const auto& f : m.frames)
     if (!f.derived && f.parent == "K0") write(f, 2);
+  return out;
+}
 
-  // Motors, named as the actuators.
-  std::string motors;
+// A motor per actuator, named as the actuator, limited by its torque limit where it has one.
+std::string motors_xml(const Json& d, const Json& settings) {
+  std::string out;
   const Json& actuated = member(d, "actuated", "model.json");
   const Json& limits = member(settings, "torque_limits", "settings");
   for (std::size_t k = 0; k < actuated.size(); ++k) {
@@ -428,14 +445,29 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
     std::string control;
     if (limits.is_array() && k < limits.size() && limits[k].is_number())
       control = fmt::format(" ctrllimited=\"true\" ctrlrange=\"{} {}\"", num(-limits[k].get<double>()), num(limits[k].get<double>()));
-    motors += fmt::format("    <motor name=\"{}\" joint=\"{}\" gear=\"1\"{}/>\n", xml(name), xml(joint), control);
+    out += fmt::format("    <motor name=\"{}\" joint=\"{}\" gear=\"1\"{}/>\n", xml(name), xml(joint), control);
   }
+  return out;
+}
 
-  const Json& gravity_name = member(d, "gravity", "model.json");
-  const double g = gravity_name.is_string() ? param(gravity_name.get<std::string>(), "gravity") : 9.81;
+}  // namespace
+
+MjcfExport mjcf_of_description(const std::string& description_json) {
+  const Json d = parse_json_bounded(description_json, "model.json");
   MjcfExport out;
-  out.model = model;
-  out.placeholders = placeholders;
+  out.model = text(d, "model", "model.json");
+  Machine m = read_machine(d);
+  const double placeholder_mass = kPlaceholderMassRatio * std::max(m.total_mass, 1.0);
+  const Json& settings = member(d, "settings", "model.json");
+  const ContactGeoms geoms(d);
+  const auto spin_joints = place_contacts(m, d, geoms, placeholder_mass, out.placeholders);
+  gather_inertials(m, placeholder_mass, out.placeholders);
+  const Constraints constraints = closure_xml(d, m, geoms);
+  check_unique_names(m, spin_joints, geoms);
+  const std::string bodies = tree_xml(m, settings);
+  const std::string motors = motors_xml(d, settings);
+  const Json& gravity_name = member(d, "gravity", "model.json");
+  const double g = gravity_name.is_string() ? m.param(gravity_name.get<std::string>(), "gravity") : 9.81;
   out.xml = fmt::format(
       "<!-- Written by wlx export mjcf from the description of model {} ({}). Do not edit: export again. -->\n"
       "<mujoco model=\"{}\">\n"
@@ -447,9 +479,9 @@ MjcfExport mjcf_of_description(const std::string& description_json) {
       "  </worldbody>\n"
       "{}{}{}"
       "</mujoco>\n",
-      comment(model), comment(text(d, "source", "model.json")), xml(model), num(-g), body_xml,
-      tendons.empty() ? "" : "  <tendon>\n" + tendons + "  </tendon>\n",
-      equalities.empty() ? "" : "  <equality>\n" + equalities + "  </equality>\n",
+      comment(out.model), comment(text(d, "source", "model.json")), xml(out.model), num(-g), bodies,
+      constraints.tendons.empty() ? "" : "  <tendon>\n" + constraints.tendons + "  </tendon>\n",
+      constraints.equalities.empty() ? "" : "  <equality>\n" + constraints.equalities + "  </equality>\n",
       motors.empty() ? "" : "  <actuator>\n" + motors + "  </actuator>\n");
   return out;
 }
