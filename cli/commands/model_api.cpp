@@ -82,8 +82,8 @@ CommandVector speeds_of(const Eigen::VectorXd& u, const char* field) {
 }
 
 // u' from a caller: finite, and at most kMaxRateChange per second (per unit of its coordinate).
+constexpr double kMaxRateChange = 1e4;  // m/s^2 or rad/s^2: 1000 g; beyond, a step's terms overflow nothing but mean no machine
 CommandVector accelerations_of(const Eigen::VectorXd& u_dot, const char* field) {
-  constexpr double kMaxRateChange = 1e4;  // m/s^2 or rad/s^2: 1000 g; beyond, a step's terms overflow nothing but mean no machine
   const CommandVector out = commands_of(u_dot, field);
   for (int k = 0; k < kCommandedCount; ++k) {
     const int c = kCommandedSpeeds[static_cast<std::size_t>(k)];
@@ -322,7 +322,7 @@ void api_inverse_dynamics_many(void* workspace, const std::string& weighting_jso
     const CommandVector speeds = Eigen::Map<const CommandVector>(u + row * kCommandedCount);
     const CommandVector rates = Eigen::Map<const CommandVector>(u_dot + row * kCommandedCount);
     if (!speeds.allFinite() || !rates.allFinite() || speeds.cwiseAbs().maxCoeff() > std::min(kMaxLinearRate, kMaxAngularRate) ||
-        rates.cwiseAbs().maxCoeff() > 1e4) {  // the named errors of the state-by-state path
+        rates.cwiseAbs().maxCoeff() > kMaxRateChange) {  // the named errors of the state-by-state path
       const std::string field = count == 1 ? std::string() : "[" + std::to_string(row) + "]";
       speeds_of(Eigen::VectorXd(speeds), ("u" + field).c_str());
       accelerations_of(Eigen::VectorXd(rates), ("u_dot" + field).c_str());
