@@ -20,12 +20,12 @@ esac
 # What building wlx and wlx-gen and writing the report need.
 packages=(cmake g++ clang-14 ninja-build pkg-config libginac-dev libeigen3-dev libfmt-dev doctest-dev
           libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev gnuplot-nox fonts-dejavu-core
-          liburdfdom-dev)   # URDF import in wlx-gen (optional in CMake; a built-in model is a URDF)
+          liburdfdom-dev    # URDF import in wlx-gen (optional in CMake; a built-in model is a URDF)
+          libmujoco-dev)    # MuJoCo 2.2.2: the report's "In a physics engine", the check of `wlx export mjcf` (optional in CMake)
 if [ "$mode" = full ]; then
   packages+=(python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
              python3-yaml python3-dask python3-distributed   # wlx sweep: spec files, and Dask for the runs
-             liborocos-kdl-dev   # Orocos KDL: the peer in wlx_bench and the KDL test (optional in CMake)
-             libmujoco-dev)      # MuJoCo 2.2.2: the check of `wlx export mjcf` (optional in CMake)
+             liborocos-kdl-dev)  # Orocos KDL: the peer in wlx_bench and the KDL test (optional in CMake)
   # The 3D viewer (viewer/, CMake option WLX_BUILD_VIEWER): emscripten compiles the model's WebAssembly,
   # node and npm bundle the page (`npm ci` from viewer/package-lock.json runs inside the build, into
   # the build tree, only when the lock file changes), chromium runs its browser test. A gigabyte

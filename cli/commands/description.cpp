@@ -123,9 +123,24 @@ Settings settings_of_description(const std::string& json_text) {
   return s;
 }
 
+namespace {
+std::string& loaded_description() {
+  static std::string text;
+  return text;
+}
+}  // namespace
+
+extern const char* const kEmbeddedDescription;  // the model's model.json, embedded by CMake ("" in a plugin)
+
+const std::string& description_text() {
+  static const std::string embedded = kEmbeddedDescription;
+  return embedded.empty() ? loaded_description() : embedded;
+}
+
 std::string load_description(const std::string& json_text) noexcept {
   try {
     set_settings(settings_of_description(json_text));
+    loaded_description() = json_text;
     return {};
   } catch (const Error& e) {
     return e.field() == "model.json" ? fmt::format("model.json: {}", e.reason()) : fmt::format("model.json: {}: {}", e.field(), e.reason());

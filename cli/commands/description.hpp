@@ -16,7 +16,12 @@ WLX_COMMANDS_BEGIN
 // Throws wlx::Error ("model.json" and the first mismatch or bad value).
 Settings settings_of_description(const std::string& json_text);
 
-// settings_of_description(), then set_settings(): "" on success, else the message.
+// settings_of_description(), then set_settings(): "" on success, else the message. Keeps the
+// text for description_text().
 std::string load_description(const std::string& json_text) noexcept;
+
+// The model's description (model.json's text): embedded in wlx for a built-in model, the one
+// load_description() was given for a model file's plugin; empty if neither.
+const std::string& description_text();
 
 WLX_COMMANDS_END

@@ -96,6 +96,7 @@ class Report {
   void evaluate_claims(report::Document& d);
   report::Document document(const ReportFigures& figures);
   std::vector<report::Section> sections(const ReportFigures& figures) const;
+  report::Section engine_section(const ReportFigures& figures) const;
 
   void write_viewer();
   // The run's page in the 3D viewer, relative to index.html; empty without the viewer.
@@ -318,8 +319,42 @@ std::vector<report::Section> Report::sections(const ReportFigures& figures) cons
          {loops}, figures.closed_loop, {}});
     out.push_back(s);
   }
+  if (any(is_dynamics)) out.push_back(engine_section(figures));
   if (!figures.poses.empty()) out.push_back({"poses", "Poses at the start and the end of each run", "", {}, figures.poses, {}});
   return out;
+}
+
+report::Section Report::engine_section(const ReportFigures& figures) const {
+  report::Section s{"engine", "In a physics engine", "", {}, figures.engine, {}};
+  if (!runner_.engine_missing().empty()) {
+    s.intro = "Not run: " + runner_.engine_missing() + ".";
+    return s;
+  }
+  s.intro = fmt::format(
+      "The machine exported as `wlx export mjcf` writes it, in MuJoCo: its wheels roll by friction on soft contacts and may "
+      "slip or lift, where the model holds them exactly. The controller of \"A controller in the loop\" (computed torque on the "
+      "model, the model file's weighting, Kp {:g} 1/s^2, Kd {:g} 1/s) reads MuJoCo's state in the model's coordinates and drives "
+      "its motors at every MuJoCo step (1 ms), along each inverse-dynamics run from the run's start and speeds (each wheel "
+      "spinning as it rolls). Slip is the speed of a contact's material point on the ground; the normal forces are compared "
+      "with the model's for the same torques (contact_forces). Slip and forces are taken after the first {:g} s, while the "
+      "contacts press in. A run stops where the machine is {:g} m or {:g} deg off its reference, or where the model's IK cannot "
+      "place MuJoCo's state: a finding about the controller on MuJoCo's machine, which is not the model, so it does not fail "
+      "the report.",
+      kTrackingKp, kTrackingKd, kEngineSettle, kEngineLostLength, kEngineLostAngle * kDegPerRad);
+  report::Table t{{"run", "result", "steps", "max tracking error (mm / deg)", "second half (mm / deg)", "slip, mean / max (mm/s)",
+                   "|normal force difference| / weight, mean / max", "CSV"},
+                  {}};
+  for (const EngineRow& r : runner_.engine())
+    t.rows.push_back({{r.id},
+                      {r.stopped ? r.stopped->describe() : "complete"},
+                      {std::to_string(r.steps)},
+                      {fmt::format("{:.3g} / {:.3g}", 1e3 * r.length_error, kDegPerRad * r.angle_error)},
+                      {fmt::format("{:.3g} / {:.3g}", 1e3 * r.late_length_error, kDegPerRad * r.late_angle_error)},
+                      {fmt::format("{:.3g} / {:.3g}", 1e3 * r.mean_slip, 1e3 * r.max_slip)},
+                      {fmt::format("{:.2e} / {:.2e}", r.mean_force_difference, r.max_force_difference)},
+                      {r.csv, "data/" + r.csv}});
+  s.tables.push_back(t);
+  return s;
 }
 
 report::Document Report::document(const ReportFigures& figures) {
@@ -394,7 +429,7 @@ int Report::run() {
   report::Document doc = document(figures);
   std::vector<report::FigureSpec> all;  // the figures drawn; an omitted one is a sentence in the page
   for (const auto* group : {&figures.ik, &figures.nonholonomic, &figures.kinematic, &figures.dynamics, &figures.forward,
-                            &figures.closed_loop, &figures.poses})
+                            &figures.closed_loop, &figures.engine, &figures.poses})
     for (const auto& f : *group)
       if (!f.omitted()) all.push_back(f);
   progress(fmt::format("rendering {} figures with gnuplot (PNG and SVG)", all.size()));
@@ -410,6 +445,8 @@ int Report::run() {
              seconds, fs::absolute(root_ / "index.html").string());
   for (const StoppedRun& r : stopped)
     wlx::diagnose("wlx: run stopped: {} at t = {:.4f} s: {}\n", r.label(), r.stop.time, r.stop.reason);
+  for (const EngineRow& r : runner_.engine())
+    if (r.stopped) wlx::diagnose("wlx: in the physics engine, {} ended at t = {:.4f} s: {}\n", r.id, r.stopped->time, r.stopped->reason);
   for (const auto& c : doc.checks)
     if (c.result != ClaimRow::Result::pass) wlx::diagnose("wlx: check failed: {}: {}\n", c.id, c.claim);
   // A stopped run fails the report as a failed check does: the report stands, the result does not.

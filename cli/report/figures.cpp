@@ -101,6 +101,7 @@ class Figures {
     runs(f.kinematic);
     dynamics(f.dynamics);
     forward(f.forward, f.closed_loop);
+    engine(f.engine);
     poses(f.poses);
     return f;
   }
@@ -442,6 +443,39 @@ class Figures {
                                             "plant 10% heavier than its model, from a perturbed start, per commanded coordinate" +
                                                 left_out(loops_why),
                      fmt::format("1100,{}", 330 * shown.size()), l});
+  }
+
+  // Per run in the physics engine: the tracking error, each contact's slip, and each contact's
+  // normal force, MuJoCo's against the model's for the same torques.
+  void engine(std::vector<FigureSpec>& out) {
+    for (const EngineRow& r : runner_.engine()) {
+      const std::string why = not_drawn(r.id + " in the physics engine", static_cast<std::size_t>(r.steps + 1), r.stopped);
+      if (!why.empty()) {
+        out.push_back(omitted("engine-" + r.id, r.id + " in the physics engine", {why}));
+        continue;
+      }
+      const std::string csv = q(data_path(r.csv));
+      std::string g = "set multiplot layout 3,1\nset xlabel 't (s)'\nset key outside right top\n";
+      g += fmt::format("set title {}\nset ylabel 'max |q_ref - q|'\nplot {} using {}:{} with lines lw 2 title 'lengths (mm)', {} using {}:{} "
+                       "with lines lw 2 dt 2 title 'angles (deg)'\n",
+                       q(r.id + " in MuJoCo: tracking error of the commanded coordinates"), csv, column("t"),
+                       column("tracking_error_m", 1e3), csv, column("t"), column("tracking_error_rad", kDegPerRad));
+      g += fmt::format("set title {}\nset ylabel 'slip (mm/s)'\nplot ", q("each contact's slip: the speed of its material point on the ground"));
+      for (int c = 0; c < kContactCount; ++c)
+        g += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", c ? ", " : "", csv, column("t"),
+                         column("slip_" + contact_name(c), 1e3), dash(static_cast<std::size_t>(c)), q(contact_name(c)));
+      g += fmt::format("\nset title {}\nset ylabel 'normal force (N)'\nplot ", q("normal forces: MuJoCo's (solid) and the model's (dashed)"));
+      for (int c = 0; c < kContactCount; ++c)
+        g += fmt::format("{0}{1} using {2}:{3} with lines lw 2 lc {5} title {6}, {1} using {2}:{4} with lines lw 2 dt 2 lc {5} notitle",
+                         c ? ", " : "", csv, column("t"), column("normal_mujoco_" + contact_name(c)), column("normal_wlx_" + contact_name(c)),
+                         c + 1, q(contact_name(c)));
+      g += "\nunset multiplot\n";
+      out.push_back({"engine-" + r.id,
+                     r.id + " in MuJoCo: the model's computed-torque controller drives the exported machine at 1 kHz along the run; "
+                            "its tracking error, each contact's slip (the model's rolling and feet hold it at zero) and the normal "
+                            "forces, MuJoCo's against the model's for the same torques",
+                     "1100,990", g});
+    }
   }
 
   void poses(std::vector<FigureSpec>& out) {

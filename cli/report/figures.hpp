@@ -13,7 +13,7 @@
 WLX_COMMANDS_BEGIN
 
 struct ReportFigures {
-  std::vector<report::FigureSpec> ik, nonholonomic, kinematic, dynamics, forward, closed_loop, poses;
+  std::vector<report::FigureSpec> ik, nonholonomic, kinematic, dynamics, forward, closed_loop, engine, poses;
 };
 
 // Also writes data/<run>-pose.dat (the skeletons at the start and the end of each run).

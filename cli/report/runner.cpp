@@ -4,13 +4,17 @@
 #include "bounded_input.hpp"
 #include "interrupt.hpp"
 #include "limits.hpp"
+#include "description.hpp"
 #include "outputs.hpp"
+#include "physics_engine.hpp"
 #include "scenario_io.hpp"
 
 #include <fmt/format.h>
 #include <wlx/csv.hpp>
+#include <wlx/contacts.hpp>
 #include <wlx/dynamics.hpp>
 #include <wlx/error.hpp>
+#include <wlx/ik.hpp>
 #include <wlx/kinematics.hpp>
 
 #include <algorithm>
@@ -37,6 +41,23 @@ std::vector<std::pair<std::string, Weighting>> weighting_variants(const std::str
 
 // Asked after every sample: a signal stops a long simulation at once, not when it ends.
 void stop_on_signal(long, long) { throw_if_interrupted(); }
+
+// A controller's reference along a run at any t: cubic Hermite between the run's samples (its
+// coordinates and rates), so evaluations between samples see the motion, not a staircase; an
+// inverse-dynamics run's commanded speeds are constant, so u_ref' = 0.
+void commanded_reference(const ReportRun& run, double t, CommandVector& q, CommandVector& u) {
+  const std::vector<Sample>& reference = run.trajectory.samples;
+  const double dt = run.scenario.dt;
+  const std::size_t k = std::min(static_cast<std::size_t>(std::max(t / dt, 0.0)), reference.size() - 2);
+  const Sample &a = reference[k], &b = reference[k + 1];
+  const double h = b.t - a.t, x = std::clamp((t - a.t) / h, 0.0, 1.0);
+  const double h00 = (1 + 2 * x) * (1 - x) * (1 - x), h10 = x * (1 - x) * (1 - x), h01 = x * x * (3 - 2 * x), h11 = x * x * (x - 1);
+  for (int j = 0; j < kCommandedCount; ++j) {
+    const int c = kCommandedSpeeds[static_cast<std::size_t>(j)];
+    q(j) = h00 * a.s(c) + h10 * h * a.sdot(c) + h01 * b.s(c) + h11 * h * b.sdot(c);
+    u(j) = a.sdot(c) + x * (b.sdot(c) - a.sdot(c));
+  }
+}
 
 }  // namespace
 
@@ -148,8 +169,8 @@ std::vector<std::string> ReportRunner::selected_scenarios() const {
 
 int ReportRunner::steps() const {
   int n = static_cast<int>(selected_sweeps().size());
-  // Each weighting's run, and the forward dynamics of weightings 1 and 2.
-  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? static_cast<int>(weighting_variants(id).size()) + 2 : 1;
+  // Each weighting's run, the forward dynamics of weightings 1 and 2, and weighting 1's in a physics engine.
+  for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? static_cast<int>(weighting_variants(id).size()) + 3 : 1;
   if (!quick_ && !spec_.integrator_scenarios.empty()) ++n;
   return n;
 }
@@ -202,6 +223,19 @@ void ReportRunner::run_all(const std::string& data_dir) {
     }
     progress_(fmt::format("forward dynamics of {}: its torques fed back, and a controller tracking it on a heavier plant", runs_[k].id));
     forward_.push_back(forward_dynamics_of(runs_[k], data_dir));
+  }
+  // The physics engine: weighting 1's run of each scenario (the controller's own split).
+  engine_missing_ = physics_engine_missing();
+  if (engine_missing_.empty() && description_text().empty()) engine_missing_ = "the model's description is not loaded";
+  for (std::size_t k = 0; k < inverse_runs; ++k) {
+    const ReportRun& run = runs_[k];
+    if (!run.scenario.weighting || run.scenario.weighting->kind != Weighting::Kind::model_weights) continue;
+    if (!engine_missing_.empty() || run.stopped) {
+      progress_(fmt::format("{} in a physics engine: not run ({})", run.id, run.stopped ? run.id + " stopped" : engine_missing_));
+      continue;
+    }
+    progress_(fmt::format("{} in a physics engine: the controller drives MuJoCo's machine", run.id));
+    engine_.push_back(physics_engine_of(run, data_dir));
   }
   if (!quick_ && !spec_.integrator_scenarios.empty()) {
     progress_(fmt::format("comparing integrators: Euler, RK4, dopri5 against RK4 at {:g} s on {} runs", spec_.reference_step,
@@ -282,21 +316,8 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
   row.samples = static_cast<long>(forward.samples.size());
   row.evaluations = forward.evaluations;
 
-  // The closed loop. The reference at any t: cubic Hermite between the run's samples (its
-  // coordinates and rates), so the controller's evaluations between samples see the motion, not a
-  // staircase; an inverse-dynamics run's commanded speeds are constant, so u_ref' = 0.
-  const auto reference_at = [&](double t, CommandVector& q, CommandVector& u) {
-    const double dt = run.scenario.dt;
-    const std::size_t k = std::min(static_cast<std::size_t>(std::max(t / dt, 0.0)), reference.size() - 2);
-    const Sample &a = reference[k], &b = reference[k + 1];
-    const double h = b.t - a.t, x = std::clamp((t - a.t) / h, 0.0, 1.0);
-    const double h00 = (1 + 2 * x) * (1 - x) * (1 - x), h10 = x * (1 - x) * (1 - x), h01 = x * x * (3 - 2 * x), h11 = x * x * (x - 1);
-    for (int j = 0; j < kCommandedCount; ++j) {
-      const int c = kCommandedSpeeds[static_cast<std::size_t>(j)];
-      q(j) = h00 * a.s(c) + h10 * h * a.sdot(c) + h01 * b.s(c) + h11 * h * b.sdot(c);
-      u(j) = a.sdot(c) + x * (b.sdot(c) - a.sdot(c));
-    }
-  };
+  // The closed loop.
+  const auto reference_at = [&](double t, CommandVector& q, CommandVector& u) { commanded_reference(run, t, q, u); };
   Scenario plant = run.scenario;
   plant.weighting.reset();
   for (const auto& body : gen::kBodyMass) {
@@ -354,6 +375,99 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
     tracking.row(values);
   }
   tracking.commit();
+  return row;
+}
+
+EngineRow ReportRunner::physics_engine_of(const ReportRun& run, const std::string& data_dir) {
+  EngineRow row;
+  row.id = run.id;
+  row.csv = run.id + "-mujoco.csv";
+  PhysicsEngine engine(description_text(), std::vector<std::string>(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end()));
+  // The run's start and speeds; the controller's split is the run's.
+  Coordinates s = run.trajectory.samples.front().s, sdot = run.trajectory.samples.front().sdot;
+  engine.set_state(s, sdot);
+  const Weighting weighting = *run.scenario.weighting;
+  const double weight = model_.total_mass() * (model_.params().*gen::kGravity);
+  const double step = engine.timestep();
+  const long steps = std::lround(run.scenario.duration / step);
+  std::vector<std::string> header{"t", "tracking_error_m", "tracking_error_rad"};
+  for (int c = 0; c < kContactCount; ++c) {
+    const std::string name = contact_name(c);
+    header.insert(header.end(), {"slip_" + name, "normal_mujoco_" + name, "normal_wlx_" + name});
+  }
+  CsvWriter csv(data_dir + "/" + row.csv, header);
+  DynamicsTerms terms;
+  ContactForces predicted;
+  double slip_sum = 0, force_sum = 0;
+  long settled = 0;
+  for (long n = 0; n <= steps; ++n) {
+    const double t = static_cast<double>(n) * step;
+    if (n % 100 == 0) throw_if_interrupted();
+    engine.read_state(s, sdot);
+    complete_tied_inputs(model_, data_, s, sdot);
+    // The controller's model of the state: MuJoCo's inputs, the dependent joints solved from them
+    // (MuJoCo holds the closure softly; the model's equations hold on it exactly).
+    std::string out_of_reach;
+    try {
+      solve_ik_closed_form(model_, s, run.scenario.branches);
+    } catch (const Error& e) {
+      out_of_reach = e.what();
+    }
+    CommandVector q_ref, u_ref, q, u;
+    commanded_reference(run, t, q_ref, u_ref);
+    double length = 0, angle = 0;
+    for (int j = 0; j < kCommandedCount; ++j) {
+      const int c = kCommandedSpeeds[static_cast<std::size_t>(j)];
+      q(j) = s(c), u(j) = sdot(c);
+      (is_angle(c) ? angle : length) = std::max(is_angle(c) ? angle : length, std::abs(q_ref(j) - q(j)));
+    }
+    // Leaving the reference ends the run where it happens: what follows is no longer the run. It
+    // is a finding about the controller on another machine, not a failure of the model: it stays
+    // out of the report's stopped simulations (and its exit status).
+    const auto stop = [&](const std::string& reason) { row.stopped = Stop{t, reason}; };
+    if (!s.allFinite() || !sdot.allFinite()) {
+      stop("MuJoCo's state is not finite");
+      break;
+    }
+    if (!out_of_reach.empty()) {
+      stop("the model's IK of MuJoCo's state: " + out_of_reach);
+      break;
+    }
+    if (length > kEngineLostLength || angle > kEngineLostAngle) {
+      stop(fmt::format("the machine left its reference ({:.3g} m, {:.3g} deg): beyond {:g} m or {:g} deg", length, angle * kDegPerRad,
+                       kEngineLostLength, kEngineLostAngle * kDegPerRad));
+      break;
+    }
+    const CommandVector u_dot = kTrackingKd * (u_ref - u) + kTrackingKp * (q_ref - q);
+    inverse_dynamics(model_, data_, s, u, u_dot, terms);
+    const TorqueVector tau = distribute_torques(terms.J_beta, terms.Qstar, weighting);
+    contact_forces(model_, data_, s, terms, tau, predicted);
+    engine.set_torques(tau);
+    const std::vector<EngineContact> contacts = engine.contacts();
+    row.length_error = std::max(row.length_error, length);
+    row.angle_error = std::max(row.angle_error, angle);
+    if (2 * n >= steps) {
+      row.late_length_error = std::max(row.late_length_error, length);
+      row.late_angle_error = std::max(row.late_angle_error, angle);
+    }
+    std::vector<double> values{t, length, angle};
+    for (int c = 0; c < kContactCount; ++c) {
+      const EngineContact& e = contacts[static_cast<std::size_t>(c)];
+      values.insert(values.end(), {e.slip, e.normal, predicted.normal(c)});
+      if (t < kEngineSettle || !gen::kContacts[static_cast<std::size_t>(c)].supports) continue;
+      const double difference = std::abs(e.normal - predicted.normal(c)) / weight;
+      row.max_slip = std::max(row.max_slip, e.slip);
+      row.max_force_difference = std::max(row.max_force_difference, difference);
+      slip_sum += e.slip;
+      force_sum += difference;
+      ++settled;
+    }
+    csv.row(values);
+    row.steps = n;
+    if (n < steps) engine.step();
+  }
+  csv.commit();
+  if (settled > 0) row.mean_slip = slip_sum / static_cast<double>(settled), row.mean_force_difference = force_sum / static_cast<double>(settled);
   return row;
 }
 

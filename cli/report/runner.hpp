@@ -81,6 +81,27 @@ struct ForwardRow {
   long closed_loop_samples = 0;
   double start_error = 0, late_error = 0;  // max |q_ref - q| over the commanded coordinates (m or rad): at t = 0, and over the second half
 };
+// The same controller on MuJoCo's machine (the report's "In a physics engine"): the model exported
+// as `wlx export mjcf` writes it, its wheels rolling by friction on soft contacts, free to slip and
+// lift, driven along an inverse-dynamics run at MuJoCo's step (1 kHz) from the run's start and
+// speeds. The controller reads MuJoCo's state in the model's coordinates.
+struct EngineRow {
+  std::string id;   // the inverse-dynamics run's
+  std::string csv;  // data/<id>-mujoco.csv: t, tracking errors, per contact slip and both normal forces
+  // Set: the machine left its reference, or MuJoCo's state the model's reach or finite numbers.
+  // Not one of the report's stopped simulations: MuJoCo's machine is not the model.
+  std::optional<Stop> stopped;
+  long steps = 0;
+  // max |q_ref - q| over the commanded lengths (m) and angles (rad): over the run, and its second half
+  double length_error = 0, angle_error = 0, late_length_error = 0, late_angle_error = 0;
+  // After the contacts settle (kEngineSettle): each contact's slip (m/s), mean and largest, and
+  // |normal force, MuJoCo's - the model's for the same torques| / the machine's weight.
+  double mean_slip = 0, max_slip = 0, mean_force_difference = 0, max_force_difference = 0;
+};
+inline constexpr double kEngineSettle = 0.05;  // s: the machine starts on its contacts, not yet pressed in
+// Where the machine is taken to have left its reference: the run stops there.
+inline constexpr double kEngineLostLength = 0.5, kEngineLostAngle = std::numbers::pi / 6;  // m, rad (30 deg)
+
 // The closed loop's plant and controller (ForwardRow).
 inline constexpr double kPlantMassFactor = 1.10;     // every body's mass and inertia, plant / model
 inline constexpr double kStartOffsetLength = 0.02;   // m, added to every commanded length coordinate at t = 0
@@ -118,6 +139,10 @@ class ReportRunner {
   const std::vector<ReportRun>& runs() const { return runs_; }
   const std::vector<IntegratorRow>& integrators() const { return integrators_; }
   const std::vector<ForwardRow>& forward() const { return forward_; }
+  const std::vector<EngineRow>& engine() const { return engine_; }
+  // Why the report has no physics engine's runs (empty: it has them, one per completed
+  // inverse-dynamics run).
+  const std::string& engine_missing() const { return engine_missing_; }
   const std::vector<int>& compared_coordinates() const { return compared_; }
   // Every simulation that stopped, in the order they ran.
   const std::vector<StoppedRun>& stopped() const { return stopped_; }
@@ -130,6 +155,7 @@ class ReportRunner {
   std::vector<std::string> selected_scenarios() const;
   void compare_integrators(const std::string& data_dir);
   ForwardRow forward_dynamics_of(const ReportRun& run, const std::string& data_dir);
+  EngineRow physics_engine_of(const ReportRun& run, const std::string& data_dir);
   // Records a stopped simulation; returns its Stop.
   Stop record_stop(const std::string& run, const std::string& part, const Trajectory& trajectory);
   // The first stop of one of these runs' simulations named in `parts` ("": the run itself; no
@@ -146,6 +172,8 @@ class ReportRunner {
   std::vector<ReportRun> runs_;
   std::vector<IntegratorRow> integrators_;
   std::vector<ForwardRow> forward_;
+  std::vector<EngineRow> engine_;
+  std::string engine_missing_;
   std::vector<StoppedRun> stopped_;
 };
 

@@ -22,4 +22,11 @@ void kinematic_update(const Model& model, Data& data, const Coordinates& s) noex
 // Fills data.Phi and, when with_jacobian, data.dPhi_ds.
 void closure(const Model& model, Data& data, const Coordinates& s, bool with_jacobian) noexcept;
 
+// The inputs the closure's point rows tie to a frame (a contact's x, y, z on the ground), set from
+// where that frame is, and their rates from those rows differentiated (0 = dPhi/ds s'): what a
+// state measured on the machine's tree alone (a physics engine's joints and floating base) leaves
+// out. The other coordinates of s and sdot are read, not changed. Leaves data's frames and
+// dPhi/ds at the completed s.
+void complete_tied_inputs(const Model& model, Data& data, Coordinates& s, Coordinates& sdot) noexcept;
+
 WLX_MODEL_NAMESPACE_END

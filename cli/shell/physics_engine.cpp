@@ -1,0 +1,332 @@
+// MuJoCo behind PhysicsEngine (physics_engine.hpp). Without MuJoCo (WLX_HAVE_MUJOCO undefined) only
+// the message of why remains.
+#include "physics_engine.hpp"
+
+#include <wlx/error.hpp>
+
+#ifdef WLX_HAVE_MUJOCO
+
+#include "bounded_input.hpp"
+#include "mjcf_export.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/QR>
+#include <fmt/format.h>
+#include <mujoco/mujoco.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <numbers>
+
+#include <unistd.h>
+
+namespace wlx::cli {
+
+std::string physics_engine_missing() { return {}; }
+
+namespace {
+
+using Json = nlohmann::json;
+
+// The floating base: the free joint's frame, its six coordinates and its rotations' axes.
+struct FreeBase {
+  std::string frame;
+  std::array<int, 3> position{}, angle{}, axis{};
+};
+
+int index_of(const std::vector<std::string>& names, const std::string& name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+// The frames MuJoCo moves by a free joint: a frame under K0 whose chain is three slides along x,
+// y, z and three rotations (as mjcf_export.cpp decides).
+std::vector<FreeBase> free_bases(const Json& d, const std::vector<std::string>& coordinates) {
+  std::vector<FreeBase> bases;
+  for (const Json& f : d.at("frames")) {
+    if (!f.contains("chain") || f.at("parent") != "K0" || f.at("chain").size() != 6) continue;
+    FreeBase b;
+    b.frame = f.at("name");
+    bool free = true;
+    for (std::size_t i = 0; i < 6 && free; ++i) {
+      const Json& step = f.at("chain")[i];
+      const char* kind = i < 3 ? "prismatic" : "revolute";
+      free = step.contains(kind) && step.contains("coordinate");
+      if (!free) break;
+      const int c = index_of(coordinates, step.at("coordinate"));
+      if (c < 0) throw Error("frames", fmt::format("frame {}: coordinate {} is not the model's", b.frame, step.at("coordinate").dump()));
+      const std::string axis = step.at(kind);
+      (i < 3 ? b.position : b.angle)[i % 3] = c;
+      if (i >= 3) b.axis[i - 3] = axis == "x" ? 0 : axis == "y" ? 1 : 2;
+    }
+    if (free) bases.push_back(b);
+  }
+  return bases;
+}
+
+Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
+  Eigen::Matrix3d H;
+  H << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+  return H;
+}
+
+// The angle nearest `near` among a + 2 pi k: a free joint's angles read back without jumps.
+double unwrap(double a, double near) {
+  constexpr double kTurn = 2 * std::numbers::pi;
+  return a + kTurn * std::round((near - a) / kTurn);
+}
+
+struct MjModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct MjDataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+
+// MuJoCo 2.2.2 loads XML from files only: the export goes through a private temporary file.
+std::unique_ptr<mjModel, MjModelDeleter> load(const std::string& xml) {
+  char path[] = "/tmp/wlx-mjcf-XXXXXX";
+  const int fd = ::mkstemp(path);
+  if (fd < 0) throw Error("physics engine", fmt::format("cannot create a temporary file for the MJCF ({})", std::strerror(errno)));
+  const bool written = ::write(fd, xml.data(), xml.size()) == static_cast<ssize_t>(xml.size());
+  const bool closed = ::close(fd) == 0;
+  if (!written || !closed) {
+    std::remove(path);
+    throw Error("physics engine", fmt::format("cannot write the MJCF to {}", path));
+  }
+  char error[1000] = "";
+  mjModel* m = mj_loadXML(path, nullptr, error, sizeof error);
+  std::remove(path);
+  if (m == nullptr) throw Error("physics engine", fmt::format("MuJoCo refuses the exported model: {}", error));
+  return std::unique_ptr<mjModel, MjModelDeleter>(m);
+}
+
+}  // namespace
+
+struct PhysicsEngine::Impl {
+  std::unique_ptr<mjModel, MjModelDeleter> m;
+  std::unique_ptr<mjData, MjDataDeleter> d;
+  std::vector<std::string> coordinates;
+  std::vector<FreeBase> bases;
+  std::vector<int> joint_coordinate;  // per MuJoCo joint: its coordinate, or -1 (a free joint, a wheel's spin)
+  std::vector<int> motors;            // per actuator in the description's order: MuJoCo's actuator
+  std::vector<std::string> contact_names;
+  std::vector<int> contact_geoms;  // per contact: its geom
+  std::vector<int> spin_joints;    // the wheels' spinning joints
+
+  const FreeBase& base_of(int joint) const {
+    const std::string name = mj_id2name(m.get(), mjOBJ_JOINT, joint);
+    for (const auto& b : bases)
+      if (b.frame == name) return b;
+    throw Error("frames", fmt::format("MuJoCo's free joint {} is no frame's floating base", name));
+  }
+
+  // G (dofs x coordinates) with qvel = G s', G' s', and qpos, at a state.
+  void map_state(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot, Eigen::MatrixXd& G, Eigen::VectorXd& Gdot_sdot,
+                 Eigen::VectorXd& qpos) const {
+    const int n = static_cast<int>(coordinates.size());
+    G = Eigen::MatrixXd::Zero(m->nv, n);
+    Gdot_sdot = Eigen::VectorXd::Zero(m->nv);
+    qpos = Eigen::VectorXd::Zero(m->nq);
+    for (int j = 0; j < m->njnt; ++j) {
+      const int qa = m->jnt_qposadr[j], va = m->jnt_dofadr[j];
+      if (m->jnt_type[j] == mjJNT_FREE) {
+        const FreeBase& b = base_of(j);
+        std::array<Eigen::Matrix3d, 3> R;
+        for (std::size_t i = 0; i < 3; ++i) {
+          qpos(qa + static_cast<int>(i)) = s(b.position[i]);
+          G(va + static_cast<int>(i), b.position[i]) = 1;
+          R[i] = Eigen::AngleAxisd(s(b.angle[i]), Eigen::Vector3d::Unit(b.axis[i])).toRotationMatrix();
+        }
+        const Eigen::Quaterniond q(R[0] * R[1] * R[2]);
+        qpos.segment<4>(qa + 3) << q.w(), q.x(), q.y(), q.z();
+        // omega_body = sum_i B_i e_i q_i' with B_i = (R_{i+1} ... R_3)^T, from B_3 = I by
+        // B_i = B_{i+1} R_{i+1}^T; and B_i' likewise, with R_k^T' = -[e_k q_k']x R_k^T.
+        Eigen::Matrix3d B = Eigen::Matrix3d::Identity(), Bdot = Eigen::Matrix3d::Zero();
+        for (int i = 2; i >= 0; --i) {
+          if (i < 2) {
+            const std::size_t k = static_cast<std::size_t>(i + 1);
+            const Eigen::Matrix3d Rt = R[k].transpose();
+            const Eigen::Matrix3d Rt_dot = -hat(Eigen::Vector3d::Unit(b.axis[k]) * sdot(b.angle[k])) * Rt;
+            Bdot = Bdot * Rt + B * Rt_dot;
+            B = B * Rt;
+          }
+          const std::size_t u = static_cast<std::size_t>(i);
+          const Eigen::Vector3d e = Eigen::Vector3d::Unit(b.axis[u]);
+          G.block<3, 1>(va + 3, b.angle[u]) = B * e;
+          Gdot_sdot.segment<3>(va + 3) += Bdot * e * sdot(b.angle[u]);
+        }
+        continue;
+      }
+      const int c = joint_coordinate[static_cast<std::size_t>(j)];
+      if (c < 0) continue;  // a wheel's spin
+      qpos(qa) = s(c);
+      G(va, c) = 1;
+    }
+  }
+};
+
+PhysicsEngine::PhysicsEngine(const std::string& description_json, const std::vector<std::string>& coordinates)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& e = *impl_;
+  e.m = load(mjcf_of_description(description_json).xml);
+  e.d.reset(mj_makeData(e.m.get()));
+  if (!e.d) throw Error("physics engine", "MuJoCo could not allocate its data");
+  e.coordinates = coordinates;
+  const Json d = parse_json_bounded(description_json, "model.json");
+  e.bases = free_bases(d, coordinates);
+  for (int j = 0; j < e.m->njnt; ++j) {
+    const char* name = mj_id2name(e.m.get(), mjOBJ_JOINT, j);
+    e.joint_coordinate.push_back(e.m->jnt_type[j] == mjJNT_FREE || name == nullptr ? -1 : index_of(coordinates, name));
+  }
+  for (const Json& a : d.at("actuated")) {
+    const std::string name = a.at("name");
+    const int id = mj_name2id(e.m.get(), mjOBJ_ACTUATOR, name.c_str());
+    if (id < 0) throw Error("actuated", fmt::format("the exported model has no motor {}", name));
+    e.motors.push_back(id);
+  }
+  // A wheel on a hub spins in a body of its own, spin_<wheel>, about the body's one hinge.
+  for (const Json& w : d.at("wheels")) {
+    const int body = mj_name2id(e.m.get(), mjOBJ_BODY, ("spin_" + w.at("name").get<std::string>()).c_str());
+    if (body >= 0 && e.m->body_jntnum[body] == 1) e.spin_joints.push_back(e.m->body_jntadr[body]);
+  }
+  for (const Json& c : d.at("contacts")) {
+    const std::string name = c.at("name"), frame = c.at("frame");
+    const int geom = mj_name2id(e.m.get(), mjOBJ_GEOM, frame.c_str());
+    if (geom < 0) throw Error("contacts", fmt::format("contact {}: the exported model has no geom {}", name, frame));
+    e.contact_names.push_back(name);
+    e.contact_geoms.push_back(geom);
+  }
+}
+
+PhysicsEngine::~PhysicsEngine() = default;
+
+double PhysicsEngine::timestep() const { return impl_->m->opt.timestep; }
+double PhysicsEngine::time() const { return impl_->d->time; }
+
+void PhysicsEngine::set_state(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot) {
+  const Impl& e = *impl_;
+  const mjModel* m = e.m.get();
+  mjData* d = e.d.get();
+  Eigen::MatrixXd G;
+  Eigen::VectorXd Gdot_sdot, qpos;
+  e.map_state(s, sdot, G, Gdot_sdot, qpos);
+  const Eigen::VectorXd qvel = G * sdot;
+  mj_resetData(m, d);
+  std::copy(qpos.data(), qpos.data() + m->nq, d->qpos);
+  std::copy(qvel.data(), qvel.data() + m->nv, d->qvel);
+  mj_forward(m, d);
+  // Each spinning wheel: the spin rate w that minimises the horizontal speed of its lowest point,
+  // v0 + w a x (p - c), the wheel's centre c on its axle a, p a radius below it.
+  for (const int j : e.spin_joints) {
+    const int body = m->jnt_bodyid[j];
+    int geom = -1;
+    for (int g = 0; g < m->ngeom; ++g)
+      if (m->geom_bodyid[g] == body) geom = g;
+    if (geom < 0) continue;
+    const Eigen::Vector3d a(d->xaxis[3 * j], d->xaxis[3 * j + 1], d->xaxis[3 * j + 2]);
+    const Eigen::Vector3d r(0, 0, -m->geom_size[3 * geom]);
+    mjtNum v[6];
+    mj_objectVelocity(m, d, mjOBJ_XBODY, body, v, 0);
+    const Eigen::Vector3d v0 = Eigen::Vector3d(v[3], v[4], v[5]) + Eigen::Vector3d(v[0], v[1], v[2]).cross(r);
+    const Eigen::Vector3d w = a.cross(r);
+    const double ww = w.head<2>().squaredNorm();
+    if (ww > 0) d->qvel[m->jnt_dofadr[j]] = -v0.head<2>().dot(w.head<2>()) / ww;
+  }
+  mj_forward(m, d);
+}
+
+void PhysicsEngine::read_state(Eigen::Ref<Eigen::VectorXd> s, Eigen::Ref<Eigen::VectorXd> sdot) const {
+  const Impl& e = *impl_;
+  const mjModel* m = e.m.get();
+  const mjData* d = e.d.get();
+  for (int j = 0; j < m->njnt; ++j) {
+    const int qa = m->jnt_qposadr[j];
+    if (m->jnt_type[j] == mjJNT_FREE) {
+      const FreeBase& b = e.base_of(j);
+      for (std::size_t i = 0; i < 3; ++i) s(b.position[i]) = d->qpos[qa + static_cast<int>(i)];
+      const Eigen::Matrix3d R = Eigen::Quaterniond(d->qpos[qa + 3], d->qpos[qa + 4], d->qpos[qa + 5], d->qpos[qa + 6]).normalized().toRotationMatrix();
+      // R = R_a(q1) R_b(q2) R_c(q3) about three different axes: sin q2 = eps R(a, c), with eps
+      // +1 for a cyclic order of (a, b, c) and -1 otherwise.
+      const int a = b.axis[0], bb = b.axis[1], c = b.axis[2];
+      const double eps = (bb - a + 3) % 3 == 1 ? 1.0 : -1.0;
+      const double q2 = std::asin(std::clamp(eps * R(a, c), -1.0, 1.0));
+      const double q1 = std::atan2(-eps * R(bb, c), R(c, c));
+      const double q3 = std::atan2(-eps * R(a, bb), R(a, a));
+      s(b.angle[0]) = unwrap(q1, s(b.angle[0]));
+      s(b.angle[1]) = unwrap(q2, s(b.angle[1]));
+      s(b.angle[2]) = unwrap(q3, s(b.angle[2]));
+      continue;
+    }
+    const int c = e.joint_coordinate[static_cast<std::size_t>(j)];
+    if (c >= 0) s(c) = d->qpos[qa];
+  }
+  Eigen::MatrixXd G;
+  Eigen::VectorXd Gdot_sdot, qpos;
+  e.map_state(s, Eigen::VectorXd::Zero(s.size()), G, Gdot_sdot, qpos);
+  const Eigen::Map<const Eigen::VectorXd> qvel(d->qvel, m->nv);
+  const Eigen::VectorXd rates = G.colPivHouseholderQr().solve(qvel);
+  for (int k = 0; k < G.cols(); ++k)
+    if (!G.col(k).isZero()) sdot(k) = rates(k);
+}
+
+void PhysicsEngine::set_torques(const Eigen::Ref<const Eigen::VectorXd>& tau) {
+  const Impl& e = *impl_;
+  if (tau.size() != static_cast<Eigen::Index>(e.motors.size()))
+    throw Error("tau", fmt::format("{} values for {} actuators", tau.size(), e.motors.size()));
+  for (std::size_t k = 0; k < e.motors.size(); ++k) e.d->ctrl[e.motors[k]] = tau(static_cast<Eigen::Index>(k));
+}
+
+void PhysicsEngine::step() { mj_step(impl_->m.get(), impl_->d.get()); }
+
+std::vector<EngineContact> PhysicsEngine::contacts() const {
+  const Impl& e = *impl_;
+  const mjModel* m = e.m.get();
+  mjData* d = e.d.get();
+  std::vector<EngineContact> out;
+  for (std::size_t k = 0; k < e.contact_geoms.size(); ++k) {
+    const int geom = e.contact_geoms[k];
+    EngineContact c{e.contact_names[k], 0, 0};
+    for (int i = 0; i < d->ncon; ++i) {
+      const mjContact& con = d->contact[i];
+      if (con.geom1 != geom && con.geom2 != geom) continue;
+      mjtNum f[6];
+      mj_contactForce(m, d, i, f);
+      c.normal += f[0] * std::abs(con.frame[2]);  // the normal's part along z: the plane's is z itself
+    }
+    // The material point a radius below the geom's centre (a wheel's rim, a foot's sphere).
+    mjtNum v[6];
+    mj_objectVelocity(m, d, mjOBJ_GEOM, geom, v, 0);
+    const Eigen::Vector3d point = Eigen::Vector3d(v[3], v[4], v[5]) + Eigen::Vector3d(v[0], v[1], v[2]).cross(Eigen::Vector3d(0, 0, -m->geom_size[3 * geom]));
+    c.slip = std::hypot(point.x(), point.y());
+    out.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace wlx::cli
+
+#else  // no MuJoCo
+
+namespace wlx::cli {
+
+std::string physics_engine_missing() { return "wlx was built without MuJoCo (Debian's libmujoco-dev: tools/setup.sh installs it)"; }
+
+struct PhysicsEngine::Impl {};
+PhysicsEngine::PhysicsEngine(const std::string&, const std::vector<std::string>&) { throw Error("physics engine", physics_engine_missing()); }
+PhysicsEngine::~PhysicsEngine() = default;
+double PhysicsEngine::timestep() const { return 0; }
+double PhysicsEngine::time() const { return 0; }
+void PhysicsEngine::set_state(const Eigen::Ref<const Eigen::VectorXd>&, const Eigen::Ref<const Eigen::VectorXd>&) {}
+void PhysicsEngine::read_state(Eigen::Ref<Eigen::VectorXd>, Eigen::Ref<Eigen::VectorXd>) const {}
+void PhysicsEngine::set_torques(const Eigen::Ref<const Eigen::VectorXd>&) {}
+void PhysicsEngine::step() {}
+std::vector<EngineContact> PhysicsEngine::contacts() const { return {}; }
+
+}  // namespace wlx::cli
+
+#endif
