@@ -22,7 +22,8 @@
 
 #ifdef WLX_HAVE_MUJOCO
 #include "mjcf_export.hpp"
-#include "mujoco_peer.hpp"
+#include "mujoco_model.hpp"
+#include "physics_engine.hpp"
 #include "open_tree.hpp"
 
 #include <fstream>
@@ -179,8 +180,8 @@ void weighting_3_part(benchmark::State& st) {
 // The nominal pose in MuJoCo too: the exported model at the same coordinates, rates 0.1 and
 // accelerations 0.2 (per coordinate; what MuJoCo's free joint and wheel spins make of them).
 struct MujocoPose : Pose {
-  std::unique_ptr<mjModel, mujoco_peer::MjModelDeleter> m;
-  std::unique_ptr<mjData, mujoco_peer::MjDataDeleter> md;
+  cli::MjModelPtr m;
+  cli::MjDataPtr md;
   Coordinates sdot = Coordinates::Constant(0.1), sddot = Coordinates::Constant(0.2);
   std::vector<double> qpos, qvel;
   MujocoPose() {
@@ -189,9 +190,10 @@ struct MujocoPose : Pose {
     std::ifstream in(WLX_DESCRIPTION_FILE);
     std::stringstream text;
     text << in.rdbuf();
-    m = mujoco_peer::load(cli::mjcf_of_description(text.str()).xml);
+    m = cli::load_mjcf(cli::mjcf_of_description(text.str()).xml);
     md.reset(mj_makeData(m.get()));
-    const mujoco_peer::Mapping map = mujoco_peer::map_state(m.get(), mujoco_peer::free_bases(text.str()), s, sdot);
+    const cli::PhysicsEngine engine(text.str(), std::vector<std::string>(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end()));
+    const cli::EngineMapping map = engine.mapping(s, sdot);
     const Eigen::VectorXd v = map.G * sdot, a = map.G * sddot + map.Gdot_sdot;
     for (int i = 0; i < m->nq; ++i) md->qpos[i] = map.qpos(i);
     for (int i = 0; i < m->nv; ++i) md->qvel[i] = v(i), md->qacc[i] = a(i);

@@ -7,6 +7,7 @@
 #include <wlx/model_namespace.hpp>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross
 
 WLX_MODEL_NAMESPACE_BEGIN
 namespace open_tree {

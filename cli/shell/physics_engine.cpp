@@ -8,6 +8,7 @@
 
 #include "bounded_input.hpp"
 #include "mjcf_export.hpp"
+#include "mujoco_model.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/QR>
@@ -18,11 +19,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <numbers>
-
-#include <unistd.h>
 
 namespace wlx::cli {
 
@@ -32,11 +29,7 @@ namespace {
 
 using Json = nlohmann::json;
 
-// The floating base: the free joint's frame, its six coordinates and its rotations' axes.
-struct FreeBase {
-  std::string frame;
-  std::array<int, 3> position{}, angle{}, axis{};
-};
+using FreeBase = EngineFreeBase;
 
 int index_of(const std::vector<std::string>& names, const std::string& name) {
   const auto it = std::find(names.begin(), names.end(), name);
@@ -45,7 +38,7 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
 
 // The frames MuJoCo moves by a free joint: a frame under K0 whose chain is three slides along x,
 // y, z and three rotations (as mjcf_export.cpp decides).
-std::vector<FreeBase> free_bases(const Json& d, const std::vector<std::string>& coordinates) {
+std::vector<FreeBase> read_free_bases(const Json& d, const std::vector<std::string>& coordinates) {
   std::vector<FreeBase> bases;
   for (const Json& f : d.at("frames")) {
     if (!f.contains("chain") || f.at("parent") != "K0" || f.at("chain").size() != 6) continue;
@@ -80,36 +73,11 @@ double unwrap(double a, double near) {
   return a + kTurn * std::round((near - a) / kTurn);
 }
 
-struct MjModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
-struct MjDataDeleter {
-  void operator()(mjData* d) const { mj_deleteData(d); }
-};
-
-// MuJoCo 2.2.2 loads XML from files only: the export goes through a private temporary file.
-std::unique_ptr<mjModel, MjModelDeleter> load(const std::string& xml) {
-  char path[] = "/tmp/wlx-mjcf-XXXXXX";
-  const int fd = ::mkstemp(path);
-  if (fd < 0) throw Error("physics engine", fmt::format("cannot create a temporary file for the MJCF ({})", std::strerror(errno)));
-  const bool written = ::write(fd, xml.data(), xml.size()) == static_cast<ssize_t>(xml.size());
-  const bool closed = ::close(fd) == 0;
-  if (!written || !closed) {
-    std::remove(path);
-    throw Error("physics engine", fmt::format("cannot write the MJCF to {}", path));
-  }
-  char error[1000] = "";
-  mjModel* m = mj_loadXML(path, nullptr, error, sizeof error);
-  std::remove(path);
-  if (m == nullptr) throw Error("physics engine", fmt::format("MuJoCo refuses the exported model: {}", error));
-  return std::unique_ptr<mjModel, MjModelDeleter>(m);
-}
-
 }  // namespace
 
 struct PhysicsEngine::Impl {
-  std::unique_ptr<mjModel, MjModelDeleter> m;
-  std::unique_ptr<mjData, MjDataDeleter> d;
+  MjModelPtr m;
+  MjDataPtr d;
   std::vector<std::string> coordinates;
   std::vector<FreeBase> bases;
   std::vector<int> joint_coordinate;  // per MuJoCo joint: its coordinate, or -1 (a free joint, a wheel's spin)
@@ -125,9 +93,8 @@ struct PhysicsEngine::Impl {
     throw Error("frames", fmt::format("MuJoCo's free joint {} is no frame's floating base", name));
   }
 
-  // G (dofs x coordinates) with qvel = G s', G' s', and qpos, at a state.
-  void map_state(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot, Eigen::MatrixXd& G, Eigen::VectorXd& Gdot_sdot,
-                 Eigen::VectorXd& qpos) const {
+  void map_state(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot, Eigen::MatrixXd& G,
+                 Eigen::VectorXd& Gdot_sdot, Eigen::VectorXd& qpos) const {
     const int n = static_cast<int>(coordinates.size());
     G = Eigen::MatrixXd::Zero(m->nv, n);
     Gdot_sdot = Eigen::VectorXd::Zero(m->nv);
@@ -173,12 +140,12 @@ struct PhysicsEngine::Impl {
 PhysicsEngine::PhysicsEngine(const std::string& description_json, const std::vector<std::string>& coordinates)
     : impl_(std::make_unique<Impl>()) {
   Impl& e = *impl_;
-  e.m = load(mjcf_of_description(description_json).xml);
+  e.m = load_mjcf(mjcf_of_description(description_json).xml);
   e.d.reset(mj_makeData(e.m.get()));
   if (!e.d) throw Error("physics engine", "MuJoCo could not allocate its data");
   e.coordinates = coordinates;
   const Json d = parse_json_bounded(description_json, "model.json");
-  e.bases = free_bases(d, coordinates);
+  e.bases = read_free_bases(d, coordinates);
   for (int j = 0; j < e.m->njnt; ++j) {
     const char* name = mj_id2name(e.m.get(), mjOBJ_JOINT, j);
     e.joint_coordinate.push_back(e.m->jnt_type[j] == mjJNT_FREE || name == nullptr ? -1 : index_of(coordinates, name));
@@ -206,6 +173,14 @@ PhysicsEngine::PhysicsEngine(const std::string& description_json, const std::vec
 PhysicsEngine::~PhysicsEngine() = default;
 
 double PhysicsEngine::timestep() const { return impl_->m->opt.timestep; }
+
+EngineMapping PhysicsEngine::mapping(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot) const {
+  EngineMapping out;
+  impl_->map_state(s, sdot, out.G, out.Gdot_sdot, out.qpos);
+  return out;
+}
+
+const std::vector<EngineFreeBase>& PhysicsEngine::free_bases() const { return impl_->bases; }
 double PhysicsEngine::time() const { return impl_->d->time; }
 
 void PhysicsEngine::set_state(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot) {
@@ -320,6 +295,11 @@ struct PhysicsEngine::Impl {};
 PhysicsEngine::PhysicsEngine(const std::string&, const std::vector<std::string>&) { throw Error("physics engine", physics_engine_missing()); }
 PhysicsEngine::~PhysicsEngine() = default;
 double PhysicsEngine::timestep() const { return 0; }
+EngineMapping PhysicsEngine::mapping(const Eigen::Ref<const Eigen::VectorXd>&, const Eigen::Ref<const Eigen::VectorXd>&) const { return {}; }
+const std::vector<EngineFreeBase>& PhysicsEngine::free_bases() const {
+  static const std::vector<EngineFreeBase> none;
+  return none;
+}
 double PhysicsEngine::time() const { return 0; }
 void PhysicsEngine::set_state(const Eigen::Ref<const Eigen::VectorXd>&, const Eigen::Ref<const Eigen::VectorXd>&) {}
 void PhysicsEngine::read_state(Eigen::Ref<Eigen::VectorXd>, Eigen::Ref<Eigen::VectorXd>) const {}

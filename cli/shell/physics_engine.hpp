@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,6 +33,20 @@ struct EngineContact {
   double slip = 0;
 };
 
+// MuJoCo's coordinates of a state of wlx's: qpos, and qvel = G s', qacc = G s'' + G' s' (MuJoCo's
+// dofs in its order; a wheel's spin is no coordinate of wlx's: its rows of G are zero).
+struct EngineMapping {
+  Eigen::MatrixXd G;  // dofs x coordinates
+  Eigen::VectorXd Gdot_sdot, qpos;
+};
+
+// A floating base: the frame whose free joint it is, its position coordinates (x, y, z) and its
+// angles with their axes (0 x, 1 y, 2 z), R = R_axis0(angle0) R_axis1(angle1) R_axis2(angle2).
+struct EngineFreeBase {
+  std::string frame;
+  std::array<int, 3> position{}, angle{}, axis{};
+};
+
 class PhysicsEngine {
  public:
   // MuJoCo's model of the description (model.json's text); `coordinates`: the model's coordinate
@@ -43,6 +58,8 @@ class PhysicsEngine {
   PhysicsEngine& operator=(const PhysicsEngine&) = delete;
 
   double timestep() const;  // s: the export's option timestep
+  EngineMapping mapping(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot) const;
+  const std::vector<EngineFreeBase>& free_bases() const;
   double time() const;      // s since the start
 
   // Sets the machine to wlx's state, at rest in the wheels' spins but for rolling: each spinning

@@ -20,8 +20,7 @@
 // Usage: wlx_mujoco_cosim DESCRIPTION.json [OUT.csv] (one row per millisecond: the tracking errors,
 // and per wheel its slip and both normal forces). Exits 1 when the run misses the bounds it states
 // at the end (docs/export.md gives the figures), 2 on bad input.
-#include "mjcf_export.hpp"
-#include "mujoco_peer.hpp"
+#include "physics_engine.hpp"
 
 #include <wlx/atomic_file.hpp>
 #include <wlx/contacts.hpp>
@@ -33,7 +32,6 @@
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
-#include <mujoco/mujoco.h>
 
 #include <algorithm>
 #include <cmath>
@@ -47,7 +45,6 @@
 #include <vector>
 
 using namespace wlx;
-namespace peer = wlx::mujoco_peer;
 
 namespace {
 
@@ -64,59 +61,10 @@ double ramp(double t) { return t < kRamp ? 0.5 * (1 - std::cos(std::numbers::pi 
 double ramp_rate(double t) { return t < kRamp ? 0.5 * std::numbers::pi / kRamp * std::sin(std::numbers::pi * t / kRamp) : 0.0; }
 
 int coordinate(const std::string& name) {
-  const int c = peer::coordinate_index(name);
-  if (c < 0) throw Error("coordinate", fmt::format("the model has no coordinate '{}'", name));
-  return c;
+  for (int c = 0; c < kCoordinateCount; ++c)
+    if (gen::kCoordinateNames[static_cast<std::size_t>(c)] == name) return c;
+  throw Error("coordinate", fmt::format("the model has no coordinate '{}'", name));
 }
-
-// wlx's coordinates and rates of MuJoCo's state (the steps 1 of the header).
-struct Measured {
-  Coordinates s = Coordinates::Zero(), sdot = Coordinates::Zero();
-};
-Measured measure(const Model& model, Data& data, const mjModel* m, const mjData* d, const std::vector<peer::FreeBase>& bases) {
-  Measured out;
-  for (int j = 0; j < m->njnt; ++j) {
-    const int qa = m->jnt_qposadr[j];
-    if (m->jnt_type[j] == mjJNT_FREE) {
-      const peer::FreeBase& b = bases.front();
-      if (b.axis != std::array<int, 3>{2, 1, 0}) throw Error("frames", "this example reads a floating base of Z-Y-X angles only");
-      for (int i = 0; i < 3; ++i) out.s(b.position[static_cast<std::size_t>(i)]) = d->qpos[qa + i];
-      const Eigen::Matrix3d R = Eigen::Quaterniond(d->qpos[qa + 3], d->qpos[qa + 4], d->qpos[qa + 5], d->qpos[qa + 6]).toRotationMatrix();
-      out.s(b.angle[0]) = std::atan2(R(1, 0), R(0, 0));
-      out.s(b.angle[1]) = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-      out.s(b.angle[2]) = std::atan2(R(2, 1), R(2, 2));
-      continue;
-    }
-    const int c = peer::coordinate_index(mj_id2name(m, mjOBJ_JOINT, j));
-    if (c >= 0) out.s(c) = d->qpos[qa];
-  }
-  // The inputs the closure ties to a frame: where that frame is.
-  forward_kinematics(model, data, out.s);
-  for (const auto& row : gen::kClosureRows)
-    if (row.kind == gen::RowKind::point) out.s(row.target) = data.frame_positions(row.axis, row.frame);
-  // Rates: qvel = G s' on the tree's coordinates (least squares: the wheels' spins are no
-  // coordinate), then each tied input's rate from its row, 0 = dPhi/ds s'.
-  const peer::Mapping map = peer::map_state(m, bases, out.s, Coordinates::Zero());
-  const Eigen::Map<const Eigen::VectorXd> qvel(d->qvel, m->nv);
-  const Eigen::VectorXd tree_rates = map.G.colPivHouseholderQr().solve(qvel);
-  out.sdot = tree_rates;
-  closure(model, data, out.s, true);
-  for (int r = 0; r < static_cast<int>(gen::kClosureRows.size()); ++r) {
-    const auto& row = gen::kClosureRows[static_cast<std::size_t>(r)];
-    if (row.kind != gen::RowKind::point) continue;
-    double rate = 0;
-    for (int k = 0; k < kCoordinateCount; ++k)
-      if (k != row.target) rate += data.dPhi_ds(r, k) * out.sdot(k);
-    out.sdot(row.target) = rate;  // dPhi/ds of the input itself is -1
-  }
-  return out;
-}
-
-// Each wheel's MuJoCo body (spin_<wheel>), geom (its contact frame's name) and radius.
-struct Wheel {
-  int body = -1, geom = -1;
-  double radius = 0;
-};
 
 }  // namespace
 
@@ -130,11 +78,8 @@ int main(int argc, char** argv) try {
   std::stringstream text;
   text << in.rdbuf();
   const std::string description = text.str();
-  const auto mj = peer::load(cli::mjcf_of_description(description).xml);
-  mjModel* m = mj.get();
-  const std::unique_ptr<mjData, peer::MjDataDeleter> data_mj(mj_makeData(m));
-  mjData* d = data_mj.get();
-  const std::vector<peer::FreeBase> bases = peer::free_bases(description);
+  cli::PhysicsEngine engine(description, std::vector<std::string>(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end()));
+  const std::vector<cli::EngineFreeBase>& bases = engine.free_bases();
   if (bases.size() != 1) throw Error("frames", "this example drives a machine with one floating base");
 
   const Model model;
@@ -145,29 +90,12 @@ int main(int argc, char** argv) try {
   // the joints' ranges, which MuJoCo's joint limits enforce), at rest.
   Coordinates s0 = nominal_inputs();
   solve_ik_closed_form(model, s0);
-  const peer::Mapping start = peer::map_state(m, bases, s0, Coordinates::Zero());
-  for (int i = 0; i < m->nq; ++i) d->qpos[i] = start.qpos(i);
-  mj_forward(m, d);
-
-  std::vector<int> motor(kActuatedCount);
-  for (int k = 0; k < kActuatedCount; ++k) {
-    motor[static_cast<std::size_t>(k)] = mj_name2id(m, mjOBJ_ACTUATOR, std::string(kActuatorNames[static_cast<std::size_t>(k)]).c_str());
-    if (motor[static_cast<std::size_t>(k)] < 0) throw Error("actuators", fmt::format("MuJoCo has no motor {}", kActuatorNames[static_cast<std::size_t>(k)]));
-  }
-  std::vector<Wheel> wheels;
-  for (int w = 0; w < kWheelCount; ++w) {
-    const std::string name(gen::kWheels[static_cast<std::size_t>(w)].name);
-    Wheel wheel;
-    wheel.body = mj_name2id(m, mjOBJ_BODY, ("spin_" + name).c_str());
-    wheel.geom = mj_name2id(m, mjOBJ_GEOM, std::string(gen::kFrameNames[static_cast<std::size_t>(gen::kWheels[static_cast<std::size_t>(w)].contact_frame)]).c_str());
-    if (wheel.body < 0 || wheel.geom < 0) throw Error("wheels", fmt::format("wheel {} has no spinning body in MuJoCo (a wheel on a hub)", name));
-    wheel.radius = m->geom_size[3 * wheel.geom];
-    wheels.push_back(wheel);
-  }
-  // The contact of each wheel among wlx's contacts.
+  engine.set_state(s0, Coordinates::Zero());
+  // The contact of each wheel among the model's (the engine's contacts are in the same order).
   std::vector<int> contact_of_wheel(kWheelCount, -1);
   for (int c = 0; c < kContactCount; ++c)
     if (gen::kContacts[static_cast<std::size_t>(c)].wheel >= 0) contact_of_wheel[static_cast<std::size_t>(gen::kContacts[static_cast<std::size_t>(c)].wheel)] = c;
+  if (std::count(contact_of_wheel.begin(), contact_of_wheel.end(), -1) > 0) throw Error("contacts", "this example needs a contact on every wheel");
 
   // The reference: the base's x, y and yaw, and each wheel's contact point carried with the base
   // (its x commanded, its y following by rolling). Every other commanded coordinate stays.
@@ -178,7 +106,7 @@ int main(int argc, char** argv) try {
     if (it == kCommandedSpeeds.end()) throw Error("speeds", fmt::format("{} is no commanded speed of the model", name));
     return static_cast<int>(it - kCommandedSpeeds.begin());
   };
-  const peer::FreeBase& base = bases.front();
+  const cli::EngineFreeBase& base = bases.front();
   const int kx = commanded(std::string(gen::kCoordinateNames[static_cast<std::size_t>(base.position[0])])),
             ky = commanded(std::string(gen::kCoordinateNames[static_cast<std::size_t>(base.position[1])])),
             kyaw = commanded(std::string(gen::kCoordinateNames[static_cast<std::size_t>(base.angle[0])]));
@@ -242,35 +170,32 @@ int main(int argc, char** argv) try {
   long samples = 0;
   const double weight = model.total_mass() * (model.params().*gen::kGravity);
   const long steps = std::lround(kDuration / kStep);
+  Coordinates last = s0;
   for (long n = 0; n <= steps; ++n) {
     const double t = static_cast<double>(n) * kStep;
-    const Measured x = measure(model, data, m, d, bases);
-    if (!x.s.allFinite() || !x.sdot.allFinite()) throw Error("simulation", fmt::format("MuJoCo's state is not finite at t = {:.3f} s", t));
+    // MuJoCo's state as the model's coordinates: the tree's from MuJoCo, the inputs the closure
+    // ties to a contact from where that contact is.
+    Coordinates s = last, sdot = Coordinates::Zero();
+    engine.read_state(s, sdot);
+    complete_tied_inputs(model, data, s, sdot);
+    if (!s.allFinite() || !sdot.allFinite()) throw Error("simulation", fmt::format("MuJoCo's state is not finite at t = {:.3f} s", t));
+    last = s;  // the angles read next are unwrapped near these
     CommandVector u, q, q_ref, u_ref, a_ref;
     reference(t, q_ref, u_ref, a_ref);
     for (int k = 0; k < kCommandedCount; ++k) {
-      u(k) = x.sdot(kCommandedSpeeds[static_cast<std::size_t>(k)]);
-      q(k) = x.s(kCommandedSpeeds[static_cast<std::size_t>(k)]);
+      u(k) = sdot(kCommandedSpeeds[static_cast<std::size_t>(k)]);
+      q(k) = s(kCommandedSpeeds[static_cast<std::size_t>(k)]);
     }
     // The controller: computed torque on wlx's reduced equations, the model's torque split.
     const CommandVector u_dot = a_ref + kKd * (u_ref - u) + kKp * (q_ref - q);
-    inverse_dynamics(model, data, x.s, u, u_dot, terms);
+    inverse_dynamics(model, data, s, u, u_dot, terms);
     const TorqueVector tau = distribute_torques(terms.J_beta, terms.Qstar, Weighting::model_weights());
     ContactForces predicted;
-    contact_forces(model, data, x.s, terms, tau, predicted);
-    for (int k = 0; k < kActuatedCount; ++k) d->ctrl[motor[static_cast<std::size_t>(k)]] = tau(k);
+    contact_forces(model, data, s, terms, tau, predicted);
+    engine.set_torques(tau);
 
-    // MuJoCo's normal force on each wheel (its contacts on the wheel's geom, from the last step).
-    std::vector<double> normal(kWheelCount, 0.0);
-    for (int c = 0; c < d->ncon; ++c) {
-      const mjContact& con = d->contact[c];
-      for (int w = 0; w < kWheelCount; ++w)
-        if (con.geom1 == wheels[static_cast<std::size_t>(w)].geom || con.geom2 == wheels[static_cast<std::size_t>(w)].geom) {
-          mjtNum f[6];
-          mj_contactForce(m, d, c, f);
-          normal[static_cast<std::size_t>(w)] += f[0];
-        }
-    }
+    // Each contact as MuJoCo has it (the forces of the last step).
+    const std::vector<cli::EngineContact> contacts = engine.contacts();
     double length = 0, angle = 0;
     for (int k = 0; k < kCommandedCount; ++k) {
       double& worst = gen::kCoordinateUnits[static_cast<std::size_t>(kCommandedSpeeds[static_cast<std::size_t>(k)])] == std::string_view("rad") ? angle : length;
@@ -284,29 +209,22 @@ int main(int argc, char** argv) try {
     }
     csv += fmt::format("{:.3f},{:.6e},{:.6e}", t, length, angle);
     for (int w = 0; w < kWheelCount; ++w) {
-      const Wheel& wheel = wheels[static_cast<std::size_t>(w)];
-      // The wheel's material point at the contact: its centre's velocity and the wheel's angular
-      // velocity (world axes, at the spinning body's origin, the centre), the point a radius below.
-      mjtNum v[6];
-      mj_objectVelocity(m, d, mjOBJ_XBODY, wheel.body, v, 0);
-      const Eigen::Vector3d omega(v[0], v[1], v[2]), centre_velocity(v[3], v[4], v[5]);
-      const Eigen::Vector3d material = centre_velocity + omega.cross(Eigen::Vector3d(0, 0, -wheel.radius));
-      const double slip = std::hypot(material.x(), material.y());
       const int contact = contact_of_wheel[static_cast<std::size_t>(w)];
-      const double wlx_normal = contact >= 0 ? predicted.normal(contact) : 0.0;
+      const double slip = contacts[static_cast<std::size_t>(contact)].slip, normal = contacts[static_cast<std::size_t>(contact)].normal;
+      const double wlx_normal = predicted.normal(contact);
       if (t >= kSettle) {
         worst_slip = std::max(worst_slip, slip);
         slip_sum += slip;
-        const double diff = std::abs(normal[static_cast<std::size_t>(w)] - wlx_normal) / weight;
+        const double diff = std::abs(normal - wlx_normal) / weight;
         force_diff_worst = std::max(force_diff_worst, diff);
         force_diff_sum += diff;
         ++samples;
       }
-      csv += fmt::format(",{:.6e},{:.6e},{:.6e}", slip, normal[static_cast<std::size_t>(w)], wlx_normal);
+      csv += fmt::format(",{:.6e},{:.6e},{:.6e}", slip, normal, wlx_normal);
     }
     csv += "\n";
     if (n < steps) {
-      mj_step(m, d);
+      engine.step();
       advance_base(t);
     }
   }

@@ -4,7 +4,7 @@
 // mass, the open tree's mass matrix (mj_fullM) and its inverse dynamics with gravity (mj_rne,
 // contacts off). Compiled once per built-in model.
 //
-// Coordinates as bench/mujoco_peer.hpp maps them, qvel = G(s) s': so M_wlx = G^T M_mj G, and
+// Coordinates as the physics engine maps them (cli/shell/physics_engine.hpp), qvel = G(s) s': so M_wlx = G^T M_mj G, and
 // Q_wlx(s, s', s'') = G^T rne(q, G s', G s'' + G' s').
 //
 // Tolerance: 1e-10 relative to the largest entry of the compared quantity. Both sides are exact
@@ -16,9 +16,10 @@
 // axis, mass or inertia shows far above it: the second test changes one inertia by 1% and sees it
 // (5e-5 relative on the wheeled quadruped's mass matrix, 5e-3 on the excavator's).
 #include "../support/random.hpp"
-#include "mujoco_peer.hpp"
-#include "open_tree.hpp"
 #include "mjcf_export.hpp"
+#include "mujoco_model.hpp"
+#include "open_tree.hpp"
+#include "physics_engine.hpp"
 
 #include <doctest/doctest.h>
 #include <fmt/format.h>
@@ -42,7 +43,6 @@
 #include <unistd.h>
 
 using namespace wlx;
-using namespace wlx::mujoco_peer;
 
 namespace {
 
@@ -62,10 +62,10 @@ struct Worst {
 };
 
 Worst compare(const std::string& xml, const std::string& description, int states) {
-  const auto model = load(xml);
+  const cli::MjModelPtr model = cli::load_mjcf(xml);
   mjModel* m = model.get();
   m->opt.disableflags |= mjDSBL_CONTACT;  // the open tree: no contact
-  const std::unique_ptr<mjData, MjDataDeleter> data(mj_makeData(m));
+  const cli::MjDataPtr data(mj_makeData(m));
   mjData* d = data.get();
   const gen::Params p{};
   Worst worst;
@@ -74,7 +74,9 @@ Worst compare(const std::string& xml, const std::string& description, int states
   for (int b = 0; b < gen::kBodyCount; ++b) mass += p.*gen::kBodyMass[static_cast<std::size_t>(b)].mass;
   worst.mass = std::abs(mj_getTotalmass(m) - mass) / mass;
 
-  const std::vector<FreeBase> bases = free_bases(description);
+  // The mapping of the description's machine (the same joints and dofs as `xml`, whose inertias
+  // the negative test changes).
+  const cli::PhysicsEngine engine(description, std::vector<std::string>(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end()));
   std::mt19937_64 rng(20261206);
   open_tree::OpenTreeWorkspace w;
   gen::FramePositions positions;
@@ -84,7 +86,7 @@ Worst compare(const std::string& xml, const std::string& description, int states
   Eigen::VectorXd rne(m->nv);
   for (int n = 0; n < states; ++n) {
     const gen::Coordinates s = test::random_coordinates(rng), sdot = test::random_rates(rng), sddot = test::random_rates(rng);
-    const Mapping map = map_state(m, bases, s, sdot);
+    const cli::EngineMapping map = engine.mapping(s, sdot);
     for (int i = 0; i < m->nq; ++i) d->qpos[i] = map.qpos(i);
     const Eigen::VectorXd qvel = map.G * sdot, qacc = map.G * sddot + map.Gdot_sdot;
     for (int i = 0; i < m->nv; ++i) {

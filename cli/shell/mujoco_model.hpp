@@ -1,0 +1,50 @@
+// MuJoCo's model of an MJCF text (MuJoCo 2.2.2, Debian's libmujoco-dev), for the code that links
+// MuJoCo: the physics engine (physics_engine.cpp), the check of the export against MuJoCo and the
+// benchmarks' MuJoCo rows. MuJoCo 2.2.2 loads XML from files only: the text goes through a private
+// temporary file, removed at once.
+#pragma once
+
+#include <wlx/error.hpp>
+
+#include <fmt/format.h>
+#include <mujoco/mujoco.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include <unistd.h>
+
+namespace wlx::cli {
+
+struct MjModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct MjDataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+using MjModelPtr = std::unique_ptr<mjModel, MjModelDeleter>;
+using MjDataPtr = std::unique_ptr<mjData, MjDataDeleter>;
+
+// Throws wlx::Error ("physics engine") for a file that cannot be written, or with MuJoCo's reason.
+inline MjModelPtr load_mjcf(const std::string& xml) {
+  char path[] = "/tmp/wlx-mjcf-XXXXXX";
+  const int fd = ::mkstemp(path);
+  if (fd < 0) throw Error("physics engine", fmt::format("cannot create a temporary file for the MJCF ({})", std::strerror(errno)));
+  const bool written = ::write(fd, xml.data(), xml.size()) == static_cast<ssize_t>(xml.size());
+  const bool closed = ::close(fd) == 0;
+  if (!written || !closed) {
+    std::remove(path);
+    throw Error("physics engine", fmt::format("cannot write the MJCF to {}", path));
+  }
+  char error[1000] = "";
+  mjModel* m = mj_loadXML(path, nullptr, error, sizeof error);
+  std::remove(path);
+  if (m == nullptr) throw Error("physics engine", fmt::format("MuJoCo refuses the exported model: {}", error));
+  return MjModelPtr(m);
+}
+
+}  // namespace wlx::cli
