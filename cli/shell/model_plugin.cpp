@@ -613,6 +613,46 @@ Description describe(const fs::path& model_file, const fs::path& scratch) {
   return description_of(read_small(out, kMaxFileBytes), "wlx-gen --describe");
 }
 
+// The generated functions' sources (WLX_PLUGIN_GENERATED_SOURCES) gathered into translation units
+// of at most kGeneratedUnitBytes of generated headers each (first fit, the largest first). Each
+// translation unit costs about 0.8 s of its own (the headers every one parses) and then about
+// 9 us per byte of generated code (clang 14, -O2): a small model's four sources compile in 2.9 s
+// as one instead of 5.0 s apart, while a large model's largest source stays alone, so that no
+// unit outlasts the runtime's (about 10 s).
+struct GeneratedUnit {
+  std::string stem;
+  std::vector<std::string> sources;
+  std::uintmax_t bytes = 0;
+};
+constexpr std::uintmax_t kGeneratedUnitBytes = 500'000;
+std::vector<GeneratedUnit> generated_units(const fs::path& runtime_sources, const fs::path& generated) {
+  // Each source's share: the generated headers it includes (`#include <wlx/gen/NAME.hpp>`, which
+  // a model may not have), by their size.
+  std::vector<std::pair<std::uintmax_t, std::string>> sized;
+  for (const auto& f : split_list(WLX_PLUGIN_GENERATED_SOURCES)) {
+    std::uintmax_t bytes = 0;
+    std::istringstream lines(read_small(runtime_sources / f, kMaxFileBytes));
+    const std::string prefix = "#include <wlx/gen/";
+    for (std::string line; std::getline(lines, line);) {
+      if (line.rfind(prefix, 0) != 0 || line.back() != '>') continue;
+      std::error_code ec;
+      const std::uintmax_t size = fs::file_size(generated / line.substr(prefix.size(), line.size() - prefix.size() - 1), ec);
+      if (!ec) bytes += size;
+    }
+    sized.emplace_back(bytes, f);
+  }
+  std::stable_sort(sized.begin(), sized.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<GeneratedUnit> units;
+  for (const auto& [size, f] : sized) {
+    const std::uintmax_t bytes = size;  // (a lambda cannot capture a structured binding in clang 14)
+    auto fits = std::find_if(units.begin(), units.end(), [&](const GeneratedUnit& u) { return u.bytes + bytes <= kGeneratedUnitBytes; });
+    if (fits == units.end()) fits = units.insert(units.end(), GeneratedUnit{fmt::format("generated_unit_{}", units.size() + 1), {}, 0});
+    fits->sources.push_back(f);
+    fits->bytes += bytes;
+  }
+  return units;  // the largest first: the longest compiles start first
+}
+
 // Generates the model's headers and compiles its plugin into `dir`.
 void build_plugin(const fs::path& model_file, const Description& description, const std::string& key, const fs::path& dir,
                   const fs::path& failed_logs) {
@@ -685,9 +725,12 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   compile("runtime", dir / "runtime_unity.cpp", "runtime_unity");
   for (const auto& f : apart) compile("runtime " + f, src.runtime_sources / f, "runtime_" + fs::path(f).stem().string());
   compile("commands", dir / "commands_unity.cpp", "commands_unity");
-  const std::vector<std::string> generated_sources = split_list(WLX_PLUGIN_GENERATED_SOURCES);
-  for (auto it = generated_sources.rbegin(); it != generated_sources.rend(); ++it)
-    compile("generated functions " + *it, src.runtime_sources / *it, fs::path(*it).stem().string());
+  for (const GeneratedUnit& unit : generated_units(src.runtime_sources, gen / "wlx" / "gen")) {
+    std::string text = "// The generated functions of " + fmt::format("{}", fmt::join(unit.sources, ", ")) + ", in one translation unit.\n";
+    for (const auto& f : unit.sources) text += include_line(src.runtime_sources / f);
+    write(dir / (unit.stem + ".cpp"), text);
+    compile("generated functions " + fmt::format("{}", fmt::join(unit.sources, " ")), dir / (unit.stem + ".cpp"), unit.stem);
+  }
   const unsigned cores = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
   const auto compiling = std::chrono::steady_clock::now();
   for (const auto& t : run_jobs(jobs, cores, failed_logs)) timings.push_back(t);
