@@ -142,7 +142,7 @@ endfunction()
 # Python's API calls, cli/shell/model_api.hpp) compiled for it, and python/module.cpp with a
 # registry that lists it, linked with the shell (wlx::cli_common).
 function(wlx_generate_python target model_name)
-  if(NOT TARGET wlx::cli_common OR NOT WLX_COMMAND_SOURCES)
+  if(NOT TARGET wlx::cli_common OR NOT WLX_MODEL_FILE_COMMAND_SOURCES)
     message(FATAL_ERROR "wlx_generate: PYTHON: this wlx was built without its command line (WLX_BUILD_CLI=OFF)")
   endif()
   if(NOT COMMAND pybind11_add_module)
@@ -150,20 +150,7 @@ function(wlx_generate_python target model_name)
     find_package(pybind11 CONFIG REQUIRED)
   endif()
   set(dir "${CMAKE_CURRENT_BINARY_DIR}/wlx_python/${target}")
-  # No embedded runs (a model file brings its runs as files), and the registry of this one model.
-  file(CONFIGURE OUTPUT "${dir}/model_${model_name}.cpp" CONTENT "// Written by wlx_generate(PYTHON). Do not edit.
-#include <string>
-#include <utility>
-#include <vector>
-namespace wlx { inline namespace ${model_name} { namespace commands {
-extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios;
-const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios = {};
-extern const char* const kEmbeddedReportFile;
-const char* const kEmbeddedReportFile = \"\";
-extern const char* const kEmbeddedDescription;
-const char* const kEmbeddedDescription = \"\";
-} } }
-")
+  # The registry of this one model (its commands embed no runs: commands/no_embedded_runs.cpp).
   file(CONFIGURE OUTPUT "${dir}/registry.cpp" CONTENT "// Written by wlx_generate(PYTHON). Do not edit.
 #include \"commands.hpp\"
 namespace wlx { inline namespace ${model_name} { namespace commands { const cli::ModelCommands& entry(); } } }
@@ -174,9 +161,9 @@ const std::vector<ModelCommands>& models() {
 }
 }  // namespace wlx::cli
 ")
-  set(sources ${WLX_COMMAND_SOURCES})
+  set(sources ${WLX_MODEL_FILE_COMMAND_SOURCES})
   list(TRANSFORM sources PREPEND "${WLX_CLI_SOURCE_DIR}/")
-  add_library(${target}_commands STATIC ${sources} "${dir}/model_${model_name}.cpp")
+  add_library(${target}_commands STATIC ${sources})
   set_target_properties(${target}_commands ${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   set_target_properties(${target}_commands PROPERTIES UNITY_BUILD ON)  # they share Eigen's templates
   target_include_directories(${target}_commands PUBLIC "${WLX_CLI_SOURCE_DIR}/commands")

@@ -684,16 +684,8 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   write(dir / "runtime_unity.cpp", runtime_unity);
   std::string commands_unity = "// The per-model commands in one translation unit (as CMake's unity build of wlx_cli_<model>).\n";
   for (const auto& f : split_list(WLX_PLUGIN_COMMAND_SOURCES)) commands_unity += include_line(src.cli / f);
-  // No embedded scenarios or report file: a model file brings its runs as files.
+  // (No embedded runs: the list ends with commands/no_embedded_runs.cpp.)
   commands_unity += fmt::format(
-      "namespace wlx {{ inline namespace {0} {{ namespace commands {{\n"
-      "extern const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios;\n"
-      "const std::vector<std::pair<std::string, std::string>> kEmbeddedScenarios = {{}};\n"
-      "extern const char* const kEmbeddedReportFile;\n"
-      "const char* const kEmbeddedReportFile = \"\";\n"
-      "extern const char* const kEmbeddedDescription;\n"
-      "const char* const kEmbeddedDescription = \"\";\n"
-      "}} }} }}\n"
       "// The entry points wlx looks up with dlsym: the commands, and the key this plugin was built for;\n"
       "// and the model's settings, from its description (model.json), which its headers leave out.\n"
       "extern \"C\" __attribute__((visibility(\"default\"))) const wlx::cli::ModelCommands* {1}(const char** key) {{\n"
