@@ -453,11 +453,19 @@ EmittedFile emit_function(const Model& m, const FunctionSpec& fn, const EmitOpti
   std::vector<OpCount> output_ops(outs.size());
   std::string body = trig.prologue;
   const auto batched = [&](std::size_t k) { return trig.names.count(plan.temporaries[k]) != 0; };
-  for (std::size_t k = 0; k < plan.temporaries.size(); ++k) {
-    if (users[k].size() < 2 || batched(k)) continue;
-    body += fmt::format("  const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], shared_ops));
-  }
+  // A temporary several outputs read is defined right before the block of the first of them, not
+  // all up front: the same operations, fewer values held at once. users[k] holds every output
+  // whose expression reaches k, through other temporaries too, so a temporary's first reader is
+  // never after the first reader of one built on it, and ascending k within a block keeps the
+  // order of dependence. (All up front, clang kept every one live across the blocks and spilled
+  // about 6 kB of stack in the wheeled quadruped's kinematic_update: 1.7x GCC's time.)
+  const auto define_shared_before = [&](std::size_t o) {
+    for (std::size_t k = 0; k < plan.temporaries.size(); ++k)
+      if (users[k].size() >= 2 && !batched(k) && static_cast<std::size_t>(*users[k].begin()) == o)
+        body += fmt::format("  const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], shared_ops));
+  };
   for (std::size_t o = 0; o < outs.size(); ++o) {
+    define_shared_before(o);
     if (o == lanes) {
       std::vector<std::string> requested;
       for (const auto& spec : fn.outputs)

@@ -560,15 +560,6 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   const Scalar t411 = t404*t409 - t410*t405;
   const Scalar t412 = t387*sin_theta_r2 - t390*cos_theta_r2;
   const Scalar t413 = t404*t412 + t410*t403;
-  const Scalar t416 = t276*t288*wl - t307*wl*t253;
-  const Scalar t418 = t87*t29 + t5*t48;
-  const Scalar t419 = theta_l6_dot*t418;
-  const Scalar t420 = theta_l5_dot*(t301*t244 - t279*t291);
-  const Scalar t421 = t419 + t96 + t420;
-  const Scalar t423 = t351*wl*t342 - t353*wl*t336;
-  const Scalar t424 = theta_r5_dot*(t346*t355 - t345*t340);
-  const Scalar t425 = -t418*theta_r6_dot;
-  const Scalar t427 = t147 + t424 + t425;
   if (dPhi_ds_dot_sdot != nullptr) {
     const Scalar t314 = t289 + t103 + t292 + t104 + t295 + t297 - (t312*t270 + t256*t313)*theta_l2_dot;
     const Scalar t318 = t300 + t306 + t116 + t302 + t308 + t119 - theta_l2_dot*(t317*t270 - t283*t313);
@@ -589,6 +580,15 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
     (*dPhi_ds_dot_sdot)(12) = t411*t405 + t412*t406 - t401*t409 - t413*t403;
     (*dPhi_ds_dot_sdot)(13) = Scalar(0.0);
   }
+  const Scalar t416 = t276*t288*wl - t307*wl*t253;
+  const Scalar t418 = t87*t29 + t5*t48;
+  const Scalar t419 = theta_l6_dot*t418;
+  const Scalar t420 = theta_l5_dot*(t301*t244 - t279*t291);
+  const Scalar t421 = t419 + t96 + t420;
+  const Scalar t423 = t351*wl*t342 - t353*wl*t336;
+  const Scalar t424 = theta_r5_dot*(t346*t355 - t345*t340);
+  const Scalar t425 = -t418*theta_r6_dot;
+  const Scalar t427 = t147 + t424 + t425;
   if (C_dot_sdot != nullptr) {
     const Scalar t414 = -Scalar(2.0)*x_C_dot;
     const Scalar t415 = -Scalar(2.0)*y_C_dot;

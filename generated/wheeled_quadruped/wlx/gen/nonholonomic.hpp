@@ -464,23 +464,6 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const Scalar t355 = t313 + t316 + t317;
   const Scalar t356 = t265*t355 + t283*(t350 + t351 + t352);
   const Scalar t357 = t264*t355 + t283*(t339 + t341 + t343);
-  const Scalar t358 = Scalar(1)/wheel_radius;
-  const Scalar t359 = t358*t14*t12;
-  const Scalar t360 = -t9*t358*t14;
-  const Scalar t361 = t9*t87*t14 + t86*t14*t12;
-  const Scalar t362 = t358*(t89*t14*t12 + t9*t90*t14);
-  const Scalar t363 = t358*t94*t96;
-  const Scalar t364 = -t358*t93*t96;
-  const Scalar t365 = -t358*(t175*t94*t96 - t93*t96*t174);
-  const Scalar t366 = -(t178*t94*t96 + t177*t93*t96)*t358;
-  const Scalar t367 = t184*t358*t181;
-  const Scalar t368 = -t184*t358*t182;
-  const Scalar t369 = t184*t257*t182 + t184*t181*t258;
-  const Scalar t370 = t184*t181*t260 + t184*t261*t182;
-  const Scalar t371 = t358*t267*t265;
-  const Scalar t372 = -t358*t264*t267;
-  const Scalar t373 = -t358*(t264*t267*t354 + t353*t267*t265);
-  const Scalar t374 = -t358*(t357*t264*t267 + t267*t265*t356);
   if (C != nullptr) {
     if (zero_fill) C->setZero();
     (*C)(0, 0) = t9*t14;
@@ -516,6 +499,23 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
     (*C)(3, 28) = -(t353*t264*t267 - t267*t265*t354);
     (*C)(3, 29) = -(t264*t267*t356 - t357*t267*t265);
   }
+  const Scalar t358 = Scalar(1)/wheel_radius;
+  const Scalar t359 = t358*t14*t12;
+  const Scalar t360 = -t9*t358*t14;
+  const Scalar t361 = t9*t87*t14 + t86*t14*t12;
+  const Scalar t362 = t358*(t89*t14*t12 + t9*t90*t14);
+  const Scalar t363 = t358*t94*t96;
+  const Scalar t364 = -t358*t93*t96;
+  const Scalar t365 = -t358*(t175*t94*t96 - t93*t96*t174);
+  const Scalar t366 = -(t178*t94*t96 + t177*t93*t96)*t358;
+  const Scalar t367 = t184*t358*t181;
+  const Scalar t368 = -t184*t358*t182;
+  const Scalar t369 = t184*t257*t182 + t184*t181*t258;
+  const Scalar t370 = t184*t181*t260 + t184*t261*t182;
+  const Scalar t371 = t358*t267*t265;
+  const Scalar t372 = -t358*t264*t267;
+  const Scalar t373 = -t358*(t264*t267*t354 + t353*t267*t265);
+  const Scalar t374 = -t358*(t357*t264*t267 + t267*t265*t356);
   if (spin != nullptr) {
     if (zero_fill) spin->setZero();
     (*spin)(0, 0) = t359;
