@@ -113,8 +113,10 @@ std::string actuator_list() {
 }  // namespace
 
 Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
-  if (v.is_number_integer() && (v == 1 || v == 2)) return v == 1 ? Weighting::model_weights() : Weighting::contribution();
-  if ((v.is_number_integer() && v == 3) || v == "contacts") return Weighting::contacts();
+  // By what they do; 1, 2 and 3 are the thesis' numbers for the same three (docs/excavator.md).
+  if (v == "model-weights" || (v.is_number_integer() && v == 1)) return Weighting::model_weights();
+  if (v == "contribution" || (v.is_number_integer() && v == 2)) return Weighting::contribution();
+  if (v == "contacts" || (v.is_number_integer() && v == 3)) return Weighting::contacts();
   if (v.is_object() && v.size() == 1 && v.contains("diag")) {
     const auto& d = v.at("diag");
     if (!d.is_array() || d.size() != static_cast<std::size_t>(kActuatedCount))
@@ -150,7 +152,8 @@ Weighting parse_weighting(const nlohmann::json& v, const std::string& key) {
       throw Error(key + ".matrix", e.reason());
     }
   }
-  throw Error(key, fmt::format("must be 1, 2, 3 (\"contacts\"), {{\"diag\": [{0} weights]}} or {{\"matrix\": [[{0} x {0}]]}}, got {1}",
+  throw Error(key, fmt::format("must be \"model-weights\" (or 1), \"contribution\" (2), \"contacts\" (3), {{\"diag\": [{0} weights]}} "
+                               "or {{\"matrix\": [[{0} x {0}]]}}, got {1}",
                                kActuatedCount, excerpt(v)));
 }
 

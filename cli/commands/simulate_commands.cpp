@@ -132,11 +132,12 @@ int run_simulate(const ModelOptions& model_options, const SimulateOptions& o) {
     sc.tolerance = *o.tolerance;
   }
   if (!o.weighting.empty()) {
-    if (o.weighting != "1" && o.weighting != "2" && o.weighting != "3")
-      throw Error("--weighting", fmt::format("must be 1, 2 or 3, got '{}'", excerpt(o.weighting)));
-    sc.weighting = o.weighting == "1"   ? Weighting::model_weights()
-                   : o.weighting == "2" ? Weighting::contribution()
-                                        : Weighting::contacts();
+    const std::string& w = o.weighting;
+    if (w != "model-weights" && w != "contribution" && w != "contacts" && w != "1" && w != "2" && w != "3")
+      throw Error("--weighting", fmt::format("must be model-weights, contribution or contacts (or the thesis' 1, 2, 3), got '{}'", excerpt(w)));
+    sc.weighting = w == "model-weights" || w == "1" ? Weighting::model_weights()
+                   : w == "contribution" || w == "2" ? Weighting::contribution()
+                                                     : Weighting::contacts();
   }
   sc.validate();
   prepare_out_dir("--out", o.out_dir);

@@ -164,18 +164,19 @@ class Model:
         return self._m.dependent_rates(_np.asarray(s, dtype=float), _np.asarray(rates, dtype=float),
                                        list(dependent or []), _params_json(params))
 
-    def inverse_dynamics(self, s, u, u_dot=None, params=None, weighting=1):
+    def inverse_dynamics(self, s, u, u_dot=None, params=None, weighting="model-weights"):
         """Q* and the actuator torques at s for the commanded speeds u and their rates u_dot
         (default 0), in the order of `commanded` (the model file's dynamics section); tau is in the
-        order of `actuators`; `weighting` as in scenario files (1, 2, 3 or "contacts": the torques
-        that keep the machine on its contacts, {"diag": [...]}, {"matrix": [[...]]}). For a model
+        order of `actuators`; `weighting` as in scenario files ("model-weights": the model file's,
+        "contribution", "contacts": the torques that keep the machine on its contacts, the thesis'
+        1, 2, 3 for the same, {"diag": [...]}, {"matrix": [[...]]}). For a model
         with contacts also "contact_force" and "contact_point" (one row per contact, in the order
         of `contacts`, K0, N and m), "friction_margin" (mu f_n - |f_t|, N) and "margins" (static
         and zero-moment-point margins in m, the force-angle margin in rad).
 
         s, u and u_dot may also be arrays of rows, one state a row (N x coordinates, N x commanded):
         then the result is {"tau": N x actuators, "Qstar": N x commanded}, computed in one call
-        (weighting 1, 2, {"diag": ...} or {"matrix": ...}; the contacts' weighting solves an
+        (any weighting but "contacts", which solves an
         optimisation per state, so goes state by state)."""
         s = _np.asarray(s, dtype=float)
         if u_dot is None:

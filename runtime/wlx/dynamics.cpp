@@ -148,11 +148,11 @@ double kinetic_energy(const Model& model, Data& d, const Coordinates& s, const C
 
 std::string Weighting::label() const {
   switch (kind) {
-    case Kind::model_weights: return "weighting 1 (the model file's weights)";
-    case Kind::contribution: return "weighting 2 (contribution)";
+    case Kind::model_weights: return "the model file's weights";
+    case Kind::contribution: return "weights by contribution";
     case Kind::diagonal: return "diagonal weights";
     case Kind::matrix: return "weight matrix";
-    case Kind::contacts: return "weighting 3 (keeps the contacts)";
+    case Kind::contacts: return "the weights that keep the contacts";
   }
   return {};
 }
@@ -561,8 +561,8 @@ TorqueVector distribute_torques(const ActuatorJacobian& J_beta, const CommandVec
   // weight matrix (out of line below: its 8 x 8 products cost more than the QR).
   if (weighting.kind == Weighting::Kind::matrix) return distribute_torques_weight_matrix(J_beta, Qstar, weighting);
   if (weighting.kind == Weighting::Kind::contacts)
-    throw Error("weighting", "weighting 3 (keeps the contacts) needs the step's contact forces: distribute_torques_on_contacts "
-                             "(contacts.hpp) computes it");
+    throw Error("weighting", "the weights that keep the contacts need the step's contact forces: distribute_torques_on_contacts "
+                             "(contacts.hpp) computes them");
   TorqueVector S;
   switch (weighting.kind) {
     case Weighting::Kind::model_weights: {

@@ -314,13 +314,19 @@ TEST_CASE("cli: wlx simulate ID-1 --weighting 2 adds the torque and Q* columns")
   fs::remove_all(dir);
   const Run r = run_wlx("simulate ID-1 --weighting 2 --out " + dir.string());
   CHECK(r.code == 0);
-  CHECK(r.out.find("inverse dynamics with weighting 2 (contribution)") != std::string::npos);
+  CHECK(r.out.find("inverse dynamics with weights by contribution") != std::string::npos);
   const std::string csv = slurp(dir / "trajectory.csv");
   const std::string header = csv.substr(0, csv.find('\n'));
   CHECK(header.find(",tau_psi_l2,tau_psi_l3,tau_psi_l4,tau_psi_r2,tau_psi_r3,tau_psi_r4,tau_theta_l6,tau_theta_r6,"
                     "Qstar_z_C,Qstar_x_C,Qstar_roll,Qstar_pitch") != std::string::npos);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 495);
-  CHECK(run_wlx("simulate ID-1 --weighting 4 --out " + dir.string()).err == "wlx: error: --weighting: must be 1, 2 or 3, got '4'\n");
+  CHECK(run_wlx("simulate ID-1 --weighting 4 --out " + dir.string()).err ==
+        "wlx: error: --weighting: must be model-weights, contribution or contacts (or the thesis' 1, 2, 3), got '4'\n");
+  // By name, the same run as by the thesis' number: the same torques to the last digit.
+  const fs::path named = fs::temp_directory_path() / "wlx_cli_test" / "id1-named";
+  fs::remove_all(named);
+  CHECK(run_wlx("simulate ID-1 --weighting contribution --out " + named.string()).code == 0);
+  CHECK(slurp(named / "trajectory.csv") == csv);
 }
 
 #ifdef WLX_BUILT_MODEL_wheeled_quadruped  // not in the sanitized tree
@@ -406,7 +412,7 @@ TEST_CASE("cli: every validation rule names the field, the value and the rule, w
        "duration: must be a positive number of seconds, got 0"},
       {"simulate FILE", "", R"({"dependent": ["y_C", "yaw"], "duration": 1e6, "dt": 1e-6})",
        "dt: 1e-06 s over 1000000 s is 1e+12 steps, more than the limit of 1e8"},
-      {"simulate FILE", "", "{" + ok + R"(, "weighting": 4})", "weighting: must be 1, 2, 3 (\"contacts\"), {\"diag\": [8 weights]} or"},
+      {"simulate FILE", "", "{" + ok + R"(, "weighting": 4})", "weighting: must be \"model-weights\" (or 1), \"contribution\" (2), \"contacts\" (3), {\"diag\": [8 weights]} or"},
       {"simulate FILE", "", "{" + ok + R"(, "weighting": {"diag": [1, 1, 1, 1, 1, 1, 1, 0]}})",
        "weighting.diag: a weight must be positive and finite, got 0"},
       {"simulate FILE", "", "{" + ok + R"(, "weighting": 1, "rates": {"theta_l5": 0.1}})",

@@ -392,7 +392,7 @@ TEST_CASE("dynamics: a rank-deficient J_beta and bad weights are clear errors; z
   ActuatorJacobian J = ActuatorJacobian::Zero();
   J(0, 0) = J(1, 1) = J(2, 2) = 1;  // nothing acts on pitch
   CHECK_THROWS_WITH_AS(distribute_torques(J, CommandVector(1, 2, 3, 4), Weighting::model_weights()),
-                       "J_beta: the actuator Jacobian has rank 3 < 4 with weighting 1 (the model file's weights): the 8 actuators "
+                       "J_beta: the actuator Jacobian has rank 3 < 4 with the model file's weights: the 8 actuators "
                        "cannot produce every generalized force on u = [z_C', x_C', roll', pitch'] in this pose: the speeds "
                        "1 pitch' move no actuator (wheels that roll freely, a joint that is not actuated): actuate a "
                        "joint they move or drive the wheels ({wheel: NAME} under dynamics.actuated), or command fewer speeds",
