@@ -383,7 +383,7 @@ class Figures {
 
   // The round trips' deviations in one figure, over time on a log axis (they span orders of
   // magnitude); the closed loops' signed tracking errors per commanded coordinate (mm, deg), one
-  // panel per motion (weighting 1; the table has both).
+  // panel per motion (the model file's weights; the table has every weighting).
   void forward(std::vector<FigureSpec>& trips, std::vector<FigureSpec>& loops) {
     const auto& rows = runner_.forward();
     if (rows.empty()) return;

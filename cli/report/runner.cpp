@@ -169,7 +169,7 @@ std::vector<std::string> ReportRunner::selected_scenarios() const {
 
 int ReportRunner::steps() const {
   int n = static_cast<int>(selected_sweeps().size());
-  // Each weighting's run, the forward dynamics of weightings 1 and 2, and weighting 1's in a physics engine.
+  // Each weighting's run, the forward dynamics of model-weights' and contribution's, and model-weights' in a physics engine.
   for (const auto& id : selected_scenarios()) n += is_dynamics(id) ? static_cast<int>(weighting_variants(id).size()) + 3 : 1;
   if (!quick_ && !spec_.integrator_scenarios.empty()) ++n;
   return n;
@@ -209,7 +209,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
   }
   const std::size_t inverse_runs = runs_.size();
   for (std::size_t k = 0; k < inverse_runs; ++k) {
-    // Forward dynamics for weightings 1 and 2 (weighting 3's torques retrace the same motion).
+    // Forward dynamics for model-weights and contribution (the contacts' torques retrace the same motion).
     if (!runs_[k].scenario.weighting || runs_[k].scenario.weighting->kind == Weighting::Kind::contacts) continue;
     if (runs_[k].stopped) {
       // Both follow the run's whole motion (its torques from 0 to its duration, its path as the
@@ -224,7 +224,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
     progress_(fmt::format("forward dynamics of {}: its torques fed back, and a controller tracking it on a heavier plant", runs_[k].id));
     forward_.push_back(forward_dynamics_of(runs_[k], data_dir));
   }
-  // The physics engine: weighting 1's run of each scenario (the controller's own split).
+  // The physics engine: each scenario's run under the model file's weights (the controller's own split).
   engine_missing_ = physics_engine_missing();
   if (engine_missing_.empty() && description_text().empty()) engine_missing_ = "the model's description is not loaded";
   for (std::size_t k = 0; k < inverse_runs; ++k) {

@@ -328,7 +328,7 @@ ContactDistribution distribute_torques_on_contacts(const Model& model, Data& d, 
   } else {
     constexpr int kA = kActuatedCount, kU = kCommandedCount, kK = kA - kU;  // kK: the torques' free directions
     const double weight = model.total_mass() * (model.params().*gen::kGravity);
-    // tau = tau_1 + scale N z: weighting 1's torques plus the null space of J_beta^T (the last
+    // tau = tau_1 + scale N z: the model file's weights' torques plus the null space of J_beta^T (the last
     // columns of a full QR of J_beta), scaled so z is of order one.
     const TorqueVector tau_1 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::model_weights());
     const Eigen::Matrix<double, kA, kK> N = numerics::left_null_space(terms.J_beta);

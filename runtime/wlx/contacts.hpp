@@ -104,7 +104,7 @@ double smallest_contact_margin(const Model& model, const ContactForces& forces);
 
 // The torque distribution that keeps the machine on its contacts (Weighting::contacts(), "weighting
 // 3"): among the torques that produce Q*, those that maximise smallest_contact_margin() within the
-// actuators' limits (gen::kTorqueLimits), ties broken by the least change from weighting 1's
+// actuators' limits (gen::kTorqueLimits), ties broken by the least change from the model file's weights'
 // torques (a penalty of `regularization` times that change squared, in units of the largest of
 // those torques). The friction cones enter as tangent planes added where the solution leaves them
 // (a cutting-plane loop of small quadratic programmes, numerics.hpp) until every cone holds to
