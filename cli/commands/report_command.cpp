@@ -341,13 +341,13 @@ report::Section Report::engine_section(const ReportFigures& figures) const {
       "place MuJoCo's state: a finding about the controller on MuJoCo's machine, which is not the model, so it does not fail "
       "the report.",
       kTrackingKp, kTrackingKd, kEngineSettle, kEngineLostLength, kEngineLostAngle * kDegPerRad);
-  report::Table t{{"run", "result", "steps", "max tracking error (mm / deg)", "second half (mm / deg)", "slip, mean / max (mm/s)",
+  report::Table t{{"run", "result", "samples (1 ms)", "max tracking error (mm / deg)", "second half (mm / deg)", "slip, mean / max (mm/s)",
                    "|normal force difference| / weight, mean / max", "CSV"},
                   {}};
   for (const EngineRow& r : runner_.engine())
     t.rows.push_back({{r.id},
                       {r.stopped ? r.stopped->describe() : "complete"},
-                      {std::to_string(r.steps)},
+                      {std::to_string(r.samples)},
                       {fmt::format("{:.3g} / {:.3g}", 1e3 * r.length_error, kDegPerRad * r.angle_error)},
                       {fmt::format("{:.3g} / {:.3g}", 1e3 * r.late_length_error, kDegPerRad * r.late_angle_error)},
                       {fmt::format("{:.3g} / {:.3g}", 1e3 * r.mean_slip, 1e3 * r.max_slip)},

@@ -449,7 +449,7 @@ class Figures {
   // normal force, MuJoCo's against the model's for the same torques.
   void engine(std::vector<FigureSpec>& out) {
     for (const EngineRow& r : runner_.engine()) {
-      const std::string why = not_drawn(r.id + " in the physics engine", static_cast<std::size_t>(r.steps + 1), r.stopped);
+      const std::string why = not_drawn(r.id + " in the physics engine", static_cast<std::size_t>(r.samples), r.stopped);
       if (!why.empty()) {
         out.push_back(omitted("engine-" + r.id, r.id + " in the physics engine", {why}));
         continue;

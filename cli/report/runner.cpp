@@ -227,6 +227,7 @@ void ReportRunner::run_all(const std::string& data_dir) {
   // The physics engine: each scenario's run under the model file's weights (the controller's own split).
   engine_missing_ = physics_engine_missing();
   if (engine_missing_.empty() && description_text().empty()) engine_missing_ = "the model's description is not loaded";
+  if (engine_missing_.empty() && kContactCount == 0) engine_missing_ = "the model has no contacts with the ground";
   for (std::size_t k = 0; k < inverse_runs; ++k) {
     const ReportRun& run = runs_[k];
     if (!run.scenario.weighting || run.scenario.weighting->kind != Weighting::Kind::model_weights) continue;
@@ -235,7 +236,14 @@ void ReportRunner::run_all(const std::string& data_dir) {
       continue;
     }
     progress_(fmt::format("{} in a physics engine: the controller drives MuJoCo's machine", run.id));
-    engine_.push_back(physics_engine_of(run, data_dir));
+    try {
+      engine_.push_back(physics_engine_of(run, data_dir));
+    } catch (const Error& e) {  // MuJoCo's machine could not be made (what the export cannot express): a row that says so
+      EngineRow row;
+      row.id = run.id;
+      row.stopped = Stop{0, std::string("no machine in MuJoCo: ") + e.what()};
+      engine_.push_back(row);
+    }
   }
   if (!quick_ && !spec_.integrator_scenarios.empty()) {
     progress_(fmt::format("comparing integrators: Euler, RK4, dopri5 against RK4 at {:g} s on {} runs", spec_.reference_step,
@@ -382,7 +390,13 @@ EngineRow ReportRunner::physics_engine_of(const ReportRun& run, const std::strin
   EngineRow row;
   row.id = run.id;
   row.csv = run.id + "-mujoco.csv";
-  PhysicsEngine engine(description_text(), std::vector<std::string>(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end()));
+  // MuJoCo's machine at the run's parameters (the report's --params, the scenario's own): the
+  // description's values replaced by them.
+  nlohmann::json description = nlohmann::json::parse(description_text());
+  Params params = run.scenario.params;
+  for (nlohmann::json& parameter : description.at("parameters"))
+    if (const double* value = find_param(params, parameter.at("name").get<std::string>())) parameter["value"] = *value;
+  PhysicsEngine engine(description.dump(), std::vector<std::string>(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end()));
   // The run's start and speeds; the controller's split is the run's.
   Coordinates s = run.trajectory.samples.front().s, sdot = run.trajectory.samples.front().sdot;
   engine.set_state(s, sdot);
@@ -438,11 +452,26 @@ EngineRow ReportRunner::physics_engine_of(const ReportRun& run, const std::strin
                        kEngineLostLength, kEngineLostAngle * kDegPerRad));
       break;
     }
+    if (const std::string trouble = engine.trouble(); !trouble.empty()) {
+      stop(trouble);
+      break;
+    }
+    // The controller, and the model's contact forces for the torques MuJoCo applies (within the
+    // motors' ranges, which it clamps to).
     const CommandVector u_dot = kTrackingKd * (u_ref - u) + kTrackingKp * (q_ref - q);
-    inverse_dynamics(model_, data_, s, u, u_dot, terms);
-    const TorqueVector tau = distribute_torques(terms.J_beta, terms.Qstar, weighting);
-    contact_forces(model_, data_, s, terms, tau, predicted);
-    engine.set_torques(tau);
+    TorqueVector applied;
+    try {
+      inverse_dynamics(model_, data_, s, u, u_dot, terms);
+      applied = engine.set_torques(distribute_torques(terms.J_beta, terms.Qstar, weighting));
+      contact_forces(model_, data_, s, terms, applied, predicted);
+    } catch (const Error& e) {
+      stop(std::string("the controller at MuJoCo's state: ") + e.what());
+      break;
+    }
+    if (!applied.allFinite() || !predicted.normal.allFinite()) {
+      stop("the controller's torques or the model's contact forces at MuJoCo's state are not finite");
+      break;
+    }
     const std::vector<EngineContact> contacts = engine.contacts();
     row.length_error = std::max(row.length_error, length);
     row.angle_error = std::max(row.angle_error, angle);
@@ -454,8 +483,9 @@ EngineRow ReportRunner::physics_engine_of(const ReportRun& run, const std::strin
     for (int c = 0; c < kContactCount; ++c) {
       const EngineContact& e = contacts[static_cast<std::size_t>(c)];
       values.insert(values.end(), {e.slip, e.normal, predicted.normal(c)});
+      // Without weight (gravity 0) the forces have no scale to compare at: slip only.
       if (t < kEngineSettle || !gen::kContacts[static_cast<std::size_t>(c)].supports) continue;
-      const double difference = std::abs(e.normal - predicted.normal(c)) / weight;
+      const double difference = weight > 0 ? std::abs(e.normal - predicted.normal(c)) / weight : 0.0;
       row.max_slip = std::max(row.max_slip, e.slip);
       row.max_force_difference = std::max(row.max_force_difference, difference);
       slip_sum += e.slip;
@@ -463,7 +493,7 @@ EngineRow ReportRunner::physics_engine_of(const ReportRun& run, const std::strin
       ++settled;
     }
     csv.row(values);
-    row.steps = n;
+    ++row.samples;
     if (n < steps) engine.step();
   }
   csv.commit();

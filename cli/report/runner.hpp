@@ -91,7 +91,7 @@ struct EngineRow {
   // Set: the machine left its reference, or MuJoCo's state the model's reach or finite numbers.
   // Not one of the report's stopped simulations: MuJoCo's machine is not the model.
   std::optional<Stop> stopped;
-  long steps = 0;
+  long samples = 0;  // rows of the CSV: one per MuJoCo step reached, t = 0 included
   // max |q_ref - q| over the commanded lengths (m) and angles (rad): over the run, and its second half
   double length_error = 0, angle_error = 0, late_length_error = 0, late_angle_error = 0;
   // After the contacts settle (kEngineSettle): each contact's slip (m/s), mean and largest, and

@@ -36,27 +36,33 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
   return it == names.end() ? -1 : static_cast<int>(it - names.begin());
 }
 
-// The frames MuJoCo moves by a free joint: a frame under K0 whose chain is three slides along x,
-// y, z and three rotations (as mjcf_export.cpp decides).
-std::vector<FreeBase> read_free_bases(const Json& d, const std::vector<std::string>& coordinates) {
+// The frames MuJoCo moves by a free joint (the export decides which: a free joint named as the
+// frame) with their coordinates, from the frames' chains: slides along x, y, z, then three turns.
+std::vector<FreeBase> read_free_bases(const Json& d, const std::vector<std::string>& coordinates, const mjModel* m) {
   std::vector<FreeBase> bases;
   for (const Json& f : d.at("frames")) {
-    if (!f.contains("chain") || f.at("parent") != "K0" || f.at("chain").size() != 6) continue;
+    const std::string name = f.at("name");
+    const int joint = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+    if (joint < 0 || m->jnt_type[joint] != mjJNT_FREE) continue;
+    const auto refuse = [&](const std::string& why) {
+      return Error("frames", fmt::format("frame {}: MuJoCo moves it by a free joint, but {}", name, why));
+    };
+    if (!f.contains("chain") || f.at("chain").size() != 6) throw refuse("its chain is not six steps");
     FreeBase b;
-    b.frame = f.at("name");
-    bool free = true;
-    for (std::size_t i = 0; i < 6 && free; ++i) {
+    b.frame = name;
+    for (std::size_t i = 0; i < 6; ++i) {
       const Json& step = f.at("chain")[i];
       const char* kind = i < 3 ? "prismatic" : "revolute";
-      free = step.contains(kind) && step.contains("coordinate");
-      if (!free) break;
+      if (!step.contains(kind) || !step.contains("coordinate")) throw refuse(fmt::format("its step {} is not a {} joint", i + 1, kind));
       const int c = index_of(coordinates, step.at("coordinate"));
-      if (c < 0) throw Error("frames", fmt::format("frame {}: coordinate {} is not the model's", b.frame, step.at("coordinate").dump()));
+      if (c < 0) throw refuse(fmt::format("its coordinate {} is not the model's", step.at("coordinate").dump()));
       const std::string axis = step.at(kind);
+      const int a = axis == "x" ? 0 : axis == "y" ? 1 : axis == "z" ? 2 : -1;
+      if (a < 0 || (i < 3 && a != static_cast<int>(i))) throw refuse(fmt::format("its step {} is along '{}'", i + 1, axis));
       (i < 3 ? b.position : b.angle)[i % 3] = c;
-      if (i >= 3) b.axis[i - 3] = axis == "x" ? 0 : axis == "y" ? 1 : 2;
+      if (i >= 3) b.axis[i - 3] = a;
     }
-    if (free) bases.push_back(b);
+    bases.push_back(b);
   }
   return bases;
 }
@@ -85,6 +91,7 @@ struct PhysicsEngine::Impl {
   std::vector<std::string> contact_names;
   std::vector<int> contact_geoms;  // per contact: its geom
   std::vector<int> spin_joints;    // the wheels' spinning joints
+  int ground = -1;                 // the ground plane's geom
 
   const FreeBase& base_of(int joint) const {
     const std::string name = mj_id2name(m.get(), mjOBJ_JOINT, joint);
@@ -145,7 +152,7 @@ PhysicsEngine::PhysicsEngine(const std::string& description_json, const std::vec
   if (!e.d) throw Error("physics engine", "MuJoCo could not allocate its data");
   e.coordinates = coordinates;
   const Json d = parse_json_bounded(description_json, "model.json");
-  e.bases = read_free_bases(d, coordinates);
+  e.bases = read_free_bases(d, coordinates, e.m.get());
   for (int j = 0; j < e.m->njnt; ++j) {
     const char* name = mj_id2name(e.m.get(), mjOBJ_JOINT, j);
     e.joint_coordinate.push_back(e.m->jnt_type[j] == mjJNT_FREE || name == nullptr ? -1 : index_of(coordinates, name));
@@ -159,8 +166,13 @@ PhysicsEngine::PhysicsEngine(const std::string& description_json, const std::vec
   // A wheel on a hub spins in a body of its own, spin_<wheel>, about the body's one hinge.
   for (const Json& w : d.at("wheels")) {
     const int body = mj_name2id(e.m.get(), mjOBJ_BODY, ("spin_" + w.at("name").get<std::string>()).c_str());
-    if (body >= 0 && e.m->body_jntnum[body] == 1) e.spin_joints.push_back(e.m->body_jntadr[body]);
+    if (body >= 0 && e.m->body_jntnum[body] == 1) {
+      e.spin_joints.push_back(e.m->body_jntadr[body]);
+      e.joint_coordinate[static_cast<std::size_t>(e.m->body_jntadr[body])] = -1;  // whatever its name: no coordinate
+    }
   }
+  e.ground = mj_name2id(e.m.get(), mjOBJ_GEOM, "ground");
+  if (e.ground < 0) throw Error("physics engine", "the exported model has no ground plane");
   for (const Json& c : d.at("contacts")) {
     const std::string name = c.at("name"), frame = c.at("frame");
     const int geom = mj_name2id(e.m.get(), mjOBJ_GEOM, frame.c_str());
@@ -249,14 +261,29 @@ void PhysicsEngine::read_state(Eigen::Ref<Eigen::VectorXd> s, Eigen::Ref<Eigen::
     if (!G.col(k).isZero()) sdot(k) = rates(k);
 }
 
-void PhysicsEngine::set_torques(const Eigen::Ref<const Eigen::VectorXd>& tau) {
+Eigen::VectorXd PhysicsEngine::set_torques(const Eigen::Ref<const Eigen::VectorXd>& tau) {
   const Impl& e = *impl_;
   if (tau.size() != static_cast<Eigen::Index>(e.motors.size()))
     throw Error("tau", fmt::format("{} values for {} actuators", tau.size(), e.motors.size()));
-  for (std::size_t k = 0; k < e.motors.size(); ++k) e.d->ctrl[e.motors[k]] = tau(static_cast<Eigen::Index>(k));
+  Eigen::VectorXd applied = tau;
+  for (std::size_t k = 0; k < e.motors.size(); ++k) {
+    const int id = e.motors[k];
+    double& value = applied(static_cast<Eigen::Index>(k));
+    if (e.m->actuator_ctrllimited[id]) value = std::clamp(value, e.m->actuator_ctrlrange[2 * id], e.m->actuator_ctrlrange[2 * id + 1]);
+    e.d->ctrl[id] = value;
+  }
+  return applied;
 }
 
 void PhysicsEngine::step() { mj_step(impl_->m.get(), impl_->d.get()); }
+
+std::string PhysicsEngine::trouble() const {
+  const mjData* d = impl_->d.get();
+  for (const auto& [warning, what] : {std::pair{mjWARN_BADQACC, "accelerations"}, std::pair{mjWARN_BADQVEL, "velocities"},
+                                      std::pair{mjWARN_BADQPOS, "positions"}})
+    if (d->warning[warning].number > 0) return fmt::format("MuJoCo's simulation met {} that were not finite and reset itself", what);
+  return {};
+}
 
 std::vector<EngineContact> PhysicsEngine::contacts() const {
   const Impl& e = *impl_;
@@ -268,7 +295,7 @@ std::vector<EngineContact> PhysicsEngine::contacts() const {
     EngineContact c{e.contact_names[k], 0, 0};
     for (int i = 0; i < d->ncon; ++i) {
       const mjContact& con = d->contact[i];
-      if (con.geom1 != geom && con.geom2 != geom) continue;
+      if (!((con.geom1 == geom && con.geom2 == e.ground) || (con.geom2 == geom && con.geom1 == e.ground))) continue;  // the ground's force only
       mjtNum f[6];
       mj_contactForce(m, d, i, f);
       c.normal += f[0] * std::abs(con.frame[2]);  // the normal's part along z: the plane's is z itself
@@ -303,8 +330,9 @@ const std::vector<EngineFreeBase>& PhysicsEngine::free_bases() const {
 double PhysicsEngine::time() const { return 0; }
 void PhysicsEngine::set_state(const Eigen::Ref<const Eigen::VectorXd>&, const Eigen::Ref<const Eigen::VectorXd>&) {}
 void PhysicsEngine::read_state(Eigen::Ref<Eigen::VectorXd>, Eigen::Ref<Eigen::VectorXd>) const {}
-void PhysicsEngine::set_torques(const Eigen::Ref<const Eigen::VectorXd>&) {}
+Eigen::VectorXd PhysicsEngine::set_torques(const Eigen::Ref<const Eigen::VectorXd>& tau) { return tau; }
 void PhysicsEngine::step() {}
+std::string PhysicsEngine::trouble() const { return physics_engine_missing(); }
 std::vector<EngineContact> PhysicsEngine::contacts() const { return {}; }
 
 }  // namespace wlx::cli

@@ -65,13 +65,19 @@ class PhysicsEngine {
   // Sets the machine to wlx's state, at rest in the wheels' spins but for rolling: each spinning
   // wheel turns so that its lowest point moves as little as it can sideways and forward.
   void set_state(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot);
-  // MuJoCo's state in wlx's coordinates, where the tree has them (the floating base's Z-Y-X
-  // angles, the joints); the other entries of s and sdot are left as they are. The rates by least
-  // squares on qvel = G s' (a wheel's spin is no coordinate of wlx's).
+  // MuJoCo's state in wlx's coordinates, where the tree has them (the floating base's angles, the
+  // joints); the other entries of s and sdot are left as they are, and the base's angles are read
+  // as the nearest to those in s (no jump of 2 pi). The rates by least squares on qvel = G s' (a
+  // wheel's spin is no coordinate of wlx's).
   void read_state(Eigen::Ref<Eigen::VectorXd> s, Eigen::Ref<Eigen::VectorXd> sdot) const;
   // Each actuator's torque or force (the description's `actuated`, in order) until the next call.
-  void set_torques(const Eigen::Ref<const Eigen::VectorXd>& tau);
+  // Returns what MuJoCo applies: tau within each motor's range (the export's `ctrlrange`, from the
+  // model's torque limits), which MuJoCo clamps to.
+  Eigen::VectorXd set_torques(const Eigen::Ref<const Eigen::VectorXd>& tau);
   void step();
+  // Why MuJoCo's simulation can no longer be trusted (it met accelerations or a state that were not
+  // finite and reset itself, as MuJoCo does then), or empty.
+  std::string trouble() const;
   // The contacts now (the forces of the last step).
   std::vector<EngineContact> contacts() const;
 
