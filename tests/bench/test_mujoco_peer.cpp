@@ -35,6 +35,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
@@ -181,4 +182,90 @@ TEST_CASE("The MuJoCo check sees the heaviest body's inertia changed by 1% in th
   // Far outside the tolerance the first test holds (1e-10): the check fails on such a file.
   CHECK(worst.mass_matrix > 1e3 * kRelativeTolerance);
   CHECK(worst.torques > 1e3 * kRelativeTolerance);
+}
+
+// The physics engine's way back (cli/shell/physics_engine.hpp), which the report's "In a physics
+// engine" reads MuJoCo's state by: a state set into MuJoCo reads back as the same coordinates and
+// rates where the tree has them, to rounding, the floating base's angles whatever their axes'
+// order and near the angles the caller had (no jump of 2 pi); the other entries are left alone.
+namespace {
+
+struct RoundTrip {
+  double s = 0, sdot = 0;
+  int tree = 0;
+};
+
+RoundTrip engine_round_trip(const std::string& description, int states) {
+  const cli::PhysicsEngine engine(description, std::vector<std::string>(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end()));
+  cli::PhysicsEngine writable(description, std::vector<std::string>(gen::kCoordinateNames.begin(), gen::kCoordinateNames.end()));
+  std::mt19937_64 rng(20261207);
+  std::uniform_real_distribution<double> middle(-1.4, 1.4);  // the base's second angle: R's Euler angles are unique within +-pi/2
+  constexpr double kSentinel = 1234.5;
+  double worst_s = 0, worst_sdot = 0;
+  int tree = 0;
+  for (int n = 0; n < states; ++n) {
+    gen::Coordinates s = test::random_coordinates(rng);
+    const gen::Coordinates sdot = test::random_rates(rng);
+    for (const cli::EngineFreeBase& b : engine.free_bases()) s(b.angle[1]) = middle(rng);
+    writable.set_state(s, sdot);
+    const cli::EngineMapping map = engine.mapping(s, sdot);
+    // What the caller had: the sentinel off the tree; on it, each base angle 2 pi away (plus a
+    // little), which the reading must follow.
+    gen::Coordinates read = gen::Coordinates::Constant(kSentinel), read_rates = gen::Coordinates::Constant(kSentinel);
+    gen::Coordinates expected = s;
+    for (int k = 0; k < gen::kCoordinateCount; ++k)
+      if (!map.G.col(k).isZero()) read(k) = s(k);
+    for (const cli::EngineFreeBase& b : engine.free_bases())
+      for (int a : b.angle) {
+        read(a) = s(a) + 2 * std::numbers::pi + 0.1;
+        expected(a) = s(a) + 2 * std::numbers::pi;
+      }
+    writable.read_state(read, read_rates);
+    tree = 0;
+    for (int k = 0; k < gen::kCoordinateCount; ++k) {
+      CAPTURE(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+      if (map.G.col(k).isZero()) {  // no coordinate of MuJoCo's: left alone
+        CHECK(read(k) == kSentinel);
+        CHECK(read_rates(k) == kSentinel);
+        continue;
+      }
+      ++tree;
+      worst_s = std::max(worst_s, std::abs(read(k) - expected(k)));
+      worst_sdot = std::max(worst_sdot, std::abs(read_rates(k) - sdot(k)));
+    }
+  }
+  return {worst_s, worst_sdot, tree};
+}
+
+}  // namespace
+
+TEST_CASE("The physics engine reads a state it was given back as the model's coordinates and rates") {
+  const RoundTrip r = engine_round_trip(description_text(), 200);
+  MESSAGE(gen::kModelName << ": " << r.tree << " coordinates of the tree; worst |s - s_read| " << r.s << ", |s' - s'_read| " << r.sdot);
+  CHECK(r.tree > 0);
+  // Rounding: quaternions and their angles back (a few ulp of pi), least squares on G (rates of 2).
+  CHECK(r.s <= 1e-12);
+  CHECK(r.sdot <= 1e-11);
+}
+
+// The same for a floating base whose three rotations come in each of the six orders of x, y, z
+// (the model's base with its chain's axes permuted): the angles of R = R_a R_b R_c read back for
+// every order, not only the models' own.
+TEST_CASE("The physics engine reads a floating base's angles back for every order of its axes") {
+  nlohmann::json d = nlohmann::json::parse(description_text());
+  nlohmann::json* base = nullptr;
+  for (auto& f : d["frames"])
+    if (f.contains("chain") && f["parent"] == "K0" && f["chain"].size() == 6 && f["chain"][3].contains("revolute")) base = &f;
+  if (base == nullptr) return;  // a fixed base: nothing to permute
+  std::array<std::string, 3> axes{"x", "y", "z"};
+  int orders = 0;
+  do {
+    for (std::size_t i = 0; i < 3; ++i) (*base)["chain"][3 + i]["revolute"] = axes[i];
+    const RoundTrip r = engine_round_trip(d.dump(), 50);
+    CAPTURE(axes[0] + axes[1] + axes[2]);
+    CHECK(r.s <= 1e-12);
+    CHECK(r.sdot <= 1e-11);
+    ++orders;
+  } while (std::next_permutation(axes.begin(), axes.end()));
+  CHECK(orders == 6);
 }
