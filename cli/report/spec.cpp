@@ -108,6 +108,14 @@ class Parser {
     if (!std::isfinite(v)) fail(n, path, "must be finite");
     return v;
   }
+  // A weighting a report's run is named by: model-weights (1, its run id's -w1) or contribution (2, -w2).
+  int weighting(const YAML::Node& n, const std::string& path) const {
+    if (n.IsScalar() && n.as<std::string>() == "model-weights") return 1;
+    if (n.IsScalar() && n.as<std::string>() == "contribution") return 2;
+    const double w = n.IsScalar() && (n.as<std::string>() == "1" || n.as<std::string>() == "2") ? number(n, path) : 0;
+    if (w != 1 && w != 2) fail(n, path, "must be model-weights (or 1: the model file's weights) or contribution (or 2)");
+    return static_cast<int>(w);
+  }
   bool flag(const YAML::Node& n, const std::string& path) const {
     try {
       return n.as<bool>();
@@ -189,11 +197,7 @@ class Parser {
     if (n["params"]) m.params = names(n["params"], path + ".params");
     if (n["factor"]) m.factor = number(n["factor"], path + ".factor");
     if (n["times_total_mass"]) m.times_total_mass = flag(n["times_total_mass"], path + ".times_total_mass");
-    if (n["weighting"]) {
-      const double w = number(n["weighting"], path + ".weighting");
-      if (w != 1 && w != 2) fail(n["weighting"], path + ".weighting", "must be 1 (the model file's weights) or 2 (by contribution)");
-      m.weighting = static_cast<int>(w);
-    }
+    if (n["weighting"]) m.weighting = weighting(n["weighting"], path + ".weighting");
     return m;
   }
 
@@ -327,9 +331,7 @@ class Parser {
           TorqueReference r;
           r.line = line(refs[k]);
           r.scenario = text(required(refs[k], "scenario", path), path + ".scenario");
-          const double w = number(required(refs[k], "weighting", path), path + ".weighting");
-          if (w != 1 && w != 2) fail(refs[k]["weighting"], path + ".weighting", "must be 1 or 2");
-          r.weighting = static_cast<int>(w);
+          r.weighting = weighting(required(refs[k], "weighting", path), path + ".weighting");
           r.figures = names(required(refs[k], "figures", path), path + ".figures");
           if (r.figures.size() != s.torque_panels.size())
             fail(refs[k]["figures"], path + ".figures", fmt::format("must name one figure per panel ({})", s.torque_panels.size()));

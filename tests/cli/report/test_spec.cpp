@@ -56,7 +56,7 @@ run_figures:
   - {id: F, runs: [R1, R2], x: a, y: [b, c], thesis: fig. 1}
 torque_figures:
   panels: [[j1, j2], [j3]]
-  thesis: [{scenario: R1, weighting: 2, figures: [fig. 2, fig. 3]}]
+  thesis: [{scenario: R1, weighting: contribution, figures: [fig. 2, fig. 3]}]
 pose: {body_frame: C, outline: [p1, p2]}
 )") + kCheck + R"(  - id: signs
     kind: observation
@@ -136,7 +136,9 @@ TEST_CASE("report file: each error names the file, the line, the key and the rea
   CHECK(error_of(variant("quantity: total_mass", "quantity: total_mass, run: R1")) ==
         "claims.yaml:7: claims[0].measure.run: does not apply to quantity 'total_mass'");
   CHECK(error_of(variant("quantity: total_mass", "quantity: static_torque, joints: [a], weighting: 3")) ==
-        "claims.yaml:7: claims[0].measure.weighting: must be 1 (the model file's weights) or 2 (by contribution)");
+        "claims.yaml:7: claims[0].measure.weighting: must be model-weights (or 1: the model file's weights) or contribution (or 2)");
+  CHECK(error_of(variant("quantity: total_mass", "quantity: static_torque, joints: [a], weighting: contacts")) ==
+        "claims.yaml:7: claims[0].measure.weighting: must be model-weights (or 1: the model file's weights) or contribution (or 2)");
   CHECK(error_of(variant("quantity: total_mass", "quantity: peak_torque, runs: []")) ==
         "claims.yaml:7: claims[0].measure.runs: must be a non-empty list of names");
   // Two claims with one id.
