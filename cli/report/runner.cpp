@@ -324,8 +324,7 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
   row.samples = static_cast<long>(forward.samples.size());
   row.evaluations = forward.evaluations;
 
-  // The closed loop.
-  const auto reference_at = [&](double t, CommandVector& q, CommandVector& u) { commanded_reference(run, t, q, u); };
+  // The closed loop, along the run's motion (commanded_reference).
   Scenario plant = run.scenario;
   plant.weighting.reset();
   for (const auto& body : gen::kBodyMass) {
@@ -340,7 +339,7 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
   DynamicsTerms terms;
   plant.torques = [&](double t, const Coordinates& s, const CommandVector& u) -> TorqueVector {
     CommandVector q_ref, u_ref;
-    reference_at(t, q_ref, u_ref);
+    commanded_reference(run, t, q_ref, u_ref);
     CommandVector q;
     for (int j = 0; j < kCommandedCount; ++j) q(j) = s(kCommandedSpeeds[static_cast<std::size_t>(j)]);
     const CommandVector u_dot = kTrackingKd * (u_ref - u) + kTrackingKp * (q_ref - q);
@@ -371,7 +370,7 @@ ForwardRow ReportRunner::forward_dynamics_of(const ReportRun& run, const std::st
   for (std::size_t k = 0; k < loop.samples.size(); ++k) {
     const Sample& smp = loop.samples[k];
     CommandVector q_ref, u_ref;
-    reference_at(smp.t, q_ref, u_ref);
+    commanded_reference(run, smp.t, q_ref, u_ref);
     std::vector<double> values{smp.t, 0};
     for (int j = 0; j < kCommandedCount; ++j) {
       const double e = q_ref(j) - smp.s(kCommandedSpeeds[static_cast<std::size_t>(j)]);
@@ -433,7 +432,8 @@ EngineRow ReportRunner::physics_engine_of(const ReportRun& run, const std::strin
     for (int j = 0; j < kCommandedCount; ++j) {
       const int c = kCommandedSpeeds[static_cast<std::size_t>(j)];
       q(j) = s(c), u(j) = sdot(c);
-      (is_angle(c) ? angle : length) = std::max(is_angle(c) ? angle : length, std::abs(q_ref(j) - q(j)));
+      double& worst = is_angle(c) ? angle : length;
+      worst = std::max(worst, std::abs(q_ref(j) - q(j)));
     }
     // Leaving the reference ends the run where it happens: what follows is no longer the run. It
     // is a finding about the controller on another machine, not a failure of the model: it stays

@@ -84,25 +84,21 @@ double unwrap(double a, double near) {
 struct PhysicsEngine::Impl {
   MjModelPtr m;
   MjDataPtr d;
-  std::vector<std::string> coordinates;
+  int coordinate_count = 0;
   std::vector<FreeBase> bases;
   std::vector<int> joint_coordinate;  // per MuJoCo joint: its coordinate, or -1 (a free joint, a wheel's spin)
+  std::vector<int> joint_base;        // per MuJoCo joint: its floating base in `bases` (a free joint), or -1
   std::vector<int> motors;            // per actuator in the description's order: MuJoCo's actuator
   std::vector<std::string> contact_names;
   std::vector<int> contact_geoms;  // per contact: its geom
   std::vector<int> spin_joints;    // the wheels' spinning joints
   int ground = -1;                 // the ground plane's geom
 
-  const FreeBase& base_of(int joint) const {
-    const std::string name = mj_id2name(m.get(), mjOBJ_JOINT, joint);
-    for (const auto& b : bases)
-      if (b.frame == name) return b;
-    throw Error("frames", fmt::format("MuJoCo's free joint {} is no frame's floating base", name));
-  }
+  const FreeBase& base_of(int joint) const { return bases[static_cast<std::size_t>(joint_base[static_cast<std::size_t>(joint)])]; }
 
   void map_state(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot, Eigen::MatrixXd& G,
                  Eigen::VectorXd& Gdot_sdot, Eigen::VectorXd& qpos) const {
-    const int n = static_cast<int>(coordinates.size());
+    const int n = coordinate_count;
     G = Eigen::MatrixXd::Zero(m->nv, n);
     Gdot_sdot = Eigen::VectorXd::Zero(m->nv);
     qpos = Eigen::VectorXd::Zero(m->nq);
@@ -150,12 +146,18 @@ PhysicsEngine::PhysicsEngine(const std::string& description_json, const std::vec
   e.m = load_mjcf(mjcf_of_description(description_json).xml);
   e.d.reset(mj_makeData(e.m.get()));
   if (!e.d) throw Error("physics engine", "MuJoCo could not allocate its data");
-  e.coordinates = coordinates;
+  e.coordinate_count = static_cast<int>(coordinates.size());
   const Json d = parse_json_bounded(description_json, "model.json");
   e.bases = read_free_bases(d, coordinates, e.m.get());
   for (int j = 0; j < e.m->njnt; ++j) {
     const char* name = mj_id2name(e.m.get(), mjOBJ_JOINT, j);
-    e.joint_coordinate.push_back(e.m->jnt_type[j] == mjJNT_FREE || name == nullptr ? -1 : index_of(coordinates, name));
+    const bool free = e.m->jnt_type[j] == mjJNT_FREE;
+    e.joint_coordinate.push_back(free || name == nullptr ? -1 : index_of(coordinates, name));
+    int base = -1;
+    for (std::size_t b = 0; free && b < e.bases.size(); ++b)
+      if (name != nullptr && e.bases[b].frame == name) base = static_cast<int>(b);
+    if (free && base < 0) throw Error("frames", fmt::format("MuJoCo's free joint {} is no frame's floating base", name == nullptr ? "" : name));
+    e.joint_base.push_back(base);
   }
   for (const Json& a : d.at("actuated")) {
     const std::string name = a.at("name");
@@ -193,7 +195,6 @@ EngineMapping PhysicsEngine::mapping(const Eigen::Ref<const Eigen::VectorXd>& s,
 }
 
 const std::vector<EngineFreeBase>& PhysicsEngine::free_bases() const { return impl_->bases; }
-double PhysicsEngine::time() const { return impl_->d->time; }
 
 void PhysicsEngine::set_state(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot) {
   const Impl& e = *impl_;
@@ -327,7 +328,6 @@ const std::vector<EngineFreeBase>& PhysicsEngine::free_bases() const {
   static const std::vector<EngineFreeBase> none;
   return none;
 }
-double PhysicsEngine::time() const { return 0; }
 void PhysicsEngine::set_state(const Eigen::Ref<const Eigen::VectorXd>&, const Eigen::Ref<const Eigen::VectorXd>&) {}
 void PhysicsEngine::read_state(Eigen::Ref<Eigen::VectorXd>, Eigen::Ref<Eigen::VectorXd>) const {}
 Eigen::VectorXd PhysicsEngine::set_torques(const Eigen::Ref<const Eigen::VectorXd>& tau) { return tau; }

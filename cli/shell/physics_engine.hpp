@@ -60,7 +60,6 @@ class PhysicsEngine {
   double timestep() const;  // s: the export's option timestep
   EngineMapping mapping(const Eigen::Ref<const Eigen::VectorXd>& s, const Eigen::Ref<const Eigen::VectorXd>& sdot) const;
   const std::vector<EngineFreeBase>& free_bases() const;
-  double time() const;      // s since the start
 
   // Sets the machine to wlx's state, at rest in the wheels' spins but for rolling: each spinning
   // wheel turns so that its lowest point moves as little as it can sideways and forward.

@@ -60,12 +60,6 @@ constexpr double kYawRate = 10 * std::numbers::pi / 180;      // rad/s
 double ramp(double t) { return t < kRamp ? 0.5 * (1 - std::cos(std::numbers::pi * t / kRamp)) : 1.0; }
 double ramp_rate(double t) { return t < kRamp ? 0.5 * std::numbers::pi / kRamp * std::sin(std::numbers::pi * t / kRamp) : 0.0; }
 
-int coordinate(const std::string& name) {
-  for (int c = 0; c < kCoordinateCount; ++c)
-    if (gen::kCoordinateNames[static_cast<std::size_t>(c)] == name) return c;
-  throw Error("coordinate", fmt::format("the model has no coordinate '{}'", name));
-}
-
 }  // namespace
 
 int main(int argc, char** argv) try {
@@ -100,16 +94,15 @@ int main(int argc, char** argv) try {
   // The reference: the base's x, y and yaw, and each wheel's contact point carried with the base
   // (its x commanded, its y following by rolling). Every other commanded coordinate stays.
   const double V = kSpeed, Omega = kYawRate;
-  const auto commanded = [&](const std::string& name) {
-    const int c = coordinate(name);
+  // A coordinate's place among the commanded speeds.
+  const auto commanded = [&](int c) {
     const auto it = std::find(kCommandedSpeeds.begin(), kCommandedSpeeds.end(), c);
-    if (it == kCommandedSpeeds.end()) throw Error("speeds", fmt::format("{} is no commanded speed of the model", name));
+    if (it == kCommandedSpeeds.end())
+      throw Error("speeds", fmt::format("{} is no commanded speed of the model", gen::kCoordinateNames[static_cast<std::size_t>(c)]));
     return static_cast<int>(it - kCommandedSpeeds.begin());
   };
   const cli::EngineFreeBase& base = bases.front();
-  const int kx = commanded(std::string(gen::kCoordinateNames[static_cast<std::size_t>(base.position[0])])),
-            ky = commanded(std::string(gen::kCoordinateNames[static_cast<std::size_t>(base.position[1])])),
-            kyaw = commanded(std::string(gen::kCoordinateNames[static_cast<std::size_t>(base.angle[0])]));
+  const int kx = commanded(base.position[0]), ky = commanded(base.position[1]), kyaw = commanded(base.angle[0]);
   struct CarriedPoint {
     int k = -1;           // its x among the commanded speeds
     double along, across;  // its place in the base's heading frame
