@@ -96,6 +96,13 @@ class Report {
   void evaluate_claims(report::Document& d);
   report::Document document(const ReportFigures& figures);
   std::vector<report::Section> sections(const ReportFigures& figures) const;
+  std::string section_title(const std::string& key, const std::string& fallback) const;
+  report::Section ik_section(const ReportFigures& figures) const;
+  template <typename Keep>
+  report::Table runs_table(Keep keep) const;
+  report::Table integrators_table() const;
+  report::Section contacts_section() const;
+  report::Section forward_section(const ReportFigures& figures) const;
   report::Section engine_section(const ReportFigures& figures) const;
 
   void write_viewer();
@@ -148,178 +155,193 @@ void Report::evaluate_claims(report::Document& d) {
   }
 }
 
-std::vector<report::Section> Report::sections(const ReportFigures& figures) const {
-  const auto title = [&](const std::string& key, const std::string& fallback) {
-    const auto it = spec_.section_titles.find(key);
-    return it == spec_.section_titles.end() ? fallback : it->second;
+std::string Report::section_title(const std::string& key, const std::string& fallback) const {
+  const auto it = spec_.section_titles.find(key);
+  return it == spec_.section_titles.end() ? fallback : it->second;
+}
+
+report::Section Report::ik_section(const ReportFigures& figures) const {
+  report::Table t{{"sweep", "input", "points", "max check, closed form (m)", "max check, Newton (m)", "max |closed form - Newton| (rad)",
+                   "Newton iterations (mean / max)", "joints' limits (branch)", "CSV"},
+                  {}};
+  // A limb without a closed form: Newton's method alone, nothing to check or compare (ik_verification.hpp).
+  const auto closed_form_cell = [](const IkSweepResult& s, double v) {
+    return s.closed_form ? fmt::format("{:.2e}", v) : std::string("no closed form");
   };
-  std::vector<report::Section> out;
-  if (!runner_.sweeps().empty()) {
-    report::Table t{{"sweep", "input", "points", "max check, closed form (m)", "max check, Newton (m)", "max |closed form - Newton| (rad)",
-                     "Newton iterations (mean / max)", "joints' limits (branch)", "CSV"},
-                    {}};
-    // A limb without a closed form: Newton's method alone, nothing to check or compare (ik_verification.hpp).
-    const auto closed_form_cell = [](const IkSweepResult& s, double v) {
-      return s.closed_form ? fmt::format("{:.2e}", v) : std::string("no closed form");
-    };
-    for (const auto& s : runner_.sweeps())
-      t.rows.push_back({{s.sweep.id},
-                        {s.sweep.input},
-                        {std::to_string(s.points.size())},
-                        {closed_form_cell(s, s.max_check_closed_form)},
-                        {fmt::format("{:.2e}", s.max_check_newton)},
-                        {closed_form_cell(s, s.max_newton_difference)},
-                        {fmt::format("{:.2f} / {}", s.mean_newton_iterations, s.max_newton_iterations)},
-                        {s.outside_limits == 0 ? fmt::format("within ({})", s.branch)
-                                               : fmt::format("{} points outside ({}), first {}", s.outside_limits, s.branch, s.first_outside)},
-                        {s.sweep.id + ".csv", "data/" + s.sweep.id + ".csv"}});
-    out.push_back({"ik", title("ik", "Inverse kinematics sweeps"), "", {t}, figures.ik, {}});
-  }
-  // A model without a clearance box (structure.hpp's kHasClearance) has no clearance column.
-  const auto runs_table = [&](auto keep) {
-    report::Table t{{"run", "description", "samples", "result", "max |v_W . n_W| (m/s)", "max cond(J_beta)"}, {}};
-    if (gen::kHasClearance) t.header.emplace_back("min clearance (m)");
-    t.header.insert(t.header.end(), {"CSV", "3D"});
-    for (const auto& r : runner_.runs()) {
-      if (!keep(r)) continue;
-      double res = 0, cond = 0, clear = 1e300;
-      for (const auto& smp : r.trajectory.samples) {
-        res = std::max(res, smp.nh_residual.cwiseAbs().maxCoeff());
-        cond = std::max(cond, smp.cond_J_beta);
-        clear = std::min(clear, smp.clearance);
-      }
-      const bool any = !r.trajectory.samples.empty();  // a run stopped at its first step has no maxima
-      std::vector<report::Cell> row{{r.id}, {r.scenario.description}, {std::to_string(r.trajectory.samples.size())},
-                                    {r.stopped ? r.stopped->describe() : "complete"}, {any ? fmt::format("{:.2e}", res) : "-"},
-                                    {any ? fmt::format("{:.3g}", cond) : "-"}};
-      if (gen::kHasClearance) row.push_back({any ? fmt::format("{:.4f}", clear) : "-"});
-      row.push_back({r.csv, "data/" + r.csv});
-      row.push_back(viewer_missing_.empty() && any ? report::Cell{"animate", viewer_link(r.id)} : report::Cell{"-"});
-      t.rows.push_back(row);
+  for (const auto& s : runner_.sweeps())
+    t.rows.push_back({{s.sweep.id},
+                      {s.sweep.input},
+                      {std::to_string(s.points.size())},
+                      {closed_form_cell(s, s.max_check_closed_form)},
+                      {fmt::format("{:.2e}", s.max_check_newton)},
+                      {closed_form_cell(s, s.max_newton_difference)},
+                      {fmt::format("{:.2f} / {}", s.mean_newton_iterations, s.max_newton_iterations)},
+                      {s.outside_limits == 0 ? fmt::format("within ({})", s.branch)
+                                             : fmt::format("{} points outside ({}), first {}", s.outside_limits, s.branch, s.first_outside)},
+                      {s.sweep.id + ".csv", "data/" + s.sweep.id + ".csv"}});
+  return {"ik", section_title("ik", "Inverse kinematics sweeps"), "", {t}, figures.ik, {}};
+}
+
+// The runs `keep` selects, a row each. A model without a clearance box (structure.hpp's
+// kHasClearance) has no clearance column.
+template <typename Keep>
+report::Table Report::runs_table(Keep keep) const {
+  report::Table t{{"run", "description", "samples", "result", "max |v_W . n_W| (m/s)", "max cond(J_beta)"}, {}};
+  if (gen::kHasClearance) t.header.emplace_back("min clearance (m)");
+  t.header.insert(t.header.end(), {"CSV", "3D"});
+  for (const auto& r : runner_.runs()) {
+    if (!keep(r)) continue;
+    double res = 0, cond = 0, clear = 1e300;
+    for (const auto& smp : r.trajectory.samples) {
+      res = std::max(res, smp.nh_residual.cwiseAbs().maxCoeff());
+      cond = std::max(cond, smp.cond_J_beta);
+      clear = std::min(clear, smp.clearance);
     }
-    return t;
-  };
+    const bool any = !r.trajectory.samples.empty();  // a run stopped at its first step has no maxima
+    std::vector<report::Cell> row{{r.id}, {r.scenario.description}, {std::to_string(r.trajectory.samples.size())},
+                                  {r.stopped ? r.stopped->describe() : "complete"}, {any ? fmt::format("{:.2e}", res) : "-"},
+                                  {any ? fmt::format("{:.3g}", cond) : "-"}};
+    if (gen::kHasClearance) row.push_back({any ? fmt::format("{:.4f}", clear) : "-"});
+    row.push_back({r.csv, "data/" + r.csv});
+    row.push_back(viewer_missing_.empty() && any ? report::Cell{"animate", viewer_link(r.id)} : report::Cell{"-"});
+    t.rows.push_back(row);
+  }
+  return t;
+}
+
+report::Table Report::integrators_table() const {
+  std::vector<std::string> header{"run", "integrator", "setting", "samples", "evaluations", "max |q - q_ref| (m or rad)"};
+  for (int c : runner_.compared_coordinates()) header.push_back(fmt::format("max |{} - ref| ({})", label(c), display_unit(c)));
+  header.push_back("CSV");
+  report::Table t{header, {}};
+  for (const auto& r : runner_.integrators()) {
+    std::vector<report::Cell> row{{r.id}, {std::string(integrator_name(r.integrator))},
+                                  {r.setting}, {std::to_string(r.samples)}, {std::to_string(r.evaluations)}, {fmt::format("{:.2e}", r.inputs)}};
+    for (std::size_t k = 0; k < r.coordinates.size(); ++k)
+      row.push_back({fmt::format("{:.2e}", r.coordinates[k] * display_scale(runner_.compared_coordinates()[k]))});
+    row.push_back({"integrators.csv", "data/integrators.csv"});
+    t.rows.push_back(row);
+  }
+  return t;
+}
+
+bool is_dynamics_run(const ReportRun& r) { return !r.nonholonomic_verification && r.scenario.weighting.has_value(); }
+
+// Will it tip, will it slip: each dynamics run's smallest margins under each weighting, side by side.
+report::Section Report::contacts_section() const {
+  report::Table t{{"run", "weighting", "smallest normal force (N)", "smallest friction margin (N)", "first slip",
+                   "first lift-off", "smallest tip-over margin (deg)", "max momentum residual"},
+                  {}};
+  for (const auto& r : runner_.runs()) {
+    if (!is_dynamics_run(r) || r.trajectory.samples.empty()) continue;
+    double normal = 1e300, friction = 1e300, tip = 1e300, residual = 0;
+    int normal_c = -1, friction_c = -1, tip_a = -1, tip_b = -1;
+    double normal_t = 0, friction_t = 0;
+    std::string slip = "none", lift = "none";
+    for (const Sample& smp : r.trajectory.samples) {
+      for (int c = 0; c < kContactCount; ++c) {
+        if (!gen::kContacts[static_cast<std::size_t>(c)].supports) continue;
+        if (smp.forces.normal(c) < normal) normal = smp.forces.normal(c), normal_c = c, normal_t = smp.t;
+        if (smp.forces.friction_margin(c) < friction) friction = smp.forces.friction_margin(c), friction_c = c, friction_t = smp.t;
+        if (slip == "none" && smp.forces.friction_margin(c) < 0) slip = fmt::format("{} at {:.3f} s", contact_name(c), smp.t);
+        if (lift == "none" && smp.forces.normal(c) < 0) lift = fmt::format("{} at {:.3f} s", contact_name(c), smp.t);
+      }
+      if (smp.stability.tip_angle < tip) tip = smp.stability.tip_angle, tip_a = smp.stability.tip_edge[0], tip_b = smp.stability.tip_edge[1];
+      residual = std::max(residual, smp.momentum_residual);
+    }
+    t.rows.push_back({{r.id},
+                      {r.scenario.weighting->label()},
+                      {fmt::format("{:.6g} ({} at {:.3f} s)", normal, normal_c >= 0 ? contact_name(normal_c) : "-", normal_t)},
+                      {fmt::format("{:.6g} ({} at {:.3f} s)", friction, friction_c >= 0 ? contact_name(friction_c) : "-", friction_t)},
+                      {slip},
+                      {lift},
+                      {tip_a >= 0 ? fmt::format("{:.4g} (edge {}-{})", tip * kDegPerRad, contact_name(tip_a), contact_name(tip_b))
+                                  : std::string("-")},
+                      {fmt::format("{:.1e}", residual)}});
+  }
+  return {"contacts", section_title("contacts", "Contacts: will it tip, will it slip"),
+          "The force the ground exerts at each contact, from the equations of motion for the torques applied (the "
+          "multipliers of the closure and rolling rows), for each inverse-dynamics run under the model file's weighting "
+          "(1), weighting by contribution (2) and the weighting that keeps the machine on its contacts (3: the largest "
+          "smallest margin of normal forces and friction at each step, within the torque limits). A negative normal "
+          "force would pull on the ground "
+          "(the contact lifts off), a negative friction margin slides; the tip-over margin is the force-angle measure "
+          "about the support polygon's edges. The momentum residual checks the forces against the bodies' "
+          "accelerations. The per-sample forces and margins are in each run's CSV.",
+          {t}, {}, {}};
+}
+
+report::Section Report::forward_section(const ReportFigures& figures) const {
+  report::Table trips{{"run", "result", "samples", "evaluations", "max |s_forward - s_inverse| (m or rad)", "max |E - E0 - W| (J)",
+                       "relative to max |W|", "CSV"},
+                      {}};
+  report::Table loops{{"run", "result", "tracking error at t = 0 (m or rad)", "max tracking error, second half (m or rad)", "CSV"}, {}};
+  for (const auto& r : runner_.forward()) {
+    if (r.not_run) {  // its inverse-dynamics run stopped: neither simulation has a motion to follow
+      const std::string why = fmt::format("not run: {} {}", r.id, r.not_run->describe());
+      trips.rows.push_back({{r.id}, {why}, {"-"}, {"-"}, {"-"}, {"-"}, {"-"}, {"-"}});
+      loops.rows.push_back({{r.id}, {why}, {"-"}, {"-"}, {"-"}});
+      continue;
+    }
+    const bool trip = r.samples > 0, loop = r.closed_loop_samples > 0;  // no sample: no maxima
+    trips.rows.push_back({{r.id}, {r.round_trip_stopped ? r.round_trip_stopped->describe() : "complete"}, {std::to_string(r.samples)},
+                          {std::to_string(r.evaluations)}, {trip ? fmt::format("{:.2e}", r.round_trip) : "-"},
+                          {trip ? fmt::format("{:.2e}", r.energy_balance) : "-"},
+                          {trip ? fmt::format("{:.1e}", r.energy_balance / std::max(r.work, 1.0)) : "-"}, {r.csv, "data/" + r.csv}});
+    loops.rows.push_back({{r.id}, {r.closed_loop_stopped ? r.closed_loop_stopped->describe() : "complete"},
+                          {loop ? fmt::format("{:.2e}", r.start_error) : "-"},
+                          {r.closed_loop_stopped ? std::string("-") : fmt::format("{:.2e}", r.late_error)},
+                          {r.closed_loop_csv, "data/" + r.closed_loop_csv}});
+  }
+  report::Section s{"forward", section_title("forward", "Forward dynamics"),
+                    "The machine moved by its actuators: from the torques and the state, forward_dynamics solves the reduced "
+                    "equations of motion M(s) u' = J_beta^T tau - b(s, u) - Q_gravity(s) for the accelerations of the commanded "
+                    "speeds u; the closure is re-solved by the closed-form IK at every evaluation and the rolling rows hold at "
+                    "velocity level, so neither can drift. Round trip: each inverse-dynamics run's torques, cubic between its "
+                    "samples, drive the machine from the run's start (dopri5 at " +
+                        fmt::format("{:.0e}", kRoundTripTolerance) +
+                        "); the deviation from the run and the energy balance (kinetic + potential energy against the "
+                        "actuators' work, trapezoid rule on the samples) are shown.",
+                    {trips}, figures.forward, {}};
+  s.subsections.push_back(
+      {"closed-loop", "A controller in the loop",
+       fmt::format("Computed torque on the model (its inverse dynamics, the run's weighting) with PD feedback on the commanded "
+                   "coordinates (Kp {:g} 1/s^2, Kd {:g} 1/s) tracks each run on a plant that is not the model: every body's mass "
+                   "and inertia x{:g}, and a start {:g} mm or {:g} deg off in every commanded coordinate. The controller reads the "
+                   "plant's coordinates and speeds and is evaluated continuously (at every stage of RK4 at the run's step); the "
+                   "reference is the run's motion, cubic Hermite between its samples. What is left after the start has decayed is "
+                   "the plant's extra weight, which the model does not know.",
+                   kTrackingKp, kTrackingKd, kPlantMassFactor, kStartOffsetLength * 1e3, kStartOffsetAngle * kDegPerRad),
+       {loops}, figures.closed_loop, {}});
+  return s;
+}
+
+std::vector<report::Section> Report::sections(const ReportFigures& figures) const {
+  std::vector<report::Section> out;
+  if (!runner_.sweeps().empty()) out.push_back(ik_section(figures));
   const auto is_nh = [](const ReportRun& r) { return r.nonholonomic_verification; };
   const auto is_kinematic = [](const ReportRun& r) { return !r.nonholonomic_verification && !r.scenario.weighting; };
-  const auto is_dynamics = [](const ReportRun& r) { return !r.nonholonomic_verification && r.scenario.weighting.has_value(); };
-  const auto any = [&](auto keep) {
-    return std::any_of(runner_.runs().begin(), runner_.runs().end(), keep);
-  };
-  if (any(is_nh)) out.push_back({"nonholonomic", title("nonholonomic", "Wheel constraint runs"), "", {runs_table(is_nh)}, figures.nonholonomic, {}});
+  const auto any = [&](auto keep) { return std::any_of(runner_.runs().begin(), runner_.runs().end(), keep); };
+  if (any(is_nh))
+    out.push_back({"nonholonomic", section_title("nonholonomic", "Wheel constraint runs"), "", {runs_table(is_nh)}, figures.nonholonomic, {}});
   if (any(is_kinematic)) {
-    report::Section s{"kinematic", title("kinematic", "Kinematic runs"), "", {runs_table(is_kinematic)}, figures.kinematic, {}};
-    if (!runner_.integrators().empty()) {
-      std::vector<std::string> header{"run", "integrator", "setting", "samples", "evaluations", "max |q - q_ref| (m or rad)"};
-      for (int c : runner_.compared_coordinates()) header.push_back(fmt::format("max |{} - ref| ({})", label(c), display_unit(c)));
-      header.push_back("CSV");
-      report::Table t{header, {}};
-      for (const auto& r : runner_.integrators()) {
-        std::vector<report::Cell> row{{r.id}, {std::string(integrator_name(r.integrator))},
-                                      {r.setting}, {std::to_string(r.samples)}, {std::to_string(r.evaluations)}, {fmt::format("{:.2e}", r.inputs)}};
-        for (std::size_t k = 0; k < r.coordinates.size(); ++k)
-          row.push_back({fmt::format("{:.2e}", r.coordinates[k] * display_scale(runner_.compared_coordinates()[k]))});
-        row.push_back({"integrators.csv", "data/integrators.csv"});
-        t.rows.push_back(row);
-      }
+    report::Section s{"kinematic", section_title("kinematic", "Kinematic runs"), "", {runs_table(is_kinematic)}, figures.kinematic, {}};
+    if (!runner_.integrators().empty())
       s.subsections.push_back({"integrators", "Integrators compared",
                                fmt::format("Each run integrated three ways and compared at its samples with RK4 at {:g} s: "
                                            "explicit Euler and RK4 (wlx's default) at the run's step, and dopri5 (adaptive "
                                            "Dormand-Prince 5(4)), which writes 10 samples per run and chooses its steps in between. "
                                            "An evaluation is one closed-form IK of every limb plus a dependent-rate solve. {}",
                                            spec_.reference_step, spec_.integrator_note),
-                               {t}, {}, {}});
-    }
+                               {integrators_table()}, {}, {}});
     out.push_back(s);
   }
-  if (any(is_dynamics)) out.push_back({"dynamics", title("dynamics", "Inverse dynamics"), "", {runs_table(is_dynamics)}, figures.dynamics, {}});
-  // Will it tip, will it slip: each dynamics run's smallest margins under each weighting, side by side.
-  if (kContactCount > 0 && any(is_dynamics)) {
-    report::Table t{{"run", "weighting", "smallest normal force (N)", "smallest friction margin (N)", "first slip",
-                     "first lift-off", "smallest tip-over margin (deg)", "max momentum residual"},
-                    {}};
-    for (const auto& r : runner_.runs()) {
-      if (!is_dynamics(r) || r.trajectory.samples.empty()) continue;
-      double normal = 1e300, friction = 1e300, tip = 1e300, residual = 0;
-      int normal_c = -1, friction_c = -1, tip_a = -1, tip_b = -1;
-      double normal_t = 0, friction_t = 0;
-      std::string slip = "none", lift = "none";
-      for (const Sample& smp : r.trajectory.samples) {
-        for (int c = 0; c < kContactCount; ++c) {
-          if (!gen::kContacts[static_cast<std::size_t>(c)].supports) continue;
-          if (smp.forces.normal(c) < normal) normal = smp.forces.normal(c), normal_c = c, normal_t = smp.t;
-          if (smp.forces.friction_margin(c) < friction) friction = smp.forces.friction_margin(c), friction_c = c, friction_t = smp.t;
-          if (slip == "none" && smp.forces.friction_margin(c) < 0) slip = fmt::format("{} at {:.3f} s", contact_name(c), smp.t);
-          if (lift == "none" && smp.forces.normal(c) < 0) lift = fmt::format("{} at {:.3f} s", contact_name(c), smp.t);
-        }
-        if (smp.stability.tip_angle < tip) tip = smp.stability.tip_angle, tip_a = smp.stability.tip_edge[0], tip_b = smp.stability.tip_edge[1];
-        residual = std::max(residual, smp.momentum_residual);
-      }
-      t.rows.push_back({{r.id},
-                        {r.scenario.weighting->label()},
-                        {fmt::format("{:.6g} ({} at {:.3f} s)", normal, normal_c >= 0 ? contact_name(normal_c) : "-", normal_t)},
-                        {fmt::format("{:.6g} ({} at {:.3f} s)", friction, friction_c >= 0 ? contact_name(friction_c) : "-", friction_t)},
-                        {slip},
-                        {lift},
-                        {tip_a >= 0 ? fmt::format("{:.4g} (edge {}-{})", tip * kDegPerRad, contact_name(tip_a), contact_name(tip_b))
-                                    : std::string("-")},
-                        {fmt::format("{:.1e}", residual)}});
-    }
-    out.push_back({"contacts", title("contacts", "Contacts: will it tip, will it slip"),
-                   "The force the ground exerts at each contact, from the equations of motion for the torques applied (the "
-                   "multipliers of the closure and rolling rows), for each inverse-dynamics run under the model file's weighting "
-                   "(1), weighting by contribution (2) and the weighting that keeps the machine on its contacts (3: the largest "
-                   "smallest margin of normal forces and friction at each step, within the torque limits). A negative normal "
-                   "force would pull on the ground "
-                   "(the contact lifts off), a negative friction margin slides; the tip-over margin is the force-angle measure "
-                   "about the support polygon's edges. The momentum residual checks the forces against the bodies' "
-                   "accelerations. The per-sample forces and margins are in each run's CSV.",
-                   {t}, {}, {}});
+  if (any(is_dynamics_run)) {
+    out.push_back({"dynamics", section_title("dynamics", "Inverse dynamics"), "", {runs_table(is_dynamics_run)}, figures.dynamics, {}});
+    if (kContactCount > 0) out.push_back(contacts_section());
   }
-  if (!runner_.forward().empty()) {
-    report::Table trips{{"run", "result", "samples", "evaluations", "max |s_forward - s_inverse| (m or rad)", "max |E - E0 - W| (J)",
-                         "relative to max |W|", "CSV"},
-                        {}};
-    report::Table loops{{"run", "result", "tracking error at t = 0 (m or rad)", "max tracking error, second half (m or rad)", "CSV"}, {}};
-    for (const auto& r : runner_.forward()) {
-      if (r.not_run) {  // its inverse-dynamics run stopped: neither simulation has a motion to follow
-        const std::string why = fmt::format("not run: {} {}", r.id, r.not_run->describe());
-        trips.rows.push_back({{r.id}, {why}, {"-"}, {"-"}, {"-"}, {"-"}, {"-"}, {"-"}});
-        loops.rows.push_back({{r.id}, {why}, {"-"}, {"-"}, {"-"}});
-        continue;
-      }
-      const bool trip = r.samples > 0, loop = r.closed_loop_samples > 0;  // no sample: no maxima
-      trips.rows.push_back({{r.id}, {r.round_trip_stopped ? r.round_trip_stopped->describe() : "complete"}, {std::to_string(r.samples)},
-                            {std::to_string(r.evaluations)}, {trip ? fmt::format("{:.2e}", r.round_trip) : "-"},
-                            {trip ? fmt::format("{:.2e}", r.energy_balance) : "-"},
-                            {trip ? fmt::format("{:.1e}", r.energy_balance / std::max(r.work, 1.0)) : "-"}, {r.csv, "data/" + r.csv}});
-      loops.rows.push_back({{r.id}, {r.closed_loop_stopped ? r.closed_loop_stopped->describe() : "complete"},
-                            {loop ? fmt::format("{:.2e}", r.start_error) : "-"},
-                            {r.closed_loop_stopped ? std::string("-") : fmt::format("{:.2e}", r.late_error)},
-                            {r.closed_loop_csv, "data/" + r.closed_loop_csv}});
-    }
-    report::Section s{"forward", title("forward", "Forward dynamics"),
-                      "The machine moved by its actuators: from the torques and the state, forward_dynamics solves the reduced "
-                      "equations of motion M(s) u' = J_beta^T tau - b(s, u) - Q_gravity(s) for the accelerations of the commanded "
-                      "speeds u; the closure is re-solved by the closed-form IK at every evaluation and the rolling rows hold at "
-                      "velocity level, so neither can drift. Round trip: each inverse-dynamics run's torques, cubic between its "
-                      "samples, drive the machine from the run's start (dopri5 at " +
-                          fmt::format("{:.0e}", kRoundTripTolerance) +
-                          "); the deviation from the run and the energy balance (kinetic + potential energy against the "
-                          "actuators' work, trapezoid rule on the samples) are shown.",
-                      {trips}, figures.forward, {}};
-    s.subsections.push_back(
-        {"closed-loop", "A controller in the loop",
-         fmt::format("Computed torque on the model (its inverse dynamics, the run's weighting) with PD feedback on the commanded "
-                     "coordinates (Kp {:g} 1/s^2, Kd {:g} 1/s) tracks each run on a plant that is not the model: every body's mass "
-                     "and inertia x{:g}, and a start {:g} mm or {:g} deg off in every commanded coordinate. The controller reads the "
-                     "plant's coordinates and speeds and is evaluated continuously (at every stage of RK4 at the run's step); the "
-                     "reference is the run's motion, cubic Hermite between its samples. What is left after the start has decayed is "
-                     "the plant's extra weight, which the model does not know.",
-                     kTrackingKp, kTrackingKd, kPlantMassFactor, kStartOffsetLength * 1e3, kStartOffsetAngle * kDegPerRad),
-         {loops}, figures.closed_loop, {}});
-    out.push_back(s);
-  }
-  if (any(is_dynamics)) out.push_back(engine_section(figures));
+  if (!runner_.forward().empty()) out.push_back(forward_section(figures));
+  if (any(is_dynamics_run)) out.push_back(engine_section(figures));
   if (!figures.poses.empty()) out.push_back({"poses", "Poses at the start and the end of each run", "", {}, figures.poses, {}});
   return out;
 }

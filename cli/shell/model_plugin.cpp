@@ -1,7 +1,9 @@
 #include "model_plugin.hpp"
 
 #include "bounded_input.hpp"
+#include "compile_jobs.hpp"
 #include "interrupt.hpp"
+#include "plugin_cache.hpp"
 #include "process.hpp"
 #include "sha256.hpp"
 
@@ -164,15 +166,6 @@ fs::path generator_program() {
   return "wlx-gen";  // from PATH
 }
 
-// The compiler that builds a missing plugin: CXX, else the one wlx was built with. Not part of the
-// key: a cached plugin is loaded whichever compiler built it (they share the C++ ABI and the
-// standard library), so that a run whose compiler cannot work (CXX=/bin/false) still loads what is
-// cached; another compiler's code for a key of its own takes other flags (WLX_PLUGIN_CXXFLAGS).
-std::string compiler() {
-  if (const char* env = std::getenv("CXX"); env != nullptr && *env != '\0') return env;
-  return WLX_PLUGIN_CXX;
-}
-
 // -O2 by default for the runtime and the generated functions (the code runs in users' loops), -O0
 // for the commands, which parse, check and write around those calls (the excavator's, alone on a
 // core: 27 s at -O2, 19 s at -O1, 10 s at -O0; a report of its runs takes 28 s against 26.5 s
@@ -187,79 +180,6 @@ std::vector<std::string> optimization_flags(bool commands = false) {
   return out;
 }
 
-std::string manifest_value(const std::string& manifest, const std::string& key) {
-  std::istringstream in(manifest);
-  for (std::string l; std::getline(in, l);)
-    if (l.rfind(key + " ", 0) == 0) return l.substr(key.size() + 1);
-  return {};
-}
-
-// What the cache holds runs inside wlx (a plugin is dlopen()ed), so only what is the user's and
-// what nobody else may write is trusted: the cache folder (followed if it is a link) and each
-// entry's folder, plugin and manifest (never links). Anything else is an error naming it, never
-// used and never removed (it is not ours to remove); the README says how to mend it.
-void check_private_stat(const struct stat& st, const fs::path& path, const char* what);
-
-void check_private(const fs::path& path, const char* what, bool follow) {
-  struct stat st {};
-  if ((follow ? ::stat(path.c_str(), &st) : ::lstat(path.c_str(), &st)) != 0) return;  // absent: nothing to trust yet
-  if (!follow && S_ISLNK(st.st_mode))
-    throw Error("--model-file", fmt::format("the cache's {} {} is a symbolic link: a cache entry is never followed elsewhere; "
-                                            "remove it",
-                                            what, path.string()));
-  check_private_stat(st, path, what);
-}
-
-// The owner and mode of what `st` describes (the cache's `what` at `path`).
-void check_private_stat(const struct stat& st, const fs::path& path, const char* what) {
-  // A sticky folder others may write (/tmp) or a folder of another user cannot be made private by
-  // its user: only another cache folder helps.
-  const bool only_elsewhere = (st.st_mode & S_ISVTX) != 0 || st.st_uid != ::geteuid();
-  if (st.st_uid != ::geteuid())
-    throw Error("--model-file", fmt::format("the cache's {} {} belongs to another user (uid {}): code in it would run inside wlx; "
-                                            "set WLX_CACHE_DIR to a folder of your own",
-                                            what, path.string(), st.st_uid));
-  if ((st.st_mode & (S_IWGRP | S_IWOTH)) != 0)
-    throw Error("--model-file", fmt::format("the cache's {} {} may be written by others (mode {:04o}): code planted in it would run "
-                                            "inside wlx; {}set WLX_CACHE_DIR to a folder of your own",
-                                            what, path.string(), st.st_mode & 07777,
-                                            only_elsewhere ? std::string() : fmt::format("chmod go-w {}, or ", path.string())));
-}
-
-// The cache's index: the SHA-256 of every plugin this cache built, one "<entry> <digest>" line
-// each, in the cache folder (which only its user may write: check_private). A plugin is
-// dlopen()ed only when its bytes have the digest recorded here when it was built, so an entry
-// whose plugin.so and manifest were replaced together, or copied in from elsewhere, is never run.
-fs::path index_path(const fs::path& cache) { return cache / "index"; }
-
-// The index's text: absent is empty; anything but a private regular file within its bound is an
-// error naming it, before any entry is judged by it (a damaged index must not cost good plugins).
-constexpr std::uintmax_t kMaxIndexBytes = std::uintmax_t{16} << 20;
-std::string index_text(const fs::path& cache) {
-  const fs::path index = index_path(cache);
-  check_private(index, "index", false);
-  struct stat st {};
-  if (::lstat(index.c_str(), &st) != 0) return {};
-  if (!S_ISREG(st.st_mode))
-    throw Error("--model-file", fmt::format("the cache's index {} is not a regular file: remove it (every plugin of the cache is "
-                                            "then built again on its next use)",
-                                            index.string()));
-  if (static_cast<std::uintmax_t>(st.st_size) > kMaxIndexBytes)
-    throw Error("--model-file", fmt::format("the cache's index {} is larger than {} bytes: remove it (every plugin of the cache is "
-                                            "then built again on its next use)",
-                                            index.string(), kMaxIndexBytes));
-  const BoundedRead r = read_bounded_file(index.string(), kMaxIndexBytes);
-  if (!r.ok()) throw Error("--model-file", fmt::format("the cache's index {} cannot be read ({})", index.string(), r.error));
-  return r.text;
-}
-
-std::string indexed_digest(const fs::path& cache, const std::string& stem) {
-  std::istringstream in(index_text(cache));
-  for (std::string line; std::getline(in, line);)
-    if (line.size() == stem.size() + 65 && line.compare(0, stem.size(), stem) == 0 && line[stem.size()] == ' ') return line.substr(stem.size() + 1);
-  return {};
-}
-
 // The plugins loaded in this process, by library and description: the same model with the same
 // numbers is that plugin again; a second description of the same code (the same model with other
 // numbers, in one Python process) gets a copy of the library of its own, since a library's
@@ -268,54 +188,6 @@ std::string indexed_digest(const fs::path& cache, const std::string& stem) {
 std::map<std::pair<std::string, std::string>, const ModelCommands*>& loaded_commands() {
   static std::map<std::pair<std::string, std::string>, const ModelCommands*> loaded;
   return loaded;
-}
-
-// A file's SHA-256 and size, read from a descriptor from its start.
-std::string fd_checksum(int fd, std::uintmax_t& size) {
-  Sha256 h;
-  size = 0;
-  std::vector<char> buffer(1 << 16);
-  for (;;) {
-    const ssize_t n = ::pread(fd, buffer.data(), buffer.size(), static_cast<off_t>(size));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return n == 0 ? h.hex() : std::string();
-    h.add(std::string_view(buffer.data(), static_cast<std::size_t>(n)));
-    size += static_cast<std::uintmax_t>(n);
-  }
-}
-
-// A file's SHA-256 and size (the plugin just built, for its manifest and the index): by its descriptor.
-std::string file_checksum(const fs::path& path, std::uintmax_t& size) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  size = 0;
-  if (fd < 0) return {};
-  const std::string digest = fd_checksum(fd, size);
-  ::close(fd);
-  return digest;
-}
-
-// An anonymous copy (memfd) of the library open at `fd`, for a second description, checked
-// against the digest the original was checked against. Nothing is written to the cache.
-int private_copy(int fd, const std::string& checksum) {
-  const int copy = ::memfd_create("wlx-plugin", MFD_CLOEXEC);
-  if (copy < 0) throw Error("--model-file", fmt::format("cannot make a copy of a plugin for a second set of numbers ({})", std::strerror(errno)));
-  std::vector<char> buffer(1 << 16);
-  for (off_t at = 0;;) {
-    const ssize_t n = ::pread(fd, buffer.data(), buffer.size(), at);
-    if (n < 0 && errno == EINTR) continue;
-    if (n == 0) break;
-    if (n < 0 || ::write(copy, buffer.data(), static_cast<std::size_t>(n)) != n) {
-      ::close(copy);
-      throw Error("--model-file", fmt::format("cannot make a copy of a plugin for a second set of numbers ({})", std::strerror(errno)));
-    }
-    at += n;
-  }
-  std::uintmax_t size = 0;
-  if (fd_checksum(copy, size) != checksum) {
-    ::close(copy);
-    throw Error("--model-file", "the copy of a plugin for a second set of numbers does not match its manifest");
-  }
-  return copy;
 }
 
 // The plugin of a complete entry, or null with the reason it cannot be used. Once loaded, it is
@@ -399,64 +271,6 @@ const ModelCommands* try_load(const fs::path& entry, const std::string& key, con
   return commands;  // never closed: its code and strings are in use until exit
 }
 
-// An exclusive lock on a file, held while the object lives (flock: released if the process dies).
-class FileLock {
- public:
-  explicit FileLock(const fs::path& path, const std::string& waiting_message) {
-    fd_ = ::open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC | O_NOFOLLOW, 0600);
-    if (fd_ < 0) throw Error("--model-file", fmt::format("cannot open the cache's lock {} ({})", path.string(), std::strerror(errno)));
-    if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
-    wlx::diagnose("{}\n", waiting_message);
-    while (::flock(fd_, LOCK_EX) != 0) {
-      if (errno != EINTR) throw Error("--model-file", fmt::format("cannot lock {} ({})", path.string(), std::strerror(errno)));
-      throw_if_interrupted();
-    }
-  }
-  ~FileLock() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  FileLock(const FileLock&) = delete;
-  FileLock& operator=(const FileLock&) = delete;
-
- private:
-  int fd_ = -1;
-};
-
-// Build folders of processes that died while compiling (kill -9): <stem>.build-*. Called with the
-// entry's lock held, which every build of that entry holds for its whole length, so none of them
-// belongs to a build that still runs (whatever pid namespace it ran in). Removed before building
-// again, so that nothing of them is left for good.
-void remove_abandoned_builds(const fs::path& cache, const std::string& stem) {
-  std::error_code ec;
-  const std::string prefix = stem + ".build-";
-  for (fs::directory_iterator it(cache, ec), end; !ec && it != end; it.increment(ec))
-    if (it->path().filename().string().rfind(prefix, 0) == 0) {
-      std::error_code removed;
-      fs::remove_all(it->path(), removed);
-    }
-}
-
-// A folder removed when the object goes, unless kept.
-struct TemporaryFolder {
-  fs::path path;
-  bool keep = false;
-  ~TemporaryFolder() {
-    std::error_code ec;
-    if (!keep && !path.empty()) fs::remove_all(path, ec);
-  }
-};
-
-// The first line of a compiler's log that reports an error (else its first line).
-std::string first_error(const std::string& log) {
-  std::istringstream in(log);
-  std::string first;
-  for (std::string l; std::getline(in, l);) {
-    if (first.empty() && !l.empty()) first = l;
-    if (l.find("error") != std::string::npos) return l;
-  }
-  return first.empty() ? "(no output)" : first;
-}
-
 // A path written into an #include: refused if it holds what a quoted include cannot carry.
 std::string include_line(const fs::path& path) {
   const std::string p = path.string();
@@ -465,98 +279,6 @@ std::string include_line(const fs::path& path) {
                                             "(WLX_CACHE_DIR) to a plain path",
                                             excerpt(p)));
   return "#include \"" + p + "\"\n";
-}
-
-// A compiler's command line that dies with wlx: util-linux's setpriv (Debian's essential set) sets
-// its parent-death signal, then runs it, so a wlx killed (kill -9) during a first use leaves no
-// compiler running. (GCC's driver dies so; the cc1plus it started finishes its file into the build
-// folder, which the next first use removes. Clang compiles in its driver's process.)
-std::vector<std::string> dying_with_wlx(const std::vector<std::string>& argv) {
-  static const bool setpriv = ::access("/usr/bin/setpriv", X_OK) == 0;
-  if (!setpriv) return argv;
-  std::vector<std::string> out{"/usr/bin/setpriv", "--pdeathsig", "KILL", "--"};
-  out.insert(out.end(), argv.begin(), argv.end());
-  return out;
-}
-
-struct Job {
-  std::string name;
-  std::vector<std::string> argv;
-  fs::path log;
-};
-
-// The wall time of each part of a first use (written to the entry's build-times.tsv: where the
-// time goes, for the user and for tools/readme_figures.sh).
-using Timings = std::vector<std::pair<std::string, double>>;
-
-// Runs the jobs, up to `parallel` at once; stops the others at the first failure or signal.
-// Returns each job's wall time, in the order they finished.
-Timings run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path& failed_logs) {
-  std::vector<std::pair<int, const Job*>> running;
-  std::map<int, std::chrono::steady_clock::time_point> started;
-  Timings timings;
-  std::size_t next = 0;
-  const auto stop_all = [&] {
-    for (const auto& [pid, job] : running) ::kill(pid, SIGTERM);
-    for (const auto& [pid, job] : running) wait_program(pid);
-    running.clear();
-  };
-  while (next < jobs.size() || !running.empty()) {
-    while (next < jobs.size() && running.size() < parallel) {
-      const Job& job = jobs[next++];
-      const int pid = start_program(dying_with_wlx(job.argv), {}, job.log.string());
-      if (pid < 0) {
-        stop_all();
-        throw Error("--model-file", fmt::format("cannot run '{}' for the {}{}", job.argv.front(), job.name,
-                                                job.argv.front() == compiler() ? " (set CXX to a C++ compiler)" : ""));
-      }
-      running.emplace_back(pid, &job);
-      started[pid] = std::chrono::steady_clock::now();
-    }
-    // Whichever finishes first frees its core for the next job.
-    int pid = 0;
-    std::vector<int> pids;
-    for (const auto& [p, job] : running) pids.push_back(p);
-    const ProgramRun r = wait_any_program(pids, pid);
-    if (pid == 0 && interrupt_signal() != 0) {  // within milliseconds of the signal, not when the compiles end
-      stop_all();
-      throw_if_interrupted();
-    }
-    const auto done = std::find_if(running.begin(), running.end(), [&](const auto& p) { return p.first == pid; });
-    if (done == running.end()) {
-      stop_all();
-      throw PluginBuildError("lost track of the compiler's processes");
-    }
-    const Job* job = done->second;
-    running.erase(done);
-    timings.emplace_back(job->name, std::chrono::duration<double>(std::chrono::steady_clock::now() - started[pid]).count());
-    if (interrupt_signal() != 0) {
-      stop_all();
-      throw_if_interrupted();
-    }
-    if (!r.started) {  // setpriv ran, the compiler did not (exit 127)
-      stop_all();
-      throw Error("--model-file", fmt::format("cannot run '{}' for the {}{}", job->argv.front(), job->name,
-                                              job->argv.front() == compiler() ? " (set CXX to a C++ compiler)" : ""));
-    }
-    if (!r.ok()) {
-      stop_all();
-      const std::string log = read_small(job->log, kMaxFileBytes);
-      std::error_code ec;
-      fs::remove_all(failed_logs, ec);
-      fs::create_directories(failed_logs, ec);
-      fs::copy_file(job->log, failed_logs / job->log.filename(), fs::copy_options::overwrite_existing, ec);
-      throw PluginBuildError(fmt::format("compiling the model's {} failed: {}\n  the whole log: {}", job->name,
-                                         first_error(log), (failed_logs / job->log.filename()).string()));
-    }
-  }
-  return timings;
-}
-
-std::string timings_text(const Timings& timings) {
-  std::string out = "part\tseconds\n";
-  for (const auto& [name, seconds] : timings) out += fmt::format("{}\t{:.2f}\n", name, seconds);
-  return out;
 }
 
 // A run of wlx-gen that did not succeed, as an error: the model file's mistake as wlx-gen states it
@@ -748,18 +470,6 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   timings.emplace_back("first use, in all", seconds);
   write(dir / "build-times.tsv", timings_text(timings));
   wlx::diagnose("wlx: compiled model {} in {:.1f} s\n", name, seconds);
-}
-
-// Records a plugin's SHA-256 in the cache's index (under its own lock: entries of other models are
-// built at the same time), replacing the entry's earlier line.
-void record_digest(const fs::path& cache, const std::string& stem, const std::string& digest) {
-  const FileLock lock(cache / "index.lock", "wlx: waiting for another wlx writing the cache's index");
-  std::istringstream in(index_text(cache));
-  std::string kept;
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty() && line.rfind(stem + " ", 0) != 0) kept += line + "\n";
-  write_file_atomically(index_path(cache).string(), kept + stem + " " + digest + "\n");
-  ::chmod(index_path(cache).c_str(), 0600);  // whatever the umask: the index is the user's alone
 }
 
 // The cache entry of the model file loaded last (load_model_file), for its viewer module.

@@ -236,80 +236,95 @@ int classify_branch(const Model& model, Limb limb, const Coordinates& s) {
 
 namespace {
 
-// Damped Newton (Levenberg-Marquardt) on the closure, limb by limb (the limbs decouple: each limb's
-// rows involve only its own joints), from the dependent joints in s. A limb's step solves
-// (J^T J + mu I) dx = -J^T r: with mu small it is Newton's step (quadratic convergence near a
-// regular solution), with mu large a short gradient step, so the method also descends from a far
-// or singular start (a straight leg). mu follows the gain ratio of each step (Nielsen's rule), one
-// generated closure evaluation serving the trial steps of every limb at once.
-NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coordinates& s, Data& data,
-                    const NewtonOptions& options) {
-  for (int k = 0; k < kCoordinateCount; ++k) require_finite(s, k);
+// What both of Newton's algorithms below keep per limb across their iterations.
+struct NewtonProgress {
   NewtonReport report;
   std::array<bool, kLimbCount> done{}, stalled{};
-  std::array<double, kLimbCount> mu{}, nu{};
-  const auto not_converged = [&](Limb limb, bool no_descent, double residual) {
-    return Error(std::string(limb_name(limb)),
-                 fmt::format("Newton's method did not converge{} (residual {:.3e} after {} iterations, tolerance "
-                             "{:.1e}): the target may be out of reach or the start too far from a solution; try a target "
-                             "nearer the limb's workspace, approach it in smaller steps from a solved pose, or give the "
-                             "limb a start nearer a solution (`start:` in the model file's limb)",
-                             no_descent ? ": no step lowers the residual any more" : "", residual,
-                             report.iterations[static_cast<std::size_t>(limb)], options.tolerance));
-  };
-  for (Limb limb : kLimbs) {
-    done[static_cast<std::size_t>(limb)] = !active[static_cast<std::size_t>(limb)];
-    nu[static_cast<std::size_t>(limb)] = 2;
+};
+
+double limb_residual(const gen::ClosureVector& Phi, const LimbIndices& idx) {
+  double r = 0;
+  for (int i = 0; i < idx.count; ++i) r = std::max(r, std::abs(Phi(idx.rows[static_cast<std::size_t>(i)])));
+  return r;
+}
+
+double half_square(const gen::ClosureVector& Phi, const LimbIndices& idx) {
+  double f = 0;
+  for (int i = 0; i < idx.count; ++i) f += 0.5 * Phi(idx.rows[static_cast<std::size_t>(i)]) * Phi(idx.rows[static_cast<std::size_t>(i)]);
+  return f;
+}
+
+// The limb's block of dPhi/ds (its rows against its own dependent joints) and its residual; a
+// smaller limb is padded with a unit diagonal and a zero residual.
+void limb_system(const Data& data, const LimbIndices& idx, LimbMatrix& J, LimbVector& r) {
+  J.setIdentity();
+  r.setZero();
+  for (int i = 0; i < idx.count; ++i) {
+    const int row = idx.rows[static_cast<std::size_t>(i)];
+    r(i) = data.Phi(row);
+    for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
   }
-  const auto limb_residual = [&](const gen::ClosureVector& Phi, const LimbIndices& idx) {
-    double r = 0;
-    for (int i = 0; i < idx.count; ++i) r = std::max(r, std::abs(Phi(idx.rows[static_cast<std::size_t>(i)])));
-    return r;
-  };
-  const auto half_square = [&](const gen::ClosureVector& Phi, const LimbIndices& idx) {
-    double f = 0;
-    for (int i = 0; i < idx.count; ++i) f += 0.5 * Phi(idx.rows[static_cast<std::size_t>(i)]) * Phi(idx.rows[static_cast<std::size_t>(i)]);
-    return f;
-  };
-  // The thesis' method (NewtonOptions::Method::backtracking): full Newton steps, each halved
-  // until max |Phi| of its limb decreases.
-  for (int iteration = 0; options.method == NewtonOptions::Method::backtracking; ++iteration) {
+}
+
+void copy_limb_joints(Limb limb, const Coordinates& from, Coordinates& s) {
+  const auto idx = indices(limb);
+  for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = from(idx.dep[static_cast<std::size_t>(j)]);
+}
+
+Error not_converged(Limb limb, bool no_descent, double residual, int iterations, const NewtonOptions& options) {
+  return Error(std::string(limb_name(limb)),
+               fmt::format("Newton's method did not converge{} (residual {:.3e} after {} iterations, tolerance "
+                           "{:.1e}): the target may be out of reach or the start too far from a solution; try a target "
+                           "nearer the limb's workspace, approach it in smaller steps from a solved pose, or give the "
+                           "limb a start nearer a solution (`start:` in the model file's limb)",
+                           no_descent ? ": no step lowers the residual any more" : "", residual, iterations,
+                           options.tolerance));
+}
+
+void require_finite_closure(const Data& data) {
+  if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
+}
+
+// Whether a limb with this residual is done: within the tolerance, or, once it stalled or ran out
+// of iterations, within the floor tolerance.
+bool limb_done(double residual, bool stalled, bool out_of_steps, const NewtonOptions& options) {
+  return residual <= options.tolerance || ((stalled || out_of_steps) && residual <= options.floor_tolerance);
+}
+
+// The thesis' method (NewtonOptions::Method::backtracking): full Newton steps, each halved until
+// max |Phi| of its limb decreases.
+void newton_backtracking(const Model& model, Coordinates& s, Data& data, const NewtonOptions& options, NewtonProgress& p) {
+  while (true) {
     closure(model, data, s, true);
-    if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
+    require_finite_closure(data);
     bool all_done = true;
     std::array<LimbVector, kLimbCount> step;
     std::array<double, kLimbCount> before{};
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
-      if (!active[l]) continue;
+      if (p.done[l]) continue;  // a converged limb stays converged: the limbs do not couple
       const auto idx = indices(limb);
-      if (done[l]) continue;  // a converged limb stays converged: the limbs do not couple
       before[l] = limb_residual(data.Phi, idx);
-      const bool out_of_steps = report.iterations[l] >= options.max_iterations;
-      done[l] = before[l] <= options.tolerance || ((stalled[l] || out_of_steps) && before[l] <= options.floor_tolerance);
-      if (done[l]) continue;
+      const bool out_of_steps = p.report.iterations[l] >= options.max_iterations;
+      p.done[l] = limb_done(before[l], p.stalled[l], out_of_steps, options);
+      if (p.done[l]) continue;
       all_done = false;
-      if (out_of_steps) throw not_converged(limb, false, before[l]);
-      // The limb's block of dPhi/ds: its rows against its own dependent joints.
-      LimbMatrix J = LimbMatrix::Identity();  // a smaller limb padded with a unit diagonal
-      LimbVector r = LimbVector::Zero();
-      for (int i = 0; i < idx.count; ++i) {
-        const int row = idx.rows[static_cast<std::size_t>(i)];
-        r(i) = data.Phi(row);
-        for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
-      }
+      if (out_of_steps) throw not_converged(limb, false, before[l], p.report.iterations[l], options);
+      LimbMatrix J;
+      LimbVector r;
+      limb_system(data, idx, J, r);
       if (!limb_steps::newton_step<gen::kMaxLimbSize>(J, r, step[l])) {
         // At a singular pose (straight leg, lever at 90 deg): Levenberg-Marquardt's step.
         const double mu = 1e-8 * std::max(1.0, J.squaredNorm());
         step[l] = limb_steps::regularized_step<gen::kMaxLimbSize>(J, r, mu);
       }
-      ++report.iterations[l];
+      ++p.report.iterations[l];
     }
-    if (all_done) break;
+    if (all_done) return;
     // Damping: halve a limb's step until its residual decreases.
     std::array<double, kLimbCount> lambda;
     lambda.fill(1.0);
-    std::array<bool, kLimbCount> accepted = done;
+    std::array<bool, kLimbCount> accepted = p.done;
     const Coordinates start = s;
     for (int halving = 0; halving < 40; ++halving) {
       for (Limb limb : kLimbs) {
@@ -333,50 +348,53 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
     }
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
-      stalled[l] = !done[l] && !accepted[l];
-      if (!stalled[l]) continue;
+      p.stalled[l] = !p.done[l] && !accepted[l];
       // No step length lowered the residual: stay where the residual was lowest.
-      const auto idx = indices(limb);
-      for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]);
+      if (p.stalled[l]) copy_limb_joints(limb, start, s);
     }
   }
-  if (options.method == NewtonOptions::Method::levenberg_marquardt) {
+}
+
+// Damped Newton (Levenberg-Marquardt): a limb's step solves (J^T J + mu I) dx = -J^T r. With mu
+// small it is Newton's step (quadratic convergence near a regular solution), with mu large a short
+// gradient step, so the method also descends from a far or singular start (a straight leg). mu
+// follows the gain ratio of each step (Nielsen's rule), one generated closure evaluation serving
+// the trial steps of every limb at once.
+void newton_levenberg_marquardt(const Model& model, Coordinates& s, Data& data, const NewtonOptions& options,
+                                NewtonProgress& p) {
+  std::array<double, kLimbCount> mu{}, nu{};
+  nu.fill(2);
   closure(model, data, s, true);
-  if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
+  require_finite_closure(data);
   std::array<LimbVector, kLimbCount> step, gradient;
   std::array<double, kLimbCount> before{};
-  for (int round = 0;; ++round) {
+  while (true) {
     bool all_done = true;
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
-      if (done[l]) continue;
+      if (p.done[l]) continue;
       const auto idx = indices(limb);
       const double residual = limb_residual(data.Phi, idx);
-      const bool out_of_steps = report.iterations[l] >= options.max_iterations;
-      done[l] = residual <= options.tolerance || ((stalled[l] || out_of_steps) && residual <= options.floor_tolerance);
-      if (done[l]) continue;
-      if (stalled[l] || out_of_steps) throw not_converged(limb, stalled[l], residual);
+      const bool out_of_steps = p.report.iterations[l] >= options.max_iterations;
+      p.done[l] = limb_done(residual, p.stalled[l], out_of_steps, options);
+      if (p.done[l]) continue;
+      if (p.stalled[l] || out_of_steps) throw not_converged(limb, p.stalled[l], residual, p.report.iterations[l], options);
       all_done = false;
-      // The limb's block of dPhi/ds (a smaller limb padded with a unit diagonal and zero residual).
-      LimbMatrix J = LimbMatrix::Identity();
-      LimbVector r = LimbVector::Zero();
-      for (int i = 0; i < idx.count; ++i) {
-        const int row = idx.rows[static_cast<std::size_t>(i)];
-        r(i) = data.Phi(row);
-        for (int j = 0; j < idx.count; ++j) J(i, j) = data.dPhi_ds(row, idx.dep[static_cast<std::size_t>(j)]);
-      }
+      LimbMatrix J;
+      LimbVector r;
+      limb_system(data, idx, J, r);
       gradient[l] = J.transpose() * r;
       if (mu[l] == 0) mu[l] = 1e-9 * std::max(1.0, J.colwise().squaredNorm().maxCoeff());  // nearly Newton's step first
       // As the least-squares problem [J; sqrt(mu) I] dx = [-r; 0], by QR (limb_steps.hpp).
       step[l] = limb_steps::damped_step<gen::kMaxLimbSize>(J, r, mu[l]);
       before[l] = half_square(data.Phi, idx);
-      ++report.iterations[l];
+      ++p.report.iterations[l];
     }
-    if (all_done) break;
+    if (all_done) return;
     const Coordinates start = s;
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
-      if (done[l]) continue;
+      if (p.done[l]) continue;
       const auto idx = indices(limb);
       for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) += step[l](j);
     }
@@ -384,9 +402,8 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
     bool restore = false;
     for (Limb limb : kLimbs) {
       const auto l = static_cast<std::size_t>(limb);
-      if (done[l]) continue;
-      const auto idx = indices(limb);
-      const double after = half_square(data.Phi, idx);
+      if (p.done[l]) continue;
+      const double after = half_square(data.Phi, indices(limb));
       // The decrease the linear model predicts: dx^T (mu dx - g) / 2 > 0.
       const double predicted = 0.5 * step[l].dot(mu[l] * step[l] - gradient[l]);
       const double gain = predicted > 0 ? (before[l] - after) / predicted : -1;
@@ -394,20 +411,23 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
         mu[l] *= std::max(1.0 / 3, 1 - std::pow(2 * gain - 1, 3));
         nu[l] = 2;
       } else {
-        for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = start(idx.dep[static_cast<std::size_t>(j)]);
+        copy_limb_joints(limb, start, s);
         restore = true;
         mu[l] *= nu[l];
         nu[l] *= 2;
         // No damping helps any more: the residual is at its floor (or a local minimum).
-        stalled[l] = nu[l] > 1e6 || !std::isfinite(mu[l]);  // twenty rejected steps in a row
+        p.stalled[l] = nu[l] > 1e6 || !std::isfinite(mu[l]);  // twenty rejected steps in a row
       }
     }
     if (restore) closure(model, data, s, true);  // Phi and dPhi/ds where every limb now stands
-    if (!data.Phi.allFinite()) throw Error("", "closure residual is not finite: the starting guess is unusable");
+    require_finite_closure(data);
   }
-  }
-  // Angles into (-pi, pi], but only where that keeps the closure: a row such as theta_4 + theta_5 = 0
-  // holds for theta_4 = -pi, not for its wrapped +pi, when the input theta_5 is pi.
+}
+
+// Angles into (-pi, pi], but only where that keeps the closure: a row such as theta_4 + theta_5 = 0
+// holds for theta_4 = -pi, not for its wrapped +pi, when the input theta_5 is pi.
+void wrap_angles_keeping_closure(const Model& model, const std::array<bool, kLimbCount>& active, const NewtonOptions& options,
+                                 Coordinates& s, Data& data) {
   std::array<double, kLimbCount> converged{};
   for (Limb limb : kLimbs)
     if (active[static_cast<std::size_t>(limb)]) converged[static_cast<std::size_t>(limb)] = limb_residual(data.Phi, indices(limb));
@@ -424,11 +444,24 @@ NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coo
   for (Limb limb : kLimbs) {
     const auto l = static_cast<std::size_t>(limb);
     if (!active[l] || limb_residual(data.Phi, indices(limb)) <= std::max(options.tolerance, 2 * converged[l])) continue;
-    const auto idx = indices(limb);
-    for (int j = 0; j < idx.count; ++j) s(idx.dep[static_cast<std::size_t>(j)]) = unwrapped(idx.dep[static_cast<std::size_t>(j)]);
+    copy_limb_joints(limb, unwrapped, s);
     reverted = true;
   }
   if (reverted) closure(model, data, s, false);
+}
+
+// Newton's method on the closure, limb by limb (the limbs decouple: each limb's rows involve only
+// its own joints), from the dependent joints in s, by the algorithm options.method names; then the
+// angles wrapped and the result checked.
+NewtonReport newton(const Model& model, std::array<bool, kLimbCount> active, Coordinates& s, Data& data,
+                    const NewtonOptions& options) {
+  for (int k = 0; k < kCoordinateCount; ++k) require_finite(s, k);
+  NewtonProgress progress;
+  for (Limb limb : kLimbs) progress.done[static_cast<std::size_t>(limb)] = !active[static_cast<std::size_t>(limb)];
+  if (options.method == NewtonOptions::Method::backtracking) newton_backtracking(model, s, data, options, progress);
+  if (options.method == NewtonOptions::Method::levenberg_marquardt) newton_levenberg_marquardt(model, s, data, options, progress);
+  wrap_angles_keeping_closure(model, active, options, s, data);
+  NewtonReport& report = progress.report;
   for (Limb limb : kLimbs) {
     if (!active[static_cast<std::size_t>(limb)]) continue;
     const double r = limb_residual(data.Phi, indices(limb));

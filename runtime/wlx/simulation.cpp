@@ -289,6 +289,63 @@ double lowest_clearance(const Params& p, const Coordinates& s) {
 #endif
 }
 
+namespace {
+
+// A sample's kinematic part: what the run's last evaluation left in (s, s') and data.
+void kinematic_sample(const Model& model, Data& data, const Coordinates& s, const Coordinates& sdot, Sample& smp) {
+  smp.s = s;
+  smp.sdot = sdot;
+  smp.cond_J_beta = data.cond_J_beta;
+  forward_kinematics(model, data, s);
+  for (int w = 0; w < kWheelCount; ++w) {
+    const int f = gen::kWheels[static_cast<std::size_t>(w)].contact_frame;
+    for (int i = 0; i < 2; ++i) smp.contacts(2 * w + i) = data.frame_positions(i, f);  // compiles for no wheels
+  }
+  smp.contact_velocity = contact_velocities(model, data, s, sdot);  // also fills data.C, data.spin
+  smp.nh_residual = data.C * sdot;
+  smp.spin_rate = data.spin * sdot;
+  smp.clearance = lowest_clearance(model.params(), s);
+}
+
+// A dynamics sample's contact forces, margins and momentum balance; the run stops where a contact
+// would pull on the ground or the machine would tip (unless asked to go on), and always where the
+// forces do not balance the bodies' accelerations: a result the model does not satisfy.
+void contact_sample(const Model& model, Data& data, const Scenario& sc, const Coordinates& s, const DynamicsTerms& terms,
+                    const TorqueVector& tau, Sample& smp) {
+  if constexpr (kContactCount > 0) {
+    // A non-finite torque or force is named by check_finite, which runs next, by its column.
+    if (!(tau.allFinite() && terms.tau_bodies.allFinite())) return;
+    contact_forces(model, data, s, terms, tau, smp.forces);
+    const MomentumBalance balance = momentum_balance(model, data, s, terms.sdot, terms.sddot, smp.forces);
+    smp.momentum_residual = std::max(balance.force, balance.moment);
+    if (!(smp.momentum_residual <= 1e-6))
+      throw Error("contacts", fmt::format("the contact forces do not balance the bodies' accelerations (relative residual "
+                                          "{:.3g}): a held input moves the machine as a whole, or the model's contacts are "
+                                          "not all closure rows to the ground",
+                                          smp.momentum_residual));
+    stability(model, data, s, smp.forces, smp.stability);
+    if (!sc.stop_on_contact_loss) return;
+    // Tipping first: where it happens a contact also unloads, and the edge says more.
+    if (smp.stability.polygon_size == 0)
+      throw Error("contacts", "no contact carries load: the machine leaves the ground, which the model does not describe");
+    if (smp.stability.tip_angle <= 0)
+      throw Error("contacts", fmt::format("the machine tips over the edge {}-{} (force-angle margin {:.4g} deg)",
+                                          contact_name(smp.stability.tip_edge[0]), contact_name(smp.stability.tip_edge[1]),
+                                          smp.stability.tip_angle * 180 / 3.14159265358979323846));
+    for (int c = 0; c < kContactCount; ++c)
+      if (gen::kContacts[static_cast<std::size_t>(c)].supports && smp.forces.normal(c) < 0)
+        throw Error("contacts", fmt::format("contact {} would pull on the ground (normal force {:.6g} N): it lifts off, which "
+                                            "the model does not describe; another weighting may keep it down, or "
+                                            "\"on_contact_loss\": \"continue\" goes on",
+                                            contact_name(c), smp.forces.normal(c)));
+  } else {
+    static_cast<void>(model), static_cast<void>(data), static_cast<void>(sc), static_cast<void>(s);
+    static_cast<void>(terms), static_cast<void>(tau), static_cast<void>(smp);
+  }
+}
+
+}  // namespace
+
 Trajectory simulate(const Scenario& sc, const Progress& progress) {
   sc.validate();
   std::vector<Sample> samples;
@@ -309,57 +366,6 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
   Trajectory out;
   const long n = sc.samples();
   double h = sc.dt;  // dopri5's step, adapted as it goes
-
-  // The samples' kinematic part: what the run's last evaluation left in (s, s') and data.
-  const auto kinematic_sample = [&](Sample& smp, const Coordinates& s, const Coordinates& sdot) {
-    smp.s = s;
-    smp.sdot = sdot;
-    smp.cond_J_beta = data.cond_J_beta;
-    forward_kinematics(model, data, s);
-    for (int w = 0; w < kWheelCount; ++w) {
-      const int f = gen::kWheels[static_cast<std::size_t>(w)].contact_frame;
-      for (int i = 0; i < 2; ++i) smp.contacts(2 * w + i) = data.frame_positions(i, f);  // compiles for no wheels
-    }
-    smp.contact_velocity = contact_velocities(model, data, s, sdot);  // also fills data.C, data.spin
-    smp.nh_residual = data.C * sdot;
-    smp.spin_rate = data.spin * sdot;
-    smp.clearance = lowest_clearance(model.params(), s);
-  };
-
-  // A dynamics sample's contact forces, margins and momentum balance; the run stops where a
-  // contact would pull on the ground or the machine would tip (unless asked to go on), and always
-  // where the forces do not balance the bodies' accelerations: a result the model does not satisfy.
-  const auto contact_sample = [&](Sample& smp, const Coordinates& s, const DynamicsTerms& terms, const TorqueVector& tau) {
-    if constexpr (kContactCount > 0) {
-      // A non-finite torque or force is named by check_finite, which runs next, by its column.
-      if (!(tau.allFinite() && terms.tau_bodies.allFinite())) return;
-      contact_forces(model, data, s, terms, tau, smp.forces);
-      const MomentumBalance balance = momentum_balance(model, data, s, terms.sdot, terms.sddot, smp.forces);
-      smp.momentum_residual = std::max(balance.force, balance.moment);
-      if (!(smp.momentum_residual <= 1e-6))
-        throw Error("contacts", fmt::format("the contact forces do not balance the bodies' accelerations (relative residual "
-                                            "{:.3g}): a held input moves the machine as a whole, or the model's contacts are "
-                                            "not all closure rows to the ground",
-                                            smp.momentum_residual));
-      stability(model, data, s, smp.forces, smp.stability);
-      if (!sc.stop_on_contact_loss) return;
-      // Tipping first: where it happens a contact also unloads, and the edge says more.
-      if (smp.stability.polygon_size == 0)
-        throw Error("contacts", "no contact carries load: the machine leaves the ground, which the model does not describe");
-      if (smp.stability.tip_angle <= 0)
-        throw Error("contacts", fmt::format("the machine tips over the edge {}-{} (force-angle margin {:.4g} deg)",
-                                            contact_name(smp.stability.tip_edge[0]), contact_name(smp.stability.tip_edge[1]),
-                                            smp.stability.tip_angle * 180 / 3.14159265358979323846));
-      for (int c = 0; c < kContactCount; ++c)
-        if (gen::kContacts[static_cast<std::size_t>(c)].supports && smp.forces.normal(c) < 0)
-          throw Error("contacts", fmt::format("contact {} would pull on the ground (normal force {:.6g} N): it lifts off, which "
-                                              "the model does not describe; another weighting may keep it down, or "
-                                              "\"on_contact_loss\": \"continue\" goes on",
-                                              contact_name(c), smp.forces.normal(c)));
-    } else {
-      static_cast<void>(smp), static_cast<void>(s), static_cast<void>(terms), static_cast<void>(tau);
-    }
-  };
 
   // The loop of every run: a sample after each step's first evaluation, then the step. `name(i)`
   // names the state's entry i for a message about a value that became non-finite.
@@ -416,7 +422,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
     f.s = sc.initial;
     start_continuation(model, f.s, f.branches);
     const auto fill = [&](Sample& smp) {
-      kinematic_sample(smp, f.s, f.terms.sdot);
+      kinematic_sample(model, data, f.s, f.terms.sdot, smp);
       smp.tau = f.tau;
       smp.Qstar = f.terms.Qstar;
       smp.u = f.u;
@@ -429,7 +435,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
 #if __has_include(<wlx/gen/generalized_forces.hpp>)  // (a run driven by torques needs a dynamics section)
       gen::generalized_forces(f.s, t.sdot, t.sddot, t.T, model.params(), {.tau = &t.tau_bodies});
 #endif
-      contact_sample(smp, f.s, t, f.tau);
+      contact_sample(model, data, sc, f.s, t, f.tau, smp);
       // Driven by torques, the body may fall: the model has no contact but its feet and wheels.
       if (smp.clearance < 0)
         throw Error("clearance", fmt::format("the clearance box's lowest corner is {:.4f} m below the ground: the body "
@@ -445,14 +451,14 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
     const CommandVector u = sc.commanded_speeds();
     DynamicsTerms terms;
     const auto fill = [&](Sample& smp) {
-      kinematic_sample(smp, f.s, f.sdot);
+      kinematic_sample(model, data, f.s, f.sdot, smp);
       if (sc.weighting) {
         inverse_dynamics(model, data, f.s, u, CommandVector::Zero(), terms, sc.nonholonomic);
         smp.Qstar = terms.Qstar;
         smp.tau = sc.weighting->kind == Weighting::Kind::contacts
                       ? distribute_torques_on_contacts(model, data, f.s, terms).tau
                       : distribute_torques(terms.J_beta, terms.Qstar, *sc.weighting);
-        contact_sample(smp, f.s, terms, smp.tau);
+        contact_sample(model, data, sc, f.s, terms, smp.tau, smp);
       }
     };
     integrate(f, InputVector(sc.initial.head<kInputCount>()), fill, coordinate);
