@@ -81,10 +81,8 @@ std::string horner(const std::vector<double>& c, const char* var = "r2", std::si
   return fmt::format("{} + {} * ({})", literal(c[i]), var, horner(c, var, i + 1));
 }
 
-}  // namespace
-
-EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
-  const TrigConstants k = derive_constants();
+// The header's opening: its banner, what its functions do, how accurately and by which method.
+std::string trig_header_opening(const Model& m, const EmitOptions& opt) {
   std::string t = banner(m, opt, "sin and cos, and atan2, of many angles in one vectorized pass (used by the generated functions).");
   t += R"(//
 // sincos(x, sin_x, cos_x) fills sin_x[i] = sin(x[i]) and cos_x[i] = cos(x[i]) for a fixed-size
@@ -105,9 +103,13 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
 #include <type_traits>
 
 )";
-  t += namespace_open(opt);
-  t += "\nnamespace trig_detail {\n\n";
-  t += fmt::format(
+  return t;
+}
+
+// trig_detail's constants: pi/2 in three parts for sincos' reduction; atan(k/8), pi/2 and pi in two
+// for atan2.
+std::string trig_constants(const TrigConstants& k) {
+  std::string t = fmt::format(
       "inline constexpr double kTwoOverPi = {};\n"
       "inline constexpr double kRoundToInteger = 6755399441055744.0;  // 1.5 * 2^52: x + this - this rounds x\n"
       "inline constexpr double kHalfPiHi = {};  // 33 bits\n"
@@ -127,22 +129,29 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
       "inline constexpr double kHalfPiHead = {}, kHalfPiTail = {};\n"
       "inline constexpr double kPiHead = {}, kPiTail = {};\n\n",
       list(k.atan_hi), list(k.atan_lo), literal(k.half_pi_hi2), literal(k.half_pi_lo2), literal(k.pi_hi), literal(k.pi_lo));
-  t += "#if (defined(__GNUC__) || defined(__clang__)) && !defined(__FAST_MATH__)\n"
-       "#define WLX_GEN_SIMD_SINCOS 1\n"
-       "// 4 lanes whatever the build targets: one AVX register, so that the AVX2 version of the generated\n"
-       "// functions (types.hpp) gets them, or two SSE2 registers, two independent chains (as fast as one\n"
-       "// 2-lane vector at a time). Vectors are passed by reference only: by value, a 32-byte vector's\n"
-       "// calling convention would depend on whether the translation unit targets AVX.\n"
-       "// reinterpret_cast between vector types of the same size gives the same bits (GCC and clang).\n"
-       "inline constexpr std::size_t kLanes = 4;\n"
-       "typedef double Doubles __attribute__((vector_size(32)));\n"
-       "typedef std::uint64_t Bits __attribute__((vector_size(32)));\n\n"
-       "inline void sincos_lanes(const Doubles& x, Doubles& sin_x, Doubles& cos_x) noexcept {\n"
-       "  const Doubles shifted = x * kTwoOverPi + kRoundToInteger;\n"
-       "  const Doubles n = shifted - kRoundToInteger;          // nearest integer to x / (pi/2)\n"
-       "  const Bits quadrant = reinterpret_cast<Bits>(shifted);  // its low bits: n mod 4\n"
-       "  const Doubles r = ((x - n * kHalfPiHi) - n * kHalfPiMid) - n * kHalfPiLo;\n"
-       "  const Doubles r2 = r * r;\n";
+  return t;
+}
+
+// sincos and atan2 of 4 angles at once on GCC / clang vectors, their polynomials in Horner form with
+// the derived coefficients (none without vector extensions, or with -ffast-math).
+std::string lane_kernels(const TrigConstants& k) {
+  std::string t =
+      "#if (defined(__GNUC__) || defined(__clang__)) && !defined(__FAST_MATH__)\n"
+      "#define WLX_GEN_SIMD_SINCOS 1\n"
+      "// 4 lanes whatever the build targets: one AVX register, so that the AVX2 version of the generated\n"
+      "// functions (types.hpp) gets them, or two SSE2 registers, two independent chains (as fast as one\n"
+      "// 2-lane vector at a time). Vectors are passed by reference only: by value, a 32-byte vector's\n"
+      "// calling convention would depend on whether the translation unit targets AVX.\n"
+      "// reinterpret_cast between vector types of the same size gives the same bits (GCC and clang).\n"
+      "inline constexpr std::size_t kLanes = 4;\n"
+      "typedef double Doubles __attribute__((vector_size(32)));\n"
+      "typedef std::uint64_t Bits __attribute__((vector_size(32)));\n\n"
+      "inline void sincos_lanes(const Doubles& x, Doubles& sin_x, Doubles& cos_x) noexcept {\n"
+      "  const Doubles shifted = x * kTwoOverPi + kRoundToInteger;\n"
+      "  const Doubles n = shifted - kRoundToInteger;          // nearest integer to x / (pi/2)\n"
+      "  const Bits quadrant = reinterpret_cast<Bits>(shifted);  // its low bits: n mod 4\n"
+      "  const Doubles r = ((x - n * kHalfPiHi) - n * kHalfPiMid) - n * kHalfPiLo;\n"
+      "  const Doubles r2 = r * r;\n";
   // r * (1 + r2 p) rather than r + r r2 p keeps the sign of sin(-0) = -0.
   t += fmt::format("  const Doubles s = r * (1.0 + r2 * ({}));\n", horner(k.sin_coefficients));
   t += fmt::format("  const Doubles c = 1.0 - 0.5 * r2 + r2 * r2 * ({});\n", horner(k.cos_coefficients));
@@ -187,115 +196,133 @@ EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
        "  angle = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(a) ^ (reinterpret_cast<Bits>(y < 0.0) & sign));  // y < 0: -a; y = -0 counts as +0\n"
        "}\n"
        "#endif\n\n";
-  t += "}  // namespace trig_detail\n\n"
-       "template <std::size_t N>\n"
-       "inline void sincos(const std::array<double, N>& x, std::array<double, N>& sin_x, std::array<double, N>& cos_x) noexcept {\n"
-       "#if defined(WLX_GEN_SIMD_SINCOS)\n"
-       "  using trig_detail::Doubles;\n"
-       "  constexpr std::size_t lanes = trig_detail::kLanes, full = N / lanes * lanes;\n"
-       "  // Loops, not unrolled: clang -O3 unrolls this one and the check below completely, which\n"
-       "  // made the generated forward kinematics 45% slower than at -O2 (GCC keeps them loops).\n"
-       "#if defined(__clang__)\n"
-       "#pragma clang loop unroll(disable)\n"
-       "#endif\n"
-       "  for (std::size_t i = 0; i < full; i += lanes) {\n"
-       "    Doubles xv, sv, cv;\n"
-       "    std::memcpy(&xv, &x[i], sizeof xv);\n"
-       "    trig_detail::sincos_lanes(xv, sv, cv);\n"
-       "    std::memcpy(&sin_x[i], &sv, sizeof sv);\n"
-       "    std::memcpy(&cos_x[i], &cv, sizeof cv);\n"
-       "  }\n"
-       "  if constexpr (full < N) {  // the last, partly filled vector\n"
-       "    Doubles xv{}, sv, cv;\n"
-       "    std::memcpy(&xv, &x[full], (N - full) * sizeof(double));\n"
-       "    trig_detail::sincos_lanes(xv, sv, cv);\n"
-       "    std::memcpy(&sin_x[full], &sv, (N - full) * sizeof(double));\n"
-       "    std::memcpy(&cos_x[full], &cv, (N - full) * sizeof(double));\n"
-       "  }\n"
-       "#if defined(__clang__)\n"
-       "#pragma clang loop unroll(disable)  // a check per angle, each a branch on the fast path\n"
-       "#endif\n"
-       "  for (std::size_t i = 0; i < N; ++i)\n"
-       "    if (!(std::abs(x[i]) <= trig_detail::kFastPathLimit)) {  // rare: huge, infinite or NaN\n"
-       "      sin_x[i] = std::sin(x[i]);\n"
-       "      cos_x[i] = std::cos(x[i]);\n"
-       "    }\n"
-       "#else\n"
-       "  for (std::size_t i = 0; i < N; ++i) {\n"
-       "    sin_x[i] = std::sin(x[i]);\n"
-       "    cos_x[i] = std::cos(x[i]);\n"
-       "  }\n"
-       "#endif\n"
-       "}\n\n"
-       "// Any other scalar type (float, automatic-differentiation numbers): its own sin and cos, found by\n"
-       "// argument-dependent lookup, or std::sin and std::cos. The exactness guarantee above is for double.\n"
-       "template <typename Scalar, std::size_t N>\n"
-       "inline void sincos(const std::array<Scalar, N>& x, std::array<Scalar, N>& sin_x, std::array<Scalar, N>& cos_x) noexcept {\n"
-       "  using std::cos;\n"
-       "  using std::sin;\n"
-       "  for (std::size_t i = 0; i < N; ++i) {\n"
-       "    sin_x[i] = sin(x[i]);\n"
-       "    cos_x[i] = cos(x[i]);\n"
-       "  }\n"
-       "}\n\n"
-       "// atan2(y, x, angle) fills angle[i] = atan2(y[i], x[i]) for fixed-size arrays, in (-pi, pi]: a half\n"
-       "// turn is +pi (y = -0 counts as +0), and the origin gives 0 (pi for x = -0). Accuracy: within\n"
-       "// 2 ulp of the result of the correctly rounded values for finite arguments; infinite or NaN ones\n"
-       "// go to std::atan2.\n"
-       "// Method: octant reduction to t = min/max of |y|, |x| in [0, 1]; atan t = atan(k/8) + atan u with\n"
-       "// k/8 the nearest eighth (k = 0 below 1/8), u = (t - k/8) / (1 + t k/8), |u| <= 1/8, and a Taylor\n"
-       "// polynomial of atan u;\n"
-       "// the octant by bit masks, so the pass is branch-free on SIMD registers like sincos().\n"
-       "template <std::size_t N>\n"
-       "inline void atan2(const std::array<double, N>& y, const std::array<double, N>& x, std::array<double, N>& angle) noexcept {\n"
-       "#if defined(WLX_GEN_SIMD_SINCOS)\n"
-       "  using trig_detail::Doubles;\n"
-       "  constexpr std::size_t lanes = trig_detail::kLanes, full = N / lanes * lanes;\n"
-       "#if defined(__clang__)\n"
-       "#pragma clang loop unroll(disable)  // as in sincos()\n"
-       "#endif\n"
-       "  for (std::size_t i = 0; i < full; i += lanes) {\n"
-       "    Doubles yv, xv;\n"
-       "    std::memcpy(&yv, &y[i], sizeof yv);\n"
-       "    std::memcpy(&xv, &x[i], sizeof xv);\n"
-       "    Doubles av;\n"
-       "    trig_detail::atan2_lanes(yv, xv, av);\n"
-       "    std::memcpy(&angle[i], &av, sizeof av);\n"
-       "  }\n"
-       "  if constexpr (full < N) {  // the last, partly filled vector\n"
-       "    Doubles yv{}, xv{};\n"
-       "    std::memcpy(&yv, &y[full], (N - full) * sizeof(double));\n"
-       "    std::memcpy(&xv, &x[full], (N - full) * sizeof(double));\n"
-       "    Doubles av;\n"
-       "    trig_detail::atan2_lanes(yv, xv, av);\n"
-       "    std::memcpy(&angle[full], &av, (N - full) * sizeof(double));\n"
-       "  }\n"
-       "#if defined(__clang__)\n"
-       "#pragma clang loop unroll(disable)\n"
-       "#endif\n"
-       "  for (std::size_t i = 0; i < N; ++i)\n"
-       "    if (!(std::abs(y[i]) <= 1.7976931348623157e308 && std::abs(x[i]) <= 1.7976931348623157e308)) {  // rare: inf, NaN\n"
-       "      angle[i] = std::atan2(y[i], x[i]);\n"
-       "      if (angle[i] == -trig_detail::kPiHead) angle[i] = trig_detail::kPiHead;\n"
-       "    }\n"
-       "#else\n"
-       "  for (std::size_t i = 0; i < N; ++i) {\n"
-       "    angle[i] = std::atan2(y[i] + 0.0, x[i]);  // + 0.0: -0 to +0, so a half turn is +pi\n"
-       "    if (angle[i] == -trig_detail::kPiHead) angle[i] = trig_detail::kPiHead;\n"
-       "  }\n"
-       "#endif\n"
-       "}\n\n"
-       "// float and long double: std::atan2, with the same conventions (a half turn is +pi).\n"
-       "template <typename Scalar, std::size_t N>\n"
-       "inline void atan2(const std::array<Scalar, N>& y, const std::array<Scalar, N>& x, std::array<Scalar, N>& angle) noexcept {\n"
-       "  static_assert(std::is_floating_point_v<Scalar>, \"atan2 of arrays is for floating-point types\");\n"
-       "  const Scalar pi = Scalar(trig_detail::kPiHead);\n"
-       "  for (std::size_t i = 0; i < N; ++i) {\n"
-       "    angle[i] = std::atan2(y[i] + Scalar(0), x[i]);  // + 0: -0 to +0, so a half turn is +pi\n"
-       "    if (angle[i] == -pi) angle[i] = pi;\n"
-       "  }\n"
-       "}\n\n";
-  t += namespace_close(opt);
+  return t;
+}
+
+// sincos() of fixed-size arrays: double through the lane kernel (std::sin and std::cos beyond its
+// range), any other scalar type through its own sin and cos.
+std::string sincos_of_arrays() {
+  return "template <std::size_t N>\n"
+         "inline void sincos(const std::array<double, N>& x, std::array<double, N>& sin_x, std::array<double, N>& cos_x) noexcept {\n"
+         "#if defined(WLX_GEN_SIMD_SINCOS)\n"
+         "  using trig_detail::Doubles;\n"
+         "  constexpr std::size_t lanes = trig_detail::kLanes, full = N / lanes * lanes;\n"
+         "  // Loops, not unrolled: clang -O3 unrolls this one and the check below completely, which\n"
+         "  // made the generated forward kinematics 45% slower than at -O2 (GCC keeps them loops).\n"
+         "#if defined(__clang__)\n"
+         "#pragma clang loop unroll(disable)\n"
+         "#endif\n"
+         "  for (std::size_t i = 0; i < full; i += lanes) {\n"
+         "    Doubles xv, sv, cv;\n"
+         "    std::memcpy(&xv, &x[i], sizeof xv);\n"
+         "    trig_detail::sincos_lanes(xv, sv, cv);\n"
+         "    std::memcpy(&sin_x[i], &sv, sizeof sv);\n"
+         "    std::memcpy(&cos_x[i], &cv, sizeof cv);\n"
+         "  }\n"
+         "  if constexpr (full < N) {  // the last, partly filled vector\n"
+         "    Doubles xv{}, sv, cv;\n"
+         "    std::memcpy(&xv, &x[full], (N - full) * sizeof(double));\n"
+         "    trig_detail::sincos_lanes(xv, sv, cv);\n"
+         "    std::memcpy(&sin_x[full], &sv, (N - full) * sizeof(double));\n"
+         "    std::memcpy(&cos_x[full], &cv, (N - full) * sizeof(double));\n"
+         "  }\n"
+         "#if defined(__clang__)\n"
+         "#pragma clang loop unroll(disable)  // a check per angle, each a branch on the fast path\n"
+         "#endif\n"
+         "  for (std::size_t i = 0; i < N; ++i)\n"
+         "    if (!(std::abs(x[i]) <= trig_detail::kFastPathLimit)) {  // rare: huge, infinite or NaN\n"
+         "      sin_x[i] = std::sin(x[i]);\n"
+         "      cos_x[i] = std::cos(x[i]);\n"
+         "    }\n"
+         "#else\n"
+         "  for (std::size_t i = 0; i < N; ++i) {\n"
+         "    sin_x[i] = std::sin(x[i]);\n"
+         "    cos_x[i] = std::cos(x[i]);\n"
+         "  }\n"
+         "#endif\n"
+         "}\n\n"
+         "// Any other scalar type (float, automatic-differentiation numbers): its own sin and cos, found by\n"
+         "// argument-dependent lookup, or std::sin and std::cos. The exactness guarantee above is for double.\n"
+         "template <typename Scalar, std::size_t N>\n"
+         "inline void sincos(const std::array<Scalar, N>& x, std::array<Scalar, N>& sin_x, std::array<Scalar, N>& cos_x) noexcept {\n"
+         "  using std::cos;\n"
+         "  using std::sin;\n"
+         "  for (std::size_t i = 0; i < N; ++i) {\n"
+         "    sin_x[i] = sin(x[i]);\n"
+         "    cos_x[i] = cos(x[i]);\n"
+         "  }\n"
+         "}\n\n";
+}
+
+// atan2() of fixed-size arrays: double through the lane kernel (std::atan2 for infinite or NaN
+// arguments), float and long double through std::atan2.
+std::string atan2_of_arrays() {
+  return "// atan2(y, x, angle) fills angle[i] = atan2(y[i], x[i]) for fixed-size arrays, in (-pi, pi]: a half\n"
+         "// turn is +pi (y = -0 counts as +0), and the origin gives 0 (pi for x = -0). Accuracy: within\n"
+         "// 2 ulp of the result of the correctly rounded values for finite arguments; infinite or NaN ones\n"
+         "// go to std::atan2.\n"
+         "// Method: octant reduction to t = min/max of |y|, |x| in [0, 1]; atan t = atan(k/8) + atan u with\n"
+         "// k/8 the nearest eighth (k = 0 below 1/8), u = (t - k/8) / (1 + t k/8), |u| <= 1/8, and a Taylor\n"
+         "// polynomial of atan u;\n"
+         "// the octant by bit masks, so the pass is branch-free on SIMD registers like sincos().\n"
+         "template <std::size_t N>\n"
+         "inline void atan2(const std::array<double, N>& y, const std::array<double, N>& x, std::array<double, N>& angle) noexcept {\n"
+         "#if defined(WLX_GEN_SIMD_SINCOS)\n"
+         "  using trig_detail::Doubles;\n"
+         "  constexpr std::size_t lanes = trig_detail::kLanes, full = N / lanes * lanes;\n"
+         "#if defined(__clang__)\n"
+         "#pragma clang loop unroll(disable)  // as in sincos()\n"
+         "#endif\n"
+         "  for (std::size_t i = 0; i < full; i += lanes) {\n"
+         "    Doubles yv, xv;\n"
+         "    std::memcpy(&yv, &y[i], sizeof yv);\n"
+         "    std::memcpy(&xv, &x[i], sizeof xv);\n"
+         "    Doubles av;\n"
+         "    trig_detail::atan2_lanes(yv, xv, av);\n"
+         "    std::memcpy(&angle[i], &av, sizeof av);\n"
+         "  }\n"
+         "  if constexpr (full < N) {  // the last, partly filled vector\n"
+         "    Doubles yv{}, xv{};\n"
+         "    std::memcpy(&yv, &y[full], (N - full) * sizeof(double));\n"
+         "    std::memcpy(&xv, &x[full], (N - full) * sizeof(double));\n"
+         "    Doubles av;\n"
+         "    trig_detail::atan2_lanes(yv, xv, av);\n"
+         "    std::memcpy(&angle[full], &av, (N - full) * sizeof(double));\n"
+         "  }\n"
+         "#if defined(__clang__)\n"
+         "#pragma clang loop unroll(disable)\n"
+         "#endif\n"
+         "  for (std::size_t i = 0; i < N; ++i)\n"
+         "    if (!(std::abs(y[i]) <= 1.7976931348623157e308 && std::abs(x[i]) <= 1.7976931348623157e308)) {  // rare: inf, NaN\n"
+         "      angle[i] = std::atan2(y[i], x[i]);\n"
+         "      if (angle[i] == -trig_detail::kPiHead) angle[i] = trig_detail::kPiHead;\n"
+         "    }\n"
+         "#else\n"
+         "  for (std::size_t i = 0; i < N; ++i) {\n"
+         "    angle[i] = std::atan2(y[i] + 0.0, x[i]);  // + 0.0: -0 to +0, so a half turn is +pi\n"
+         "    if (angle[i] == -trig_detail::kPiHead) angle[i] = trig_detail::kPiHead;\n"
+         "  }\n"
+         "#endif\n"
+         "}\n\n"
+         "// float and long double: std::atan2, with the same conventions (a half turn is +pi).\n"
+         "template <typename Scalar, std::size_t N>\n"
+         "inline void atan2(const std::array<Scalar, N>& y, const std::array<Scalar, N>& x, std::array<Scalar, N>& angle) noexcept {\n"
+         "  static_assert(std::is_floating_point_v<Scalar>, \"atan2 of arrays is for floating-point types\");\n"
+         "  const Scalar pi = Scalar(trig_detail::kPiHead);\n"
+         "  for (std::size_t i = 0; i < N; ++i) {\n"
+         "    angle[i] = std::atan2(y[i] + Scalar(0), x[i]);  // + 0: -0 to +0, so a half turn is +pi\n"
+         "    if (angle[i] == -pi) angle[i] = pi;\n"
+         "  }\n"
+         "}\n\n";
+}
+
+}  // namespace
+
+EmittedFile emit_trig_header(const Model& m, const EmitOptions& opt) {
+  const TrigConstants k = derive_constants();
+  std::string t = trig_header_opening(m, opt) + namespace_open(opt);
+  t += "\nnamespace trig_detail {\n\n" + trig_constants(k) + lane_kernels(k) + "}  // namespace trig_detail\n\n";
+  t += sincos_of_arrays() + atan2_of_arrays() + namespace_close(opt);
   return {"wlx/gen/trig.hpp", t};
 }
 
