@@ -320,6 +320,61 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
 
 )";
 
+// ik_all(): every limb's solver stages (`solved`: the limbs with a closed form), one atan2 pass
+// for all their joints, then every limb's check.
+std::string fused_ik(const Model& m, const std::vector<std::pair<const Limb*, Solve>>& solved, const EmitOptions& opt,
+                     std::vector<std::string>& report) {
+  std::vector<Stage> stages, checks;
+  std::vector<SolvedJoint> joints;
+  std::vector<std::pair<int, std::string>> outputs;
+  std::string prologue, newton;
+  for (std::size_t k = 0; k < solved.size(); ++k) {
+    const auto& [limb, solve] = solved[k];
+    const int index = static_cast<int>(limb - m.limbs.data());
+    for (Stage& st : fused_stages(m, solve.stages, limb->name, index)) stages.push_back(std::move(st));
+    for (Stage& st : fused_stages(m, {check_stage(m, *limb, solve)}, limb->name, index)) checks.push_back(std::move(st));
+    joints.insert(joints.end(), solve.joints.begin(), solve.joints.end());
+    for (const auto& o : solve_outputs(m, solve)) outputs.push_back(o);
+    prologue += fmt::format("  const int ik_{0}_branch = branches[{1}];\n"
+                            "  if (ik_{0}_branch < 0 || ik_{0}_branch >= {2}) {{\n    failed = {1};\n    return IkStatus::bad_branch;\n  }}\n",
+                            limb->name, index, solve.branches);
+  }
+  for (const Limb& limb : m.limbs)
+    if (std::none_of(solved.begin(), solved.end(), [&](const auto& sv) { return sv.first == &limb; }))
+      newton += (newton.empty() ? "" : ", ") + limb.name;
+  if (!joints.empty()) stages.push_back(angle_stage(stages, joints));
+  stages.insert(stages.end(), checks.begin(), checks.end());
+  OpCount ops;
+  const std::string body = emit_body(m, stages, outputs, opt, ops);
+  std::string t = fmt::format(
+      "// The closed forms of the {0} limbs that have one{6} in one pass: what ik_<limb>() computes for each,\n"
+      "// with the sines and cosines of every input angle and the subexpressions the limbs share computed once.\n"
+      "// branches[k] is limb k's branch (kLimbs order). On failure returns the status of the first limb that\n"
+      "// failed (every limb's reach is tested before any limb's residual check), `failed` its index and `why`\n"
+      "// its numbers; out is written only when every limb succeeded.\n"
+      "// Operations: {1} (adds {2}, muls {3}, divs {4}, calls {5}), plus the solver calls.\n"
+      "// Scalar: float or double.\n"
+      "template <typename Scalar>\n"
+      "inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const std::array<int, {7}>& branches,\n"
+      "                       detail::NonDeduced<CoordinatesOf<Scalar>>& out, int& failed, IkDiagnostics& why) noexcept {{\n"
+      "  static_assert(std::is_floating_point_v<Scalar>, \"the closed-form IK is for float and double\");\n"
+      "  static_cast<void>(s);\n  static_cast<void>(p);\n  static_cast<void>(branches);\n  static_cast<void>(out);\n"
+      "  static_cast<void>(failed);\n  static_cast<void>(why);\n",
+      solved.size(), ops.total(), ops.adds, ops.muls, ops.divs, ops.calls,
+      newton.empty() ? "" : " (not " + newton + ": Newton's method at run time)", m.limbs.size());
+  t += prologue + body + "}\n\n";
+  t += double_overload(opt, "ik_all", "IkStatus",
+                       {{"const Coordinates& s", ""},
+                        {"const Params& p", ""},
+                        {fmt::format("const std::array<int, {}>& branches", m.limbs.size()), ""},
+                        {"Coordinates& out", ""},
+                        {"int& failed", ""},
+                        {"IkDiagnostics& why", ""}},
+                       "what the runtime calls");
+  report.push_back(fmt::format("all limbs fused: {} operations", ops.total()));
+  return t;
+}
+
 }  // namespace
 
 EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<std::string>& report) {
@@ -383,57 +438,7 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
   const bool all = solved.size() == m.limbs.size();
   t += fmt::format("// Whether every limb has a closed form (ik_all then solves them all).\ninline constexpr bool kHasFusedIk = {};\n\n",
                    all ? "true" : "false");
-  {
-    // Every limb's solver stages, one atan2 pass for all their joints, then every limb's check.
-    std::vector<Stage> stages, checks;
-    std::vector<SolvedJoint> joints;
-    std::vector<std::pair<int, std::string>> outputs;
-    std::string prologue, newton;
-    for (std::size_t k = 0; k < solved.size(); ++k) {
-      const auto& [limb, solve] = solved[k];
-      const int index = static_cast<int>(limb - m.limbs.data());
-      for (Stage& st : fused_stages(m, solve.stages, limb->name, index)) stages.push_back(std::move(st));
-      for (Stage& st : fused_stages(m, {check_stage(m, *limb, solve)}, limb->name, index)) checks.push_back(std::move(st));
-      joints.insert(joints.end(), solve.joints.begin(), solve.joints.end());
-      for (const auto& o : solve_outputs(m, solve)) outputs.push_back(o);
-      prologue += fmt::format("  const int ik_{0}_branch = branches[{1}];\n"
-                              "  if (ik_{0}_branch < 0 || ik_{0}_branch >= {2}) {{\n    failed = {1};\n    return IkStatus::bad_branch;\n  }}\n",
-                              limb->name, index, solve.branches);
-    }
-    for (const Limb& limb : m.limbs)
-      if (std::none_of(solved.begin(), solved.end(), [&](const auto& sv) { return sv.first == &limb; }))
-        newton += (newton.empty() ? "" : ", ") + limb.name;
-    if (!joints.empty()) stages.push_back(angle_stage(stages, joints));
-    stages.insert(stages.end(), checks.begin(), checks.end());
-    OpCount ops;
-    const std::string body = emit_body(m, stages, outputs, opt, ops);
-    t += fmt::format(
-        "// The closed forms of the {0} limbs that have one{6} in one pass: what ik_<limb>() computes for each,\n"
-        "// with the sines and cosines of every input angle and the subexpressions the limbs share computed once.\n"
-        "// branches[k] is limb k's branch (kLimbs order). On failure returns the status of the first limb that\n"
-        "// failed (every limb's reach is tested before any limb's residual check), `failed` its index and `why`\n"
-        "// its numbers; out is written only when every limb succeeded.\n"
-        "// Operations: {1} (adds {2}, muls {3}, divs {4}, calls {5}), plus the solver calls.\n"
-        "// Scalar: float or double.\n"
-        "template <typename Scalar>\n"
-        "inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const std::array<int, {7}>& branches,\n"
-        "                       detail::NonDeduced<CoordinatesOf<Scalar>>& out, int& failed, IkDiagnostics& why) noexcept {{\n"
-        "  static_assert(std::is_floating_point_v<Scalar>, \"the closed-form IK is for float and double\");\n"
-        "  static_cast<void>(s);\n  static_cast<void>(p);\n  static_cast<void>(branches);\n  static_cast<void>(out);\n"
-        "  static_cast<void>(failed);\n  static_cast<void>(why);\n",
-        solved.size(), ops.total(), ops.adds, ops.muls, ops.divs, ops.calls,
-        newton.empty() ? "" : " (not " + newton + ": Newton's method at run time)", m.limbs.size());
-    t += prologue + body + "}\n\n";
-    t += double_overload(opt, "ik_all", "IkStatus",
-                         {{"const Coordinates& s", ""},
-                          {"const Params& p", ""},
-                          {fmt::format("const std::array<int, {}>& branches", m.limbs.size()), ""},
-                          {"Coordinates& out", ""},
-                          {"int& failed", ""},
-                          {"IkDiagnostics& why", ""}},
-                         "what the runtime calls");
-    report.push_back(fmt::format("all limbs fused: {} operations", ops.total()));
-  }
+  t += fused_ik(m, solved, opt, report);
   t += namespace_close(opt);
   return {"wlx/gen/ik.hpp", t};
 }

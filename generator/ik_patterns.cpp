@@ -168,7 +168,19 @@ Vec3 in_axes(const Mat3& R, const Vec3& v) {
 
 // ---- point3 -------------------------------------------------------------------------------------
 
-Solve plan_point3(const Model& m, const Limb& limb) {
+namespace {
+
+// A point3 leg's geometry, its preconditions checked.
+struct Point3 {
+  std::string frame;          // the frame the rows place
+  std::array<int, 3> target;  // the inputs its x, y and z equal
+  CanonicalChain chain;       // frame's
+  Frame meeting;              // the frame before the first joint, moved to P, where the first two axes meet
+  Mat3 M;                     // the turns from the second joint to the third
+  Vec3 p, t;                  // P to the third joint (in the second joint's axes), the third joint to the point
+};
+
+Point3 point3(const Model& m, const Limb& limb) {
   const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
   const auto [frame, target] = point_rows(m, limb, "point3");
   if (m.frames[static_cast<std::size_t>(m.frame_index(frame))].derived_from_wheel >= 0)
@@ -209,17 +221,22 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   }
   // The meeting point P: on the first axis at the offset's component along it; from the second
   // joint's frame it lies back along the second axis by the offset's component along that one.
-  Frame base = base_frame(m, c);
-  for (const Rot& t : before_first) base = base.turned(t.axis, t.angle);
-  if (!identically_zero(between.offset[a1])) base = base.translated(between.offset[a1] * unit(j1.axis));
+  Frame meeting = base_frame(m, c);
+  for (const Rot& t : before_first) meeting = meeting.turned(t.axis, t.angle);
+  if (!identically_zero(between.offset[a1])) meeting = meeting.translated(between.offset[a1] * unit(j1.axis));
   const Mat3 M = product(after_second) * product(c.fixed[2].turns);
   const Vec3 p = between.offset[a2] * unit(j2.axis) + product(after_second) * c.fixed[2].offset;  // P to the third joint
   const Vec3 t = c.fixed[3].offset;                                                                  // the third joint to the point
+  return {frame, target, c, meeting, M, p, t};
+}
 
-  Solve solve;
-  solve.pattern = "point3";
-  const SolvedJoint q1 = joint_symbols(m, j1.coordinate), q2 = joint_symbols(m, j2.coordinate), q3 = joint_symbols(m, j3.coordinate);
-  solve.joints = {q1, q2, q3};
+// The solve's report line, documentation, branch bits and failure messages.
+void describe_point3(const Model& m, const Point3& leg, Solve& solve) {
+  const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
+  const ChainStep &j1 = leg.chain.joints[0], &j2 = leg.chain.joints[1], &j3 = leg.chain.joints[2];
+  const std::string n1 = name(j1.coordinate), n2 = name(j2.coordinate), n3 = name(j3.coordinate);
+  const std::string& frame = leg.frame;
+  const std::array<int, 3>& target = leg.target;
   solve.summary = fmt::format("point3: {} at (x, y, z) = ({}, {}, {}) by {} ({}), {} ({}) with meeting axes, then {} ({})", frame,
                               name(target[0]), name(target[1]), name(target[2]), n1, axis_name(j1.axis), n2, axis_name(j2.axis), n3,
                               axis_name(j3.axis));
@@ -240,10 +257,24 @@ Solve plan_point3(const Model& m, const Limb& limb) {
                   "{{high:.4f}} m off the plane normal to the axis of {} (through the meeting point), but its target is "
                   "{{value:.4f}} m off it",
                   frame, n3, n1)};
+}
+
+}  // namespace
+
+Solve plan_point3(const Model& m, const Limb& limb) {
+  const Point3 leg = point3(m, limb);
+  const ChainStep &j1 = leg.chain.joints[0], &j2 = leg.chain.joints[1], &j3 = leg.chain.joints[2];
+  const Vec3 &p = leg.p, &t = leg.t;
+  const Mat3& M = leg.M;
+  Solve solve;
+  solve.pattern = "point3";
+  const SolvedJoint q1 = joint_symbols(m, j1.coordinate), q2 = joint_symbols(m, j2.coordinate), q3 = joint_symbols(m, j3.coordinate);
+  solve.joints = {q1, q2, q3};
+  describe_point3(m, leg, solve);
 
   // Stage 0: the target seen from the meeting point; |d|^2 = K + A cos q3 + B sin q3.
   Stage s0;
-  targets_from(m, base, target, s0);
+  targets_from(m, leg.meeting, leg.target, s0);
   const Sinusoid distance = distance_squared(p, M, j3, t);
   const realsymbol K_("ik_K"), A_("ik_A"), B_("ik_B");
   s0.locals.emplace_back(K_, distance.c);
