@@ -79,11 +79,11 @@ EmittedFile emit_settings_header(const Model& m, const EmitOptions& opt);
 // `code_key`, a fingerprint of the code (every other emitted file), which a plugin's cache is keyed by.
 EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::vector<EmittedFile>& code);
 // ik.hpp: the closed-form inverse kinematics of every limb whose chain matches one of the solvable
-// patterns (emit_ik.cpp documents them), with all its branches; `report` receives one line per
+// patterns (ik_patterns.cpp documents them), with all its branches; `report` receives one line per
 // limb: the pattern used, or why none applies (that limb is then left to Newton's method).
 EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<std::string>& report);
 // The chain from K0 to `frame` from its first dependent joint on, in the canonical form the IK
-// patterns match on (emit_ik.cpp): per gap between joints one translation (if any) then the turns,
+// patterns match on (ik_chains.cpp): per gap between joints one translation (if any) then the turns,
 // offsets slid along the joint axes they commute with, identities dropped. The steps before the
 // first dependent joint are left out (they stay as written).
 std::vector<ChainStep> canonical_ik_chain(const Model& m, const std::string& frame);

@@ -1,4 +1,4 @@
-// Property test of the closed-form IK (generator/emit_ik.cpp): for random geometries of every limb
+// Property test of the closed-form IK (generator/ik_patterns.cpp): for random geometries of every limb
 // shape in ik_shapes.yaml (each offset and fixed turn a parameter, drawn here at run time), a
 // target made from random joint angles through the generated closure, every branch that returns a
 // solution solves the limb's closure rows to 1e-12 m, and the solution Newton's method finds from

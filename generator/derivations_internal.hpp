@@ -1,0 +1,83 @@
+// What the derivations' files share: the closure's and the wheels' rows (derivations.cpp), and the
+// structure both dynamics passes (reduced_dynamics.cpp, generalized_forces.cpp) are built on, the
+// roles of the coordinates in s' = T u and the tree of the bodies' chains (dynamics_tree.cpp).
+// Internal to the generator.
+#pragma once
+
+#include "derivations.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace wlx::codegen::derivation {
+
+inline int coordinate_count(const Model& m) { return static_cast<int>(m.coordinates.size()); }
+
+// An output's prologue that zeroes a matrix before its nonzero elements are written.
+inline constexpr const char* kZeroMatrix = "{}->setZero();";
+
+// ---- rows (derivations.cpp) ---------------------------------------------------------------------
+
+struct ClosureRow {
+  ex value;
+  std::vector<ex> gradient;
+  ex convective;  // (d/dt dPhi_i/ds) s'
+};
+ClosureRow closure_row(const Model& m, const ClosureCondition& c);
+
+struct WheelRow {
+  std::vector<ex> C;     // v_W . n_W = C s'
+  std::vector<ex> spin;  // spin rate = spin s'
+  ex convective;         // (d/dt C) s'
+};
+WheelRow wheel_row(const Model& m, const NonholonomicWheel& wheel);
+
+// ---- the dynamics' structure (dynamics_tree.cpp) ------------------------------------------------
+
+// The coordinates' roles in s' = T u (model with a dynamics section): each commanded speed's index
+// in u (-1 for the others), and whether T's row is dense (the dependent pair and the dependent joints).
+struct RateRoles {
+  std::vector<int> speed_of;
+  std::vector<bool> dense;
+  // Coordinate j's joint moves in a step: its rate is a commanded speed or a dense row of T (the
+  // other inputs are held, and add nothing to a twist).
+  bool moves(int j) const { return dense[static_cast<std::size_t>(j)] || speed_of[static_cast<std::size_t>(j)] >= 0; }
+};
+RateRoles rate_roles(const Model& m);
+
+// The commanded speeds each coordinate's rate depends on (T's nonzero columns in its row), from the
+// structure of the equations that fix the dense rates: the closure rows and the wheels' rolling
+// rows, linear in s'. Their unknowns (the dependent pair and the dependent joints) split into
+// independent blocks, the connected parts of "row r involves unknown j" (a leg's joints and its
+// wheel's rate, say); a block's rates depend on the commanded speeds its rows involve, and on no
+// other. A commanded speed's rate is itself; a held input's is zero (no speeds).
+std::vector<std::vector<int>> rate_speeds(const Model& m, const RateRoles& roles);
+
+// A joint of the bodies' chains as a node of their common tree (chains that share a prefix share
+// its nodes), with the partial twists of the chain up to it on lanes.
+struct TwistNode {
+  const JointRecord* joint = nullptr;
+  int parent = -1;
+  std::vector<int> children, bodies;
+  std::array<std::string, 6> twist;  // lanes of (omega; velocity of the point at K0's origin)
+  std::array<std::string, 6> wrench;  // lanes of the sum over the bodies beyond: (force; moment about K0's origin)
+};
+
+// The tree of the bodies' chains through the joints that move in a step (RateRoles::moves): chains
+// share their common joints; nodes come parents first.
+struct TwistTree {
+  std::vector<TwistNode> nodes;
+  std::vector<int> body_node;  // each body's last node, -1 for a body no such joint moves
+};
+TwistTree twist_tree(const Model& m, const RateRoles& roles);
+
+// A joint's twist per unit rate in K0, (omega; velocity of the point at K0's origin): (a; o x a)
+// for a revolute joint (axis a through o), (0; a) for a prismatic one.
+std::array<ex, 6> spatial_axis(const JointRecord& joint);
+
+// A value the lane code reads, named and handed to CSE with the function's other expressions; ""
+// for an exact zero, which the code writers drop.
+std::string lane_scalar(FunctionSpec& fn, const std::string& name, const ex& value);
+
+}  // namespace wlx::codegen::derivation

@@ -1,0 +1,105 @@
+// What the closed-form inverse kinematics' three parts share: the canonical chains (ik_chains.cpp),
+// the patterns' planning (ik_patterns.cpp) and the printing of the planned solves (emit_ik.cpp).
+// Internal to the generator.
+#pragma once
+
+#include "model.hpp"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace wlx::codegen::ik {
+
+using GiNaC::realsymbol;
+
+// Why a limb matches no pattern (wlx-gen reports every pattern's reason).
+struct Unsolvable {
+  std::string reason;
+};
+
+const char* axis_name(Axis a);
+
+// ---- chains (ik_chains.cpp) ---------------------------------------------------------------------
+
+// Every step from K0 to the frame, parents first.
+std::vector<ChainStep> full_chain(const Model& m, const std::string& frame);
+Frame apply(const Model& m, const Frame& f, const ChainStep& st);
+bool driven(const ChainStep& st);
+// The patterns read joint steps as turns about +x, +y or +z; a chain with a negated joint
+// (`ry: -q`) or a wheel's derived contact frame is not theirs.
+void require_plain_chain(const Model& m, const std::string& frame, const std::vector<ChainStep>& chain, const char* pattern);
+
+// A rotation whose angle is an expression, for reducing orientation chains.
+struct Rot {
+  Axis axis;
+  ex angle;
+};
+// Adjacent rotations about the same axis add up; zero angles vanish (so a coupling q4 = -q5 between
+// Rz(q5) Rz(q4) leaves nothing, and the rotations on both sides may then merge).
+std::vector<Rot> merge(const std::vector<Rot>& seq);
+Mat3 product(const std::vector<Rot>& seq);
+
+// A rigid transform that depends on parameters only: T(offset), then the turns in order.
+struct Rigid {
+  Vec3 offset;
+  std::vector<Rot> turns;
+};
+
+// A chain in the canonical form the patterns match on (ik_chains.cpp explains it).
+struct CanonicalChain {
+  std::vector<ChainStep> prefix;  // the steps before the first dependent joint, as written
+  std::vector<ChainStep> joints;  // every joint step from the first dependent one on
+  std::vector<Rigid> fixed;       // fixed[k] before joints[k]; fixed[joints.size()] after the last
+};
+CanonicalChain canonical_chain(const Model& m, const std::vector<ChainStep>& chain);
+// The frame before the first dependent joint: the prefix and the fixed transform after it.
+Frame base_frame(const Model& m, const CanonicalChain& c);
+// The transform as the model file would write it, for messages.
+std::string describe(const Rigid& r);
+
+bool identically_zero(const ex& e);
+bool identically_zero(const Vec3& v);
+// e at the parameters' defaults (for messages and for telling "not identically" from "not at all").
+double at_defaults(const Model& m, const ex& e);
+Vec3 expanded(const Vec3& v);
+
+// ---- planned solves (ik_patterns.cpp) -----------------------------------------------------------
+
+// The generated code of one limb's solve: stages of named values (expressions of the inputs, the
+// parameters and earlier stages' results) each followed by code calling a solver.
+struct Stage {
+  std::vector<std::pair<realsymbol, ex>> locals;
+  std::string code;
+  std::vector<std::string> defines;  // the variables its code computes (usable from the next stage on)
+};
+
+struct SolvedJoint {
+  int coordinate;
+  realsymbol q, c, s;  // value, cosine, sine in the generated code
+};
+
+struct Solve {
+  std::string pattern;
+  std::string summary;  // one line for wlx-gen's report
+  std::vector<std::string> doc;
+  int branches = 1;
+  std::vector<std::string> bits;  // meaning of each branch bit
+  std::vector<std::string> failures;  // message template of each failing stage (1-based in IkDiagnostics)
+  std::vector<Stage> stages;
+  std::vector<SolvedJoint> joints;
+  std::vector<std::pair<int, ex>> coupled;  // joints fixed by a sum row: coordinate, value
+};
+
+SolvedJoint joint_symbols(const Model& m, int coordinate);
+// An expression in the model's symbols, rewritten in the solve's results: sines and cosines of the
+// solved joints by their computed values, the joints themselves by theirs, coupled joints by
+// their expressions.
+ex in_results(const Model& m, ex e, const Solve& solve);
+
+// The patterns, in the order they are tried; each throws Unsolvable when the limb is not its.
+Solve plan_point3(const Model& m, const Limb& limb);
+Solve plan_wheel_leg(const Model& m, const Limb& limb);
+Solve plan_lever(const Model& m, const Limb& limb);
+
+}  // namespace wlx::codegen::ik
