@@ -22,6 +22,10 @@
 #include <utility>
 #include <vector>
 
+namespace wlx::codegen {
+struct UrdfRobot;  // urdf_import.hpp
+}
+
 namespace wlx::codegen::model_file_detail {
 
 // ---- names (model_file_names.cpp) -------------------------------------------------------------
@@ -114,6 +118,21 @@ Axis axis_of(const Item& it);
 // FNV-1a, 64 bits: a stable fingerprint of the model file for the generated banners.
 std::uint64_t fingerprint(const std::string& text);
 
+// ---- what a URDF gives the sections (model_file_urdf.cpp) -------------------------------------
+
+struct UrdfAxle {
+  Axis axis;
+  std::string place, joint;
+};
+struct UrdfLimit {
+  std::optional<double> lower, upper, effort, velocity;
+  std::string place;  // file:line of the <limit>
+};
+struct UrdfWheelShape {
+  std::string radius, offset;  // the parameters with_urdf made from the hub's collision shape
+};
+struct UrdfFileFacts;
+
 // ---- the parser -------------------------------------------------------------------------------
 
 class Parser {
@@ -133,6 +152,10 @@ class Parser {
   const std::string& urdf_file() const { return urdf_file_; }
 
  private:
+  // ---- a URDF written into the file (model_file_urdf.cpp) ----
+  UrdfRobot open_urdf(const Item& where, const std::optional<Item>& urdf_item, const std::string& shown);
+  UrdfFileFacts urdf_file_facts(const Fields& f);
+
   // ---- repetition, names and expressions (model_file_references.cpp) ----
   void repeats(const Item& r);
   // Calls fn for every entry of a list, writing out entries with `for:` once per row (nested
@@ -172,19 +195,8 @@ class Parser {
 
   Source src_;
   std::string directory_, urdf_override_, urdf_fingerprint_, urdf_file_;
-  struct UrdfAxle {
-    Axis axis;
-    std::string place, joint;
-  };
   std::map<std::string, UrdfAxle> urdf_axle_;  // a wheel's hub link -> its URDF joint's axis
-  struct UrdfLimit {
-    std::optional<double> lower, upper, effort, velocity;
-    std::string place;  // file:line of the <limit>
-  };
   std::map<std::string, UrdfLimit> urdf_limits_;  // a URDF joint's name -> its <limit>
-  struct UrdfWheelShape {
-    std::string radius, offset;  // the parameters with_urdf made from the hub's collision shape
-  };
   std::map<std::string, UrdfWheelShape> urdf_wheel_shape_;  // a hub link -> its wheel's radius and offset
   Model m_;
   GiNaC::symtab params_, coordinates_;
