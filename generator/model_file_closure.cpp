@@ -85,9 +85,7 @@ void Parser::limbs(const std::optional<Item>& list, const Item& top) {
     // The branch of its closed form every command takes unless told otherwise (checked against
     // the branches wlx-gen finds, which come later: emit_ik.cpp).
     if (auto b = f.optional("branch")) {
-      const double v = b->number();
-      if (!(v >= 0 && v <= 1023 && v == std::floor(v))) b->fail(fmt::format("a branch is a whole number from 0, got {}", v));
-      limb.branch = static_cast<int>(v);
+      limb.branch = b->branch();
       const YAML::Mark mark = b->mark();
       limb.branch_place = fmt::format("{}:{}:{}: {}", src_.name, mark.line + 1, mark.column + 1, b->path());
     }

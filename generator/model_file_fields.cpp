@@ -91,6 +91,12 @@ std::vector<Item> Item::list() const {
   return out;
 }
 
+int Item::branch() const {
+  const double v = number();
+  if (!(v >= 0 && v <= 1023 && v == std::floor(v))) fail(fmt::format("a branch is a whole number from 0, got {}", v));
+  return static_cast<int>(v);
+}
+
 Fields::Fields(const Item& item, std::vector<std::string> allowed) : item_(item), allowed_(std::move(allowed)) {
   if (!item.is_map()) item.fail("must be a map of fields (key: value)");
   for (const auto& kv : item.node()) {

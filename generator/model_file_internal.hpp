@@ -86,6 +86,8 @@ class Item {
   // A number; with `constant`, also an expression of numbers (such as <sign>*0.5).
   double number(bool constant = false) const;
   std::vector<Item> list() const;
+  // A branch of a closed form: a whole number from 0 to 1023.
+  int branch() const;
 
  private:
   const Source* src_;

@@ -261,11 +261,7 @@ void Parser::sweeps(const std::optional<Item>& section) {
     if (sw.limb < 0) s["limb"].fail(fmt::format("no limb '{}'", limb));
     // The branch the sweep checks (checked against the closed form's branches at run time, as
     // every branch a file or a request gives: settings).
-    if (auto b = s.optional("branch")) {
-      const double v = b->number();
-      if (!(v >= 0 && v <= 1023 && v == std::floor(v))) b->fail(fmt::format("a branch is a whole number from 0, got {}", v));
-      sw.branch = static_cast<int>(v);
-    }
+    if (auto b = s.optional("branch")) sw.branch = b->branch();
     m_.sweeps.push_back(std::move(sw));
   });
 }

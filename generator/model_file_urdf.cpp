@@ -326,14 +326,14 @@ class UrdfSections {
   // `owner` is the link or joint whose number it is ("link", "base"), for the message.
   void add_parameter(int line, const char* kind_of_owner, const std::string& owner, const std::string& name, double value,
                      const char* kind, const char* unit, const std::string& meaning) {
+    const auto fail = [&](const std::string& problem) {
+      messages_.fail(line, fmt::format("{} '{}'", kind_of_owner, owner),
+                     fmt::format("{}{}", problem, messages_.rename_hint(owner, std::string("_") + kind_of_owner)));
+    };
     if (file_.parameters.count(name) || file_.inputs.count(name) || generated_parameters_.count(name) || robot_.joint_index(name) >= 0)
-      messages_.fail(line, fmt::format("{} '{}'", kind_of_owner, owner),
-                     fmt::format("its parameter '{}' is already a name in the model: {}", name,
-                                 messages_.rename_hint(owner, std::string("_") + kind_of_owner)));
+      fail(fmt::format("its parameter '{}' is already a name in the model: ", name));
     if (const std::string why = reserved_reason(name); !why.empty())
-      messages_.fail(line, fmt::format("{} '{}'", kind_of_owner, owner),
-                     fmt::format("its parameter '{}' cannot be used as a name: {}; {}", name, why,
-                                 messages_.rename_hint(owner, std::string("_") + kind_of_owner)));
+      fail(fmt::format("its parameter '{}' cannot be used as a name: {}; ", name, why));
     generated_parameters_.insert(name);
     YAML::Node p(YAML::NodeType::Map);
     p["name"] = name;
@@ -395,11 +395,12 @@ class UrdfSections {
                                    "rolling radius; turn its <origin rpy>, or give the wheel a `radius`",
                                    shape.axis[0], shape.axis[1], shape.axis[2], "xyz"[a]));
       const std::string place = fmt::format("{}:{}", messages_.urdf, shape.line);
+      const char* shape_kind = shape.cylinder ? "cylinder" : "sphere";
       add_parameter(shape.line, "link", hub, hub + "_radius", shape.radius, "length", "m",
-                    fmt::format("rolling radius of the wheel on {} (its collision {}, {})", hub, shape.cylinder ? "cylinder" : "sphere", place));
+                    fmt::format("rolling radius of the wheel on {} (its collision {}, {})", hub, shape_kind, place));
       add_parameter(shape.line, "link", hub, hub + "_offset", shape.center[a], "offset", "m",
                     fmt::format("the wheel's rolling plane along the axle {} of {} (its collision {}'s centre, {})", "xyz"[a], hub,
-                                shape.cylinder ? "cylinder" : "sphere", place));
+                                shape_kind, place));
       shapes[hub] = {hub + "_radius", hub + "_offset"};
     }
     return shapes;
