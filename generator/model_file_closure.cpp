@@ -3,7 +3,6 @@
 #include "model_file_internal.hpp"
 
 #include <algorithm>
-#include <cmath>
 
 namespace wlx::codegen::model_file_detail {
 

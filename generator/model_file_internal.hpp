@@ -133,7 +133,7 @@ struct UrdfLimit {
 struct UrdfWheelShape {
   std::string radius, offset;  // the parameters with_urdf made from the hub's collision shape
 };
-struct UrdfFileFacts;
+struct UrdfFileFacts;  // what the file says about the URDF's joints
 
 // ---- the parser -------------------------------------------------------------------------------
 
