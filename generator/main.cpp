@@ -18,6 +18,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <iterator>
 #include <regex>
 #include <set>
@@ -233,44 +234,47 @@ void write_depfile(const std::string& depfile, const std::string& target, const 
   wlx::write_file_atomically(depfile, text + "\n");
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"wlx-gen: derive a model's kinematics and dynamics symbolically and emit C++ headers"};
+// What the command line asks for.
+struct Request {
   std::string model_path, out_dir, with_path;
   std::vector<std::string> bake_args;
   bool bake_defaults = false, stats_only = false, quiet = false, print_model = false, describe = false;
+  std::string depfile, depfile_target, expected_model;
   EmitOptions opt;
-  opt.generator_version = WLX_VERSION;
-  app.add_option("MODEL", model_path,
+};
+
+void add_options(CLI::App& app, Request& r) {
+  app.add_option("MODEL", r.model_path,
                  "the model file (models/*.yaml; format: docs/model-format.md), or a URDF (robot.urdf) with --with")
       ->required();
-  app.add_option("--with", with_path,
+  app.add_option("--with", r.with_path,
                  "for a URDF as MODEL: the YAML file that says what URDF cannot (docs/model-format.md, URDF import)");
-  app.add_option("--out", out_dir, "output root; headers go to OUT/wlx/gen/ (required unless --print-model)");
-  app.add_flag("--print-model", print_model,
+  app.add_option("--out", r.out_dir, "output root; headers go to OUT/wlx/gen/ (required unless --print-model)");
+  app.add_flag("--print-model", r.print_model,
                "print the model file wlx-gen reads (for a URDF: the frames, joints and bodies it maps to) and exit");
-  app.add_flag("--data-at-run-time", opt.data_at_run_time,
+  app.add_flag("--data-at-run-time", r.opt.data_at_run_time,
                "leave the model file's numbers out of the headers (no settings.hpp, NaN parameter defaults): a plugin "
                "reads them from model.json, so that editing them compiles nothing");
-  app.add_flag("--describe", describe,
+  app.add_flag("--describe", r.describe,
                "derive everything, write nothing, and print model.json (the description, with the code's fingerprint "
                "code_key) on stdout");
-  app.add_option("--bake", bake_args, "bake a parameter in as a constant: NAME=VALUE (repeatable)");
-  app.add_flag("--bake-defaults", bake_defaults, "bake every geometry parameter (kinds length, offset, angle) in at its default");
-  app.add_option("--namespace", opt.name_space,
+  app.add_option("--bake", r.bake_args, "bake a parameter in as a constant: NAME=VALUE (repeatable)");
+  app.add_flag("--bake-defaults", r.bake_defaults, "bake every geometry parameter (kinds length, offset, angle) in at its default");
+  app.add_option("--namespace", r.opt.name_space,
                  "C++ namespace of the emitted code (default: wlx::<model>::gen, <model> inline)");
-  std::string depfile, depfile_target, expected_model;
-  app.add_option("--depfile", depfile,
+  app.add_option("--depfile", r.depfile,
                  "also write a Makefile-style depfile: the files the headers were derived from (the model file and "
                  "the URDF it names), so that a build system reruns wlx-gen when any of them changes");
-  app.add_option("--depfile-target", depfile_target, "the depfile's target (default: OUT/wlx/gen/all.hpp)");
-  app.add_option("--expect-model", expected_model,
+  app.add_option("--depfile-target", r.depfile_target, "the depfile's target (default: OUT/wlx/gen/all.hpp)");
+  app.add_option("--expect-model", r.expected_model,
                  "the model's name the build was told (CMake's wlx_generate): a model file whose `model:` differs is an error");
-  app.add_flag("--quiet", quiet, "print nothing on success");
-  app.add_flag("--stats", stats_only, "print the operation-count table (always printed unless --quiet)");
+  app.add_flag("--quiet", r.quiet, "print nothing on success");
+  app.add_flag("--stats", r.stats_only, "print the operation-count table (always printed unless --quiet)");
   app.set_version_flag("--version", WLX_VERSION, "print the version and exit");
-  install_signal_handlers();
+}
+
+// The exit code when the command line is all that is done (--help, --version, a bad command line).
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --version
@@ -286,143 +290,201 @@ int main(int argc, char** argv) {
     wlx::diagnose("wlx-gen: error: {}\n", e.what());
     return 2;
   }
+  return std::nullopt;
+}
+
+void check_namespace(const std::string& name_space) {
+  // A qualified C++ identifier, nothing else: the name is pasted into every header.
+  static const std::regex qualified("[A-Za-z_][A-Za-z0-9_]*(::[A-Za-z_][A-Za-z0-9_]*)*");
+  if (!std::regex_match(name_space, qualified))
+    throw ModelFileError(fmt::format("--namespace: '{}' is not a C++ qualified name such as wlx::mine", name_space.substr(0, 60)));
+  // Each part is pasted in as a name: no keyword, macro, std or Eigen (the model file's rule).
+  for (std::size_t begin = 0; begin <= name_space.size();) {
+    const std::size_t end = std::min(name_space.find("::", begin), name_space.size());
+    const std::string part = name_space.substr(begin, end - begin);
+    if (const std::string why = cpp_name_problem(part); !why.empty())
+      throw ModelFileError(fmt::format("--namespace: '{}' cannot be used: {}", part, why));
+    begin = end + 2;
+  }
+}
+
+// `wlx-gen robot.urdf --with robot.yaml`: the YAML file is the model, the URDF its robot. Returns
+// the URDF's path (empty when MODEL is a model file).
+std::string urdf_from_command_line(std::string& model_path, const std::string& with_path) {
+  std::string urdf_path;
+  const bool urdf_given = model_path.size() >= 5 && model_path.compare(model_path.size() - 5, 5, ".urdf") == 0;
+  if (urdf_given) {
+    if (with_path.empty())
+      throw ModelFileError(fmt::format("{}: a URDF needs --with robot.yaml, the file that names the base's inputs, the "
+                                       "wheels, limbs and dynamics (docs/model-format.md, URDF import)",
+                                       model_path.substr(0, 200)));
+    urdf_path = model_path;
+    model_path = with_path;
+  } else if (!with_path.empty()) {
+    throw ModelFileError("--with: only a URDF as MODEL takes --with (a model file names its URDF with `urdf:`)");
+  }
+  return urdf_path;
+}
+
+// The options that exclude or need each other.
+void check_option_combinations(const Request& r) {
+  if (r.describe && !r.out_dir.empty()) throw ModelFileError("--describe writes nothing: give --out or --describe, not both");
+  if (r.out_dir.empty() && !r.describe) throw ModelFileError("--out is required (the output root; headers go to OUT/wlx/gen/)");
+  if (r.opt.data_at_run_time && (r.bake_defaults || !r.bake_args.empty()))
+    throw ModelFileError("--data-at-run-time reads every parameter's value at run time: it cannot bake any (--bake, --bake-defaults)");
+  if (!r.depfile.empty() && r.out_dir.empty()) throw ModelFileError("--depfile lists what --out's headers depend on: give --out");
+}
+
+// One --bake NAME=VALUE; `baked_by` maps each NAME to its --bake argument: a second one would
+// silently win.
+void bake_argument(const std::string& arg, const Model& model, std::map<std::string, std::string>& baked_by,
+                   std::map<std::string, double>& baked) {
+  const auto eq = arg.find('=');
+  const std::string shown = arg.substr(0, 60);
+  if (eq == std::string::npos) throw ModelFileError(fmt::format("--bake {}: expected NAME=VALUE", shown));
+  const std::string name = arg.substr(0, eq);
+  if (const auto [first, added] = baked_by.emplace(name, shown); !added)
+    throw ModelFileError(fmt::format("--bake {}: '{}' is given twice (first as --bake {})", shown, name.substr(0, 60), first->second));
+  std::vector<std::string> names;
+  std::size_t index = model.parameters.size();
+  for (std::size_t k = 0; k < model.parameters.size(); ++k) {
+    names.push_back(model.parameters[k].name);
+    if (model.parameters[k].name == name) index = k;
+  }
+  if (index == model.parameters.size())
+    throw ModelFileError(fmt::format("--bake {}: the model has no parameter '{}'{}", shown, name.substr(0, 60),
+                                     did_you_mean(name, names)));
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(arg.substr(eq + 1), &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != arg.size() - eq - 1 || !std::isfinite(value))
+    throw ModelFileError(fmt::format("--bake {}: the value of '{}' is not a finite number", shown, name));
+  // Baked values obey the rules of the parameter's kind, as the model file's values do.
+  const ParameterKind kind = model.parameter_kinds[index];
+  if (const std::string why = parameter_value_problem(kind, value); !why.empty())
+    throw ModelFileError(fmt::format("--bake {}: '{}' is {}, which {}", shown, name,
+                                     kind == ParameterKind::gravity ? std::string("gravity") : fmt::format("a {}", kind_name(kind)), why));
+  baked[name] = value;
+}
+
+// --bake-defaults (every geometry parameter at its default), then each --bake.
+void bake_parameters(const Model& model, bool bake_defaults, const std::vector<std::string>& bake_args,
+                     std::map<std::string, double>& baked) {
+  if (bake_defaults)
+    for (std::size_t k = 0; k < model.parameters.size(); ++k) {
+      const ParameterKind kind = model.parameter_kinds[k];
+      if (kind == ParameterKind::length || kind == ParameterKind::offset || kind == ParameterKind::angle)
+        baked[model.parameters[k].name] = model.parameters[k].default_value;
+    }
+  std::map<std::string, std::string> baked_by;
+  for (const auto& arg : bake_args) bake_argument(arg, model, baked_by, baked);
+}
+
+// The headers of a model, with what the report says of them.
+struct Emitted {
+  std::vector<EmittedFile> files;  // the description (model.json) last
+  std::vector<FunctionStats> stats;
+  std::vector<std::string> ik_report;
+  std::chrono::steady_clock::time_point model_built;  // before the derivations
+};
+
+Emitted derive_and_emit(const Model& model, const EmitOptions& opt) {
+  Emitted out;
+  std::vector<EmittedFile>& files = out.files;
+  files = emit_model_headers(model, opt);
+  files.push_back(emit_trig_header(model, opt));
+  files.push_back(emit_structure_header(model, opt));
+  if (!opt.data_at_run_time) files.push_back(emit_settings_header(model, opt));
+  out.model_built = std::chrono::steady_clock::now();
+  std::vector<FunctionSpec> fns;
+  for (const Derivation& derivation : derivations(model)) {
+    const auto d0 = std::chrono::steady_clock::now();
+    fns.push_back(derivation.derive(model));
+    const double derive_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
+    FunctionStats s;
+    files.push_back(emit_function(model, fns.back(), opt, s));
+    s.seconds += derive_s;
+    out.stats.push_back(s);
+  }
+  files.push_back(emit_ik_header(model, opt, out.ik_report));
+  files.push_back(emit_umbrella(model, fns, out.stats, opt));
+  files.push_back(emit_description(model, opt, files));
+  return out;
+}
+
+// The operation-count table and the summary line.
+std::string stats_report(const Emitted& emitted, double model_seconds, double total_seconds, const std::string& out_dir, int changed,
+                         int removed) {
+  std::string report;
+  const auto out = std::back_inserter(report);
+  fmt::format_to(out, "{:<14} {:>8} {:>12} {:>11} {:>9}\n", "function", "temps", "ops before", "ops after", "seconds");
+  long b = 0, a = 0;
+  for (const auto& s : emitted.stats) {
+    fmt::format_to(out, "{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", s.name, s.intermediates, s.before_cse.total(),
+               s.after_cse.total(), s.seconds);
+    b += s.before_cse.total();
+    a += s.after_cse.total();
+  }
+  fmt::format_to(out, "{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", "total", "", b, a, total_seconds);
+  for (const auto& line : emitted.ik_report) fmt::format_to(out, "closed-form IK, {}\n", line);
+  fmt::format_to(out, "model built in {:.3f} s; {} files written to {} ({} changed{})\n", model_seconds, emitted.files.size(),
+             out_dir, changed, removed ? fmt::format(", {} stale removed", removed) : "");
+  return report;
+}
+
+// Everything after the command line is parsed; returns the exit code, throws what main reports.
+int run(Request& r) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!r.opt.name_space.empty()) check_namespace(r.opt.name_space);
+  const std::string urdf_path = urdf_from_command_line(r.model_path, r.with_path);
+  if (r.print_model) {
+    write_stdout(print_model_file(r.model_path, urdf_path));
+    return 0;
+  }
+  check_option_combinations(r);
+  const Model model = load_model_file(r.model_path, urdf_path);
+  if (!r.expected_model.empty() && r.expected_model != model.name)
+    throw ModelFileError(fmt::format("{}: `model: {}`, where the build expects the model '{}' (wlx_generate's NAME, else the "
+                                     "file's name without .yaml): rename the model or the file, or give NAME",
+                                     r.model_path.substr(0, 200), model.name, r.expected_model.substr(0, 60)));
+  r.opt.model_name = model.name;
+  bake_parameters(model, r.bake_defaults, r.bake_args, r.opt.baked);
+
+  const Emitted emitted = derive_and_emit(model, r.opt);
+  if (r.describe) {
+    write_stdout(emitted.files.back().text);
+    return 0;
+  }
+  writing = 1;  // from here a signal is polled (stop_if_signalled), so that the writing can undo itself
+  const int changed = write_header_set(r.out_dir, emitted.files);
+  const int removed = remove_stale(r.out_dir, emitted.files);
+  writing = 0;
+  if (const int signal = received_signal) throw Interrupted{signal};  // the new set is whole; still stop as asked
+  if (!r.depfile.empty())
+    write_depfile(r.depfile, r.depfile_target.empty() ? (fs::path(r.out_dir) / "wlx" / "gen" / "all.hpp").string() : r.depfile_target,
+                  model.input_files);
+  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!r.quiet || r.stats_only)
+    write_stdout(stats_report(emitted, std::chrono::duration<double>(emitted.model_built - t0).count(), total, r.out_dir, changed, removed));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"wlx-gen: derive a model's kinematics and dynamics symbolically and emit C++ headers"};
+  Request request;
+  request.opt.generator_version = WLX_VERSION;
+  add_options(app, request);
+  install_signal_handlers();
+  if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
 
   try {
-    const auto t0 = std::chrono::steady_clock::now();
-    if (!opt.name_space.empty()) {
-      // A qualified C++ identifier, nothing else: the name is pasted into every header.
-      static const std::regex qualified("[A-Za-z_][A-Za-z0-9_]*(::[A-Za-z_][A-Za-z0-9_]*)*");
-      if (!std::regex_match(opt.name_space, qualified))
-        throw ModelFileError(fmt::format("--namespace: '{}' is not a C++ qualified name such as wlx::mine",
-                                         opt.name_space.substr(0, 60)));
-      // Each part is pasted in as a name: no keyword, macro, std or Eigen (the model file's rule).
-      for (std::size_t begin = 0; begin <= opt.name_space.size();) {
-        const std::size_t end = std::min(opt.name_space.find("::", begin), opt.name_space.size());
-        const std::string part = opt.name_space.substr(begin, end - begin);
-        if (const std::string why = cpp_name_problem(part); !why.empty())
-          throw ModelFileError(fmt::format("--namespace: '{}' cannot be used: {}", part, why));
-        begin = end + 2;
-      }
-    }
-    // `wlx-gen robot.urdf --with robot.yaml`: the YAML file is the model, the URDF its robot.
-    std::string urdf_path;
-    const bool urdf_given = model_path.size() >= 5 && model_path.compare(model_path.size() - 5, 5, ".urdf") == 0;
-    if (urdf_given) {
-      if (with_path.empty())
-        throw ModelFileError(fmt::format("{}: a URDF needs --with robot.yaml, the file that names the base's inputs, the "
-                                         "wheels, limbs and dynamics (docs/model-format.md, URDF import)",
-                                         model_path.substr(0, 200)));
-      urdf_path = model_path;
-      model_path = with_path;
-    } else if (!with_path.empty()) {
-      throw ModelFileError("--with: only a URDF as MODEL takes --with (a model file names its URDF with `urdf:`)");
-    }
-    if (print_model) {
-      write_stdout(print_model_file(model_path, urdf_path));
-      return 0;
-    }
-    if (describe && !out_dir.empty()) throw ModelFileError("--describe writes nothing: give --out or --describe, not both");
-    if (out_dir.empty() && !describe) throw ModelFileError("--out is required (the output root; headers go to OUT/wlx/gen/)");
-    if (opt.data_at_run_time && (bake_defaults || !bake_args.empty()))
-      throw ModelFileError("--data-at-run-time reads every parameter's value at run time: it cannot bake any (--bake, --bake-defaults)");
-    if (!depfile.empty() && out_dir.empty()) throw ModelFileError("--depfile lists what --out's headers depend on: give --out");
-    const Model model = load_model_file(model_path, urdf_path);
-    if (!expected_model.empty() && expected_model != model.name)
-      throw ModelFileError(fmt::format("{}: `model: {}`, where the build expects the model '{}' (wlx_generate's NAME, else the "
-                                       "file's name without .yaml): rename the model or the file, or give NAME",
-                                       model_path.substr(0, 200), model.name, expected_model.substr(0, 60)));
-    opt.model_name = model.name;
-    if (bake_defaults)
-      for (std::size_t k = 0; k < model.parameters.size(); ++k) {
-        const ParameterKind kind = model.parameter_kinds[k];
-        if (kind == ParameterKind::length || kind == ParameterKind::offset || kind == ParameterKind::angle)
-          opt.baked[model.parameters[k].name] = model.parameters[k].default_value;
-      }
-    std::map<std::string, std::string> baked_by;  // NAME -> its --bake argument: a second one would silently win
-    for (const auto& arg : bake_args) {
-      const auto eq = arg.find('=');
-      const std::string shown = arg.substr(0, 60);
-      if (eq == std::string::npos) throw ModelFileError(fmt::format("--bake {}: expected NAME=VALUE", shown));
-      const std::string name = arg.substr(0, eq);
-      if (const auto [first, added] = baked_by.emplace(name, shown); !added)
-        throw ModelFileError(fmt::format("--bake {}: '{}' is given twice (first as --bake {})", shown, name.substr(0, 60), first->second));
-      std::vector<std::string> names;
-      std::size_t index = model.parameters.size();
-      for (std::size_t k = 0; k < model.parameters.size(); ++k) {
-        names.push_back(model.parameters[k].name);
-        if (model.parameters[k].name == name) index = k;
-      }
-      if (index == model.parameters.size())
-        throw ModelFileError(fmt::format("--bake {}: the model has no parameter '{}'{}", shown, name.substr(0, 60),
-                                         did_you_mean(name, names)));
-      std::size_t used = 0;
-      double value = 0;
-      try {
-        value = std::stod(arg.substr(eq + 1), &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != arg.size() - eq - 1 || !std::isfinite(value))
-        throw ModelFileError(fmt::format("--bake {}: the value of '{}' is not a finite number", shown, name));
-      // Baked values obey the rules of the parameter's kind, as the model file's values do.
-      const ParameterKind kind = model.parameter_kinds[index];
-      if (const std::string why = parameter_value_problem(kind, value); !why.empty())
-        throw ModelFileError(fmt::format("--bake {}: '{}' is {}, which {}", shown, name,
-                                         kind == ParameterKind::gravity ? std::string("gravity") : fmt::format("a {}", kind_name(kind)), why));
-      opt.baked[name] = value;
-    }
-
-    std::vector<EmittedFile> files = emit_model_headers(model, opt);
-    files.push_back(emit_trig_header(model, opt));
-    files.push_back(emit_structure_header(model, opt));
-    if (!opt.data_at_run_time) files.push_back(emit_settings_header(model, opt));
-    const auto t1 = std::chrono::steady_clock::now();
-    std::vector<FunctionSpec> fns;
-    std::vector<FunctionStats> stats;
-    for (const Derivation& derivation : derivations(model)) {
-      const auto d0 = std::chrono::steady_clock::now();
-      fns.push_back(derivation.derive(model));
-      const double derive_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
-      FunctionStats s;
-      files.push_back(emit_function(model, fns.back(), opt, s));
-      s.seconds += derive_s;
-      stats.push_back(s);
-    }
-    std::vector<std::string> ik_report;
-    files.push_back(emit_ik_header(model, opt, ik_report));
-    files.push_back(emit_umbrella(model, fns, stats, opt));
-    files.push_back(emit_description(model, opt, files));
-    if (describe) {
-      write_stdout(files.back().text);
-      return 0;
-    }
-    writing = 1;  // from here a signal is polled (stop_if_signalled), so that the writing can undo itself
-    const int changed = write_header_set(out_dir, files);
-    const int removed = remove_stale(out_dir, files);
-    writing = 0;
-    if (const int signal = received_signal) throw Interrupted{signal};  // the new set is whole; still stop as asked
-    if (!depfile.empty())
-      write_depfile(depfile, depfile_target.empty() ? (fs::path(out_dir) / "wlx" / "gen" / "all.hpp").string() : depfile_target,
-                    model.input_files);
-    const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!quiet || stats_only) {
-      std::string report;
-      const auto out = std::back_inserter(report);
-      fmt::format_to(out, "{:<14} {:>8} {:>12} {:>11} {:>9}\n", "function", "temps", "ops before", "ops after", "seconds");
-      long b = 0, a = 0;
-      for (const auto& s : stats) {
-        fmt::format_to(out, "{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", s.name, s.intermediates, s.before_cse.total(),
-                   s.after_cse.total(), s.seconds);
-        b += s.before_cse.total();
-        a += s.after_cse.total();
-      }
-      fmt::format_to(out, "{:<14} {:>8} {:>12} {:>11} {:>9.3f}\n", "total", "", b, a, total);
-      for (const auto& line : ik_report) fmt::format_to(out, "closed-form IK, {}\n", line);
-      fmt::format_to(out, "model built in {:.3f} s; {} files written to {} ({} changed{})\n",
-                 std::chrono::duration<double>(t1 - t0).count(), files.size(), out_dir, changed,
-                 removed ? fmt::format(", {} stale removed", removed) : "");
-      write_stdout(report);
-    }
+    return run(request);
   } catch (const Interrupted& e) {
     // The shell's convention: 128 + the signal (130 SIGINT, 143 SIGTERM, 129 SIGHUP).
     wlx::diagnose("{}", signal_message(e.signal));
@@ -441,5 +503,4 @@ int main(int argc, char** argv) {
     wlx::diagnose("wlx-gen: error: {}\n", e.what());
     return 1;
   }
-  return 0;
 }

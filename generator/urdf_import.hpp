@@ -1,6 +1,6 @@
 // Reading a URDF robot description (liburdfdom) into plain data: the links with their inertials,
 // the joints with their origins and axes, in tree order, every one with its line in the file.
-// model_file.cpp turns this, with the small YAML file that says what URDF cannot (the base's
+// model_file_urdf.cpp turns this, with the small YAML file that says what URDF cannot (the base's
 // inputs, wheels, closures, limbs, dynamics), into the same Model a model file gives.
 //
 // The subset read: joints of type revolute, continuous, prismatic and fixed; <origin xyz rpy>;
