@@ -115,7 +115,20 @@ py::dict to_dict(const wlx::cli::NamedArrays& arrays) {
 
 PYBIND11_MODULE(_wlx, m) {
   m.doc() = "wlx's C++ core; use the package wlx";
-  py::register_exception<Error>(m, "Error", PyExc_ValueError);
+  // wlx.Error: a ValueError with the message, and `kind`, what kind of failure it is ("out-of-reach",
+  // "singular", "contact", "limit" or "other": wlx::error_kind_name), so that a program acts on the
+  // kind rather than on the words.
+  static py::exception<Error> error_type(m, "Error", PyExc_ValueError);
+  error_type.attr("kind") = "other";
+  py::register_exception_translator([](std::exception_ptr thrown) {
+    try {
+      if (thrown) std::rethrow_exception(thrown);
+    } catch (const Error& e) {
+      py::object instance = py::handle(error_type.ptr())(e.what());  // an instance, to carry the kind
+      instance.attr("kind") = wlx::error_kind_name(e.kind());
+      PyErr_SetObject(error_type.ptr(), instance.ptr());
+    }
+  });
 
   py::class_<Workspace>(m, "Workspace", "The model at one set of parameters, with its working memory (use wlx.Model)");
 
@@ -239,12 +252,15 @@ PYBIND11_MODULE(_wlx, m) {
             out["id"] = run.id;
             out["complete"] = run.complete;
             out["stopped"] = run.stopped;
+            out["stop_kind"] = run.stop_kind;
+            out["summary"] = to_dict(run.summary);
             out["evaluations"] = run.evaluations;
             return out;
           },
           py::arg("scenario_json"), py::arg("params_json") = "{}", py::arg("every") = 1, py::arg("torques") = py::none(),
           "simulate(scenario_json, params_json=\"{}\", every=1, torques=None) -> dict: columns (the CSV's, as arrays; every k-th sample), complete, "
-          "stopped (why, if early); torques: a function f(t, s, u) -> tau driving the run");
+          "stopped (why, if early), stop_kind (what kind of failure: wlx.Error's kinds), summary (over all samples: "
+          "peak_cond_J_beta, min_clearance, peak_tau, rms_tau, each where the run has it); torques: a function f(t, s, u) -> tau driving the run");
 
   py::list models;
   for (const auto& c : wlx::cli::models()) models.append(std::string(c.name));

@@ -170,7 +170,7 @@ int run_ik(const ModelOptions& model_options, bool batch) {
       ++failures;
       wlx::diagnose("wlx ik: line {}: {}\n", number, e.what());
       // replace: an ill-formed byte in a message must not end the batch (excerpts are valid UTF-8 already).
-      std::cout << nlohmann::ordered_json{{"error", e.what()}, {"line", number}}.dump(-1, ' ', false,
+      std::cout << nlohmann::ordered_json{{"error", e.what()}, {"kind", error_kind_name(e.kind())}, {"line", number}}.dump(-1, ' ', false,
                                                                                      nlohmann::json::error_handler_t::replace)
                 << "\n";
     }

@@ -7,6 +7,7 @@
 #include "model_api.hpp"
 #include "model_commands.hpp"
 #include "outputs.hpp"
+#include "run_summary.hpp"
 #include "scenario_io.hpp"
 
 #include <fmt/format.h>
@@ -227,6 +228,21 @@ NamedArrays api_forward_dynamics(const Eigen::VectorXd& s_in, const Eigen::Vecto
           {"M", Eigen::MatrixXd(terms.M), false}};
 }
 
+// A run's summary as named arrays (model_api.hpp's SimulationOutcome::summary).
+NamedArrays summary_arrays(const RunSummary& summary, bool dynamics) {
+  NamedArrays out;
+  if (summary.samples == 0) return out;
+  out.push_back({"peak_cond_J_beta", Eigen::VectorXd::Constant(1, summary.worst_cond)});
+  if (gen::kHasClearance) out.push_back({"min_clearance", Eigen::VectorXd::Constant(1, summary.min_clearance)});
+  if (dynamics) {
+    Eigen::VectorXd rms(kActuatedCount);
+    for (int k = 0; k < kActuatedCount; ++k) rms(k) = summary.rms_tau(k);
+    out.push_back({"peak_tau", Eigen::VectorXd(summary.peak_tau)});
+    out.push_back({"rms_tau", rms});
+  }
+  return out;
+}
+
 SimulationOutcome api_simulate(const std::string& scenario_json, const std::string& params_json, long every, TorqueFunction torques,
                                const SimulationSink& sink) {
   const nlohmann::json j = parse_json(scenario_json, "scenario");
@@ -261,12 +277,16 @@ SimulationOutcome api_simulate(const std::string& scenario_json, const std::stri
   const long kept = (sc.samples() + every - 1) / every;
   sink.begin(header, kept);
   long index = 0, rows = 0;
+  const bool dynamics = sc.weighting || sc.driven_by_torques();
+  RunSummary summary;
   const Trajectory run = simulate_each(sc, [&](const Sample& smp) {
     if (sink.poll) sink.poll();
+    summary.add(smp, dynamics);
     if (index++ % every != 0 || rows >= kept) return;
     sink.row(rows++, trajectory_row(smp, sc));
   });
-  return {sc.id, run.complete, run.error, run.evaluations, rows};
+  return {sc.id, run.complete, run.error, run.complete ? std::string() : error_kind_name(run.stop_kind), run.evaluations, rows,
+          summary_arrays(summary, dynamics)};
 }
 
 // The fast paths (model_api.hpp): a workspace, and states by the array.

@@ -9,6 +9,7 @@
 #include "bounded_input.hpp"
 #include "interrupt.hpp"
 #include "output_checks.hpp"
+#include "run_summary.hpp"
 #include "report/figures.hpp"
 #include "report/html.hpp"
 #include "report/runner.hpp"
@@ -191,17 +192,13 @@ report::Table Report::runs_table(Keep keep) const {
   t.header.insert(t.header.end(), {"CSV", "3D"});
   for (const auto& r : runner_.runs()) {
     if (!keep(r)) continue;
-    double res = 0, cond = 0, clear = 1e300;
-    for (const auto& smp : r.trajectory.samples) {
-      res = std::max(res, smp.nh_residual.cwiseAbs().maxCoeff());
-      cond = std::max(cond, smp.cond_J_beta);
-      clear = std::min(clear, smp.clearance);
-    }
-    const bool any = !r.trajectory.samples.empty();  // a run stopped at its first step has no maxima
-    std::vector<report::Cell> row{{r.id}, {r.scenario.description}, {std::to_string(r.trajectory.samples.size())},
-                                  {r.stopped ? r.stopped->describe() : "complete"}, {any ? fmt::format("{:.2e}", res) : "-"},
-                                  {any ? fmt::format("{:.3g}", cond) : "-"}};
-    if (gen::kHasClearance) row.push_back({any ? fmt::format("{:.4f}", clear) : "-"});
+    const RunSummary summary = summarize(r.trajectory, false);
+    const bool any = summary.samples > 0;  // a run stopped at its first step has no maxima
+    std::vector<report::Cell> row{{r.id}, {r.scenario.description}, {std::to_string(summary.samples)},
+                                  {r.stopped ? r.stopped->describe() : "complete"},
+                                  {any ? fmt::format("{:.2e}", summary.worst_rolling_residual()) : "-"},
+                                  {any ? fmt::format("{:.3g}", summary.worst_cond) : "-"}};
+    if (gen::kHasClearance) row.push_back({any ? fmt::format("{:.4f}", summary.min_clearance) : "-"});
     row.push_back({r.csv, "data/" + r.csv});
     row.push_back(viewer_missing_.empty() && any ? report::Cell{"animate", viewer_link(r.id)} : report::Cell{"-"});
     t.rows.push_back(row);
@@ -234,30 +231,24 @@ report::Section Report::contacts_section() const {
                   {}};
   for (const auto& r : runner_.runs()) {
     if (!is_dynamics_run(r) || r.trajectory.samples.empty()) continue;
-    double normal = 1e300, friction = 1e300, tip = 1e300, residual = 0;
-    int normal_c = -1, friction_c = -1, tip_a = -1, tip_b = -1;
-    double normal_t = 0, friction_t = 0;
-    std::string slip = "none", lift = "none";
-    for (const Sample& smp : r.trajectory.samples) {
-      for (int c = 0; c < kContactCount; ++c) {
-        if (!gen::kContacts[static_cast<std::size_t>(c)].supports) continue;
-        if (smp.forces.normal(c) < normal) normal = smp.forces.normal(c), normal_c = c, normal_t = smp.t;
-        if (smp.forces.friction_margin(c) < friction) friction = smp.forces.friction_margin(c), friction_c = c, friction_t = smp.t;
-        if (slip == "none" && smp.forces.friction_margin(c) < 0) slip = fmt::format("{} at {:.3f} s", contact_name(c), smp.t);
-        if (lift == "none" && smp.forces.normal(c) < 0) lift = fmt::format("{} at {:.3f} s", contact_name(c), smp.t);
-      }
-      if (smp.stability.tip_angle < tip) tip = smp.stability.tip_angle, tip_a = smp.stability.tip_edge[0], tip_b = smp.stability.tip_edge[1];
-      residual = std::max(residual, smp.momentum_residual);
-    }
+    const RunSummary st = summarize(r.trajectory, true);
+    const auto lowest = [](const RunSummary::Lowest& l) {
+      return fmt::format("{:.6g} ({} at {:.3f} s)", l.value, l.contact >= 0 ? contact_name(l.contact) : "-", l.t);
+    };
+    const auto first = [](int contact, double t) {
+      return contact >= 0 ? fmt::format("{} at {:.3f} s", contact_name(contact), t) : std::string("none");
+    };
     t.rows.push_back({{r.id},
                       {r.scenario.weighting->label()},
-                      {fmt::format("{:.6g} ({} at {:.3f} s)", normal, normal_c >= 0 ? contact_name(normal_c) : "-", normal_t)},
-                      {fmt::format("{:.6g} ({} at {:.3f} s)", friction, friction_c >= 0 ? contact_name(friction_c) : "-", friction_t)},
-                      {slip},
-                      {lift},
-                      {tip_a >= 0 ? fmt::format("{:.4g} (edge {}-{})", tip * kDegPerRad, contact_name(tip_a), contact_name(tip_b))
-                                  : std::string("-")},
-                      {fmt::format("{:.1e}", residual)}});
+                      {lowest(st.normal)},
+                      {lowest(st.friction)},
+                      {first(st.first_slip, st.slip_t)},
+                      {first(st.first_pull, st.pull_t)},
+                      {st.tip.contact >= 0 && st.tip.other >= 0
+                           ? fmt::format("{:.4g} (edge {}-{})", st.tip.value * kDegPerRad, contact_name(st.tip.contact),
+                                         contact_name(st.tip.other))
+                           : std::string("-")},
+                      {fmt::format("{:.1e}", st.worst_momentum)}});
   }
   return {"contacts", section_title("contacts", "Contacts: will it tip, will it slip"),
           "The force the ground exerts at each contact, from the equations of motion for the torques applied (the "

@@ -5,6 +5,7 @@
 #include "interrupt.hpp"
 #include "output_checks.hpp"
 #include "outputs.hpp"
+#include "run_summary.hpp"
 #include "scenario_io.hpp"
 
 #include <fmt/format.h>
@@ -162,13 +163,10 @@ int run_verify_nonholonomic(const ModelOptions& model_options, const std::string
     const Scenario sc = parse_scenario(model_scenario_json(id), params, model_scenario_directory());
     const Trajectory tr = simulate(sc);
     write_trajectory((std::filesystem::path(out_dir) / (id + ".csv")).string(), tr, sc);
-    WheelVector worst = WheelVector::Zero();
-    double cond = 0;
-    for (const auto& smp : tr.samples) {
-      worst = worst.cwiseMax(smp.nh_residual.cwiseAbs());
-      cond = std::max(cond, smp.cond_J_beta);
-    }
-    const bool pass = tr.complete && worst.maxCoeff() <= kLimit;
+    const RunSummary summary = summarize(tr, false);
+    const WheelVector& worst = summary.worst_residual;
+    const double cond = summary.worst_cond;
+    const bool pass = tr.complete && summary.worst_rolling_residual() <= kLimit;
     ok = ok && pass;
     std::string line = fmt::format("{:<6} {:>8}", id, tr.samples.size());
     for (int w = 0; w < kWheelCount; ++w)

@@ -4,6 +4,7 @@
 #include "bounded_input.hpp"
 #include "interrupt.hpp"
 #include "outputs.hpp"
+#include "run_summary.hpp"
 
 #include <fmt/format.h>
 #include <wlx/diagnostics.hpp>
@@ -25,63 +26,12 @@ struct StopRun {
   std::exception_ptr cause;
 };
 
-// Maxima and minima over the samples written; printed only when at least one sample exists, so a
-// run that fails at step 0 prints no initial values such as 1e300 or 0.
-struct Summary {
-  long samples = 0;
-  double last_t = 0;
-  double worst_residual = 0, worst_cond = 0, min_clearance = 0, peak_tau = 0;
-  EnergyBalance energy;  // runs driven by torques
-  // Dynamics runs of a model with contacts: the lowest normal force, friction margin and tip
-  // angle with their contact (or edge) and time, the first sample where a contact slips or pulls.
-  struct Lowest {
-    double value = 0, t = 0;
-    int contact = -1, other = -1;
-    void add(double v, int c, double time, int d = -1) {
-      if (contact < 0 || v < value) value = v, contact = c, other = d, t = time;
-    }
-  } normal, friction, tip;
-  int first_slip = -1, first_pull = -1;
-  double slip_t = 0, pull_t = 0, worst_momentum = 0;
-
-  void add_contacts(const Sample& smp) {
-    if constexpr (kContactCount > 0) {
-      for (int c = 0; c < kContactCount; ++c) {
-        if (!gen::kContacts[static_cast<std::size_t>(c)].supports) continue;
-        normal.add(smp.forces.normal(c), c, smp.t);
-        friction.add(smp.forces.friction_margin(c), c, smp.t);
-        if (first_slip < 0 && smp.forces.friction_margin(c) < 0) first_slip = c, slip_t = smp.t;
-        if (first_pull < 0 && smp.forces.normal(c) < 0) first_pull = c, pull_t = smp.t;
-      }
-      tip.add(smp.stability.tip_angle, smp.stability.tip_edge[0], smp.t, smp.stability.tip_edge[1]);
-      worst_momentum = std::max(worst_momentum, smp.momentum_residual);
-    } else {
-      static_cast<void>(smp);
-    }
-  }
-
-  void add(const Sample& smp) {
-    energy.add(smp);
-    const double residual = smp.nh_residual.cwiseAbs().maxCoeff(), tau = smp.tau.cwiseAbs().maxCoeff();
-    if (samples == 0) {
-      worst_residual = residual, worst_cond = smp.cond_J_beta, min_clearance = smp.clearance, peak_tau = tau;
-    } else {
-      worst_residual = std::max(worst_residual, residual);
-      worst_cond = std::max(worst_cond, smp.cond_J_beta);
-      min_clearance = std::min(min_clearance, smp.clearance);
-      peak_tau = std::max(peak_tau, tau);
-    }
-    last_t = smp.t;
-    ++samples;
-  }
-};
-
 }  // namespace
 
 int stream_simulation(const Scenario& sc, const std::string& label, const std::string& out_dir) {
   const std::string path = (std::filesystem::path(out_dir) / "trajectory.csv").string();
   CsvWriter csv(path, trajectory_header(sc));
-  Summary summary;
+  RunSummary summary;  // over the samples written
   std::optional<Interrupted> interrupted;
   Trajectory tr;
   try {
@@ -92,8 +42,7 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
       } catch (...) {
         throw StopRun{std::current_exception()};
       }
-      summary.add(smp);
-      if (sc.weighting || sc.driven_by_torques()) summary.add_contacts(smp);
+      summary.add(smp, sc.weighting || sc.driven_by_torques());
     });
   } catch (const StopRun& stop) {
     try {
@@ -116,9 +65,9 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
   if (summary.samples == 0) {
     fmt::print("no sample was computed\n");
   } else {
-    fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, {}\n", summary.worst_residual, summary.worst_cond,
+    fmt::print("max |v_W . n_W| = {:.2e} m/s, max cond(J_beta) = {:.3g}, {}\n", summary.worst_rolling_residual(), summary.worst_cond,
                gen::kHasClearance ? fmt::format("min clearance = {:.4f} m", summary.min_clearance) : std::string("no clearance box"));
-    if (sc.weighting) fmt::print("inverse dynamics with {}: largest |tau| = {:.4g} N m\n", sc.weighting->label(), summary.peak_tau);
+    if (sc.weighting) fmt::print("inverse dynamics with {}: largest |tau| = {:.4g} N m\n", sc.weighting->label(), summary.largest_tau());
     if ((sc.weighting || sc.driven_by_torques()) && summary.normal.contact >= 0) {
       const auto& st = summary;
       fmt::print("contacts: smallest normal force {:.6g} N ({} at t = {:.4f} s), smallest friction margin {:.6g} N ({} at t = "
@@ -138,7 +87,7 @@ int stream_simulation(const Scenario& sc, const std::string& label, const std::s
     if (sc.driven_by_torques())
       fmt::print("driven by torques: largest |tau| = {:.4g} N m; kinetic + potential energy {:.6g} -> {:.6g} J, the "
                  "actuators' work {:.6g} J (trapezoid on the samples): balance off by {:.2e} J\n",
-                 summary.peak_tau, summary.energy.first, summary.energy.last, summary.energy.work,
+                 summary.largest_tau(), summary.energy.first, summary.energy.last, summary.energy.work,
                  summary.energy.residual());
   }
   fmt::print("wrote {}\n", path);

@@ -42,9 +42,15 @@ struct SimulationSink {
 struct SimulationOutcome {
   std::string id;
   bool complete = false;
-  std::string stopped;  // why a run ended early
+  std::string stopped;    // why a run ended early
+  std::string stop_kind;  // what kind of failure ended it (wlx::error_kind_name), empty when complete
   long evaluations = 0;
   long rows = 0;
+  // The run's summary over all its samples (kept or not; cli/commands/run_summary.hpp, as `wlx
+  // simulate` prints it and the report tabulates it), for a sweep's metrics. Each is present only
+  // where the run has the quantity and at least one sample: peak_tau and rms_tau (per actuator)
+  // for a run with torques, min_clearance for a model with a clearance box.
+  NamedArrays summary;
 };
 
 struct ModelApi {

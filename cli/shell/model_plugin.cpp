@@ -66,9 +66,9 @@ namespace fs = std::filesystem;
 // the model's description (model.json's text), null on success, else why they were refused.
 using PluginEntry = const ModelCommands* (*)(const char** key);
 using PluginSettings = const char* (*)(const char* description);
-constexpr const char* kEntrySymbol = "wlx_model_plugin_v4";
-constexpr const char* kSettingsSymbol = "wlx_model_plugin_v4_settings";
-static_assert(kPluginInterface == 4, "rename kEntrySymbol and kSettingsSymbol with the interface's version");
+constexpr const char* kEntrySymbol = "wlx_model_plugin_v5";
+constexpr const char* kSettingsSymbol = "wlx_model_plugin_v5_settings";
+static_assert(kPluginInterface == 5, "rename kEntrySymbol and kSettingsSymbol with the interface's version");
 
 // The runtime's sources (their generated-function files apart: each is its own translation unit)
 // and the per-model commands: CMakeLists.txt's lists for the built-in models, '|'-separated.

@@ -29,7 +29,7 @@ namespace wlx::cli {
 
 // The plugin interface's version: part of every key and of the entry point's name, so a plugin
 // of another interface is never loaded.
-inline constexpr int kPluginInterface = 4;
+inline constexpr int kPluginInterface = 5;
 
 // A plugin that could not be built from a correct model file (the compiler failed): exit 1, not
 // the 2 of a bad input.

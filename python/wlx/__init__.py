@@ -199,7 +199,12 @@ class Model:
         """Runs a scenario: an embedded id ("NH-1"), a path to a JSON file, or a dict in the scenario
         format; `params` ({name: value}) override the scenario's own parameters, key by key (as a
         sweep's variant does). Returns the CSV's columns as arrays by name (every `every`-th sample, from t = 0),
-        plus "complete", "stopped" (why a run ended early) and "evaluations". A run whose kept
+        plus "complete", "stopped" (why a run ended early), "stop_kind" (what kind of failure ended
+        it, as wlx.Error's `kind`: "out-of-reach", "singular", "contact", "limit" or "other"; "" for a
+        complete run), "summary" (over every sample, kept or not, as `wlx simulate` prints it and
+        the report and a sweep use it: "peak_cond_J_beta", "min_clearance" with a clearance box, and
+        for a run with torques "peak_tau" and "rms_tau" per actuator, in `actuators` order; empty
+        without samples) and "evaluations". A run whose kept
         samples would take more than 256 MiB is refused (ValueError naming `every`): keep fewer, or
         stream it to a file with `wlx simulate`.
 
@@ -218,7 +223,7 @@ class Model:
             raise TypeError("torques: must be a function f(t, s, u) -> tau, or None")
         result = self._m.simulate(text, _params_json(params), every, torques)
         out = dict(result["columns"])
-        for k in ("id", "complete", "stopped", "evaluations"):
+        for k in ("id", "complete", "stopped", "stop_kind", "summary", "evaluations"):
             out[k] = result[k]
         return out
 

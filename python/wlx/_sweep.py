@@ -55,7 +55,7 @@ METRICS = {
     "peak_cond_J_beta": ("1", "largest cond(J_beta) over the run"),
     "min_clearance": ("m", "smallest clearance over the run"),
     "energy": ("J", "the actuators' positive work, each actuator's own (none recovered), trapezoidal over the samples"),
-    "reach_failure": ("1", "1 if the run stopped at a pose out of reach, else 0"),
+    "reach_failure": ("1", "1 if the run stopped at a pose out of reach (its failure's kind \"out-of-reach\"), else 0"),
 }
 _MODES = ("grid", "list", "random")
 
@@ -379,23 +379,20 @@ def _energy(run, actuators):
 
 
 def _reduce(run, metrics, actuators):
-    """One run's metric values, in the header's order (None: the run has no such quantity)."""
+    """One run's metric values, in the header's order (None: the run has no such quantity). The
+    torques', condition's and clearance's are the run's summary (m.simulate's "summary", computed
+    where `wlx simulate` and the report compute theirs)."""
     out = []
-    taus = [run.get(f"tau_{a}") for a in actuators]
-    has_tau = all(x is not None and len(x) for x in taus)
+    summary = run["summary"]
     for m in metrics:
         if m in ("peak_tau", "rms_tau"):
-            if not has_tau:
+            if m not in summary or len(summary[m]) != len(actuators):
                 out += [None] * (1 + len(actuators))
                 continue
-            each = [float(np.abs(x).max()) if m == "peak_tau" else float(np.sqrt(np.mean(np.square(x)))) for x in taus]
+            each = [float(x) for x in summary[m]]
             out += [max(each), *each]
-        elif m == "peak_cond_J_beta":
-            c = run.get("cond_J_beta")
-            out.append(float(c.max()) if c is not None and len(c) else None)
-        elif m == "min_clearance":
-            c = run.get("clearance")
-            out.append(float(c.min()) if c is not None and len(c) else None)
+        elif m in ("peak_cond_J_beta", "min_clearance"):
+            out.append(float(summary[m][0]) if m in summary else None)
         elif m == "energy":
             out.append(_energy(run, actuators))
         elif m == "reach_failure":
@@ -403,17 +400,15 @@ def _reduce(run, metrics, actuators):
     return out
 
 
-_REACH = re.compile(r"reach|unreachable|no real solution|no solution", re.I)
-
-
-def _failed(metrics, actuators, reason):
-    """The metric cells of a run that did not complete: empty, except reach_failure."""
+def _failed(metrics, actuators, kind):
+    """The metric cells of a run that did not complete: empty, except reach_failure, 1 where the
+    failure's kind (wlx.Error's `kind`, a run's "stop_kind") is a pose out of reach."""
     out = []
     for m in metrics:
         if m in ("peak_tau", "rms_tau"):
             out += [None] * (1 + len(actuators))
         elif m == "reach_failure":
-            out.append(1 if _REACH.search(reason) else 0)
+            out.append(1 if kind == "out-of-reach" else 0)
         else:
             out.append(None)
     return out
@@ -441,18 +436,19 @@ def run_batch(reference, names, runs, metrics, indices, values):
                 run = model.simulate(scenario, params=params)
             except Error as e:  # wlx's own checks: bad parameters, a start out of reach, ...
                 reason = _one_line(e)
-                rows.append([index, *row_values, label, False, reason, 0.0, *_failed(metrics, actuators, reason)])
+                kind = getattr(e, "kind", "other")
+                rows.append([index, *row_values, label, False, reason, 0.0, *_failed(metrics, actuators, kind)])
                 continue
             except Exception as e:  # noqa: BLE001 - a variant never aborts the sweep; its row says what happened
                 reason = _one_line(f"{type(e).__name__}: {e}")
-                rows.append([index, *row_values, label, False, reason, 0.0, *_failed(metrics, actuators, reason)])
+                rows.append([index, *row_values, label, False, reason, 0.0, *_failed(metrics, actuators, "other")])
                 continue
             t_end = float(run["t"][-1]) if len(run["t"]) else 0.0
             if run["complete"]:
                 rows.append([index, *row_values, label, True, "", t_end, *_reduce(run, metrics, actuators)])
             else:
                 reason = _one_line(run["stopped"])
-                rows.append([index, *row_values, label, False, reason, t_end, *_failed(metrics, actuators, reason)])
+                rows.append([index, *row_values, label, False, reason, t_end, *_failed(metrics, actuators, run["stop_kind"])])
     return rows
 
 

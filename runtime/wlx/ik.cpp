@@ -74,7 +74,8 @@ namespace {
       throw Error(std::string(limb_name(limb)),
                   fmt::format(fmt::runtime(cf.failures[static_cast<std::size_t>(std::clamp(why.stage, 1, 2) - 1)]),
                               fmt::arg("value", why.value), fmt::arg("low", why.low), fmt::arg("high", why.high),
-                              fmt::arg("aux", why.aux)));
+                              fmt::arg("aux", why.aux)),
+                  ErrorKind::out_of_reach);
     case gen::IkStatus::residual:
       throw Error(std::string(limb_name(limb)),
                   fmt::format("the closed-form solution does not satisfy the model: the limb's closure residual is {:.3e}, "
@@ -278,7 +279,8 @@ Error not_converged(Limb limb, bool no_descent, double residual, int iterations,
                            "nearer the limb's workspace, approach it in smaller steps from a solved pose, or give the "
                            "limb a start nearer a solution (`start:` in the model file's limb)",
                            no_descent ? ": no step lowers the residual any more" : "", residual, iterations,
-                           options.tolerance));
+                           options.tolerance),
+               ErrorKind::out_of_reach);
 }
 
 void require_finite_closure(const Data& data) {

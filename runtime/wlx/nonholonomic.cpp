@@ -63,7 +63,8 @@ void reduce(Data& d) {
                               "rates are undefined here",
                               std::isfinite(rcond) ? rcond : 0.0,  // an exactly singular block inverts to inf/NaN
                               "its joints cannot move its targets in every direction here (a chain stretched straight "
-                              "or folded, or two joint axes aligned)"));
+                              "or folded, or two joint axes aligned)"),
+                  ErrorKind::singular);
     if constexpr (kWheelCount > 0) {
       const Eigen::Matrix<double, kLimbMax, kWheelCount> lambda = inverse.transpose().lazyProduct(rhs);
       for (int i = 0; i < b.size; ++i) d.wheel_adjoint.row(b.rows[static_cast<std::size_t>(i)]) = lambda.row(i);
@@ -203,7 +204,8 @@ void factorize_dependent_rates(Data& d, const DependentPair& pair, const Nonholo
         fmt::format("J_beta for the dependent pair {} is singular: condition number {:.3g} exceeds the threshold "
                     "{:.3g}. The wheels' sideways constraint lines coincide (collinear wheel axes, thesis "
                     "4.1.4), e.g. wheels on the same level under a level body. {}",
-                    pair.label(), d.cond_J_beta, options.max_condition, raise_a_wheel_hint()));
+                    pair.label(), d.cond_J_beta, options.max_condition, raise_a_wheel_hint()),
+        ErrorKind::singular);
 }
 
 void solve_dependent_accelerations(const Model& model, Data& d, const Coordinates& s, const Coordinates& sdot,

@@ -109,6 +109,7 @@ void dopri5_span(F& f, State& x, State k1, double t, double span, double toleran
     State next, k7;
     double scaled = 0;
     std::string failure;  // a stage that left the workspace (unreachable pose, singular J_beta)
+    ErrorKind failure_kind = ErrorKind::other;
     try {
       const State k2 = f(now + c2 * step, x + step * a21 * k1);
       const State k3 = f(now + c3 * step, x + step * (a31 * k1 + a32 * k2));
@@ -128,6 +129,7 @@ void dopri5_span(F& f, State& x, State k1, double t, double span, double toleran
       // a long step can probe poses the motion itself never reaches: reject and shrink. A real
       // failure shrinks the step to nothing and is reported below.
       failure = e.what();
+      failure_kind = e.kind();
       scaled = 1e10;
     }
     // The usual controller: the error scales as step^5; a safety factor and bounded changes.
@@ -143,7 +145,8 @@ void dopri5_span(F& f, State& x, State k1, double t, double span, double toleran
       ++stats.rejected_steps;
       h = step * std::min(factor, 0.5);
       if (++rejected_in_a_row > 60 || h < 1e-14 * std::max(1.0, std::abs(end))) {
-        if (!failure.empty()) throw Error("", fmt::format("at t = {:.6f} s (adaptive step {:.3g} s): {}", now, step, failure));
+        if (!failure.empty())
+          throw Error("", fmt::format("at t = {:.6f} s (adaptive step {:.3g} s): {}", now, step, failure), failure_kind);
         throw Error("tolerance", fmt::format("the adaptive step fell to {:.3g} s at t = {:.6f} s without meeting the "
                                              "tolerance {:.3g}: the motion is not smooth here (a singular J_beta or a "
                                              "limb at its reach); use rk4 with a small dt or loosen the tolerance",
@@ -327,17 +330,20 @@ void contact_sample(const Model& model, Data& data, const Scenario& sc, const Co
     if (!sc.stop_on_contact_loss) return;
     // Tipping first: where it happens a contact also unloads, and the edge says more.
     if (smp.stability.polygon_size == 0)
-      throw Error("contacts", "no contact carries load: the machine leaves the ground, which the model does not describe");
+      throw Error("contacts", "no contact carries load: the machine leaves the ground, which the model does not describe",
+                  ErrorKind::contact);
     if (smp.stability.tip_angle <= 0)
       throw Error("contacts", fmt::format("the machine tips over the edge {}-{} (force-angle margin {:.4g} deg)",
                                           contact_name(smp.stability.tip_edge[0]), contact_name(smp.stability.tip_edge[1]),
-                                          smp.stability.tip_angle * 180 / 3.14159265358979323846));
+                                          smp.stability.tip_angle * 180 / 3.14159265358979323846),
+                  ErrorKind::contact);
     for (int c = 0; c < kContactCount; ++c)
       if (gen::kContacts[static_cast<std::size_t>(c)].supports && smp.forces.normal(c) < 0)
         throw Error("contacts", fmt::format("contact {} would pull on the ground (normal force {:.6g} N): it lifts off, which "
                                             "the model does not describe; another weighting may keep it down, or "
                                             "\"on_contact_loss\": \"continue\" goes on",
-                                            contact_name(c), smp.forces.normal(c)));
+                                            contact_name(c), smp.forces.normal(c)),
+                    ErrorKind::contact);
   } else {
     static_cast<void>(model), static_cast<void>(data), static_cast<void>(sc), static_cast<void>(s);
     static_cast<void>(terms), static_cast<void>(tau), static_cast<void>(smp);
@@ -380,7 +386,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
         fill(smp);
         check_finite(smp, sc);
         if (const std::string why = limit_violation(smp); !why.empty()) {
-          if (sc.stop_on_limit) throw Error("limits", why + " (\"on_limit\": \"continue\" goes on)");
+          if (sc.stop_on_limit) throw Error("limits", why + " (\"on_limit\": \"continue\" goes on)", ErrorKind::limit);
           if (out.limit_warning.empty()) out.limit_warning = fmt::format("at t = {:.4f} s: {}", t, why);
         }
         on_sample(smp);
@@ -408,6 +414,7 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
         out.error = fmt::format("stopped at t = {:.4f} s (step {} of {}): {}", t, k, n - 1, e.what());
         out.stop_time = t;
         out.stop_reason = e.what();
+        out.stop_kind = e.kind();
         break;
       }
     }
@@ -439,7 +446,8 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       // Driven by torques, the body may fall: the model has no contact but its feet and wheels.
       if (smp.clearance < 0)
         throw Error("clearance", fmt::format("the clearance box's lowest corner is {:.4f} m below the ground: the body "
-                                             "touches it, which the model does not describe", -smp.clearance));
+                                             "touches it, which the model does not describe", -smp.clearance),
+                    ErrorKind::contact);
     };
     integrate(f, x, fill, [&](int i) {
       return i < kInputCount ? coordinate(i) : "u." + coordinate(kCommandedSpeeds[static_cast<std::size_t>(i - kInputCount)]);

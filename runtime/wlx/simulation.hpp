@@ -5,6 +5,7 @@
 #pragma once
 
 #include "wlx/contacts.hpp"
+#include "wlx/error.hpp"
 #include "wlx/dynamics.hpp"
 #include "wlx/forward_dynamics.hpp"
 #include "wlx/ik.hpp"
@@ -108,6 +109,7 @@ struct Trajectory {
   // before it) and the reason alone, for a caller that lists stopped runs in a table.
   double stop_time = 0;
   std::string stop_reason;
+  ErrorKind stop_kind = ErrorKind::other;  // what kind of failure stopped it (error.hpp)
   // Integration work: accepted steps, rejected steps (dopri5 only), right-hand-side evaluations
   // (each one an IK of every limb plus a dependent-rate solve).
   long steps = 0, rejected_steps = 0, evaluations = 0;

@@ -241,6 +241,7 @@ TEST_CASE("cli: wlx ik --batch answers line by line and keeps going after a bad 
   CHECK(out[0].contains("psi_l2"));
   CHECK(out[1].at("line") == 2);
   CHECK(out[1].at("error").get<std::string>().rfind("left leg: F_l out of reach", 0) == 0);
+  CHECK(out[1].at("kind") == "out-of-reach");  // the IK's status, for a program that acts on it
   CHECK(out[2].at("closure_residual").get<double>() <= 1e-13);
   // Warm start from line 1: a small step needs few iterations.
   CHECK(out[2].at("iterations").at("leg_l").get<int>() <= 4);

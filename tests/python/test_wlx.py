@@ -120,6 +120,51 @@ def test_simulate_gives_the_csv_of_wlx_simulate(tmp_path, model_and_id):
         np.testing.assert_array_equal(run[column], table[:, c], err_msg=column)
 
 
+def test_errors_and_stopped_runs_say_what_kind_of_failure_they_are():
+    # A program acts on the kind (the IK's status, the run's stop), never on the words.
+    robot = wlx.model("excavator")
+    with pytest.raises(wlx.Error, match="out of reach") as e:
+        robot.ik({"z_C": 10.0})
+    assert e.value.kind == "out-of-reach"
+    with pytest.raises(wlx.Error, match="must be a number") as e:
+        robot.ik({"z_C": "high"})
+    assert e.value.kind == "other"
+    # The body rises until the legs cannot reach the feet (3.5 m from the hip).
+    run = robot.simulate({"rates": {"z_C": 1.0}, "duration": 4.0, "dt": 0.01, "dependent": ["y_C", "yaw"]})
+    assert not run["complete"] and run["stop_kind"] == "out-of-reach" and "out of reach" in run["stopped"]
+    # Both wheels on the ground under a level body: their sideways lines coincide.
+    run = robot.simulate({"rates": {"roll": 0.1}, "duration": 0.1, "dt": 0.01, "dependent": ["y_C", "yaw"],
+                          "initial": {"z_Wl": 0.0, "z_Wr": 0.0}})
+    assert run["stop_kind"] == "singular" and "singular" in run["stopped"]
+    assert robot.simulate("NH-1")["stop_kind"] == ""
+    quadruped = wlx.model("wheeled_quadruped")
+    base = {"dependent": ["y_lf", "y_rf", "y_lh", "y_rh"], "dt": 0.01, "duration": 2.0}
+    # Lowering the body bends the knees beyond the URDF's -2.8 rad.
+    run = quadruped.simulate({**base, "rates": {"z_B": -0.3}})
+    assert run["stop_kind"] == "limit" and "outside its range" in run["stopped"]
+    # Pitching up at 1 rad/s, limits let go: the machine tips over its hind wheels.
+    run = quadruped.simulate({**base, "rates": {"pitch": 1.0}, "weighting": "contribution", "on_limit": "continue"})
+    assert run["stop_kind"] == "contact" and "tips over" in run["stopped"]
+
+
+def test_a_runs_summary_covers_every_sample_also_the_ones_not_kept():
+    robot = wlx.model("excavator")
+    full = robot.simulate("ID-1")
+    thinned = robot.simulate("ID-1", every=7)
+    assert len(thinned["t"]) < len(full["t"])
+    for run in (full, thinned):  # the same C++ sums over the same samples: equal to the last bit
+        summary = run["summary"]
+        assert summary["peak_cond_J_beta"][0] == full["cond_J_beta"].max()
+        assert summary["min_clearance"][0] == full["clearance"].min()
+        peaks = [np.abs(full[f"tau_{a}"]).max() for a in robot.actuators]
+        np.testing.assert_array_equal(summary["peak_tau"], peaks)
+        # Squares summed in time order against NumPy's pairwise sum: n eps relative (n = 2001).
+        rms = [np.sqrt(np.mean(full[f"tau_{a}"] ** 2)) for a in robot.actuators]
+        np.testing.assert_allclose(summary["rms_tau"], rms, rtol=2001 * 2.2e-16, atol=0)
+    # A kinematic run has no torques; no sample, no summary.
+    assert set(robot.simulate("NH-1")["summary"]) == {"peak_cond_J_beta", "min_clearance"}
+
+
 def test_simulate_takes_a_scenario_dict_like_a_file(tmp_path):
     robot = wlx.model("excavator")
     scenario = {"id": "mine", "rates": {"x_C": 1.0, "z_C": -0.5, "pitch": {"deg/s": 5}}, "dependent": ["y_C", "yaw"],
