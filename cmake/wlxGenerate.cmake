@@ -179,7 +179,9 @@ const std::vector<ModelCommands>& models() {
   target_compile_definitions(${target}_python PRIVATE WLX_VERSION="${wlx_VERSION}" WLX_BIN_FROM_PYTHON_MODULE="wlx-gen-is-not-here"
                                                      WLX_BUILD_BIN_DIR="$<TARGET_FILE_DIR:wlx::wlx-gen>")
   set_target_properties(${target}_python PROPERTIES OUTPUT_NAME _wlx LIBRARY_OUTPUT_DIRECTORY "${dir}/wlx")
-  foreach(file __init__.py _sweep.py __main__.py)  # the package's Python files (the sweep engine too)
+  # The package's Python files (the sweep engine too): CMakeLists.txt's WLX_PYTHON_FILES.
+  foreach(file __init__.py __main__.py _sweep.py _sweep_spec.py _sweep_metrics.py _sweep_store.py _sweep_cluster.py
+               _sweep_plots.py _sweep_errors.py)
     configure_file("${WLX_PYTHON_SOURCE_DIR}/wlx/${file}" "${dir}/wlx/${file}" COPYONLY)
   endforeach()
   wlx_write_python_built_for("${dir}/wlx/_built_for.py")
