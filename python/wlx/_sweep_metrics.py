@@ -1,7 +1,8 @@
 """What a worker does: run_batch runs a batch of variants through every run and reduces each run to
-its row (variant, parameters, run, complete, stopped, t_end, then METRICS' columns). A run that did
-not complete is a row saying why. Everything here is sent to Dask's workers by name: module-level
-functions only."""
+its row (variant, parameters, run, complete, stopped, t_end, then METRICS' columns); a run that did
+not complete is a row saying why. Dask sends run_batch to the workers by name (this module and the
+function's), so it and what it calls stay module-level functions; each worker process loads its
+model once (_model_of)."""
 
 import json
 import os
@@ -35,6 +36,7 @@ def _model_of(reference):
 
 
 def _reference(model):
+    """The model as a task names it, for _model_of on a worker (a compiled model cannot be pickled)."""
     return ("file", os.path.abspath(model._path)) if model._path is not None else ("builtin", model.name)
 
 

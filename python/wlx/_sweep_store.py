@@ -243,9 +243,9 @@ def _claim(out, plan):
 
 
 def _resume(out, plan, header, keep):
-    """What the output folder `out` already holds of this sweep (a killed sweep's batches, checked)
-    and the folder made ready for the rest: (its batches/ folder, which variants are written, a
-    bool each, their rows by variant (keep), the batch files). Without `out`: nothing written."""
+    """What the output folder `out` already holds of this sweep (a killed sweep's batches, each
+    checked), the folder made ready for the rest (_claim): (the batches' folder, done: a bool per
+    variant, kept: variant -> its rows (keep), files). Without `out`: nothing is written yet."""
     n = len(plan.values)
     done = np.zeros(n, dtype=bool)
     kept = {}  # variant -> its rows (keep=True)
