@@ -33,7 +33,6 @@ std::string code_fingerprint(const std::vector<EmittedFile>& code) {
   return fmt::format("{:016x}{:016x}", a, b);
 }
 
-const char* axis_name(Axis a) { return a == Axis::X ? "x" : a == Axis::Y ? "y" : "z"; }
 
 // An expression of parameters as the number it is at the description's parameter values (the code's
 // baked ones, else the defaults). The model file's reader has checked every such expression finite

@@ -12,8 +12,6 @@ namespace wlx::codegen {
 
 namespace ik {
 
-const char* axis_name(Axis a) { return a == Axis::X ? "x" : a == Axis::Y ? "y" : "z"; }
-
 std::vector<ChainStep> full_chain(const Model& m, const std::string& frame) {
   std::vector<const NamedFrame*> path;
   for (std::string f = frame; f != "K0";) {
@@ -128,7 +126,7 @@ CanonicalChain canonical_chain(const Model& m, const std::vector<ChainStep>& cha
 
 namespace {
 
-Frame apply(const Frame& f, const Rigid& r) {
+Frame apply_rigid(const Frame& f, const Rigid& r) {
   Frame out = identically_zero(r.offset) ? f : f.translated(r.offset);
   for (const Rot& t : r.turns) out = out.turned(t.axis, t.angle);
   return out;
@@ -139,7 +137,7 @@ Frame apply(const Frame& f, const Rigid& r) {
 Frame base_frame(const Model& m, const CanonicalChain& c) {
   Frame base = Frame::ground();
   for (const ChainStep& st : c.prefix) base = apply(m, base, st);
-  return apply(base, c.fixed[0]);
+  return apply_rigid(base, c.fixed[0]);
 }
 
 std::string describe(const Rigid& r) {

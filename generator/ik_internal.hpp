@@ -18,8 +18,6 @@ struct Unsolvable {
   std::string reason;
 };
 
-const char* axis_name(Axis a);
-
 // ---- chains (ik_chains.cpp) ---------------------------------------------------------------------
 
 // Every step from K0 to the frame, parents first.

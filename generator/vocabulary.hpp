@@ -45,6 +45,7 @@ Mat3 operator*(const Mat3& a, const Mat3& b);
 Vec3 operator*(const Mat3& a, const Vec3& v);
 
 enum class Axis { X = 0, Y = 1, Z = 2 };
+inline const char* axis_name(Axis a) { return a == Axis::X ? "x" : a == Axis::Y ? "y" : "z"; }
 Vec3 unit(Axis axis);
 // Elementary rotation, right-handed: Ry(a)*(1,0,0) = (cos a, 0, -sin a).
 Mat3 rot(Axis axis, const ex& angle);

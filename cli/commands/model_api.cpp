@@ -239,6 +239,13 @@ NamedArrays summary_arrays(const RunSummary& summary, bool dynamics) {
     for (int k = 0; k < kActuatedCount; ++k) rms(k) = summary.rms_tau(k);
     out.push_back({"peak_tau", Eigen::VectorXd(summary.peak_tau)});
     out.push_back({"rms_tau", rms});
+    // Will it slip or tip: the supporting contacts' smallest normal force and friction margin (N),
+    // and the smallest force-angle margin (rad), as the report's contacts table gives them.
+    if (summary.normal.contact >= 0) {
+      out.push_back({"min_normal_force", Eigen::VectorXd::Constant(1, summary.normal.value)});
+      out.push_back({"min_friction_margin", Eigen::VectorXd::Constant(1, summary.friction.value)});
+    }
+    if (summary.tip.contact >= 0) out.push_back({"min_tip_margin", Eigen::VectorXd::Constant(1, summary.tip.value)});
   }
   return out;
 }

@@ -121,7 +121,7 @@ class Report {
 
 void Report::evaluate_claims(report::Document& d) {
   for (const auto& c : spec_.claims) {
-    ClaimRow row{c.id, c.claim, c.source, c.thesis, c.spec, c.why, {}, {}, ClaimRow::Result::none};
+    ClaimRow row{c.id, c.claim, c.source, c.why, c.claimed, {}, {}, ClaimRow::Result::none};
     bool pass = true, measured = true;
     for (const auto& t : c.tests) {
       const std::optional<Measured> m = runner_.measure(t.measure);

@@ -135,7 +135,7 @@ int run_simulate(const ModelOptions& model_options, const SimulateOptions& o) {
   if (!o.weighting.empty()) {
     const std::string& w = o.weighting;
     if (w != "model-weights" && w != "contribution" && w != "contacts" && w != "1" && w != "2" && w != "3")
-      throw Error("--weighting", fmt::format("must be model-weights, contribution or contacts (or the thesis' 1, 2, 3), got '{}'", excerpt(w)));
+      throw Error("--weighting", fmt::format("must be model-weights, contribution or contacts (or 1, 2, 3), got '{}'", excerpt(w)));
     sc.weighting = w == "model-weights" || w == "1" ? Weighting::model_weights()
                    : w == "contribution" || w == "2" ? Weighting::contribution()
                                                      : Weighting::contacts();

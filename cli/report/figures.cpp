@@ -295,7 +295,7 @@ class Figures {
       }
       b += "unset multiplot\n";
       std::string caption = fmt::format("{}: {} over the driving input {}", g.id, fmt::format("{}", fmt::join(g.y, " and ")), g.x);
-      if (!g.thesis.empty()) caption += "; cf. thesis " + g.thesis;
+      if (!g.reference.empty()) caption += "; cf. " + g.reference;
       out.push_back({"run-" + g.id, caption + left_out(why), "1100,450", b});
       out.push_back(top_view(g.id, runs));
     }
@@ -368,7 +368,7 @@ class Figures {
         // Equal to rounding: 1e-9 of the largest torque of the run.
         const auto titles = legend_titles(names, curves, 1e-9 * std::max(scale, 1.0));
         b += fmt::format("set title {}\nplot ", q(fmt::format("{}, {}: torques{}", r.scenario_id, r.scenario.weighting->label(),
-                                                                reference ? " (cf. thesis " + reference->figures[p] + ")" : "")));
+                                                                reference ? " (cf. " + reference->figures[p] + ")" : "")));
         for (std::size_t k = 0; k < names.size(); ++k)
           b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(data_path(r.csv)), column("t"),
                            column(names[k]), dash(k), q(titles[k]));
@@ -376,7 +376,7 @@ class Figures {
       }
       b += "unset multiplot\n";
       std::string caption = fmt::format("{}: actuator torques with {}", r.scenario_id, r.scenario.weighting->label());
-      if (reference) caption += fmt::format("; cf. thesis {}", fmt::join(reference->figures, ", "));
+      if (reference) caption += fmt::format("; cf. {}", fmt::join(reference->figures, ", "));
       out.push_back({"id-" + r.id, caption, fmt::format("1100,{}", 380 * panels.size()), b});
     }
   }

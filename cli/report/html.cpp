@@ -33,14 +33,17 @@ std::string table(const Table& t) {
   return h + "</table>\n";
 }
 
-std::string claims_table(const std::vector<ClaimRow>& rows, bool with_criterion) {
-  std::string h = "<table class=\"claims\">\n<tr><th>claim</th><th>source</th><th>thesis</th><th>model specification</th>"
-                  "<th>wlx</th>";
+// A column per source, headed by its name (the report file's), for the value as it states it.
+std::string claims_table(const std::vector<ClaimRow>& rows, bool with_criterion, const std::vector<std::pair<std::string, std::string>>& sources) {
+  std::string h = "<table class=\"claims\">\n<tr><th>claim</th><th>source</th>";
+  for (const auto& [name, what] : sources) h += "<th>" + escape(name) + "</th>";
+  h += "<th>wlx</th>";
   h += with_criterion ? "<th>criterion</th><th>result</th>" : "";
   h += "<th>why</th></tr>\n";
   for (const auto& r : rows) {
-    h += fmt::format("<tr id=\"claim-{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"wlx\">{}</td>", escape(r.id),
-                     escape(r.claim), escape(r.source), escape(r.thesis), escape(r.spec), lines(r.measured));
+    h += fmt::format("<tr id=\"claim-{}\"><td>{}</td><td>{}</td>", escape(r.id), escape(r.claim), escape(r.source));
+    for (std::size_t k = 0; k < sources.size(); ++k) h += "<td>" + escape(k < r.claimed.size() ? r.claimed[k] : std::string()) + "</td>";
+    h += fmt::format("<td class=\"wlx\">{}</td>", lines(r.measured));
     if (with_criterion) {
       const bool pass = r.result == ClaimRow::Result::pass;
       h += fmt::format("<td class=\"criterion\">{}</td><td class=\"{}\">{}</td>", lines(r.criteria), pass ? "pass" : "fail", pass ? "pass" : "FAIL");
@@ -119,7 +122,7 @@ std::string render_html(const Document& d) {
   if (d.claims_source.empty()) {
     h += "<p>This model has no report file with claims: the report shows its runs without checks.</p>\n";
   } else {
-    h += fmt::format("<p>{} of {} checks pass. Each check is a claim of the thesis or the model specification that wlx's "
+    h += fmt::format("<p>{} of {} checks pass. Each check is a claim of the sources below that wlx's "
                      "result could fail: its criterion (in the unit shown) stands beside the measured value, its "
                      "justification in the last column. The claims and their sources are data: <code>{}</code>.{}</p>\n",
                      d.checks.size() - failed, d.checks.size(), escape(d.claims_source),
@@ -131,15 +134,15 @@ std::string render_html(const Document& d) {
       for (const auto& [name, what] : d.sources) h += fmt::format(" <b>{}</b>: {}.", escape(name), escape(what));
       h += "</p>\n";
     }
-    h += claims_table(d.checks, true);
+    h += claims_table(d.checks, true, d.sources);
   }
   h += "<h2 id=\"inputs\">Inputs and set-up (not checks)</h2>\n<p>Values the sources report that follow from the "
        "inputs of a run (a commanded rate times the duration, a coordinate held constant, a sum of input masses): "
        "wlx reproduces them by construction, so they cannot fail and are not counted as checks.</p>\n";
-  if (!d.inputs.empty()) h += claims_table(d.inputs, false);
+  if (!d.inputs.empty()) h += claims_table(d.inputs, false, d.sources);
   h += "<h2 id=\"observations\">Observations: where wlx differs from its sources</h2>\n<p>Where wlx deliberately "
        "computes something else than the source, or the source gives no number to hold wlx against.</p>\n";
-  if (!d.observations.empty()) h += claims_table(d.observations, false);
+  if (!d.observations.empty()) h += claims_table(d.observations, false, d.sources);
   for (const auto& s : d.sections) section(h, s, 2);
   h += "<h2 id=\"parameters\">Parameters</h2>\n" + table(d.parameters);
   h += "</body>\n</html>\n";

@@ -26,7 +26,8 @@ struct Table {
 
 // One claim of the report file with wlx's measured values (one line per test).
 struct ClaimRow {
-  std::string id, claim, source, thesis, spec, why;
+  std::string id, claim, source, why;
+  std::vector<std::string> claimed;  // as each of Document::sources states it ("" where it does not)
   std::vector<std::string> measured, criteria;
   enum class Result { pass, fail, none } result = Result::none;  // none: inputs and observations
 };
@@ -45,7 +46,7 @@ struct Document {
   Table parameters;
   std::vector<ClaimRow> checks, inputs, observations;
   Table stopped_runs;  // the simulations that ended before their duration: run, time, reason (no rows: none)
-  std::map<std::string, std::string> sources;  // "thesis", "spec": what a row's source names
+  std::vector<std::pair<std::string, std::string>> sources;  // the claims' sources: name, what it is (a column each)
   std::string claims_source;  // where the claims come from (a file), or empty: the model has none
   int skipped_claims = 0;     // claims about runs this report did not make (--quick)
   std::vector<Section> sections;

@@ -109,7 +109,7 @@ void ReportRunner::validate() const {
     check(f.y, coordinates, f.line, "run_figures." + f.id + ".y", "a coordinate");
   }
   for (const auto& p : spec_.torque_panels) check(p, joints, 1, "torque_figures.panels", "an actuated joint");
-  for (const auto& r : spec_.torque_references) check({r.scenario}, scenarios, r.line, "torque_figures.thesis.scenario", "a scenario");
+  for (const auto& r : spec_.torque_references) check({r.scenario}, scenarios, r.line, "torque_figures.references.scenario", "a scenario");
   if (!spec_.pose_frame.empty() && frame_index(spec_.pose_frame) < 0) {
     std::vector<std::string> frames(gen::kFrameNames.begin(), gen::kFrameNames.end());
     fail(spec_.pose_line, "pose.body_frame", "a frame", spec_.pose_frame, frames);

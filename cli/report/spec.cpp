@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 #include <wlx/yaml_key_check.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -17,6 +18,10 @@
 namespace wlx::cli::report {
 
 namespace {
+
+// A source is a column of the claims' tables: a few fit a page.
+constexpr std::size_t kMaxSources = 6;
+constexpr const char* kNameCharacters = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-";
 
 // Quantity -> the measure keys it requires (beyond `quantity`), and the ones it may take.
 struct QuantityRule {
@@ -210,8 +215,10 @@ class Parser {
     return t;
   }
 
-  Claim claim(const YAML::Node& n, const std::string& path) const {
-    keys(n, path, {"id", "kind", "claim", "source", "thesis", "spec", "measure", "criterion", "tests", "why"});
+  using Sources = std::vector<std::pair<std::string, std::string>>;
+
+  Claim claim(const YAML::Node& n, const std::string& path, const Sources& sources) const {
+    keys(n, path, {"id", "kind", "claim", "source", "claimed", "measure", "criterion", "tests", "why"});
     Claim c;
     c.line = line(n);
     c.id = text(required(n, "id", path), path + ".id");
@@ -221,14 +228,20 @@ class Parser {
     else if (kind == "observation") c.kind = ClaimKind::observation;
     else fail(n["kind"], path + ".kind", fmt::format("must be check, input or observation, got '{}'", kind));
     c.claim = text(required(n, "claim", path), path + ".claim");
+    std::vector<std::string> names;
+    for (const auto& [name, what] : sources) names.push_back(name);
     const YAML::Node source = required(n, "source", path);
-    keys(source, path + ".source", {"thesis", "spec"});
-    for (const char* doc : {"thesis", "spec"})
-      if (source[doc]) c.source += (c.source.empty() ? "" : "; ") + std::string(doc) + " " + text(source[doc], path + ".source." + doc);
-    if (c.source.empty()) fail(source, path + ".source", "must name the thesis or the spec (with section, figure or table)");
-    c.thesis = optional_text(n, "thesis", path);
-    c.spec = optional_text(n, "spec", path);
-    if (c.thesis.empty() && c.spec.empty()) fail(n, path, "must give the claimed value as 'thesis' or 'spec'");
+    if (sources.empty()) fail(source, path + ".source", "cites a source, but the file names none: list them under `sources`");
+    keys(source, path + ".source", names);
+    for (const std::string& name : names)
+      if (source[name]) c.source += (c.source.empty() ? "" : "; ") + name + " " + text(source[name], path + ".source." + name);
+    if (c.source.empty())
+      fail(source, path + ".source", fmt::format("must cite one of the sources ({}) with its section, figure or table", fmt::join(names, ", ")));
+    const YAML::Node claimed = required(n, "claimed", path);
+    keys(claimed, path + ".claimed", names);
+    for (const std::string& name : names) c.claimed.push_back(claimed[name] ? text(claimed[name], path + ".claimed." + name) : "");
+    if (std::all_of(c.claimed.begin(), c.claimed.end(), [](const std::string& v) { return v.empty(); }))
+      fail(claimed, path + ".claimed", fmt::format("must give the value as a source states it ({})", fmt::join(names, ", ")));
     c.why = text(required(n, "why", path), path + ".why");
     if (n["tests"]) {
       if (n["measure"] || n["criterion"]) fail(n, path, "give either 'tests' or 'measure' (and 'criterion'), not both");
@@ -286,8 +299,14 @@ class Parser {
       }
     }
     if (const YAML::Node src = root["sources"]) {
-      keys(src, "sources", {"thesis", "spec"});
-      for (const auto& kv : src) s.sources[kv.first.as<std::string>()] = text(kv.second, "sources." + kv.first.as<std::string>());
+      if (!src.IsMap() || src.size() == 0) fail(src, "sources", "must be a map {name: what the source is}");
+      if (src.size() > kMaxSources) fail(src, "sources", fmt::format("names {} sources; at most {} (a column each)", src.size(), kMaxSources));
+      for (const auto& kv : src) {
+        const std::string name = kv.first.as<std::string>();
+        if (name.empty() || name.size() > 40 || name.find_first_not_of(kNameCharacters) != std::string::npos)
+          fail(kv.first, "sources", fmt::format("'{}' is not a source's name: letters, digits, '_' and '-', at most 40", excerpt(name)));
+        s.sources.emplace_back(name, text(kv.second, "sources." + name));
+      }
     }
     if (const YAML::Node sec = root["sections"]) {
       keys(sec, "sections", {"ik", "nonholonomic", "kinematic", "dynamics", "forward"});
@@ -307,26 +326,26 @@ class Parser {
       if (!figs.IsSequence()) fail(figs, "run_figures", "must be a list");
       for (std::size_t k = 0; k < figs.size(); ++k) {
         const std::string path = fmt::format("run_figures[{}]", k);
-        keys(figs[k], path, {"id", "runs", "x", "y", "thesis"});
+        keys(figs[k], path, {"id", "runs", "x", "y", "reference"});
         RunFigure f;
         f.line = line(figs[k]);
         f.id = text(required(figs[k], "id", path), path + ".id");
         f.runs = names(required(figs[k], "runs", path), path + ".runs");
         f.x = text(required(figs[k], "x", path), path + ".x");
         f.y = names(required(figs[k], "y", path), path + ".y");
-        f.thesis = optional_text(figs[k], "thesis", path);
+        f.reference = optional_text(figs[k], "reference", path);
         s.run_figures.push_back(f);
       }
     }
     if (const YAML::Node tf = root["torque_figures"]) {
-      keys(tf, "torque_figures", {"panels", "thesis"});
+      keys(tf, "torque_figures", {"panels", "references"});
       const YAML::Node panels = required(tf, "panels", "torque_figures");
       if (!panels.IsSequence() || panels.size() == 0) fail(panels, "torque_figures.panels", "must be a non-empty list of lists");
       for (std::size_t k = 0; k < panels.size(); ++k) s.torque_panels.push_back(names(panels[k], fmt::format("torque_figures.panels[{}]", k)));
-      if (const YAML::Node refs = tf["thesis"]) {
-        if (!refs.IsSequence()) fail(refs, "torque_figures.thesis", "must be a list");
+      if (const YAML::Node refs = tf["references"]) {
+        if (!refs.IsSequence()) fail(refs, "torque_figures.references", "must be a list");
         for (std::size_t k = 0; k < refs.size(); ++k) {
-          const std::string path = fmt::format("torque_figures.thesis[{}]", k);
+          const std::string path = fmt::format("torque_figures.references[{}]", k);
           keys(refs[k], path, {"scenario", "weighting", "figures"});
           TorqueReference r;
           r.line = line(refs[k]);
@@ -352,7 +371,7 @@ class Parser {
       if (!claims.IsSequence()) fail(claims, "claims", "must be a list");
       std::set<std::string> ids;
       for (std::size_t k = 0; k < claims.size(); ++k) {
-        Claim c = claim(claims[k], fmt::format("claims[{}]", k));
+        Claim c = claim(claims[k], fmt::format("claims[{}]", k), s.sources);
         if (!ids.insert(c.id).second) fail(claims[k]["id"], fmt::format("claims[{}].id", k), fmt::format("'{}' is given twice", c.id));
         s.claims.push_back(std::move(c));
       }

@@ -1,5 +1,6 @@
-// A model's report file (scenarios/<model>/report.yaml): the thesis' claims with their sources and
-// how wlx measures each, and how the report groups runs into figures. Parsed here into names
+// A model's report file (scenarios/<model>/report.yaml): the claims its sources (a paper, a
+// specification: any documents the file names) make, with their citations, how wlx measures each,
+// and how the report groups runs into figures. Parsed here into names
 // (strings); the per-model code resolves the names against the generated tables and the model's
 // scenarios (report/resolve.hpp). Model-independent, so a model without a report file, or any
 // model, uses the same parser. The format: scenarios/README.md, "Report files".
@@ -45,15 +46,16 @@ struct Claim {
   std::string id;
   ClaimKind kind = ClaimKind::check;
   std::string claim;
-  std::string source;  // "thesis section 3.4, Tables 3-2 to 3-13", "spec section 5"
-  std::string thesis, spec;  // the values as the sources give them (text)
+  std::string source;  // the citations, "<source> <where>" joined by "; ": "paper section 3.4; spec section 5"
+  std::vector<std::string> claimed;  // the value as each source states it (ReportSpec::sources' order; "" where it does not)
   std::string why;           // why the criterion, or where the value comes from
   std::vector<Test> tests;
   int line = 0;
 };
 
 struct RunFigure {
-  std::string id, x, thesis;
+  std::string id, x;
+  std::string reference;  // the sources' figure of the same, cited in the caption (may be empty)
   std::vector<std::string> runs, y;
   int line = 0;
 };
@@ -65,15 +67,15 @@ struct TorqueReference {
   int line = 0;
 };
 
-// A horizontal line in a figure: a value the sources quote (the thesis' error level, ...).
+// A horizontal line in a figure: a value the sources quote (an error level they report, ...).
 struct ReferenceLine {
   double value = 0;
   std::string label;
 };
 
 struct ReportSpec {
-  std::string file;   // for messages: "scenarios/excavator/report.yaml" or the user's path
-  std::string title;  // "the walking excavator of the diploma thesis"
+  std::string file;   // for messages: "scenarios/<model>/report.yaml" or the user's path
+  std::string title;  // what the report is of, in words
   std::optional<std::vector<std::string>> quick_sweeps, quick_scenarios;  // unset: all
   std::vector<std::string> integrator_scenarios, integrator_coordinates;
   double reference_step = 1e-4;
@@ -81,10 +83,12 @@ struct ReportSpec {
   // Keyed by the figure they go into: ik_check_error (IK sweeps), wheel_residual (wheel constraint runs).
   std::map<std::string, ReferenceLine> reference_lines;
   std::map<std::string, std::string> section_titles;  // ik, nonholonomic, kinematic, dynamics
-  std::map<std::string, std::string> sources;  // thesis, spec: what the sources are, for the reader
+  // The documents the claims cite, in the file's order: a short name (a claim's `source` and
+  // `claimed` keys, a column of the claims' tables) and what it is, for the reader.
+  std::vector<std::pair<std::string, std::string>> sources;
   std::vector<RunFigure> run_figures;
   std::vector<std::vector<std::string>> torque_panels;
-  std::vector<TorqueReference> torque_references;
+  std::vector<TorqueReference> torque_references;  // the sources' figures of the same torques
   std::string pose_frame;
   std::vector<std::string> pose_outline;  // two parameters: length along x, width along y
   int pose_line = 0;

@@ -48,7 +48,7 @@ void define_command_line(CLI::App& app, Invocation& inv, const std::vector<std::
                        "rk4, euler or dopri5 (adaptive Dormand-Prince 5(4)); default: the scenario's");
   inv.simulate->add_option("--dt", inv.sim.dt, "step in seconds, or with dopri5 the output interval (default: the scenario's)");
   inv.simulate->add_option("--tolerance", inv.sim.tolerance, "dopri5's local error bound per step, relative to 1 + |q| (default 1e-10)");
-  inv.simulate->add_option("--weighting", inv.sim.weighting, "torque weighting: model-weights (the model file's), contribution or contacts (keeps the machine on its contacts); the thesis' 1, 2, 3 name them too; for inverse dynamics (default: the scenario's)");
+  inv.simulate->add_option("--weighting", inv.sim.weighting, "torque weighting: model-weights (the model file's), contribution or contacts (keeps the machine on its contacts), also 1, 2, 3; for inverse dynamics (default: the scenario's)");
   inv.simulate->add_flag("--list", inv.sim.list, "list the built-in scenarios");
 
   inv.report = app.add_subcommand("report", "run the model's verifications and scenarios, check the claims of its report file, and write an HTML report with figures");

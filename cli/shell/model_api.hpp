@@ -49,7 +49,9 @@ struct SimulationOutcome {
   // The run's summary over all its samples (kept or not; cli/commands/run_summary.hpp, as `wlx
   // simulate` prints it and the report tabulates it), for a sweep's metrics. Each is present only
   // where the run has the quantity and at least one sample: peak_tau and rms_tau (per actuator)
-  // for a run with torques, min_clearance for a model with a clearance box.
+  // for a run with torques, min_clearance for a model with a clearance box; for a run with torques
+  // on a model with contacts, min_normal_force and min_friction_margin (N, over the supporting
+  // contacts) and min_tip_margin (the force-angle margin, rad).
   NamedArrays summary;
 };
 

@@ -18,6 +18,9 @@ METRICS = {
     "rms_tau": ("N m or N", "largest RMS of tau over the samples, of all actuators (and rms_tau_<actuator> each)"),
     "peak_cond_J_beta": ("1", "largest cond(J_beta) over the run"),
     "min_clearance": ("m", "smallest clearance over the run"),
+    "min_normal_force": ("N", "smallest normal force of the supporting contacts over the run (below 0: one would lift off)"),
+    "min_friction_margin": ("N", "smallest friction margin mu f_n - f_t of the supporting contacts (below 0: one would slide)"),
+    "min_tip_margin": ("rad", "smallest force-angle (tip-over) margin over the run (below 0: the machine tips)"),
     "energy": ("J", "the actuators' positive work, each actuator's own (none recovered), trapezoidal over the samples"),
     "reach_failure": ("1", "1 if the run stopped at a pose out of reach (its failure's kind \"out-of-reach\"), else 0"),
 }
@@ -70,8 +73,8 @@ def _energy(run, actuators):
 
 def _reduce(run, metrics, actuators):
     """One run's metric values, in the header's order (None: the run has no such quantity). The
-    torques', condition's and clearance's are the run's summary (m.simulate's "summary", computed
-    where `wlx simulate` and the report compute theirs)."""
+    torques', condition's, clearance's and contacts' are the run's summary (m.simulate's "summary",
+    computed where `wlx simulate` and the report compute theirs)."""
     out = []
     summary = run["summary"]
     for m in metrics:
@@ -81,7 +84,7 @@ def _reduce(run, metrics, actuators):
                 continue
             each = [float(x) for x in summary[m]]
             out += [max(each), *each]
-        elif m in ("peak_cond_J_beta", "min_clearance"):
+        elif m in ("peak_cond_J_beta", "min_clearance", "min_normal_force", "min_friction_margin", "min_tip_margin"):
             out.append(float(summary[m][0]) if m in summary else None)
         elif m == "energy":
             out.append(_energy(run, actuators))

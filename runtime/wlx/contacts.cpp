@@ -187,14 +187,7 @@ double signed_distance(const std::array<Eigen::Vector2d, kContactCount>& v, int 
 void stability(const Model& model, Data& d, const Coordinates& s, const ContactForces& forces, Stability& out) {
   const Params& p = model.params();
   gen::bodies(s, Coordinates::Zero(), p, {.com = &d.body_com}, false);
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();
-  double mass = 0;
-  for (int b = 0; b < gen::kBodyCount; ++b) {
-    const double m = p.*gen::kBodyMass[at(b)].mass;
-    com += m * d.body_com.col(b);
-    mass += m;
-  }
-  out.com = com / mass;
+  out.com = centre_of_mass(model, d);
 
   // The supporting contacts in load, then their convex hull (Andrew's monotone chain) seen from above.
   std::array<int, kContactCount> loaded{};
@@ -273,13 +266,7 @@ MomentumBalance momentum_balance(const Model& model, Data& d, const Coordinates&
                .Jw_dot_sdot = &d.body_Jw_dot_sdot},
               false);
   const double g = gen::kHasDynamics ? p.*gen::kGravity : 0.0;
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();
-  double mass = 0;
-  for (int b = 0; b < gen::kBodyCount; ++b) {
-    com += (p.*gen::kBodyMass[at(b)].mass) * d.body_com.col(b);
-    mass += p.*gen::kBodyMass[at(b)].mass;
-  }
-  com /= mass;
+  const Eigen::Vector3d com = centre_of_mass(model, d);
   // Each sum's terms are added up with their largest magnitude kept: the residual is relative to it.
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
   double force_scale = 0, moment_scale = 0;
@@ -293,10 +280,8 @@ MomentumBalance momentum_balance(const Model& model, Data& d, const Coordinates&
     add(moment, moment_scale, forces.moment.col(c));
   }
   for (int b = 0; b < gen::kBodyCount; ++b) {
-    const auto& info = gen::kBodyMass[at(b)];
-    const double m = p.*info.mass;
-    const Eigen::Matrix3d& R = d.body_rotations[at(b)];
-    const Eigen::Matrix3d I = R * Eigen::Vector3d(p.*info.inertia[0], p.*info.inertia[1], p.*info.inertia[2]).asDiagonal() * R.transpose();
+    const double m = p.*gen::kBodyMass[at(b)].mass;
+    const Eigen::Matrix3d I = world_inertia(p, b, d.body_rotations[at(b)]);
     const Eigen::Vector3d a = d.body_Jv[at(b)] * sddot + d.body_Jv_dot_sdot.col(b);
     const Eigen::Vector3d w = d.body_Jw[at(b)] * sdot;
     const Eigen::Vector3d alpha = d.body_Jw[at(b)] * sddot + d.body_Jw_dot_sdot.col(b);

@@ -13,13 +13,20 @@
 
 WLX_MODEL_NAMESPACE_BEGIN
 
-namespace {
-
 Eigen::Matrix3d world_inertia(const Params& p, int body, const Eigen::Matrix3d& R) {
   const auto& info = gen::kBodyMass[static_cast<std::size_t>(body)];
   const Eigen::Vector3d I(p.*info.inertia[0], p.*info.inertia[1], p.*info.inertia[2]);
   return R * I.asDiagonal() * R.transpose();
 }
+
+Eigen::Vector3d centre_of_mass(const Model& model, const Data& data) {
+  const Params& p = model.params();
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  for (int b = 0; b < gen::kBodyCount; ++b) com += (p.*gen::kBodyMass[static_cast<std::size_t>(b)].mass) * data.body_com.col(b);
+  return com / model.total_mass();
+}
+
+namespace {
 
 double mass(const Params& p, int body) { return p.*gen::kBodyMass[static_cast<std::size_t>(body)].mass; }
 

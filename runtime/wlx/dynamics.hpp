@@ -83,6 +83,11 @@ void equations_of_motion(const Model& model, Data& data, const Coordinates& s, c
 
 // Potential and kinetic energy of the bodies (for the energy checks).
 double potential_energy(const Model& model, Data& data, const Coordinates& s);
+// The whole machine's centre of mass in K0, from the bodies' centres that gen::bodies left in
+// data.body_com (the energies, the momentum balance and the margins all sum it here).
+Eigen::Vector3d centre_of_mass(const Model& model, const Data& data);
+// A body's inertia about its centre of mass, in K0: its principal moments turned by its rotation R.
+Eigen::Matrix3d world_inertia(const Params& p, int body, const Eigen::Matrix3d& R);
 double kinetic_energy(const Model& model, Data& data, const Coordinates& s, const Coordinates& sdot);
 
 struct Weighting {

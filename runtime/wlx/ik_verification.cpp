@@ -120,9 +120,9 @@ IkSweepResult run_ik_sweep(const Model& model, Data& data, const IkSweep& sweep)
     Coordinates cold = start;  // the thesis' way: every point from the same start pose
     cold(input) = pt.value;
     try {
-      NewtonOptions thesis;  // the thesis' Newton with backtracking, whose basins the cold starts show
-      thesis.method = NewtonOptions::Method::backtracking;
-      solve_ik_newton(model, data, cold, thesis);
+      NewtonOptions backtracking;  // Newton with backtracking (the thesis' method), whose basins the cold starts show
+      backtracking.method = NewtonOptions::Method::backtracking;
+      solve_ik_newton(model, data, cold, backtracking);
       pt.cold_newton_branch = classify_branch(model, sweep.limb, cold);
     } catch (const Error&) {
       pt.cold_newton_branch = -1;

@@ -202,8 +202,8 @@ void factorize_dependent_rates(Data& d, const DependentPair& pair, const Nonholo
     throw Error(
         "dependent",
         fmt::format("J_beta for the dependent pair {} is singular: condition number {:.3g} exceeds the threshold "
-                    "{:.3g}. The wheels' sideways constraint lines coincide (collinear wheel axes, thesis "
-                    "4.1.4), e.g. wheels on the same level under a level body. {}",
+                    "{:.3g}. The wheels' sideways constraint lines coincide (collinear wheel axes), "
+                    "e.g. wheels on the same level under a level body. {}",
                     pair.label(), d.cond_J_beta, options.max_condition, raise_a_wheel_hint()),
         ErrorKind::singular);
 }

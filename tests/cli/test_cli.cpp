@@ -322,7 +322,7 @@ TEST_CASE("cli: wlx simulate ID-1 --weighting 2 adds the torque and Q* columns")
                     "Qstar_z_C,Qstar_x_C,Qstar_roll,Qstar_pitch") != std::string::npos);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 495);
   CHECK(run_wlx("simulate ID-1 --weighting 4 --out " + dir.string()).err ==
-        "wlx: error: --weighting: must be model-weights, contribution or contacts (or the thesis' 1, 2, 3), got '4'\n");
+        "wlx: error: --weighting: must be model-weights, contribution or contacts (or 1, 2, 3), got '4'\n");
   // By name, the same run as by the thesis' number: the same torques to the last digit.
   const fs::path named = fs::temp_directory_path() / "wlx_cli_test" / "id1-named";
   fs::remove_all(named);

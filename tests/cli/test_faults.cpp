@@ -658,7 +658,7 @@ TEST_CASE("faults: a --claims label with a line break and a system() call is ref
   Result r = run({"report", "--quick", "--claims", (base / "newline.yaml").string(), "--out", (base / "r1").string()}, {.cwd = base});
   CAPTURE(r.err);
   CHECK(r.code == 2);
-  CHECK(r.err.find("newline.yaml:31: reference_lines.ik_check_error.label: has a line break at byte 1") != std::string::npos);
+  CHECK(r.err.find("newline.yaml:32: reference_lines.ik_check_error.label: has a line break at byte 1") != std::string::npos);
   CHECK(!fs::exists(base / "r1" / "index.html"));
   // Every other way out of a gnuplot string, and HTML in a claim: written as text.
   std::string text = report_file_with(anchor, "label: \"x' . system('touch PWNED') . 'y `touch PWNED2` @z \\u00fc </script>\"}");

@@ -707,12 +707,13 @@ TEST_CASE("--model-file without a clearance box: simulate, report and the viewer
   CHECK(data.find("inf") == std::string::npos);
 
   // A claim measured from the clearance box is a bad input for this model: named, exit 2, no report.
-  write(runs / "report.yaml", "claims:\n  - {id: touch, kind: check, claim: the body touches down, source: {spec: a test}, spec: 1 s, "
+  write(runs / "report.yaml", "sources: {spec: a test's}\n"
+                              "claims:\n  - {id: touch, kind: check, claim: the body touches down, source: {spec: a test}, claimed: {spec: 1 s}, "
                               "measure: {quantity: ground_contact_time, run: roll}, criterion: {at_least: 0}, why: a test}\n");
   const fs::path bad = wlx_test::work_dir() / "newton_leg_bad_report";
   const auto refused = run({"--model-file", model.string(), "--scenarios", runs.string(), "report", "--out", bad.string()});
   CHECK(refused.code == 2);
-  CHECK(refused.err.find("report.yaml:2: claims.touch.measure.quantity: ground_contact_time needs a clearance box, and model "
+  CHECK(refused.err.find("report.yaml:3: claims.touch.measure.quantity: ground_contact_time needs a clearance box, and model "
                          "newton_leg has none") != std::string::npos);
   CHECK(!fs::exists(bad / "index.html"));
 }

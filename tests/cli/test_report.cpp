@@ -153,9 +153,9 @@ void write(const fs::path& p, const std::string& text) {
 std::string claims_with_mass_check(const std::string& criterion) {
   // quick: one sweep and one run, so that --quick draws few figures (without it, a file of claims
   // alone draws every run: 6.8 s, and 37 s under the sanitizers, for a check of the mass).
-  return "quick: {sweeps: [IK-L3], scenarios: [NH-1]}\n"
-         "claims:\n  - id: mass\n    kind: check\n    claim: the total mass\n    source: {thesis: Table 6-1}\n"
-         "    thesis: 6153.98 kg\n    measure: {quantity: total_mass}\n    criterion: " +
+  return "quick: {sweeps: [IK-L3], scenarios: [NH-1]}\nsources: {datasheet: the maker's data sheet}\n"
+         "claims:\n  - id: mass\n    kind: check\n    claim: the total mass\n    source: {datasheet: Table 6-1}\n"
+         "    claimed: {datasheet: 6153.98 kg}\n    measure: {quantity: total_mass}\n    criterion: " +
          criterion + "\n    why: a test\n";
 }
 
@@ -174,6 +174,9 @@ TEST_CASE("report: a check whose measured value is outside its criterion fails t
   const std::string html = slurp(dir / "out" / "index.html");
   CHECK(html.find("class=\"fail\"") != std::string::npos);
   CHECK(html.find("0 of 1 checks pass") != std::string::npos);
+  // The file's own source is the claims' column, its value under it.
+  CHECK(html.find("<th>datasheet</th>") != std::string::npos);
+  CHECK(html.find("<td>6153.98 kg</td>") != std::string::npos);
   CHECK(slurp(dir / "log").find("check failed: mass") != std::string::npos);
 }
 
@@ -185,7 +188,7 @@ TEST_CASE("report: a malformed or inapplicable report file is a bad input (exit 
   const std::string command = std::string(WLX_BINARY) + " report --quick --claims " + claims + " --out " + (dir / "out").string();
   write(claims, claims_with_mass_check("{near: 6000}"));
   CHECK(run(command, dir / "log") == 2);
-  CHECK(slurp(dir / "log").find(claims + ":9: claims[0].criterion: 'near' needs a 'tolerance'") != std::string::npos);
+  CHECK(slurp(dir / "log").find(claims + ":10: claims[0].criterion: 'near' needs a 'tolerance'") != std::string::npos);
   // Well formed, but the name is not one of the model's coordinates.
   write(claims, "run_figures:\n  - {id: F, runs: [NH-1], x: rol, y: [yaw]}\n");
   CHECK(run(command, dir / "log") == 2);
@@ -349,12 +352,13 @@ TEST_CASE("report: runs that stop are rows of the report, which is written all t
     "rates": {"z_C": -0.5}, "dependent": ["y_C", "yaw"], "duration": 0.2, "dt": 0.001, "weighting": 1})");
   // Checks on each kind of stop, one on none (the mass) and one on a round trip that completes.
   const auto check = [](const std::string& id, const std::string& measure, const std::string& criterion) {
-    return "  - {id: " + id + ", kind: check, claim: " + id + ", source: {spec: a test}, spec: the test's, measure: " + measure + ", criterion: " +
+    return "  - {id: " + id + ", kind: check, claim: " + id + ", source: {spec: a test}, claimed: {spec: the test's}, measure: " + measure + ", criterion: " +
            criterion + ", why: a test}\n";
   };
   write(dir / "runs" / "report.yaml",
         "quick: {sweeps: [IK-L3], scenarios: [UP, OUT, HIGH]}\n"
         "integrator_comparison: {scenarios: [UP], coordinates: [y_C]}\n"
+        "sources: {spec: the test's specification}\n"
         "claims:\n" +
             check("mass", "{quantity: total_mass}", "{at_least: 1}") +
             check("up-end", "{quantity: end_value, run: UP, coordinate: z_C}", "{at_least: 2.5}") +
@@ -453,7 +457,8 @@ TEST_CASE("report: runs that stop are rows of the report, which is written all t
   }
 
   // Bad input stays bad input: a name that is not a run of the folder, exit 2 and no report.
-  write(dir / "claims.yaml", "claims:\n" + check("x", "{quantity: end_value, run: UPP, coordinate: z_C}", "{at_least: 1}"));
+  write(dir / "claims.yaml", "sources: {spec: the test's specification}\nclaims:\n" +
+                                 check("x", "{quantity: end_value, run: UPP, coordinate: z_C}", "{at_least: 1}"));
   const fs::path out = dir / "bad";
   CHECK(run(std::string(WLX_BINARY) + " --scenarios " + (dir / "runs").string() + " report --quick --claims " +
                 (dir / "claims.yaml").string() + " --out " + out.string(),

@@ -162,6 +162,13 @@ def test_every_metric_against_its_definition(robot, client):
     assert table["peak_tau"] == [max(float(np.abs(x).max()) for x in taus.values())]
     assert table["peak_cond_J_beta"] == [r["cond_J_beta"].max()]
     assert table["min_clearance"] == [r["clearance"].min()]
+    # Will it lift off, slip or tip: the CSV's columns, over the supporting contacts (those with a
+    # friction margin); the same doubles, so equal to the last bit.
+    supporting = [c for c in robot.contacts if f"friction_margin_{c}" in r]
+    assert supporting
+    assert table["min_normal_force"] == [min(r[f"f_n_{c}"].min() for c in supporting)]
+    assert table["min_friction_margin"] == [min(r[f"friction_margin_{c}"].min() for c in supporting)]
+    assert table["min_tip_margin"] == [r["margin_tip"].min()]
     assert table["reach_failure"] == [0]
     # Energy: each actuator's positive work, rates by central differences of its angle.
     work = 0.0
