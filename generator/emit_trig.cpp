@@ -1,6 +1,6 @@
 // Emission of trig.hpp: sin and cos of all of a function's angles in one vectorized pass.
 //
-// Why: every generated function needs sin and cos of up to 21 joint and cabin angles, and the
+// Why: every generated function needs sin and cos of up to a few dozen joint and body angles, and the
 // libm calls (about 6.5 ns per angle here, even fused into sincos) are over half of the fused
 // kinematic update. The angles are independent, so one SIMD pass over all of them is cheaper.
 // The constants are derived here with GiNaC's arbitrary precision, not copied from a libm.

@@ -64,7 +64,7 @@ struct Coordinate {
   std::string meaning;
 };
 
-// A named model parameter (geometry or mass), with its default from docs/excavator.md.
+// A named model parameter (geometry or mass), with its default from the model file.
 struct Parameter {
   std::string name;
   double default_value = 0;

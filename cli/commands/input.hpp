@@ -1,4 +1,4 @@
-// JSON input of the CLI: docs/excavator.md names as keys, validated with messages that name the field.
+// JSON input of the CLI: the model's names as keys, validated with messages that name the field.
 #pragma once
 
 #include "per_model.hpp"

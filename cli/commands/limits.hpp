@@ -1,4 +1,4 @@
-// Upper bounds on what a walking excavator can be or do. Values beyond them are accepted by the
+// Upper bounds on what a wheeled-legged machine can be or do. Values beyond them are accepted by the
 // arithmetic but make no machine (a 1e308 kg body, gravity 1e304 m/s^2, a rate of 1e200 rad/s) and
 // overflow to inf/NaN inside a step; they are rejected up front with the field named. The numbers
 // are documented in README.md ("Hardening") and scenarios/README.md.

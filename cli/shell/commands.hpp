@@ -57,7 +57,7 @@ struct ModelCommands {
   const char* description_json;
 };
 
-// The built-in models, the default (the thesis excavator) first.
+// The built-in models, the default first.
 const std::vector<ModelCommands>& models();
 
 }  // namespace wlx::cli

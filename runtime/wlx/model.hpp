@@ -84,7 +84,7 @@ struct Data {
   double cond_J_beta = 0;
 };
 
-// Index of a coordinate by its docs/excavator.md name, or -1.
+// Index of a coordinate by its name in the model file, or -1.
 int coordinate_index(std::string_view name) noexcept;
 // Index of a frame of interest by name (C, hip_l, F_l, W_r, ...), or -1.
 int frame_index(std::string_view name) noexcept;

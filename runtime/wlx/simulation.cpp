@@ -279,14 +279,14 @@ void Scenario::validate() const {
   }
 }
 
-double lowest_clearance(const Params& p, const Coordinates& s) {
+double lowest_clearance(const Model& model, const Coordinates& s) {
 // wlx-gen writes clearance.hpp only for a model file with a clearance box (and removes a stale one).
 #if __has_include(<wlx/gen/clearance.hpp>)
   double lowest = 0;
-  gen::clearance(s, p, {.lowest = &lowest});
+  gen::clearance(s, model.params(), {.lowest = &lowest});
   return lowest;
 #else
-  static_cast<void>(p);
+  static_cast<void>(model);
   static_cast<void>(s);
   return std::numeric_limits<double>::infinity();
 #endif
@@ -307,7 +307,7 @@ void kinematic_sample(const Model& model, Data& data, const Coordinates& s, cons
   smp.contact_velocity = contact_velocities(model, data, s, sdot);  // also fills data.C, data.spin
   smp.nh_residual = data.C * sdot;
   smp.spin_rate = data.spin * sdot;
-  smp.clearance = lowest_clearance(model.params(), s);
+  smp.clearance = lowest_clearance(model, s);
 }
 
 // A dynamics sample's contact forces, margins and momentum balance; the run stops where a contact

@@ -127,6 +127,6 @@ Trajectory simulate_each(const Scenario& scenario, const std::function<void(cons
 
 // The height above the ground (z = 0 of K0) of the lowest corner of the model file's clearance box;
 // +infinity for a model without one.
-double lowest_clearance(const Params& p, const Coordinates& s);
+double lowest_clearance(const Model& model, const Coordinates& s);
 
 WLX_MODEL_NAMESPACE_END

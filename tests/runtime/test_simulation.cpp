@@ -112,10 +112,11 @@ TEST_CASE("simulation: scenario validation names the field") {
 
 TEST_CASE("simulation: cabin clearance of the 3 x 3 x 0.5 m block") {
   const Params p;
+  const Model model{p};
   Coordinates s = nominal_inputs();
-  CHECK(lowest_clearance(p, s) == doctest::Approx(2.0 - 0.25));
+  CHECK(lowest_clearance(model, s) == doctest::Approx(2.0 - 0.25));
   s(c::roll) = 0.1;
-  CHECK(lowest_clearance(p, s) == doctest::Approx(2.0 - (std::sin(0.1) * 1.5 + std::cos(0.1) * 0.25)));
+  CHECK(lowest_clearance(model, s) == doctest::Approx(2.0 - (std::sin(0.1) * 1.5 + std::cos(0.1) * 0.25)));
   // The box itself, for drawings (the viewer): the cabin frame and half the model file's sizes.
   CHECK(gen::kClearanceFrame == gen::frame::C);
   Eigen::Vector3d half;
