@@ -18,11 +18,16 @@
 #include "wlx/dynamics.hpp"
 
 #include <array>
+#include <cstddef>
 #include <string>
 
 WLX_MODEL_NAMESPACE_BEGIN
 
 inline constexpr int kContactCount = gen::kContactCount;
+namespace contacts_detail {
+// A contact's or body's slot in the generated tables (std::arrays) from a loop's int.
+constexpr std::size_t at(int i) noexcept { return static_cast<std::size_t>(i); }
+}  // namespace contacts_detail
 // One slot per contact, and one unused slot for a model without contacts: Eigen refuses a column of
 // a 3 x 0 matrix at compile time even where no loop reaches it. Loops run to kContactCount.
 inline constexpr int kContactSlots = kContactCount > 0 ? kContactCount : 1;
