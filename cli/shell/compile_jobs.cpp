@@ -51,9 +51,11 @@ std::vector<std::string> dying_with_wlx(const std::vector<std::string>& argv) {
 
 }  // namespace
 
+const char* built_with_compiler() { return WLX_PLUGIN_CXX; }
+
 std::string compiler() {
   if (const char* env = std::getenv("CXX"); env != nullptr && *env != '\0') return env;
-  return WLX_PLUGIN_CXX;
+  return built_with_compiler();
 }
 
 Timings run_jobs(const std::vector<Job>& jobs, unsigned parallel, const fs::path& failed_logs) {

@@ -14,6 +14,8 @@ namespace wlx::cli {
 // standard library), so that a run whose compiler cannot work (CXX=/bin/false) still loads what is
 // cached; another compiler's code for a key of its own takes other flags (WLX_PLUGIN_CXXFLAGS).
 std::string compiler();
+// The compiler wlx was built with (CMake's, whatever CXX says): part of a plugin's key.
+const char* built_with_compiler();
 
 // One program run of a build: what it makes (for messages and timings), its command line and the
 // file its output goes to.

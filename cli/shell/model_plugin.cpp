@@ -34,12 +34,9 @@
 #include <thread>
 #include <unistd.h>
 
-// Set by CMake (CMakeLists.txt, wlx_cli_common): the compiler wlx was built with, the include
-// folders of Eigen, fmt and nlohmann-json, fmt's library, the source tree, and where an installed
+// Set by CMake (CMakeLists.txt, wlx_cli_common; the compiler wlx was built with is
+// compile_jobs.cpp's): the include folders of Eigen, fmt and nlohmann-json, fmt's library, the source tree, and where an installed
 // wlx keeps the runtime's headers and the sources a plugin compiles (relative to its bin folder).
-#ifndef WLX_PLUGIN_CXX
-#define WLX_PLUGIN_CXX "c++"
-#endif
 #ifndef WLX_PLUGIN_INCLUDES
 #define WLX_PLUGIN_INCLUDES ""
 #endif
@@ -531,7 +528,7 @@ const ModelCommands& load_model_file(const std::string& model_file, const std::s
   h.add(version);
   h.add(name);
   h.add(description.code_key);
-  h.add(WLX_PLUGIN_CXX);
+  h.add(built_with_compiler());
   for (const bool commands : {false, true})
     for (const auto& f : optimization_flags(commands)) h.add(f);
   h.add(WLX_PLUGIN_INCLUDES);
