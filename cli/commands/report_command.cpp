@@ -192,7 +192,7 @@ report::Table Report::runs_table(Keep keep) const {
   t.header.insert(t.header.end(), {"CSV", "3D"});
   for (const auto& r : runner_.runs()) {
     if (!keep(r)) continue;
-    const RunSummary summary = summarize(r.trajectory, false);
+    const RunSummary& summary = r.summary;
     const bool any = summary.samples > 0;  // a run stopped at its first step has no maxima
     std::vector<report::Cell> row{{r.id}, {r.scenario.description}, {std::to_string(summary.samples)},
                                   {r.stopped ? r.stopped->describe() : "complete"},
@@ -229,15 +229,15 @@ report::Section Report::contacts_section() const {
   report::Table t{{"run", "weighting", "smallest normal force (N)", "smallest friction margin (N)", "first slip",
                    "first lift-off", "smallest tip-over margin (deg)", "max momentum residual"},
                   {}};
+  const auto lowest = [](const RunSummary::Lowest& l) {
+    return fmt::format("{:.6g} ({} at {:.3f} s)", l.value, l.contact >= 0 ? contact_name(l.contact) : "-", l.t);
+  };
+  const auto first = [](int contact, double t) {
+    return contact >= 0 ? fmt::format("{} at {:.3f} s", contact_name(contact), t) : std::string("none");
+  };
   for (const auto& r : runner_.runs()) {
     if (!is_dynamics_run(r) || r.trajectory.samples.empty()) continue;
-    const RunSummary st = summarize(r.trajectory, true);
-    const auto lowest = [](const RunSummary::Lowest& l) {
-      return fmt::format("{:.6g} ({} at {:.3f} s)", l.value, l.contact >= 0 ? contact_name(l.contact) : "-", l.t);
-    };
-    const auto first = [](int contact, double t) {
-      return contact >= 0 ? fmt::format("{} at {:.3f} s", contact_name(contact), t) : std::string("none");
-    };
+    const RunSummary& st = r.summary;
     t.rows.push_back({{r.id},
                       {r.scenario.weighting->label()},
                       {lowest(st.normal)},

@@ -352,8 +352,7 @@ class Figures {
       const report::TorqueReference* reference = nullptr;
       for (const auto& ref : spec_.torque_references)
         if (ref.scenario == r.scenario_id && ref.weighting == weighting) reference = &ref;
-      double scale = 0;
-      for (const auto& smp : r.trajectory.samples) scale = std::max(scale, smp.tau.cwiseAbs().maxCoeff());
+      const double scale = r.summary.largest_tau();
       std::string b = fmt::format("set multiplot layout {},1\nset xlabel 't (s)'\nset ylabel 'torque (N m)'\nset key outside right top\n",
                                   panels.size());
       for (std::size_t p = 0; p < panels.size(); ++p) {

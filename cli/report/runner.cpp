@@ -199,7 +199,8 @@ void ReportRunner::run_all(const std::string& data_dir) {
       // its contacts table, not the end of the report.
       if (weighting) sc.stop_on_contact_loss = false;
       progress_(fmt::format("simulating {}{}: {}", id, weighting ? " (" + weighting->label() + ")" : "", sc.description));
-      ReportRun r{id, scenario_id, sc, simulate(sc, stop_on_signal), id + ".csv", verify, std::nullopt};
+      ReportRun r{id, scenario_id, sc, simulate(sc, stop_on_signal), id + ".csv", verify, std::nullopt, {}};
+      r.summary = summarize(r.trajectory, sc.weighting || sc.driven_by_torques());
       // A run that stops is one row of the report, with what it computed up to there: the
       // others still run, and the report says where and why.
       if (!r.trajectory.complete) r.stopped = record_stop(id, "", r.trajectory);
@@ -569,8 +570,7 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
     for (const auto& r : runs_) all_runs.push_back(r.id);
     if (const StoppedRun* s = first_stop(all_runs)) return stopped(*s, "m/s");
     double worst = 0;
-    for (const auto& r : runs_)
-      for (const auto& smp : r.trajectory.samples) worst = std::max(worst, smp.nh_residual.cwiseAbs().maxCoeff());
+    for (const auto& r : runs_) worst = std::max(worst, r.summary.worst_rolling_residual());
     return Measured{worst, "m/s"};
   }
   if (q == "integrator_deviation") {
@@ -614,10 +614,7 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
     for (const auto& id : m.runs)
       if (!find_run(id)) return std::nullopt;
     if (const StoppedRun* s = first_stop(m.runs)) return stopped(*s, "N m");
-    for (const auto& id : m.runs) {
-      const ReportRun* r = find_run(id);
-      for (const auto& smp : r->trajectory.samples) worst = std::max(worst, smp.tau.cwiseAbs().maxCoeff());
-    }
+    for (const auto& id : m.runs) worst = std::max(worst, find_run(id)->summary.largest_tau());
     return Measured{worst, "N m"};
   }
   if (q == "round_trip_deviation" || q == "energy_balance" || q == "closed_loop_error") {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "per_model.hpp"
+#include "run_summary.hpp"
 #include "report/spec.hpp"
 
 #include <wlx/ik_verification.hpp>
@@ -50,6 +51,8 @@ struct ReportRun {
   std::string csv;  // file name in data/
   bool nonholonomic_verification = false;  // the scenario is marked "verify": "nonholonomic"
   std::optional<Stop> stopped;  // set: the run ended before its duration
+  // Its maxima and minima (run_summary.hpp), once: the tables', the claims' and the figures'.
+  RunSummary summary;
 };
 
 // One run integrated one way, against RK4 at the reference step.
