@@ -1,7 +1,7 @@
 // Benchmarks (Google Benchmark): generated functions per call, and closed-form vs Newton IK.
 // Compare numbers from one run only (ratios): these machines are noisy.
 #include "numeric_baseline.hpp"
-#include "../tests/support/kane_over_bodies.hpp"
+#include "../tests/helpers/kane_over_bodies.hpp"
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>

@@ -4,7 +4,7 @@
 #include "printer.hpp"
 
 #include <fmt/format.h>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 #include <algorithm>
 #include <set>
@@ -44,7 +44,7 @@ std::string namespace_close(const EmitOptions& opt) {
   return fmt::format("}}  // namespace {}\n", opt.name_space);
 }
 
-// The generator's two ways of writing text from the model file into C++ (wlx/text.hpp): every
+// The generator's two ways of writing text from the model file into C++ (wlx/support/text.hpp): every
 // string literal through quoted(), every comment through comment(), so that no unit, meaning,
 // title or file name can end a literal or a comment and add code or a #define to the headers.
 std::string quoted(const std::string& text) { return text::cpp_string(text); }

@@ -3,7 +3,7 @@
 #include "derivations_internal.hpp"
 
 #include <fmt/format.h>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 #include <algorithm>
 #include <map>

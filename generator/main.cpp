@@ -5,9 +5,9 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
-#include <wlx/diagnostics.hpp>
-#include <wlx/atomic_file.hpp>
-#include <wlx/bounded_file.hpp>
+#include <wlx/support/diagnostics.hpp>
+#include <wlx/support/atomic_file.hpp>
+#include <wlx/support/bounded_file.hpp>
 
 #include <chrono>
 #include <csignal>

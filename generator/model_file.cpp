@@ -5,8 +5,8 @@
 
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/eventhandler.h>
-#include <wlx/bounded_file.hpp>
-#include <wlx/yaml_key_check.hpp>
+#include <wlx/support/bounded_file.hpp>
+#include <wlx/support/yaml_key_check.hpp>
 
 #include <cmath>
 #include <sstream>

@@ -11,7 +11,7 @@
 #include <fmt/format.h>
 #include <ginac/ginac.h>
 #include <yaml-cpp/yaml.h>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 #include <cstdint>
 #include <functional>

@@ -4,7 +4,7 @@
 #include "derivations_internal.hpp"
 
 #include <fmt/format.h>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 #include <algorithm>
 #include <iterator>
@@ -91,7 +91,7 @@ class LaneWriter {
     rows_[name] = {speeds, wide};
     return name;
   }
-  // Quoted for a comment (wlx/text.hpp): the text may hold a body's meaning from the model file.
+  // Quoted for a comment (wlx/support/text.hpp): the text may hold a body's meaning from the model file.
   void comment(const std::string& text) { add("", "    // " + text::cpp_comment(text) + "\n", {}); }
   std::string zero(bool wide = false) const { return fmt::format("detail::zero_lanes<Scalar, {}>()", lanes(wide)); }
   std::string type(bool wide) const { return wide ? "LW" : "L"; }

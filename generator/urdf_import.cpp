@@ -3,7 +3,7 @@
 #include "model_file.hpp"
 
 #include <fmt/format.h>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <wlx/bounded_file.hpp>
+#include <wlx/support/bounded_file.hpp>
 #include <wlx/error.hpp>
 #include <wlx/ik.hpp>
 #include <wlx/kinematics.hpp>
@@ -31,7 +31,7 @@ constexpr std::size_t kMaxParamsFileBytes = std::size_t{1} << 20;
 
 Params load_params(const ModelOptions& model) {
   if (model.params_file.empty()) return settings().params;
-  // Bounded, regular files only (wlx/bounded_file.hpp): a FIFO without a writer is an error, not a hang.
+  // Bounded, regular files only (wlx/support/bounded_file.hpp): a FIFO without a writer is an error, not a hang.
   const BoundedRead file = read_bounded_file(model.params_file, kMaxParamsFileBytes);
   if (!file.ok()) {
     if (file.error.rfind("cannot open", 0) == 0)

@@ -9,8 +9,8 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
-#include <wlx/diagnostics.hpp>
-#include <wlx/csv.hpp>
+#include <wlx/support/diagnostics.hpp>
+#include <wlx/support/csv.hpp>
 #include <wlx/error.hpp>
 #include <wlx/ik_verification.hpp>
 #include <wlx/kinematics.hpp>

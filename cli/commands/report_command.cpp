@@ -18,9 +18,9 @@
 #include "viewer_export.hpp"
 
 #include <fmt/format.h>
-#include <wlx/diagnostics.hpp>
-#include <wlx/bounded_file.hpp>
-#include <wlx/atomic_file.hpp>
+#include <wlx/support/diagnostics.hpp>
+#include <wlx/support/bounded_file.hpp>
+#include <wlx/support/atomic_file.hpp>
 #include <wlx/error.hpp>
 
 #include <chrono>
@@ -46,7 +46,7 @@ report::ReportSpec load_spec(const std::string& claims_file) {
     return report::parse_report_spec(folder->report_text, folder->report_text.empty() ? folder->dir + "/report.yaml" : folder->report_path);
   if (claims_file.empty())
     return report::parse_report_spec(kEmbeddedReportFile, fmt::format("scenarios/{}/report.yaml", gen::kModelName));
-  // Bounded, regular files only (wlx/bounded_file.hpp): /dev/zero or a FIFO is an error, not a hang.
+  // Bounded, regular files only (wlx/support/bounded_file.hpp): /dev/zero or a FIFO is an error, not a hang.
   const BoundedRead file = read_bounded_file(claims_file, kMaxReportFileBytes);
   if (!file.ok()) throw Error("--claims", fmt::format("{} {}", excerpt(claims_file), file.error));
   return report::parse_report_spec(file.text, claims_file);

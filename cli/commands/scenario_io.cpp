@@ -9,8 +9,8 @@
 #include "scenario_folder.hpp"
 
 #include <fmt/format.h>
-#include <wlx/text.hpp>
-#include <wlx/bounded_file.hpp>
+#include <wlx/support/text.hpp>
+#include <wlx/support/bounded_file.hpp>
 #include <wlx/error.hpp>
 
 #include <algorithm>

@@ -9,7 +9,7 @@
 #include "scenario_io.hpp"
 
 #include <fmt/format.h>
-#include <wlx/csv.hpp>
+#include <wlx/support/csv.hpp>
 #include <wlx/error.hpp>
 
 #include <filesystem>

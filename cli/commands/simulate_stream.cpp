@@ -7,8 +7,8 @@
 #include "run_summary.hpp"
 
 #include <fmt/format.h>
-#include <wlx/diagnostics.hpp>
-#include <wlx/csv.hpp>
+#include <wlx/support/diagnostics.hpp>
+#include <wlx/support/csv.hpp>
 #include <wlx/error.hpp>
 
 #include <algorithm>

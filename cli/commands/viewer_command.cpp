@@ -8,7 +8,7 @@
 #include "viewer_export.hpp"
 
 #include <fmt/format.h>
-#include <wlx/diagnostics.hpp>
+#include <wlx/support/diagnostics.hpp>
 #include <wlx/error.hpp>
 
 #include <filesystem>

@@ -6,10 +6,10 @@
 #include "limits.hpp"
 
 #include <fmt/format.h>
-#include <wlx/atomic_file.hpp>
+#include <wlx/support/atomic_file.hpp>
 #include <wlx/dynamics.hpp>
 #include <wlx/kinematics.hpp>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -6,9 +6,9 @@
 #include "process.hpp"
 
 #include <fmt/format.h>
-#include <wlx/atomic_file.hpp>
+#include <wlx/support/atomic_file.hpp>
 #include <wlx/error.hpp>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 #include <atomic>
 #include <filesystem>

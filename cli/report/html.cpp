@@ -2,11 +2,11 @@
 #include "report/html.hpp"
 
 #include <fmt/format.h>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 namespace wlx::cli::report {
 
-// One quoting function for all of the page (wlx/text.hpp): element text and attribute values.
+// One quoting function for all of the page (wlx/support/text.hpp): element text and attribute values.
 std::string escape(const std::string& s) { return text::html(s); }
 
 namespace {

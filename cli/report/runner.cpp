@@ -10,7 +10,7 @@
 #include "scenario_io.hpp"
 
 #include <fmt/format.h>
-#include <wlx/csv.hpp>
+#include <wlx/support/csv.hpp>
 #include <wlx/contacts.hpp>
 #include <wlx/dynamics.hpp>
 #include <wlx/error.hpp>

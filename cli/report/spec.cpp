@@ -6,9 +6,9 @@
 
 #include <fmt/format.h>
 #include <wlx/error.hpp>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 #include <yaml-cpp/yaml.h>
-#include <wlx/yaml_key_check.hpp>
+#include <wlx/support/yaml_key_check.hpp>
 
 #include <algorithm>
 #include <cmath>

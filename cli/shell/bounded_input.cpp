@@ -8,7 +8,7 @@
 #include <cctype>
 #include <cmath>
 #include <wlx/error.hpp>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 namespace wlx::cli {
 

@@ -3,7 +3,7 @@
 #include "bounded_input.hpp"
 
 #include <fmt/format.h>
-#include <wlx/diagnostics.hpp>
+#include <wlx/support/diagnostics.hpp>
 #include <wlx/error.hpp>
 
 #include <regex>

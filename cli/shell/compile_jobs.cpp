@@ -6,7 +6,7 @@
 #include "process.hpp"
 
 #include <fmt/format.h>
-#include <wlx/bounded_file.hpp>
+#include <wlx/support/bounded_file.hpp>
 
 #include <algorithm>
 #include <chrono>

@@ -9,9 +9,9 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <wlx/diagnostics.hpp>
-#include <wlx/atomic_file.hpp>
-#include <wlx/bounded_file.hpp>
+#include <wlx/support/diagnostics.hpp>
+#include <wlx/support/atomic_file.hpp>
+#include <wlx/support/bounded_file.hpp>
 #include <wlx/error.hpp>
 
 #include <algorithm>
@@ -120,6 +120,7 @@ std::string read_small(const fs::path& path, std::size_t limit) {
 // Where the sources a plugin compiles are: an installed wlx's share/wlx, else the source tree.
 struct Sources {
   fs::path runtime_include;  // holds wlx/*.hpp
+  fs::path support_include;  // holds wlx/support/*.hpp (the support library the shell and commands include)
   fs::path runtime_sources;  // the runtime's *.cpp
   fs::path cli;              // holds shell/, commands/, report/
   fs::path viewer_module;    // holds viewer_module.cpp (the viewer's WebAssembly interface)
@@ -130,10 +131,10 @@ Sources find_sources() {
   const fs::path bin = executable_dir();
   const fs::path share = (bin / WLX_SHARE_FROM_BINDIR).lexically_normal();
   if (!bin.empty() && fs::is_regular_file(share / "cli" / "commands" / "per_model.hpp", ec))
-    return {(bin / WLX_INCLUDE_FROM_BINDIR).lexically_normal(), share / "runtime", share / "cli", share / "viewer_module"};
+    return {(bin / WLX_INCLUDE_FROM_BINDIR).lexically_normal(), share / "support", share / "runtime", share / "cli", share / "viewer_module"};
   const fs::path tree = WLX_SOURCE_TREE;
   if (!tree.empty() && fs::is_regular_file(tree / "cli" / "commands" / "per_model.hpp", ec))
-    return {tree / "runtime", tree / "runtime" / "wlx", tree / "cli", tree / "viewer" / "wasm"};
+    return {tree / "runtime", tree / "support", tree / "runtime" / "wlx", tree / "cli", tree / "viewer" / "wasm"};
   throw Error("--model-file", fmt::format("the sources a model's plugin is compiled from are missing (looked in {} and {}): "
                                           "reinstall wlx",
                                           share.string(), tree.string()));
@@ -143,7 +144,7 @@ Sources find_sources() {
 void hash_sources(const Sources& src, Hash& h) {
   std::vector<fs::path> files;
   std::error_code ec;
-  for (const fs::path& dir : {src.runtime_include / "wlx", src.runtime_sources, src.cli / "shell", src.cli / "commands", src.cli / "report",
+  for (const fs::path& dir : {src.runtime_include / "wlx", src.support_include / "wlx" / "support", src.runtime_sources, src.cli / "shell", src.cli / "commands", src.cli / "report",
                               src.viewer_module})
     for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
       if (const auto ext = it->path().extension(); (ext == ".hpp" || ext == ".cpp") && it->is_regular_file(ec)) files.push_back(it->path());
@@ -422,7 +423,7 @@ void build_plugin(const fs::path& model_file, const Description& description, co
 
   const std::string cxx = compiler();
   std::vector<std::string> common{cxx, "-std=c++20", "-fPIC", "-DNDEBUG", "-DWLX_MODEL=" + name, "-DWLX_GEN_COMPILED_" + name};
-  for (const fs::path& include : {gen, src.runtime_include, src.cli / "shell", src.cli, src.cli / "commands"}) common.push_back("-I" + include.string());
+  for (const fs::path& include : {gen, src.runtime_include, src.support_include, src.cli / "shell", src.cli, src.cli / "commands"}) common.push_back("-I" + include.string());
   for (const auto& include : split_list(WLX_PLUGIN_INCLUDES)) common.push_back("-isystem" + include);
   std::vector<Job> jobs;
   std::vector<std::string> objects;

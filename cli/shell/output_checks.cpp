@@ -1,8 +1,8 @@
 #include "output_checks.hpp"
 
 #include <fmt/format.h>
-#include <wlx/diagnostics.hpp>
-#include <wlx/atomic_file.hpp>
+#include <wlx/support/diagnostics.hpp>
+#include <wlx/support/atomic_file.hpp>
 #include <wlx/error.hpp>
 
 #include <cerrno>

@@ -5,9 +5,9 @@
 #include "sha256.hpp"
 
 #include <fmt/format.h>
-#include <wlx/atomic_file.hpp>
-#include <wlx/bounded_file.hpp>
-#include <wlx/diagnostics.hpp>
+#include <wlx/support/atomic_file.hpp>
+#include <wlx/support/bounded_file.hpp>
+#include <wlx/support/diagnostics.hpp>
 
 #include <cerrno>
 #include <cstring>

@@ -3,7 +3,7 @@
 #include "bounded_input.hpp"
 
 #include <fmt/format.h>
-#include <wlx/bounded_file.hpp>
+#include <wlx/support/bounded_file.hpp>
 #include <wlx/error.hpp>
 
 #include <algorithm>

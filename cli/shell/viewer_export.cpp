@@ -5,9 +5,9 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <wlx/bounded_file.hpp>
-#include <wlx/text.hpp>
-#include <wlx/atomic_file.hpp>
+#include <wlx/support/bounded_file.hpp>
+#include <wlx/support/text.hpp>
+#include <wlx/support/atomic_file.hpp>
 #include <wlx/error.hpp>
 
 #include <algorithm>

@@ -22,7 +22,7 @@
 // at the end (docs/export.md gives the figures), 2 on bad input.
 #include "physics_engine.hpp"
 
-#include <wlx/atomic_file.hpp>
+#include <wlx/support/atomic_file.hpp>
 #include <wlx/contacts.hpp>
 #include <wlx/dynamics.hpp>
 #include <wlx/error.hpp>

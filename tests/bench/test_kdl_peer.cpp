@@ -8,7 +8,7 @@
 // few dozen operations per entry, so they differ by rounding: some 1e-15 relative. 1e-12 leaves
 // a factor of ~1000 for cancellation at the random poses and catches any wrong offset, axis, order,
 // sign, mass or inertia, which show at 1e-3 or more.
-#include "../support/random.hpp"
+#include "../helpers/random.hpp"
 #include "kdl_peer.hpp"
 
 #include <doctest/doctest.h>

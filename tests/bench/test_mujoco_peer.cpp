@@ -15,7 +15,7 @@
 // change entries by at most that much. 1e-10 leaves margin for cancellation, and a wrong offset,
 // axis, mass or inertia shows far above it: the second test changes one inertia by 1% and sees it
 // (5e-5 relative on the wheeled quadruped's mass matrix, 5e-3 on the excavator's).
-#include "../support/random.hpp"
+#include "../helpers/random.hpp"
 #include "mjcf_export.hpp"
 #include "mujoco_model.hpp"
 #include "open_tree.hpp"

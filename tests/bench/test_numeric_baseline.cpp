@@ -1,7 +1,7 @@
 // The numeric baseline the benchmarks compare against computes the same quantities: a ratio
 // against a baseline that computed something else would mean nothing.
 #include "../../bench/numeric_baseline.hpp"
-#include "../support/random.hpp"
+#include "../helpers/random.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/all.hpp>

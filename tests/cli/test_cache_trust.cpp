@@ -2,7 +2,7 @@
 // before anything is generated, compiled or loaded: here they run in the sanitized tree too
 // (ASan, UBSan), where test_model_file_plugin, which compiles plugins, does not. CXX=/bin/false:
 // a check that let a bad folder pass would end in a failed compile, never in a minute's build.
-#include "../support/run_wlx.hpp"
+#include "../helpers/run_wlx.hpp"
 
 #include <doctest/doctest.h>
 

@@ -1,7 +1,7 @@
 // Issue 14: bad inputs and faults, run as a user would (wlx started with posix_spawn and an
 // argument vector, never through a shell). Each case asserts the exit code, the field named in
 // the message, a bounded message, and that no output file is left incomplete without saying so.
-#include "../support/run_wlx.hpp"
+#include "../helpers/run_wlx.hpp"
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>

@@ -5,8 +5,8 @@
 // computes when given the same parameters (--params). The plugins are compiled at -O0
 // (WLX_PLUGIN_CXXFLAGS, part of the cache key): these tests check the mechanism, and -O0 halves
 // their compile time; users get -O2.
-#include "../support/csv.hpp"
-#include "../support/run_wlx.hpp"
+#include "../helpers/csv.hpp"
+#include "../helpers/run_wlx.hpp"
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>

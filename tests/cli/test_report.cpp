@@ -1,5 +1,5 @@
 // `wlx report` end to end: every run, every figure, a checks table without failures, valid HTML.
-#include "../support/csv.hpp"
+#include "../helpers/csv.hpp"
 
 #include <doctest/doctest.h>
 

@@ -1,6 +1,6 @@
 // The shipped scenario files: each runs, keeps both wheels from sliding, and shows the thesis'
 // observations (docs/excavator.md section 8).
-#include "../support/units.hpp"
+#include "../helpers/units.hpp"
 
 #include <doctest/doctest.h>
 #include <fmt/format.h>

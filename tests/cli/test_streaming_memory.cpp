@@ -1,7 +1,7 @@
 // `wlx simulate` streams its samples to the CSV: peak memory does not grow with the number of
 // steps. Its own program: the peak RSS a parent reads for a spawned child includes the parent's
 // own at the time of the spawn (Linux carries it across exec), so the parent must stay small.
-#include "../support/run_wlx.hpp"
+#include "../helpers/run_wlx.hpp"
 
 #include <doctest/doctest.h>
 

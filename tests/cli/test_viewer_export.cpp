@@ -3,7 +3,7 @@
 
 #include "viewer_export.hpp"
 
-#include "../support/run_wlx.hpp"
+#include "../helpers/run_wlx.hpp"
 
 #include <nlohmann/json.hpp>
 #include <wlx/error.hpp>

@@ -4,7 +4,7 @@
 #include "report/spec.hpp"
 
 #include <wlx/error.hpp>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 #include <cstdint>
 #include <cstdlib>

@@ -1,6 +1,6 @@
 // Body kinematics for the dynamics against exact derivatives of the reference chain.
-#include "../support/random.hpp"
-#include "../support/reference_chain.hpp"
+#include "../helpers/random.hpp"
+#include "../helpers/reference_chain.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/bodies.hpp>

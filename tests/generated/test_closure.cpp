@@ -1,7 +1,7 @@
 // Closure equations and their Jacobian and convective terms, checked with exact derivatives
 // (Taylor jets) of the independent reference chain, and with finite differences.
-#include "../support/random.hpp"
-#include "../support/reference_chain.hpp"
+#include "../helpers/random.hpp"
+#include "../helpers/reference_chain.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/closure.hpp>

@@ -1,5 +1,5 @@
 // The fused kinematic update computes exactly what kinematics, closure and nonholonomic compute.
-#include "../support/random.hpp"
+#include "../helpers/random.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/all.hpp>

@@ -1,6 +1,6 @@
 // Generated forward kinematics against an independent chain and the thesis' printed equations.
-#include "../support/random.hpp"
-#include "../support/reference_chain.hpp"
+#include "../helpers/random.hpp"
+#include "../helpers/reference_chain.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/kinematics.hpp>

@@ -2,7 +2,7 @@
 // CPU that has them (types.hpp). Both builds evaluate the same expressions; fused multiply-adds
 // only round once where the portable build rounds twice, so they agree to rounding, and on such a
 // CPU they must differ somewhere (else the overload did not switch).
-#include "../support/random.hpp"
+#include "../helpers/random.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/all.hpp>

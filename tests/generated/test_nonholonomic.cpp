@@ -1,6 +1,6 @@
 // Non-holonomic rows C(s), spin rows and (d/dt C) s' against exact derivatives of the reference.
-#include "../support/random.hpp"
-#include "../support/reference_chain.hpp"
+#include "../helpers/random.hpp"
+#include "../helpers/reference_chain.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/convective.hpp>

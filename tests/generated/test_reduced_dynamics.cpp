@@ -1,8 +1,8 @@
 // reduced_dynamics (Kane's sums on the commanded speeds, generated on lanes from the joints'
 // twists and the bodies' wrenches) against the same sums written out over the bodies' full
 // Jacobians from bodies() (itself checked against exact derivatives in test_bodies.cpp).
-#include "../support/kane_over_bodies.hpp"
-#include "../support/random.hpp"
+#include "../helpers/kane_over_bodies.hpp"
+#include "../helpers/random.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/all.hpp>

@@ -1,8 +1,8 @@
 // The generated functions as templates on the scalar type: float agrees with double to float
 // precision, the float IK solves what the double IK solves, and a dual number (Jet) through the
 // generated closure and body functions gives the generated Jacobians and convective terms.
-#include "../support/jet_eigen.hpp"
-#include "../support/random.hpp"
+#include "../helpers/jet_eigen.hpp"
+#include "../helpers/random.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/all.hpp>

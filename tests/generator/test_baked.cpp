@@ -1,6 +1,6 @@
 // `wlx-gen --bake-defaults` output (built into the build tree in namespace wlx::baked) computes
 // the same as the committed symbolic headers at the default parameters.
-#include "../support/random.hpp"
+#include "../helpers/random.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/gen/all.hpp>

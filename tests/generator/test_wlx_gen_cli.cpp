@@ -1,6 +1,6 @@
 // wlx-gen as a user runs it: bad options and bad values exit 2 naming the option and the reason,
 // and nothing is written; the emitted namespace and baked values are validated before emission.
-#include "../support/run_wlx.hpp"
+#include "../helpers/run_wlx.hpp"
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>

@@ -7,9 +7,9 @@
 // generated functions themselves: the derivative code is not what is evaluated), the IK against
 // the model's own closure and Newton's method, the dependent rates against the rolling rows and
 // finite differences of a run, and the inverse dynamics against power and energy balances.
-#include "../support/balance_checks.hpp"
-#include "../support/chain_algebra.hpp"
-#include "../support/jet_eigen.hpp"
+#include "../helpers/balance_checks.hpp"
+#include "../helpers/chain_algebra.hpp"
+#include "../helpers/jet_eigen.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/QR>

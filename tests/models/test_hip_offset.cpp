@@ -3,7 +3,7 @@
 // hip_offset_variant.cmake), regenerated, and the unchanged runtime compiled for it. The closed-form
 // IK, Newton's method, the non-holonomic rates and the inverse dynamics must all follow, which is
 // checked here against geometry computed in the test.
-#include "../support/balance_checks.hpp"
+#include "../helpers/balance_checks.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/dynamics.hpp>

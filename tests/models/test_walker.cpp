@@ -1,11 +1,11 @@
 // The second built-in model, models/walker.yaml, passes the checks the excavator passes: its
-// generated kinematics against an independent chain written here (tests/support/walker_chain.hpp),
+// generated kinematics against an independent chain written here (tests/helpers/walker_chain.hpp),
 // every Jacobian and convective term against exact derivatives (jets), the closed-form IK that
 // wlx-gen derived for it against Newton's method, the dependent rates against the wheel
 // constraints and finite differences, and the inverse dynamics against power and energy balances.
-#include "../support/balance_checks.hpp"
-#include "../support/random.hpp"
-#include "../support/walker_chain.hpp"
+#include "../helpers/balance_checks.hpp"
+#include "../helpers/random.hpp"
+#include "../helpers/walker_chain.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/dynamics.hpp>

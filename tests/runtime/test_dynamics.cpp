@@ -1,6 +1,6 @@
 // Inverse dynamics: checks independent of the Kane formula under test (energy, power, statics).
-#include "../support/units.hpp"
-#include "../support/random.hpp"
+#include "../helpers/units.hpp"
+#include "../helpers/random.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/dynamics.hpp>

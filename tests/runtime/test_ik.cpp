@@ -1,6 +1,6 @@
 // Inverse kinematics: round trips through the generated forward kinematics for every branch,
 // both methods, the workspace boundaries, continuity along the thesis sweeps, and the errors.
-#include "../support/random.hpp"
+#include "../helpers/random.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/error.hpp>

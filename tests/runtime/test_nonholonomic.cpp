@@ -1,5 +1,5 @@
 // Dependent rates of the non-holonomic wheels at velocity and acceleration level.
-#include "../support/units.hpp"
+#include "../helpers/units.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/error.hpp>

@@ -1,5 +1,5 @@
 // Integration: no drift, convergence, the thesis' singular crossing, stopping cleanly.
-#include "../support/units.hpp"
+#include "../helpers/units.hpp"
 
 #include <doctest/doctest.h>
 #include <wlx/error.hpp>

@@ -3,9 +3,9 @@
 // before that (an error, an interruption) leaves nothing behind.
 #pragma once
 
-#include "wlx/atomic_file.hpp"
+#include "wlx/support/atomic_file.hpp"
 #include "wlx/error.hpp"
-#include "wlx/text.hpp"
+#include "wlx/support/text.hpp"
 
 #include <fmt/format.h>
 
@@ -33,7 +33,7 @@ class CsvWriter {
 
   // One row; a non-finite value is an error naming its column, and nothing of the row is written.
   void row(const std::vector<double>& values) { row({}, values); }
-  // The same after leading text columns (quoted as CSV fields, wlx/text.hpp).
+  // The same after leading text columns (quoted as CSV fields, wlx/support/text.hpp).
   void row(const std::vector<std::string>& labels, const std::vector<double>& values) {
     if (labels.size() + values.size() != columns_)
       throw Error(path_, fmt::format("row has {} values for {} columns", labels.size() + values.size(), columns_));

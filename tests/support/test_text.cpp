@@ -1,9 +1,9 @@
-// wlx/text.hpp: every quoting function fed every dangerous character, and checked by the language
+// wlx/support/text.hpp: every quoting function fed every dangerous character, and checked by the language
 // itself where one is at hand (gnuplot runs the quoted strings, the C++ compiler compiles the
 // literals and comments), otherwise by decoding the output back (HTML, JSON/JS, CSV).
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
-#include <wlx/text.hpp>
+#include <wlx/support/text.hpp>
 
 #include <cstdio>
 #include <cstdlib>
