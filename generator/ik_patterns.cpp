@@ -68,12 +68,6 @@ ex in_results(const Model& m, ex e, const Solve& solve) {
   return e.subs(trig).subs(plain);
 }
 
-namespace {
-
-// a cos q + b sin q + c = e, for e linear in cos q and sin q; throws otherwise.
-struct Sinusoid {
-  ex a, b, c;
-};
 Sinusoid sinusoid(const ex& e, const realsymbol& q, const std::string& what) {
   const realsymbol C("ik_cos"), S("ik_sin");
   const ex f = e.subs(GiNaC::lst{GiNaC::cos(q) == C, GiNaC::sin(q) == S});
@@ -86,6 +80,8 @@ Sinusoid sinusoid(const ex& e, const realsymbol& q, const std::string& what) {
     throw Unsolvable{what + " is not of the form a cos " + q.get_name() + " + b sin " + q.get_name() + " + c"};
   return out;
 }
+
+namespace {
 
 std::string two_axis_call(Axis a, Axis b, const std::string& v, const std::string& d, const std::string& flip,
                           const SolvedJoint& first, const SolvedJoint& second) {
@@ -132,6 +128,8 @@ void require_three_joints(const Model& m, const CanonicalChain& c, const std::st
   if (c.joints.size() != 3) throw Unsolvable{fmt::format("{}: {} dependent joints drive {}; the pattern solves three", pattern, c.joints.size(), frame)};
 }
 
+}  // namespace
+
 // sin and cos of the joint from those of theta = sign q that a solver computed.
 std::string unsign(const ChainStep& j, const SolvedJoint& s) {
   return j.sign < 0 ? fmt::format("  {0} = -{0};  // the step turns about the negative axis: q = -theta\n", s.s.get_name()) : "";
@@ -163,8 +161,6 @@ Vec3 in_axes(const Mat3& R, const Vec3& v) {
     for (int k = 0; k < 3; ++k) out[i] += R(k, i) * v[k];
   return out;
 }
-
-}  // namespace
 
 // ---- point3 -------------------------------------------------------------------------------------
 
