@@ -28,6 +28,10 @@
 //   rows make the third axis vertical, two rotations again (bit 1: q_b's root, bit 2: the root of
 //   q_p + q_q), and the point row is then a cos q_p + b sin q_p = c (bit 0).
 //
+// steering leg (ik_steering_leg.cpp): three point rows and a sum row; a first joint, three parallel
+//   joints the sum row holds at a known total turn, then inputs' joints: the plane's offset fixes
+//   q1 (bit 0), a planar two-link leg q3 (bit 1) and q2, the sum row q4.
+//
 // Roots: branch 0 takes, in every equation, the root nearest the joint's zero (largest cosine; on
 // a tie the positive angle); a set bit takes the other root. Every solve ends by evaluating the
 // limb's own closure rows at the solution: a residual above kIkTolerance is reported, never
