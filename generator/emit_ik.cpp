@@ -52,6 +52,26 @@ Stage angle_stage(const std::vector<Stage>& before, const std::vector<SolvedJoin
   return st;
 }
 
+// The joints a sum row fixes from joints the solve computes (a steering leg's last parallel joint),
+// from the angles the batched atan2 computed: the sum row then holds exactly, where an atan2 of
+// the joint's own sine and cosine would leave it off by a whole turn. Empty when every coupled
+// joint is already a stage's local (a leveled lever's, fixed by inputs alone).
+Stage coupled_stage(const Model& m, const std::vector<Stage>& before, const Solve& solve) {
+  std::set<std::string> defined;
+  for (const Stage& st : before) {
+    for (const auto& [sym, value] : st.locals) defined.insert(sym.get_name());
+    defined.insert(st.defines.begin(), st.defines.end());
+  }
+  GiNaC::lst angles;
+  for (const SolvedJoint& j : solve.joints) angles.append(m.coordinates[static_cast<std::size_t>(j.coordinate)].q == j.q);
+  Stage st;
+  for (const auto& [k, value] : solve.coupled) {
+    const realsymbol q = joint_symbols(m, k).q;
+    if (!defined.count(q.get_name())) st.locals.emplace_back(q, value.subs(angles));
+  }
+  return st;
+}
+
 // The last stage of a limb's solve: its own closure rows at the solution, and the check.
 Stage check_stage(const Model& m, const Limb& limb, const Solve& solve) {
   Stage check;
@@ -184,6 +204,7 @@ std::vector<Stage> fused_stages(const Model& m, const std::vector<Stage>& stages
 EmittedSolve emit_solve(const Model& m, const Limb& limb, Solve solve, const EmitOptions& opt) {
   std::vector<Stage> stages = solve.stages;
   stages.push_back(angle_stage(stages, solve.joints));
+  if (Stage coupled = coupled_stage(m, solve.stages, solve); !coupled.locals.empty()) stages.push_back(std::move(coupled));
   stages.push_back(check_stage(m, limb, solve));
   OpCount ops;
   const std::string body = emit_body(m, stages, solve_outputs(m, solve), opt, ops);
@@ -324,7 +345,7 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
 // for all their joints, then every limb's check.
 std::string fused_ik(const Model& m, const std::vector<std::pair<const Limb*, Solve>>& solved, const EmitOptions& opt,
                      std::vector<std::string>& report) {
-  std::vector<Stage> stages, checks;
+  std::vector<Stage> stages, coupled, checks;
   std::vector<SolvedJoint> joints;
   std::vector<std::pair<int, std::string>> outputs;
   std::string prologue, newton;
@@ -332,6 +353,7 @@ std::string fused_ik(const Model& m, const std::vector<std::pair<const Limb*, So
     const auto& [limb, solve] = solved[k];
     const int index = static_cast<int>(limb - m.limbs.data());
     for (Stage& st : fused_stages(m, solve.stages, limb->name, index)) stages.push_back(std::move(st));
+    if (Stage st = coupled_stage(m, solve.stages, solve); !st.locals.empty()) coupled.push_back(std::move(st));  // names kept
     for (Stage& st : fused_stages(m, {check_stage(m, *limb, solve)}, limb->name, index)) checks.push_back(std::move(st));
     joints.insert(joints.end(), solve.joints.begin(), solve.joints.end());
     for (const auto& o : solve_outputs(m, solve)) outputs.push_back(o);
@@ -343,6 +365,7 @@ std::string fused_ik(const Model& m, const std::vector<std::pair<const Limb*, So
     if (std::none_of(solved.begin(), solved.end(), [&](const auto& sv) { return sv.first == &limb; }))
       newton += (newton.empty() ? "" : ", ") + limb.name;
   if (!joints.empty()) stages.push_back(angle_stage(stages, joints));
+  stages.insert(stages.end(), coupled.begin(), coupled.end());
   stages.insert(stages.end(), checks.begin(), checks.end());
   OpCount ops;
   const std::string body = emit_body(m, stages, outputs, opt, ops);
@@ -389,7 +412,7 @@ EmittedFile emit_ik_header(const Model& m, const EmitOptions& opt, std::vector<s
   for (const Limb& limb : m.limbs) {
     std::optional<Solve> solve;
     std::vector<std::string> reasons;
-    for (auto plan : {plan_point3, plan_wheel_leg, plan_lever}) {
+    for (auto plan : {plan_point3, plan_wheel_leg, plan_lever, plan_steering_leg}) {
       try {
         solve = plan(m, limb);
         break;

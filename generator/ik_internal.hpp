@@ -5,6 +5,7 @@
 
 #include "model.hpp"
 
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -95,9 +96,25 @@ SolvedJoint joint_symbols(const Model& m, int coordinate);
 // their expressions.
 ex in_results(const Model& m, ex e, const Solve& solve);
 
+// The planning tools the patterns share (ik_patterns.cpp).
+// a cos q + b sin q + c = e, for e linear in cos q and sin q; throws Unsolvable otherwise.
+struct Sinusoid {
+  ex a, b, c;
+};
+Sinusoid sinusoid(const ex& e, const realsymbol& q, const std::string& what);
+// |p + M R_axis(sign q) t|^2 = K + A cos q + B sin q (K in c), for p, t and M free of the joint's q.
+Sinusoid distance_squared(const Vec3& p, const Mat3& M, const ChainStep& joint, const Vec3& t);
+// The targets seen from `base` (from its origin, in its axes): the stage's locals ik_d0, ik_d1, ik_d2.
+Vec3 targets_from(const Model& m, const Frame& base, const std::array<int, 3>& target, Stage& stage);
+// R^T v: v in the axes of a frame turned by R.
+Vec3 in_axes(const Mat3& R, const Vec3& v);
+// Code making sin and cos of the joint from those of theta = sign q that a solver computed.
+std::string unsign(const ChainStep& j, const SolvedJoint& s);
+
 // The patterns, in the order they are tried; each throws Unsolvable when the limb is not its.
 Solve plan_point3(const Model& m, const Limb& limb);
 Solve plan_wheel_leg(const Model& m, const Limb& limb);
 Solve plan_lever(const Model& m, const Limb& limb);
+Solve plan_steering_leg(const Model& m, const Limb& limb);  // ik_steering_leg.cpp
 
 }  // namespace wlx::codegen::ik

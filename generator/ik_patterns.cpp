@@ -28,6 +28,10 @@
 //   rows make the third axis vertical, two rotations again (bit 1: q_b's root, bit 2: the root of
 //   q_p + q_q), and the point row is then a cos q_p + b sin q_p = c (bit 0).
 //
+// steering leg (ik_steering_leg.cpp): three point rows and a sum row; a first joint, three parallel
+//   joints the sum row holds at a known total turn, then inputs' joints: the plane's offset fixes
+//   q1 (bit 0), a planar two-link leg q3 (bit 1) and q2, the sum row q4.
+//
 // Roots: branch 0 takes, in every equation, the root nearest the joint's zero (largest cosine; on
 // a tie the positive angle); a set bit takes the other root. Every solve ends by evaluating the
 // limb's own closure rows at the solution: a residual above kIkTolerance is reported, never
@@ -68,12 +72,6 @@ ex in_results(const Model& m, ex e, const Solve& solve) {
   return e.subs(trig).subs(plain);
 }
 
-namespace {
-
-// a cos q + b sin q + c = e, for e linear in cos q and sin q; throws otherwise.
-struct Sinusoid {
-  ex a, b, c;
-};
 Sinusoid sinusoid(const ex& e, const realsymbol& q, const std::string& what) {
   const realsymbol C("ik_cos"), S("ik_sin");
   const ex f = e.subs(GiNaC::lst{GiNaC::cos(q) == C, GiNaC::sin(q) == S});
@@ -86,6 +84,8 @@ Sinusoid sinusoid(const ex& e, const realsymbol& q, const std::string& what) {
     throw Unsolvable{what + " is not of the form a cos " + q.get_name() + " + b sin " + q.get_name() + " + c"};
   return out;
 }
+
+namespace {
 
 std::string two_axis_call(Axis a, Axis b, const std::string& v, const std::string& d, const std::string& flip,
                           const SolvedJoint& first, const SolvedJoint& second) {
@@ -132,6 +132,8 @@ void require_three_joints(const Model& m, const CanonicalChain& c, const std::st
   if (c.joints.size() != 3) throw Unsolvable{fmt::format("{}: {} dependent joints drive {}; the pattern solves three", pattern, c.joints.size(), frame)};
 }
 
+}  // namespace
+
 // sin and cos of the joint from those of theta = sign q that a solver computed.
 std::string unsign(const ChainStep& j, const SolvedJoint& s) {
   return j.sign < 0 ? fmt::format("  {0} = -{0};  // the step turns about the negative axis: q = -theta\n", s.s.get_name()) : "";
@@ -163,8 +165,6 @@ Vec3 in_axes(const Mat3& R, const Vec3& v) {
     for (int k = 0; k < 3; ++k) out[i] += R(k, i) * v[k];
   return out;
 }
-
-}  // namespace
 
 // ---- point3 -------------------------------------------------------------------------------------
 

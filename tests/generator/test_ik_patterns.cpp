@@ -143,3 +143,62 @@ TEST_CASE("IK patterns: point3 tests whether the axes meet, whatever separates t
   CHECK(four.find("point3 solves exactly three point rows (x, y and z of one frame); this limb has 4: foot_at_x, foot_at_y, "
                   "foot_at_z, on_ground") != std::string::npos);
 }
+
+#ifdef WLX_HAVE_URDF_TESTS
+TEST_CASE("IK patterns: a steering leg (a hip, three parallel joints held by a sum row, then the inputs' joints and a wheel)") {
+  // tests/models/big_wheeled: hip yaw, hip pitch, knee, ankle pitch (the sum row squares the
+  // steering axis), then ankle yaw and roll (inputs) and the wheel. On its floating base, which
+  // pitches and rolls, the hip yaw axis tilts: the rim point nearest the ground then moves with
+  // the hip yaw's angle, and the pattern says so.
+  const std::string path = WLX_BIG_WHEELED_FILE;
+  const std::string original = text_of(path);
+  const std::string directory = path.substr(0, path.rfind('/'));
+  const Model tilting = parse_model(original, "big_wheeled.yaml", directory);
+  const std::string refused = ik_line(tilting, "leg_lf");
+  CHECK(refused.find("no closed form") != std::string::npos);
+  CHECK(refused.find("steering leg: the axis of hip_yaw_lf is not vertical whatever the inputs (pitch, roll tilt it)") !=
+        std::string::npos);
+  CHECK(refused.find("for a wheel the pattern needs that axis vertical") != std::string::npos);
+  // On a base that only yaws every leg is a steering leg.
+  const std::string level_text = replaced(original, "chain: [tx: x_B, ty: y_B, tz: z_B, rz: yaw, ry: pitch, rx: roll]",
+                                          "chain: [tx: x_B, ty: y_B, tz: z_B, rz: yaw]");
+  const Model level = parse_model(level_text, "level.yaml", directory);
+  for (const char* leg : {"leg_lf", "leg_rf", "leg_lh", "leg_rh"}) {
+    CAPTURE(leg);
+    CHECK(ik_line(level, leg).rfind(std::string(leg) + ": steering leg: the contact point of wheel ", 0) == 0);
+  }
+  CHECK(ik_line(level, "leg_lf").find("by hip_yaw_lf (z), then hip_pitch_lf and knee_lf (parallel, about y), ankle_pitch_lf by the "
+                                      "sum row ankle_square_lf; inputs after it: ankle_yaw_lf, ankle_roll_lf (4 branches") !=
+        std::string::npos);
+  // A sum row that leaves the ankle pitch out does not fix the parallel joints' total turn.
+  const std::string partial = replaced(level_text, "coordinates: [hip_pitch_<leg>, knee_<leg>, ankle_pitch_<leg>]",
+                                       "coordinates: [hip_pitch_<leg>, knee_<leg>, hip_yaw_<leg>]");
+  const std::string partial_line = ik_line(parse_model(partial, "partial.yaml", directory), "leg_lf");
+  CHECK(partial_line.find("steering leg: the sum row ankle_square_lf holds other dependent joints than the three parallel ones "
+                          "(hip_pitch_lf, knee_lf, ankle_pitch_lf)") != std::string::npos);
+}
+#endif
+
+TEST_CASE("IK patterns: a steering leg's preconditions are its geometry's") {
+  // tests/ik_shapes/ik_shapes.yaml's leg_e (a wheel) and leg_f (a point, on the tilting base).
+  const std::string original = text_of(WLX_IK_SHAPES_FILE);
+  const Model m = parse_model(original, "ik_shapes.yaml");
+  CHECK(ik_line(m, "leg_e").rfind("leg_e: steering leg: the contact point of wheel e (contact_e)", 0) == 0);
+  CHECK(ik_line(m, "leg_f").rfind("leg_f: steering leg: f_foot at (x, y, z) = (xf, yf, zf) by f1 (y), then f2 and f3", 0) == 0);
+  // A third joint about another axis than the second's.
+  const std::string skewed = ik_line(parse_model(replaced(original, "ry: eturn, ry: e3", "ry: eturn, rx: e3"), "skewed.yaml"), "leg_e");
+  CHECK(skewed.find("steering leg: the axes of e2, e3 and e4 are not parallel (") != std::string::npos);
+  CHECK(skewed.find("ry: eturn between the first two") != std::string::npos);
+  CHECK(skewed.find("the pattern needs three joints about one axis, with turns between them only about that axis") != std::string::npos);
+  // A turn between the parallel joints about another axis tilts the next one.
+  const std::string tilted = ik_line(parse_model(replaced(original, "rx: fturn, rx: -f4", "rz: fturn, rx: -f4"), "tilted.yaml"), "leg_f");
+  CHECK(tilted.find("steering leg: the axes of f2, f3 and f4 are not parallel") != std::string::npos);
+  // The parallel joints about opposite directions: the sum row does not fix their total turn.
+  const std::string opposed = ik_line(parse_model(replaced(original, "ry: e4]", "ry: -e4]"), "opposed.yaml"), "leg_e");
+  CHECK(opposed.find("steering leg: e2, e3 and e4 turn about opposite directions of their axis") != std::string::npos);
+  // An input's joint among the four dependent ones.
+  const std::string moved = replaced(replaced(original, "rz: swivel_f, tz: slide_f", "tz: slide_f"), "rx: -f2]", "rx: -f2, rz: swivel_f]");
+  const std::string between = ik_line(parse_model(moved, "between.yaml"), "leg_f");
+  CHECK(between.find("steering leg: input swivel_f moves the chain between the first dependent joint f1 and the fourth") !=
+        std::string::npos);
+}

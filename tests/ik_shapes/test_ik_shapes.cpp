@@ -1,9 +1,10 @@
-// Property test of the closed-form IK (generator/ik_patterns.cpp): for random geometries of every limb
-// shape in ik_shapes.yaml (each offset and fixed turn a parameter, drawn here at run time), a
-// target made from random joint angles through the generated closure, every branch that returns a
-// solution solves the limb's closure rows to 1e-12 m, and the solution Newton's method finds from
-// near those angles is one of the branches (to 1e-9 rad). Newton uses the generated dPhi/ds, the
-// closed form nothing of it: the two share only the model's chains.
+// Property test of the closed-form IK (generator/ik_patterns.cpp, ik_steering_leg.cpp): for random
+// geometries of every limb shape in ik_shapes.yaml (each offset and fixed turn a parameter, drawn
+// here at run time), a target made from random joint angles through the generated closure, every
+// branch that returns a solution solves the limb's closure rows to 1e-12 m, and the solution
+// Newton's method finds from near those angles is one of the branches (to 1e-9 rad). Newton uses
+// the generated dPhi/ds, the closed form nothing of it: the two share only the model's chains.
+// A limb has three point rows, and a steering leg a sum row besides (four rows, four joints).
 #include <wlx/gen/all.hpp>  // its time stamp moves with any header's (wlx-gen): the build recompiles this
 #include <wlx/gen/closure.hpp>
 #include <wlx/gen/ik.hpp>
@@ -16,6 +17,8 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <utility>
+#include <vector>
 
 namespace gen = wlx::ik_shapes::gen;
 
@@ -31,12 +34,12 @@ double limb_residual(const gen::Coordinates& s, const gen::Params& p, const gen:
   return r;
 }
 
-Eigen::Matrix3d limb_jacobian(const gen::Coordinates& s, const gen::Params& p, const gen::LimbInfo& limb) {
+Eigen::MatrixXd limb_jacobian(const gen::Coordinates& s, const gen::Params& p, const gen::LimbInfo& limb) {
   gen::ClosureJacobian J;
   gen::closure(s, p, {.dPhi_ds = &J});
-  Eigen::Matrix3d B;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) B(i, j) = J(limb.rows[static_cast<std::size_t>(i)], limb.joints[static_cast<std::size_t>(j)]);
+  Eigen::MatrixXd B(limb.size, limb.size);
+  for (int i = 0; i < limb.size; ++i)
+    for (int j = 0; j < limb.size; ++j) B(i, j) = J(limb.rows[static_cast<std::size_t>(i)], limb.joints[static_cast<std::size_t>(j)]);
   return B;
 }
 
@@ -46,11 +49,11 @@ bool newton(gen::Coordinates& s, const gen::Params& p, const gen::LimbInfo& limb
   for (int it = 0; it < 30; ++it) {
     gen::ClosureVector Phi;
     gen::closure(s, p, {.Phi = &Phi});
-    Eigen::Vector3d r;
-    for (int i = 0; i < 3; ++i) r(i) = Phi(limb.rows[static_cast<std::size_t>(i)]);
+    Eigen::VectorXd r(limb.size);
+    for (int i = 0; i < limb.size; ++i) r(i) = Phi(limb.rows[static_cast<std::size_t>(i)]);
     if (r.cwiseAbs().maxCoeff() <= 1e-13) return true;
-    const Eigen::Vector3d step = limb_jacobian(s, p, limb).fullPivLu().solve(-r);
-    for (int j = 0; j < 3; ++j) s(limb.joints[static_cast<std::size_t>(j)]) += step(j);
+    const Eigen::VectorXd step = limb_jacobian(s, p, limb).fullPivLu().solve(-r);
+    for (int j = 0; j < limb.size; ++j) s(limb.joints[static_cast<std::size_t>(j)]) += step(j);
   }
   return false;
 }
@@ -76,25 +79,38 @@ TEST_CASE("closed-form IK on random geometries of every limb shape: every branch
         if (info.kind == gen::ParamKind::angle) p.*info.member = std::numbers::pi * unit(rng);
       }
       gen::Coordinates s = gen::Coordinates::Zero();
+      for (int k = 6; k < gen::kInputCount; ++k) s(k) = unit(rng);  // the other inputs (the targets are set below)
       for (int k = 0; k < 3; ++k) s(k) = unit(rng);  // base position
       s(3) = std::numbers::pi * unit(rng);          // yaw
       s(4) = 0.6 * unit(rng);                       // pitch and roll tilt a wheel's axle
       s(5) = 0.6 * unit(rng);
       gen::Coordinates truth = s;
       for (int j = 0; j < limb.size; ++j) truth(limb.joints[static_cast<std::size_t>(j)]) = std::numbers::pi * unit(rng);
-      // The targets: with them at zero, each point row is the point's component; the row's target
-      // is the input whose dPhi/ds entry is -1 (the base's own inputs move the point, +1).
+      // A point row's target is the input whose dPhi/ds entry is -1 (the base's own inputs move the
+      // point, +1); a row without one is a sum row, which the limb's last joint in it then meets.
       gen::ClosureVector Phi;
       gen::ClosureJacobian J;
       gen::closure(truth, p, {.Phi = &Phi, .dPhi_ds = &J});
+      std::vector<std::pair<int, int>> targets;  // row, input
       for (int i = 0; i < limb.size; ++i) {
         const int row = limb.rows[static_cast<std::size_t>(i)];
         int target = -1;
         for (int k = 6; k < gen::kInputCount; ++k)
           if (J(row, k) == -1.0) target = k;
-        REQUIRE(target >= 0);
-        truth(target) = Phi(row);  // s's targets are zero, so Phi is the point's component
+        if (target >= 0) {
+          targets.emplace_back(row, target);
+          continue;
+        }
+        int last = -1;
+        for (int j = 0; j < limb.size; ++j)
+          if (J(row, limb.joints[static_cast<std::size_t>(j)]) == 1.0) last = limb.joints[static_cast<std::size_t>(j)];
+        REQUIRE(last >= 0);
+        truth(last) -= Phi(row);  // the sum of its coordinates, now zero
       }
+      // The targets: set to zero, each point row is the point's component.
+      for (const auto& [row, target] : targets) truth(target) = 0;
+      gen::closure(truth, p, {.Phi = &Phi});
+      for (const auto& [row, target] : targets) truth(target) = Phi(row);
       for (int k = 0; k < gen::kInputCount; ++k) s(k) = truth(k);
       REQUIRE(limb_residual(truth, p, limb) <= 1e-13);
 
@@ -105,8 +121,8 @@ TEST_CASE("closed-form IK on random geometries of every limb shape: every branch
         ++newton_failed;
         continue;
       }
-      const Eigen::Vector3d sv = limb_jacobian(n, p, limb).jacobiSvd().singularValues();
-      const bool well_conditioned = sv(2) >= 1e-3;
+      const Eigen::VectorXd sv = limb_jacobian(n, p, limb).jacobiSvd().singularValues();
+      const bool well_conditioned = sv(limb.size - 1) >= 1e-3;
       double nearest = std::numeric_limits<double>::infinity();
       for (int b = 0; b < cf.branches; ++b) {
         gen::Coordinates out = s;
