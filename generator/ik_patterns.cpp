@@ -333,7 +333,8 @@ struct WheelLeg {
   Mat3 R1, R2;                               // the fixed turns after the first and the second joint
   Vec3 p1, p2, p3;                           // the fixed offsets after the three joints
   Vec3 normal;                               // the leg plane's normal in the frame after q1
-  ex plane;                                  // Y: the leg plane's offset along the normal
+  ex plane;                                  // Y: the leg plane's offset along the normal, of the rows' point
+  ex rim;                                    // a wheel: its rolling plane's offset along the normal from the hub (0: none)
 };
 
 WheelLeg wheel_leg(const Model& m, const Limb& limb) {
@@ -370,7 +371,17 @@ WheelLeg wheel_leg(const Model& m, const Limb& limb) {
   const ex plane = dot(normal, hub).expand();
   if (plane.has(q2) || plane.has(q3))
     throw std::logic_error("wlx-gen: the leg plane's offset depends on the planar joints");  // parallel axes exclude it
-  return {frame, target, wheel, pattern, point, c, R1, R2, p1, p2, p3, normal, plane};
+  // A wheel's rolling plane sits `offset` along the axle from the hub (c = h + o a - r u): the axle
+  // is the plane's normal up to its sign, so the contact point's plane lies o (a . n) beyond the hub's.
+  // Its sign, a . n, is structural (R1 turns both alike; q2 and q3 and the turns the checks above
+  // allow keep the axis): exact when those turns are about the axis itself, else read at the defaults.
+  ex rim = 0;
+  if (wheel && !wheel->offset.empty()) {
+    ex sign = dot(R2 * (product(c.fixed[3].turns) * unit(wheel->axle)), unit(j2.axis)).expand();
+    if (!sign.is_equal(1) && !sign.is_equal(-1)) sign = at_defaults(m, sign) > 0 ? 1 : -1;
+    rim = m.parameter(wheel->offset).symbol * sign;
+  }
+  return {frame, target, wheel, pattern, point, c, R1, R2, p1, p2, p3, normal, plane + rim, rim};
 }
 
 // The solve's report line, documentation, branch bits and failure messages.
@@ -497,13 +508,13 @@ Solve plan_wheel_leg(const Model& m, const Limb& limb) {
   st0.defines = {s1.c.get_name(), s1.s.get_name()};
   solve.stages.push_back(st0);
 
-  // The hub at the target + r u (a wheel; u from stage 1), in the frame before q1.
+  // The hub at the target - o a + r u (a wheel; u from stage 1), in the frame before q1: o a = rim n.
   Vec3 hub_target = d;
   if (leg.wheel) {
     solve.stages.push_back(rim_stage(m, solve, base.R * (turn1 * leg.normal)));
     const ex r = m.parameter(leg.wheel->radius).symbol;
     const Vec3 up(realsymbol("ik_u0"), realsymbol("ik_u1"), realsymbol("ik_u2"));
-    hub_target = hub_target + r * in_axes(base.R, up);
+    hub_target = hub_target - leg.rim * (turn1 * leg.normal) + r * in_axes(base.R, up);
   }
   solve.stages.push_back(hub_distance_stage(m, solve, leg, hub_target, s3));
   solve.stages.push_back(leg_rotation_stage(m, solve, leg, s2));

@@ -471,7 +471,8 @@ def cmd_help(options):
     if os.path.exists(generator):
         text = run([generator, "--help"]).stdout  # (stderr may hold a sanitizer's report)
         listed = set(re.findall(r"^\s+(--[\w-]+)", text, flags=re.M)) - {"--help", "--version"}
-        m = re.search(r"`wlx-gen ([^`]*)`", readme)
+        # The synopsis is the span that starts a line (prose may quote `wlx-gen --option` too).
+        m = re.search(r"^`wlx-gen ([^`]*)`", readme, flags=re.M)
         documented, documented_positionals = synopsis_options(m[1]) if m else (set(), set())
         for option in sorted(listed ^ documented):
             problems.append(f"wlx-gen {option}: in only one of --help and README.md's synopsis")
