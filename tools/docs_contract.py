@@ -856,7 +856,8 @@ def model_file_figures(build, today):
     if loaded is not None:
         rows.append(f"| cached `wlx.load(FILE)` in Python (median of 5) | {loaded * 1000:.0f} ms |")
     return (f"Measured {today} on {machine()} by `tools/readme_figures.sh`: a copy of `models/excavator.yaml` in a "
-            "fresh cache, the default flags (the runtime and the generated functions at `-O2`, the commands at `-O0`); "
+            "fresh cache, the default flags (cmake/wlxModelBuild.cmake: the runtime and the generated functions at `-O3`, "
+            "the commands at `-O0`); "
             "the parts from the entry's `build-times.tsv`.\n\n| part | wall time |\n|---|---:|\n" + "\n".join(rows) + "\n")
 
 

@@ -68,12 +68,12 @@ constexpr const char* kSettingsSymbol = "wlx_model_plugin_v5_settings";
 static_assert(kPluginInterface == 5, "rename kEntrySymbol and kSettingsSymbol with the interface's version");
 
 // The runtime's sources (their generated-function files apart: each is its own translation unit)
-// and the per-model commands: CMakeLists.txt's lists for the built-in models, '|'-separated.
+// and the per-model commands: cmake/wlxModelBuild.cmake's lists, as for the built-in models, '|'-separated.
 // The runtime in one translation unit, which shares Eigen's templates (measured at -O2: 27 s,
 // where the files one by one take 48 s of CPU); it runs on one core while the commands and the
 // generated functions take the others.
-#ifndef WLX_PLUGIN_RUNTIME_SOURCES
-#error "CMakeLists.txt defines WLX_PLUGIN_RUNTIME_SOURCES, WLX_PLUGIN_RUNTIME_APART, WLX_PLUGIN_GENERATED_SOURCES and WLX_PLUGIN_COMMAND_SOURCES"
+#if !defined(WLX_PLUGIN_RUNTIME_SOURCES) || !defined(WLX_PLUGIN_RUNTIME_OPTIMIZATION) || !defined(WLX_PLUGIN_COMMANDS_OPTIMIZATION)
+#error "CMakeLists.txt defines WLX_PLUGIN_RUNTIME_SOURCES, WLX_PLUGIN_RUNTIME_APART, WLX_PLUGIN_GENERATED_SOURCES, WLX_PLUGIN_COMMAND_SOURCES and the parts' optimizations (cmake/wlxModelBuild.cmake)"
 #endif
 
 // FNV-1a, twice with different offsets: a 128-bit content key (a cache key, not a signature).
@@ -164,16 +164,13 @@ fs::path generator_program() {
   return "wlx-gen";  // from PATH
 }
 
-// -O2 by default for the runtime and the generated functions (the code runs in users' loops), -O0
-// for the commands, which parse, check and write around those calls (the excavator's, alone on a
-// core: 27 s at -O2, 19 s at -O1, 10 s at -O0; a report of its runs takes 28 s against 26.5 s
-// with them at -O1, most of both the viewer's module). WLX_PLUGIN_CXXFLAGS replaces both (all
-// part of the key).
-const char* const kCommandsOptimization = "-O0";
+// Each part's optimization, as cmake/wlxModelBuild.cmake defines it for every builder of a model's
+// code (the runtime and the generated functions -O3, the commands -O0: why, there).
+// WLX_PLUGIN_CXXFLAGS replaces both (all part of the key).
 std::vector<std::string> optimization_flags(bool commands = false) {
   const char* env = std::getenv("WLX_PLUGIN_CXXFLAGS");
   std::vector<std::string> out;
-  std::istringstream in(env != nullptr && *env != '\0' ? env : commands ? kCommandsOptimization : "-O2");
+  std::istringstream in(env != nullptr && *env != '\0' ? env : commands ? WLX_PLUGIN_COMMANDS_OPTIMIZATION : WLX_PLUGIN_RUNTIME_OPTIMIZATION);
   for (std::string flag; in >> flag;) out.push_back(flag);
   return out;
 }
@@ -585,10 +582,11 @@ std::string model_file_viewer_module() {
   throw Error("viewer", "this wlx was built without the viewer (emscripten, node and npm were missing when it was built), so it "
                         "cannot build one for a model file");
 #else
-  // -O2 by default; WLX_PLUGIN_EMCCFLAGS replaces it (the tests' -O0).
+  // The viewer's optimization (cmake/wlxModelBuild.cmake) by default; WLX_PLUGIN_EMCCFLAGS replaces
+  // it (the tests' -O0).
   std::vector<std::string> flags;
   const char* env = std::getenv("WLX_PLUGIN_EMCCFLAGS");
-  std::istringstream in(env != nullptr && *env != '\0' ? env : "-O2");
+  std::istringstream in(env != nullptr && *env != '\0' ? env : WLX_VIEWER_OPTIMIZATION);
   for (std::string flag; in >> flag;) flags.push_back(flag);
   // The module's folder is named by what it is compiled with beyond the entry's key (which holds
   // the sources): emscripten itself, the flags, the exports and the source lists that
