@@ -5,6 +5,7 @@
 #pragma once
 
 #include "derivations.hpp"
+#include "lane_code.hpp"
 
 #include <array>
 #include <string>
@@ -60,8 +61,8 @@ struct TwistNode {
   const JointRecord* joint = nullptr;
   int parent = -1;
   std::vector<int> children, bodies;
-  std::array<std::string, 6> twist;  // lanes of (omega; velocity of the point at K0's origin)
-  std::array<std::string, 6> wrench;  // lanes of the sum over the bodies beyond: (force; moment about K0's origin)
+  std::array<lane_code::ValueId, 6> twist;   // lanes of (omega; velocity of the point at K0's origin)
+  std::array<lane_code::ValueId, 6> wrench;  // lanes of the sum over the bodies beyond: (force; moment about K0's origin)
 };
 
 // The tree of the bodies' chains through the joints that move in a step (RateRoles::moves): chains
