@@ -77,8 +77,4 @@ TwistTree twist_tree(const Model& m, const RateRoles& roles);
 // for a revolute joint (axis a through o), (0; a) for a prismatic one.
 std::array<ex, 6> spatial_axis(const JointRecord& joint);
 
-// A value the lane code reads, named and handed to CSE with the function's other expressions; ""
-// for an exact zero, which the code writers drop.
-std::string lane_scalar(FunctionSpec& fn, const std::string& name, const ex& value);
-
 }  // namespace wlx::codegen::derivation
