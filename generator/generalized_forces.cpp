@@ -1,5 +1,6 @@
-// generalized_forces: the bodies' inverse dynamics by the recursive Newton-Euler equations, written
-// as straight-line scalar code, projected onto the commanded speeds.
+// generalized_forces: the bodies' inverse dynamics by the recursive Newton-Euler equations, derived
+// as straight-line scalar code (lane_code.hpp, printed by lane_printer.hpp), projected onto the
+// commanded speeds.
 #include "derivations_internal.hpp"
 #include "lane_printer.hpp"
 

@@ -59,9 +59,9 @@ constexpr Spelling kSpellings[] = {
     {Quantity::bias_column, "kane_B_{}", nullptr},
 };
 
-class Printer {
+class LanePrinter {
  public:
-  explicit Printer(const LaneProgram& program) : program_(program) {}
+  explicit LanePrinter(const LaneProgram& program) : program_(program) {}
 
   std::string name(const ValueId& id) const {
     const auto* spelling = std::find_if(std::begin(kSpellings), std::end(kSpellings), [&](const Spelling& s) { return s.what == id.what; });
@@ -186,7 +186,7 @@ void reserve_printer_names(const Model& m) {
 
 PrintedCode print(const LaneProgram& program, std::size_t outputs) {
   const std::vector<bool> keep = kept_statements(program);
-  Printer printer(program);
+  LanePrinter printer(program);
   PrintedCode out;
   out.ops.resize(outputs);
   std::set<ValueId> read;

@@ -1,6 +1,6 @@
-// reduced_dynamics: Kane's equations projected onto the commanded speeds, written as code on
-// lanes (one per commanded speed) that sums the joints' twists out along the bodies' chains and the
-// bodies' wrenches back along them.
+// reduced_dynamics: Kane's equations projected onto the commanded speeds, derived as code on lanes
+// (one per commanded speed, lane_code.hpp) that sums the joints' twists out along the bodies'
+// chains and the bodies' wrenches back along them; lane_printer.hpp writes it as C++.
 #include "derivations_internal.hpp"
 #include "lane_printer.hpp"
 
