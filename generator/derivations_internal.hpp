@@ -5,6 +5,7 @@
 #pragma once
 
 #include "derivations.hpp"
+#include "lane_code.hpp"
 
 #include <array>
 #include <string>
@@ -60,8 +61,8 @@ struct TwistNode {
   const JointRecord* joint = nullptr;
   int parent = -1;
   std::vector<int> children, bodies;
-  std::array<std::string, 6> twist;  // lanes of (omega; velocity of the point at K0's origin)
-  std::array<std::string, 6> wrench;  // lanes of the sum over the bodies beyond: (force; moment about K0's origin)
+  std::array<lane_code::ValueId, 6> twist;   // lanes of (omega; velocity of the point at K0's origin)
+  std::array<lane_code::ValueId, 6> wrench;  // lanes of the sum over the bodies beyond: (force; moment about K0's origin)
 };
 
 // The tree of the bodies' chains through the joints that move in a step (RateRoles::moves): chains
@@ -75,9 +76,5 @@ TwistTree twist_tree(const Model& m, const RateRoles& roles);
 // A joint's twist per unit rate in K0, (omega; velocity of the point at K0's origin): (a; o x a)
 // for a revolute joint (axis a through o), (0; a) for a prismatic one.
 std::array<ex, 6> spatial_axis(const JointRecord& joint);
-
-// A value the lane code reads, named and handed to CSE with the function's other expressions; ""
-// for an exact zero, which the code writers drop.
-std::string lane_scalar(FunctionSpec& fn, const std::string& name, const ex& value);
 
 }  // namespace wlx::codegen::derivation

@@ -88,12 +88,6 @@ std::array<ex, 6> spatial_axis(const JointRecord& joint) {
   return S;
 }
 
-std::string lane_scalar(FunctionSpec& fn, const std::string& name, const ex& value) {
-  if (value.is_zero()) return {};
-  fn.lane_scalars.emplace_back(name, value);
-  return name;
-}
-
 TwistTree twist_tree(const Model& m, const RateRoles& roles) {
   TwistTree tree;
   std::vector<int> roots;  // the nodes next to K0

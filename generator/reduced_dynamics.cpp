@@ -1,183 +1,141 @@
-// reduced_dynamics: Kane's equations projected onto the commanded speeds, written as code on
-// lanes (one per commanded speed) that sums the joints' twists out along the bodies' chains and the
-// bodies' wrenches back along them.
+// reduced_dynamics: Kane's equations projected onto the commanded speeds, derived as code on lanes
+// (one per commanded speed, lane_code.hpp) that sums the joints' twists out along the bodies'
+// chains and the bodies' wrenches back along them; lane_printer.hpp writes it as C++.
 #include "derivations_internal.hpp"
+#include "lane_printer.hpp"
 
 #include <fmt/format.h>
-#include <wlx/support/text.hpp>
 
 #include <algorithm>
 #include <iterator>
 #include <map>
 #include <set>
-#include <stdexcept>
 
 namespace wlx::codegen {
 
 using namespace derivation;
+using lane_code::Layout;
+using lane_code::Quantity;
+using lane_code::Term;
+using lane_code::value_id;
+using lane_code::ValueId;
 
 namespace {
 
-// Writes reduced_dynamics' lane code: statements on rows of scalars (detail::Lanes), one lane per
-// commanded speed, and counts their operations scalar by scalar, per output (`charge_to`).
-// A row is named by its variable, or "" when it is structurally zero (nothing is written for it).
+// Builds reduced_dynamics' lane code (lane_code.hpp): statements on rows of scalars
+// (detail::Lanes), one lane per commanded speed, each counted for an output (`charge_to`). A row
+// that is structurally zero is the zero ValueId (no statement is made for it).
 //
-// Rows are narrow or wide. A wide row (type LW) holds every commanded speed, lane k for speed k. A
-// narrow row (type L) holds only the speeds its set names, speed k in lane slot[k]: speeds that
-// never move the same body (the commanded speeds of two legs, say) share a lane, so that a
-// machine with many commanded speeds but few per limb runs its limbs' sums on short rows. A row
-// is narrow when its speeds' slots are distinct; sums whose speeds collide (the wrenches where the
-// limbs meet) are wide, their narrow parts widened first. With no sharing (slot[k] = k) every row
-// is narrow and L holds every speed.
-class LaneWriter {
+// Rows are narrow or wide. A wide row holds every commanded speed, lane k for speed k. A narrow
+// row holds only the speeds its set names, speed k in lane slot[k]: speeds that never move the
+// same body (the commanded speeds of two legs, say) share a lane, so that a machine with many
+// commanded speeds but few per limb runs its limbs' sums on short rows. A row is narrow when its
+// speeds' slots are distinct; sums whose speeds collide (the wrenches where the limbs meet) are
+// wide, their narrow parts widened first. With no sharing (slot[k] = k) every row is narrow and
+// holds every speed.
+class LaneBuilder {
  public:
-  using Set = std::vector<int>;  // commanded speeds, ascending
-  using Terms = std::vector<std::pair<std::string, std::string>>;  // (scalar factor, row)
-  LaneWriter(std::vector<int> slot, int width) : slot_(std::move(slot)), width_(width), speeds_(static_cast<int>(slot_.size())) {}
+  using Set = std::vector<int>;                              // commanded speeds, ascending
+  using Terms = std::vector<std::pair<ValueId, ValueId>>;  // (scalar factor, row)
+  LaneBuilder(std::vector<int> slot, int width) : slot_(std::move(slot)) {
+    program_.kind = lane_code::LaneProgram::Kind::lanes;
+    program_.width = width;
+    program_.speeds = static_cast<int>(slot_.size());
+  }
   int charge_to = 0;  // the output the next statements' operations count for
-  bool shares_lanes() const { return width_ < speeds_; }
-  int width() const { return width_; }
-  // A row the caller declares (T's rows): its name and speeds, narrow.
-  void declare(const std::string& name, const Set& speeds) { rows_[name] = {speeds, false}; }
-  const Set& speeds(const std::string& row) const { return rows_.at(row).speeds; }
-  // A new row "name = base + sum_i factor_i * row_i" (zero terms, "" rows, dropped); returns the
-  // name, or base itself when no term remains (no code).
-  std::string define(const std::string& name, const std::string& base, const Terms& terms) {
+  bool shares_lanes() const { return program_.shares_lanes(); }
+  // A row the caller declares (T's rows): its speeds, narrow.
+  void declare(const ValueId& row, const Set& speeds) { rows_[row] = {speeds, false}; }
+  // A lane scalar (zero for an exact zero).
+  ValueId scalar(const ValueId& id, const ex& value) { return program_.scalar(id, value); }
+  // A new row "target = base + sum_i factor_i * row_i" (terms with a zero factor or row dropped);
+  // returns target, or base itself when no term remains (no code).
+  ValueId define(const ValueId& target, const ValueId& base, const Terms& terms) {
     const Terms kept = nonzero(terms);
     if (kept.empty()) return base;
-    std::vector<std::string> rows = rows_of(kept);
-    if (!base.empty()) rows.insert(rows.begin(), base);
-    const Layout layout = unify(rows);
-    OpCount ops;
-    const std::string rhs = products(base.empty() ? "" : as(base, layout.wide), kept, layout.wide, ops);
-    add(name, fmt::format("    const {} {} = {};\n", type(layout.wide), name, rhs), ops);
-    rows_[name] = {layout.speeds, layout.wide};
-    return name;
+    std::vector<ValueId> rows = rows_of(kept);
+    if (!base.is_zero()) rows.insert(rows.begin(), base);
+    const Row layout = unify(rows);
+    std::vector<Term> sum;
+    if (!base.is_zero()) sum.push_back({lane_code::kOne, as(base, layout.wide)});
+    products(kept, layout.wide, sum);
+    add(lane_code::Define{target, kind(layout.wide), std::move(sum)});
+    rows_[target] = layout;
+    return target;
   }
   // A new row, the sum of `rows` (at least two).
-  std::string define_sum(const std::string& name, const std::vector<std::string>& rows) {
-    const Layout layout = unify(rows);
-    std::vector<std::string> operands;
-    for (const auto& r : rows) operands.push_back(as(r, layout.wide));
-    add(name, fmt::format("    const {} {} = {};\n", type(layout.wide), name, fmt::join(operands, " + ")),
-        OpCount{static_cast<long>(rows.size() - 1) * lanes(layout.wide), 0, 0, 0});
-    rows_[name] = {layout.speeds, layout.wide};
-    return name;
+  ValueId define_sum(const ValueId& target, const std::vector<ValueId>& rows) {
+    const Row layout = unify(rows);
+    std::vector<Term> sum;
+    for (const auto& r : rows) sum.push_back({lane_code::kOne, as(r, layout.wide)});
+    add(lane_code::Define{target, kind(layout.wide), std::move(sum)});
+    rows_[target] = layout;
+    return target;
   }
   // "accumulator += sum_i factor_i * row_i": into one of the accumulator's parts (one whose
   // speeds, with the terms', keep distinct lanes; else a new part).
-  void accumulate(const std::string& accumulator, const Terms& terms) {
+  void accumulate(const ValueId& accumulator, const Terms& terms) {
     const Terms kept = nonzero(terms);
     if (kept.empty()) return;
     const Part& part = part_for(accumulator, unify(rows_of(kept)));
-    OpCount ops{lanes(part.wide), 0, 0, 0};  // the +=
-    const std::string rhs = products("", kept, part.wide, ops);
-    add("", fmt::format("    {} += {};\n", part.name, rhs), ops);
+    std::vector<Term> sum;
+    products(kept, part.wide, sum);
+    add(lane_code::Accumulate{part.id, kind(part.wide), std::move(sum)});
   }
   // "accumulator += row".
-  void add_row(const std::string& accumulator, const std::string& row) {
-    const Layout layout = unify({row});
-    const Part& part = part_for(accumulator, layout);
-    add("", fmt::format("    {} += {};\n", part.name, as(row, part.wide)), OpCount{lanes(part.wide), 0, 0, 0});
+  void add_row(const ValueId& accumulator, const ValueId& row) {
+    const Part& part = part_for(accumulator, unify({row}));
+    add(lane_code::Accumulate{part.id, kind(part.wide), {{lane_code::kOne, as(row, part.wide)}}});
   }
   // A new row equal to `base` (or zero) plus `value` for speed k only: a unit row of T.
-  std::string plus_lane(const std::string& name, const std::string& base, int k, const std::string& value) {
-    Set speeds = base.empty() ? Set{} : rows_.at(base).speeds;
+  ValueId plus_lane(const ValueId& target, const ValueId& base, int k, const ValueId& value) {
+    Set speeds = base.is_zero() ? Set{} : rows_.at(base).speeds;
     speeds = merged(speeds, {k});
-    const bool wide = (!base.empty() && rows_.at(base).wide) || !distinct(speeds);
-    add(name, fmt::format("    {} {} = {};\n    {}.add_to_lane({}, {});\n", type(wide), name, base.empty() ? zero(wide) : as(base, wide),
-                          name, wide ? k : slot_[static_cast<std::size_t>(k)], value),
-        OpCount{1, 0, 0, 0});
-    rows_[name] = {speeds, wide};
-    return name;
+    const bool wide = (!base.is_zero() && rows_.at(base).wide) || !distinct(speeds);
+    const ValueId from = base.is_zero() ? base : as(base, wide);
+    add(lane_code::PlusLane{target, kind(wide), from, lane(k, wide), value});
+    rows_[target] = {speeds, wide};
+    return target;
   }
-  // Quoted for a comment (wlx/support/text.hpp): the text may hold a body's meaning from the model file.
-  void comment(const std::string& text) { add("", "    // " + text::cpp_comment(text) + "\n", {}); }
-  std::string zero(bool wide = false) const { return fmt::format("detail::zero_lanes<Scalar, {}>()", lanes(wide)); }
-  std::string type(bool wide) const { return wide ? "LW" : "L"; }
+  void comment(const std::string& text) { add(lane_code::Comment{text}); }
   // The lane of speed k in a row of the given kind.
   int lane(int k, bool wide) const { return wide ? k : slot_[static_cast<std::size_t>(k)]; }
+  static Layout kind(bool wide) { return wide ? Layout::wide : Layout::narrow; }
 
   struct Part {
-    std::string name;
+    ValueId id;
     Set speeds;
     bool wide = false;
   };
   // Every accumulator's parts, in the order they were made (the caller declares them, zero).
-  const std::map<std::string, std::vector<Part>>& accumulators() const { return accumulators_; }
+  const std::map<ValueId, std::vector<Part>>& accumulators() const { return accumulators_; }
   // An accumulator nothing was added to gets one narrow part, so the caller's code can name it.
-  void ensure(const std::string& accumulator) {
+  void ensure(const ValueId& accumulator) {
     if (!accumulators_.count(accumulator)) accumulators_[accumulator].push_back({accumulator, {}, false});
   }
-  // The code, without the rows nothing reads (a dense joint's wrench sums feed only the
-  // components its twist has), and each output's operations.
-  std::string finish(std::vector<OpCount>& ops) const {
-    // How many kept statements read each named row; dropping a row that none reads can leave its
-    // own inputs unread, so this runs until nothing changes.
-    std::map<std::string, int> readers;
-    std::vector<std::set<std::string>> reads(statements_.size());
-    for (std::size_t i = 0; i < statements_.size(); ++i) {
-      for (const auto& word : identifiers(statements_[i].text))
-        if (word != statements_[i].name) reads[i].insert(word);
-      for (const auto& word : reads[i]) ++readers[word];
-    }
-    std::vector<bool> keep(statements_.size(), true);
-    for (bool changed = true; changed;) {
-      changed = false;
-      for (std::size_t i = 0; i < statements_.size(); ++i) {
-        if (!keep[i] || statements_[i].name.empty() || readers[statements_[i].name] > 0) continue;
-        keep[i] = false;
-        changed = true;
-        for (const auto& word : reads[i]) --readers[word];
-      }
-    }
-    std::string code;
-    for (std::size_t i = 0; i < statements_.size(); ++i) {
-      if (!keep[i]) continue;
-      code += statements_[i].text;
-      ops[static_cast<std::size_t>(statements_[i].output)] += statements_[i].ops;
-    }
-    return code;
-  }
+  // The code so far (the statements before it and after it are the caller's).
+  lane_code::LaneProgram& program() { return program_; }
 
  private:
   struct Row {
     Set speeds;
     bool wide = false;
   };
-  struct Layout {
-    Set speeds;
-    bool wide = false;
-  };
-  struct Statement {
-    std::string name, text;
-    OpCount ops;
-    int output = 0;
-  };
   // The terms without a zero factor or row, and their rows.
   static Terms nonzero(const Terms& terms) {
     Terms kept;
     for (const auto& t : terms)
-      if (!t.first.empty() && !t.second.empty()) kept.push_back(t);
+      if (!t.first.is_zero() && !t.second.is_zero()) kept.push_back(t);
     return kept;
   }
-  static std::vector<std::string> rows_of(const Terms& terms) {
-    std::vector<std::string> rows;
+  static std::vector<ValueId> rows_of(const Terms& terms) {
+    std::vector<ValueId> rows;
     for (const auto& t : terms) rows.push_back(t.second);
     return rows;
   }
-  // "rhs + factor_i * row_i + ...", the rows as rows of the given kind; counts the operations on its lanes.
-  std::string products(std::string rhs, const Terms& terms, bool wide, OpCount& ops) {
-    const int n = lanes(wide);
-    for (const auto& [factor, row] : terms) {
-      if (!rhs.empty()) {
-        rhs += " + ";
-        ops.adds += n;
-      }
-      rhs += factor + " * " + as(row, wide);
-      ops.muls += n;
-    }
-    return rhs;
+  // factor_i * row_i appended to `sum`, the rows as rows of the given kind.
+  void products(const Terms& terms, bool wide, std::vector<Term>& sum) {
+    for (const auto& [factor, row] : terms) sum.push_back({factor, as(row, wide)});
   }
   static Set merged(const Set& a, const Set& b) {
     Set out;
@@ -190,9 +148,8 @@ class LaneWriter {
       if (!used.insert(slot_[static_cast<std::size_t>(k)]).second) return false;
     return true;
   }
-  int lanes(bool wide) const { return wide ? speeds_ : width_; }
-  Layout unify(const std::vector<std::string>& rows) const {
-    Layout out;
+  Row unify(const std::vector<ValueId>& rows) const {
+    Row out;
     for (const auto& r : rows) {
       const Row& row = rows_.at(r);
       out.speeds = merged(out.speeds, row.speeds);
@@ -203,18 +160,19 @@ class LaneWriter {
   }
   // `row` as a row of the given kind: itself, or (narrow to wide) its lanes moved to a new wide
   // row, once.
-  std::string as(const std::string& row, bool wide) {
+  ValueId as(const ValueId& row, bool wide) {
     const Row info = rows_.at(row);
     if (info.wide == wide) return row;
-    const std::string name = row + "_all";
-    if (rows_.count(name)) return name;
-    std::string text = fmt::format("    LW {} = {};\n", name, zero(true));
-    for (int k : info.speeds) text += fmt::format("    {}.set_lane({}, {}.lane({}));\n", name, k, row, slot_[static_cast<std::size_t>(k)]);
-    add(name, text, {});
-    rows_[name] = {info.speeds, true};
-    return name;
+    ValueId copy = row;
+    copy.wide_copy = true;
+    if (rows_.count(copy)) return copy;
+    lane_code::Widen widen{copy, row, {}};
+    for (int k : info.speeds) widen.lanes.emplace_back(k, slot_[static_cast<std::size_t>(k)]);
+    add(std::move(widen));
+    rows_[copy] = {info.speeds, true};
+    return copy;
   }
-  const Part& part_for(const std::string& accumulator, const Layout& layout) {
+  const Part& part_for(const ValueId& accumulator, const Row& layout) {
     auto& parts = accumulators_[accumulator];
     for (Part& p : parts) {
       if (p.wide != layout.wide) continue;
@@ -224,20 +182,17 @@ class LaneWriter {
         return p;
       }
     }
-    const std::string name = parts.empty() ? accumulator
-                             : layout.wide ? accumulator + "_all"
-                                           : fmt::format("{}_part{}", accumulator, parts.size());
-    parts.push_back({name, layout.speeds, layout.wide});
+    ValueId id = accumulator;  // the first part is the accumulator itself
+    if (!parts.empty() && layout.wide) id.wide_copy = true;
+    else if (!parts.empty()) id.part = static_cast<int>(parts.size());
+    parts.push_back({id, layout.speeds, layout.wide});
     return parts.back();
   }
-  void add(const std::string& name, const std::string& text, const OpCount& ops) {
-    statements_.push_back({name, text, ops, charge_to});
-  }
+  void add(lane_code::Step step) { program_.statements.push_back({std::move(step), charge_to}); }
   std::vector<int> slot_;
-  int width_, speeds_;
-  std::map<std::string, Row> rows_;
-  std::map<std::string, std::vector<Part>> accumulators_;
-  std::vector<Statement> statements_;
+  lane_code::LaneProgram program_;
+  std::map<ValueId, Row> rows_;
+  std::map<ValueId, std::vector<Part>> accumulators_;
 };
 
 // A lane for each commanded speed such that the speeds of any one set (the speeds that move one
@@ -261,14 +216,15 @@ std::vector<int> shared_lanes(int nu, const std::vector<std::vector<int>>& sets)
   return slot;
 }
 
-// The outputs whose shares of the lane code's operations are counted apart (LaneWriter::charge_to);
+// The outputs whose shares of the lane code's operations are counted apart (LaneBuilder::charge_to);
 // the twists and D P count with M.
-enum ReducedOutput { kM, kB_velocity, kB_bias, kQ_gravity };
+enum ReducedOutput { kM, kB_velocity, kB_bias, kQ_gravity, kReducedOutputs };
 
-using Wrench = std::array<std::string, 6>;  // lanes of (force; moment about K0's origin), as in TwistNode
+using Wrench = std::array<ValueId, 6>;  // lanes of (force; moment about K0's origin), as in TwistNode
+using Twist = std::array<ValueId, 6>;
 
-// reduced_dynamics as declared: its documentation and its input T. The names of its lane code start
-// with kane_, which the model's coordinates and parameters therefore must not.
+// reduced_dynamics as declared: its documentation and its input T. The names of its lane code are
+// the printer's, which the model's coordinates and parameters therefore must not take.
 FunctionSpec reduced_dynamics_spec(const Model& m) {
   FunctionSpec fn{"reduced_dynamics", "reduced_dynamics.hpp",
                   "Kane's equations on the commanded speeds u, in one pass with the convective terms: with "
@@ -279,11 +235,7 @@ FunctionSpec reduced_dynamics_spec(const Model& m) {
                   "B_bias = sum P^T D [Jv; R^T Jw]. P comes from the joints' twists summed along the chains (one "
                   "lane per speed), B_bias from the bodies' wrenches summed back along them.",
                   true, {}};
-  const auto reserved = [](const char* what, const std::string& name) {
-    if (name.rfind("kane_", 0) == 0) throw std::runtime_error(std::string(what) + " name " + name + ": names starting with kane_ are reserved");
-  };
-  for (const auto& c : m.coordinates) reserved("coordinate", c.name);
-  for (const auto& par : m.parameters) reserved("parameter", par.name);
+  lane_code::reserve_printer_names(m);
   fn.inputs = {{"T", "RateBasis",
                 "s' = T u, the rates caused by unit commanded speeds (rate_basis at s); only the rows of the dependent "
                 "pair and of the dependent joints are read, the others are fixed by the model file, and in them only "
@@ -291,10 +243,10 @@ FunctionSpec reduced_dynamics_spec(const Model& m) {
   return fn;
 }
 
-// The writer of the lane code, its lanes laid out for the speeds that move each joint of the tree
+// The builder of the lane code, its lanes laid out for the speeds that move each joint of the tree
 // (speeds_of: each coordinate's), T's dense rows declared.
-LaneWriter lane_writer(const Model& m, const RateRoles& roles, const std::vector<TwistNode>& nodes,
-                       const std::vector<std::vector<int>>& speeds_of) {
+LaneBuilder lane_builder(const Model& m, const RateRoles& roles, const std::vector<TwistNode>& nodes,
+                         const std::vector<std::vector<int>>& speeds_of) {
   const int n = coordinate_count(m);
   const int nu = static_cast<int>(m.dynamics->commanded.size());
   std::vector<std::vector<int>> node_speeds(nodes.size());
@@ -309,40 +261,39 @@ LaneWriter lane_writer(const Model& m, const RateRoles& roles, const std::vector
   const int width = slot.empty() ? nu : *std::max_element(slot.begin(), slot.end()) + 1;
   if (width >= nu)  // nothing to gain: every speed its own lane
     for (int k = 0; k < nu; ++k) slot[static_cast<std::size_t>(k)] = k;
-  LaneWriter w(slot, std::min(width, nu));
+  LaneBuilder w(slot, std::min(width, nu));
   for (int j = 0; j < n; ++j)
-    if (roles.dense[static_cast<std::size_t>(j)]) w.declare(fmt::format("kane_T_{}", j), speeds_of[static_cast<std::size_t>(j)]);
+    if (roles.dense[static_cast<std::size_t>(j)]) w.declare(value_id(Quantity::rate_row, j), speeds_of[static_cast<std::size_t>(j)]);
   return w;
 }
 
 // Forward: a joint's twist per unit rate is (a, o x a) for a revolute joint (axis a through o),
 // (0, a) for a prismatic one; times T's row of its coordinate, added to its parent's. Writes the
 // nodes' twists and adds the dense rows of T they read to rows_used; returns each joint's own
-// twist per unit rate (its scalars' names).
-std::vector<std::array<std::string, 6>> forward_twists(FunctionSpec& fn, const RateRoles& roles, std::vector<TwistNode>& nodes,
-                                                       LaneWriter& w, std::set<int>& rows_used) {
+// twist per unit rate (its lane scalars).
+std::vector<Twist> forward_twists(const RateRoles& roles, std::vector<TwistNode>& nodes, LaneBuilder& w, std::set<int>& rows_used) {
   w.charge_to = kM;
   w.comment("The joints' partial twists (omega; velocity of the point at K0's origin), one lane per commanded");
   w.comment("speed, summed along the bodies' chains from K0 (chains share their common joints).");
-  std::vector<std::array<std::string, 6>> joint_twist(nodes.size());
+  std::vector<Twist> joint_twist(nodes.size());
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     TwistNode& node = nodes[k];
     const JointRecord& joint = *node.joint;
     const std::array<ex, 6> S = spatial_axis(joint);
-    for (std::size_t c = 0; c < 6; ++c) joint_twist[k][c] = lane_scalar(fn, fmt::format("kane_twist_{}_{}", k, c), S[c]);
+    const int kk = static_cast<int>(k);
+    for (std::size_t c = 0; c < 6; ++c) joint_twist[k][c] = w.scalar(value_id(Quantity::joint_axis, kk, static_cast<int>(c)), S[c]);
     const int j = joint.coordinate;
-    const std::array<std::string, 6> base =
-        node.parent < 0 ? std::array<std::string, 6>{} : nodes[static_cast<std::size_t>(node.parent)].twist;
+    const Twist base = node.parent < 0 ? Twist{} : nodes[static_cast<std::size_t>(node.parent)].twist;
     for (std::size_t c = 0; c < 6; ++c) {
-      const std::string name = fmt::format("twist{}_{}", k, c);
-      const std::string& x = joint_twist[k][c];
-      if (x.empty()) {
+      const ValueId target = value_id(Quantity::spatial_velocity, kk, static_cast<int>(c));
+      const ValueId& x = joint_twist[k][c];
+      if (x.is_zero()) {
         node.twist[c] = base[c];
       } else if (roles.dense[static_cast<std::size_t>(j)]) {
         rows_used.insert(j);
-        node.twist[c] = w.define(name, base[c], {{x, fmt::format("kane_T_{}", j)}});
+        node.twist[c] = w.define(target, base[c], {{x, value_id(Quantity::rate_row, j)}});
       } else {
-        node.twist[c] = w.plus_lane(name, base[c], roles.speed_of[static_cast<std::size_t>(j)], x);
+        node.twist[c] = w.plus_lane(target, base[c], roles.speed_of[static_cast<std::size_t>(j)], x);
       }
     }
   }
@@ -351,38 +302,36 @@ std::vector<std::array<std::string, 6>> forward_twists(FunctionSpec& fn, const R
 
 // Body i (tw: the twist at its node; minus_g: the lane scalar -g): P from the twist at its CoM,
 // D P, and its terms of M, b_velocity and Q_gravity; returns its wrench per unit speed.
-Wrench body_terms(const Model& m, std::size_t i, const std::array<std::string, 6>& tw, const std::string& minus_g, FunctionSpec& fn,
-                  LaneWriter& w) {
-  const auto scalar = [&](const std::string& name, const ex& value) { return lane_scalar(fn, name, value); };
+Wrench body_terms(const Model& m, std::size_t i, const Twist& tw, const ValueId& minus_g, LaneBuilder& w) {
   const Body& body = m.bodies[i];
   const Frame& f = body.com_frame;
-  const auto name = [&](const char* what, int a) { return fmt::format("kane_{}_{}_{}", what, i, a); };
+  const int index = static_cast<int>(i);
+  const auto id = [&](Quantity what, int a) { return value_id(what, index, a); };
   w.charge_to = kM;
   w.comment(fmt::format("body {}: {}", body.name, body.meaning));
-  std::array<std::string, 3> p, minus_p, pv, pb, dv, db;
+  std::array<ValueId, 3> p, minus_p, pv, pb, dv, db;
   for (int c = 0; c < 3; ++c) {
-    p[static_cast<std::size_t>(c)] = scalar(name("p", c), f.r[c]);
-    minus_p[static_cast<std::size_t>(c)] = scalar(name("minus_p", c), -f.r[c]);
+    p[static_cast<std::size_t>(c)] = w.scalar(id(Quantity::com_offset, c), f.r[c]);
+    minus_p[static_cast<std::size_t>(c)] = w.scalar(id(Quantity::minus_com_offset, c), -f.r[c]);
   }
-  const auto at = [](const auto& a, int c) -> const std::string& { return a[static_cast<std::size_t>(c)]; };
+  const auto at = [](const auto& a, int c) -> const ValueId& { return a[static_cast<std::size_t>(c)]; };
   // v = v_0 + omega x p.
   for (int c = 0; c < 3; ++c) {
     const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
-    pv[static_cast<std::size_t>(c)] = w.define(fmt::format("pv{}_{}", i, c), at(tw, c + 3),
-                                               {{at(p, c2), at(tw, c1)}, {at(minus_p, c1), at(tw, c2)}});
+    pv[static_cast<std::size_t>(c)] = w.define(id(Quantity::com_velocity, c), at(tw, c + 3), {{at(p, c2), at(tw, c1)}, {at(minus_p, c1), at(tw, c2)}});
   }
-  std::array<std::string, 9> R;
+  std::array<ValueId, 9> R;
   for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) R[static_cast<std::size_t>(3 * a + b)] = scalar(fmt::format("kane_R_{}_{}_{}", i, a, b), f.R(a, b));
-  const auto Rab = [&](int a, int b) -> const std::string& { return R[static_cast<std::size_t>(3 * a + b)]; };
+    for (int b = 0; b < 3; ++b) R[static_cast<std::size_t>(3 * a + b)] = w.scalar(value_id(Quantity::com_rotation, index, a, b), f.R(a, b));
+  const auto Rab = [&](int a, int b) -> const ValueId& { return R[static_cast<std::size_t>(3 * a + b)]; };
   for (int a = 0; a < 3; ++a)
-    pb[static_cast<std::size_t>(a)] = w.define(fmt::format("pb{}_{}", i, a), "", {{Rab(0, a), at(tw, 0)}, {Rab(1, a), at(tw, 1)}, {Rab(2, a), at(tw, 2)}});
-  const std::string mass = scalar(name("mass", 0), m.parameter(body.mass).symbol);
+    pb[static_cast<std::size_t>(a)] = w.define(id(Quantity::body_rate, a), {}, {{Rab(0, a), at(tw, 0)}, {Rab(1, a), at(tw, 1)}, {Rab(2, a), at(tw, 2)}});
+  const ValueId mass = w.scalar(value_id(Quantity::mass, index), m.parameter(body.mass).symbol);
   Vec3 I;
   for (int a = 0; a < 3; ++a) I[a] = m.parameter(body.inertia[static_cast<std::size_t>(a)]).symbol;
-  for (int c = 0; c < 3; ++c) dv[static_cast<std::size_t>(c)] = w.define(fmt::format("dv{}_{}", i, c), "", {{mass, at(pv, c)}});
+  for (int c = 0; c < 3; ++c) dv[static_cast<std::size_t>(c)] = w.define(id(Quantity::force, c), {}, {{mass, at(pv, c)}});
   for (int a = 0; a < 3; ++a)
-    db[static_cast<std::size_t>(a)] = w.define(fmt::format("db{}_{}", i, a), "", {{scalar(name("inertia", a), I[a]), at(pb, a)}});
+    db[static_cast<std::size_t>(a)] = w.define(id(Quantity::angular_momentum, a), {}, {{w.scalar(id(Quantity::inertia, a), I[a]), at(pb, a)}});
   // b_velocity += P^T [m a; I alpha_b + omega_b x I omega_b] (body axes); Q_gravity += Pv^T m g.
   const auto to_body = [&](const Vec3& v) {
     Vec3 out;
@@ -392,22 +341,22 @@ Wrench body_terms(const Model& m, std::size_t i, const std::array<std::string, 6
   const auto inertia_times = [&](const Vec3& v) { return Vec3(I[0] * v[0], I[1] * v[1], I[2] * v[2]); };
   const Vec3 omega = to_body(f.omega);
   const Vec3 torque = inertia_times(to_body(f.alpha_bias)) + cross(omega, inertia_times(omega));
-  std::vector<std::pair<std::string, std::string>> force;
-  for (int c = 0; c < 3; ++c) force.emplace_back(scalar(name("acc", c), f.a_bias[c]), at(dv, c));
-  for (int a = 0; a < 3; ++a) force.emplace_back(scalar(name("torque", a), torque[a]), at(pb, a));
+  LaneBuilder::Terms force;
+  for (int c = 0; c < 3; ++c) force.emplace_back(w.scalar(id(Quantity::bias_acceleration, c), f.a_bias[c]), at(dv, c));
+  for (int a = 0; a < 3; ++a) force.emplace_back(w.scalar(id(Quantity::bias_torque, a), torque[a]), at(pb, a));
   w.charge_to = kB_velocity;
-  w.accumulate("kane_b", force);
+  w.accumulate(value_id(Quantity::velocity_forces), force);
   w.charge_to = kQ_gravity;
-  w.accumulate("kane_Q", {{minus_g, at(dv, 2)}});
+  w.accumulate(value_id(Quantity::gravity_forces), {{minus_g, at(dv, 2)}});
   w.charge_to = kM;
   // Its wrench per unit speed: force D P_v and moment p x force + R (I P_b), in K0.
   Wrench wr;
   for (int c = 0; c < 3; ++c) wr[static_cast<std::size_t>(c)] = at(dv, c);
   for (int c = 0; c < 3; ++c) {
     const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
-    wr[static_cast<std::size_t>(c + 3)] = w.define(
-        fmt::format("moment{}_{}", i, c), "",
-        {{Rab(c, 0), at(db, 0)}, {Rab(c, 1), at(db, 1)}, {Rab(c, 2), at(db, 2)}, {at(p, c1), at(dv, c2)}, {at(minus_p, c2), at(dv, c1)}});
+    wr[static_cast<std::size_t>(c + 3)] =
+        w.define(id(Quantity::moment, c), {},
+                 {{Rab(c, 0), at(db, 0)}, {Rab(c, 1), at(db, 1)}, {Rab(c, 2), at(db, 2)}, {at(p, c1), at(dv, c2)}, {at(minus_p, c2), at(dv, c1)}});
   }
   return wr;
 }
@@ -417,9 +366,8 @@ Wrench body_terms(const Model& m, std::size_t i, const std::array<std::string, 6
 // M = P^T D P summed over the bodies = sum over the joints of T(j, :)^T tau_j: a commanded speed's
 // joint adds its tau to row k, a dense joint T(j, k) tau_j to every row k. Returns B_bias's
 // columns that get a tau.
-std::set<int> backward_wrenches(const RateRoles& roles, const std::vector<std::vector<int>>& speeds_of,
-                                const std::vector<std::array<std::string, 6>>& joint_twist, const std::vector<Wrench>& body_wrench,
-                                std::vector<TwistNode>& nodes, LaneWriter& w) {
+std::set<int> backward_wrenches(const RateRoles& roles, const std::vector<std::vector<int>>& speeds_of, const std::vector<Twist>& joint_twist,
+                                const std::vector<Wrench>& body_wrench, std::vector<TwistNode>& nodes, LaneBuilder& w) {
   const auto dense = [&](int j) { return roles.dense[static_cast<std::size_t>(j)]; };
   std::set<int> bias_columns;
   w.charge_to = kM;
@@ -428,30 +376,31 @@ std::set<int> backward_wrenches(const RateRoles& roles, const std::vector<std::v
   for (std::size_t k = nodes.size(); k-- > 0;) {
     TwistNode& node = nodes[k];
     for (std::size_t c = 0; c < 6; ++c) {
-      std::vector<std::string> parts;
+      std::vector<ValueId> parts;
       for (int i : node.bodies)
-        if (!body_wrench[static_cast<std::size_t>(i)][c].empty()) parts.push_back(body_wrench[static_cast<std::size_t>(i)][c]);
+        if (!body_wrench[static_cast<std::size_t>(i)][c].is_zero()) parts.push_back(body_wrench[static_cast<std::size_t>(i)][c]);
       for (int child : node.children)
-        if (!nodes[static_cast<std::size_t>(child)].wrench[c].empty()) parts.push_back(nodes[static_cast<std::size_t>(child)].wrench[c]);
+        if (!nodes[static_cast<std::size_t>(child)].wrench[c].is_zero()) parts.push_back(nodes[static_cast<std::size_t>(child)].wrench[c]);
       if (parts.size() == 1) node.wrench[c] = parts[0];
-      else if (!parts.empty()) node.wrench[c] = w.define_sum(fmt::format("wrench{}_{}", k, c), parts);
+      else if (!parts.empty()) node.wrench[c] = w.define_sum(value_id(Quantity::wrench, static_cast<int>(k), static_cast<int>(c)), parts);
     }
     const int j = node.joint->coordinate;
-    std::vector<std::pair<std::string, std::string>> terms;
+    LaneBuilder::Terms terms;
     for (std::size_t c = 0; c < 3; ++c) terms.emplace_back(joint_twist[k][c], node.wrench[c + 3]);
     for (std::size_t c = 0; c < 3; ++c) terms.emplace_back(joint_twist[k][c + 3], node.wrench[c]);
     w.charge_to = dense(j) ? kB_bias : kM;
-    const std::string tau = w.define(fmt::format("tau{}", k), "", terms);
-    if (tau.empty()) continue;
+    const ValueId tau = w.define(value_id(Quantity::joint_force, static_cast<int>(k)), {}, terms);
+    if (tau.is_zero()) continue;
     if (dense(j)) {
       bias_columns.insert(j);
-      w.add_row(fmt::format("kane_B_{}", j), tau);
+      w.add_row(value_id(Quantity::bias_column, j), tau);
       w.charge_to = kM;
       // T(j, l) is zero for the speeds j's rate does not depend on.
-      for (int l : speeds_of[static_cast<std::size_t>(j)]) w.accumulate(fmt::format("kane_M_{}", l), {{fmt::format("T({}, {})", j, l), tau}});
+      for (int l : speeds_of[static_cast<std::size_t>(j)])
+        w.accumulate(value_id(Quantity::mass_matrix_row, l), {{value_id(Quantity::rate_basis_entry, j, l), tau}});
     } else {
       w.charge_to = kM;
-      w.add_row(fmt::format("kane_M_{}", roles.speed_of[static_cast<std::size_t>(j)]), tau);
+      w.add_row(value_id(Quantity::mass_matrix_row, roles.speed_of[static_cast<std::size_t>(j)]), tau);
     }
   }
   return bias_columns;
@@ -459,71 +408,56 @@ std::set<int> backward_wrenches(const RateRoles& roles, const std::vector<std::v
 
 // Before the bodies' code: the lane types, T's dense rows the twists read (rows_used) and the
 // accumulators of M's rows, b_velocity, Q_gravity and B_bias's columns.
-std::string lane_declarations(const std::vector<std::vector<int>>& speeds_of, const std::set<int>& rows_used, int nu, LaneWriter& w) {
-  for (int k = 0; k < nu; ++k) w.ensure(fmt::format("kane_M_{}", k));
-  w.ensure("kane_b");
-  w.ensure("kane_Q");
-  std::string code = fmt::format("    using L = detail::Lanes<Scalar, {}>;\n", w.width());
-  if (w.shares_lanes()) code += fmt::format("    using LW = detail::Lanes<Scalar, {}>;\n", nu);
-  code += "    // T's dense rows; the accumulators of M's rows, b_velocity, Q_gravity and B_bias's columns.\n";
+std::vector<lane_code::Statement> lane_declarations(const std::vector<std::vector<int>>& speeds_of, const std::set<int>& rows_used, int nu,
+                                                    LaneBuilder& w) {
+  for (int k = 0; k < nu; ++k) w.ensure(value_id(Quantity::mass_matrix_row, k));
+  w.ensure(value_id(Quantity::velocity_forces));
+  w.ensure(value_id(Quantity::gravity_forces));
+  std::vector<lane_code::Statement> out;
+  out.push_back({lane_code::LaneTypes{}});
+  out.push_back({lane_code::Comment{"T's dense rows; the accumulators of M's rows, b_velocity, Q_gravity and B_bias's columns."}});
   for (int j : rows_used) {
     const auto& speeds = speeds_of[static_cast<std::size_t>(j)];
-    if (!w.shares_lanes() && static_cast<int>(speeds.size()) == nu) {
-      code += fmt::format("    const L kane_T_{0} = detail::lanes_of_row<Scalar, {1}>(T, {0});\n", j, nu);
-      continue;
-    }
-    code += fmt::format("    L kane_T_{} = {};\n", j, w.zero());
-    for (int l : speeds) code += fmt::format("    kane_T_{}.set_lane({}, T({}, {}));\n", j, w.lane(l, false), j, l);
+    // Without shared lanes, a row every speed moves is T's row as it is.
+    lane_code::LoadRow row{value_id(Quantity::rate_row, j), j, !w.shares_lanes() && static_cast<int>(speeds.size()) == nu, {}};
+    if (!row.whole)
+      for (int l : speeds) row.lanes.emplace_back(w.lane(l, false), value_id(Quantity::rate_basis_entry, j, l));
+    out.push_back({std::move(row)});
   }
   for (const auto& [name, parts] : w.accumulators())
-    for (const auto& part : parts) code += fmt::format("    {} {} = {};\n", w.type(part.wide), part.name, w.zero(part.wide));
-  return code;
+    for (const auto& part : parts) out.push_back({lane_code::ZeroRow{part.id, LaneBuilder::kind(part.wide)}});
+  return out;
 }
 
 // After the bodies' code: the outputs' entries from the accumulators' parts, their additions
-// counted for their outputs in lane_ops.
-std::string output_entries(const std::set<int>& bias_columns, int nu, const LaneWriter& w, std::vector<OpCount>& lane_ops) {
-  std::string code;
+// counted for their outputs.
+void output_entries(const std::set<int>& bias_columns, int nu, LaneBuilder& w) {
+  auto& code = w.program().statements;
   // An output entry: the sum of the accumulator's parts that hold speed l.
-  OpCount output_adds;
-  const auto entry = [&](const std::string& accumulator, int l) {
-    std::vector<std::string> terms;
+  const auto entry = [&](const ValueId& accumulator, int l) {
+    std::vector<Term> terms;
     for (const auto& part : w.accumulators().at(accumulator))
-      if (std::binary_search(part.speeds.begin(), part.speeds.end(), l)) terms.push_back(fmt::format("{}.lane({})", part.name, w.lane(l, part.wide)));
-    if (terms.empty()) return std::string("Scalar(0)");
-    output_adds.adds += static_cast<long>(terms.size()) - 1;
-    return fmt::format("{}", fmt::join(terms, " + "));
+      if (std::binary_search(part.speeds.begin(), part.speeds.end(), l)) terms.push_back({lane_code::kOne, part.id, w.lane(l, part.wide)});
+    return terms;
   };
-  code += "    if (M != nullptr) {  // the upper triangle, mirrored: M is symmetric to the last bit\n";
-  output_adds = {};
+  using lane_code::CloseOutput, lane_code::OpenOutput, lane_code::Store;
+  code.push_back({OpenOutput{"M", "the upper triangle, mirrored: M is symmetric to the last bit"}});
   for (int k = 0; k < nu; ++k)
-    for (int l = k; l < nu; ++l) {
-      const std::string e = entry(fmt::format("kane_M_{}", k), l);
-      code += k == l ? fmt::format("      (*M)({0}, {0}) = {1};\n", k, e) : fmt::format("      (*M)({0}, {1}) = (*M)({1}, {0}) = {2};\n", k, l, e);
-    }
-  const OpCount M_adds = output_adds;
-  code += "    }\n    if (b_velocity != nullptr) {\n";
-  output_adds = {};
-  for (int k = 0; k < nu; ++k) code += fmt::format("      (*b_velocity)({}) = {};\n", k, entry("kane_b", k));
-  const OpCount b_adds = output_adds;
-  code += "    }\n    if (Q_gravity != nullptr) {\n";
-  output_adds = {};
-  for (int k = 0; k < nu; ++k) code += fmt::format("      (*Q_gravity)({}) = {};\n", k, entry("kane_Q", k));
-  const OpCount Q_adds = output_adds;
-  code += "    }\n    if (B_bias != nullptr) {\n      if (zero_fill) B_bias->setZero();\n";
-  output_adds = {};
+    for (int l = k; l < nu; ++l) code.push_back({Store{"M", k, l, k != l, entry(value_id(Quantity::mass_matrix_row, k), l)}, kM});
+  code.push_back({CloseOutput{}});
+  code.push_back({OpenOutput{"b_velocity", ""}});
+  for (int k = 0; k < nu; ++k) code.push_back({Store{"b_velocity", k, -1, false, entry(value_id(Quantity::velocity_forces), k)}, kB_velocity});
+  code.push_back({CloseOutput{}});
+  code.push_back({OpenOutput{"Q_gravity", ""}});
+  for (int k = 0; k < nu; ++k) code.push_back({Store{"Q_gravity", k, -1, false, entry(value_id(Quantity::gravity_forces), k)}, kQ_gravity});
+  code.push_back({CloseOutput{}});
+  code.push_back({OpenOutput{"B_bias", "", OpenOutput::Prologue::zero_if_asked}});
   for (int j : bias_columns)
     for (int k = 0; k < nu; ++k) {
-      const std::string e = entry(fmt::format("kane_B_{}", j), k);
-      if (e != "Scalar(0)") code += fmt::format("      (*B_bias)({}, {}) = {};\n", k, j, e);
+      std::vector<Term> e = entry(value_id(Quantity::bias_column, j), k);
+      if (!e.empty()) code.push_back({Store{"B_bias", k, j, false, std::move(e)}, kB_bias});
     }
-  const OpCount B_adds = output_adds;
-  code += "    }\n";
-  lane_ops[kM] += M_adds;
-  lane_ops[kB_velocity] += b_adds;
-  lane_ops[kQ_gravity] += Q_adds;
-  lane_ops[kB_bias] += B_adds;
-  return code;
+  code.push_back({CloseOutput{}});
 }
 
 }  // namespace
@@ -541,31 +475,32 @@ FunctionSpec derive_reduced_dynamics(const Model& m) {
   TwistTree tree = twist_tree(m, roles);
   std::vector<TwistNode>& nodes = tree.nodes;
 
-  // Which commanded speeds each joint's rate depends on, and the lanes they take (LaneWriter).
+  // Which commanded speeds each joint's rate depends on, and the lanes they take (LaneBuilder).
   const std::vector<std::vector<int>> speeds_of = rate_speeds(m, roles);  // = rate_basis_pattern(m), from the roles at hand
-  LaneWriter w = lane_writer(m, roles, nodes, speeds_of);
+  LaneBuilder w = lane_builder(m, roles, nodes, speeds_of);
   std::set<int> rows_used;
-  const std::vector<std::array<std::string, 6>> joint_twist = forward_twists(fn, roles, nodes, w, rows_used);
+  const std::vector<Twist> joint_twist = forward_twists(roles, nodes, w, rows_used);
 
   const ex g = m.parameter(dyn.gravity).symbol;
-  const std::string minus_g = lane_scalar(fn, "kane_minus_g", -g);
+  const ValueId minus_g = w.scalar(value_id(Quantity::minus_gravity), -g);
   std::vector<Wrench> body_wrench(m.bodies.size());
   for (std::size_t i = 0; i < m.bodies.size(); ++i) {
     const int at = tree.body_node[i];
     if (at < 0) continue;  // moved by no joint of T: no part in u's dynamics
-    body_wrench[i] = body_terms(m, i, nodes[static_cast<std::size_t>(at)].twist, minus_g, fn, w);
+    body_wrench[i] = body_terms(m, i, nodes[static_cast<std::size_t>(at)].twist, minus_g, w);
   }
   const std::set<int> bias_columns = backward_wrenches(roles, speeds_of, joint_twist, body_wrench, nodes, w);
 
-  std::vector<OpCount> lane_ops(4);
-  const std::string body_code = w.finish(lane_ops);
-  const auto body_words = identifiers(body_code);
-  const std::set<std::string> read(body_words.begin(), body_words.end());
-  std::erase_if(fn.lane_scalars, [&](const auto& named) { return !read.count(named.first); });
   // Around the bodies: T's rows, the accumulators, then the outputs.
-  const std::string before = lane_declarations(speeds_of, rows_used, nu, w);
-  fn.lane_code = before + body_code + output_entries(bias_columns, nu, w, lane_ops);
-  fn.lane_layout = w.shares_lanes() ? fmt::format("{} lanes, {} where the limbs' sums meet", w.width(), nu) : fmt::format("{} lanes", nu);
+  std::vector<lane_code::Statement> before = lane_declarations(speeds_of, rows_used, nu, w);
+  auto& statements = w.program().statements;
+  statements.insert(statements.begin(), std::make_move_iterator(before.begin()), std::make_move_iterator(before.end()));
+  output_entries(bias_columns, nu, w);
+  lane_code::PrintedCode printed = lane_code::print(w.program(), kReducedOutputs);
+  fn.lane_code = std::move(printed.code);
+  fn.lane_scalars = std::move(printed.scalars);
+  fn.lane_layout = std::move(printed.layout);
+  const std::vector<OpCount>& lane_ops = printed.ops;
 
   const FunctionSpec c = derive_convective(m);
   OutputSpec Mo{"M", "CommandMatrix", "generalized mass matrix on u (symmetric)", "", {}};
