@@ -111,6 +111,19 @@ Vec3 in_axes(const Mat3& R, const Vec3& v);
 // Code making sin and cos of the joint from those of theta = sign q that a solver computed.
 std::string unsign(const ChainStep& j, const SolvedJoint& s);
 
+// The steps a leg's patterns share (a hip that swings the plane of parallel joints through the
+// target, then a planar two-link chain in it; ik_patterns.cpp).
+// The hip from its plane's offset: alpha cos q1 + beta sin q1 = plane - first.c, with `first` the
+// target's component along the turned normal (branch bit 0 picks the root); into `stage`.
+void add_plane_offset_solve(Stage& stage, const Sinusoid& first, const ex& plane, const SolvedJoint& s1);
+// The knee from the distance |w| of the point it moves from the second joint's origin (w, in the
+// frame before the second joint, the stage's ik_w0..2): |p2 + R2 R_3(q3) p3|^2 = |w|^2 (bit 1).
+Stage two_link_distance_stage(const Model& m, const Solve& solve, const Vec3& w, const Vec3& p2, const Mat3& R2,
+                              const ChainStep& j3, const Vec3& p3, const SolvedJoint& s3);
+// The second joint: the rotation about its axis that takes v = p2 + R2 R_3(q3) p3 onto w.
+Stage two_link_rotation_stage(const Model& m, const Solve& solve, const Vec3& p2, const Mat3& R2, const ChainStep& j2,
+                              const ChainStep& j3, const Vec3& p3, const SolvedJoint& s2);
+
 // The patterns, in the order they are tried; each throws Unsolvable when the limb is not its.
 Solve plan_point3(const Model& m, const Limb& limb);
 Solve plan_wheel_leg(const Model& m, const Limb& limb);

@@ -166,6 +166,24 @@ Vec3 in_axes(const Mat3& R, const Vec3& v) {
   return out;
 }
 
+namespace {
+
+// The code that solves K + A cos q + B sin q = |v|^2 for a joint, v the stage's ik_<v>0..2 (a
+// distance fixes a knee): `bit` of the branch picks the root, `stage` is the failure's number.
+std::string distance_solve_code(const std::string& v, int bit, int stage, const SolvedJoint& s) {
+  return fmt::format(
+      "  const Scalar ik_{0}{0} = ik_{0}0 * ik_{0}0 + ik_{0}1 * ik_{0}1 + ik_{0}2 * ik_{0}2;\n"
+      "  Scalar {1}, {2};\n"
+      "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_{0}{0} - ik_K, (branch & {3}) != 0, {1}, {2})) {{\n"
+      "    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
+      "    why = {{{4}, std::sqrt(ik_{0}{0}), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
+      "    return IkStatus::out_of_reach;\n"
+      "  }}\n",
+      v, s.c.get_name(), s.s.get_name(), bit, stage);
+}
+
+}  // namespace
+
 // ---- point3 -------------------------------------------------------------------------------------
 
 namespace {
@@ -280,15 +298,7 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   s0.locals.emplace_back(K_, distance.c);
   s0.locals.emplace_back(A_, distance.a);
   s0.locals.emplace_back(B_, distance.b);
-  s0.code = fmt::format(
-      "  const Scalar ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;\n"
-      "  Scalar {0}, {1};\n"
-      "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, {0}, {1})) {{\n"
-      "    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
-      "    why = {{1, std::sqrt(ik_dd), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
-      "    return IkStatus::out_of_reach;\n"
-      "  }}\n",
-      q3.c.get_name(), q3.s.get_name());
+  s0.code = distance_solve_code("d", 1, 1, q3);
   s0.defines = {q3.c.get_name(), q3.s.get_name()};
   solve.stages.push_back(s0);
 
@@ -306,6 +316,52 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   s1.defines = {q1.c.get_name(), q1.s.get_name(), q2.c.get_name(), q2.s.get_name()};
   solve.stages.push_back(s1);
   return solve;
+}
+
+// ---- the steps of a leg's patterns (wheel leg, plane leg, steering leg) -------------------------
+
+void add_plane_offset_solve(Stage& stage, const Sinusoid& first, const ex& plane, const SolvedJoint& s1) {
+  stage.locals.emplace_back(realsymbol("ik_alpha"), first.a);
+  stage.locals.emplace_back(realsymbol("ik_beta"), first.b);
+  stage.locals.emplace_back(realsymbol("ik_gamma"), (plane - first.c).expand());
+  stage.code += fmt::format(
+      "  Scalar {0}, {1};\n"
+      "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, {0}, {1})) {{\n"
+      "    why = {{1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0}};\n"
+      "    return IkStatus::out_of_reach;\n"
+      "  }}\n",
+      s1.c.get_name(), s1.s.get_name());
+  stage.defines = {s1.c.get_name(), s1.s.get_name()};
+}
+
+Stage two_link_distance_stage(const Model& m, const Solve& solve, const Vec3& w, const Vec3& p2, const Mat3& R2,
+                              const ChainStep& j3, const Vec3& p3, const SolvedJoint& s3) {
+  Stage st;
+  for (int i = 0; i < 3; ++i) st.locals.emplace_back(realsymbol(fmt::format("ik_w{}", i)), in_results(m, w[i], solve));
+  const Sinusoid distance = distance_squared(p2, R2, j3, p3);
+  st.locals.emplace_back(realsymbol("ik_K"), distance.c);
+  st.locals.emplace_back(realsymbol("ik_A"), distance.a);
+  st.locals.emplace_back(realsymbol("ik_B"), distance.b);
+  st.code = distance_solve_code("w", 2, 2, s3);
+  st.defines = {s3.c.get_name(), s3.s.get_name()};
+  return st;
+}
+
+Stage two_link_rotation_stage(const Model& m, const Solve& solve, const Vec3& p2, const Mat3& R2, const ChainStep& j2,
+                              const ChainStep& j3, const Vec3& p3, const SolvedJoint& s2) {
+  const ex& q3 = m.coordinates[static_cast<std::size_t>(j3.coordinate)].q;
+  Stage st;
+  const Vec3 v = p2 + R2 * (signed_rot(j3.axis, j3.sign, q3) * p3);
+  const int b = static_cast<int>(j2.axis), i = (b + 1) % 3, j = (b + 2) % 3;  // R_b turns i towards j
+  for (int k : {i, j}) st.locals.emplace_back(realsymbol(fmt::format("ik_v{}", k)), in_results(m, v[k], solve));  // v_b = w_b
+  st.code = fmt::format(
+      "  const Scalar ik_x = ik_v{0} * ik_w{0} + ik_v{1} * ik_w{1}, ik_y = ik_v{0} * ik_w{1} - ik_v{1} * ik_w{0};\n"
+      "  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);\n"
+      "  Scalar {2} = ik_r > 0 ? ik_x / ik_r : Scalar(1), {3} = ik_r > 0 ? ik_y / ik_r : Scalar(0);\n",
+      i, j, s2.c.get_name(), s2.s.get_name()) +
+      unsign(j2, s2);
+  st.defines = {s2.c.get_name(), s2.s.get_name()};
+  return st;
 }
 
 // ---- wheel leg (and plane leg) ------------------------------------------------------------------
@@ -434,47 +490,12 @@ Stage rim_stage(const Model& m, const Solve& solve, const Vec3& axle) {
 }
 
 // Stage 2: the hub (point) from the second joint's origin, in the frame before q2; its distance
-// fixes q3: |p2 + R2 R_3(q3) p3|^2 = |w|^2.
+// fixes q3.
 Stage hub_distance_stage(const Model& m, const Solve& solve, const WheelLeg& leg, const Vec3& hub_target, const SolvedJoint& s3) {
-  const ChainStep &j1 = leg.chain.joints[0], &j3 = leg.chain.joints[2];
+  const ChainStep& j1 = leg.chain.joints[0];
   const realsymbol& q1 = m.coordinates[static_cast<std::size_t>(j1.coordinate)].q;
-  Stage st2;
-  const Vec3 w_local = in_axes(leg.R1, signed_rot(j1.axis, -j1.sign, q1) * hub_target - leg.p1);
-  const realsymbol w[3] = {realsymbol("ik_w0"), realsymbol("ik_w1"), realsymbol("ik_w2")};
-  for (int i = 0; i < 3; ++i) st2.locals.emplace_back(w[i], in_results(m, w_local[i], solve));
-  const Sinusoid distance = distance_squared(leg.p2, leg.R2, j3, leg.p3);
-  st2.locals.emplace_back(realsymbol("ik_K"), distance.c);
-  st2.locals.emplace_back(realsymbol("ik_A"), distance.a);
-  st2.locals.emplace_back(realsymbol("ik_B"), distance.b);
-  st2.code = fmt::format(
-      "  const Scalar ik_ww = ik_w0 * ik_w0 + ik_w1 * ik_w1 + ik_w2 * ik_w2;\n"
-      "  Scalar {0}, {1};\n"
-      "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_ww - ik_K, (branch & 2) != 0, {0}, {1})) {{\n"
-      "    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
-      "    why = {{2, std::sqrt(ik_ww), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
-      "    return IkStatus::out_of_reach;\n"
-      "  }}\n",
-      s3.c.get_name(), s3.s.get_name());
-  st2.defines = {s3.c.get_name(), s3.s.get_name()};
-  return st2;
-}
-
-// Stage 3: v = p2 + R2 R_3(q3) p3; the rotation about the plane's normal that takes v onto w.
-Stage leg_rotation_stage(const Model& m, const Solve& solve, const WheelLeg& leg, const SolvedJoint& s2) {
-  const ChainStep &j2 = leg.chain.joints[1], &j3 = leg.chain.joints[2];
-  const ex& q3 = m.coordinates[static_cast<std::size_t>(j3.coordinate)].q;
-  Stage st3;
-  const Vec3 v = leg.p2 + leg.R2 * (signed_rot(j3.axis, j3.sign, q3) * leg.p3);
-  const int b = static_cast<int>(j2.axis), i = (b + 1) % 3, j = (b + 2) % 3;  // R_b turns i towards j
-  for (int k : {i, j}) st3.locals.emplace_back(realsymbol(fmt::format("ik_v{}", k)), in_results(m, v[k], solve));  // v_b = w_b
-  st3.code = fmt::format(
-      "  const Scalar ik_x = ik_v{0} * ik_w{0} + ik_v{1} * ik_w{1}, ik_y = ik_v{0} * ik_w{1} - ik_v{1} * ik_w{0};\n"
-      "  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);\n"
-      "  Scalar {2} = ik_r > 0 ? ik_x / ik_r : Scalar(1), {3} = ik_r > 0 ? ik_y / ik_r : Scalar(0);\n",
-      i, j, s2.c.get_name(), s2.s.get_name()) +
-      unsign(j2, s2);
-  st3.defines = {s2.c.get_name(), s2.s.get_name()};
-  return st3;
+  const Vec3 w = in_axes(leg.R1, signed_rot(j1.axis, -j1.sign, q1) * hub_target - leg.p1);
+  return two_link_distance_stage(m, solve, w, leg.p2, leg.R2, leg.chain.joints[2], leg.p3, s3);
 }
 
 }  // namespace
@@ -495,17 +516,7 @@ Solve plan_wheel_leg(const Model& m, const Limb& limb) {
   const realsymbol& q1 = m.coordinates[static_cast<std::size_t>(j1.coordinate)].q;
   const Mat3 turn1 = signed_rot(j1.axis, j1.sign, q1);
   const Sinusoid first = sinusoid(dot(turn1 * leg.normal, d).expand(), q1, "the leg plane's offset");
-  st0.locals.emplace_back(realsymbol("ik_alpha"), first.a);
-  st0.locals.emplace_back(realsymbol("ik_beta"), first.b);
-  st0.locals.emplace_back(realsymbol("ik_gamma"), (leg.plane - first.c).expand());
-  st0.code = fmt::format(
-      "  Scalar {0}, {1};\n"
-      "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, {0}, {1})) {{\n"
-      "    why = {{1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0}};\n"
-      "    return IkStatus::out_of_reach;\n"
-      "  }}\n",
-      s1.c.get_name(), s1.s.get_name());
-  st0.defines = {s1.c.get_name(), s1.s.get_name()};
+  add_plane_offset_solve(st0, first, leg.plane, s1);
   solve.stages.push_back(st0);
 
   // The hub at the target - o a + r u (a wheel; u from stage 1), in the frame before q1: o a = rim n.
@@ -517,7 +528,7 @@ Solve plan_wheel_leg(const Model& m, const Limb& limb) {
     hub_target = hub_target - leg.rim * (turn1 * leg.normal) + r * in_axes(base.R, up);
   }
   solve.stages.push_back(hub_distance_stage(m, solve, leg, hub_target, s3));
-  solve.stages.push_back(leg_rotation_stage(m, solve, leg, s2));
+  solve.stages.push_back(two_link_rotation_stage(m, solve, leg.p2, leg.R2, j2, j3, leg.p3, s2));
   return solve;
 }
 

@@ -293,66 +293,18 @@ Stage first_joint_stage(const Model& m, const SteeringLeg& leg, const Vec3& k, c
   const Sinusoid first =
       sinusoid(dot(signed_rot(j1.axis, j1.sign, q1) * normal, d).expand(), q1, "the leg plane's offset");
   const ex plane = dot(normal, leg.p1) + dot(unit(A), leg.p2 + leg.p3 + leg.total_turn * leg.tail) + dot(normal, k);
-  st.locals.emplace_back(realsymbol("ik_alpha"), first.a);
-  st.locals.emplace_back(realsymbol("ik_beta"), first.b);
-  st.locals.emplace_back(realsymbol("ik_gamma"), (plane - first.c).expand());
-  st.code = fmt::format(
-      "  Scalar {0}, {1};\n"
-      "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, {0}, {1})) {{\n"
-      "    why = {{1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * "
-      "ik_beta)), 0.0}};\n"
-      "    return IkStatus::out_of_reach;\n"
-      "  }}\n",
-      s1.c.get_name(), s1.s.get_name());
-  st.defines = {s1.c.get_name(), s1.s.get_name()};
+  add_plane_offset_solve(st, first, plane, s1);
   return st;
 }
 
 // Stage: w, the fourth joint from the second in the frame before the second; its distance fixes
-// the third joint, |p2 + R2 R_3(q3) p3|^2 = |w|^2.
+// the third joint.
 Stage two_link_stage(const Model& m, const Solve& solve, const SteeringLeg& leg, const Vec3& d, const Vec3& k,
                      const SolvedJoint& s3) {
-  const ChainStep &j1 = leg.chain.joints[0], &j3 = leg.chain.joints[2];
+  const ChainStep& j1 = leg.chain.joints[0];
   const realsymbol& q1 = m.coordinates[static_cast<std::size_t>(j1.coordinate)].q;
   const Vec3 w = in_axes(leg.R1, signed_rot(j1.axis, -j1.sign, q1) * d - leg.p1 - k) - leg.total_turn * leg.tail;
-  Stage st;
-  for (int i = 0; i < 3; ++i) st.locals.emplace_back(realsymbol(fmt::format("ik_w{}", i)), in_results(m, w[i], solve));
-  const Sinusoid distance = distance_squared(leg.p2, leg.R2, j3, leg.p3);
-  st.locals.emplace_back(realsymbol("ik_K"), distance.c);
-  st.locals.emplace_back(realsymbol("ik_A"), distance.a);
-  st.locals.emplace_back(realsymbol("ik_B"), distance.b);
-  st.code = fmt::format(
-      "  const Scalar ik_ww = ik_w0 * ik_w0 + ik_w1 * ik_w1 + ik_w2 * ik_w2;\n"
-      "  Scalar {0}, {1};\n"
-      "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_ww - ik_K, (branch & 2) != 0, {0}, {1})) {{\n"
-      "    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
-      "    why = {{2, std::sqrt(ik_ww), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + "
-      "ik_R), 0.0}};\n"
-      "    return IkStatus::out_of_reach;\n"
-      "  }}\n",
-      s3.c.get_name(), s3.s.get_name());
-  st.defines = {s3.c.get_name(), s3.s.get_name()};
-  return st;
-}
-
-// Stage: v = p2 + R2 R_3(q3) p3; the rotation about A that takes v onto w is the second joint.
-Stage second_joint_stage(const Model& m, const Solve& solve, const SteeringLeg& leg, const SolvedJoint& s2) {
-  const ChainStep &j2 = leg.chain.joints[1], &j3 = leg.chain.joints[2];
-  const ex& q3 = m.coordinates[static_cast<std::size_t>(j3.coordinate)].q;
-  const Vec3 v = leg.p2 + leg.R2 * (signed_rot(j3.axis, j3.sign, q3) * leg.p3);
-  const int b = static_cast<int>(j2.axis), i = (b + 1) % 3, j = (b + 2) % 3;  // R_b turns i towards j
-  Stage st;
-  for (int e : {i, j})
-    st.locals.emplace_back(realsymbol(fmt::format("ik_v{}", e)), in_results(m, v[e], solve));  // v_b = w_b
-  st.code = fmt::format(
-                "  const Scalar ik_x = ik_v{0} * ik_w{0} + ik_v{1} * ik_w{1};\n"
-                "  const Scalar ik_y = ik_v{0} * ik_w{1} - ik_v{1} * ik_w{0};\n"
-                "  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);\n"
-                "  Scalar {2} = ik_r > 0 ? ik_x / ik_r : Scalar(1), {3} = ik_r > 0 ? ik_y / ik_r : Scalar(0);\n",
-                i, j, s2.c.get_name(), s2.s.get_name()) +
-            unsign(j2, s2);
-  st.defines = {s2.c.get_name(), s2.s.get_name()};
-  return st;
+  return two_link_distance_stage(m, solve, w, leg.p2, leg.R2, leg.chain.joints[2], leg.p3, s3);
 }
 
 }  // namespace
@@ -375,7 +327,7 @@ Solve plan_steering_leg(const Model& m, const Limb& limb) {
   Vec3 d;
   solve.stages.push_back(first_joint_stage(m, leg, k, s1, d));
   solve.stages.push_back(two_link_stage(m, solve, leg, d, k, s3));
-  solve.stages.push_back(second_joint_stage(m, solve, leg, s2));
+  solve.stages.push_back(two_link_rotation_stage(m, solve, leg.p2, leg.R2, c.joints[1], c.joints[2], leg.p3, s2));
   return solve;
 }
 
