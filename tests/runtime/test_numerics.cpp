@@ -164,6 +164,10 @@ namespace {
 
 // The LU's solves and the condition number at size N against Eigen's PartialPivLU and JacobiSVD, on
 // random matrices with singular values from 1 down to 10^-k (U diag V^T with random orthogonal U, V).
+// The references are Eigen's dynamic-size decompositions: one instantiation of each for the six
+// sizes (fixed-size ones took about 20 s of this file's compile, sanitized 50 s); below its
+// blocking size Eigen runs the same unblocked elimination on either.
+using Dense = Eigen::MatrixXd;
 template <int N>
 void check_small_dense(std::mt19937& random) {
   using Square = Eigen::Matrix<double, N, N>;
@@ -172,8 +176,8 @@ void check_small_dense(std::mt19937& random) {
   const auto gaussian = [&] { return Square::NullaryExpr([&](Eigen::Index, Eigen::Index) { return normal(random); }); };
   for (int trial = 0; trial < 200; ++trial) {
     const int k = trial % 11;  // condition numbers 1 to 1e10
-    const Square U = Eigen::HouseholderQR<Square>(gaussian()).householderQ();
-    const Square V = Eigen::HouseholderQR<Square>(gaussian()).householderQ();
+    const Square U = Dense(Eigen::HouseholderQR<Dense>(Dense(gaussian())).householderQ());
+    const Square V = Dense(Eigen::HouseholderQR<Dense>(Dense(gaussian())).householderQ());
     Column sigma;
     for (int i = 0; i < N; ++i) sigma(i) = N == 1 ? 1.0 : std::pow(10.0, -k * double(i) / (N - 1));
     const Square A = U * sigma.asDiagonal() * V.transpose();
@@ -181,11 +185,11 @@ void check_small_dense(std::mt19937& random) {
 
     wlx::small::PartialPivotLu<N> lu;
     lu.compute(A);
-    const Eigen::PartialPivLU<Square> eigen(A);
+    const Eigen::PartialPivLU<Dense> eigen{Dense(A)};
     Eigen::Matrix<double, N, 2> B;
     B << b, 2 * b;
     lu.template solve_in_place<2>(B);
-    const Column x_eigen = eigen.solve(b), xt_eigen = eigen.transpose().solve(b);
+    const Column x_eigen = eigen.solve(Eigen::VectorXd(b)), xt_eigen = eigen.transpose().solve(Eigen::VectorXd(b));
     Column xt;
     lu.solve_transposed(b, xt);
     // Both are backward stable and pivot the same way: the solutions agree to the condition
@@ -198,8 +202,8 @@ void check_small_dense(std::mt19937& random) {
     // the largest entry (the compilers may contract a multiply-add differently).
     const Square eigen_lu = eigen.matrixLU();
     CHECK((lu.lu - eigen_lu).cwiseAbs().maxCoeff() <= 8 * std::numeric_limits<double>::epsilon() * eigen_lu.cwiseAbs().maxCoeff());
-    const Eigen::PermutationMatrix<N, N> eigen_inverse = eigen.permutationP().transpose();  // row k of P A is A's row [k]
-    const Eigen::Matrix<int, N, 1> eigen_rows = eigen_inverse.indices();
+    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic> eigen_inverse = eigen.permutationP().transpose();  // row k of P A is A's row [k]
+    const Eigen::VectorXi eigen_rows = eigen_inverse.indices();
     for (int i = 0; i < N; ++i) CHECK(lu.row[i] == eigen_rows(i));
     CHECK((A * B.col(0) - b).norm() <= 1e-14 * N * (1 + A.norm() * B.col(0).norm()));
     CHECK((A.transpose() * xt - b).norm() <= 1e-14 * N * (1 + A.norm() * xt.norm()));
@@ -207,7 +211,7 @@ void check_small_dense(std::mt19937& random) {
     // The condition number against Eigen's SVD of the same stored A: any backward-stable method
     // finds sigma_min to about eps sigma_max, so the two agree to a relative 1e-14 cond (1e-4 at
     // 1e10, 1e-14 at 1), and both to the construction's sigma (whose rounding is of that order too).
-    const Column sv = Eigen::JacobiSVD<Square>(A).singularValues();
+    const Column sv = Eigen::JacobiSVD<Dense>(Dense(A)).singularValues();
     const double mine = wlx::small::condition_number<N>(A), eigens = sv(0) / sv(N - 1);
     CHECK(std::abs(mine - eigens) <= 1e-14 * cond * eigens);
     CHECK(std::abs(mine - cond) <= 1e-14 * cond * cond);
@@ -218,7 +222,7 @@ void check_small_dense(std::mt19937& random) {
       const Square S = A * A.transpose();
       Column y;
       REQUIRE(wlx::small::cholesky_solve<N>(S, b, y));
-      const Column y_eigen = Eigen::LLT<Square>(S).solve(b);
+      const Column y_eigen = Eigen::LLT<Dense>(Dense(S)).solve(Eigen::VectorXd(b));
       CHECK((y - y_eigen).norm() <= 1e-14 * cond * cond * y_eigen.norm());
       CHECK((S * y - b).norm() <= 1e-14 * N * (1 + S.norm() * y.norm()));
     }
@@ -232,11 +236,11 @@ void check_small_dense(std::mt19937& random) {
     structured.row(N - 1) = structured.row(0);  // with N = 2: rows (0 1), (0 1) after the swap: singular
     wlx::small::PartialPivotLu<N> lu;
     lu.compute(structured);
-    const Eigen::PartialPivLU<Square> eigen(structured);
+    const Eigen::PartialPivLU<Dense> eigen{Dense(structured)};
     const Square eigen_lu = eigen.matrixLU();
     CHECK((lu.lu - eigen_lu).cwiseAbs().maxCoeff() == 0);
-    const Eigen::PermutationMatrix<N, N> eigen_inverse = eigen.permutationP().transpose();  // row k of P A is A's row [k]
-    const Eigen::Matrix<int, N, 1> eigen_rows = eigen_inverse.indices();
+    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic> eigen_inverse = eigen.permutationP().transpose();  // row k of P A is A's row [k]
+    const Eigen::VectorXi eigen_rows = eigen_inverse.indices();
     for (int i = 0; i < N; ++i) CHECK(lu.row[i] == eigen_rows(i));
     CHECK(wlx::small::condition_number<N>(structured) >= 1e15);
   }
