@@ -37,7 +37,7 @@ Frame apply(const Model& m, const Frame& f, const ChainStep& st) {
 bool driven(const ChainStep& st) { return st.kind == ChainStep::Kind::Rotate || st.kind == ChainStep::Kind::Slide; }
 
 void require_plain_chain(const Model& m, const std::string& frame, const std::vector<ChainStep>& chain, const char* pattern) {
-  if (m.frames[static_cast<std::size_t>(m.frame_index(frame))].derived_from_wheel >= 0)
+  if (wheel_of_contact(m, frame) != nullptr)
     throw Unsolvable{std::string(pattern) + ": " + frame + " is a wheel's derived contact point"};
   for (const ChainStep& st : chain)
     if (driven(st) && st.sign < 0)

@@ -106,13 +106,23 @@ Sinusoid sinusoid(const ex& e, const realsymbol& q, const std::string& what);
 Sinusoid distance_squared(const Vec3& p, const Mat3& M, const ChainStep& joint, const Vec3& t);
 // The targets seen from `base` (from its origin, in its axes): the stage's locals ik_d0, ik_d1, ik_d2.
 Vec3 targets_from(const Model& m, const Frame& base, const std::array<int, 3>& target, Stage& stage);
+// A point row of a limb's three (x, y, z of one frame): its frame checked against the others' and
+// its target put in `target`; throws Unsolvable naming `pattern` when it does not fit.
+void add_point_row(const ClosureCondition& row, const std::string& pattern, std::string& frame, std::array<int, 3>& target);
+// The wheel whose derived contact frame `frame` is, or nullptr for any other frame.
+const NonholonomicWheel* wheel_of_contact(const Model& m, const std::string& frame);
+// a and b parallel, identically or at the parameters' defaults (a geometry that moves no plane).
+bool parallel_at_defaults(const Model& m, const Vec3& a, const Vec3& b);
 // R^T v: v in the axes of a frame turned by R.
 Vec3 in_axes(const Mat3& R, const Vec3& v);
 // Code making sin and cos of the joint from those of theta = sign q that a solver computed.
 std::string unsign(const ChainStep& j, const SolvedJoint& s);
 
 // The steps a leg's patterns share (a hip that swings the plane of parallel joints through the
-// target, then a planar two-link chain in it; ik_patterns.cpp).
+// target, then a planar two-link chain in it; ik_leg_steps.cpp).
+// The code that solves K + A cos q + B sin q = |v|^2 for a joint, v the stage's ik_<v>0..2 (a
+// distance fixes a knee): `bit` of the branch picks the root, `stage` is the failure's number.
+std::string distance_solve_code(const std::string& v, int bit, int stage, const SolvedJoint& s);
 // The hip from its plane's offset: alpha cos q1 + beta sin q1 = plane - first.c, with `first` the
 // target's component along the turned normal (branch bit 0 picks the root); into `stage`.
 void add_plane_offset_solve(Stage& stage, const Sinusoid& first, const ex& plane, const SolvedJoint& s1);

@@ -111,11 +111,7 @@ std::pair<std::string, std::array<int, 3>> point_rows(const Model& m, const Limb
   for (int r : limb.rows) {
     const ClosureCondition& c = m.closure[static_cast<std::size_t>(r)];
     if (c.kind != ClosureCondition::Kind::PointEqualsCoordinate) throw Unsolvable{pattern + ": row " + c.name + " is not a point row"};
-    if (!frame.empty() && c.frame != frame) throw Unsolvable{pattern + ": the rows place different frames (" + frame + ", " + c.frame + ")"};
-    frame = c.frame;
-    auto& t = target[static_cast<std::size_t>(c.axis)];
-    if (t >= 0) throw Unsolvable{pattern + ": two rows fix the same component"};
-    t = c.target;
+    add_point_row(c, pattern, frame, target);
   }
   return {frame, target};
 }
@@ -133,6 +129,25 @@ void require_three_joints(const Model& m, const CanonicalChain& c, const std::st
 }
 
 }  // namespace
+
+void add_point_row(const ClosureCondition& row, const std::string& pattern, std::string& frame, std::array<int, 3>& target) {
+  if (!frame.empty() && row.frame != frame) throw Unsolvable{pattern + ": the rows place different frames (" + frame + ", " + row.frame + ")"};
+  frame = row.frame;
+  auto& t = target[static_cast<std::size_t>(row.axis)];
+  if (t >= 0) throw Unsolvable{pattern + ": two rows fix the same component"};
+  t = row.target;
+}
+
+const NonholonomicWheel* wheel_of_contact(const Model& m, const std::string& frame) {
+  const NamedFrame& placed = m.frames[static_cast<std::size_t>(m.frame_index(frame))];
+  return placed.derived_from_wheel >= 0 ? &m.wheels[static_cast<std::size_t>(placed.derived_from_wheel)] : nullptr;
+}
+
+bool parallel_at_defaults(const Model& m, const Vec3& a, const Vec3& b) {
+  const Vec3 across = cross(a, b);
+  return identically_zero(across) ||
+         std::abs(at_defaults(m, across[0])) + std::abs(at_defaults(m, across[1])) + std::abs(at_defaults(m, across[2])) < 1e-9;
+}
 
 // sin and cos of the joint from those of theta = sign q that a solver computed.
 std::string unsign(const ChainStep& j, const SolvedJoint& s) {
@@ -166,24 +181,6 @@ Vec3 in_axes(const Mat3& R, const Vec3& v) {
   return out;
 }
 
-namespace {
-
-// The code that solves K + A cos q + B sin q = |v|^2 for a joint, v the stage's ik_<v>0..2 (a
-// distance fixes a knee): `bit` of the branch picks the root, `stage` is the failure's number.
-std::string distance_solve_code(const std::string& v, int bit, int stage, const SolvedJoint& s) {
-  return fmt::format(
-      "  const Scalar ik_{0}{0} = ik_{0}0 * ik_{0}0 + ik_{0}1 * ik_{0}1 + ik_{0}2 * ik_{0}2;\n"
-      "  Scalar {1}, {2};\n"
-      "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_{0}{0} - ik_K, (branch & {3}) != 0, {1}, {2})) {{\n"
-      "    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
-      "    why = {{{4}, std::sqrt(ik_{0}{0}), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
-      "    return IkStatus::out_of_reach;\n"
-      "  }}\n",
-      v, s.c.get_name(), s.s.get_name(), bit, stage);
-}
-
-}  // namespace
-
 // ---- point3 -------------------------------------------------------------------------------------
 
 namespace {
@@ -201,7 +198,7 @@ struct Point3 {
 Point3 point3(const Model& m, const Limb& limb) {
   const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
   const auto [frame, target] = point_rows(m, limb, "point3");
-  if (m.frames[static_cast<std::size_t>(m.frame_index(frame))].derived_from_wheel >= 0)
+  if (wheel_of_contact(m, frame) != nullptr)
     throw Unsolvable{"point3: " + frame + " is a wheel's contact point (the wheel-leg pattern places it)"};
   const CanonicalChain c = canonical_chain(m, full_chain(m, frame));
   require_three_joints(m, c, frame, "point3");
@@ -318,52 +315,6 @@ Solve plan_point3(const Model& m, const Limb& limb) {
   return solve;
 }
 
-// ---- the steps of a leg's patterns (wheel leg, plane leg, steering leg) -------------------------
-
-void add_plane_offset_solve(Stage& stage, const Sinusoid& first, const ex& plane, const SolvedJoint& s1) {
-  stage.locals.emplace_back(realsymbol("ik_alpha"), first.a);
-  stage.locals.emplace_back(realsymbol("ik_beta"), first.b);
-  stage.locals.emplace_back(realsymbol("ik_gamma"), (plane - first.c).expand());
-  stage.code += fmt::format(
-      "  Scalar {0}, {1};\n"
-      "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, {0}, {1})) {{\n"
-      "    why = {{1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0}};\n"
-      "    return IkStatus::out_of_reach;\n"
-      "  }}\n",
-      s1.c.get_name(), s1.s.get_name());
-  stage.defines = {s1.c.get_name(), s1.s.get_name()};
-}
-
-Stage two_link_distance_stage(const Model& m, const Solve& solve, const Vec3& w, const Vec3& p2, const Mat3& R2,
-                              const ChainStep& j3, const Vec3& p3, const SolvedJoint& s3) {
-  Stage st;
-  for (int i = 0; i < 3; ++i) st.locals.emplace_back(realsymbol(fmt::format("ik_w{}", i)), in_results(m, w[i], solve));
-  const Sinusoid distance = distance_squared(p2, R2, j3, p3);
-  st.locals.emplace_back(realsymbol("ik_K"), distance.c);
-  st.locals.emplace_back(realsymbol("ik_A"), distance.a);
-  st.locals.emplace_back(realsymbol("ik_B"), distance.b);
-  st.code = distance_solve_code("w", 2, 2, s3);
-  st.defines = {s3.c.get_name(), s3.s.get_name()};
-  return st;
-}
-
-Stage two_link_rotation_stage(const Model& m, const Solve& solve, const Vec3& p2, const Mat3& R2, const ChainStep& j2,
-                              const ChainStep& j3, const Vec3& p3, const SolvedJoint& s2) {
-  const ex& q3 = m.coordinates[static_cast<std::size_t>(j3.coordinate)].q;
-  Stage st;
-  const Vec3 v = p2 + R2 * (signed_rot(j3.axis, j3.sign, q3) * p3);
-  const int b = static_cast<int>(j2.axis), i = (b + 1) % 3, j = (b + 2) % 3;  // R_b turns i towards j
-  for (int k : {i, j}) st.locals.emplace_back(realsymbol(fmt::format("ik_v{}", k)), in_results(m, v[k], solve));  // v_b = w_b
-  st.code = fmt::format(
-      "  const Scalar ik_x = ik_v{0} * ik_w{0} + ik_v{1} * ik_w{1}, ik_y = ik_v{0} * ik_w{1} - ik_v{1} * ik_w{0};\n"
-      "  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);\n"
-      "  Scalar {2} = ik_r > 0 ? ik_x / ik_r : Scalar(1), {3} = ik_r > 0 ? ik_y / ik_r : Scalar(0);\n",
-      i, j, s2.c.get_name(), s2.s.get_name()) +
-      unsign(j2, s2);
-  st.defines = {s2.c.get_name(), s2.s.get_name()};
-  return st;
-}
-
 // ---- wheel leg (and plane leg) ------------------------------------------------------------------
 //
 // Three revolute joints, the last two (and, for a wheel, its axle) parallel: a hip that swings the
@@ -396,8 +347,7 @@ struct WheelLeg {
 WheelLeg wheel_leg(const Model& m, const Limb& limb) {
   const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
   const auto [frame, target] = point_rows(m, limb, "wheel leg");
-  const NamedFrame& placed = m.frames[static_cast<std::size_t>(m.frame_index(frame))];
-  const NonholonomicWheel* wheel = placed.derived_from_wheel >= 0 ? &m.wheels[static_cast<std::size_t>(placed.derived_from_wheel)] : nullptr;
+  const NonholonomicWheel* wheel = wheel_of_contact(m, frame);
   const std::string pattern = wheel ? "wheel leg" : "plane leg";
   const std::string point = wheel ? wheel->hub : frame;
   const CanonicalChain c = canonical_chain(m, full_chain(m, point));
@@ -414,9 +364,7 @@ WheelLeg wheel_leg(const Model& m, const Limb& limb) {
                      ") is not parallel to the axis of " + n3 + "; the pattern needs the wheel turning in the leg's plane"};
   const Mat3 R1 = product(c.fixed[1].turns);
   const Vec3 normal = R1 * unit(j2.axis);  // the leg plane's normal in the frame after q1
-  if (parallel(unit(j1.axis), normal) || std::abs(at_defaults(m, cross(unit(j1.axis), normal)[0])) +
-                                                 std::abs(at_defaults(m, cross(unit(j1.axis), normal)[1])) +
-                                                 std::abs(at_defaults(m, cross(unit(j1.axis), normal)[2])) < 1e-9)
+  if (parallel_at_defaults(m, unit(j1.axis), normal))
     throw Unsolvable{pattern + ": the axis of " + n1 + " is parallel to those of " + n2 + " and " + n3 + " (a planar leg: " + n1 +
                      " cannot move the leg's plane)"};
   const ex& q2 = m.coordinates[static_cast<std::size_t>(j2.coordinate)].q;

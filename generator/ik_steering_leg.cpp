@@ -54,12 +54,7 @@ SteeringRows steering_rows(const Model& m, const Limb& limb) {
       rows.sum = &c;
     } else if (c.kind == ClosureCondition::Kind::PointEqualsCoordinate) {
       ++points;
-      if (!rows.frame.empty() && c.frame != rows.frame)
-        throw Unsolvable{fmt::format("{}: the rows place different frames ({}, {})", kPattern, rows.frame, c.frame)};
-      rows.frame = c.frame;
-      int& t = rows.target[static_cast<std::size_t>(c.axis)];
-      if (t >= 0) throw Unsolvable{fmt::format("{}: two rows fix the same component", kPattern)};
-      t = c.target;
+      add_point_row(c, kPattern, rows.frame, rows.target);
     }
   }
   if (points != 3 || sums != 1 || limb.rows.size() != 4)
@@ -171,8 +166,7 @@ SteeringLeg steering_leg(const Model& m, const Limb& limb) {
   const auto name = [&](int k) { return m.coordinates[static_cast<std::size_t>(k)].name; };
   SteeringLeg leg;
   leg.rows = steering_rows(m, limb);
-  const NamedFrame& placed = m.frames[static_cast<std::size_t>(m.frame_index(leg.rows.frame))];
-  if (placed.derived_from_wheel >= 0) leg.wheel = &m.wheels[static_cast<std::size_t>(placed.derived_from_wheel)];
+  leg.wheel = wheel_of_contact(m, leg.rows.frame);
   leg.point = leg.wheel ? leg.wheel->hub : leg.rows.frame;
   const CanonicalChain c = leg.chain = canonical_chain(m, full_chain(m, leg.point));
   require_four_joints(m, c, leg.point);
@@ -185,11 +179,7 @@ SteeringLeg steering_leg(const Model& m, const Limb& limb) {
   leg.p1 = c.fixed[1].offset;
   leg.p2 = c.fixed[2].offset;
   leg.p3 = c.fixed[3].offset;
-  const Vec3 normal = leg.R1 * unit(A);
-  const Vec3 across = cross(unit(j1.axis), normal);
-  if (identically_zero(across) ||
-      std::abs(at_defaults(m, across[0])) + std::abs(at_defaults(m, across[1])) + std::abs(at_defaults(m, across[2])) <
-          1e-9)
+  if (parallel_at_defaults(m, unit(j1.axis), leg.R1 * unit(A)))
     throw Unsolvable{fmt::format(
         "{}: the axis of {} is parallel to those of {}, {} and {} (a planar leg: {} cannot move the leg's plane)",
         kPattern, name(j1.coordinate), name(j2.coordinate), name(c.joints[2].coordinate), name(c.joints[3].coordinate),
