@@ -166,9 +166,9 @@ const std::vector<ModelCommands>& models() {
   add_library(${target}_commands STATIC ${sources})
   set_target_properties(${target}_commands ${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   set_target_properties(${target}_commands PROPERTIES UNITY_BUILD ON)  # they share Eigen's templates
-  # The commands' optimization (cmake/wlxModelBuild.cmake) in optimized configurations: they parse
-  # and write around the runtime's calls, which keep this project's own flags.
-  target_compile_options(${target}_commands PRIVATE $<$<NOT:$<CONFIG:Debug>>:${WLX_COMMANDS_OPTIMIZATION}>)
+  # The commands' optimization (cmake/wlxModelBuild.cmake): they parse and write around the
+  # runtime's calls, which keep this project's own flags.
+  wlx_optimize(${target}_commands ${WLX_COMMANDS_OPTIMIZATION})
   target_include_directories(${target}_commands PUBLIC "${WLX_CLI_SOURCE_DIR}/commands")
   target_link_libraries(${target}_commands PUBLIC ${target} wlx::cli_common)
   pybind11_add_module(${target}_python MODULE NO_EXTRAS "${WLX_PYTHON_SOURCE_DIR}/module.cpp" "${dir}/registry.cpp")

@@ -60,3 +60,15 @@ set(WLX_VIEWER_EXPORTED_FUNCTIONS
 set(WLX_RUNTIME_OPTIMIZATION -O3)
 set(WLX_COMMANDS_OPTIMIZATION -O0)
 set(WLX_VIEWER_OPTIMIZATION -O2)
+
+# wlx_optimize(TARGET FLAG...): a part's optimization above, after the configuration's own flags (so
+# that it wins over Release's -O3), in the optimized configurations only: Debug keeps -O0, and the
+# sanitized tree (WLX_SANITIZE, WLX_FUZZ) its -O1, the flags its reports and run times were tuned for.
+function(wlx_optimize target)
+  if(WLX_SANITIZE OR WLX_FUZZ)
+    return()
+  endif()
+  foreach(flag IN LISTS ARGN)  # one generator expression per flag: a list would split it
+    target_compile_options(${target} PRIVATE $<$<NOT:$<CONFIG:Debug>>:${flag}>)
+  endforeach()
+endfunction()

@@ -167,12 +167,16 @@ fs::path generator_program() {
 // Each part's optimization, as cmake/wlxModelBuild.cmake defines it for every builder of a model's
 // code (the runtime and the generated functions -O3, the commands -O0: why, there).
 // WLX_PLUGIN_CXXFLAGS replaces both (all part of the key).
-std::vector<std::string> optimization_flags(bool commands = false) {
-  const char* env = std::getenv("WLX_PLUGIN_CXXFLAGS");
+// The flags an environment variable gives (whitespace-separated), else `fallback`'s.
+std::vector<std::string> flags_from_environment(const char* variable, const char* fallback) {
+  const char* env = std::getenv(variable);
   std::vector<std::string> out;
-  std::istringstream in(env != nullptr && *env != '\0' ? env : commands ? WLX_PLUGIN_COMMANDS_OPTIMIZATION : WLX_PLUGIN_RUNTIME_OPTIMIZATION);
+  std::istringstream in(env != nullptr && *env != '\0' ? env : fallback);
   for (std::string flag; in >> flag;) out.push_back(flag);
   return out;
+}
+std::vector<std::string> optimization_flags(bool commands = false) {
+  return flags_from_environment("WLX_PLUGIN_CXXFLAGS", commands ? WLX_PLUGIN_COMMANDS_OPTIMIZATION : WLX_PLUGIN_RUNTIME_OPTIMIZATION);
 }
 
 // The plugins loaded in this process, by library and description: the same model with the same
@@ -584,10 +588,7 @@ std::string model_file_viewer_module() {
 #else
   // The viewer's optimization (cmake/wlxModelBuild.cmake) by default; WLX_PLUGIN_EMCCFLAGS replaces
   // it (the tests' -O0).
-  std::vector<std::string> flags;
-  const char* env = std::getenv("WLX_PLUGIN_EMCCFLAGS");
-  std::istringstream in(env != nullptr && *env != '\0' ? env : WLX_VIEWER_OPTIMIZATION);
-  for (std::string flag; in >> flag;) flags.push_back(flag);
+  const std::vector<std::string> flags = flags_from_environment("WLX_PLUGIN_EMCCFLAGS", WLX_VIEWER_OPTIMIZATION);
   // The module's folder is named by what it is compiled with beyond the entry's key (which holds
   // the sources): emscripten itself, the flags, the exports and the source lists that
   // viewer/CMakeLists.txt gave this wlx. Another wlx or other flags: another folder, never a stale
