@@ -6,8 +6,9 @@
 #   tools/sanitizer_tree.sh fuzz SECONDS  configure, build the libFuzzer targets, fuzz each for SECONDS
 # Not sanitized: the benchmarks, the viewer (emscripten's WebAssembly) and the Python module, which
 # take no untrusted input beyond what the tests run through the command line; the KDL comparison
-# (an outside library's numbers, checked in the normal tree); and of the built-in models all but the
-# excavator: its runtime and commands (two wheels, eight actuators, a closure, wheel levers) and the
+# and MuJoCo's check of the exported models (outside libraries' numbers, checked in the normal
+# tree; the export itself is sanitized in the command-line tests); and of the built-in models all
+# but the excavator: its runtime and commands (two wheels, eight actuators, a closure, wheel levers) and the
 # test models built beside it (tests/models: a floating tripod on pinned feet with no wheels, an open
 # arm, a one-wheeled leg of Newton limbs; tests/ik_shapes: every closed-form limb pattern) take
 # every path of the generic runtime with every count of wheels the runtime distinguishes (0, 1,
