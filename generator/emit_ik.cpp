@@ -275,7 +275,7 @@ template <typename Scalar>
 inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& cos_x, Scalar& sin_x) noexcept {
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
-  const Scalar r = std::sqrt(a * a + b * b);
+  const Scalar r = detail::square_root(a * a + b * b);
   if (!(r > 0)) {
     // The joint does not move what it solves for: the reachable range is the one value c = 0
     // (reported as [v, v]), where every x solves; x = 0 is the root nearest zero.
@@ -290,7 +290,7 @@ inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& c
     ratio = std::copysign(Scalar(1), ratio);
   }
   const Scalar cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
-  const Scalar sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
+  const Scalar sin_delta = detail::square_root((1 - ratio) * (1 + ratio));
   Scalar sign = sin_psi > 0 ? Scalar(-1) : sin_psi < 0 ? Scalar(1) : (cos_psi >= 0 ? Scalar(1) : Scalar(-1));
   if (other) sign = -sign;
   cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
@@ -314,18 +314,18 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
   if (k2 < 0) {
     if (-k2 > ik_reach_slack<Scalar>() * (across + v[B] * v[B])) {
       beside = std::abs(d[A]);
-      room = std::sqrt(v[A] * v[A] + v[C] * v[C]);
+      room = detail::square_root(v[A] * v[A] + v[C] * v[C]);
       return false;
     }
     k2 = 0;
   }
-  Scalar k = std::sqrt(k2);
+  Scalar k = detail::square_root(k2);
   if ((v[C] < 0) != flip) k = -k;
   Scalar t[3] = {0, 0, 0};
   t[A] = d[A];
   t[C] = k;
   const Scalar y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
-  const Scalar r = std::sqrt(x * x + y * y);
+  const Scalar r = detail::square_root(x * x + y * y);
   c2 = r > 0 ? x / r : Scalar(1);
   s2 = r > 0 ? y / r : Scalar(0);
   Scalar w[3];
@@ -333,7 +333,7 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
   w[i] = c2 * v[i] - s2 * v[j];
   w[j] = s2 * v[i] + c2 * v[j];
   const Scalar y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
-  const Scalar r1 = std::sqrt(x1 * x1 + y1 * y1);
+  const Scalar r1 = detail::square_root(x1 * x1 + y1 * y1);
   c1 = r1 > 0 ? x1 / r1 : Scalar(1);
   s1 = r1 > 0 ? y1 / r1 : Scalar(0);
   return true;

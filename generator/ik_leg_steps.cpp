@@ -17,8 +17,8 @@ std::string distance_solve_code(const std::string& v, int bit, int stage, const 
       "  const Scalar ik_{0}{0} = ik_{0}0 * ik_{0}0 + ik_{0}1 * ik_{0}1 + ik_{0}2 * ik_{0}2;\n"
       "  Scalar {1}, {2};\n"
       "  if (!ik_solve_cos_sin(ik_A, ik_B, ik_{0}{0} - ik_K, (branch & {3}) != 0, {1}, {2})) {{\n"
-      "    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);\n"
-      "    why = {{{4}, std::sqrt(ik_{0}{0}), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0}};\n"
+      "    const Scalar ik_R = detail::square_root(ik_A * ik_A + ik_B * ik_B);\n"
+      "    why = {{{4}, detail::square_root(ik_{0}{0}), detail::square_root(std::max(Scalar(0), ik_K - ik_R)), detail::square_root(ik_K + ik_R), 0.0}};\n"
       "    return IkStatus::out_of_reach;\n"
       "  }}\n",
       v, s.c.get_name(), s.s.get_name(), bit, stage);
@@ -31,7 +31,7 @@ void add_plane_offset_solve(Stage& stage, const Sinusoid& first, const ex& plane
   stage.code += fmt::format(
       "  Scalar {0}, {1};\n"
       "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, {0}, {1})) {{\n"
-      "    why = {{1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0}};\n"
+      "    why = {{1, double(std::abs(ik_gamma)), 0.0, double(detail::square_root(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0}};\n"
       "    return IkStatus::out_of_reach;\n"
       "  }}\n",
       s1.c.get_name(), s1.s.get_name());
@@ -60,7 +60,7 @@ Stage two_link_rotation_stage(const Model& m, const Solve& solve, const Vec3& p2
   for (int k : {i, j}) st.locals.emplace_back(realsymbol(fmt::format("ik_v{}", k)), in_results(m, v[k], solve));  // v_b = w_b
   st.code = fmt::format(
       "  const Scalar ik_x = ik_v{0} * ik_w{0} + ik_v{1} * ik_w{1}, ik_y = ik_v{0} * ik_w{1} - ik_v{1} * ik_w{0};\n"
-      "  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);\n"
+      "  const Scalar ik_r = detail::square_root(ik_x * ik_x + ik_y * ik_y);\n"
       "  Scalar {2} = ik_r > 0 ? ik_x / ik_r : Scalar(1), {3} = ik_r > 0 ? ik_y / ik_r : Scalar(0);\n",
       i, j, s2.c.get_name(), s2.s.get_name()) +
       unsign(j2, s2);

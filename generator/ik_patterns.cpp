@@ -431,7 +431,7 @@ Stage rim_stage(const Model& m, const Solve& solve, const Vec3& axle) {
       "    why = {1, 0.0, 0.0, 0.0, 0.0};\n"
       "    return IkStatus::out_of_reach;\n"
       "  }\n"
-      "  const Scalar ik_tilt = std::sqrt(ik_tilt2);\n"
+      "  const Scalar ik_tilt = detail::square_root(ik_tilt2);\n"
       "  const Scalar ik_u0 = -ik_a2 * ik_a0 / ik_tilt, ik_u1 = -ik_a2 * ik_a1 / ik_tilt, ik_u2 = ik_tilt;\n";
   st1.defines = {"ik_u0", "ik_u1", "ik_u2"};
   return st1;
@@ -707,7 +707,7 @@ Stage point_row_stage(const Model& m, const Solve& solve, const LeverRows& rows,
   s1.code = fmt::format(
       "  Scalar {0}, {1};\n"
       "  if (!ik_solve_cos_sin(ik_alpha, ik_beta, {2} - ik_gamma, (branch & 1) != 0, {0}, {1})) {{\n"
-      "    const Scalar ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);\n"
+      "    const Scalar ik_R = detail::square_root(ik_alpha * ik_alpha + ik_beta * ik_beta);\n"
       "    why = {{1, {2}, ik_gamma - ik_R, ik_gamma + ik_R, 0.0}};\n"
       "    return IkStatus::out_of_reach;\n"
       "  }}\n"

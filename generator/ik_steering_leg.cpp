@@ -264,7 +264,7 @@ Stage contact_offset_stage(const Model& m, const SteeringLeg& leg) {
       "    why = {1, 0.0, 0.0, 0.0, 0.0};\n"
       "    return IkStatus::out_of_reach;\n"
       "  }\n"
-      "  const Scalar ik_rim = ik_radius / std::sqrt(ik_tilt2);\n"
+      "  const Scalar ik_rim = ik_radius / detail::square_root(ik_tilt2);\n"
       "  const Scalar ik_k0 = ik_offset * ik_a0 - ik_rim * (ik_z0 - ik_az * ik_a0);\n"
       "  const Scalar ik_k1 = ik_offset * ik_a1 - ik_rim * (ik_z1 - ik_az * ik_a1);\n"
       "  const Scalar ik_k2 = ik_offset * ik_a2 - ik_rim * (ik_z2 - ik_az * ik_a2);\n";

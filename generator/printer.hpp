@@ -64,7 +64,8 @@ class Printer {
   std::string define(int id, OpCount& ops) { return node(id, Context::Root, ops, nullptr); }
   // Node `id` as an output's value: its variable if it has one, else its definition.
   std::string value(int id, OpCount& ops) { return use(id, Context::Root, ops, nullptr); }
-  // The functions the printed code calls (sqrt, ...): each needs `using std::name;`.
+  // The functions the printed code calls (sin, pow, ...): each needs `using std::name;`. (Square
+  // roots are detail::square_root, types.hpp: errno-free for double and float.)
   const std::set<std::string>& calls() const { return calls_; }
 
  private:
@@ -174,20 +175,17 @@ class Printer {
     }
     ++ops.calls;
     if (n.value == 0.5) {
-      calls_.insert("sqrt");
-      return fmt::format("sqrt({})", base);
+      return fmt::format("detail::square_root({})", base);
     }
     if (n.value == -0.5) {
       ++ops.divs;
-      calls_.insert("sqrt");
-      return fmt::format("Scalar(1)/sqrt({})", base);
+      return fmt::format("Scalar(1)/detail::square_root({})", base);
     }
     // x^(k + 1/2) = x^k sqrt(x) (a derived contact point's second derivatives have x^(-3/2)):
     // a multiply and a square root instead of pow, which number types need not have.
     if (integer_exponent(2 * n.value)) {
       const long k = static_cast<long>(std::abs(n.value));  // |v| = k + 1/2
-      calls_.insert("sqrt");
-      std::string s = fmt::format("sqrt({})", base);
+      std::string s = fmt::format("detail::square_root({})", base);
       for (long i = 0; i < k; ++i) s = base + "*" + s;
       ops.muls += k;
       if (n.value > 0) return s;

@@ -43,3 +43,33 @@ TEST_CASE("generated/ is fresh: byte-identical to what wlx-gen produces from the
        << problems << "Run `cmake --build build --target regenerate` and commit generated/.");
   CHECK(problems.empty());
 }
+
+// Every square root the generated functions take is detail::square_root (types.hpp), which for
+// double is one instruction: the library's sqrt must set errno for a negative argument, and clang
+// then keeps a library call beside each one (a wheeled quadruped's kinematic_update ran 1.4x slower
+// under clang than under GCC for it; tools/kernels_by_compiler.sh). Exempt: comments, square_root's
+// own definition (Eigen's for double and float, the scalar type's own else) and the one square root
+// of a constant (the IK's tolerance for float).
+TEST_CASE("generated/: square roots through detail::square_root, none through the library's errno path") {
+  const fs::path committed = WLX_COMMITTED_DIR;
+  std::string found;
+  long roots = 0;
+  for (const auto& f : files_below(committed)) {
+    if (fs::path(f).extension() != ".hpp") continue;
+    std::istringstream in(slurp(committed / f));
+    int number = 0;
+    for (std::string line; std::getline(in, line);) {
+      ++number;
+      const std::string code = line.substr(0, line.find("//"));
+      for (std::size_t at = code.find("square_root("); at != std::string::npos; at = code.find("square_root(", at + 1)) ++roots;
+      if (code.find("sqrt(") == std::string::npos) continue;
+      const bool definition = fs::path(f).filename() == "types.hpp" &&
+                              (code.find("Eigen::numext::sqrt(x)") != std::string::npos || code == "  return sqrt(x);");
+      if (!definition && code.find("kIkTolerance") == std::string::npos)
+        found += "  generated/" + f + ":" + std::to_string(number) + ": " + line + "\n";
+    }
+  }
+  INFO("square roots outside detail::square_root:\n" << found);
+  CHECK(found.empty());
+  CHECK(roots > 100);  // the built-in models take square roots (their IK and contact normals): the scan saw them
+}

@@ -68,7 +68,7 @@ template <typename Scalar>
 inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& cos_x, Scalar& sin_x) noexcept {
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
-  const Scalar r = std::sqrt(a * a + b * b);
+  const Scalar r = detail::square_root(a * a + b * b);
   if (!(r > 0)) {
     // The joint does not move what it solves for: the reachable range is the one value c = 0
     // (reported as [v, v]), where every x solves; x = 0 is the root nearest zero.
@@ -83,7 +83,7 @@ inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& c
     ratio = std::copysign(Scalar(1), ratio);
   }
   const Scalar cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
-  const Scalar sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
+  const Scalar sin_delta = detail::square_root((1 - ratio) * (1 + ratio));
   Scalar sign = sin_psi > 0 ? Scalar(-1) : sin_psi < 0 ? Scalar(1) : (cos_psi >= 0 ? Scalar(1) : Scalar(-1));
   if (other) sign = -sign;
   cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
@@ -107,18 +107,18 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
   if (k2 < 0) {
     if (-k2 > ik_reach_slack<Scalar>() * (across + v[B] * v[B])) {
       beside = std::abs(d[A]);
-      room = std::sqrt(v[A] * v[A] + v[C] * v[C]);
+      room = detail::square_root(v[A] * v[A] + v[C] * v[C]);
       return false;
     }
     k2 = 0;
   }
-  Scalar k = std::sqrt(k2);
+  Scalar k = detail::square_root(k2);
   if ((v[C] < 0) != flip) k = -k;
   Scalar t[3] = {0, 0, 0};
   t[A] = d[A];
   t[C] = k;
   const Scalar y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
-  const Scalar r = std::sqrt(x * x + y * y);
+  const Scalar r = detail::square_root(x * x + y * y);
   c2 = r > 0 ? x / r : Scalar(1);
   s2 = r > 0 ? y / r : Scalar(0);
   Scalar w[3];
@@ -126,7 +126,7 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
   w[i] = c2 * v[i] - s2 * v[j];
   w[j] = s2 * v[i] + c2 * v[j];
   const Scalar y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
-  const Scalar r1 = std::sqrt(x1 * x1 + y1 * y1);
+  const Scalar r1 = detail::square_root(x1 * x1 + y1 * y1);
   c1 = r1 > 0 ? x1 / r1 : Scalar(1);
   s1 = r1 > 0 ? y1 / r1 : Scalar(0);
   return true;
@@ -204,8 +204,8 @@ inline IkStatus ik_leg_l(const CoordinatesOf<Scalar>& s, const Params& p, int br
   const Scalar ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
   Scalar ik_c_knee_l, ik_s_knee_l;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_knee_l, ik_s_knee_l)) {
-    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = detail::square_root(ik_A * ik_A + ik_B * ik_B);
+    why = {1, detail::square_root(ik_dd), detail::square_root(std::max(Scalar(0), ik_K - ik_R)), detail::square_root(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_v0 = thigh + shank*ik_c_knee_l;
@@ -325,8 +325,8 @@ inline IkStatus ik_leg_r(const CoordinatesOf<Scalar>& s, const Params& p, int br
   const Scalar ik_dd = ik_d0 * ik_d0 + ik_d1 * ik_d1 + ik_d2 * ik_d2;
   Scalar ik_c_knee_r, ik_s_knee_r;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_dd - ik_K, (branch & 1) != 0, ik_c_knee_r, ik_s_knee_r)) {
-    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {1, std::sqrt(ik_dd), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = detail::square_root(ik_A * ik_A + ik_B * ik_B);
+    why = {1, detail::square_root(ik_dd), detail::square_root(std::max(Scalar(0), ik_K - ik_R)), detail::square_root(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_v0 = thigh + shank*ik_c_knee_r;
@@ -427,7 +427,7 @@ inline IkStatus ik_lever_l(const CoordinatesOf<Scalar>& s, const Params& p, int 
   const Scalar ik_gamma = ik_t4 + sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + sin_pitch*rear_x - radius*ik_c_sum*cos_roll*cos_pitch - cos_roll*rear_drop*cos_pitch;
   Scalar ik_c_swing_l, ik_s_swing_l;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, ground_l - ik_gamma, (branch & 1) != 0, ik_c_swing_l, ik_s_swing_l)) {
-    const Scalar ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
+    const Scalar ik_R = detail::square_root(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, ground_l, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
@@ -526,7 +526,7 @@ inline IkStatus ik_lever_r(const CoordinatesOf<Scalar>& s, const Params& p, int 
   const Scalar ik_gamma = ik_t4 + ik_t7 + z_C + ik_t8 + ik_t9 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*ik_c_sum*cos_roll*cos_pitch;
   Scalar ik_c_swing_r, ik_s_swing_r;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, ground_r - ik_gamma, (branch & 1) != 0, ik_c_swing_r, ik_s_swing_r)) {
-    const Scalar ik_R = std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta);
+    const Scalar ik_R = detail::square_root(ik_alpha * ik_alpha + ik_beta * ik_beta);
     why = {1, ground_r, ik_gamma - ik_R, ik_gamma + ik_R, 0.0};
     return IkStatus::out_of_reach;
   }
@@ -727,8 +727,8 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_l_dd = ik_leg_l_d0 * ik_leg_l_d0 + ik_leg_l_d1 * ik_leg_l_d1 + ik_leg_l_d2 * ik_leg_l_d2;
   Scalar ik_c_knee_l, ik_s_knee_l;
   if (!ik_solve_cos_sin(ik_leg_l_A, ik_leg_l_B, ik_leg_l_dd - ik_leg_l_K, (ik_leg_l_branch & 1) != 0, ik_c_knee_l, ik_s_knee_l)) {
-    const Scalar ik_leg_l_R = std::sqrt(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
-    why = {1, std::sqrt(ik_leg_l_dd), std::sqrt(std::max(Scalar(0), ik_leg_l_K - ik_leg_l_R)), std::sqrt(ik_leg_l_K + ik_leg_l_R), 0.0};
+    const Scalar ik_leg_l_R = detail::square_root(ik_leg_l_A * ik_leg_l_A + ik_leg_l_B * ik_leg_l_B);
+    why = {1, detail::square_root(ik_leg_l_dd), detail::square_root(std::max(Scalar(0), ik_leg_l_K - ik_leg_l_R)), detail::square_root(ik_leg_l_K + ik_leg_l_R), 0.0};
     failed = 0;
     return IkStatus::out_of_reach;
   }
@@ -759,8 +759,8 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_r_dd = ik_leg_r_d0 * ik_leg_r_d0 + ik_leg_r_d1 * ik_leg_r_d1 + ik_leg_r_d2 * ik_leg_r_d2;
   Scalar ik_c_knee_r, ik_s_knee_r;
   if (!ik_solve_cos_sin(ik_leg_r_A, ik_leg_r_B, ik_leg_r_dd - ik_leg_r_K, (ik_leg_r_branch & 1) != 0, ik_c_knee_r, ik_s_knee_r)) {
-    const Scalar ik_leg_r_R = std::sqrt(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
-    why = {1, std::sqrt(ik_leg_r_dd), std::sqrt(std::max(Scalar(0), ik_leg_r_K - ik_leg_r_R)), std::sqrt(ik_leg_r_K + ik_leg_r_R), 0.0};
+    const Scalar ik_leg_r_R = detail::square_root(ik_leg_r_A * ik_leg_r_A + ik_leg_r_B * ik_leg_r_B);
+    why = {1, detail::square_root(ik_leg_r_dd), detail::square_root(std::max(Scalar(0), ik_leg_r_K - ik_leg_r_R)), detail::square_root(ik_leg_r_K + ik_leg_r_R), 0.0};
     failed = 1;
     return IkStatus::out_of_reach;
   }
@@ -802,7 +802,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_lever_l_gamma = sin_roll*(lever_offset*cos_steer_l + hub_offset - sin_steer_l*lever)*cos_pitch + sin_roll*rear_y*cos_pitch + z_C + ik_t55 + radius*sin_pitch*ik_lever_l_s_sum + ik_t56 - radius*ik_lever_l_c_sum*cos_roll*cos_pitch;
   Scalar ik_c_swing_l, ik_s_swing_l;
   if (!ik_solve_cos_sin(ik_lever_l_alpha, ik_lever_l_beta, ground_l - ik_lever_l_gamma, (ik_lever_l_branch & 1) != 0, ik_c_swing_l, ik_s_swing_l)) {
-    const Scalar ik_lever_l_R = std::sqrt(ik_lever_l_alpha * ik_lever_l_alpha + ik_lever_l_beta * ik_lever_l_beta);
+    const Scalar ik_lever_l_R = detail::square_root(ik_lever_l_alpha * ik_lever_l_alpha + ik_lever_l_beta * ik_lever_l_beta);
     why = {1, ground_l, ik_lever_l_gamma - ik_lever_l_R, ik_lever_l_gamma + ik_lever_l_R, 0.0};
     failed = 2;
     return IkStatus::out_of_reach;
@@ -837,7 +837,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_lever_r_gamma = ik_t57 + ik_t62 + z_C + ik_t55 + ik_t56 - sin_roll*(cos_steer_r*lever_offset + sin_steer_r*lever + hub_offset)*cos_pitch - radius*cos_roll*cos_pitch*ik_lever_r_c_sum;
   Scalar ik_c_swing_r, ik_s_swing_r;
   if (!ik_solve_cos_sin(ik_lever_r_alpha, ik_lever_r_beta, ground_r - ik_lever_r_gamma, (ik_lever_r_branch & 1) != 0, ik_c_swing_r, ik_s_swing_r)) {
-    const Scalar ik_lever_r_R = std::sqrt(ik_lever_r_alpha * ik_lever_r_alpha + ik_lever_r_beta * ik_lever_r_beta);
+    const Scalar ik_lever_r_R = detail::square_root(ik_lever_r_alpha * ik_lever_r_alpha + ik_lever_r_beta * ik_lever_r_beta);
     why = {1, ground_r, ik_lever_r_gamma - ik_lever_r_R, ik_lever_r_gamma + ik_lever_r_R, 0.0};
     failed = 3;
     return IkStatus::out_of_reach;

@@ -46,7 +46,6 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
   static_cast<void>(p);
   const auto Phi = out.Phi;
   const auto dPhi_ds = out.dPhi_ds;
-  using std::sqrt;
   const Scalar x_B = s(0);
   const Scalar y_B = s(1);
   const Scalar z_B = s(2);
@@ -156,7 +155,7 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
   const Scalar t13 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
   const Scalar t14 = t12*sin_haa_lf + t13*cos_haa_lf;
   const Scalar t15 = t14*t14 + t9*t9;
-  const Scalar t16 = Scalar(1)/sqrt(t15);
+  const Scalar t16 = Scalar(1)/detail::square_root(t15);
   const Scalar t17 = t9*t11*wheel_radius*t16;
   const Scalar t20 = t7*cos_haa_lf - t5*sin_haa_lf;
   const Scalar t22 = cos_hfe_lf*t20 + cos_yaw*sin_hfe_lf*cos_pitch;
@@ -213,7 +212,7 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
   const Scalar t81 = haa_rf_y*t5;
   const Scalar t82 = t13*cos_haa_rf + t12*sin_haa_rf;
   const Scalar t83 = t76*t76 + t82*t82;
-  const Scalar t84 = Scalar(1)/sqrt(t83);
+  const Scalar t84 = Scalar(1)/detail::square_root(t83);
   const Scalar t85 = cos_roll*cos_pitch*sin_haa_rf + sin_roll*cos_haa_rf*cos_pitch;
   const Scalar t86 = wheel_radius*t76*t84*t85;
   const Scalar t87 = t76*kfe_rf_y;
@@ -256,7 +255,7 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
   const Scalar t130 = sin_haa_lh*cos_roll*cos_pitch + sin_roll*cos_haa_lh*cos_pitch;
   const Scalar t131 = cos_haa_lh*t13 + sin_haa_lh*t12;
   const Scalar t132 = t131*t131 + t127*t127;
-  const Scalar t133 = Scalar(1)/sqrt(t132);
+  const Scalar t133 = Scalar(1)/detail::square_root(t132);
   const Scalar t134 = wheel_radius*t130*t133*t127;
   const Scalar t135 = kfe_lh_y*t127;
   const Scalar t136 = -kfe_lh_z*t121;
@@ -300,7 +299,7 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
   const Scalar t180 = sin_roll*cos_haa_rh*cos_pitch + sin_haa_rh*cos_roll*cos_pitch;
   const Scalar t181 = t12*sin_haa_rh + t13*cos_haa_rh;
   const Scalar t182 = t178*t178 + t181*t181;
-  const Scalar t183 = Scalar(1)/sqrt(t182);
+  const Scalar t183 = Scalar(1)/detail::square_root(t182);
   const Scalar t184 = t180*wheel_radius*t178*t183;
   const Scalar t185 = wheel_joint_rh_y*t178;
   const Scalar t186 = cos_kfe_rh*t170 - t172*sin_kfe_rh;
@@ -331,23 +330,23 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
     const Scalar t56 = -z_B;
     (*Phi)(0) = t17 + t26 + t27 + x_B + t29 + t30 + t31 + t32 + t33 + t34 + t35 - x_lf;
     (*Phi)(1) = t36 + t40 + t41 + t42 + y_B + t43 + t44 + t45 + t46 + t47 + t48 - y_lf;
-    (*Phi)(2) = -(t51 + t52 + t55 + t56 + t57 + ground_lf + t59 + t60 + sqrt(t15)*wheel_radius + t61 + t62 + t63);
+    (*Phi)(2) = -(t51 + t52 + t55 + t56 + t57 + ground_lf + t59 + t60 + detail::square_root(t15)*wheel_radius + t61 + t62 + t63);
     (*Phi)(3) = t73 + t74 + t75 + t77 + x_B + t78 + t79 + t80 + t81 + t86 + t87 - x_rf;
     (*Phi)(4) = t88 + t89 + t90 + t91 + t95 + y_B + t96 + t97 + t98 + t99 + t100 - y_rf;
-    (*Phi)(5) = -(t101 + ground_rf + t56 + t104 + t105 + t106 + t109 + t110 + t111 + wheel_radius*sqrt(t83) + t112 + t114);
+    (*Phi)(5) = -(t101 + ground_rf + t56 + t104 + t105 + t106 + t109 + t110 + t111 + wheel_radius*detail::square_root(t83) + t112 + t114);
     (*Phi)(6) = t115 + t125 + t126 + t128 + x_B + t129 + t134 + t135 + t136 + t137 + t138 - x_lh;
     (*Phi)(7) = t139 + t140 + t143 + t144 + t145 + t147 + y_B + t148 + t149 + t150 + t151 - y_lh;
-    (*Phi)(8) = -(t154 + t155 + t157 + t56 + t158 + wheel_radius*sqrt(t132) + ground_lh + t159 + t160 + t161 + t162 + t163);
+    (*Phi)(8) = -(t154 + t155 + t157 + t56 + t158 + wheel_radius*detail::square_root(t132) + ground_lh + t159 + t160 + t161 + t162 + t163);
     (*Phi)(9) = t174 + t175 + x_B + t176 + t177 + t179 + t184 + t185 + t187 + t188 + t189 - x_rh;
     (*Phi)(10) = t192 + t193 + t196 + y_B + t197 + t198 + t199 + t200 + t201 + t203 + t204 - y_rh;
-    (*Phi)(11) = -(wheel_radius*sqrt(t182) + t56 + haa_rh_x*sin_pitch + t208*wheel_joint_rh_x + ground_rh + hfe_rh_x*sin_pitch - kfe_rh_z*t206 - sin_roll*cos_pitch*haa_rh_y - t180*hfe_rh_y - t180*kfe_rh_y - t180*wheel_joint_rh_y - t209*wheel_joint_rh_z);
+    (*Phi)(11) = -(wheel_radius*detail::square_root(t182) + t56 + haa_rh_x*sin_pitch + t208*wheel_joint_rh_x + ground_rh + hfe_rh_x*sin_pitch - kfe_rh_z*t206 - sin_roll*cos_pitch*haa_rh_y - t180*hfe_rh_y - t180*kfe_rh_y - t180*wheel_joint_rh_y - t209*wheel_joint_rh_z);
   }
   if (dPhi_ds != nullptr) {
     if (zero_fill) dPhi_ds->setZero();
     const Scalar t210 = t51 + t52 + t55 + t57 + t59 + t60 + t61 + t62 + t63;
     const Scalar t211 = sin_yaw*t14 + t9*cos_yaw;
     const Scalar t212 = t11*sin_yaw*t14 + t9*cos_yaw*t11;
-    const Scalar t213 = Scalar(1)/(t15*sqrt(t15));
+    const Scalar t213 = Scalar(1)/(t15*detail::square_root(t15));
     const Scalar t214 = t11*cos_pitch*sin_yaw + sin_pitch*t14;
     const Scalar t215 = cos_yaw*t11*cos_pitch + t9*sin_pitch;
     const Scalar t216 = t215*t14 - t9*t214;
@@ -378,7 +377,7 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
     const Scalar t241 = t82*sin_yaw + cos_yaw*t76;
     const Scalar t242 = t101 + t104 + t105 + t106 + t109 + t110 + t111 + t112 + t114;
     const Scalar t243 = t82*sin_yaw*t85 + cos_yaw*t76*t85;
-    const Scalar t244 = Scalar(1)/(t83*sqrt(t83));
+    const Scalar t244 = Scalar(1)/(t83*detail::square_root(t83));
     const Scalar t245 = cos_yaw*t82*cos_pitch - t76*cos_pitch*sin_yaw;
     const Scalar t246 = t245*wheel_radius*t76*t84;
     const Scalar t247 = cos_pitch*sin_yaw*t85 + sin_pitch*t82;
@@ -403,7 +402,7 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
     const Scalar t266 = wheel_radius*t249*t84;
     const Scalar t267 = t131*sin_yaw + cos_yaw*t127;
     const Scalar t268 = t130*t131*sin_yaw + cos_yaw*t130*t127;
-    const Scalar t269 = Scalar(1)/(t132*sqrt(t132));
+    const Scalar t269 = Scalar(1)/(t132*detail::square_root(t132));
     const Scalar t270 = t154 + t155 + t157 + t158 + t159 + t160 + t161 + t162 + t163;
     const Scalar t271 = cos_yaw*t131*cos_pitch - cos_pitch*sin_yaw*t127;
     const Scalar t272 = wheel_radius*t133*t271*t127;
@@ -425,7 +424,7 @@ inline void closure(const CoordinatesOf<Scalar>& s, const Params& p, const detai
     const Scalar t288 = t125 + t128 + t135 + t136 + t138;
     const Scalar t289 = t125 + t128 + t138;
     const Scalar t290 = wheel_radius*t133*t275;
-    const Scalar t291 = Scalar(1)/(t182*sqrt(t182));
+    const Scalar t291 = Scalar(1)/(t182*detail::square_root(t182));
     const Scalar t292 = t180*cos_yaw*t178 + t180*t181*sin_yaw;
     const Scalar t293 = kfe_rh_z*t206;
     const Scalar t294 = t180*kfe_rh_y;

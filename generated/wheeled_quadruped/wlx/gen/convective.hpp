@@ -45,7 +45,6 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
   const auto dPhi_ds_dot_sdot = out.dPhi_ds_dot_sdot;
   const auto C_dot_sdot = out.C_dot_sdot;
   static_cast<void>(sdot);
-  using std::sqrt;
   const Scalar yaw = s(3);
   const Scalar pitch = s(4);
   const Scalar roll = s(5);
@@ -174,7 +173,7 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
   const Scalar t30 = t5*t29 - t20*t24;
   const Scalar t31 = t21*t24 + t11*t30;
   const Scalar t32 = t24*t24 + t11*t11;
-  const Scalar t33 = Scalar(1)/(t32*sqrt(t32));
+  const Scalar t33 = Scalar(1)/(t32*detail::square_root(t32));
   const Scalar t34 = t19 + yaw_dot;
   const Scalar t35 = t12 + t15;
   const Scalar t36 = cos_yaw*t34*cos_pitch - sin_pitch*t35;
@@ -207,7 +206,7 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
   const Scalar t63 = -haa_lf_dot*t62;
   const Scalar t64 = t58 + t59 + t61 + t63 + (t5*t48 - t38*t24)*kfe_lf_dot;
   const Scalar t65 = t11*t56 + t16*t47 + t5*t64 - t30*t20;
-  const Scalar t66 = Scalar(1)/sqrt(t32);
+  const Scalar t66 = Scalar(1)/detail::square_root(t32);
   const Scalar t67 = (t11*t57 + t65*t24 - t21*t21 - t30*t30)*t66;
   const Scalar t68 = Scalar(3.0)*t31*t31*t33 + t67;
   const Scalar t69 = Scalar(1)/t32;
@@ -289,7 +288,7 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
   const Scalar t153 = sin_hfe_rf*cos_pitch*sin_yaw + cos_hfe_rf*t152;
   const Scalar t154 = t141*kfe_rf_y - t153*kfe_rf_z;
   const Scalar t155 = t146*t146 + t141*t141;
-  const Scalar t156 = Scalar(1)/sqrt(t155);
+  const Scalar t156 = Scalar(1)/detail::square_root(t155);
   const Scalar t157 = hfe_rf_dot*t141;
   const Scalar t158 = -haa_rf_dot*cos_pitch*sin_yaw;
   const Scalar t159 = -pitch_dot*cos_yaw;
@@ -344,7 +343,7 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
   const Scalar t210 = t209*t175;
   const Scalar t211 = t207 + t210;
   const Scalar t212 = t179*t146 - t141*t177;
-  const Scalar t213 = Scalar(1)/(t155*sqrt(t155));
+  const Scalar t213 = Scalar(1)/(t155*detail::square_root(t155));
   const Scalar t214 = t146*t212*t213 - t179*t156;
   const Scalar t215 = t141*t175 + t146*t178;
   const Scalar t216 = Scalar(1)/t155;
@@ -411,8 +410,8 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
   const Scalar t283 = t250*t281 + t244*t279;
   const Scalar t284 = t250*t282 - t283*t237;
   const Scalar t285 = t250*t250 + t237*t237;
-  const Scalar t286 = Scalar(1)/(t285*sqrt(t285));
-  const Scalar t287 = Scalar(1)/sqrt(t285);
+  const Scalar t286 = Scalar(1)/(t285*detail::square_root(t285));
+  const Scalar t287 = Scalar(1)/detail::square_root(t285);
   const Scalar t288 = t284*t237*t286 + t283*t287;
   const Scalar t289 = sin_roll*haa_lh_y*cos_pitch - sin_pitch*haa_lh_x;
   const Scalar t290 = t268 + t44 + t269 + t45;
@@ -514,8 +513,8 @@ inline void convective(const CoordinatesOf<Scalar>& s, const detail::NonDeduced<
   const Scalar t392 = t388 + t389 + t390 + kfe_rh_dot*(t356*t376 + t391*t349);
   const Scalar t393 = t344*t379 - t385*t362 - t387*t386 - t392*t356;
   const Scalar t394 = t349*t349 + t356*t356;
-  const Scalar t395 = Scalar(1)/sqrt(t394);
-  const Scalar t396 = Scalar(1)/(t394*sqrt(t394));
+  const Scalar t395 = Scalar(1)/detail::square_root(t394);
+  const Scalar t396 = Scalar(1)/(t394*detail::square_root(t394));
   const Scalar t397 = t344*t362 - t356*t386;
   const Scalar t398 = t387*t356 + t349*t397;
   const Scalar t399 = haa_rh_dot*t62;

@@ -49,7 +49,6 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   const auto dPhi_ds = out.dPhi_ds;
   const auto C = out.C;
   const auto drive = out.drive;
-  using std::sqrt;
   const Scalar yaw = s(3);
   const Scalar pitch = s(4);
   const Scalar roll = s(5);
@@ -144,7 +143,7 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   const Scalar t13 = sin_pitch*cos_yaw*cos_roll + sin_roll*sin_yaw;
   const Scalar t14 = t12*cos_haa_lf + t13*sin_haa_lf;
   const Scalar t15 = t11*t11 + t14*t14;
-  const Scalar t16 = Scalar(1)/sqrt(t15);
+  const Scalar t16 = Scalar(1)/detail::square_root(t15);
   const Scalar t18 = t9*cos_haa_lf - t10*sin_haa_lf;
   const Scalar t21 = cos_hfe_lf*cos_pitch*sin_yaw - t18*sin_hfe_lf;
   const Scalar t23 = sin_hfe_lf*cos_pitch*sin_yaw + t18*cos_hfe_lf;
@@ -173,7 +172,7 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   const Scalar t46 = t36 + t37 + t40 + haa_lf_x*sin_pitch + t42 + t43 + t44 + t45 - sin_roll*cos_pitch*haa_lf_y;
   const Scalar t47 = sin_yaw*t11 + t14*cos_yaw;
   const Scalar t48 = t5*sin_yaw*t11 + t14*cos_yaw*t5;
-  const Scalar t49 = Scalar(1)/(t15*sqrt(t15));
+  const Scalar t49 = Scalar(1)/(t15*detail::square_root(t15));
   const Scalar t50 = t5*wheel_radius*(cos_yaw*t5*t16 - t14*t48*t49) - cos_yaw*t46 - t14*wheel_radius*t47*t16;
   const Scalar t51 = t5*cos_pitch*sin_yaw + sin_pitch*t11;
   const Scalar t52 = cos_yaw*t5*cos_pitch + t14*sin_pitch;
@@ -225,7 +224,7 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   const Scalar t101 = t10*cos_haa_rf + t9*sin_haa_rf;
   const Scalar t102 = cos_haa_rf*t12 + t13*sin_haa_rf;
   const Scalar t103 = t102*t102 + t101*t101;
-  const Scalar t104 = Scalar(1)/sqrt(t103);
+  const Scalar t104 = Scalar(1)/detail::square_root(t103);
   const Scalar t105 = cos_roll*cos_pitch*sin_haa_rf;
   const Scalar t106 = sin_roll*cos_haa_rf*cos_pitch;
   const Scalar t107 = t105 + t106;
@@ -255,7 +254,7 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   const Scalar t135 = -t134*wheel_joint_rf_z;
   const Scalar t136 = t124 + t127 + t128 + t129 + t132 + sin_pitch*haa_rf_x + t133 + t135 - sin_roll*haa_rf_y*cos_pitch;
   const Scalar t137 = t101*sin_yaw*t107 + cos_yaw*t102*t107;
-  const Scalar t138 = Scalar(1)/(t103*sqrt(t103));
+  const Scalar t138 = Scalar(1)/(t103*detail::square_root(t103));
   const Scalar t139 = wheel_radius*t123*t102*t104 + cos_yaw*t136 + wheel_radius*(t137*t102*t138 - cos_yaw*t104*t107)*t107;
   const Scalar t140 = cos_yaw*t101*cos_pitch - t102*cos_pitch*sin_yaw;
   const Scalar t141 = t140*wheel_radius*t102*t104;
@@ -320,7 +319,7 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   const Scalar t205 = t203 + t204;
   const Scalar t206 = t13*sin_haa_lh + cos_haa_lh*t12;
   const Scalar t207 = t194*t194 + t206*t206;
-  const Scalar t208 = Scalar(1)/sqrt(t207);
+  const Scalar t208 = Scalar(1)/detail::square_root(t207);
   const Scalar t211 = cos_pitch*sin_yaw*cos_hfe_lh - t198*sin_hfe_lh;
   const Scalar t212 = -(sin_kfe_lh*t200 - cos_kfe_lh*t211)*wheel_joint_lh_x;
   const Scalar t213 = hfe_lh_x*cos_pitch*sin_yaw;
@@ -330,7 +329,7 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   const Scalar t217 = t195 + t196 + t201 + t202 + wheel_radius*t205*t208*t194 + t212 + t213 + t214 + t215 + t216;
   const Scalar t218 = t194*sin_yaw + cos_yaw*t206;
   const Scalar t219 = t205*t194*sin_yaw + cos_yaw*t205*t206;
-  const Scalar t220 = Scalar(1)/(t207*sqrt(t207));
+  const Scalar t220 = Scalar(1)/(t207*detail::square_root(t207));
   const Scalar t221 = sin_roll*sin_haa_lh*cos_pitch - cos_haa_lh*cos_roll*cos_pitch;
   const Scalar t222 = sin_pitch*sin_hfe_lh + t221*cos_hfe_lh;
   const Scalar t223 = kfe_lh_z*t222;
@@ -405,14 +404,14 @@ inline void dynamics_update(const CoordinatesOf<Scalar>& s, const Params& p, con
   const Scalar t299 = t297 + t298;
   const Scalar t300 = t13*sin_haa_rh + t12*cos_haa_rh;
   const Scalar t301 = t300*t300 + t288*t288;
-  const Scalar t302 = Scalar(1)/sqrt(t301);
+  const Scalar t302 = Scalar(1)/detail::square_root(t301);
   const Scalar t303 = t10*haa_rh_y;
   const Scalar t304 = t288*kfe_rh_y;
   const Scalar t305 = cos_kfe_rh*t291 - sin_kfe_rh*t286;
   const Scalar t306 = t305*wheel_joint_rh_x;
   const Scalar t307 = haa_rh_x*cos_pitch*sin_yaw;
   const Scalar t308 = t287 + t289 + t294 + t295 + t296 + t299*wheel_radius*t302*t288 + t303 + t304 + t306 + t307;
-  const Scalar t309 = Scalar(1)/(t301*sqrt(t301));
+  const Scalar t309 = Scalar(1)/(t301*detail::square_root(t301));
   const Scalar t310 = t299*cos_yaw*t300 + t299*t288*sin_yaw;
   const Scalar t311 = sin_roll*sin_haa_rh*cos_pitch - cos_haa_rh*cos_roll*cos_pitch;
   const Scalar t312 = sin_pitch*sin_hfe_rh - t311*cos_hfe_rh;

@@ -68,7 +68,7 @@ template <typename Scalar>
 inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& cos_x, Scalar& sin_x) noexcept {
   // sqrt, not std::hypot (several times slower): a and b are lengths or products of unit vectors
   // and lengths, nowhere near overflow.
-  const Scalar r = std::sqrt(a * a + b * b);
+  const Scalar r = detail::square_root(a * a + b * b);
   if (!(r > 0)) {
     // The joint does not move what it solves for: the reachable range is the one value c = 0
     // (reported as [v, v]), where every x solves; x = 0 is the root nearest zero.
@@ -83,7 +83,7 @@ inline bool ik_solve_cos_sin(Scalar a, Scalar b, Scalar c, bool other, Scalar& c
     ratio = std::copysign(Scalar(1), ratio);
   }
   const Scalar cos_psi = a / r, sin_psi = b / r;  // x = psi +- delta
-  const Scalar sin_delta = std::sqrt((1 - ratio) * (1 + ratio));
+  const Scalar sin_delta = detail::square_root((1 - ratio) * (1 + ratio));
   Scalar sign = sin_psi > 0 ? Scalar(-1) : sin_psi < 0 ? Scalar(1) : (cos_psi >= 0 ? Scalar(1) : Scalar(-1));
   if (other) sign = -sign;
   cos_x = cos_psi * ratio - sign * sin_psi * sin_delta;
@@ -107,18 +107,18 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
   if (k2 < 0) {
     if (-k2 > ik_reach_slack<Scalar>() * (across + v[B] * v[B])) {
       beside = std::abs(d[A]);
-      room = std::sqrt(v[A] * v[A] + v[C] * v[C]);
+      room = detail::square_root(v[A] * v[A] + v[C] * v[C]);
       return false;
     }
     k2 = 0;
   }
-  Scalar k = std::sqrt(k2);
+  Scalar k = detail::square_root(k2);
   if ((v[C] < 0) != flip) k = -k;
   Scalar t[3] = {0, 0, 0};
   t[A] = d[A];
   t[C] = k;
   const Scalar y = v[i] * t[j] - v[j] * t[i], x = v[i] * t[i] + v[j] * t[j];
-  const Scalar r = std::sqrt(x * x + y * y);
+  const Scalar r = detail::square_root(x * x + y * y);
   c2 = r > 0 ? x / r : Scalar(1);
   s2 = r > 0 ? y / r : Scalar(0);
   Scalar w[3];
@@ -126,7 +126,7 @@ inline bool ik_solve_two_axis(const Scalar (&v)[3], const Scalar (&d)[3], bool f
   w[i] = c2 * v[i] - s2 * v[j];
   w[j] = s2 * v[i] + c2 * v[j];
   const Scalar y1 = w[i1] * d[j1] - w[j1] * d[i1], x1 = w[i1] * d[i1] + w[j1] * d[j1];
-  const Scalar r1 = std::sqrt(x1 * x1 + y1 * y1);
+  const Scalar r1 = detail::square_root(x1 * x1 + y1 * y1);
   c1 = r1 > 0 ? x1 / r1 : Scalar(1);
   s1 = r1 > 0 ? y1 / r1 : Scalar(0);
   return true;
@@ -151,7 +151,6 @@ inline IkStatus ik_leg_lf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 4) return IkStatus::bad_branch;
-  using std::sqrt;
   const Scalar x_B = s(0);
   const Scalar y_B = s(1);
   const Scalar z_B = s(2);
@@ -196,7 +195,7 @@ inline IkStatus ik_leg_lf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_gamma = hfe_lf_y + wheel_joint_lf_y + kfe_lf_y;
   Scalar ik_c_haa_lf, ik_s_haa_lf;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, ik_c_haa_lf, ik_s_haa_lf)) {
-    why = {1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0};
+    why = {1, double(std::abs(ik_gamma)), 0.0, double(detail::square_root(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_t13 = ik_t12*ik_s_haa_lf + ik_t5*ik_c_haa_lf;
@@ -204,7 +203,7 @@ inline IkStatus ik_leg_lf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_t15 = sin_roll*cos_pitch*ik_c_haa_lf + cos_roll*cos_pitch*ik_s_haa_lf;
   const Scalar ik_t18 = ik_t12*ik_c_haa_lf - ik_t5*ik_s_haa_lf;
   const Scalar ik_t21 = ik_t14*ik_t14 + ik_t13*ik_t13;
-  const Scalar ik_t22 = Scalar(1)/sqrt(ik_t21);
+  const Scalar ik_t22 = Scalar(1)/detail::square_root(ik_t21);
   const Scalar ik_t23 = ik_t8*ik_s_haa_lf - ik_t11*ik_c_haa_lf;
   const Scalar ik_t26 = cos_roll*cos_pitch*ik_c_haa_lf - sin_roll*cos_pitch*ik_s_haa_lf;
   const Scalar ik_a0 = ik_t13;
@@ -215,7 +214,7 @@ inline IkStatus ik_leg_lf(const CoordinatesOf<Scalar>& s, const Params& p, int b
     why = {1, 0.0, 0.0, 0.0, 0.0};
     return IkStatus::out_of_reach;
   }
-  const Scalar ik_tilt = std::sqrt(ik_tilt2);
+  const Scalar ik_tilt = detail::square_root(ik_tilt2);
   const Scalar ik_u0 = -ik_a2 * ik_a0 / ik_tilt, ik_u1 = -ik_a2 * ik_a1 / ik_tilt, ik_u2 = ik_tilt;
   const Scalar ik_t16 = ik_d1 + (sin_roll*ik_u2*cos_pitch + ik_t5*ik_u0 + ik_u1*ik_t8)*wheel_radius;
   const Scalar ik_t17 = wheel_radius*(ik_u2*cos_roll*cos_pitch + ik_t12*ik_u0 + ik_u1*ik_t11) + ik_d2;
@@ -228,14 +227,14 @@ inline IkStatus ik_leg_lf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_ww = ik_w0 * ik_w0 + ik_w1 * ik_w1 + ik_w2 * ik_w2;
   Scalar ik_c_kfe_lf, ik_s_kfe_lf;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_ww - ik_K, (branch & 2) != 0, ik_c_kfe_lf, ik_s_kfe_lf)) {
-    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {2, std::sqrt(ik_ww), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = detail::square_root(ik_A * ik_A + ik_B * ik_B);
+    why = {2, detail::square_root(ik_ww), detail::square_root(std::max(Scalar(0), ik_K - ik_R)), detail::square_root(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_v2 = ik_c_kfe_lf*wheel_joint_lf_z + kfe_lf_z - ik_s_kfe_lf*wheel_joint_lf_x;
   const Scalar ik_v0 = ik_c_kfe_lf*wheel_joint_lf_x + ik_s_kfe_lf*wheel_joint_lf_z;
   const Scalar ik_x = ik_v2 * ik_w2 + ik_v0 * ik_w0, ik_y = ik_v2 * ik_w0 - ik_v0 * ik_w2;
-  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);
+  const Scalar ik_r = detail::square_root(ik_x * ik_x + ik_y * ik_y);
   Scalar ik_c_hfe_lf = ik_r > 0 ? ik_x / ik_r : Scalar(1), ik_s_hfe_lf = ik_r > 0 ? ik_y / ik_r : Scalar(0);
   const Scalar ik_t19 = cos_yaw*ik_s_hfe_lf*cos_pitch + ik_c_hfe_lf*ik_t18;
   const Scalar ik_t20 = ik_s_hfe_lf*ik_t18 - ik_c_hfe_lf*cos_yaw*cos_pitch;
@@ -251,7 +250,7 @@ inline IkStatus ik_leg_lf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_q_kfe_lf = ik_angles[2];
   const Scalar ik_row0 = -((ik_s_kfe_lf*ik_t20 - ik_t19*ik_c_kfe_lf)*wheel_joint_lf_z + (ik_c_kfe_lf*ik_t20 + ik_s_kfe_lf*ik_t19)*wheel_joint_lf_x + x_lf - ik_t15*wheel_radius*ik_t22*ik_t13 - ik_t19*kfe_lf_z - hfe_lf_y*ik_t13 - ik_t13*wheel_joint_lf_y - haa_lf_x*cos_yaw*cos_pitch - x_B - ik_t5*haa_lf_y - cos_yaw*hfe_lf_x*cos_pitch - ik_t13*kfe_lf_y);
   const Scalar ik_row1 = -((ik_s_kfe_lf*ik_t25 - ik_c_kfe_lf*ik_t24)*wheel_joint_lf_x + y_lf - ik_t14*kfe_lf_y - hfe_lf_x*cos_pitch*sin_yaw - kfe_lf_z*ik_t25 - ik_t15*wheel_radius*ik_t22*ik_t14 - ik_t8*haa_lf_y - wheel_joint_lf_y*ik_t14 - haa_lf_x*cos_pitch*sin_yaw - y_B - wheel_joint_lf_z*(ik_s_kfe_lf*ik_t24 + ik_c_kfe_lf*ik_t25) - hfe_lf_y*ik_t14);
-  const Scalar ik_row2 = -(wheel_radius*sqrt(ik_t21) + haa_lf_x*sin_pitch + ground_lf + sin_pitch*hfe_lf_x + (ik_c_kfe_lf*ik_t28 + ik_s_kfe_lf*ik_t27)*wheel_joint_lf_x - z_B - sin_roll*cos_pitch*haa_lf_y - ik_t15*kfe_lf_y - ik_t15*wheel_joint_lf_y - ik_t15*hfe_lf_y - wheel_joint_lf_z*(ik_c_kfe_lf*ik_t27 - ik_s_kfe_lf*ik_t28) - ik_t27*kfe_lf_z);
+  const Scalar ik_row2 = -(wheel_radius*detail::square_root(ik_t21) + haa_lf_x*sin_pitch + ground_lf + sin_pitch*hfe_lf_x + (ik_c_kfe_lf*ik_t28 + ik_s_kfe_lf*ik_t27)*wheel_joint_lf_x - z_B - sin_roll*cos_pitch*haa_lf_y - ik_t15*kfe_lf_y - ik_t15*wheel_joint_lf_y - ik_t15*hfe_lf_y - wheel_joint_lf_z*(ik_c_kfe_lf*ik_t27 - ik_s_kfe_lf*ik_t28) - ik_t27*kfe_lf_z);
   const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
   if (!(ik_residual <= ik_tolerance<Scalar>())) {
     why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
@@ -282,7 +281,6 @@ inline IkStatus ik_leg_rf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 4) return IkStatus::bad_branch;
-  using std::sqrt;
   const Scalar x_B = s(0);
   const Scalar y_B = s(1);
   const Scalar z_B = s(2);
@@ -327,7 +325,7 @@ inline IkStatus ik_leg_rf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_gamma = hfe_rf_y + wheel_joint_rf_y + kfe_rf_y;
   Scalar ik_c_haa_rf, ik_s_haa_rf;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, ik_c_haa_rf, ik_s_haa_rf)) {
-    why = {1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0};
+    why = {1, double(std::abs(ik_gamma)), 0.0, double(detail::square_root(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_t13 = ik_t11*ik_s_haa_rf + ik_t9*ik_c_haa_rf;
@@ -335,7 +333,7 @@ inline IkStatus ik_leg_rf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_t15 = sin_roll*ik_c_haa_rf*cos_pitch + ik_s_haa_rf*cos_roll*cos_pitch;
   const Scalar ik_t18 = ik_t9*ik_s_haa_rf - ik_t11*ik_c_haa_rf;
   const Scalar ik_t21 = ik_t14*ik_t14 + ik_t13*ik_t13;
-  const Scalar ik_t22 = Scalar(1)/sqrt(ik_t21);
+  const Scalar ik_t22 = Scalar(1)/detail::square_root(ik_t21);
   const Scalar ik_t23 = ik_t7*ik_s_haa_rf - ik_t12*ik_c_haa_rf;
   const Scalar ik_t26 = ik_c_haa_rf*cos_roll*cos_pitch - sin_roll*ik_s_haa_rf*cos_pitch;
   const Scalar ik_a0 = ik_t13;
@@ -346,7 +344,7 @@ inline IkStatus ik_leg_rf(const CoordinatesOf<Scalar>& s, const Params& p, int b
     why = {1, 0.0, 0.0, 0.0, 0.0};
     return IkStatus::out_of_reach;
   }
-  const Scalar ik_tilt = std::sqrt(ik_tilt2);
+  const Scalar ik_tilt = detail::square_root(ik_tilt2);
   const Scalar ik_u0 = -ik_a2 * ik_a0 / ik_tilt, ik_u1 = -ik_a2 * ik_a1 / ik_tilt, ik_u2 = ik_tilt;
   const Scalar ik_t16 = wheel_radius*(ik_u2*cos_roll*cos_pitch + ik_t11*ik_u0 + ik_u1*ik_t12) + ik_d2;
   const Scalar ik_t17 = ik_d1 + (sin_roll*ik_u2*cos_pitch + ik_t9*ik_u0 + ik_u1*ik_t7)*wheel_radius;
@@ -359,14 +357,14 @@ inline IkStatus ik_leg_rf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_ww = ik_w0 * ik_w0 + ik_w1 * ik_w1 + ik_w2 * ik_w2;
   Scalar ik_c_kfe_rf, ik_s_kfe_rf;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_ww - ik_K, (branch & 2) != 0, ik_c_kfe_rf, ik_s_kfe_rf)) {
-    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {2, std::sqrt(ik_ww), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = detail::square_root(ik_A * ik_A + ik_B * ik_B);
+    why = {2, detail::square_root(ik_ww), detail::square_root(std::max(Scalar(0), ik_K - ik_R)), detail::square_root(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_v2 = wheel_joint_rf_z*ik_c_kfe_rf + ik_s_kfe_rf*wheel_joint_rf_x + kfe_rf_z;
   const Scalar ik_v0 = ik_c_kfe_rf*wheel_joint_rf_x - wheel_joint_rf_z*ik_s_kfe_rf;
   const Scalar ik_x = ik_v2 * ik_w2 + ik_v0 * ik_w0, ik_y = ik_v2 * ik_w0 - ik_v0 * ik_w2;
-  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);
+  const Scalar ik_r = detail::square_root(ik_x * ik_x + ik_y * ik_y);
   Scalar ik_c_hfe_rf = ik_r > 0 ? ik_x / ik_r : Scalar(1), ik_s_hfe_rf = ik_r > 0 ? ik_y / ik_r : Scalar(0);
   ik_s_hfe_rf = -ik_s_hfe_rf;  // the step turns about the negative axis: q = -theta
   const Scalar ik_t19 = cos_yaw*ik_s_hfe_rf*cos_pitch + ik_c_hfe_rf*ik_t18;
@@ -383,7 +381,7 @@ inline IkStatus ik_leg_rf(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_q_kfe_rf = ik_angles[2];
   const Scalar ik_row0 = -(kfe_rf_z*ik_t19 + (ik_s_kfe_rf*ik_t19 + ik_t20*ik_c_kfe_rf)*wheel_joint_rf_x + (ik_c_kfe_rf*ik_t19 - ik_t20*ik_s_kfe_rf)*wheel_joint_rf_z + x_rf - wheel_joint_rf_y*ik_t13 - kfe_rf_y*ik_t13 - cos_yaw*cos_pitch*hfe_rf_x - haa_rf_y*ik_t9 - hfe_rf_y*ik_t13 - x_B - cos_yaw*haa_rf_x*cos_pitch - wheel_radius*ik_t22*ik_t15*ik_t13);
   const Scalar ik_row1 = -(ik_t24*kfe_rf_z + y_rf + wheel_joint_rf_z*(ik_t24*ik_c_kfe_rf - ik_t25*ik_s_kfe_rf) + (ik_t24*ik_s_kfe_rf + ik_t25*ik_c_kfe_rf)*wheel_joint_rf_x - haa_rf_y*ik_t7 - cos_pitch*sin_yaw*hfe_rf_x - haa_rf_x*cos_pitch*sin_yaw - wheel_radius*ik_t14*ik_t22*ik_t15 - wheel_joint_rf_y*ik_t14 - y_B - hfe_rf_y*ik_t14 - ik_t14*kfe_rf_y);
-  const Scalar ik_row2 = wheel_joint_rf_y*ik_t15 + hfe_rf_y*ik_t15 + z_B + sin_roll*haa_rf_y*cos_pitch + kfe_rf_z*ik_t28 + (ik_s_kfe_rf*ik_t28 + ik_t27*ik_c_kfe_rf)*wheel_joint_rf_x + kfe_rf_y*ik_t15 - wheel_joint_rf_z*(ik_t27*ik_s_kfe_rf - ik_c_kfe_rf*ik_t28) - sin_pitch*haa_rf_x - ground_rf - sqrt(ik_t21)*wheel_radius - sin_pitch*hfe_rf_x;
+  const Scalar ik_row2 = wheel_joint_rf_y*ik_t15 + hfe_rf_y*ik_t15 + z_B + sin_roll*haa_rf_y*cos_pitch + kfe_rf_z*ik_t28 + (ik_s_kfe_rf*ik_t28 + ik_t27*ik_c_kfe_rf)*wheel_joint_rf_x + kfe_rf_y*ik_t15 - wheel_joint_rf_z*(ik_t27*ik_s_kfe_rf - ik_c_kfe_rf*ik_t28) - sin_pitch*haa_rf_x - ground_rf - detail::square_root(ik_t21)*wheel_radius - sin_pitch*hfe_rf_x;
   const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
   if (!(ik_residual <= ik_tolerance<Scalar>())) {
     why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
@@ -414,7 +412,6 @@ inline IkStatus ik_leg_lh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 4) return IkStatus::bad_branch;
-  using std::sqrt;
   const Scalar x_B = s(0);
   const Scalar y_B = s(1);
   const Scalar z_B = s(2);
@@ -471,7 +468,7 @@ inline IkStatus ik_leg_lh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_gamma = kfe_lh_y + wheel_joint_lh_y + hfe_lh_y;
   Scalar ik_c_haa_lh, ik_s_haa_lh;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, ik_c_haa_lh, ik_s_haa_lh)) {
-    why = {1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0};
+    why = {1, double(std::abs(ik_gamma)), 0.0, double(detail::square_root(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_t25 = ik_t19*ik_c_haa_lh + ik_t23*ik_s_haa_lh;
@@ -479,7 +476,7 @@ inline IkStatus ik_leg_lh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_t27 = sin_roll*cos_pitch*ik_c_haa_lh + cos_roll*cos_pitch*ik_s_haa_lh;
   const Scalar ik_t30 = ik_t19*ik_s_haa_lh - ik_t23*ik_c_haa_lh;
   const Scalar ik_t33 = ik_t25*ik_t25 + ik_t26*ik_t26;
-  const Scalar ik_t34 = Scalar(1)/sqrt(ik_t33);
+  const Scalar ik_t34 = Scalar(1)/detail::square_root(ik_t33);
   const Scalar ik_t35 = ik_t24*ik_c_haa_lh - ik_t13*ik_s_haa_lh;
   const Scalar ik_t38 = sin_roll*cos_pitch*ik_s_haa_lh - cos_roll*cos_pitch*ik_c_haa_lh;
   const Scalar ik_a0 = ik_t25;
@@ -490,7 +487,7 @@ inline IkStatus ik_leg_lh(const CoordinatesOf<Scalar>& s, const Params& p, int b
     why = {1, 0.0, 0.0, 0.0, 0.0};
     return IkStatus::out_of_reach;
   }
-  const Scalar ik_tilt = std::sqrt(ik_tilt2);
+  const Scalar ik_tilt = detail::square_root(ik_tilt2);
   const Scalar ik_u0 = -ik_a2 * ik_a0 / ik_tilt, ik_u1 = -ik_a2 * ik_a1 / ik_tilt, ik_u2 = ik_tilt;
   const Scalar ik_t28 = ik_d1 + (sin_roll*ik_u2*cos_pitch + ik_t19*ik_u0 + ik_u1*ik_t13)*wheel_radius;
   const Scalar ik_t29 = wheel_radius*(ik_u2*cos_roll*cos_pitch + ik_t23*ik_u0 + ik_u1*ik_t24) + ik_d2;
@@ -503,14 +500,14 @@ inline IkStatus ik_leg_lh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_ww = ik_w0 * ik_w0 + ik_w1 * ik_w1 + ik_w2 * ik_w2;
   Scalar ik_c_kfe_lh, ik_s_kfe_lh;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_ww - ik_K, (branch & 2) != 0, ik_c_kfe_lh, ik_s_kfe_lh)) {
-    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {2, std::sqrt(ik_ww), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = detail::square_root(ik_A * ik_A + ik_B * ik_B);
+    why = {2, detail::square_root(ik_ww), detail::square_root(std::max(Scalar(0), ik_K - ik_R)), detail::square_root(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_v2 = kfe_lh_z + ik_c_kfe_lh*wheel_joint_lh_z - ik_s_kfe_lh*wheel_joint_lh_x;
   const Scalar ik_v0 = ik_s_kfe_lh*wheel_joint_lh_z + ik_c_kfe_lh*wheel_joint_lh_x;
   const Scalar ik_x = ik_v2 * ik_w2 + ik_v0 * ik_w0, ik_y = ik_v2 * ik_w0 - ik_v0 * ik_w2;
-  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);
+  const Scalar ik_r = detail::square_root(ik_x * ik_x + ik_y * ik_y);
   Scalar ik_c_hfe_lh = ik_r > 0 ? ik_x / ik_r : Scalar(1), ik_s_hfe_lh = ik_r > 0 ? ik_y / ik_r : Scalar(0);
   const Scalar ik_t31 = cos_yaw*ik_s_hfe_lh*cos_pitch - ik_c_hfe_lh*ik_t30;
   const Scalar ik_t32 = ik_s_hfe_lh*ik_t30 + ik_c_hfe_lh*cos_yaw*cos_pitch;
@@ -526,7 +523,7 @@ inline IkStatus ik_leg_lh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_q_kfe_lh = ik_angles[2];
   const Scalar ik_row0 = ik_t17 + ik_t18 + x_B + ik_t20 + (ik_c_kfe_lh*ik_t31 + ik_s_kfe_lh*ik_t32)*wheel_joint_lh_z + kfe_lh_z*ik_t31 + ik_t21 + kfe_lh_y*ik_t25 + wheel_radius*ik_t27*ik_t34*ik_t25 + wheel_joint_lh_y*ik_t25 + ik_t25*hfe_lh_y - (ik_s_kfe_lh*ik_t31 - ik_c_kfe_lh*ik_t32)*wheel_joint_lh_x;
   const Scalar ik_row1 = wheel_joint_lh_y*ik_t26 + kfe_lh_y*ik_t26 + ik_t9 + y_B + wheel_radius*ik_t27*ik_t34*ik_t26 + ik_t10 + ik_t26*hfe_lh_y + kfe_lh_z*ik_t37 + ik_t14 + ik_t15 - (ik_c_kfe_lh*ik_t36 + ik_s_kfe_lh*ik_t37)*wheel_joint_lh_x - wheel_joint_lh_z*(ik_s_kfe_lh*ik_t36 - ik_c_kfe_lh*ik_t37);
-  const Scalar ik_row2 = ik_t1 + kfe_lh_y*ik_t27 + z_B + ik_t4 + ik_t27*hfe_lh_y + ik_t5 + ik_t27*wheel_joint_lh_y + ik_t6 + wheel_joint_lh_x*(ik_s_kfe_lh*ik_t39 - ik_c_kfe_lh*ik_t40) - kfe_lh_z*ik_t39 - (ik_s_kfe_lh*ik_t40 + ik_c_kfe_lh*ik_t39)*wheel_joint_lh_z - wheel_radius*sqrt(ik_t33);
+  const Scalar ik_row2 = ik_t1 + kfe_lh_y*ik_t27 + z_B + ik_t4 + ik_t27*hfe_lh_y + ik_t5 + ik_t27*wheel_joint_lh_y + ik_t6 + wheel_joint_lh_x*(ik_s_kfe_lh*ik_t39 - ik_c_kfe_lh*ik_t40) - kfe_lh_z*ik_t39 - (ik_s_kfe_lh*ik_t40 + ik_c_kfe_lh*ik_t39)*wheel_joint_lh_z - wheel_radius*detail::square_root(ik_t33);
   const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
   if (!(ik_residual <= ik_tolerance<Scalar>())) {
     why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
@@ -557,7 +554,6 @@ inline IkStatus ik_leg_rh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   static_assert(std::is_floating_point_v<Scalar>, "the closed-form IK is for float and double");
   static_cast<void>(p);
   if (branch < 0 || branch >= 4) return IkStatus::bad_branch;
-  using std::sqrt;
   const Scalar x_B = s(0);
   const Scalar y_B = s(1);
   const Scalar z_B = s(2);
@@ -610,7 +606,7 @@ inline IkStatus ik_leg_rh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_gamma = wheel_joint_rh_y + hfe_rh_y + kfe_rh_y;
   Scalar ik_c_haa_rh, ik_s_haa_rh;
   if (!ik_solve_cos_sin(ik_alpha, ik_beta, ik_gamma, (branch & 1) != 0, ik_c_haa_rh, ik_s_haa_rh)) {
-    why = {1, double(std::abs(ik_gamma)), 0.0, double(std::sqrt(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0};
+    why = {1, double(std::abs(ik_gamma)), 0.0, double(detail::square_root(ik_alpha * ik_alpha + ik_beta * ik_beta)), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_t21 = ik_t20*ik_s_haa_rh + ik_t14*ik_c_haa_rh;
@@ -618,7 +614,7 @@ inline IkStatus ik_leg_rh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_t23 = ik_s_haa_rh*cos_roll*cos_pitch + sin_roll*ik_c_haa_rh*cos_pitch;
   const Scalar ik_t26 = ik_t20*ik_c_haa_rh - ik_t14*ik_s_haa_rh;
   const Scalar ik_t29 = ik_t22*ik_t22 + ik_t21*ik_t21;
-  const Scalar ik_t30 = Scalar(1)/sqrt(ik_t29);
+  const Scalar ik_t30 = Scalar(1)/detail::square_root(ik_t29);
   const Scalar ik_t31 = ik_t19*ik_c_haa_rh - ik_t11*ik_s_haa_rh;
   const Scalar ik_t34 = ik_c_haa_rh*cos_roll*cos_pitch - sin_roll*ik_s_haa_rh*cos_pitch;
   const Scalar ik_a0 = ik_t21;
@@ -629,7 +625,7 @@ inline IkStatus ik_leg_rh(const CoordinatesOf<Scalar>& s, const Params& p, int b
     why = {1, 0.0, 0.0, 0.0, 0.0};
     return IkStatus::out_of_reach;
   }
-  const Scalar ik_tilt = std::sqrt(ik_tilt2);
+  const Scalar ik_tilt = detail::square_root(ik_tilt2);
   const Scalar ik_u0 = -ik_a2 * ik_a0 / ik_tilt, ik_u1 = -ik_a2 * ik_a1 / ik_tilt, ik_u2 = ik_tilt;
   const Scalar ik_t24 = ik_d1 + (sin_roll*ik_u2*cos_pitch + ik_t14*ik_u0 + ik_u1*ik_t11)*wheel_radius;
   const Scalar ik_t25 = wheel_radius*(ik_u2*cos_roll*cos_pitch + ik_t20*ik_u0 + ik_u1*ik_t19) + ik_d2;
@@ -642,14 +638,14 @@ inline IkStatus ik_leg_rh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_ww = ik_w0 * ik_w0 + ik_w1 * ik_w1 + ik_w2 * ik_w2;
   Scalar ik_c_kfe_rh, ik_s_kfe_rh;
   if (!ik_solve_cos_sin(ik_A, ik_B, ik_ww - ik_K, (branch & 2) != 0, ik_c_kfe_rh, ik_s_kfe_rh)) {
-    const Scalar ik_R = std::sqrt(ik_A * ik_A + ik_B * ik_B);
-    why = {2, std::sqrt(ik_ww), std::sqrt(std::max(Scalar(0), ik_K - ik_R)), std::sqrt(ik_K + ik_R), 0.0};
+    const Scalar ik_R = detail::square_root(ik_A * ik_A + ik_B * ik_B);
+    why = {2, detail::square_root(ik_ww), detail::square_root(std::max(Scalar(0), ik_K - ik_R)), detail::square_root(ik_K + ik_R), 0.0};
     return IkStatus::out_of_reach;
   }
   const Scalar ik_v2 = kfe_rh_z + ik_s_kfe_rh*wheel_joint_rh_x + ik_c_kfe_rh*wheel_joint_rh_z;
   const Scalar ik_v0 = -(ik_s_kfe_rh*wheel_joint_rh_z - ik_c_kfe_rh*wheel_joint_rh_x);
   const Scalar ik_x = ik_v2 * ik_w2 + ik_v0 * ik_w0, ik_y = ik_v2 * ik_w0 - ik_v0 * ik_w2;
-  const Scalar ik_r = std::sqrt(ik_x * ik_x + ik_y * ik_y);
+  const Scalar ik_r = detail::square_root(ik_x * ik_x + ik_y * ik_y);
   Scalar ik_c_hfe_rh = ik_r > 0 ? ik_x / ik_r : Scalar(1), ik_s_hfe_rh = ik_r > 0 ? ik_y / ik_r : Scalar(0);
   ik_s_hfe_rh = -ik_s_hfe_rh;  // the step turns about the negative axis: q = -theta
   const Scalar ik_t27 = ik_s_hfe_rh*cos_yaw*cos_pitch - ik_t26*ik_c_hfe_rh;
@@ -666,7 +662,7 @@ inline IkStatus ik_leg_rh(const CoordinatesOf<Scalar>& s, const Params& p, int b
   const Scalar ik_q_kfe_rh = ik_angles[2];
   const Scalar ik_row0 = ik_t13 + x_B + ik_t15 + wheel_joint_rh_y*ik_t21 + hfe_rh_y*ik_t21 + ik_t16 + ik_t17 + kfe_rh_y*ik_t21 + ik_t23*wheel_radius*ik_t30*ik_t21 - wheel_joint_rh_x*(ik_s_kfe_rh*ik_t27 - ik_t28*ik_c_kfe_rh) - (ik_c_kfe_rh*ik_t27 + ik_t28*ik_s_kfe_rh)*wheel_joint_rh_z - kfe_rh_z*ik_t27;
   const Scalar ik_row1 = wheel_joint_rh_x*(ik_c_kfe_rh*ik_t32 - ik_s_kfe_rh*ik_t33) + ik_t22*kfe_rh_y + y_B + wheel_joint_rh_y*ik_t22 + hfe_rh_x*cos_pitch*sin_yaw + ik_t23*ik_t22*wheel_radius*ik_t30 + ik_t22*hfe_rh_y + ik_t11*haa_rh_y + haa_rh_x*cos_pitch*sin_yaw - (ik_s_kfe_rh*ik_t32 + ik_c_kfe_rh*ik_t33)*wheel_joint_rh_z - kfe_rh_z*ik_t33 - y_rh;
-  const Scalar ik_row2 = ik_t1 + ik_t4 + ik_t23*kfe_rh_y + z_B + (ik_t35*ik_c_kfe_rh + ik_t36*ik_s_kfe_rh)*wheel_joint_rh_z + ik_t5 + ik_t23*hfe_rh_y + ik_t35*kfe_rh_z + ik_t23*wheel_joint_rh_y + wheel_joint_rh_x*(ik_t35*ik_s_kfe_rh - ik_t36*ik_c_kfe_rh) + ik_t6 - sqrt(ik_t29)*wheel_radius;
+  const Scalar ik_row2 = ik_t1 + ik_t4 + ik_t23*kfe_rh_y + z_B + (ik_t35*ik_c_kfe_rh + ik_t36*ik_s_kfe_rh)*wheel_joint_rh_z + ik_t5 + ik_t23*hfe_rh_y + ik_t35*kfe_rh_z + ik_t23*wheel_joint_rh_y + wheel_joint_rh_x*(ik_t35*ik_s_kfe_rh - ik_t36*ik_c_kfe_rh) + ik_t6 - detail::square_root(ik_t29)*wheel_radius;
   const Scalar ik_residual = std::max({std::abs(ik_row0), std::abs(ik_row1), std::abs(ik_row2)});
   if (!(ik_residual <= ik_tolerance<Scalar>())) {
     why = {0, ik_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
@@ -738,7 +734,6 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
     failed = 3;
     return IkStatus::bad_branch;
   }
-  using std::sqrt;
   const Scalar x_B = s(0);
   const Scalar y_B = s(1);
   const Scalar z_B = s(2);
@@ -851,7 +846,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_lf_gamma = hfe_lf_y + wheel_joint_lf_y + kfe_lf_y;
   Scalar ik_c_haa_lf, ik_s_haa_lf;
   if (!ik_solve_cos_sin(ik_leg_lf_alpha, ik_leg_lf_beta, ik_leg_lf_gamma, (ik_leg_lf_branch & 1) != 0, ik_c_haa_lf, ik_s_haa_lf)) {
-    why = {1, double(std::abs(ik_leg_lf_gamma)), 0.0, double(std::sqrt(ik_leg_lf_alpha * ik_leg_lf_alpha + ik_leg_lf_beta * ik_leg_lf_beta)), 0.0};
+    why = {1, double(std::abs(ik_leg_lf_gamma)), 0.0, double(detail::square_root(ik_leg_lf_alpha * ik_leg_lf_alpha + ik_leg_lf_beta * ik_leg_lf_beta)), 0.0};
     failed = 0;
     return IkStatus::out_of_reach;
   }
@@ -860,7 +855,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_t15 = sin_roll*cos_pitch*ik_c_haa_lf + cos_roll*cos_pitch*ik_s_haa_lf;
   const Scalar ik_t64 = ik_t12*ik_c_haa_lf - ik_t5*ik_s_haa_lf;
   const Scalar ik_t67 = ik_t14*ik_t14 + ik_t13*ik_t13;
-  const Scalar ik_t68 = Scalar(1)/sqrt(ik_t67);
+  const Scalar ik_t68 = Scalar(1)/detail::square_root(ik_t67);
   const Scalar ik_t70 = ik_t8*ik_s_haa_lf - ik_t11*ik_c_haa_lf;
   const Scalar ik_t73 = cos_roll*cos_pitch*ik_c_haa_lf - sin_roll*cos_pitch*ik_s_haa_lf;
   const Scalar ik_leg_lf_a0 = ik_t13;
@@ -872,7 +867,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
     failed = 0;
     return IkStatus::out_of_reach;
   }
-  const Scalar ik_leg_lf_tilt = std::sqrt(ik_leg_lf_tilt2);
+  const Scalar ik_leg_lf_tilt = detail::square_root(ik_leg_lf_tilt2);
   const Scalar ik_leg_lf_u0 = -ik_leg_lf_a2 * ik_leg_lf_a0 / ik_leg_lf_tilt, ik_leg_lf_u1 = -ik_leg_lf_a2 * ik_leg_lf_a1 / ik_leg_lf_tilt, ik_leg_lf_u2 = ik_leg_lf_tilt;
   const Scalar ik_t16 = ik_leg_lf_d2 + (ik_leg_lf_u1*ik_t11 + ik_leg_lf_u2*cos_roll*cos_pitch + ik_t12*ik_leg_lf_u0)*wheel_radius;
   const Scalar ik_t17 = (sin_roll*ik_leg_lf_u2*cos_pitch + ik_leg_lf_u1*ik_t8 + ik_t5*ik_leg_lf_u0)*wheel_radius + ik_leg_lf_d1;
@@ -885,15 +880,15 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_lf_ww = ik_leg_lf_w0 * ik_leg_lf_w0 + ik_leg_lf_w1 * ik_leg_lf_w1 + ik_leg_lf_w2 * ik_leg_lf_w2;
   Scalar ik_c_kfe_lf, ik_s_kfe_lf;
   if (!ik_solve_cos_sin(ik_leg_lf_A, ik_leg_lf_B, ik_leg_lf_ww - ik_leg_lf_K, (ik_leg_lf_branch & 2) != 0, ik_c_kfe_lf, ik_s_kfe_lf)) {
-    const Scalar ik_leg_lf_R = std::sqrt(ik_leg_lf_A * ik_leg_lf_A + ik_leg_lf_B * ik_leg_lf_B);
-    why = {2, std::sqrt(ik_leg_lf_ww), std::sqrt(std::max(Scalar(0), ik_leg_lf_K - ik_leg_lf_R)), std::sqrt(ik_leg_lf_K + ik_leg_lf_R), 0.0};
+    const Scalar ik_leg_lf_R = detail::square_root(ik_leg_lf_A * ik_leg_lf_A + ik_leg_lf_B * ik_leg_lf_B);
+    why = {2, detail::square_root(ik_leg_lf_ww), detail::square_root(std::max(Scalar(0), ik_leg_lf_K - ik_leg_lf_R)), detail::square_root(ik_leg_lf_K + ik_leg_lf_R), 0.0};
     failed = 0;
     return IkStatus::out_of_reach;
   }
   const Scalar ik_leg_lf_v2 = ik_c_kfe_lf*wheel_joint_lf_z + kfe_lf_z - ik_s_kfe_lf*wheel_joint_lf_x;
   const Scalar ik_leg_lf_v0 = ik_c_kfe_lf*wheel_joint_lf_x + ik_s_kfe_lf*wheel_joint_lf_z;
   const Scalar ik_leg_lf_x = ik_leg_lf_v2 * ik_leg_lf_w2 + ik_leg_lf_v0 * ik_leg_lf_w0, ik_leg_lf_y = ik_leg_lf_v2 * ik_leg_lf_w0 - ik_leg_lf_v0 * ik_leg_lf_w2;
-  const Scalar ik_leg_lf_r = std::sqrt(ik_leg_lf_x * ik_leg_lf_x + ik_leg_lf_y * ik_leg_lf_y);
+  const Scalar ik_leg_lf_r = detail::square_root(ik_leg_lf_x * ik_leg_lf_x + ik_leg_lf_y * ik_leg_lf_y);
   Scalar ik_c_hfe_lf = ik_leg_lf_r > 0 ? ik_leg_lf_x / ik_leg_lf_r : Scalar(1), ik_s_hfe_lf = ik_leg_lf_r > 0 ? ik_leg_lf_y / ik_leg_lf_r : Scalar(0);
   const Scalar ik_t65 = cos_yaw*ik_s_hfe_lf*cos_pitch + ik_c_hfe_lf*ik_t64;
   const Scalar ik_t66 = ik_s_hfe_lf*ik_t64 - ik_c_hfe_lf*cos_yaw*cos_pitch;
@@ -909,7 +904,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_rf_gamma = hfe_rf_y + wheel_joint_rf_y + kfe_rf_y;
   Scalar ik_c_haa_rf, ik_s_haa_rf;
   if (!ik_solve_cos_sin(ik_leg_rf_alpha, ik_leg_rf_beta, ik_leg_rf_gamma, (ik_leg_rf_branch & 1) != 0, ik_c_haa_rf, ik_s_haa_rf)) {
-    why = {1, double(std::abs(ik_leg_rf_gamma)), 0.0, double(std::sqrt(ik_leg_rf_alpha * ik_leg_rf_alpha + ik_leg_rf_beta * ik_leg_rf_beta)), 0.0};
+    why = {1, double(std::abs(ik_leg_rf_gamma)), 0.0, double(detail::square_root(ik_leg_rf_alpha * ik_leg_rf_alpha + ik_leg_rf_beta * ik_leg_rf_beta)), 0.0};
     failed = 1;
     return IkStatus::out_of_reach;
   }
@@ -918,7 +913,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_t24 = sin_roll*ik_c_haa_rf*cos_pitch + ik_s_haa_rf*cos_roll*cos_pitch;
   const Scalar ik_t76 = ik_t5*ik_s_haa_rf - ik_t12*ik_c_haa_rf;
   const Scalar ik_t79 = ik_t23*ik_t23 + ik_t22*ik_t22;
-  const Scalar ik_t80 = Scalar(1)/sqrt(ik_t79);
+  const Scalar ik_t80 = Scalar(1)/detail::square_root(ik_t79);
   const Scalar ik_t81 = ik_t8*ik_s_haa_rf - ik_t11*ik_c_haa_rf;
   const Scalar ik_t84 = ik_c_haa_rf*cos_roll*cos_pitch - sin_roll*ik_s_haa_rf*cos_pitch;
   const Scalar ik_leg_rf_a0 = ik_t22;
@@ -930,7 +925,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
     failed = 1;
     return IkStatus::out_of_reach;
   }
-  const Scalar ik_leg_rf_tilt = std::sqrt(ik_leg_rf_tilt2);
+  const Scalar ik_leg_rf_tilt = detail::square_root(ik_leg_rf_tilt2);
   const Scalar ik_leg_rf_u0 = -ik_leg_rf_a2 * ik_leg_rf_a0 / ik_leg_rf_tilt, ik_leg_rf_u1 = -ik_leg_rf_a2 * ik_leg_rf_a1 / ik_leg_rf_tilt, ik_leg_rf_u2 = ik_leg_rf_tilt;
   const Scalar ik_t25 = wheel_radius*(sin_roll*ik_leg_rf_u2*cos_pitch + ik_leg_rf_u0*ik_t5 + ik_t8*ik_leg_rf_u1) + ik_leg_rf_d1;
   const Scalar ik_t26 = wheel_radius*(cos_roll*ik_leg_rf_u2*cos_pitch + ik_t12*ik_leg_rf_u0 + ik_t11*ik_leg_rf_u1) + ik_leg_rf_d2;
@@ -943,15 +938,15 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_rf_ww = ik_leg_rf_w0 * ik_leg_rf_w0 + ik_leg_rf_w1 * ik_leg_rf_w1 + ik_leg_rf_w2 * ik_leg_rf_w2;
   Scalar ik_c_kfe_rf, ik_s_kfe_rf;
   if (!ik_solve_cos_sin(ik_leg_rf_A, ik_leg_rf_B, ik_leg_rf_ww - ik_leg_rf_K, (ik_leg_rf_branch & 2) != 0, ik_c_kfe_rf, ik_s_kfe_rf)) {
-    const Scalar ik_leg_rf_R = std::sqrt(ik_leg_rf_A * ik_leg_rf_A + ik_leg_rf_B * ik_leg_rf_B);
-    why = {2, std::sqrt(ik_leg_rf_ww), std::sqrt(std::max(Scalar(0), ik_leg_rf_K - ik_leg_rf_R)), std::sqrt(ik_leg_rf_K + ik_leg_rf_R), 0.0};
+    const Scalar ik_leg_rf_R = detail::square_root(ik_leg_rf_A * ik_leg_rf_A + ik_leg_rf_B * ik_leg_rf_B);
+    why = {2, detail::square_root(ik_leg_rf_ww), detail::square_root(std::max(Scalar(0), ik_leg_rf_K - ik_leg_rf_R)), detail::square_root(ik_leg_rf_K + ik_leg_rf_R), 0.0};
     failed = 1;
     return IkStatus::out_of_reach;
   }
   const Scalar ik_leg_rf_v2 = wheel_joint_rf_z*ik_c_kfe_rf + ik_s_kfe_rf*wheel_joint_rf_x + kfe_rf_z;
   const Scalar ik_leg_rf_v0 = ik_c_kfe_rf*wheel_joint_rf_x - wheel_joint_rf_z*ik_s_kfe_rf;
   const Scalar ik_leg_rf_x = ik_leg_rf_v2 * ik_leg_rf_w2 + ik_leg_rf_v0 * ik_leg_rf_w0, ik_leg_rf_y = ik_leg_rf_v2 * ik_leg_rf_w0 - ik_leg_rf_v0 * ik_leg_rf_w2;
-  const Scalar ik_leg_rf_r = std::sqrt(ik_leg_rf_x * ik_leg_rf_x + ik_leg_rf_y * ik_leg_rf_y);
+  const Scalar ik_leg_rf_r = detail::square_root(ik_leg_rf_x * ik_leg_rf_x + ik_leg_rf_y * ik_leg_rf_y);
   Scalar ik_c_hfe_rf = ik_leg_rf_r > 0 ? ik_leg_rf_x / ik_leg_rf_r : Scalar(1), ik_s_hfe_rf = ik_leg_rf_r > 0 ? ik_leg_rf_y / ik_leg_rf_r : Scalar(0);
   ik_s_hfe_rf = -ik_s_hfe_rf;  // the step turns about the negative axis: q = -theta
   const Scalar ik_t77 = cos_yaw*ik_s_hfe_rf*cos_pitch + ik_c_hfe_rf*ik_t76;
@@ -968,7 +963,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_lh_gamma = kfe_lh_y + wheel_joint_lh_y + hfe_lh_y;
   Scalar ik_c_haa_lh, ik_s_haa_lh;
   if (!ik_solve_cos_sin(ik_leg_lh_alpha, ik_leg_lh_beta, ik_leg_lh_gamma, (ik_leg_lh_branch & 1) != 0, ik_c_haa_lh, ik_s_haa_lh)) {
-    why = {1, double(std::abs(ik_leg_lh_gamma)), 0.0, double(std::sqrt(ik_leg_lh_alpha * ik_leg_lh_alpha + ik_leg_lh_beta * ik_leg_lh_beta)), 0.0};
+    why = {1, double(std::abs(ik_leg_lh_gamma)), 0.0, double(detail::square_root(ik_leg_lh_alpha * ik_leg_lh_alpha + ik_leg_lh_beta * ik_leg_lh_beta)), 0.0};
     failed = 2;
     return IkStatus::out_of_reach;
   }
@@ -977,7 +972,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_t44 = sin_roll*cos_pitch*ik_c_haa_lh + cos_roll*cos_pitch*ik_s_haa_lh;
   const Scalar ik_t87 = ik_t5*ik_s_haa_lh - ik_t12*ik_c_haa_lh;
   const Scalar ik_t90 = ik_t42*ik_t42 + ik_t43*ik_t43;
-  const Scalar ik_t91 = Scalar(1)/sqrt(ik_t90);
+  const Scalar ik_t91 = Scalar(1)/detail::square_root(ik_t90);
   const Scalar ik_t92 = ik_t11*ik_c_haa_lh - ik_t8*ik_s_haa_lh;
   const Scalar ik_t95 = sin_roll*cos_pitch*ik_s_haa_lh - cos_roll*cos_pitch*ik_c_haa_lh;
   const Scalar ik_leg_lh_a0 = ik_t42;
@@ -989,7 +984,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
     failed = 2;
     return IkStatus::out_of_reach;
   }
-  const Scalar ik_leg_lh_tilt = std::sqrt(ik_leg_lh_tilt2);
+  const Scalar ik_leg_lh_tilt = detail::square_root(ik_leg_lh_tilt2);
   const Scalar ik_leg_lh_u0 = -ik_leg_lh_a2 * ik_leg_lh_a0 / ik_leg_lh_tilt, ik_leg_lh_u1 = -ik_leg_lh_a2 * ik_leg_lh_a1 / ik_leg_lh_tilt, ik_leg_lh_u2 = ik_leg_lh_tilt;
   const Scalar ik_t45 = wheel_radius*(ik_t11*ik_leg_lh_u1 + ik_t12*ik_leg_lh_u0 + cos_roll*cos_pitch*ik_leg_lh_u2) + ik_leg_lh_d2;
   const Scalar ik_t46 = ik_leg_lh_d1 + wheel_radius*(ik_t5*ik_leg_lh_u0 + sin_roll*cos_pitch*ik_leg_lh_u2 + ik_t8*ik_leg_lh_u1);
@@ -1002,15 +997,15 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_lh_ww = ik_leg_lh_w0 * ik_leg_lh_w0 + ik_leg_lh_w1 * ik_leg_lh_w1 + ik_leg_lh_w2 * ik_leg_lh_w2;
   Scalar ik_c_kfe_lh, ik_s_kfe_lh;
   if (!ik_solve_cos_sin(ik_leg_lh_A, ik_leg_lh_B, ik_leg_lh_ww - ik_leg_lh_K, (ik_leg_lh_branch & 2) != 0, ik_c_kfe_lh, ik_s_kfe_lh)) {
-    const Scalar ik_leg_lh_R = std::sqrt(ik_leg_lh_A * ik_leg_lh_A + ik_leg_lh_B * ik_leg_lh_B);
-    why = {2, std::sqrt(ik_leg_lh_ww), std::sqrt(std::max(Scalar(0), ik_leg_lh_K - ik_leg_lh_R)), std::sqrt(ik_leg_lh_K + ik_leg_lh_R), 0.0};
+    const Scalar ik_leg_lh_R = detail::square_root(ik_leg_lh_A * ik_leg_lh_A + ik_leg_lh_B * ik_leg_lh_B);
+    why = {2, detail::square_root(ik_leg_lh_ww), detail::square_root(std::max(Scalar(0), ik_leg_lh_K - ik_leg_lh_R)), detail::square_root(ik_leg_lh_K + ik_leg_lh_R), 0.0};
     failed = 2;
     return IkStatus::out_of_reach;
   }
   const Scalar ik_leg_lh_v2 = kfe_lh_z + ik_c_kfe_lh*wheel_joint_lh_z - ik_s_kfe_lh*wheel_joint_lh_x;
   const Scalar ik_leg_lh_v0 = ik_s_kfe_lh*wheel_joint_lh_z + ik_c_kfe_lh*wheel_joint_lh_x;
   const Scalar ik_leg_lh_x = ik_leg_lh_v2 * ik_leg_lh_w2 + ik_leg_lh_v0 * ik_leg_lh_w0, ik_leg_lh_y = ik_leg_lh_v2 * ik_leg_lh_w0 - ik_leg_lh_v0 * ik_leg_lh_w2;
-  const Scalar ik_leg_lh_r = std::sqrt(ik_leg_lh_x * ik_leg_lh_x + ik_leg_lh_y * ik_leg_lh_y);
+  const Scalar ik_leg_lh_r = detail::square_root(ik_leg_lh_x * ik_leg_lh_x + ik_leg_lh_y * ik_leg_lh_y);
   Scalar ik_c_hfe_lh = ik_leg_lh_r > 0 ? ik_leg_lh_x / ik_leg_lh_r : Scalar(1), ik_s_hfe_lh = ik_leg_lh_r > 0 ? ik_leg_lh_y / ik_leg_lh_r : Scalar(0);
   const Scalar ik_t88 = cos_yaw*ik_s_hfe_lh*cos_pitch - ik_c_hfe_lh*ik_t87;
   const Scalar ik_t89 = ik_s_hfe_lh*ik_t87 + ik_c_hfe_lh*cos_yaw*cos_pitch;
@@ -1026,7 +1021,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_rh_gamma = wheel_joint_rh_y + hfe_rh_y + kfe_rh_y;
   Scalar ik_c_haa_rh, ik_s_haa_rh;
   if (!ik_solve_cos_sin(ik_leg_rh_alpha, ik_leg_rh_beta, ik_leg_rh_gamma, (ik_leg_rh_branch & 1) != 0, ik_c_haa_rh, ik_s_haa_rh)) {
-    why = {1, double(std::abs(ik_leg_rh_gamma)), 0.0, double(std::sqrt(ik_leg_rh_alpha * ik_leg_rh_alpha + ik_leg_rh_beta * ik_leg_rh_beta)), 0.0};
+    why = {1, double(std::abs(ik_leg_rh_gamma)), 0.0, double(detail::square_root(ik_leg_rh_alpha * ik_leg_rh_alpha + ik_leg_rh_beta * ik_leg_rh_beta)), 0.0};
     failed = 3;
     return IkStatus::out_of_reach;
   }
@@ -1035,7 +1030,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_t61 = ik_s_haa_rh*cos_roll*cos_pitch + sin_roll*ik_c_haa_rh*cos_pitch;
   const Scalar ik_t98 = ik_t12*ik_c_haa_rh - ik_t5*ik_s_haa_rh;
   const Scalar ik_t101 = ik_t60*ik_t60 + ik_t59*ik_t59;
-  const Scalar ik_t102 = Scalar(1)/sqrt(ik_t101);
+  const Scalar ik_t102 = Scalar(1)/detail::square_root(ik_t101);
   const Scalar ik_t103 = ik_t11*ik_c_haa_rh - ik_t8*ik_s_haa_rh;
   const Scalar ik_t106 = ik_c_haa_rh*cos_roll*cos_pitch - sin_roll*ik_s_haa_rh*cos_pitch;
   const Scalar ik_leg_rh_a0 = ik_t59;
@@ -1047,7 +1042,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
     failed = 3;
     return IkStatus::out_of_reach;
   }
-  const Scalar ik_leg_rh_tilt = std::sqrt(ik_leg_rh_tilt2);
+  const Scalar ik_leg_rh_tilt = detail::square_root(ik_leg_rh_tilt2);
   const Scalar ik_leg_rh_u0 = -ik_leg_rh_a2 * ik_leg_rh_a0 / ik_leg_rh_tilt, ik_leg_rh_u1 = -ik_leg_rh_a2 * ik_leg_rh_a1 / ik_leg_rh_tilt, ik_leg_rh_u2 = ik_leg_rh_tilt;
   const Scalar ik_t62 = wheel_radius*(ik_leg_rh_u0*ik_t5 + sin_roll*ik_leg_rh_u2*cos_pitch + ik_t8*ik_leg_rh_u1) + ik_leg_rh_d1;
   const Scalar ik_t63 = wheel_radius*(ik_t12*ik_leg_rh_u0 + ik_leg_rh_u2*cos_roll*cos_pitch + ik_t11*ik_leg_rh_u1) + ik_leg_rh_d2;
@@ -1060,15 +1055,15 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_leg_rh_ww = ik_leg_rh_w0 * ik_leg_rh_w0 + ik_leg_rh_w1 * ik_leg_rh_w1 + ik_leg_rh_w2 * ik_leg_rh_w2;
   Scalar ik_c_kfe_rh, ik_s_kfe_rh;
   if (!ik_solve_cos_sin(ik_leg_rh_A, ik_leg_rh_B, ik_leg_rh_ww - ik_leg_rh_K, (ik_leg_rh_branch & 2) != 0, ik_c_kfe_rh, ik_s_kfe_rh)) {
-    const Scalar ik_leg_rh_R = std::sqrt(ik_leg_rh_A * ik_leg_rh_A + ik_leg_rh_B * ik_leg_rh_B);
-    why = {2, std::sqrt(ik_leg_rh_ww), std::sqrt(std::max(Scalar(0), ik_leg_rh_K - ik_leg_rh_R)), std::sqrt(ik_leg_rh_K + ik_leg_rh_R), 0.0};
+    const Scalar ik_leg_rh_R = detail::square_root(ik_leg_rh_A * ik_leg_rh_A + ik_leg_rh_B * ik_leg_rh_B);
+    why = {2, detail::square_root(ik_leg_rh_ww), detail::square_root(std::max(Scalar(0), ik_leg_rh_K - ik_leg_rh_R)), detail::square_root(ik_leg_rh_K + ik_leg_rh_R), 0.0};
     failed = 3;
     return IkStatus::out_of_reach;
   }
   const Scalar ik_leg_rh_v2 = kfe_rh_z + ik_s_kfe_rh*wheel_joint_rh_x + ik_c_kfe_rh*wheel_joint_rh_z;
   const Scalar ik_leg_rh_v0 = -(ik_s_kfe_rh*wheel_joint_rh_z - ik_c_kfe_rh*wheel_joint_rh_x);
   const Scalar ik_leg_rh_x = ik_leg_rh_v2 * ik_leg_rh_w2 + ik_leg_rh_v0 * ik_leg_rh_w0, ik_leg_rh_y = ik_leg_rh_v2 * ik_leg_rh_w0 - ik_leg_rh_v0 * ik_leg_rh_w2;
-  const Scalar ik_leg_rh_r = std::sqrt(ik_leg_rh_x * ik_leg_rh_x + ik_leg_rh_y * ik_leg_rh_y);
+  const Scalar ik_leg_rh_r = detail::square_root(ik_leg_rh_x * ik_leg_rh_x + ik_leg_rh_y * ik_leg_rh_y);
   Scalar ik_c_hfe_rh = ik_leg_rh_r > 0 ? ik_leg_rh_x / ik_leg_rh_r : Scalar(1), ik_s_hfe_rh = ik_leg_rh_r > 0 ? ik_leg_rh_y / ik_leg_rh_r : Scalar(0);
   ik_s_hfe_rh = -ik_s_hfe_rh;  // the step turns about the negative axis: q = -theta
   const Scalar ik_t99 = ik_s_hfe_rh*cos_yaw*cos_pitch - ik_t98*ik_c_hfe_rh;
@@ -1094,7 +1089,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   const Scalar ik_q_kfe_rh = ik_angles[11];
   const Scalar ik_leg_lf_row0 = -((ik_s_kfe_lf*ik_t66 - ik_t65*ik_c_kfe_lf)*wheel_joint_lf_z + (ik_c_kfe_lf*ik_t66 + ik_s_kfe_lf*ik_t65)*wheel_joint_lf_x + x_lf + ik_t69 - ik_t15*wheel_radius*ik_t68*ik_t13 - ik_t65*kfe_lf_z - hfe_lf_y*ik_t13 - ik_t13*wheel_joint_lf_y - haa_lf_x*cos_yaw*cos_pitch - ik_t5*haa_lf_y - cos_yaw*hfe_lf_x*cos_pitch - ik_t13*kfe_lf_y);
   const Scalar ik_leg_lf_row1 = -((ik_s_kfe_lf*ik_t72 - ik_c_kfe_lf*ik_t71)*wheel_joint_lf_x + y_lf + ik_t52 - ik_t14*kfe_lf_y - hfe_lf_x*cos_pitch*sin_yaw - kfe_lf_z*ik_t72 - ik_t15*wheel_radius*ik_t68*ik_t14 - ik_t8*haa_lf_y - wheel_joint_lf_y*ik_t14 - haa_lf_x*cos_pitch*sin_yaw - wheel_joint_lf_z*(ik_s_kfe_lf*ik_t71 + ik_c_kfe_lf*ik_t72) - hfe_lf_y*ik_t14);
-  const Scalar ik_leg_lf_row2 = -(wheel_radius*sqrt(ik_t67) + ik_t18 + haa_lf_x*sin_pitch + ground_lf + sin_pitch*hfe_lf_x + (ik_c_kfe_lf*ik_t75 + ik_s_kfe_lf*ik_t74)*wheel_joint_lf_x - sin_roll*cos_pitch*haa_lf_y - ik_t15*kfe_lf_y - ik_t15*wheel_joint_lf_y - ik_t15*hfe_lf_y - wheel_joint_lf_z*(ik_c_kfe_lf*ik_t74 - ik_s_kfe_lf*ik_t75) - ik_t74*kfe_lf_z);
+  const Scalar ik_leg_lf_row2 = -(wheel_radius*detail::square_root(ik_t67) + ik_t18 + haa_lf_x*sin_pitch + ground_lf + sin_pitch*hfe_lf_x + (ik_c_kfe_lf*ik_t75 + ik_s_kfe_lf*ik_t74)*wheel_joint_lf_x - sin_roll*cos_pitch*haa_lf_y - ik_t15*kfe_lf_y - ik_t15*wheel_joint_lf_y - ik_t15*hfe_lf_y - wheel_joint_lf_z*(ik_c_kfe_lf*ik_t74 - ik_s_kfe_lf*ik_t75) - ik_t74*kfe_lf_z);
   const Scalar ik_leg_lf_residual = std::max({std::abs(ik_leg_lf_row0), std::abs(ik_leg_lf_row1), std::abs(ik_leg_lf_row2)});
   if (!(ik_leg_lf_residual <= ik_tolerance<Scalar>())) {
     why = {0, ik_leg_lf_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
@@ -1103,7 +1098,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   }
   const Scalar ik_leg_rf_row0 = -(kfe_rf_z*ik_t77 + (ik_s_kfe_rf*ik_t77 + ik_t78*ik_c_kfe_rf)*wheel_joint_rf_x + (ik_c_kfe_rf*ik_t77 - ik_t78*ik_s_kfe_rf)*wheel_joint_rf_z + x_rf + ik_t69 - wheel_joint_rf_y*ik_t22 - kfe_rf_y*ik_t22 - cos_yaw*cos_pitch*hfe_rf_x - haa_rf_y*ik_t5 - hfe_rf_y*ik_t22 - cos_yaw*haa_rf_x*cos_pitch - wheel_radius*ik_t80*ik_t24*ik_t22);
   const Scalar ik_leg_rf_row1 = -(ik_t82*kfe_rf_z + y_rf + wheel_joint_rf_z*(ik_t82*ik_c_kfe_rf - ik_t83*ik_s_kfe_rf) + (ik_t82*ik_s_kfe_rf + ik_t83*ik_c_kfe_rf)*wheel_joint_rf_x + ik_t52 - haa_rf_y*ik_t8 - cos_pitch*sin_yaw*hfe_rf_x - haa_rf_x*cos_pitch*sin_yaw - wheel_radius*ik_t23*ik_t80*ik_t24 - wheel_joint_rf_y*ik_t23 - hfe_rf_y*ik_t23 - ik_t23*kfe_rf_y);
-  const Scalar ik_leg_rf_row2 = wheel_joint_rf_y*ik_t24 + hfe_rf_y*ik_t24 + z_B + sin_roll*haa_rf_y*cos_pitch + kfe_rf_z*ik_t86 + (ik_s_kfe_rf*ik_t86 + ik_t85*ik_c_kfe_rf)*wheel_joint_rf_x + kfe_rf_y*ik_t24 - wheel_joint_rf_z*(ik_t85*ik_s_kfe_rf - ik_c_kfe_rf*ik_t86) - sin_pitch*haa_rf_x - ground_rf - sqrt(ik_t79)*wheel_radius - sin_pitch*hfe_rf_x;
+  const Scalar ik_leg_rf_row2 = wheel_joint_rf_y*ik_t24 + hfe_rf_y*ik_t24 + z_B + sin_roll*haa_rf_y*cos_pitch + kfe_rf_z*ik_t86 + (ik_s_kfe_rf*ik_t86 + ik_t85*ik_c_kfe_rf)*wheel_joint_rf_x + kfe_rf_y*ik_t24 - wheel_joint_rf_z*(ik_t85*ik_s_kfe_rf - ik_c_kfe_rf*ik_t86) - sin_pitch*haa_rf_x - ground_rf - detail::square_root(ik_t79)*wheel_radius - sin_pitch*hfe_rf_x;
   const Scalar ik_leg_rf_residual = std::max({std::abs(ik_leg_rf_row0), std::abs(ik_leg_rf_row1), std::abs(ik_leg_rf_row2)});
   if (!(ik_leg_rf_residual <= ik_tolerance<Scalar>())) {
     why = {0, ik_leg_rf_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
@@ -1112,7 +1107,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   }
   const Scalar ik_leg_lh_row0 = ik_t37 + ik_t38 + x_B + ik_t39 + (ik_c_kfe_lh*ik_t88 + ik_s_kfe_lh*ik_t89)*wheel_joint_lh_z + kfe_lh_z*ik_t88 + ik_t40 + kfe_lh_y*ik_t42 + wheel_radius*ik_t44*ik_t91*ik_t42 + wheel_joint_lh_y*ik_t42 + ik_t42*hfe_lh_y - (ik_s_kfe_lh*ik_t88 - ik_c_kfe_lh*ik_t89)*wheel_joint_lh_x;
   const Scalar ik_leg_lh_row1 = wheel_joint_lh_y*ik_t43 + kfe_lh_y*ik_t43 + ik_t32 + y_B + wheel_radius*ik_t44*ik_t91*ik_t43 + ik_t33 + ik_t43*hfe_lh_y + kfe_lh_z*ik_t94 + ik_t34 + ik_t35 - (ik_c_kfe_lh*ik_t93 + ik_s_kfe_lh*ik_t94)*wheel_joint_lh_x - wheel_joint_lh_z*(ik_s_kfe_lh*ik_t93 - ik_c_kfe_lh*ik_t94);
-  const Scalar ik_leg_lh_row2 = ik_t27 + kfe_lh_y*ik_t44 + z_B + ik_t28 + ik_t44*hfe_lh_y + ik_t29 + ik_t44*wheel_joint_lh_y + ik_t30 + wheel_joint_lh_x*(ik_s_kfe_lh*ik_t96 - ik_c_kfe_lh*ik_t97) - kfe_lh_z*ik_t96 - (ik_s_kfe_lh*ik_t97 + ik_c_kfe_lh*ik_t96)*wheel_joint_lh_z - wheel_radius*sqrt(ik_t90);
+  const Scalar ik_leg_lh_row2 = ik_t27 + kfe_lh_y*ik_t44 + z_B + ik_t28 + ik_t44*hfe_lh_y + ik_t29 + ik_t44*wheel_joint_lh_y + ik_t30 + wheel_joint_lh_x*(ik_s_kfe_lh*ik_t96 - ik_c_kfe_lh*ik_t97) - kfe_lh_z*ik_t96 - (ik_s_kfe_lh*ik_t97 + ik_c_kfe_lh*ik_t96)*wheel_joint_lh_z - wheel_radius*detail::square_root(ik_t90);
   const Scalar ik_leg_lh_residual = std::max({std::abs(ik_leg_lh_row0), std::abs(ik_leg_lh_row1), std::abs(ik_leg_lh_row2)});
   if (!(ik_leg_lh_residual <= ik_tolerance<Scalar>())) {
     why = {0, ik_leg_lh_residual, 0.0, ik_tolerance<Scalar>(), 0.0};
@@ -1121,7 +1116,7 @@ inline IkStatus ik_all(const CoordinatesOf<Scalar>& s, const Params& p, const st
   }
   const Scalar ik_leg_rh_row0 = ik_t54 + x_B + ik_t55 + wheel_joint_rh_y*ik_t59 + hfe_rh_y*ik_t59 + ik_t56 + ik_t57 + kfe_rh_y*ik_t59 + ik_t61*wheel_radius*ik_t102*ik_t59 - wheel_joint_rh_x*(ik_s_kfe_rh*ik_t99 - ik_t100*ik_c_kfe_rh) - (ik_c_kfe_rh*ik_t99 + ik_t100*ik_s_kfe_rh)*wheel_joint_rh_z - kfe_rh_z*ik_t99;
   const Scalar ik_leg_rh_row1 = wheel_joint_rh_x*(ik_c_kfe_rh*ik_t104 - ik_s_kfe_rh*ik_t105) + ik_t60*kfe_rh_y + y_B + wheel_joint_rh_y*ik_t60 + hfe_rh_x*cos_pitch*sin_yaw + ik_t61*ik_t60*wheel_radius*ik_t102 + ik_t60*hfe_rh_y + ik_t8*haa_rh_y + haa_rh_x*cos_pitch*sin_yaw - (ik_s_kfe_rh*ik_t104 + ik_c_kfe_rh*ik_t105)*wheel_joint_rh_z - kfe_rh_z*ik_t105 - y_rh;
-  const Scalar ik_leg_rh_row2 = ik_t47 + ik_t48 + ik_t61*kfe_rh_y + z_B + (ik_t107*ik_c_kfe_rh + ik_t108*ik_s_kfe_rh)*wheel_joint_rh_z + ik_t49 + ik_t61*hfe_rh_y + ik_t107*kfe_rh_z + ik_t61*wheel_joint_rh_y + wheel_joint_rh_x*(ik_t107*ik_s_kfe_rh - ik_t108*ik_c_kfe_rh) + ik_t50 - sqrt(ik_t101)*wheel_radius;
+  const Scalar ik_leg_rh_row2 = ik_t47 + ik_t48 + ik_t61*kfe_rh_y + z_B + (ik_t107*ik_c_kfe_rh + ik_t108*ik_s_kfe_rh)*wheel_joint_rh_z + ik_t49 + ik_t61*hfe_rh_y + ik_t107*kfe_rh_z + ik_t61*wheel_joint_rh_y + wheel_joint_rh_x*(ik_t107*ik_s_kfe_rh - ik_t108*ik_c_kfe_rh) + ik_t50 - detail::square_root(ik_t101)*wheel_radius;
   const Scalar ik_leg_rh_residual = std::max({std::abs(ik_leg_rh_row0), std::abs(ik_leg_rh_row1), std::abs(ik_leg_rh_row2)});
   if (!(ik_leg_rh_residual <= ik_tolerance<Scalar>())) {
     why = {0, ik_leg_rh_residual, 0.0, ik_tolerance<Scalar>(), 0.0};

@@ -46,7 +46,6 @@ inline void kinematics(const CoordinatesOf<Scalar>& s, const Params& p, const de
   const auto rotations = out.rotations;
   using std::cos;
   using std::sin;
-  using std::sqrt;
   const Scalar x_B = s(0);
   const Scalar y_B = s(1);
   const Scalar z_B = s(2);
@@ -222,13 +221,13 @@ inline void kinematics(const CoordinatesOf<Scalar>& s, const Params& p, const de
   const Scalar t212 = cos_kfe_rh*t211 - sin_kfe_rh*t194;
   const Scalar t213 = sin_kfe_rh*t211 + cos_kfe_rh*t194;
   const Scalar t214 = t21*t21 + t19*t19;
-  const Scalar t215 = Scalar(1)/sqrt(t214);
+  const Scalar t215 = Scalar(1)/detail::square_root(t214);
   const Scalar t216 = t70*t70 + t74*t74;
-  const Scalar t217 = Scalar(1)/sqrt(t216);
+  const Scalar t217 = Scalar(1)/detail::square_root(t216);
   const Scalar t218 = t125*t125 + t122*t122;
-  const Scalar t219 = Scalar(1)/sqrt(t218);
+  const Scalar t219 = Scalar(1)/detail::square_root(t218);
   const Scalar t220 = t174*t174 + t177*t177;
-  const Scalar t221 = Scalar(1)/sqrt(t220);
+  const Scalar t221 = Scalar(1)/detail::square_root(t220);
   if (positions != nullptr) {
     const Scalar t10 = t7*haa_lf_y;
     const Scalar t11 = haa_lf_x*cos_yaw*cos_pitch;
@@ -403,16 +402,16 @@ inline void kinematics(const CoordinatesOf<Scalar>& s, const Params& p, const de
     (*positions)(2, 20) = t170 + t171 + t195 + t196 + t181 + z_B + t180*wheel_joint_rh_y + t182 + t213*wheel_joint_rh_z - t212*wheel_joint_rh_x;
     (*positions)(0, 21) = t19*t24*wheel_radius*t215 + t19*wheel_joint_lf_y + x_B + t48*wheel_joint_lf_z + t10 + t16 + t11 + t20 + t25 + t30 - t47*wheel_joint_lf_x;
     (*positions)(1, 21) = t24*wheel_radius*t215*t21 + t52 + t31 + t12 + y_B + t53 + t55 + t22 + t13 + t34 + t23;
-    (*positions)(2, 21) = -(t37 + t38 + t58 + t39 + t40 + t60 + t41 + sqrt(t214)*wheel_radius + t42 + t61 + t43);
+    (*positions)(2, 21) = -(t37 + t38 + t58 + t39 + t40 + t60 + t41 + detail::square_root(t214)*wheel_radius + t42 + t61 + t43);
     (*positions)(0, 22) = t95 + t96 + t62 + t71 + x_B + t98 + t99 + t72 + t63 + wheel_radius*t70*t217*t77 + t100;
     (*positions)(1, 22) = t64 + t73 + wheel_radius*t74*t217*t77 + t75 + t103 + y_B + t104 + t83 + t86 + t106 + t65;
-    (*positions)(2, 22) = z_B + t66 + t107 + t87 + t76 + t110 + t78 + t67 + t90 + t112 - wheel_radius*sqrt(t216);
+    (*positions)(2, 22) = z_B + t66 + t107 + t87 + t76 + t110 + t78 + t67 + t90 + t112 - wheel_radius*detail::square_root(t216);
     (*positions)(0, 23) = t119 + t150 + t113 + t151 + x_B + t114 + wheel_radius*t127*t219*t122 + t128 + t133 + t123 + t153;
     (*positions)(1, 23) = t154 + t134 + t137 + t115 + wheel_radius*t127*t219*t125 + t157 + y_B + t124 + t126 + t159 + t116;
-    (*positions)(2, 23) = -(t140 + t141 + t162 + t39 + t142 + wheel_radius*sqrt(t218) + t143 + t144 + t164 + t165 + t145);
+    (*positions)(2, 23) = -(t140 + t141 + t162 + t39 + t142 + wheel_radius*detail::square_root(t218) + t143 + t144 + t164 + t165 + t145);
     (*positions)(0, 24) = t201 + t166 + x_B + t187 + t167 + t175 + t180*wheel_radius*t174*t221 + t202 + t204 + t176 + t188;
     (*positions)(1, 24) = t191 + t178 + t207 + y_B + t208 + t179 + t180*wheel_radius*t221*t177 + t168 + t192 + t210 + t169;
-    (*positions)(2, 24) = -(wheel_radius*sqrt(t220) + t39 + haa_rh_x*sin_pitch + t212*wheel_joint_rh_x + hfe_rh_x*sin_pitch - kfe_rh_z*t194 - sin_roll*cos_pitch*haa_rh_y - t180*hfe_rh_y - t180*kfe_rh_y - t180*wheel_joint_rh_y - t213*wheel_joint_rh_z);
+    (*positions)(2, 24) = -(wheel_radius*detail::square_root(t220) + t39 + haa_rh_x*sin_pitch + t212*wheel_joint_rh_x + hfe_rh_x*sin_pitch - kfe_rh_z*t194 - sin_roll*cos_pitch*haa_rh_y - t180*hfe_rh_y - t180*kfe_rh_y - t180*wheel_joint_rh_y - t213*wheel_joint_rh_z);
   }
   if (rotations != nullptr) {
     const Scalar t222 = cos_yaw*cos_pitch;

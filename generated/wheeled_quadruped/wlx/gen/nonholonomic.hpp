@@ -49,7 +49,6 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const auto C = out.C;
   const auto spin = out.spin;
   const auto drive = out.drive;
-  using std::sqrt;
   const Scalar yaw = s(3);
   const Scalar pitch = s(4);
   const Scalar roll = s(5);
@@ -143,7 +142,7 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const Scalar t11 = cos_yaw*cos_roll + sin_roll*sin_pitch*sin_yaw;
   const Scalar t12 = t10*sin_haa_lf + t11*cos_haa_lf;
   const Scalar t13 = t12*t12 + t9*t9;
-  const Scalar t14 = Scalar(1)/sqrt(t13);
+  const Scalar t14 = Scalar(1)/detail::square_root(t13);
   const Scalar t16 = sin_roll*cos_haa_lf*cos_pitch + sin_haa_lf*cos_roll*cos_pitch;
   const Scalar t19 = t7*cos_haa_lf - t5*sin_haa_lf;
   const Scalar t21 = cos_hfe_lf*t19 + cos_yaw*sin_hfe_lf*cos_pitch;
@@ -179,7 +178,7 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const Scalar t52 = t42 + t43 + t46 + haa_lf_x*sin_pitch + t48 + t49 + t50 + t51 - sin_roll*cos_pitch*haa_lf_y;
   const Scalar t53 = sin_yaw*t12 + t9*cos_yaw;
   const Scalar t54 = t16*sin_yaw*t12 + t9*cos_yaw*t16;
-  const Scalar t55 = Scalar(1)/(t13*sqrt(t13));
+  const Scalar t55 = Scalar(1)/(t13*detail::square_root(t13));
   const Scalar t56 = sin_yaw*t52 + wheel_radius*t53*t14*t12 + t16*wheel_radius*(t54*t55*t12 - t16*t14*sin_yaw);
   const Scalar t57 = t16*wheel_radius*(cos_yaw*t16*t14 - t9*t54*t55) - cos_yaw*t52 - t9*wheel_radius*t53*t14;
   const Scalar t58 = t16*cos_pitch*sin_yaw + sin_pitch*t12;
@@ -218,7 +217,7 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const Scalar t93 = cos_haa_rf*t5 + t7*sin_haa_rf;
   const Scalar t94 = t11*cos_haa_rf + t10*sin_haa_rf;
   const Scalar t95 = t93*t93 + t94*t94;
-  const Scalar t96 = Scalar(1)/sqrt(t95);
+  const Scalar t96 = Scalar(1)/detail::square_root(t95);
   const Scalar t100 = t5*sin_haa_rf - t7*cos_haa_rf;
   const Scalar t101 = cos_yaw*cos_hfe_rf*cos_pitch - sin_hfe_rf*t100;
   const Scalar t102 = t100*cos_hfe_rf + sin_hfe_rf*cos_yaw*cos_pitch;
@@ -250,7 +249,7 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const Scalar t129 = t117 + t118 + wheel_radius*t94*t96*t114 + t119 + t123 + t124 + t125 + t126 + t127 + t128;
   const Scalar t130 = t94*sin_yaw + cos_yaw*t93;
   const Scalar t131 = t94*sin_yaw*t114 + cos_yaw*t93*t114;
-  const Scalar t132 = Scalar(1)/(t95*sqrt(t95));
+  const Scalar t132 = Scalar(1)/(t95*detail::square_root(t95));
   const Scalar t133 = -hfe_rf_y*t114;
   const Scalar t134 = sin_roll*cos_pitch*sin_haa_rf - cos_haa_rf*cos_roll*cos_pitch;
   const Scalar t135 = sin_hfe_rf*sin_pitch - cos_hfe_rf*t134;
@@ -300,7 +299,7 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const Scalar t181 = cos_haa_lh*t11 + sin_haa_lh*t10;
   const Scalar t182 = t7*sin_haa_lh + cos_haa_lh*t5;
   const Scalar t183 = t181*t181 + t182*t182;
-  const Scalar t184 = Scalar(1)/sqrt(t183);
+  const Scalar t184 = Scalar(1)/detail::square_root(t183);
   const Scalar t185 = cos_yaw*hfe_lh_x*cos_pitch;
   const Scalar t187 = sin_haa_lh*t5 - t7*cos_haa_lh;
   const Scalar t189 = t187*cos_hfe_lh - cos_yaw*cos_pitch*sin_hfe_lh;
@@ -332,7 +331,7 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const Scalar t217 = t205 + t206 + t209 + t210 + wheel_radius*t199*t184*t181 + t212 + t213 + t214 + t215 + t216;
   const Scalar t218 = t181*sin_yaw + cos_yaw*t182;
   const Scalar t219 = t199*t181*sin_yaw + cos_yaw*t199*t182;
-  const Scalar t220 = Scalar(1)/(t183*sqrt(t183));
+  const Scalar t220 = Scalar(1)/(t183*detail::square_root(t183));
   const Scalar t221 = sin_roll*sin_haa_lh*cos_pitch - cos_haa_lh*cos_roll*cos_pitch;
   const Scalar t222 = sin_pitch*sin_hfe_lh + t221*cos_hfe_lh;
   const Scalar t223 = kfe_lh_z*t222;
@@ -377,7 +376,7 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const Scalar t264 = t7*sin_haa_rh + t5*cos_haa_rh;
   const Scalar t265 = t10*sin_haa_rh + t11*cos_haa_rh;
   const Scalar t266 = t264*t264 + t265*t265;
-  const Scalar t267 = Scalar(1)/sqrt(t266);
+  const Scalar t267 = Scalar(1)/detail::square_root(t266);
   const Scalar t270 = t5*sin_haa_rh - t7*cos_haa_rh;
   const Scalar t272 = cos_hfe_rh*t270 + cos_yaw*sin_hfe_rh*cos_pitch;
   const Scalar t274 = sin_hfe_rh*t270 - cos_yaw*cos_hfe_rh*cos_pitch;
@@ -411,7 +410,7 @@ inline void nonholonomic(const CoordinatesOf<Scalar>& s, const Params& p, const 
   const Scalar t302 = t301*wheel_joint_rh_x;
   const Scalar t303 = haa_rh_x*cos_pitch*sin_yaw;
   const Scalar t304 = t292 + t293 + t296 + t297 + t298 + t283*wheel_radius*t267*t265 + t299 + t300 + t302 + t303;
-  const Scalar t305 = Scalar(1)/(t266*sqrt(t266));
+  const Scalar t305 = Scalar(1)/(t266*detail::square_root(t266));
   const Scalar t306 = t283*cos_yaw*t264 + t283*t265*sin_yaw;
   const Scalar t307 = t265*sin_yaw + cos_yaw*t264;
   const Scalar t308 = sin_roll*sin_haa_rh*cos_pitch - cos_haa_rh*cos_roll*cos_pitch;

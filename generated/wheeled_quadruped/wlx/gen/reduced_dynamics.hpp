@@ -63,7 +63,6 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   const auto Q_gravity = out.Q_gravity;
   static_cast<void>(sdot);
   static_cast<void>(T);
-  using std::sqrt;
   const Scalar x_B = s(0);
   const Scalar y_B = s(1);
   const Scalar z_B = s(2);
@@ -264,7 +263,7 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   const Scalar t30 = t5*t29 - t20*t24;
   const Scalar t31 = t21*t24 + t11*t30;
   const Scalar t32 = t24*t24 + t11*t11;
-  const Scalar t33 = Scalar(1)/(t32*sqrt(t32));
+  const Scalar t33 = Scalar(1)/(t32*detail::square_root(t32));
   const Scalar t34 = t19 + yaw_dot;
   const Scalar t35 = t12 + t15;
   const Scalar t36 = cos_yaw*t34*cos_pitch - sin_pitch*t35;
@@ -297,7 +296,7 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   const Scalar t63 = -haa_lf_dot*t62;
   const Scalar t64 = t58 + t59 + t61 + t63 + (t5*t48 - t38*t24)*kfe_lf_dot;
   const Scalar t65 = t11*t56 + t16*t47 + t5*t64 - t30*t20;
-  const Scalar t66 = Scalar(1)/sqrt(t32);
+  const Scalar t66 = Scalar(1)/detail::square_root(t32);
   const Scalar t67 = (t11*t57 + t65*t24 - t21*t21 - t30*t30)*t66;
   const Scalar t68 = Scalar(3.0)*t31*t31*t33 + t67;
   const Scalar t69 = Scalar(1)/t32;
@@ -448,7 +447,7 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   const Scalar t222 = t216 + t221;
   const Scalar t223 = t215*t222;
   const Scalar t224 = t212*t212 + t207*t207;
-  const Scalar t225 = Scalar(1)/sqrt(t224);
+  const Scalar t225 = Scalar(1)/detail::square_root(t224);
   const Scalar t226 = hfe_rf_dot*t207;
   const Scalar t227 = -haa_rf_dot*cos_pitch*sin_yaw;
   const Scalar t228 = -pitch_dot*cos_yaw;
@@ -544,7 +543,7 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   const Scalar t320 = t319*t245;
   const Scalar t321 = t51*t307*roll_dot;
   const Scalar t322 = t248*t212 - t207*t246;
-  const Scalar t323 = Scalar(1)/(t224*sqrt(t224));
+  const Scalar t323 = Scalar(1)/(t224*detail::square_root(t224));
   const Scalar t324 = t212*t322*t323 - t248*t225;
   const Scalar t325 = t207*t244 + t212*t247;
   const Scalar t326 = Scalar(1)/t224;
@@ -666,8 +665,8 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   const Scalar t448 = t402*t446 + t393*t444;
   const Scalar t449 = t402*t447 - t448*t385;
   const Scalar t450 = t402*t402 + t385*t385;
-  const Scalar t451 = Scalar(1)/(t450*sqrt(t450));
-  const Scalar t452 = Scalar(1)/sqrt(t450);
+  const Scalar t451 = Scalar(1)/(t450*detail::square_root(t450));
+  const Scalar t452 = Scalar(1)/detail::square_root(t450);
   const Scalar t453 = t449*t385*t451 + t448*t452;
   const Scalar t454 = sin_roll*haa_lh_y*cos_pitch;
   const Scalar t455 = -sin_pitch*haa_lh_x;
@@ -841,8 +840,8 @@ inline void reduced_dynamics(const CoordinatesOf<Scalar>& s, const detail::NonDe
   const Scalar t629 = t625 + t626 + t627 + kfe_rh_dot*(t571*t602 + t628*t563);
   const Scalar t630 = t557*t605 - t622*t583 - t624*t623 - t629*t571;
   const Scalar t631 = t563*t563 + t571*t571;
-  const Scalar t632 = Scalar(1)/sqrt(t631);
-  const Scalar t633 = Scalar(1)/(t631*sqrt(t631));
+  const Scalar t632 = Scalar(1)/detail::square_root(t631);
+  const Scalar t633 = Scalar(1)/(t631*detail::square_root(t631));
   const Scalar t634 = t557*t583 - t571*t623;
   const Scalar t635 = t624*t571 + t563*t634;
   const Scalar t636 = haa_rh_dot*t62;
