@@ -42,7 +42,8 @@ std::size_t entry_of(int a, int b) {
   throw std::logic_error("inertia entry");
 }
 
-// A spatial inertia about K0's origin, in K0: mass, first moment h = m p, rotational inertia J.
+// A spatial inertia about the reference point (Projection::origin), in K0: mass, first moment
+// h = m p (p the CoM from the reference point), rotational inertia J.
 struct Inertia {
   Signed mass;
   S3 h;
@@ -50,11 +51,11 @@ struct Inertia {
   const Signed& Jab(int a, int b) const { return J[entry_of(a, b)]; }
 };
 
-// Body slot s of unit u about K0's origin: J = R diag(I) R^T + m (|p|^2 1 - p p^T). With R's
+// Body slot s of unit u about the reference point: J = R diag(I) R^T + m (|p|^2 1 - p p^T). With R's
 // columns r_k orthonormal, R diag(I) R^T = I_1 1 + (I_2 - I_1) r_2 r_2^T + (I_3 - I_1) r_3 r_3^T, so
 // J = sigma 1 + (I_2 - I_1) r_2 r_2^T + (I_3 - I_1) r_3 r_3^T - h p^T with sigma = I_1 + h . p
 // (h = m p): two products per entry fewer than R diag(I) R^T written out.
-Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, Builder& w) {
+Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, const Vec3& origin, Builder& w) {
   const int index = u.bodies[s][0];  // the values' names: the first lane's body
   const auto per_lane = [&](Quantity what, int a, int b, const auto& value) {
     std::vector<Signed> lanes;
@@ -65,7 +66,7 @@ Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, Builder& w) {
   Inertia out;
   out.mass = per_lane(Quantity::mass, 0, 0, [&](const Body& b) { return m.parameter(b.mass).symbol; });
   S3 p;
-  for (int c = 0; c < 3; ++c) p[at(c)] = per_lane(Quantity::com_offset, c, 0, [&](const Body& b) { return b.com_frame.r[c]; });
+  for (int c = 0; c < 3; ++c) p[at(c)] = per_lane(Quantity::com_offset, c, 0, [&](const Body& b) { return b.com_frame.r[c] - origin[c]; });
   const auto R = [&](int a, int k) { return per_lane(Quantity::com_rotation, a, k, [&](const Body& b) { return b.com_frame.R(a, k); }); };
   std::array<S3, 2> weighted;  // (I_k - I_1) r_k for k = 2, 3
   for (int k = 1; k < 3; ++k) {
@@ -107,12 +108,12 @@ struct Summands {
 };
 
 // The composite inertias, from the leaves in.
-std::vector<Inertia> composite_inertias(const Model& m, const Units& units, Builder& w) {
+std::vector<Inertia> composite_inertias(const Model& m, const Units& units, const Vec3& origin, Builder& w) {
   std::vector<Inertia> out(units.units.size());
   for (std::size_t u = units.units.size(); u-- > 0;) {
     const Unit& unit = units.units[u];
     std::vector<Inertia> own;
-    for (std::size_t s = 0; s < unit.bodies.size(); ++s) own.push_back(body_inertia(m, unit, s, w));
+    for (std::size_t s = 0; s < unit.bodies.size(); ++s) own.push_back(body_inertia(m, unit, s, origin, w));
     const Summands sum{units, u};
     const int k = unit.nodes[0];
     const auto total = [&](const ValueId& target, const auto& pick) {
@@ -134,7 +135,7 @@ std::vector<Inertia> composite_inertias(const Model& m, const Units& units, Buil
 }
 
 // I S for a composite inertia and a joint's axis S = (a; b): the momentum of the bodies beyond per
-// unit rate, (force m b + a x h; moment about K0's origin J a + h x b).
+// unit rate, (force m b + a x h; moment about the reference point J a + h x b).
 S6 momentum(const Inertia& I, const S6& S, int node, Builder& w) {
   const S3 a{S[0], S[1], S[2]}, b{S[3], S[4], S[5]};
   S6 out;
@@ -246,7 +247,7 @@ void gravity_forces(const Model& m, const Projection& pr, const std::vector<Iner
 
 // Body slot s of unit u: its wrench at zero u' without gravity (force m a_bias; moment p x force +
 // R N, N = I alpha_b + omega_b x I omega_b in body axes), as Kane's sums weigh it.
-S6 bias_wrench(const Model& m, const Unit& u, std::size_t s, Builder& w) {
+S6 bias_wrench(const Model& m, const Unit& u, std::size_t s, const Vec3& origin, Builder& w) {
   const int index = u.bodies[s][0];
   const auto per_lane = [&](Quantity what, int a, int b, const auto& value) {
     std::vector<Signed> lanes;
@@ -269,7 +270,7 @@ S6 bias_wrench(const Model& m, const Unit& u, std::size_t s, Builder& w) {
   const Signed mass = per_lane(Quantity::mass, 0, 0, [&](const Body& b) { return m.parameter(b.mass).symbol; });
   S3 p, F, N;
   for (int c = 0; c < 3; ++c) {
-    p[at(c)] = per_lane(Quantity::com_offset, c, 0, [&](const Body& b) { return b.com_frame.r[c]; });
+    p[at(c)] = per_lane(Quantity::com_offset, c, 0, [&](const Body& b) { return b.com_frame.r[c] - origin[c]; });
     N[at(c)] = per_lane(Quantity::bias_torque, c, 0, [&](const Body& b) { return torque(b)[c]; });
     const Signed a = per_lane(Quantity::bias_acceleration, c, 0, [&](const Body& b) { return b.com_frame.a_bias[c]; });
     F[at(c)] = w.define(value_id(Quantity::force, index, c), {{mass, a}});
@@ -292,7 +293,7 @@ void velocity_forces(const Model& m, const Projection& pr, Builder& w) {
   std::vector<Signed> per_unit(units.units.size());
   for (std::size_t u = units.units.size(); u-- > 0;) {
     std::vector<S6> own;
-    for (std::size_t s = 0; s < units.units[u].bodies.size(); ++s) own.push_back(bias_wrench(m, units.units[u], s, w));
+    for (std::size_t s = 0; s < units.units[u].bodies.size(); ++s) own.push_back(bias_wrench(m, units.units[u], s, pr.origin, w));
     const Summands sum{units, u};
     for (int c = 0; c < 6; ++c)
       beyond[u][at(c)] = w.define(value_id(Quantity::wrench, units.units[u].nodes[0], c), sum(
@@ -311,6 +312,29 @@ void velocity_forces(const Model& m, const Projection& pr, Builder& w) {
   w.add(lane_code::CloseOutput{});
 }
 
+// The point the spatial quantities are taken about: the first revolute joint's (a floating base's
+// position, a fixed base's first joint), so that the inertias about it stay of the machine's size
+// wherever it stands (about K0's origin, m |p|^2 would cancel in M to the square of its distance
+// over its size), and a rotation at the base has no linear part. K0's origin without one.
+Vec3 reference_point(const TwistTree& tree) {
+  for (const TwistNode& node : tree.nodes)
+    if (node.joint->revolute) return node.joint->origin;
+  return Vec3(0, 0, 0);
+}
+
+// A joint's twist per unit rate about `origin`: (a; (o - origin) x a) for a revolute joint (axis a
+// through o), (0; a) for a prismatic one.
+std::array<ex, 6> axis_about(const JointRecord& joint, const Vec3& origin) {
+  const Vec3 arm(joint.origin[0] - origin[0], joint.origin[1] - origin[1], joint.origin[2] - origin[2]);
+  const Vec3 linear = joint.revolute ? wlx::codegen::cross(arm, joint.axis) : joint.axis;
+  std::array<ex, 6> S;
+  for (int c = 0; c < 3; ++c) {
+    S[at(c)] = joint.revolute ? joint.axis[c] : ex(0);
+    S[at(c + 3)] = linear[c];
+  }
+  return S;
+}
+
 }  // namespace
 
 lane_code::LaneProgram composite_rigid_body_program(const Model& m) {
@@ -318,7 +342,7 @@ lane_code::LaneProgram composite_rigid_body_program(const Model& m) {
   const TwistTree tree = twist_tree(m, roles);
   const Units units = group_units(tree, roles);
   Builder w(units.width);
-  Projection pr{units, roles, rate_speeds(m, roles), static_cast<int>(m.dynamics->commanded.size()), {}};
+  Projection pr{units, roles, rate_speeds(m, roles), static_cast<int>(m.dynamics->commanded.size()), {}, reference_point(tree)};
   w.charge_to = kM;
   if (units.width > 1) w.add(lane_code::LaneTypes{});
   for (const Unit& u : units.units) {
@@ -326,13 +350,13 @@ lane_code::LaneProgram composite_rigid_body_program(const Model& m) {
     S6 S;
     for (int c = 0; c < 6; ++c) {
       std::vector<Signed> lanes;
-      for (int node : u.nodes) lanes.push_back(w.scalar(value_id(Quantity::joint_axis, node, c), spatial_axis(*tree.nodes[at(node)].joint)[at(c)]));
+      for (int node : u.nodes) lanes.push_back(w.scalar(value_id(Quantity::joint_axis, node, c), axis_about(*tree.nodes[at(node)].joint, pr.origin)[at(c)]));
       S[at(c)] = w.pack(value_id(Quantity::joint_axis, k, c), lanes);
     }
     pr.axis.push_back(S);
   }
-  w.add(lane_code::Comment{"The bodies' inertias about K0's origin, in K0, and their composites beyond each joint."});
-  const std::vector<Inertia> composite = composite_inertias(m, units, w);
+  w.add(lane_code::Comment{"The bodies' inertias about the first revolute joint's origin, in K0, and their composites beyond each joint."});
+  const std::vector<Inertia> composite = composite_inertias(m, units, pr.origin, w);
   w.add(lane_code::Comment{"M on the coordinates: S_j . (I_k S_k) for each joint k and each joint j on its chain."});
   const auto M = unit_mass(pr, composite, w);
   w.add(lane_code::Comment{"M on the commanded speeds: T^T M T on T's pattern (T^T M's dense columns are B_bias)."});

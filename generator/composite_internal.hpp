@@ -85,7 +85,8 @@ struct Projection {
   RateRoles roles;
   std::vector<std::vector<int>> speeds_of;
   int nu = 0;
-  std::vector<std::array<Signed, 6>> axis;  // per unit
+  std::vector<std::array<Signed, 6>> axis;  // per unit, about `origin`
+  Vec3 origin;                              // the point moments and twists are taken about
   int coordinate(int u, int lane) const { return units.units[at(u)].coordinates[at(lane)]; }
   bool dense_plain(int u) const { return !units.units[at(u)].row() && roles.dense[at(coordinate(u, 0))]; }
   // The plain units of speed b's coordinate.

@@ -56,15 +56,16 @@ enum class Quantity : unsigned char {
   joint_force,                // (k): node k's tau
   coordinate_force,           // (j): the sum of coordinate j's joints' taus
   commanded_force,            // (l): Q*_l
-  // The composite-rigid-body pass of reduced_dynamics (scalars): inertias about K0's origin, in K0.
+  // The composite-rigid-body pass of reduced_dynamics: inertias about its reference point (the
+  // first revolute joint's origin), in K0.
   first_moment,               // (i, c): a body's m p
   inertia_difference,         // (i, k): a body's principal moment k less the first (a lane scalar)
   rotated_inertia,            // (i, a, k): R(a, k) times inertia_difference (i, k)
   inertia_shift,              // (i): a body's first principal moment plus m |p|^2
-  origin_inertia,             // (i, a, b): a body's rotational inertia about K0's origin
+  origin_inertia,             // (i, a, b): a body's rotational inertia about the reference point
   composite_mass,             // (k): the mass of the bodies beyond node k
   composite_first_moment,     // (k, c)
-  composite_inertia,          // (k, a, b): rotational, about K0's origin
+  composite_inertia,          // (k, a, b): rotational, about the reference point
   joint_momentum,             // (k, c): the composite inertia beyond node k times its axis, (force; moment)
   joint_mass,                 // (j, k): M between the joints of nodes j and k, k beyond j
   projected_mass,             // (l, k): (T^T M)(l, the coordinate of node k)

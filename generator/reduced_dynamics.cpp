@@ -224,12 +224,13 @@ using Twist = std::array<ValueId, 6>;
 constexpr const char* kCompositeDoc =
     "The equations of motion on the commanded speeds u, in one pass with the convective terms: with s' = T u and "
     "s'' = T u' + s''_bias, the generalized inertia, velocity and gravity forces on u are M u' + b_velocity + "
-    "B_bias s''_bias and Q_gravity. M by composite rigid bodies: each body's inertia about K0's origin is added to "
-    "the composite I_k beyond its joint k, M on the coordinates is S_j . (I_k S_k) for each joint k and each joint "
-    "j on its chain up to k (S the joints' axes in K0), and M on u is T^T M T on T's pattern, whose T^T M on the "
-    "dense rows' coordinates is B_bias. b_velocity = T^T tau for the bodies' wrenches at u' = 0 and s''_bias = 0 "
-    "(m a; I alpha + omega x I omega) summed back along the chains, and Q_gravity = T^T tau for gravity, from the "
-    "composites' masses and first moments. Limbs of one shape run side by side, one lane each.";
+    "B_bias s''_bias and Q_gravity. M by composite rigid bodies: each body's inertia about the first revolute "
+    "joint's origin is added to the composite I_k beyond its joint k, M on the coordinates is S_j . (I_k S_k) for "
+    "each joint k and each joint j on its chain up to k (S the joints' axes in K0), and M on u is T^T M T on T's "
+    "pattern, whose T^T M on the dense rows' coordinates is B_bias. b_velocity = T^T tau for the bodies' wrenches "
+    "at u' = 0 and s''_bias = 0 (m a; I alpha + omega x I omega) summed back along the chains, and Q_gravity = "
+    "T^T tau for gravity, from the composites' masses and first moments. Limbs of one shape run side by side, one "
+    "lane each.";
 
 // reduced_dynamics as declared: its documentation and its input T. The names of its lane code are
 // the printer's, which the model's coordinates and parameters therefore must not take.
