@@ -32,7 +32,9 @@ std::vector<Product> cross(const S3& x, const S3& y, int c) {
   const std::size_t c1 = at((c + 1) % 3), c2 = at((c + 2) % 3);
   return {{x[c1], y[c2]}, {-x[c2], y[c1]}};
 }
-void append(std::vector<Product>& to, const std::vector<Product>& more) { to.insert(to.end(), more.begin(), more.end()); }
+void append(std::vector<Product>& to, const std::vector<Product>& more) {
+  to.insert(to.end(), more.begin(), more.end());
+}
 
 // The rotational inertia's six entries (a <= b), in this order.
 constexpr std::array<std::pair<int, int>, 6> kInertiaEntries{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
@@ -66,14 +68,20 @@ Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, const Vec3& o
   Inertia out;
   out.mass = per_lane(Quantity::mass, 0, 0, [&](const Body& b) { return m.parameter(b.mass).symbol; });
   S3 p;
-  for (int c = 0; c < 3; ++c) p[at(c)] = per_lane(Quantity::com_offset, c, 0, [&](const Body& b) { return b.com_frame.r[c] - origin[c]; });
-  const auto R = [&](int a, int k) { return per_lane(Quantity::com_rotation, a, k, [&](const Body& b) { return b.com_frame.R(a, k); }); };
+  for (int c = 0; c < 3; ++c)
+    p[at(c)] = per_lane(Quantity::com_offset, c, 0, [&](const Body& b) { return b.com_frame.r[c] - origin[c]; });
+  const auto R = [&](int a, int k) {
+    return per_lane(Quantity::com_rotation, a, k, [&](const Body& b) { return b.com_frame.R(a, k); });
+  };
   std::array<S3, 2> weighted;  // (I_k - I_1) r_k for k = 2, 3
   for (int k = 1; k < 3; ++k) {
-    const Signed difference = per_lane(Quantity::inertia_difference, k, 0, [&](const Body& b) { return moment(b, k) - moment(b, 0); });
-    for (int a = 0; a < 3; ++a) weighted[at(k - 1)][at(a)] = w.define(value_id(Quantity::rotated_inertia, index, a, k), {{R(a, k), difference}});
+    const Signed difference =
+        per_lane(Quantity::inertia_difference, k, 0, [&](const Body& b) { return moment(b, k) - moment(b, 0); });
+    for (int a = 0; a < 3; ++a)
+      weighted[at(k - 1)][at(a)] = w.define(value_id(Quantity::rotated_inertia, index, a, k), {{R(a, k), difference}});
   }
-  for (int c = 0; c < 3; ++c) out.h[at(c)] = w.define(value_id(Quantity::first_moment, index, c), {{out.mass, p[at(c)]}});
+  for (int c = 0; c < 3; ++c)
+    out.h[at(c)] = w.define(value_id(Quantity::first_moment, index, c), {{out.mass, p[at(c)]}});
   std::vector<Product> shift{{per_lane(Quantity::inertia, 0, 0, [&](const Body& b) { return moment(b, 0); })}};
   for (int c = 0; c < 3; ++c) shift.push_back({out.h[at(c)], p[at(c)]});
   const Signed sigma = w.define(value_id(Quantity::inertia_shift, index), shift);
@@ -126,7 +134,9 @@ std::vector<Inertia> composite_inertias(const Model& m, const Units& units, cons
                                   [&](std::size_t child) { return pick(out[child]); }));
     };
     out[u].mass = total(value_id(Quantity::composite_mass, k), [](const Inertia& x) { return x.mass; });
-    for (int c = 0; c < 3; ++c) out[u].h[at(c)] = total(value_id(Quantity::composite_first_moment, k, c), [&](const Inertia& x) { return x.h[at(c)]; });
+    for (int c = 0; c < 3; ++c)
+      out[u].h[at(c)] =
+          total(value_id(Quantity::composite_first_moment, k, c), [&](const Inertia& x) { return x.h[at(c)]; });
     for (std::size_t e = 0; e < kInertiaEntries.size(); ++e)
       out[u].J[e] = total(value_id(Quantity::composite_inertia, k, kInertiaEntries[e].first, kInertiaEntries[e].second),
                           [&](const Inertia& x) { return x.J[e]; });
@@ -163,13 +173,15 @@ std::vector<Product> power(const S6& S, const S6& wrench) {
 
 // M between units: S_j . (I_k S_k) for each unit k and each unit j on its chain up to k (a row
 // where k is a row unit: lane g pairs the joints of lane g), keyed (j, k).
-std::map<std::pair<int, int>, Signed> unit_mass(const Projection& pr, const std::vector<Inertia>& composite, Builder& w) {
+std::map<std::pair<int, int>, Signed> unit_mass(const Projection& pr, const std::vector<Inertia>& composite,
+                                                Builder& w) {
   std::map<std::pair<int, int>, Signed> out;
   for (std::size_t k = 0; k < pr.units.units.size(); ++k) {
     const S6 F = momentum(composite[k], pr.axis[k], pr.units.units[k].nodes[0], w);
     for (int j = static_cast<int>(k); j >= 0; j = pr.units.units[at(j)].parent) {
-      const Signed v = w.define(value_id(Quantity::joint_mass, pr.units.units[at(j)].nodes[0], pr.units.units[k].nodes[0]),
-                                power(pr.axis[at(j)], F));
+      const Signed v =
+          w.define(value_id(Quantity::joint_mass, pr.units.units[at(j)].nodes[0], pr.units.units[k].nodes[0]),
+                   power(pr.axis[at(j)], F));
       if (!v.is_zero()) out[{j, static_cast<int>(k)}] = v;
     }
   }
@@ -178,8 +190,8 @@ std::map<std::pair<int, int>, Signed> unit_mass(const Projection& pr, const std:
 
 // The outputs' entries (Store) of M, b_velocity, Q_gravity and B_bias: factor times v (v's lane
 // `lane` of a row).
-void store(Builder& w, const std::string& output, int row, int column, bool mirrored, const Signed& v, const Signed& factor = kUnit,
-           int lane = -1) {
+void store(Builder& w, const std::string& output, int row, int column, bool mirrored, const Signed& v,
+           const Signed& factor = kUnit, int lane = -1) {
   std::vector<Term> terms;
   if (!v.is_zero()) terms.push_back({factor.id, v.id, lane, v.negate != factor.negate});
   w.add(lane_code::Store{output, row, column, mirrored, std::move(terms)});
@@ -194,7 +206,8 @@ void project_mass(const Projection& pr, const std::map<std::pair<int, int>, Sign
   for (int l = 0; l < pr.nu; ++l)
     for (std::size_t u = 0; u < pr.units.units.size(); ++u)
       if (pr.units.units[u].row() || pr.dense_plain(static_cast<int>(u)))
-        bias[{l, static_cast<int>(u)}] = pr.projected(value_id(Quantity::projected_mass, l, pr.units.units[u].nodes[0]), l, static_cast<int>(u), M, w);
+        bias[{l, static_cast<int>(u)}] = pr.projected(value_id(Quantity::projected_mass, l, pr.units.units[u].nodes[0]),
+                                                      l, static_cast<int>(u), M, w);
   // Every value before the outputs' blocks, none inside one: the code a value needs is placed
   // before its first reader (emit_function.cpp), which must not be in a block a later reader is not.
   w.charge_to = kM;
@@ -235,7 +248,8 @@ void gravity_forces(const Model& m, const Projection& pr, const std::vector<Iner
   for (std::size_t u = 0; u < pr.units.units.size(); ++u) {
     const S6& S = pr.axis[u];
     const Inertia& I = composite[u];
-    per_unit[u] = w.define(value_id(Quantity::gravity_force, pr.units.units[u].nodes[0]), {{S[5], I.mass}, {S[0], I.h[1]}, {-S[1], I.h[0]}});
+    per_unit[u] = w.define(value_id(Quantity::gravity_force, pr.units.units[u].nodes[0]),
+                           {{S[5], I.mass}, {S[0], I.h[1]}, {-S[1], I.h[0]}});
   }
   const Signed minus_g = w.scalar(value_id(Quantity::minus_gravity), -m.parameter(m.dynamics->gravity).symbol);
   std::vector<Signed> Q;
@@ -279,7 +293,8 @@ S6 bias_wrench(const Model& m, const Unit& u, std::size_t s, const Vec3& origin,
   for (int c = 0; c < 3; ++c) {
     std::vector<Product> t = cross(p, F, c);
     for (int k = 0; k < 3; ++k)
-      t.push_back({per_lane(Quantity::com_rotation, c, k, [&](const Body& b) { return b.com_frame.R(c, k); }), N[at(k)]});
+      t.push_back(
+          {per_lane(Quantity::com_rotation, c, k, [&](const Body& b) { return b.com_frame.R(c, k); }), N[at(k)]});
     out[at(c + 3)] = w.define(value_id(Quantity::moment, index, c), t);
   }
   return out;
@@ -293,16 +308,18 @@ void velocity_forces(const Model& m, const Projection& pr, Builder& w) {
   std::vector<Signed> per_unit(units.units.size());
   for (std::size_t u = units.units.size(); u-- > 0;) {
     std::vector<S6> own;
-    for (std::size_t s = 0; s < units.units[u].bodies.size(); ++s) own.push_back(bias_wrench(m, units.units[u], s, pr.origin, w));
+    for (std::size_t s = 0; s < units.units[u].bodies.size(); ++s)
+      own.push_back(bias_wrench(m, units.units[u], s, pr.origin, w));
     const Summands sum{units, u};
     for (int c = 0; c < 6; ++c)
-      beyond[u][at(c)] = w.define(value_id(Quantity::wrench, units.units[u].nodes[0], c), sum(
-                                                                                            [&] {
-                                                                                              std::vector<Product> t;
-                                                                                              for (const S6& x : own) t.push_back({x[at(c)]});
-                                                                                              return t;
-                                                                                            },
-                                                                                            [&](std::size_t child) { return beyond[child][at(c)]; }));
+      beyond[u][at(c)] = w.define(value_id(Quantity::wrench, units.units[u].nodes[0], c),
+                                  sum(
+                                      [&] {
+                                        std::vector<Product> t;
+                                        for (const S6& x : own) t.push_back({x[at(c)]});
+                                        return t;
+                                      },
+                                      [&](std::size_t child) { return beyond[child][at(c)]; }));
     per_unit[u] = w.define(value_id(Quantity::joint_force, units.units[u].nodes[0]), power(pr.axis[u], beyond[u]));
   }
   std::vector<Signed> b;
@@ -342,7 +359,8 @@ lane_code::LaneProgram composite_rigid_body_program(const Model& m) {
   const TwistTree tree = twist_tree(m, roles);
   const Units units = group_units(tree, roles);
   Builder w(units.width);
-  Projection pr{units, roles, rate_speeds(m, roles), static_cast<int>(m.dynamics->commanded.size()), {}, reference_point(tree)};
+  Projection pr{
+      units, roles, rate_speeds(m, roles), static_cast<int>(m.dynamics->commanded.size()), {}, reference_point(tree)};
   w.charge_to = kM;
   if (units.width > 1) w.add(lane_code::LaneTypes{});
   for (const Unit& u : units.units) {
@@ -350,12 +368,15 @@ lane_code::LaneProgram composite_rigid_body_program(const Model& m) {
     S6 S;
     for (int c = 0; c < 6; ++c) {
       std::vector<Signed> lanes;
-      for (int node : u.nodes) lanes.push_back(w.scalar(value_id(Quantity::joint_axis, node, c), axis_about(*tree.nodes[at(node)].joint, pr.origin)[at(c)]));
+      for (int node : u.nodes)
+        lanes.push_back(w.scalar(value_id(Quantity::joint_axis, node, c),
+                                 axis_about(*tree.nodes[at(node)].joint, pr.origin)[at(c)]));
       S[at(c)] = w.pack(value_id(Quantity::joint_axis, k, c), lanes);
     }
     pr.axis.push_back(S);
   }
-  w.add(lane_code::Comment{"The bodies' inertias about the first revolute joint's origin, in K0, and their composites beyond each joint."});
+  w.add(lane_code::Comment{
+      "The bodies' inertias about the first revolute joint's origin, in K0, and their composites beyond each joint."});
   const std::vector<Inertia> composite = composite_inertias(m, units, pr.origin, w);
   w.add(lane_code::Comment{"M on the coordinates: S_j . (I_k S_k) for each joint k and each joint j on its chain."});
   const auto M = unit_mass(pr, composite, w);

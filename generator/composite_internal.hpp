@@ -101,7 +101,8 @@ struct Projection {
   Signed transposed(const lane_code::ValueId& target, int l, const std::vector<Signed>& per_unit, Builder& w) const;
   // (T^T M)(l, u's coordinates) from M between units (keyed (ancestor, unit)): u's kind of value;
   // for a plain unit, added to a sum instead.
-  Signed projected(const lane_code::ValueId& target, int l, int u, const std::map<std::pair<int, int>, Signed>& M, Builder& w) const;
+  Signed projected(const lane_code::ValueId& target, int l, int u, const std::map<std::pair<int, int>, Signed>& M,
+                   Builder& w) const;
   void add_projected(Sum& sum, int l, int u, const std::map<std::pair<int, int>, Signed>& M, Builder& w) const;
 };
 

@@ -85,7 +85,8 @@ Signed Builder::define(const ValueId& target, const std::vector<Product>& produc
   if (all_negative)
     for (Term& t : terms) t.negate = false;
   std::stable_partition(terms.begin(), terms.end(), [](const Term& t) { return !t.negate; });
-  if (terms.size() == 1 && terms[0].factor.what == Quantity::one && terms[0].lane < 0) return {terms[0].value, all_negative};
+  if (terms.size() == 1 && terms[0].factor.what == Quantity::one && terms[0].lane < 0)
+    return {terms[0].value, all_negative};
   add(lane_code::Define{target, row ? Layout::narrow : Layout::scalar, std::move(terms)});
   if (row) rows_.insert(target);
   return {target, all_negative};
@@ -163,13 +164,15 @@ Units group_units(const TwistTree& tree, const RateRoles& roles) {
       return;
     }
     for (const auto& group : same_shapes(nodes[at(lanes[0])].children)) {
-      if (out.width > 1 && static_cast<int>(group.size()) == out.width) make(group, index);
+      if (out.width > 1 && static_cast<int>(group.size()) == out.width)
+        make(group, index);
       else
         for (int n : group) make({n}, index);
     }
   };
   for (const auto& group : same_shapes(roots)) {
-    if (out.width > 1 && static_cast<int>(group.size()) == out.width) make(group, -1);
+    if (out.width > 1 && static_cast<int>(group.size()) == out.width)
+      make(group, -1);
     else
       for (int n : group) make({n}, -1);
   }
@@ -179,14 +182,16 @@ Units group_units(const TwistTree& tree, const RateRoles& roles) {
 std::vector<int> Projection::units_of_speed(int b) const {
   std::vector<int> out;
   for (std::size_t u = 0; u < units.units.size(); ++u)
-    if (!units.units[u].row() && roles.speed_of[at(coordinate(static_cast<int>(u), 0))] == b) out.push_back(static_cast<int>(u));
+    if (!units.units[u].row() && roles.speed_of[at(coordinate(static_cast<int>(u), 0))] == b)
+      out.push_back(static_cast<int>(u));
   return out;
 }
 
 Signed Projection::T(int r, int l) const {
   if (roles.speed_of[at(r)] == l) return kUnit;
   const auto& speeds = speeds_of[at(r)];
-  if (roles.dense[at(r)] && std::binary_search(speeds.begin(), speeds.end(), l)) return {value_id(Quantity::rate_basis_entry, r, l)};
+  if (roles.dense[at(r)] && std::binary_search(speeds.begin(), speeds.end(), l))
+    return {value_id(Quantity::rate_basis_entry, r, l)};
   return {};
 }
 
@@ -207,8 +212,10 @@ void Projection::times_T(Sum& sum, const Signed& value, int u, int b, Builder& w
   std::vector<int> lanes;
   for (int g = 0; g < static_cast<int>(unit.nodes.size()); ++g)
     if (!T(coordinate(u, g), b).is_zero()) lanes.push_back(g);
-  if (lanes.size() == 1) sum.scalar.push_back({T(coordinate(u, lanes[0]), b), value, lanes[0]});
-  else if (!lanes.empty()) sum.row.push_back({value, T_of(u, b, w)});
+  if (lanes.size() == 1)
+    sum.scalar.push_back({T(coordinate(u, lanes[0]), b), value, lanes[0]});
+  else if (!lanes.empty())
+    sum.row.push_back({value, T_of(u, b, w)});
 }
 
 Signed Projection::transposed(const ValueId& target, int l, const std::vector<Signed>& per_unit, Builder& w) const {
@@ -217,14 +224,16 @@ Signed Projection::transposed(const ValueId& target, int l, const std::vector<Si
   return w.define_sum(target, sum);
 }
 
-Signed Projection::projected(const ValueId& target, int l, int u, const std::map<std::pair<int, int>, Signed>& M, Builder& w) const {
+Signed Projection::projected(const ValueId& target, int l, int u, const std::map<std::pair<int, int>, Signed>& M,
+                             Builder& w) const {
   Sum sum;
   add_projected(sum, l, u, M, w);
   if (units.units[at(u)].row()) return w.define(target, sum.row);
   return w.define_sum(target, sum);
 }
 
-void Projection::add_projected(Sum& sum, int l, int u, const std::map<std::pair<int, int>, Signed>& M, Builder& w) const {
+void Projection::add_projected(Sum& sum, int l, int u, const std::map<std::pair<int, int>, Signed>& M,
+                               Builder& w) const {
   const auto entry = [&](int a, int b) {  // a an ancestor of b, or b itself
     const auto it = M.find({a, b});
     return it == M.end() ? Signed{} : it->second;
@@ -232,13 +241,17 @@ void Projection::add_projected(Sum& sum, int l, int u, const std::map<std::pair<
   const bool row = units.units[at(u)].row();
   // The units on u's chain, and those beyond u.
   for (int r = u; r >= 0; r = units.units[at(r)].parent) {
-    if (row) sum.row.push_back({T_of(r, l, w), entry(r, u)});
-    else sum.scalar.push_back({T(coordinate(r, 0), l), entry(r, u)});
+    if (row)
+      sum.row.push_back({T_of(r, l, w), entry(r, u)});
+    else
+      sum.scalar.push_back({T(coordinate(r, 0), l), entry(r, u)});
   }
   const std::function<void(int)> beyond = [&](int r) {
     for (int c : units.units[at(r)].children) {
-      if (row) sum.row.push_back({T_of(c, l, w), entry(u, c)});
-      else times_T(sum, entry(u, c), c, l, w);
+      if (row)
+        sum.row.push_back({T_of(c, l, w), entry(u, c)});
+      else
+        times_T(sum, entry(u, c), c, l, w);
       beyond(c);
     }
   };
