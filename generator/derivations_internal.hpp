@@ -77,4 +77,11 @@ TwistTree twist_tree(const Model& m, const RateRoles& roles);
 // for a revolute joint (axis a through o), (0; a) for a prismatic one.
 std::array<ex, 6> spatial_axis(const JointRecord& joint);
 
+// reduced_dynamics' outputs, in the numbering of its code's statements (lane_code::Statement::output).
+enum ReducedOutput { kM, kB_velocity, kB_bias, kQ_gravity, kReducedOutputs };
+
+// reduced_dynamics by composite rigid bodies (composite_dynamics.cpp): scalar code that writes M,
+// b_velocity, B_bias and Q_gravity from the composite inertias beyond each joint, and T's pattern.
+lane_code::LaneProgram composite_rigid_body_program(const Model& m);
+
 }  // namespace wlx::codegen::derivation

@@ -2,6 +2,7 @@
 // statements stay, and what each costs.
 #include "lane_code.hpp"
 
+#include <algorithm>
 #include <map>
 #include <type_traits>
 
@@ -85,6 +86,32 @@ OpCount operations(const LaneProgram& program, const Step& step) {
                                [](const PlusLane&) { return OpCount{1, 0, 0, 0}; },  // one lane's addition
                                [](const auto&) { return OpCount{}; }},
                     step);
+}
+
+long instructions(const LaneProgram& program) {
+  const std::vector<bool> keep = kept_statements(program);
+  const auto vectors = [&](Layout layout) { return layout == Layout::scalar ? 1L : (program.lanes(layout) + 3L) / 4L; };
+  // A lane read into a scalar sum is one move.
+  const auto lanes_read = [](const std::vector<Term>& terms) {
+    return static_cast<long>(std::count_if(terms.begin(), terms.end(), [](const Term& t) { return t.lane >= 0; }));
+  };
+  const auto row_ops = [&](const Step& step, Layout layout, const std::vector<Term>& terms) {
+    return operations(program, step).total() / program.lanes(layout) * vectors(layout) + (layout == Layout::scalar ? lanes_read(terms) : 0L);
+  };
+  long out = 0;
+  for (std::size_t i = 0; i < program.statements.size(); ++i) {
+    if (!keep[i]) continue;
+    const Step& step = program.statements[i].step;
+    out += std::visit(Overloaded{[&](const Define& s) { return row_ops(step, s.layout, s.terms); },
+                                 [&](const Accumulate& s) { return row_ops(step, s.layout, s.terms); },
+                                 [&](const Store& s) { return operations(program, step).total() + lanes_read(s.terms); },
+                                 [](const PlusLane&) { return 2L; },  // the lane out, added to, and back
+                                 [](const Widen& s) { return static_cast<long>(s.lanes.size()); },
+                                 [&](const LoadRow& s) { return s.whole ? vectors(Layout::narrow) : static_cast<long>(s.lanes.size()); },
+                                 [&](const ZeroRow& s) { return vectors(s.layout); }, [](const auto&) { return 0L; }},
+                      step);
+  }
+  return out;
 }
 
 }  // namespace wlx::codegen::lane_code

@@ -56,6 +56,27 @@ enum class Quantity : unsigned char {
   joint_force,                // (k): node k's tau
   coordinate_force,           // (j): the sum of coordinate j's joints' taus
   commanded_force,            // (l): Q*_l
+  // The composite-rigid-body pass of reduced_dynamics: inertias about its reference point (the
+  // first revolute joint's origin), in K0.
+  first_moment,               // (i, c): a body's m p
+  inertia_difference,         // (i, k): a body's principal moment k less the first (a lane scalar)
+  rotated_inertia,            // (i, a, k): R(a, k) times inertia_difference (i, k)
+  inertia_shift,              // (i): a body's first principal moment plus m |p|^2
+  origin_inertia,             // (i, a, b): a body's rotational inertia about the reference point
+  composite_mass,             // (k): the mass of the bodies beyond node k
+  composite_first_moment,     // (k, c)
+  composite_inertia,          // (k, a, b): rotational, about the reference point
+  joint_momentum,             // (k, c): the composite inertia beyond node k times its axis, (force; moment)
+  joint_mass,                 // (j, k): M between the joints of nodes j and k, k beyond j
+  projected_mass,             // (l, k): (T^T M)(l, the coordinate of node k)
+  reduced_mass,               // (l, b): M on the commanded speeds, l <= b
+  gravity_force,              // (k): node k's tau from gravity, over -g
+  commanded_gravity,          // (l): Q_gravity_l over -g
+  // Values of the composite pass' own making (composite_units.cpp), named after another value v:
+  lanes_of,  // (v): a row of lanes, v's quantity for each limb of a row unit
+  row_sum,   // (v): the row whose lanes add up to v
+  negated,   // (v): -v, to be put in a lane
+  constant,  // (0): 1, (1): -1, to be put in a lane
   // Rows of the lane code's own: T's row of a dense coordinate j, and the accumulators of the
   // outputs (M's row k, b_velocity, Q_gravity, B_bias's column j).
   rate_row,
@@ -199,5 +220,10 @@ std::vector<ValueId> reads(const Step& step);
 ValueId defined_unless_unread(const Step& step);
 // Its operations, lane by lane.
 OpCount operations(const LaneProgram& program, const Step& step);
+// What the kept statements cost the machine, in instructions: a row's operation is one per vector
+// of 4 lanes (the lanes of detail::Lanes<double, N> in 32-byte vectors), and moving a lane in or
+// out of a row (PlusLane, Widen, LoadRow, a Store's lane) one each. Operation counts weigh each lane
+// as a scalar; this weighs the code as it runs, to choose between two derivations of one function.
+long instructions(const LaneProgram& program);
 
 }  // namespace wlx::codegen::lane_code

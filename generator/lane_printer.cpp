@@ -5,6 +5,7 @@
 #include <wlx/support/text.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <set>
 #include <stdexcept>
 
@@ -33,10 +34,10 @@ constexpr Spelling kSpellings[] = {
     {Quantity::com_rotation, "kane_R_{}_{}_{}", "kane_R_{}_{}_{}"},
     {Quantity::mass, "kane_mass_{}_0", "kane_mass_{}"},
     {Quantity::inertia, "kane_inertia_{}_{}", "kane_inertia_{}_{}"},
-    {Quantity::bias_acceleration, "kane_acc_{}_{}", nullptr},
-    {Quantity::bias_torque, "kane_torque_{}_{}", nullptr},
+    {Quantity::bias_acceleration, "kane_acc_{}_{}", "kane_acc_{}_{}"},
+    {Quantity::bias_torque, "kane_torque_{}_{}", "kane_torque_{}_{}"},
     {Quantity::gravity, nullptr, "kane_g"},
-    {Quantity::minus_gravity, "kane_minus_g", nullptr},
+    {Quantity::minus_gravity, "kane_minus_g", "kane_minus_g"},
     {Quantity::spatial_velocity, "twist{}_{}", "kane_V{}_{}"},
     {Quantity::motion_cross, nullptr, "kane_X{}_{}"},
     {Quantity::spatial_acceleration, nullptr, "kane_A{}_{}"},
@@ -52,6 +53,21 @@ constexpr Spelling kSpellings[] = {
     {Quantity::joint_force, "tau{}", "kane_tau{}"},
     {Quantity::coordinate_force, nullptr, "kane_tau_s{}"},
     {Quantity::commanded_force, nullptr, "kane_Q{}"},
+    {Quantity::first_moment, nullptr, "kane_h{}_{}"},
+    {Quantity::inertia_difference, nullptr, "kane_dI{}_{}"},
+    {Quantity::rotated_inertia, nullptr, "kane_RI{}_{}_{}"},
+    {Quantity::inertia_shift, nullptr, "kane_sigma{}"},
+    {Quantity::origin_inertia, nullptr, "kane_J{}_{}_{}"},
+    {Quantity::composite_mass, nullptr, "kane_mc{}"},
+    {Quantity::composite_first_moment, nullptr, "kane_hc{}_{}"},
+    {Quantity::composite_inertia, nullptr, "kane_Jc{}_{}_{}"},
+    {Quantity::joint_momentum, nullptr, "kane_IS{}_{}"},
+    {Quantity::joint_mass, nullptr, "kane_Mjk{}_{}"},
+    {Quantity::projected_mass, nullptr, "kane_TM{}_{}"},
+    {Quantity::reduced_mass, nullptr, "kane_Mu{}_{}"},
+    {Quantity::gravity_force, nullptr, "kane_G{}"},
+    {Quantity::commanded_gravity, nullptr, "kane_Gu{}"},
+    {Quantity::constant, nullptr, "kane_c{}"},
     {Quantity::rate_row, "kane_T_{}", nullptr},
     {Quantity::mass_matrix_row, "kane_M_{}", nullptr},
     {Quantity::velocity_forces, "kane_b", nullptr},
@@ -64,6 +80,18 @@ class LanePrinter {
   explicit LanePrinter(const LaneProgram& program) : program_(program) {}
 
   std::string name(const ValueId& id) const {
+    // The composite pass' values named after another one (composite_units.cpp folds that one's
+    // quantity into the first index): its name, marked.
+    if (id.what == Quantity::lanes_of || id.what == Quantity::row_sum || id.what == Quantity::negated) {
+      const ValueId from = value_id(static_cast<Quantity>(id.index[0] / 1000), id.index[0] % 1000, id.index[1], id.index[2]);
+      std::string base;
+      for (const char c : name(from))  // T(18, 0) as kane_T_18_0
+        if (std::isalnum(static_cast<unsigned char>(c)) || c == '_') base += c;
+        else if (!base.empty() && base.back() != '_') base += '_';
+      while (!base.empty() && base.back() == '_') base.pop_back();
+      if (!base.starts_with(kReservedPrefix)) base = std::string(kReservedPrefix) + base;
+      return base + (id.what == Quantity::lanes_of ? "_lanes" : id.what == Quantity::row_sum ? "_by_lane" : "_negated");
+    }
     const auto* spelling = std::find_if(std::begin(kSpellings), std::end(kSpellings), [&](const Spelling& s) { return s.what == id.what; });
     const char* pattern = spelling == std::end(kSpellings) ? nullptr
                           : program_.kind == LaneProgram::Kind::lanes ? spelling->lanes

@@ -90,7 +90,8 @@ namespace detail {
 template <typename T> struct NonDeducedType { using type = T; };
 template <typename T> using NonDeduced = typename NonDeducedType<T>::type;
 // N scalars side by side, for code that does the same to N columns at once (reduced_dynamics:
-// Kane's sums, one lane per commanded speed). Loops over a fixed N, which compilers unroll.
+// Kane's sums, one lane per commanded speed, or the composite pass, one lane per limb of one
+// shape). Loops over a fixed N, which compilers unroll.
 template <typename Scalar, int N>
 struct Lanes {
   Scalar v[N];
@@ -102,6 +103,18 @@ struct Lanes {
     return *this;
   }
   friend Lanes operator+(Lanes a, const Lanes& b) noexcept { return a += b; }
+  friend Lanes operator-(Lanes a, const Lanes& b) noexcept {
+    for (int i = 0; i < N; ++i) a.v[i] -= b.v[i];
+    return a;
+  }
+  friend Lanes operator-(Lanes a) noexcept {
+    for (int i = 0; i < N; ++i) a.v[i] = -a.v[i];
+    return a;
+  }
+  friend Lanes operator*(Lanes a, const Lanes& b) noexcept {
+    for (int i = 0; i < N; ++i) a.v[i] *= b.v[i];
+    return a;
+  }
   friend Lanes operator*(const Scalar& s, const Lanes& a) noexcept {
     Lanes out;
     for (int i = 0; i < N; ++i) out.v[i] = s * a.v[i];
@@ -127,6 +140,18 @@ struct Lanes<double, N> {
     return *this;
   }
   __attribute__((always_inline)) friend Lanes operator+(Lanes a, const Lanes& b) noexcept { return a += b; }
+  __attribute__((always_inline)) friend Lanes operator-(Lanes a, const Lanes& b) noexcept {
+    for (int k = 0; k < kVectors; ++k) a.c[k] -= b.c[k];
+    return a;
+  }
+  __attribute__((always_inline)) friend Lanes operator-(Lanes a) noexcept {
+    for (int k = 0; k < kVectors; ++k) a.c[k] = -a.c[k];
+    return a;
+  }
+  __attribute__((always_inline)) friend Lanes operator*(Lanes a, const Lanes& b) noexcept {
+    for (int k = 0; k < kVectors; ++k) a.c[k] *= b.c[k];
+    return a;
+  }
   __attribute__((always_inline)) friend Lanes operator*(const double& s, const Lanes& a) noexcept {
     Lanes out;
     for (int k = 0; k < kVectors; ++k) out.c[k] = s * a.c[k];

@@ -14,10 +14,10 @@
 //   bodies                      1018        165475          5175
 //   kinematic_update             420         98350          2296
 //   dynamics_update              361        102428          1916
-//   reduced_dynamics            1130        371844         18793
+//   reduced_dynamics            1057        364609         10308
 //   generalized_forces           236         16742          4979
 //   clearance                      0            22            22
-//   total                                  1111767         39860
+//   total                                  1104532         31375
 #pragma once
 
 #include "ik.hpp"

@@ -1,0 +1,109 @@
+// What the composite-rigid-body pass of reduced_dynamics (composite_dynamics.cpp) is built from
+// (composite_units.cpp): signed values, a builder of its statements that folds zeros, ones and
+// signs, the tree's joints as units (sibling limbs of one shape grouped into rows of lanes, one limb
+// per lane), and the projections by T on T's pattern. Internal to the generator.
+#pragma once
+
+#include "derivations_internal.hpp"
+
+#include <map>
+#include <set>
+#include <stdexcept>
+
+namespace wlx::codegen::derivation::composite {
+
+inline std::size_t at(int i) { return static_cast<std::size_t>(i); }
+
+// A value or its negative; the value may be one (a unit entry of an axis, of a rotation or of T)
+// or zero (an exact zero: products with it are dropped).
+struct Signed {
+  lane_code::ValueId id;
+  bool negate = false;
+  bool is_zero() const { return id.is_zero(); }
+  bool is_one() const { return id.what == lane_code::Quantity::one; }
+  Signed operator-() const { return {id, !negate}; }
+};
+inline const Signed kUnit{lane_code::kOne, false};
+
+// a * b; with `lane` set, b is a row read at that lane (a scalar).
+struct Product {
+  Signed a, b = kUnit;
+  int lane = -1;
+};
+
+// A scalar as scalar products plus the lanes of a row's sum of products.
+struct Sum {
+  std::vector<Product> scalar, row;
+};
+
+// Builds the code, one definition per value, each statement counted for `charge_to`. A value is a
+// scalar or a row of `width` lanes (a row unit's, lane g for limb g); a sum is a row when any of
+// its products has a row in it, and then every product must. Exact zeros, ones and signs are
+// folded while building: a sum of one plain product is no statement, a sum whose terms are all
+// negative is defined positive and read negated.
+class Builder {
+ public:
+  explicit Builder(int width);
+  int charge_to = 0;
+  // A lane scalar, made once however often it is asked for.
+  Signed scalar(const lane_code::ValueId& id, const ex& value);
+  // A row of the lanes' values (one lane: that value itself), made once per key.
+  Signed pack(const lane_code::ValueId& key, const std::vector<Signed>& lanes);
+  Signed define(const lane_code::ValueId& target, const std::vector<Product>& products);
+  // A scalar: sum.scalar plus every lane of the row sum.row adds up to.
+  Signed define_sum(const lane_code::ValueId& target, const Sum& sum);
+  bool is_row(const Signed& v) const { return rows_.count(v.id) > 0; }
+  void add(lane_code::Step step) { program_.statements.push_back({std::move(step), charge_to}); }
+  lane_code::LaneProgram& program() { return program_; }
+
+ private:
+  lane_code::ValueId holding(const Signed& v);  // a value equal to v: v itself, a one, a negation
+  lane_code::LaneProgram program_;
+  std::set<lane_code::ValueId> made_, rows_;
+  std::map<lane_code::ValueId, Signed> packed_;
+};
+
+// A joint of the tree, or the joints at one place of G sibling limbs of one shape (a row unit: lane
+// g is limb g). A row unit's joints each have their own coordinate, dense (a row of T), that no
+// other joint has.
+struct Unit {
+  std::vector<int> nodes, coordinates;  // per lane
+  int parent = -1;
+  std::vector<int> children;
+  std::vector<std::vector<int>> bodies;  // per body at the joint: the body in each lane
+  bool row() const { return nodes.size() > 1; }
+};
+struct Units {
+  std::vector<Unit> units;  // parents first
+  int width = 1;            // the lanes of a row: the largest set of sibling limbs of one shape
+};
+Units group_units(const TwistTree& tree, const RateRoles& roles);
+
+// The projections by T (s' = T u) of values per unit.
+struct Projection {
+  const Units& units;
+  RateRoles roles;
+  std::vector<std::vector<int>> speeds_of;
+  int nu = 0;
+  std::vector<std::array<Signed, 6>> axis;  // per unit, about `origin`
+  Vec3 origin;                              // the point moments and twists are taken about
+  int coordinate(int u, int lane) const { return units.units[at(u)].coordinates[at(lane)]; }
+  bool dense_plain(int u) const { return !units.units[at(u)].row() && roles.dense[at(coordinate(u, 0))]; }
+  // The plain units of speed b's coordinate.
+  std::vector<int> units_of_speed(int b) const;
+  // T(r, l) of a coordinate: one, an entry of T's pattern, or zero.
+  Signed T(int r, int l) const;
+  // T(u's coordinates, l): a scalar, or a row unit's row.
+  Signed T_of(int u, int l, Builder& w) const;
+  // sum += value * T(u's coordinates, b), value being u's (a row for a row unit).
+  void times_T(Sum& sum, const Signed& value, int u, int b, Builder& w) const;
+  // sum over the units of T(u's coordinates, l) * value_u: a scalar.
+  Signed transposed(const lane_code::ValueId& target, int l, const std::vector<Signed>& per_unit, Builder& w) const;
+  // (T^T M)(l, u's coordinates) from M between units (keyed (ancestor, unit)): u's kind of value;
+  // for a plain unit, added to a sum instead.
+  Signed projected(const lane_code::ValueId& target, int l, int u, const std::map<std::pair<int, int>, Signed>& M,
+                   Builder& w) const;
+  void add_projected(Sum& sum, int l, int u, const std::map<std::pair<int, int>, Signed>& M, Builder& w) const;
+};
+
+}  // namespace wlx::codegen::derivation::composite
