@@ -20,6 +20,9 @@
 #include <string>
 #include <vector>
 
+#ifdef WLX_PINOCCHIO_URDF
+#include "pinocchio_peer.hpp"
+#endif
 #ifdef WLX_HAVE_MUJOCO
 #include "mjcf_export.hpp"
 #include "mujoco_model.hpp"
@@ -176,6 +179,47 @@ void weighting_3_part(benchmark::State& st) {
   }
 }
 
+#ifdef WLX_PINOCCHIO_URDF
+// The generated kernels alone at the nominal pose, its rates s' = T u and s'' = 0.2 on every
+// coordinate: the Newton-Euler pass's tau (generalized_forces, the open tree's inverse dynamics
+// where every joint that carries a body moves, as on the wheeled quadruped) and M on the
+// commanded speeds (reduced_dynamics), beside Pinocchio's rnea and crba.
+struct KernelPose : Pose {
+  gen::Coordinates sddot = gen::Coordinates::Constant(0.2), tau;
+  CommandMatrix M;
+  KernelPose() { equations_of_motion(model, d, s, u, terms); }
+};
+void newton_euler(benchmark::State& st) {
+  auto x = std::make_unique<KernelPose>();
+  for (auto _ : st) {
+    gen::generalized_forces(x->s, x->terms.sdot, x->sddot, x->terms.T, x->model.params(), {.tau = &x->tau});
+    benchmark::DoNotOptimize(x->tau.data());
+  }
+}
+void mass_matrix(benchmark::State& st) {
+  auto x = std::make_unique<KernelPose>();
+  for (auto _ : st) {
+    gen::reduced_dynamics(x->s, x->terms.sdot, x->terms.T, x->model.params(), {.M = &x->M}, false);
+    benchmark::DoNotOptimize(x->M.data());
+  }
+}
+// Every body's Jacobians (linear at its centre of mass, angular), with its pose, at the nominal
+// pose: what Pinocchio's computeJointJacobians gives per joint (with the joints' placements).
+void body_jacobians(benchmark::State& st) {
+  auto x = std::make_unique<Pose>();
+  const Coordinates sdot = Coordinates::Zero();  // (read only for the convective terms, not asked for)
+  gen::BodyVectors com;
+  gen::BodyRotations rotations;
+  gen::BodyJacobians Jv, Jw;
+  for (auto& J : Jv) J.setZero();
+  for (auto& J : Jw) J.setZero();
+  for (auto _ : st) {
+    gen::bodies(x->s, sdot, x->model.params(), {.com = &com, .rotations = &rotations, .Jv = &Jv, .Jw = &Jw}, false);
+    benchmark::DoNotOptimize(Jv.data());
+  }
+}
+#endif
+
 #ifdef WLX_HAVE_MUJOCO
 // The nominal pose in MuJoCo too: the exported model at the same coordinates, rates 0.1 and
 // accelerations 0.2 (per coordinate; what MuJoCo's free joint and wheel spins make of them).
@@ -287,6 +331,16 @@ const bool registered = [] {
       benchmark::RegisterBenchmark((model + "/weighting_3").c_str(), weighting_3_part);
     }
   }
+#ifdef WLX_PINOCCHIO_URDF
+  // Pinocchio on this model's URDF (bench/pinocchio_peer.cpp), and the body Jacobians to set beside
+  // its joint Jacobians.
+  wlx_peer::register_pinocchio_benchmarks(model, WLX_PINOCCHIO_URDF);
+  benchmark::RegisterBenchmark((model + "/body_jacobians").c_str(), body_jacobians);
+  if (gen::kHasDynamics) {
+    benchmark::RegisterBenchmark((model + "/newton_euler").c_str(), newton_euler);
+    benchmark::RegisterBenchmark((model + "/mass_matrix").c_str(), mass_matrix);
+  }
+#endif
 #ifdef WLX_HAVE_MUJOCO
   benchmark::RegisterBenchmark((model + "/fk_all_frames").c_str(), fk_all_frames);
   benchmark::RegisterBenchmark((model + "/mujoco_kinematics").c_str(), mujoco_kinematics);

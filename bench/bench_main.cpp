@@ -820,6 +820,33 @@ int main(int argc, char** argv) {
                         first_mujoco ? "MuJoCo on the same machine (`wlx export mjcf`; speedup: MuJoCo's time over wlx's)" : nullptr});
         first_mujoco = false;
       }
+    // Pinocchio 3 (-DWLX_PINOCCHIO_DIR: bench/pinocchio_peer.cpp), on the model's URDF loaded by its
+    // own parser with a free flyer: the same quantity but for the mass matrix (wlx's M on the
+    // commanded speeds, alone and with b and the dependent rates; Pinocchio's M of the open tree),
+    // the forward step (wlx's constrained one; Pinocchio's aba on the open tree) and the Jacobians
+    // (wlx's of every body at its centre of mass; Pinocchio's of every joint).
+    bool first_pinocchio = true;
+    for (const std::string& model : models)
+      for (const auto& [ours, theirs, what] :
+           {std::tuple<const char*, const char*, const char*>{"fk_all_frames", "pinocchio_fk", "FK of all frames (Pinocchio: framesForwardKinematics)"},
+            {"open_tree_inverse_dynamics", "pinocchio_rnea", "open-tree inverse dynamics by Kane's sums over the bodies' Jacobians (Pinocchio: rnea)"},
+            {"newton_euler", "pinocchio_rnea", "open-tree inverse dynamics by the generated Newton-Euler pass (Pinocchio: rnea)"},
+            {"mass_matrix", "pinocchio_crba", "M on the commanded speeds, reduced_dynamics alone (Pinocchio: the open tree's M, crba)"},
+            {"equations_of_motion", "pinocchio_crba", "M, b on the commanded speeds, with the dependent rates (Pinocchio: the open tree's M, crba)"},
+            {"forward_dynamics_step", "pinocchio_aba", "constrained forward-dynamics step (Pinocchio: the open tree's aba)"},
+            {"body_jacobians", "pinocchio_jacobians", "body Jacobians (Pinocchio: computeJointJacobians)"}}) {
+        const std::string mine = model + "/" + ours, peer = model + "/" + theirs;
+        if (!collector.median_ns.count(mine) || !collector.median_ns.count(peer)) continue;
+        rows.push_back({texts.emplace_back(fmt::format("Pinocchio peer: {}: {}", model, what)).c_str(), texts.emplace_back(mine).c_str(),
+                        texts.emplace_back(peer).c_str(), 0,
+#ifdef WLX_PINOCCHIO_VERSION
+                        "Pinocchio " WLX_PINOCCHIO_VERSION,
+#else
+                        "Pinocchio",
+#endif
+                        first_pinocchio ? "Pinocchio on the same machine (the model's URDF; speedup: Pinocchio's time over wlx's)" : nullptr});
+        first_pinocchio = false;
+      }
   }
   const auto get = [&](const char* name) {
     const auto it = collector.median_ns.find(name);
