@@ -33,6 +33,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <initializer_list>
 #include <tuple>
 #include <vector>
 
@@ -802,51 +803,46 @@ int main(int argc, char** argv) {
                                  : nullptr});
       first_pair = false;
     }
+    // A peer library's rows beside wlx's, per model: (wlx's row, the peer's row, what they compute).
+    using PeerRows = std::initializer_list<std::tuple<const char*, const char*, const char*>>;
+    const auto peer_rows = [&](const char* peer_name, const char* label, const char* group, PeerRows pairs) {
+      bool first_row = true;
+      for (const std::string& model : models)
+        for (const auto& [ours, theirs, what] : pairs) {
+          const std::string mine = model + "/" + ours, peer = model + "/" + theirs;
+          if (!collector.median_ns.count(mine) || !collector.median_ns.count(peer)) continue;
+          rows.push_back({texts.emplace_back(fmt::format("{}: {}: {}", label, model, what)).c_str(), texts.emplace_back(mine).c_str(),
+                          texts.emplace_back(peer).c_str(), 0, peer_name, first_row ? group : nullptr});
+          first_row = false;
+        }
+    };
     // MuJoCo (built with libmujoco-dev), on each model exported by `wlx export mjcf`: the same
     // quantity in both, but for the mass matrix (wlx's on the commanded speeds, MuJoCo's on the
     // open tree) and the step (wlx's constrained forward dynamics; MuJoCo's contacts, solver and
     // integration of 1 ms).
-    bool first_mujoco = true;
-    for (const std::string& model : models)
-      for (const auto& [ours, theirs, what] :
-           {std::tuple<const char*, const char*, const char*>{"fk_all_frames", "mujoco_kinematics", "FK of all frames (MuJoCo: mj_kinematics)"},
-            {"open_tree_inverse_dynamics", "mujoco_rne", "open-tree inverse dynamics (MuJoCo: kinematics, com, velocities, mj_rne)"},
-            {"equations_of_motion", "mujoco_crb", "M, b on the commanded speeds (MuJoCo: open-tree M, mj_crb)"},
-            {"forward_dynamics_step", "mujoco_step", "forward-dynamics step (MuJoCo: mj_step of 1 ms on the ground)"}}) {
-        const std::string mine = model + "/" + ours, peer = model + "/" + theirs;
-        if (!collector.median_ns.count(mine) || !collector.median_ns.count(peer)) continue;
-        rows.push_back({texts.emplace_back(fmt::format("MuJoCo peer: {}: {}", model, what)).c_str(), texts.emplace_back(mine).c_str(),
-                        texts.emplace_back(peer).c_str(), 0, "MuJoCo 2.2.2",
-                        first_mujoco ? "MuJoCo on the same machine (`wlx export mjcf`; speedup: MuJoCo's time over wlx's)" : nullptr});
-        first_mujoco = false;
-      }
+    peer_rows("MuJoCo 2.2.2", "MuJoCo peer", "MuJoCo on the same machine (`wlx export mjcf`; speedup: MuJoCo's time over wlx's)",
+              {{"fk_all_frames", "mujoco_kinematics", "FK of all frames (MuJoCo: mj_kinematics)"},
+               {"open_tree_inverse_dynamics", "mujoco_rne", "open-tree inverse dynamics (MuJoCo: kinematics, com, velocities, mj_rne)"},
+               {"equations_of_motion", "mujoco_crb", "M, b on the commanded speeds (MuJoCo: open-tree M, mj_crb)"},
+               {"forward_dynamics_step", "mujoco_step", "forward-dynamics step (MuJoCo: mj_step of 1 ms on the ground)"}});
     // Pinocchio 3 (-DWLX_PINOCCHIO_DIR: bench/pinocchio_peer.cpp), on the model's URDF loaded by its
     // own parser with a free flyer: the same quantity but for the mass matrix (wlx's M on the
     // commanded speeds, alone and with b and the dependent rates; Pinocchio's M of the open tree),
     // the forward step (wlx's constrained one; Pinocchio's aba on the open tree) and the Jacobians
     // (wlx's of every body at its centre of mass; Pinocchio's of every joint).
-    bool first_pinocchio = true;
-    for (const std::string& model : models)
-      for (const auto& [ours, theirs, what] :
-           {std::tuple<const char*, const char*, const char*>{"fk_all_frames", "pinocchio_fk", "FK of all frames (Pinocchio: framesForwardKinematics)"},
-            {"open_tree_inverse_dynamics", "pinocchio_rnea", "open-tree inverse dynamics by Kane's sums over the bodies' Jacobians (Pinocchio: rnea)"},
-            {"newton_euler", "pinocchio_rnea", "open-tree inverse dynamics by the generated Newton-Euler pass (Pinocchio: rnea)"},
-            {"mass_matrix", "pinocchio_crba", "M on the commanded speeds, reduced_dynamics alone (Pinocchio: the open tree's M, crba)"},
-            {"equations_of_motion", "pinocchio_crba", "M, b on the commanded speeds, with the dependent rates (Pinocchio: the open tree's M, crba)"},
-            {"forward_dynamics_step", "pinocchio_aba", "constrained forward-dynamics step (Pinocchio: the open tree's aba)"},
-            {"body_jacobians", "pinocchio_jacobians", "body Jacobians (Pinocchio: computeJointJacobians)"}}) {
-        const std::string mine = model + "/" + ours, peer = model + "/" + theirs;
-        if (!collector.median_ns.count(mine) || !collector.median_ns.count(peer)) continue;
-        rows.push_back({texts.emplace_back(fmt::format("Pinocchio peer: {}: {}", model, what)).c_str(), texts.emplace_back(mine).c_str(),
-                        texts.emplace_back(peer).c_str(), 0,
 #ifdef WLX_PINOCCHIO_VERSION
-                        "Pinocchio " WLX_PINOCCHIO_VERSION,
+    const char* const pinocchio = "Pinocchio " WLX_PINOCCHIO_VERSION;
 #else
-                        "Pinocchio",
+    const char* const pinocchio = "Pinocchio";
 #endif
-                        first_pinocchio ? "Pinocchio on the same machine (the model's URDF; speedup: Pinocchio's time over wlx's)" : nullptr});
-        first_pinocchio = false;
-      }
+    peer_rows(pinocchio, "Pinocchio peer", "Pinocchio on the same machine (the model's URDF; speedup: Pinocchio's time over wlx's)",
+              {{"fk_all_frames", "pinocchio_fk", "FK of all frames (Pinocchio: framesForwardKinematics)"},
+               {"open_tree_inverse_dynamics", "pinocchio_rnea", "open-tree inverse dynamics by Kane's sums over the bodies' Jacobians (Pinocchio: rnea)"},
+               {"newton_euler", "pinocchio_rnea", "open-tree inverse dynamics by the generated Newton-Euler pass (Pinocchio: rnea)"},
+               {"mass_matrix", "pinocchio_crba", "M on the commanded speeds, reduced_dynamics alone (Pinocchio: the open tree's M, crba)"},
+               {"equations_of_motion", "pinocchio_crba", "M, b on the commanded speeds, with the dependent rates (Pinocchio: the open tree's M, crba)"},
+               {"forward_dynamics_step", "pinocchio_aba", "constrained forward-dynamics step (Pinocchio: the open tree's aba)"},
+               {"body_jacobians", "pinocchio_jacobians", "body Jacobians (Pinocchio: computeJointJacobians)"}});
   }
   const auto get = [&](const char* name) {
     const auto it = collector.median_ns.find(name);
