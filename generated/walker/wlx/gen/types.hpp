@@ -140,7 +140,7 @@ struct Lanes {
 // within one expression by default, and a row's `a + s * b` is two of these inline operators: here
 // it may fuse them, as GCC does (the excavator's Kane's sums, AVX2 build: 533 ns unfused, 445 ns
 // fused, GCC 445 ns). Only these operators: the includer's own code keeps its own setting.
-#if defined(__clang__)
+#if defined(__clang__) && __clang_major__ >= 12  // float_control: clang 11 on (12: Apple clang 12.0.0 is older)
 #pragma float_control(push)
 #pragma clang fp contract(fast)
 #endif
@@ -176,7 +176,7 @@ struct Lanes<double, N> {
     return out;
   }
 };
-#if defined(__clang__)
+#if defined(__clang__) && __clang_major__ >= 12
 #pragma float_control(pop)
 #endif
 #else
