@@ -21,29 +21,38 @@
 
 namespace wlx_peer {
 
-struct PinocchioRobot::Impl {
+namespace {
+
+// The URDF's robot with its root joined as `root` says, and a Data for it.
+struct Loaded {
   pinocchio::Model model;
   std::unique_ptr<pinocchio::Data> data;
+  Loaded(const std::string& urdf_file, Root root) {
+    if (root == Root::free_flyer) {
+      pinocchio::urdf::buildModel(urdf_file, pinocchio::JointModelFreeFlyer(), model);
+    } else {
+      pinocchio::JointModelComposite base;
+      base.addJoint(pinocchio::JointModelPX());
+      base.addJoint(pinocchio::JointModelPY());
+      base.addJoint(pinocchio::JointModelPZ());
+      base.addJoint(pinocchio::JointModelRZ());
+      base.addJoint(pinocchio::JointModelRY());
+      base.addJoint(pinocchio::JointModelRX());
+      pinocchio::urdf::buildModel(urdf_file, base, model);
+    }
+    data = std::make_unique<pinocchio::Data>(model);
+  }
 };
 
-PinocchioRobot::PinocchioRobot(const std::string& urdf_file, Root root) : impl_(std::make_unique<Impl>()) {
-  if (root == Root::free_flyer) {
-    pinocchio::urdf::buildModel(urdf_file, pinocchio::JointModelFreeFlyer(), impl_->model);
-  } else {
-    pinocchio::JointModelComposite base;
-    base.addJoint(pinocchio::JointModelPX());
-    base.addJoint(pinocchio::JointModelPY());
-    base.addJoint(pinocchio::JointModelPZ());
-    base.addJoint(pinocchio::JointModelRZ());
-    base.addJoint(pinocchio::JointModelRY());
-    base.addJoint(pinocchio::JointModelRX());
-    pinocchio::urdf::buildModel(urdf_file, base, impl_->model);
-  }
-  impl_->data = std::make_unique<pinocchio::Data>(impl_->model);
-}
+}  // namespace
+
+struct PinocchioRobot::Impl : Loaded {
+  using Loaded::Loaded;
+};
+
+PinocchioRobot::PinocchioRobot(const std::string& urdf_file, Root root) : impl_(std::make_unique<Impl>(urdf_file, root)) {}
 PinocchioRobot::~PinocchioRobot() = default;
 
-int PinocchioRobot::nq() const { return impl_->model.nq; }
 int PinocchioRobot::nv() const { return impl_->model.nv; }
 int PinocchioRobot::q_index(const std::string& name) const {
   return impl_->model.existJointName(name) ? impl_->model.idx_qs[impl_->model.getJointId(name)] : -1;
@@ -56,24 +65,20 @@ int PinocchioRobot::q_size(const std::string& name) const {
 }
 Eigen::VectorXd PinocchioRobot::neutral() const { return pinocchio::neutral(impl_->model); }
 
-Eigen::Matrix<double, 3, 4> PinocchioRobot::link_placement(const Eigen::VectorXd& q, const std::string& link) {
-  if (!impl_->model.existBodyName(link)) throw std::invalid_argument("Pinocchio's model has no link " + link);
-  const auto frame = impl_->model.getBodyId(link);
+std::vector<Eigen::Matrix<double, 3, 4>> PinocchioRobot::link_placements(const Eigen::VectorXd& q, const std::vector<std::string>& links) {
   pinocchio::framesForwardKinematics(impl_->model, *impl_->data, q);
-  Eigen::Matrix<double, 3, 4> out;
-  out.leftCols<3>() = impl_->data->oMf[frame].rotation();
-  out.col(3) = impl_->data->oMf[frame].translation();
+  std::vector<Eigen::Matrix<double, 3, 4>> out(links.size());
+  for (std::size_t k = 0; k < links.size(); ++k) {
+    if (!impl_->model.existBodyName(links[k])) throw std::invalid_argument("Pinocchio's model has no link " + links[k]);
+    const auto& X = impl_->data->oMf[impl_->model.getBodyId(links[k])];
+    out[k].leftCols<3>() = X.rotation();
+    out[k].col(3) = X.translation();
+  }
   return out;
 }
 
 Eigen::VectorXd PinocchioRobot::inverse_dynamics(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
   return pinocchio::rnea(impl_->model, *impl_->data, q, v, a);
-}
-
-Eigen::MatrixXd PinocchioRobot::mass_matrix(const Eigen::VectorXd& q) {
-  Eigen::MatrixXd M = pinocchio::crba(impl_->model, *impl_->data, q);
-  M.triangularView<Eigen::StrictlyLower>() = M.transpose().triangularView<Eigen::StrictlyLower>();  // crba fills the upper triangle
-  return M;
 }
 
 #ifdef WLX_PINOCCHIO_BENCHMARKS
@@ -82,13 +87,9 @@ namespace {
 // The robot as Pinocchio users load it (free flyer) at a random state: the neutral configuration
 // moved by a random velocity (joint-configuration's integrate keeps the quaternion and the
 // continuous joints' (cos, sin) on their manifolds), random rates, accelerations and torques.
-struct PeerState {
-  pinocchio::Model model;
-  std::unique_ptr<pinocchio::Data> data;
+struct PeerState : Loaded {
   Eigen::VectorXd q, v, a, tau;
-  explicit PeerState(const std::string& urdf) {
-    pinocchio::urdf::buildModel(urdf, pinocchio::JointModelFreeFlyer(), model);
-    data = std::make_unique<pinocchio::Data>(model);
+  explicit PeerState(const std::string& urdf) : Loaded(urdf, Root::free_flyer) {
     std::mt19937_64 rng(7);
     std::normal_distribution<double> n(0.0, 0.3);
     const auto random = [&](int size) {

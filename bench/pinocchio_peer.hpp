@@ -27,7 +27,6 @@ class PinocchioRobot {
   PinocchioRobot(const PinocchioRobot&) = delete;
   PinocchioRobot& operator=(const PinocchioRobot&) = delete;
 
-  int nq() const;
   int nv() const;
   // Where joint `name`'s configuration and velocity start (-1 for no such joint); the root's are 0.
   int q_index(const std::string& name) const;
@@ -35,20 +34,17 @@ class PinocchioRobot {
   int q_size(const std::string& name) const;  // 1 for a revolute joint, 2 for a continuous one (cos, sin)
   Eigen::VectorXd neutral() const;
 
-  // The world placement of the frame of URDF link `link` at q (a 3 x 4 [R | p]); throws for no such link.
-  Eigen::Matrix<double, 3, 4> link_placement(const Eigen::VectorXd& q, const std::string& link);
-  // The open tree's generalized forces with gravity (rnea) and its mass matrix (crba, both triangles).
+  // The world placements of the frames of URDF links `links` at q (each a 3 x 4 [R | p]), from one
+  // forward-kinematics pass; throws for a name that is no link.
+  std::vector<Eigen::Matrix<double, 3, 4>> link_placements(const Eigen::VectorXd& q, const std::vector<std::string>& links);
+  // The open tree's generalized forces with gravity (rnea).
   Eigen::VectorXd inverse_dynamics(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a);
-  Eigen::MatrixXd mass_matrix(const Eigen::VectorXd& q);
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace wlx_peer
-
-namespace wlx_peer {
 // Registers the rows <model>/pinocchio_fk (framesForwardKinematics), _rnea, _crba, _aba and
 // _jacobians (computeJointJacobians) on the URDF, loaded with a free flyer (wlx_bench only).
 void register_pinocchio_benchmarks(const std::string& model, const std::string& urdf);

@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <random>
 #include <string>
+#include <vector>
 
 using namespace wlx;
 
@@ -71,6 +72,16 @@ Worst compare(const gen::Params& p) {
   const Mapping map(robot);
   // Every joint that moves a body is a wlx coordinate: the base's six and the legs' joints.
   REQUIRE(robot.nv() == static_cast<int>(map.v_of.size()) + gen::kWheelCount);
+  // wlx's frames of URDF links: all but the wheels' contact frames.
+  std::vector<int> link_frames;
+  std::vector<std::string> link_names;
+  for (int f = 0; f < gen::kFrameCount; ++f) {
+    const std::string name(gen::kFrameNames[static_cast<std::size_t>(f)]);
+    if (name.rfind("contact_", 0) == 0) continue;
+    link_frames.push_back(f);
+    link_names.push_back(name);
+  }
+  CHECK(link_frames.size() == static_cast<std::size_t>(gen::kFrameCount - gen::kWheelCount));
   std::mt19937_64 rng(20261206);
   open_tree::OpenTreeWorkspace w;
   Worst worst;
@@ -81,17 +92,13 @@ Worst compare(const gen::Params& p) {
     gen::FrameRotations rotations;
     gen::kinematics(s, p, {.positions = &positions, .rotations = &rotations});
     double pose_difference = 0, pose_scale = 1;  // rotations' entries are of order 1
-    int links = 0;
-    for (int f = 0; f < gen::kFrameCount; ++f) {
-      const std::string name(gen::kFrameNames[static_cast<std::size_t>(f)]);
-      if (name.rfind("contact_", 0) == 0) continue;  // wlx's wheel contact frames: no URDF link
-      const Eigen::Matrix<double, 3, 4> X = robot.link_placement(q, name);
-      pose_difference = std::max({pose_difference, (X.leftCols<3>() - rotations[static_cast<std::size_t>(f)]).cwiseAbs().maxCoeff(),
-                                  (X.col(3) - positions.col(f)).cwiseAbs().maxCoeff()});
+    const std::vector<Eigen::Matrix<double, 3, 4>> X = robot.link_placements(q, link_names);
+    for (std::size_t k = 0; k < link_frames.size(); ++k) {
+      const int f = link_frames[k];
+      pose_difference = std::max({pose_difference, (X[k].leftCols<3>() - rotations[static_cast<std::size_t>(f)]).cwiseAbs().maxCoeff(),
+                                  (X[k].col(3) - positions.col(f)).cwiseAbs().maxCoeff()});
       pose_scale = std::max(pose_scale, positions.col(f).cwiseAbs().maxCoeff());
-      ++links;
     }
-    CHECK(links == gen::kFrameCount - gen::kWheelCount);
     gen::Coordinates Q;
     open_tree::open_tree_inverse_dynamics(p, s, sdot, sddot, w, Q);
     const Eigen::VectorXd tau = robot.inverse_dynamics(q, map.v(sdot), map.v(sddot));
