@@ -9,6 +9,7 @@
 #include <wlx/support/atomic_file.hpp>
 #include <wlx/support/bounded_file.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -20,9 +21,9 @@
 #include <memory>
 #include <optional>
 #include <iterator>
-#include <regex>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -295,8 +296,19 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
 
 void check_namespace(const std::string& name_space) {
   // A qualified C++ identifier, nothing else: the name is pasted into every header.
-  static const std::regex qualified("[A-Za-z_][A-Za-z0-9_]*(::[A-Za-z_][A-Za-z0-9_]*)*");
-  if (!std::regex_match(name_space, qualified))
+  // (Checked by hand, not by std::regex, which costs this file a third of its compile.)
+  const auto identifier = [](std::string_view part) {
+    const auto letter = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; };
+    return !part.empty() && letter(part[0]) &&
+           std::all_of(part.begin(), part.end(), [&](char c) { return letter(c) || (c >= '0' && c <= '9'); });
+  };
+  bool qualified = true;
+  for (std::size_t begin = 0; qualified && begin <= name_space.size();) {
+    const std::size_t end = std::min(name_space.find("::", begin), name_space.size());
+    qualified = identifier(std::string_view(name_space).substr(begin, end - begin));
+    begin = end + 2;
+  }
+  if (!qualified)
     throw ModelFileError(fmt::format("--namespace: '{}' is not a C++ qualified name such as wlx::mine", name_space.substr(0, 60)));
   // Each part is pasted in as a name: no keyword, macro, std or Eigen (the model file's rule).
   for (std::size_t begin = 0; begin <= name_space.size();) {

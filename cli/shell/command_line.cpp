@@ -6,11 +6,27 @@
 #include <wlx/support/diagnostics.hpp>
 #include <wlx/error.hpp>
 
-#include <regex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
 
 namespace wlx::cli {
 
 namespace {
+
+// CLI11's message `<prefix><name><separator><rest>` as (name, rest), where the name is one word
+// and the rest one line; nullopt for any other message. (By hand, not by std::regex, which cost
+// this file half its compile.)
+std::optional<std::pair<std::string, std::string>> split_message(const std::string& text, std::string_view prefix,
+                                                                 std::string_view separator) {
+  if (text.compare(0, prefix.size(), prefix) != 0) return std::nullopt;
+  const std::size_t at = text.find(separator, prefix.size());
+  if (at == std::string::npos || at == prefix.size()) return std::nullopt;
+  std::string name = text.substr(prefix.size(), at - prefix.size()), rest = text.substr(at + separator.size());
+  if (name.find_first_of(" \t\r\n\f\v") != std::string::npos || rest.find_first_of("\r\n") != std::string::npos) return std::nullopt;
+  return std::pair{std::move(name), std::move(rest)};
+}
 
 // Options that may be repeated on purpose (e.g. --sweep IK-L1 --sweep IK-L2).
 bool repeatable(const CLI::Option* option) { return option->get_expected_max() > 1; }
@@ -117,21 +133,18 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ConversionError& e) {
     // "Could not convert: --dt = abc" -> "--dt: 'abc' is not a valid value".
-    static const std::regex pattern("Could not convert: (\\S+) = (.*)");
-    std::smatch m;
     const std::string what = e.what();
-    if (std::regex_match(what, m, pattern))
-      wlx::diagnose("wlx: error: {}: '{}' is not a valid value (a number is expected)\n", m[1].str(), excerpt(m[2].str()));
+    if (const auto parts = split_message(what, "Could not convert: ", " = "))
+      wlx::diagnose("wlx: error: {}: '{}' is not a valid value (a number is expected)\n", parts->first, excerpt(parts->second));
     else
       wlx::diagnose("wlx: error: {}\n", excerpt(what));
     return 2;
   } catch (const CLI::ArgumentMismatch& e) {
     // A single-valued option given twice: "--dt: At Most 1 required but received 2".
-    static const std::regex pattern("(\\S+): At Most 1 required but received (\\d+)");
-    std::smatch m;
     const std::string what = e.what();
-    if (std::regex_match(what, m, pattern))
-      wlx::diagnose("wlx: error: {}: given {} times; give it once\n", m[1].str(), m[2].str());
+    const auto parts = split_message(what, "", ": At Most 1 required but received ");
+    if (parts && !parts->second.empty() && parts->second.find_first_not_of("0123456789") == std::string::npos)
+      wlx::diagnose("wlx: error: {}: given {} times; give it once\n", parts->first, parts->second);
     else
       wlx::diagnose("wlx: error: {} (wlx --help)\n", what);
     return 2;
