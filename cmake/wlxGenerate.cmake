@@ -56,6 +56,30 @@ function(wlx_add_generation stamp file out expected_model comment)
   cmake_policy(POP)
 endfunction()
 
+# wlx_generated_function_units(OUT_VAR NAME GENERATED_DIR): the generated functions' units of one
+# model (WLX_GENERATED_FUNCTION_FILES), each a one-line file in this build folder that includes the
+# runtime's generated_*.cpp, and that depends on GENERATED_DIR's all.hpp. wlx-gen rewrites all.hpp
+# whenever any header changes and its command names it (wlx_add_generation), so Ninja recompiles
+# these units in the same build; a unit that includes kinematics.hpp alone, which no rule names,
+# would otherwise be compiled from the old header until the next build (and linked against the
+# new ones: an arm given a fourth joint failed to link once, then built). One file per model: a
+# source file's properties are its folder's, shared by every model built there.
+function(wlx_generated_function_units out_var name generated_dir)
+  set(units)
+  foreach(file IN LISTS WLX_GENERATED_FUNCTION_FILES)
+    set(unit "${CMAKE_CURRENT_BINARY_DIR}/wlx-generated-units/${name}/${file}")
+    # The path as a C++ string literal: a backslash, quote or line break in it is escaped.
+    set(path "${WLX_RUNTIME_SOURCE_DIR}/${file}")
+    string(REPLACE "\\" "\\\\" path "${path}")
+    string(REPLACE "\"" "\\\"" path "${path}")
+    string(REPLACE "\n" "\\n" path "${path}")
+    file(CONFIGURE OUTPUT "${unit}" CONTENT "// ${file} for the model ${name} (cmake/wlxGenerate.cmake).\n#include \"${path}\"\n" @ONLY)
+    list(APPEND units "${unit}")
+  endforeach()
+  set_source_files_properties(${units} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON OBJECT_DEPENDS "${generated_dir}/wlx/gen/all.hpp")
+  set(${out_var} ${units} PARENT_SCOPE)
+endfunction()
+
 function(wlx_generate)
   cmake_parse_arguments(PARSE_ARGV 0 arg "PYTHON" "TARGET;MODEL;NAMESPACE;NAME" "BAKE")
   if(arg_UNPARSED_ARGUMENTS)
@@ -91,14 +115,12 @@ function(wlx_generate)
     target_link_libraries(${arg_TARGET} INTERFACE Eigen3::Eigen)
   else()
     set(runtime_sources ${WLX_RUNTIME_FILES})
-    set(generated_function_sources ${WLX_GENERATED_FUNCTION_FILES})
     list(TRANSFORM runtime_sources PREPEND "${WLX_RUNTIME_SOURCE_DIR}/")
-    list(TRANSFORM generated_function_sources PREPEND "${WLX_RUNTIME_SOURCE_DIR}/")
+    wlx_generated_function_units(generated_function_sources ${arg_TARGET} "${out}")
     add_library(${arg_TARGET} STATIC ${runtime_sources} ${generated_function_sources})
     # The runtime's sources in one translation unit (they share their Eigen templates: half the
     # compile time); the generated functions' files apart, each defines WLX_GEN_DEFINE_DOUBLE.
     set_target_properties(${arg_TARGET} PROPERTIES UNITY_BUILD ON)
-    set_source_files_properties(${generated_function_sources} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
     target_include_directories(${arg_TARGET} PUBLIC "${out}")
     # The generated functions' double versions are compiled once, here (generated_*.cpp).
     target_compile_definitions(${arg_TARGET} PUBLIC WLX_MODEL=${model_name} WLX_GEN_COMPILED_${model_name})

@@ -63,6 +63,10 @@ struct TwistNode {
   std::vector<int> children, bodies;
   std::array<lane_code::ValueId, 6> twist;   // lanes of (omega; velocity of the point at K0's origin)
   std::array<lane_code::ValueId, 6> wrench;  // lanes of the sum over the bodies beyond: (force; moment about K0's origin)
+  // The frame just after this joint in the frame just after the parent node's joint (K0 for a
+  // root), through the held joints between them at their coordinates: orientation and origin.
+  Mat3 placement_R = Mat3::identity();
+  Vec3 placement_r;
 };
 
 // The tree of the bodies' chains through the joints that move in a step (RateRoles::moves): chains
@@ -70,6 +74,9 @@ struct TwistNode {
 struct TwistTree {
   std::vector<TwistNode> nodes;
   std::vector<int> body_node;  // each body's last node, -1 for a body no such joint moves
+  // Each body's CoM frame in the frame just after its last node's joint (K0 for no node).
+  std::vector<Mat3> body_R;
+  std::vector<Vec3> body_r;
 };
 TwistTree twist_tree(const Model& m, const RateRoles& roles);
 

@@ -92,10 +92,19 @@ TwistTree twist_tree(const Model& m, const RateRoles& roles) {
   TwistTree tree;
   std::vector<int> roots;  // the nodes next to K0
   tree.body_node.assign(m.bodies.size(), -1);
+  tree.body_R.assign(m.bodies.size(), Mat3::identity());
+  tree.body_r.assign(m.bodies.size(), Vec3());
   for (std::size_t i = 0; i < m.bodies.size(); ++i) {
     int at = -1;
+    // The placement since the last moving joint: the held joints' in between, composed.
+    Mat3 held_R = Mat3::identity();
+    Vec3 held_r;
     for (const JointRecord& joint : m.bodies[i].com_frame.joints) {
-      if (!roles.moves(joint.coordinate)) continue;
+      if (!roles.moves(joint.coordinate)) {
+        held_r = held_r + held_R * joint.placement_r;
+        held_R = held_R * joint.placement_R;
+        continue;
+      }
       std::vector<int>& siblings = at < 0 ? roots : tree.nodes[static_cast<std::size_t>(at)].children;
       int next = -1;
       for (int c : siblings)
@@ -103,11 +112,15 @@ TwistTree twist_tree(const Model& m, const RateRoles& roles) {
       if (next < 0) {
         next = static_cast<int>(tree.nodes.size());
         siblings.push_back(next);  // before nodes grows: `siblings` may live in it
-        tree.nodes.push_back({&joint, at, {}, {}, {}, {}});
+        tree.nodes.push_back({&joint, at, {}, {}, {}, {}, held_R * joint.placement_R, held_r + held_R * joint.placement_r});
       }
       at = next;
+      held_R = Mat3::identity();
+      held_r = Vec3();
     }
     tree.body_node[i] = at;
+    tree.body_r[i] = held_r + held_R * m.bodies[i].com_frame.local_r;
+    tree.body_R[i] = held_R * m.bodies[i].com_frame.local_R;
     if (at >= 0) tree.nodes[static_cast<std::size_t>(at)].bodies.push_back(static_cast<int>(i));
   }
   return tree;

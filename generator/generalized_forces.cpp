@@ -2,6 +2,7 @@
 // as straight-line scalar code (lane_code.hpp, printed by lane_printer.hpp), projected onto the
 // commanded speeds.
 #include "derivations_internal.hpp"
+#include "expr_graph.hpp"
 #include "lane_printer.hpp"
 
 #include <fmt/format.h>
@@ -211,6 +212,233 @@ std::map<int, ValueId> joint_forces(const TwistTree& tree, const std::vector<V6>
   return tau_of;
 }
 
+// ---- the same pass in the joints' own frames ---------------------------------------------------
+// Each node's motion in the axes of the frame just after its joint, carried from its parent's by
+// the placement between them (TwistNode::placement_R, placement_r): an axis-aligned joint then
+// adds its rate to one component, and a placement's zero and unit entries cost nothing. The world
+// frame's pass instead recomputes every joint's axis and origin in K0 from s (a third of its
+// operations on the wheeled quadruped).
+
+// A lane scalar that may be an exact 0 or +-1 (a placement's entries): as a product's factor, a
+// zero drops the product and a unit leaves the value alone.
+struct Coefficient {
+  ValueId id;  // zero: 0; kOne: +-1
+  bool negate = false;
+};
+using C3 = std::array<Coefficient, 3>;
+using C33 = std::array<Coefficient, 9>;  // row-major
+
+Coefficient coefficient(ScalarBuilder& w, const ValueId& id, const ex& value) {
+  if (value.is_zero()) return {};
+  if (value.is_equal(1)) return {kOne, false};
+  if (value.is_equal(-1)) return {kOne, true};
+  return {w.scalar(id, value), false};
+}
+// c * v (negated when `negate`).
+Product times(const Coefficient& c, const ValueId& v, bool negate = false) { return {v, c.id, c.negate != negate}; }
+// (x cross v)_c and (v cross x)_c for coefficients x and values v.
+std::vector<Product> cross_cv(const C3& x, const V3& v, int c) {
+  const auto c1 = static_cast<std::size_t>((c + 1) % 3), c2 = static_cast<std::size_t>((c + 2) % 3);
+  return {times(x[c1], v[c2]), times(x[c2], v[c1], true)};
+}
+std::vector<Product> cross_vc(const V3& v, const C3& x, int c) {
+  const auto c1 = static_cast<std::size_t>((c + 1) % 3), c2 = static_cast<std::size_t>((c + 2) % 3);
+  return {times(x[c2], v[c1]), times(x[c1], v[c2], true)};
+}
+std::vector<Product> join(std::vector<Product> a, const std::vector<Product>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+C33 coefficients(ScalarBuilder& w, Quantity what, int index, const Mat3& R) {
+  C33 out;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) out[static_cast<std::size_t>(3 * a + b)] = coefficient(w, value_id(what, index, a, b), R(a, b));
+  return out;
+}
+C3 coefficients(ScalarBuilder& w, Quantity what, int index, const Vec3& r) {
+  C3 out;
+  for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(c)] = coefficient(w, value_id(what, index, c), r[c]);
+  return out;
+}
+const Coefficient& at(const C33& R, int a, int b) { return R[static_cast<std::size_t>(3 * a + b)]; }
+// (R^T v)_a and (R v)_a.
+std::vector<Product> turned_back(const C33& R, const V3& v, int a) {
+  return {times(at(R, 0, a), v[0]), times(at(R, 1, a), v[1]), times(at(R, 2, a), v[2])};
+}
+std::vector<Product> turned(const C33& R, const V3& v, int a) {
+  return {times(at(R, a, 0), v[0]), times(at(R, a, 1), v[1]), times(at(R, a, 2), v[2])};
+}
+
+struct LocalMotion {
+  std::vector<V3> omega, velocity, alpha, acceleration;  // at each node's origin, in its axes
+  std::vector<C33> R;
+  std::vector<C3> r;
+};
+
+// Out along the chains: omega_k = R^T omega_p + e s'_k, v_k = R^T (v_p + omega_p x r),
+// alpha_k = R^T alpha_p + e s''_k + (R^T omega_p) x e s'_k, a_k = R^T (a_p + alpha_p x r +
+// omega_p x (omega_p x r)) for a revolute joint of axis e (a prismatic one adds e s'_k to v and
+// e s''_k + 2 omega_k x e s'_k to a instead). K0's acceleration is g e_z upwards, which puts
+// gravity into every body's force.
+LocalMotion local_motion(const TwistTree& tree, const ValueId& g, ScalarBuilder& w) {
+  const std::size_t n = tree.nodes.size();
+  LocalMotion m{std::vector<V3>(n), std::vector<V3>(n), std::vector<V3>(n), std::vector<V3>(n), std::vector<C33>(n), std::vector<C3>(n)};
+  for (std::size_t k = 0; k < n; ++k) {
+    const TwistNode& node = tree.nodes[k];
+    const JointRecord& joint = *node.joint;
+    const int kk = static_cast<int>(k);
+    const auto id = [&](Quantity what, int c) { return value_id(what, kk, c); };
+    m.R[k] = coefficients(w, Quantity::local_rotation, kk, node.placement_R);
+    m.r[k] = coefficients(w, Quantity::local_offset, kk, node.placement_r);
+    const C33& R = m.R[k];
+    const C3& r = m.r[k];
+    const auto p = static_cast<std::size_t>(node.parent);
+    const V3 w0 = node.parent < 0 ? V3{} : m.omega[p], v0 = node.parent < 0 ? V3{} : m.velocity[p];
+    const V3 al0 = node.parent < 0 ? V3{} : m.alpha[p], a0 = node.parent < 0 ? V3{ValueId{}, ValueId{}, g} : m.acceleration[p];
+    V3 wr, cv, ca, w_in, v_in, al_in, a_in;
+    for (int c = 0; c < 3; ++c) wr[static_cast<std::size_t>(c)] = w.define(id(Quantity::offset_velocity, c), cross_vc(w0, r, c));
+    for (int c = 0; c < 3; ++c) {
+      const auto cc = static_cast<std::size_t>(c);
+      cv[cc] = w.define(id(Quantity::carried_motion, c), {{v0[cc], kOne}, {wr[cc], kOne}});
+      ca[cc] = w.define(id(Quantity::carried_motion, c + 3), join(join({{a0[cc], kOne}}, cross_vc(al0, r, c)), cross_terms(w0, wr, c)));
+    }
+    for (int a = 0; a < 3; ++a) {
+      const auto aa = static_cast<std::size_t>(a);
+      w_in[aa] = w.define(id(Quantity::incoming_motion, a), turned_back(R, w0, a));
+      v_in[aa] = w.define(id(Quantity::incoming_motion, a + 3), turned_back(R, cv, a));
+      al_in[aa] = w.define(id(Quantity::incoming_motion, a + 6), turned_back(R, al0, a));
+      a_in[aa] = w.define(id(Quantity::incoming_motion, a + 9), turned_back(R, ca, a));
+    }
+    const ValueId sd = value_id(Quantity::rate, joint.coordinate), sdd = value_id(Quantity::acceleration, joint.coordinate);
+    const int i = static_cast<int>(joint.local_axis);
+    const bool minus = joint.sign < 0;
+    // (x cross e s')_c for the joint's axis e = sign e_i: x_{i+2} s' at c = i+1, -x_{i+1} s' at
+    // c = i+2, zero along the axis.
+    const auto cross_axis = [&](const V3& x, int c) -> std::vector<Product> {
+      if (c == (i + 1) % 3) return {{x[static_cast<std::size_t>((i + 2) % 3)], sd, minus}};
+      if (c == (i + 2) % 3) return {{x[static_cast<std::size_t>((i + 1) % 3)], sd, !minus}};
+      return {};
+    };
+    for (int c = 0; c < 3; ++c) {
+      const auto cc = static_cast<std::size_t>(c);
+      std::vector<Product> wt{{w_in[cc], kOne}}, vt{{v_in[cc], kOne}}, alt{{al_in[cc], kOne}}, at_{{a_in[cc], kOne}};
+      if (joint.revolute) {
+        if (c == i) {
+          wt.push_back({sd, kOne, minus});
+          alt.push_back({sdd, kOne, minus});
+        }
+        alt = join(alt, cross_axis(w_in, c));
+      } else {
+        if (c == i) {
+          vt.push_back({sd, kOne, minus});
+          at_.push_back({sdd, kOne, minus});
+        }
+        const std::vector<Product> coriolis = cross_axis(w_in, c);
+        at_ = join(join(at_, coriolis), coriolis);  // 2 omega x e s'
+      }
+      m.omega[k][cc] = w.define(value_id(Quantity::spatial_velocity, kk, c), wt);
+      m.velocity[k][cc] = w.define(value_id(Quantity::spatial_velocity, kk, c + 3), vt);
+      m.alpha[k][cc] = w.define(value_id(Quantity::spatial_acceleration, kk, c), alt);
+      m.acceleration[k][cc] = w.define(value_id(Quantity::spatial_acceleration, kk, c + 3), at_);
+    }
+  }
+  return m;
+}
+
+// Body i at node k (its CoM frame at (Rc, c) in the node's frame): a_c = a + alpha x c +
+// omega x (omega x c), F = m a_c; in body axes N = I alpha_b + omega_b x I omega_b; its wrench
+// (F; Rc N + c x F) about the node's origin, in the node's axes.
+V6 local_body_wrench(const Model& m, const TwistTree& tree, std::size_t i, const LocalMotion& motion, ScalarBuilder& w) {
+  const Body& body = m.bodies[i];
+  const auto k = static_cast<std::size_t>(tree.body_node[i]);
+  const int index = static_cast<int>(i);
+  const auto id = [&](Quantity what, int c) { return value_id(what, index, c); };
+  w.add(lane_code::Comment{fmt::format("body {}: {}", body.name, body.meaning)});
+  const C33 Rc = coefficients(w, Quantity::com_rotation, index, tree.body_R[i]);
+  const C3 c = coefficients(w, Quantity::com_offset, index, tree.body_r[i]);
+  const ValueId mass = w.scalar(value_id(Quantity::mass, index), m.parameter(body.mass).symbol);
+  V3 I;
+  for (int a = 0; a < 3; ++a)
+    I[static_cast<std::size_t>(a)] = w.scalar(id(Quantity::inertia, a), m.parameter(body.inertia[static_cast<std::size_t>(a)]).symbol);
+  const V3 &om = motion.omega[k], &al = motion.alpha[k], &acc = motion.acceleration[k];
+  V3 wc, ac, F, wb, ab, Iw, N, M;
+  for (int a = 0; a < 3; ++a) wc[static_cast<std::size_t>(a)] = w.define(id(Quantity::com_velocity, a), cross_vc(om, c, a));
+  for (int a = 0; a < 3; ++a) {
+    const auto aa = static_cast<std::size_t>(a);
+    ac[aa] = w.define(id(Quantity::com_acceleration, a), join(join({{acc[aa], kOne}}, cross_vc(al, c, a)), cross_terms(om, wc, a)));
+    F[aa] = w.define(id(Quantity::force, a), {{mass, ac[aa]}});
+  }
+  for (int a = 0; a < 3; ++a) {
+    wb[static_cast<std::size_t>(a)] = w.define(id(Quantity::body_rate, a), turned_back(Rc, om, a));
+    ab[static_cast<std::size_t>(a)] = w.define(id(Quantity::body_angular_acceleration, a), turned_back(Rc, al, a));
+  }
+  for (int a = 0; a < 3; ++a)
+    Iw[static_cast<std::size_t>(a)] = w.define(id(Quantity::angular_momentum, a), {{I[static_cast<std::size_t>(a)], wb[static_cast<std::size_t>(a)]}});
+  for (int a = 0; a < 3; ++a)
+    N[static_cast<std::size_t>(a)] = w.define(id(Quantity::body_moment, a), join({{I[static_cast<std::size_t>(a)], ab[static_cast<std::size_t>(a)]}}, cross_terms(wb, Iw, a)));
+  for (int a = 0; a < 3; ++a) M[static_cast<std::size_t>(a)] = w.define(id(Quantity::moment, a), join(turned(Rc, N, a), cross_cv(c, F, a)));
+  return {F[0], F[1], F[2], M[0], M[1], M[2]};
+}
+
+// Back along the chains, in each node's axes: f_k = the bodies' forces + sum R_j f_j over the
+// children j, n_k = the bodies' moments + sum (R_j n_j + r_j x R_j f_j); tau_k = e . n_k
+// (revolute) or e . f_k (prismatic).
+std::map<int, ValueId> local_joint_forces(const TwistTree& tree, const LocalMotion& motion, const std::vector<V6>& wrench, ScalarBuilder& w) {
+  w.add(lane_code::Comment{"Back along the chains, in each joint's frame: the wrenches beyond each joint and the joints' generalized forces."});
+  const std::size_t n = tree.nodes.size();
+  std::vector<V3> f(n), moment(n), transmitted(n);
+  std::map<int, std::vector<Product>> tau_terms;
+  for (std::size_t k = n; k-- > 0;) {
+    const TwistNode& node = tree.nodes[k];
+    const int kk = static_cast<int>(k);
+    for (int c = 0; c < 3; ++c) {
+      const auto cc = static_cast<std::size_t>(c);
+      std::vector<Product> ft, nt;
+      for (int i : node.bodies) {
+        ft.push_back({wrench[static_cast<std::size_t>(i)][cc], kOne});
+        nt.push_back({wrench[static_cast<std::size_t>(i)][cc + 3], kOne});
+      }
+      for (int child : node.children) {
+        const auto ch = static_cast<std::size_t>(child);
+        ft.push_back({transmitted[ch][cc], kOne});
+        nt = join(join(nt, turned(motion.R[ch], moment[ch], c)), cross_cv(motion.r[ch], transmitted[ch], c));
+      }
+      f[k][cc] = w.define(value_id(Quantity::wrench, kk, c), ft);
+      moment[k][cc] = w.define(value_id(Quantity::wrench, kk, c + 3), nt);
+    }
+    if (node.parent >= 0)
+      for (int c = 0; c < 3; ++c) transmitted[k][static_cast<std::size_t>(c)] = w.define(value_id(Quantity::transmitted_force, kk, c), turned(motion.R[k], f[k], c));
+    const JointRecord& joint = *node.joint;
+    const auto i = static_cast<std::size_t>(joint.local_axis);
+    const ValueId tau = w.define(value_id(Quantity::joint_force, kk), {{joint.revolute ? moment[k][i] : f[k][i], kOne, joint.sign < 0}});
+    if (!tau.is_zero()) tau_terms[joint.coordinate].push_back({tau, kOne});
+  }
+  std::map<int, ValueId> tau_of;
+  for (const auto& [j, terms] : tau_terms) {
+    const ValueId t = w.define(value_id(Quantity::coordinate_force, j), terms);
+    if (!t.is_zero()) tau_of[j] = t;
+  }
+  return tau_of;
+}
+
+// A printed pass' operations: its own, and its lane scalars' (each distinct subexpression once, as
+// the emitted code computes them: the world frame's pass spends a third of its operations there).
+long operations(const lane_code::PrintedCode& printed) {
+  ExprGraph graph;
+  std::vector<int> stack;
+  for (const auto& [name, value] : printed.scalars) stack.push_back(graph.add(value));
+  std::set<int> seen;
+  long ops = printed.ops[0].total();
+  while (!stack.empty()) {
+    const int id = stack.back();
+    stack.pop_back();
+    if (graph.is_leaf(id) || !seen.insert(id).second) continue;
+    ops += graph.own_ops(id).total();
+    for (int a : graph.node(id).args) stack.push_back(a);
+  }
+  return ops;
+}
+
 // The outputs: Q*_l = sum_j T(j, l) tau_j: a commanded speed's coordinate adds its tau to its row;
 // a dense coordinate's, times T(j, l), to the rows of the speeds its rate depends on
 // (kRateBasisPattern); and tau itself.
@@ -243,21 +471,35 @@ FunctionSpec derive_generalized_forces(const Model& m) {
   FunctionSpec fn = generalized_forces_spec();
   const RateRoles roles = rate_roles(m);
   const TwistTree tree = twist_tree(m, roles);
-  ScalarBuilder w;
-  const SpatialMotion motion = spatial_motion(tree, w);
-  const ValueId g = w.scalar(value_id(Quantity::gravity), m.parameter(m.dynamics->gravity).symbol);
-  std::vector<V6> wrench(m.bodies.size());
-  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
-    const int at_node = tree.body_node[i];
-    if (at_node < 0) continue;
-    wrench[i] = body_wrench(m, i, motion.velocity[static_cast<std::size_t>(at_node)], motion.acceleration[static_cast<std::size_t>(at_node)], g, w);
+  // The pass in K0, and the same in the joints' own frames: the one with fewer operations.
+  ScalarBuilder world;
+  {
+    const SpatialMotion motion = spatial_motion(tree, world);
+    const ValueId g = world.scalar(value_id(Quantity::gravity), m.parameter(m.dynamics->gravity).symbol);
+    std::vector<V6> wrench(m.bodies.size());
+    for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+      const int at_node = tree.body_node[i];
+      if (at_node < 0) continue;
+      wrench[i] = body_wrench(m, i, motion.velocity[static_cast<std::size_t>(at_node)], motion.acceleration[static_cast<std::size_t>(at_node)], g, world);
+    }
+    write_outputs(m, roles, joint_forces(tree, motion.axis, wrench, world), world);
   }
-  write_outputs(m, roles, joint_forces(tree, motion.axis, wrench, w), w);
+  ScalarBuilder local;
+  {
+    const ValueId g = local.scalar(value_id(Quantity::gravity), m.parameter(m.dynamics->gravity).symbol);
+    const LocalMotion motion = local_motion(tree, g, local);
+    std::vector<V6> wrench(m.bodies.size());
+    for (std::size_t i = 0; i < m.bodies.size(); ++i)
+      if (tree.body_node[i] >= 0) wrench[i] = local_body_wrench(m, tree, i, motion, local);
+    write_outputs(m, roles, local_joint_forces(tree, motion, wrench, local), local);
+  }
   // Unread values are left out (a link turning about one axis: of its I omega only the component
   // along that axis, which omega x I omega never reads), and so are the scalars only they read (a
   // body whose rotation or offset the recursion never reads, one link on a fixed joint: its
   // wrench needs only p and the mass).
-  lane_code::PrintedCode printed = lane_code::print(w.program(), 1);
+  lane_code::PrintedCode printed = lane_code::print(world.program(), 1);
+  lane_code::PrintedCode printed_local = lane_code::print(local.program(), 1);
+  if (operations(printed_local) < operations(printed)) printed = std::move(printed_local);
   fn.lane_code = std::move(printed.code);
   fn.lane_scalars = std::move(printed.scalars);
   // The pass runs for either output: its operations are Q*'s (tau adds no operation of its own).

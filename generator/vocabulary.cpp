@@ -61,6 +61,7 @@ Frame Frame::translated(const Vec3& local_offset) const {
   Frame f = *this;
   const Vec3 rho = R * local_offset;
   f.r = r + rho;
+  f.local_r = local_r + local_R * local_offset;
   f.v = v + cross(omega, rho);
   f.a_bias = a_bias + cross(alpha_bias, rho) + cross(omega, cross(omega, rho));
   return f;
@@ -72,7 +73,9 @@ Frame Frame::rotated(Axis axis, const Coordinate& c, int sign) const {
   f.R = R * signed_rot(axis, sign, c.q);
   f.omega = omega + ex(c.qdot) * a;
   f.alpha_bias = alpha_bias + ex(c.qdot) * cross(omega, a);  // the axis turns with the frame before
-  f.joints.push_back({c.index, true, a, r});
+  f.joints.push_back({c.index, true, a, r, local_R * signed_rot(axis, sign, c.q), local_r, axis, sign});
+  f.local_R = Mat3::identity();
+  f.local_r = Vec3();
   return f;
 }
 
@@ -84,13 +87,16 @@ Frame Frame::slid(Axis axis, const Coordinate& c, int sign) const {
   f.v = v + cross(omega, d) + ex(c.qdot) * a;
   f.a_bias = a_bias + cross(alpha_bias, d) + cross(omega, cross(omega, d)) +
              ex(2 * c.qdot) * cross(omega, a);
-  f.joints.push_back({c.index, false, a, r});
+  f.joints.push_back({c.index, false, a, r, local_R, local_r + local_R * (ex(sign * c.q) * unit(axis)), axis, sign});
+  f.local_R = Mat3::identity();
+  f.local_r = Vec3();
   return f;
 }
 
 Frame Frame::turned(Axis axis, const ex& angle) const {
   Frame f = *this;
   f.R = R * rot(axis, angle);
+  f.local_R = local_R * rot(axis, angle);
   return f;
 }
 

@@ -78,6 +78,13 @@ struct JointRecord {
   bool revolute = true;
   Vec3 axis;    // unit joint axis in K0
   Vec3 origin;  // a point on the axis, in K0
+  // The same joint in local terms, for recursions in the joints' own frames: the frame just after
+  // it (moved by its coordinate) in the frame just after the joint before it in the chain (K0 for
+  // the first): orientation and origin; and its axis in that frame, sign * unit(local_axis).
+  Mat3 placement_R = Mat3::identity();
+  Vec3 placement_r;
+  Axis local_axis = Axis::X;
+  int sign = 1;
 };
 
 class Frame {
@@ -89,6 +96,9 @@ class Frame {
   Vec3 alpha_bias;            // angular acceleration with all coordinate accelerations zero
   Vec3 a_bias;                // origin acceleration with all coordinate accelerations zero
   std::vector<JointRecord> joints;  // every joint between K0 and this frame
+  // This frame in the frame just after the last of `joints` (K0 when there is none).
+  Mat3 local_R = Mat3::identity();
+  Vec3 local_r;
   // The origin's velocity Jacobian, one column per coordinate, for a point that is not fixed in the
   // chain (a wheel's contact point slides round the rim); empty for a rigidly attached frame, whose
   // columns follow from `joints`.

@@ -373,7 +373,7 @@ TEST_CASE("wlx-gen: text from the model file cannot add code to the headers: the
   const std::string param_meaning = R"(*/ #define evil 1 /* ??/)";
   std::string text = replaced(arm_text(), "{name: upper, frame: upper,", "{name: upper, meaning: '" + meaning + "', frame: upper,");
   text = replaced(text, "meaning: upper arm length}", "meaning: '" + param_meaning + "'}");
-  text = replaced(text, "description: a fixed three-joint arm (no closure, no wheels)", R"(description: 'say "hi" \ there')");
+  text = replaced(text, "description: a fixed arm of three revolute and one prismatic joint (no closure, no wheels)", R"(description: 'say "hi" \ there')");
   const std::filesystem::path dir = wlx_test::work_dir() / "hostile-text";
   std::filesystem::create_directories(dir);
   const std::filesystem::path model = dir / "arm\n#define upper 0\n.yaml";

@@ -15,9 +15,9 @@
 //   kinematic_update             194         48373          1304
 //   dynamics_update              150         37306          1043
 //   reduced_dynamics             484        145199          6505
-//   generalized_forces           110          7426          2377
+//   generalized_forces             6           100          1120
 //   clearance                      0            22            23
-//   total                                   420193         17429
+//   total                                   412867         16172
 #pragma once
 
 #include "ik.hpp"

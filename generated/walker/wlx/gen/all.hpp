@@ -15,9 +15,9 @@
 //   kinematic_update             234         60493          1338
 //   dynamics_update              183         47698           988
 //   reduced_dynamics             601        151284          6482
-//   generalized_forces           122          7864          2412
+//   generalized_forces             5            92          1228
 //   clearance                      0            22            23
-//   total                                   477877         17766
+//   total                                   470105         16582
 #pragma once
 
 #include "ik.hpp"

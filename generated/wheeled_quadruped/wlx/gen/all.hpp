@@ -15,9 +15,9 @@
 //   kinematic_update             420         98350          2296
 //   dynamics_update              361        102428          1916
 //   reduced_dynamics            1057        364609         10308
-//   generalized_forces           236         16742          4979
+//   generalized_forces             0            60          2262
 //   clearance                      0            22            22
-//   total                                  1104532         31375
+//   total                                  1087850         28658
 #pragma once
 
 #include "ik.hpp"
