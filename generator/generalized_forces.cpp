@@ -270,19 +270,20 @@ std::vector<Product> turned(const C33& R, const V3& v, int a) {
 }
 
 struct LocalMotion {
-  std::vector<V3> omega, velocity, alpha, acceleration;  // at each node's origin, in its axes
+  // At each node's origin, in its axes. (The origin's velocity is not needed: a body's
+  // acceleration and moment take omega, alpha and the origin's acceleration.)
+  std::vector<V3> omega, alpha, acceleration;
   std::vector<C33> R;
   std::vector<C3> r;
 };
 
-// Out along the chains: omega_k = R^T omega_p + e s'_k, v_k = R^T (v_p + omega_p x r),
-// alpha_k = R^T alpha_p + e s''_k + (R^T omega_p) x e s'_k, a_k = R^T (a_p + alpha_p x r +
-// omega_p x (omega_p x r)) for a revolute joint of axis e (a prismatic one adds e s'_k to v and
-// e s''_k + 2 omega_k x e s'_k to a instead). K0's acceleration is g e_z upwards, which puts
+// Out along the chains: omega_k = R^T omega_p + e s'_k, alpha_k = R^T alpha_p + e s''_k +
+// (R^T omega_p) x e s'_k, a_k = R^T (a_p + alpha_p x r + omega_p x (omega_p x r)) for a revolute
+// joint of axis e (a prismatic one adds e s''_k + 2 omega_k x e s'_k to a instead). K0's acceleration is g e_z upwards, which puts
 // gravity into every body's force.
 LocalMotion local_motion(const TwistTree& tree, const ValueId& g, ScalarBuilder& w) {
   const std::size_t n = tree.nodes.size();
-  LocalMotion m{std::vector<V3>(n), std::vector<V3>(n), std::vector<V3>(n), std::vector<V3>(n), std::vector<C33>(n), std::vector<C3>(n)};
+  LocalMotion m{std::vector<V3>(n), std::vector<V3>(n), std::vector<V3>(n), std::vector<C33>(n), std::vector<C3>(n)};
   for (std::size_t k = 0; k < n; ++k) {
     const TwistNode& node = tree.nodes[k];
     const JointRecord& joint = *node.joint;
@@ -293,21 +294,18 @@ LocalMotion local_motion(const TwistTree& tree, const ValueId& g, ScalarBuilder&
     const C33& R = m.R[k];
     const C3& r = m.r[k];
     const auto p = static_cast<std::size_t>(node.parent);
-    const V3 w0 = node.parent < 0 ? V3{} : m.omega[p], v0 = node.parent < 0 ? V3{} : m.velocity[p];
-    const V3 al0 = node.parent < 0 ? V3{} : m.alpha[p], a0 = node.parent < 0 ? V3{ValueId{}, ValueId{}, g} : m.acceleration[p];
-    V3 wr, cv, ca, w_in, v_in, al_in, a_in;
+    const V3 w0 = node.parent < 0 ? V3{} : m.omega[p], al0 = node.parent < 0 ? V3{} : m.alpha[p];
+    const V3 a0 = node.parent < 0 ? V3{ValueId{}, ValueId{}, g} : m.acceleration[p];
+    V3 wr, ca, w_in, al_in, a_in;
     for (int c = 0; c < 3; ++c) wr[static_cast<std::size_t>(c)] = w.define(id(Quantity::offset_velocity, c), cross_vc(w0, r, c));
-    for (int c = 0; c < 3; ++c) {
-      const auto cc = static_cast<std::size_t>(c);
-      cv[cc] = w.define(id(Quantity::carried_motion, c), {{v0[cc], kOne}, {wr[cc], kOne}});
-      ca[cc] = w.define(id(Quantity::carried_motion, c + 3), join(join({{a0[cc], kOne}}, cross_vc(al0, r, c)), cross_terms(w0, wr, c)));
-    }
+    for (int c = 0; c < 3; ++c)
+      ca[static_cast<std::size_t>(c)] = w.define(id(Quantity::carried_acceleration, c),
+                                                 join(join({{a0[static_cast<std::size_t>(c)], kOne}}, cross_vc(al0, r, c)), cross_terms(w0, wr, c)));
     for (int a = 0; a < 3; ++a) {
       const auto aa = static_cast<std::size_t>(a);
       w_in[aa] = w.define(id(Quantity::incoming_motion, a), turned_back(R, w0, a));
-      v_in[aa] = w.define(id(Quantity::incoming_motion, a + 3), turned_back(R, cv, a));
-      al_in[aa] = w.define(id(Quantity::incoming_motion, a + 6), turned_back(R, al0, a));
-      a_in[aa] = w.define(id(Quantity::incoming_motion, a + 9), turned_back(R, ca, a));
+      al_in[aa] = w.define(id(Quantity::incoming_motion, a + 3), turned_back(R, al0, a));
+      a_in[aa] = w.define(id(Quantity::incoming_motion, a + 6), turned_back(R, ca, a));
     }
     const ValueId sd = value_id(Quantity::rate, joint.coordinate), sdd = value_id(Quantity::acceleration, joint.coordinate);
     const int i = static_cast<int>(joint.local_axis);
@@ -321,7 +319,7 @@ LocalMotion local_motion(const TwistTree& tree, const ValueId& g, ScalarBuilder&
     };
     for (int c = 0; c < 3; ++c) {
       const auto cc = static_cast<std::size_t>(c);
-      std::vector<Product> wt{{w_in[cc], kOne}}, vt{{v_in[cc], kOne}}, alt{{al_in[cc], kOne}}, at_{{a_in[cc], kOne}};
+      std::vector<Product> wt{{w_in[cc], kOne}}, alt{{al_in[cc], kOne}}, at_{{a_in[cc], kOne}};
       if (joint.revolute) {
         if (c == i) {
           wt.push_back({sd, kOne, minus});
@@ -329,15 +327,11 @@ LocalMotion local_motion(const TwistTree& tree, const ValueId& g, ScalarBuilder&
         }
         alt = join(alt, cross_axis(w_in, c));
       } else {
-        if (c == i) {
-          vt.push_back({sd, kOne, minus});
-          at_.push_back({sdd, kOne, minus});
-        }
+        if (c == i) at_.push_back({sdd, kOne, minus});
         const std::vector<Product> coriolis = cross_axis(w_in, c);
         at_ = join(join(at_, coriolis), coriolis);  // 2 omega x e s'
       }
       m.omega[k][cc] = w.define(value_id(Quantity::spatial_velocity, kk, c), wt);
-      m.velocity[k][cc] = w.define(value_id(Quantity::spatial_velocity, kk, c + 3), vt);
       m.alpha[k][cc] = w.define(value_id(Quantity::spatial_acceleration, kk, c), alt);
       m.acceleration[k][cc] = w.define(value_id(Quantity::spatial_acceleration, kk, c + 3), at_);
     }

@@ -72,12 +72,12 @@ enum class Quantity : unsigned char {
   reduced_mass,               // (l, b): M on the commanded speeds, l <= b
   gravity_force,              // (k): node k's tau from gravity, over -g
   commanded_gravity,          // (l): Q_gravity_l over -g
-  // generalized_forces' recursion in the joints' own frames (local_newton_euler).
+  // generalized_forces' recursion in the joints' own frames (local_motion in generalized_forces.cpp).
   local_rotation,     // (k, a, b): node k's frame in its parent's (a lane scalar)
   local_offset,       // (k, c): node k's origin in its parent's frame (a lane scalar)
-  offset_velocity,    // (k, c): the parent's omega x node k's origin, in the parent's axes
-  carried_motion,     // (k, c): the parent's velocity (c < 3) and acceleration (c >= 3) at node k's origin, parent's axes
-  incoming_motion,    // (k, c): the parent's omega, v, alpha, a at node k's origin, in node k's axes (3 each)
+  offset_velocity,       // (k, c): the parent's omega x node k's origin, in the parent's axes
+  carried_acceleration,  // (k, c): the parent's acceleration at node k's origin, in the parent's axes
+  incoming_motion,       // (k, c): the parent's omega, alpha, a at node k's origin, in node k's axes (3 each)
   transmitted_force,  // (k, c): the force beyond node k in its parent's axes
   // Values of the composite pass' own making (composite_units.cpp), named after another value v:
   lanes_of,  // (v): a row of lanes, v's quantity for each limb of a row unit

@@ -70,7 +70,7 @@ constexpr Spelling kSpellings[] = {
     {Quantity::local_rotation, nullptr, "kane_Rl{}_{}_{}"},
     {Quantity::local_offset, nullptr, "kane_rl{}_{}"},
     {Quantity::offset_velocity, nullptr, "kane_wr{}_{}"},
-    {Quantity::carried_motion, nullptr, "kane_C{}_{}"},
+    {Quantity::carried_acceleration, nullptr, "kane_C{}_{}"},
     {Quantity::incoming_motion, nullptr, "kane_In{}_{}"},
     {Quantity::transmitted_force, nullptr, "kane_Ft{}_{}"},
     {Quantity::constant, nullptr, "kane_c{}"},

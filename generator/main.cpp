@@ -24,6 +24,7 @@
 #include <set>
 #include <sstream>
 #include <string_view>
+#include <vector>
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -302,22 +303,18 @@ void check_namespace(const std::string& name_space) {
     return !part.empty() && letter(part[0]) &&
            std::all_of(part.begin(), part.end(), [&](char c) { return letter(c) || (c >= '0' && c <= '9'); });
   };
-  bool qualified = true;
-  for (std::size_t begin = 0; qualified && begin <= name_space.size();) {
-    const std::size_t end = std::min(name_space.find("::", begin), name_space.size());
-    qualified = identifier(std::string_view(name_space).substr(begin, end - begin));
-    begin = end + 2;
-  }
-  if (!qualified)
-    throw ModelFileError(fmt::format("--namespace: '{}' is not a C++ qualified name such as wlx::mine", name_space.substr(0, 60)));
-  // Each part is pasted in as a name: no keyword, macro, std or Eigen (the model file's rule).
+  std::vector<std::string> parts;
   for (std::size_t begin = 0; begin <= name_space.size();) {
     const std::size_t end = std::min(name_space.find("::", begin), name_space.size());
-    const std::string part = name_space.substr(begin, end - begin);
-    if (const std::string why = cpp_name_problem(part); !why.empty())
-      throw ModelFileError(fmt::format("--namespace: '{}' cannot be used: {}", part, why));
+    parts.push_back(name_space.substr(begin, end - begin));
     begin = end + 2;
   }
+  if (!std::all_of(parts.begin(), parts.end(), identifier))
+    throw ModelFileError(fmt::format("--namespace: '{}' is not a C++ qualified name such as wlx::mine", name_space.substr(0, 60)));
+  // Each part is pasted in as a name: no keyword, macro, std or Eigen (the model file's rule).
+  for (const std::string& part : parts)
+    if (const std::string why = cpp_name_problem(part); !why.empty())
+      throw ModelFileError(fmt::format("--namespace: '{}' cannot be used: {}", part, why));
 }
 
 // `wlx-gen robot.urdf --with robot.yaml`: the YAML file is the model, the URDF its robot. Returns
