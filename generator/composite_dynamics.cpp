@@ -1,255 +1,141 @@
-// reduced_dynamics by composite rigid bodies: straight-line code (lane_code.hpp) that forms M on the
-// coordinates from the composite inertias beyond each joint, projects it onto the commanded speeds
-// on T's pattern, and gets b_velocity and Q_gravity from one backward sum each. Kane's sums
-// (reduced_dynamics.cpp) carry a row of lanes per commanded speed through every body; here each
-// body's inertia is added once, to the composite of its node, so the cost grows with the pairs of
-// joints on a chain rather than with bodies times speeds. Sibling limbs of one shape (a walking
-// machine's legs) run side by side, one lane each (composite_units.cpp).
+// reduced_dynamics by composite rigid bodies in the joints' own frames: the composite inertias are
+// carried from each joint's frame into its parent's by the placement between them (TwistNode::
+// placement_R, placement_r), a joint's I S walks up its chain the same way, and b_velocity comes
+// from the Newton-Euler recursion at zero u' in the same frames. An axis-aligned joint's S is then a
+// signed unit vector (I S is a column of I, S . W one component), and a placement's zero and unit
+// entries cost nothing; the pass in K0 (composite_dynamics.cpp) instead needs every joint's axis and
+// every body's pose in K0 from s, which on a legged machine cost more than the pass itself (the
+// wheeled quadruped: 6,779 instructions and lane-scalar operations in K0, 2,984 here; Kane's sums
+// over the bodies, on lanes per commanded speed, 8,915). Sibling limbs of one shape run side by
+// side, one lane each (composite_units.cpp).
 #include "composite_internal.hpp"
 
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <map>
-
 namespace wlx::codegen::derivation {
 
-using lane_code::kOne;
-using lane_code::Layout;
 using lane_code::Quantity;
-using lane_code::Term;
 using lane_code::value_id;
 using lane_code::ValueId;
 using namespace composite;
 
 namespace {
 
-using S3 = std::array<Signed, 3>;
-using S6 = std::array<Signed, 6>;  // (angular; linear) of a motion, (force; moment) of a wrench
-
-// (x cross y)_c as two products.
-std::vector<Product> cross(const S3& x, const S3& y, int c) {
-  const std::size_t c1 = at((c + 1) % 3), c2 = at((c + 2) % 3);
-  return {{x[c1], y[c2]}, {-x[c2], y[c1]}};
-}
-void append(std::vector<Product>& to, const std::vector<Product>& more) {
-  to.insert(to.end(), more.begin(), more.end());
-}
-
-// The rotational inertia's six entries (a <= b), in this order.
-constexpr std::array<std::pair<int, int>, 6> kInertiaEntries{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
-std::size_t entry_of(int a, int b) {
-  for (std::size_t e = 0; e < kInertiaEntries.size(); ++e)
-    if (kInertiaEntries[e] == std::pair{std::min(a, b), std::max(a, b)}) return e;
-  throw std::logic_error("inertia entry");
-}
-
-// A spatial inertia about the reference point (Projection::origin), in K0: mass, first moment
-// h = m p (p the CoM from the reference point), rotational inertia J.
-struct Inertia {
-  Signed mass;
-  S3 h;
-  std::array<Signed, 6> J;
-  const Signed& Jab(int a, int b) const { return J[entry_of(a, b)]; }
+// Each unit's joints' placements in their parents' frames (lane g: limb g's).
+struct Placement {
+  std::array<Signed, 9> R;  // row-major
+  S3 r;
+  const Signed& at(int a, int b) const { return R[composite::at(3 * a + b)]; }
 };
 
-// Body slot s of unit u about the reference point: J = R diag(I) R^T + m (|p|^2 1 - p p^T). With R's
-// columns r_k orthonormal, R diag(I) R^T = I_1 1 + (I_2 - I_1) r_2 r_2^T + (I_3 - I_1) r_3 r_3^T, so
-// J = sigma 1 + (I_2 - I_1) r_2 r_2^T + (I_3 - I_1) r_3 r_3^T - h p^T with sigma = I_1 + h . p
-// (h = m p): two products per entry fewer than R diag(I) R^T written out.
-Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, const Vec3& origin, Builder& w) {
-  const int index = u.bodies[s][0];  // the values' names: the first lane's body
-  const auto per_lane = [&](Quantity what, int a, int b, const auto& value) {
-    std::vector<Signed> lanes;
-    for (int i : u.bodies[s]) lanes.push_back(w.scalar(value_id(what, i, a, b), value(m.bodies[at(i)])));
-    return w.pack(value_id(what, index, a, b), lanes);
-  };
-  const auto moment = [&](const Body& b, int k) { return m.parameter(b.inertia[at(k)]).symbol; };
-  Inertia out;
-  out.mass = per_lane(Quantity::mass, 0, 0, [&](const Body& b) { return m.parameter(b.mass).symbol; });
-  S3 p;
-  for (int c = 0; c < 3; ++c)
-    p[at(c)] = per_lane(Quantity::com_offset, c, 0, [&](const Body& b) { return b.com_frame.r[c] - origin[c]; });
-  const auto R = [&](int a, int k) {
-    return per_lane(Quantity::com_rotation, a, k, [&](const Body& b) { return b.com_frame.R(a, k); });
-  };
-  std::array<S3, 2> weighted;  // (I_k - I_1) r_k for k = 2, 3
-  for (int k = 1; k < 3; ++k) {
-    const Signed difference =
-        per_lane(Quantity::inertia_difference, k, 0, [&](const Body& b) { return moment(b, k) - moment(b, 0); });
-    for (int a = 0; a < 3; ++a)
-      weighted[at(k - 1)][at(a)] = w.define(value_id(Quantity::rotated_inertia, index, a, k), {{R(a, k), difference}});
+// A row of a unit's per-joint values (value(node)): lane g for limb g.
+Signed per_joint(Builder& w, const Unit& u, Quantity what, int a, int b, const std::function<ex(int)>& value) {
+  std::vector<Signed> lanes;
+  for (int node : u.nodes) lanes.push_back(w.scalar(value_id(what, node, a, b), value(node)));
+  return w.pack(value_id(what, u.nodes[0], a, b), lanes);
+}
+
+// (R^T v)_a and (R v)_a as products.
+std::vector<Product> turned_back(const Placement& X, const S3& v, int a) {
+  return {{X.at(0, a), v[0]}, {X.at(1, a), v[1]}, {X.at(2, a), v[2]}};
+}
+std::vector<Product> turned(const Placement& X, const S3& v, int a) {
+  return {{X.at(a, 0), v[0]}, {X.at(a, 1), v[1]}, {X.at(a, 2), v[2]}};
+}
+std::vector<Product> joined(std::vector<Product> a, const std::vector<Product>& b) {
+  append(a, b);
+  return a;
+}
+S3 head(const S6& v) { return {v[0], v[1], v[2]}; }
+S3 tail(const S6& v) { return {v[3], v[4], v[5]}; }
+
+// Unit u's composite inertia I in its parent's frame: h' = R h + m r, and about the parent's origin
+// J' = R J R^T + sigma 1 - r h'^T - (R h) r^T with sigma = r . h' + r . R h (the parallel-axis
+// shift of the bodies' m |x|^2 1 - x x^T for x = r + R y).
+Inertia carried(const Inertia& I, const Placement& X, int node, Builder& w) {
+  S3 hr, hp;
+  for (int a = 0; a < 3; ++a) hr[at(a)] = w.define(value_id(Quantity::turned_first_moment, node, a), turned(X, I.h, a));
+  for (int a = 0; a < 3; ++a)
+    hp[at(a)] = w.define(value_id(Quantity::carried_first_moment, node, a), {{hr[at(a)]}, {I.mass, X.r[at(a)]}});
+  std::array<S3, 3> RJ;  // rows of R J
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      RJ[at(a)][at(b)] = w.define(value_id(Quantity::turned_inertia, node, a, b),
+                                  {{X.at(a, 0), I.Jab(0, b)}, {X.at(a, 1), I.Jab(1, b)}, {X.at(a, 2), I.Jab(2, b)}});
+  std::vector<Product> shift;
+  for (int c = 0; c < 3; ++c) {
+    shift.push_back({X.r[at(c)], hp[at(c)]});
+    shift.push_back({X.r[at(c)], hr[at(c)]});
   }
-  for (int c = 0; c < 3; ++c)
-    out.h[at(c)] = w.define(value_id(Quantity::first_moment, index, c), {{out.mass, p[at(c)]}});
-  std::vector<Product> shift{{per_lane(Quantity::inertia, 0, 0, [&](const Body& b) { return moment(b, 0); })}};
-  for (int c = 0; c < 3; ++c) shift.push_back({out.h[at(c)], p[at(c)]});
-  const Signed sigma = w.define(value_id(Quantity::inertia_shift, index), shift);
+  const Signed sigma = w.define(value_id(Quantity::carried_shift, node), shift);
+  Inertia out;
+  out.mass = I.mass;
+  out.h = hp;
   for (std::size_t e = 0; e < kInertiaEntries.size(); ++e) {
     const auto [a, b] = kInertiaEntries[e];
-    std::vector<Product> t;
-    for (int k = 1; k < 3; ++k) t.push_back({weighted[at(k - 1)][at(a)], R(b, k)});
-    t.push_back({-out.h[at(a)], p[at(b)]});
+    std::vector<Product> t{{RJ[at(a)][0], X.at(b, 0)}, {RJ[at(a)][1], X.at(b, 1)}, {RJ[at(a)][2], X.at(b, 2)},
+                           {-X.r[at(a)], hp[at(b)]},   {-hr[at(a)], X.r[at(b)]}};
     if (a == b) t.push_back({sigma});
-    out.J[e] = w.define(value_id(Quantity::origin_inertia, index, a, b), t);
+    out.J[e] = w.define(value_id(Quantity::carried_inertia, node, a, b), t);
   }
   return out;
 }
 
-// A unit's parts summed: its own values and its children's (a row unit's children in the same
-// lanes; a plain unit's row children lane by lane).
-struct Summands {
-  const Units& units;
-  std::size_t u;
-  template <class Own, class OfChild>
-  std::vector<Product> operator()(const Own& own, const OfChild& of_child) const {
-    std::vector<Product> t = own();
-    for (int child : units.units[u].children) {
-      const Signed v = of_child(at(child));
-      if (units.units[at(child)].row() && !units.units[u].row())
-        for (int g = 0; g < units.width; ++g) t.push_back({v, kUnit, g});
-      else
-        t.push_back({v});
-    }
-    return t;
-  }
-};
-
-// The composite inertias, from the leaves in.
-std::vector<Inertia> composite_inertias(const Model& m, const Units& units, const Vec3& origin, Builder& w) {
-  std::vector<Inertia> out(units.units.size());
-  for (std::size_t u = units.units.size(); u-- > 0;) {
-    const Unit& unit = units.units[u];
-    std::vector<Inertia> own;
-    for (std::size_t s = 0; s < unit.bodies.size(); ++s) own.push_back(body_inertia(m, unit, s, origin, w));
-    const Summands sum{units, u};
-    const int k = unit.nodes[0];
-    const auto total = [&](const ValueId& target, const auto& pick) {
-      return w.define(target, sum(
-                                  [&] {
-                                    std::vector<Product> t;
-                                    for (const Inertia& x : own) t.push_back({pick(x)});
-                                    return t;
-                                  },
-                                  [&](std::size_t child) { return pick(out[child]); }));
-    };
-    out[u].mass = total(value_id(Quantity::composite_mass, k), [](const Inertia& x) { return x.mass; });
-    for (int c = 0; c < 3; ++c)
-      out[u].h[at(c)] =
-          total(value_id(Quantity::composite_first_moment, k, c), [&](const Inertia& x) { return x.h[at(c)]; });
-    for (std::size_t e = 0; e < kInertiaEntries.size(); ++e)
-      out[u].J[e] = total(value_id(Quantity::composite_inertia, k, kInertiaEntries[e].first, kInertiaEntries[e].second),
-                          [&](const Inertia& x) { return x.J[e]; });
-  }
-  return out;
-}
-
-// I S for a composite inertia and a joint's axis S = (a; b): the momentum of the bodies beyond per
-// unit rate, (force m b + a x h; moment about the reference point J a + h x b).
-S6 momentum(const Inertia& I, const S6& S, int node, Builder& w) {
-  const S3 a{S[0], S[1], S[2]}, b{S[3], S[4], S[5]};
+// A wrench (force; moment) in unit u's frame, in its parent's: (R f; R n + r x R f).
+S6 carried_wrench(const S6& W, const Placement& X, int to_node, int of_node, Builder& w) {
   S6 out;
-  for (int c = 0; c < 3; ++c) {
-    std::vector<Product> force{{I.mass, b[at(c)]}};
-    append(force, cross(a, I.h, c));
-    out[at(c)] = w.define(value_id(Quantity::joint_momentum, node, c), force);
-    std::vector<Product> moment;
-    for (int d = 0; d < 3; ++d) moment.push_back({I.Jab(c, d), a[at(d)]});
-    append(moment, cross(I.h, b, c));
-    out[at(c + 3)] = w.define(value_id(Quantity::joint_momentum, node, c + 3), moment);
-  }
+  for (int a = 0; a < 3; ++a) out[at(a)] = w.define(value_id(Quantity::carried_momentum, to_node, of_node, a), turned(X, head(W), a));
+  for (int a = 0; a < 3; ++a)
+    out[at(a + 3)] = w.define(value_id(Quantity::carried_momentum, to_node, of_node, a + 3),
+                              joined(turned(X, tail(W), a), cross(X.r, head(out), a)));
   return out;
 }
 
-// S_j . W as products: the angular part against the moment, the linear against the force.
-std::vector<Product> power(const S6& S, const S6& wrench) {
-  std::vector<Product> t;
-  for (int c = 0; c < 3; ++c) {
-    t.push_back({S[at(c)], wrench[at(c + 3)]});
-    t.push_back({S[at(c + 3)], wrench[at(c)]});
-  }
-  return t;
-}
-
-// M between units: S_j . (I_k S_k) for each unit k and each unit j on its chain up to k (a row
-// where k is a row unit: lane g pairs the joints of lane g), keyed (j, k).
-std::map<std::pair<int, int>, Signed> unit_mass(const Projection& pr, const std::vector<Inertia>& composite,
-                                                Builder& w) {
+// M between units, keyed (j, k): I_k S_k in k's frame, carried up the chain, S_j . (I_k S_k) at
+// each unit j on it.
+std::map<std::pair<int, int>, Signed> unit_mass(const Projection& pr, const std::vector<Placement>& X,
+                                                const std::vector<Inertia>& composite, Builder& w) {
   std::map<std::pair<int, int>, Signed> out;
-  for (std::size_t k = 0; k < pr.units.units.size(); ++k) {
-    const S6 F = momentum(composite[k], pr.axis[k], pr.units.units[k].nodes[0], w);
-    for (int j = static_cast<int>(k); j >= 0; j = pr.units.units[at(j)].parent) {
-      const Signed v =
-          w.define(value_id(Quantity::joint_mass, pr.units.units[at(j)].nodes[0], pr.units.units[k].nodes[0]),
-                   power(pr.axis[at(j)], F));
+  const auto& units = pr.units.units;
+  for (std::size_t k = 0; k < units.size(); ++k) {
+    const int node = units[k].nodes[0];
+    S6 F = momentum(composite[k], pr.axis[k], node, w);
+    for (int j = static_cast<int>(k);;) {
+      const int j_node = units[at(j)].nodes[0];
+      const Signed v = w.define(value_id(Quantity::joint_mass, j_node, node), power(pr.axis[at(j)], F));
       if (!v.is_zero()) out[{j, static_cast<int>(k)}] = v;
+      const int parent = units[at(j)].parent;
+      if (parent < 0) break;
+      F = carried_wrench(F, X[at(j)], units[at(parent)].nodes[0], node, w);
+      j = parent;
     }
   }
   return out;
 }
 
-// The outputs' entries (Store) of M, b_velocity, Q_gravity and B_bias: factor times v (v's lane
-// `lane` of a row).
-void store(Builder& w, const std::string& output, int row, int column, bool mirrored, const Signed& v,
-           const Signed& factor = kUnit, int lane = -1) {
-  std::vector<Term> terms;
-  if (!v.is_zero()) terms.push_back({factor.id, v.id, lane, v.negate != factor.negate});
-  w.add(lane_code::Store{output, row, column, mirrored, std::move(terms)});
-}
-
-// M* = T^T M T on T's pattern: P = T^T M (its columns of the dense coordinates are B_bias's), then
-// M*(l, b) = P(l, b's coordinate) + sum over the dense c of P(l, c) T(c, b), for l <= b.
-void project_mass(const Projection& pr, const std::map<std::pair<int, int>, Signed>& M, Builder& w) {
-  // P(l, c) for each dense coordinate c, as a value per unit (a row for a row unit).
-  std::map<std::pair<int, int>, Signed> bias;  // (l, unit) -> P(l, the unit's coordinates)
-  w.charge_to = kB_bias;
-  for (int l = 0; l < pr.nu; ++l)
-    for (std::size_t u = 0; u < pr.units.units.size(); ++u)
-      if (pr.units.units[u].row() || pr.dense_plain(static_cast<int>(u)))
-        bias[{l, static_cast<int>(u)}] = pr.projected(value_id(Quantity::projected_mass, l, pr.units.units[u].nodes[0]),
-                                                      l, static_cast<int>(u), M, w);
-  // Every value before the outputs' blocks, none inside one: the code a value needs is placed
-  // before its first reader (emit_function.cpp), which must not be in a block a later reader is not.
-  w.charge_to = kM;
-  std::map<std::pair<int, int>, Signed> reduced;
-  for (int l = 0; l < pr.nu; ++l)
-    for (int b = l; b < pr.nu; ++b) {
-      Sum sum;
-      for (int u : pr.units_of_speed(b)) pr.add_projected(sum, l, u, M, w);
-      for (const auto& [key, p] : bias)
-        if (key.first == l) pr.times_T(sum, p, key.second, b, w);
-      reduced[{l, b}] = w.define_sum(value_id(Quantity::reduced_mass, l, b), sum);
-    }
-  w.add(lane_code::OpenOutput{"M", "the upper triangle, mirrored: M is symmetric to the last bit"});
-  for (const auto& [lb, v] : reduced) store(w, "M", lb.first, lb.second, lb.first != lb.second, v);
-  w.add(lane_code::CloseOutput{});
-  w.charge_to = kB_bias;
-  // B_bias(l, c): the sum over c's joints (a lane of a row unit's).
-  std::map<std::pair<int, int>, std::vector<Term>> entries;  // (coordinate, l)
-  for (const auto& [key, p] : bias) {
-    if (p.is_zero()) continue;
-    const Unit& unit = pr.units.units[at(key.second)];
-    for (int g = 0; g < static_cast<int>(unit.nodes.size()); ++g)
-      entries[{pr.coordinate(key.second, g), key.first}].push_back({kOne, p.id, unit.row() ? g : -1, p.negate});
-  }
-  w.add(lane_code::OpenOutput{"B_bias", "", lane_code::OpenOutput::Prologue::zero_if_asked});
-  for (auto& [key, terms] : entries) {
-    std::stable_partition(terms.begin(), terms.end(), [](const Term& t) { return !t.negate; });
-    w.add(lane_code::Store{"B_bias", key.second, key.first, false, std::move(terms)});
-  }
-  w.add(lane_code::CloseOutput{});
-}
-
-// Q_gravity = T^T tau_g: gravity's wrench beyond a joint is (force -g m e_z; moment -g h x e_z) of
-// its composite, so tau_g = -g (b_z m + a_x h_y - a_y h_x) for the axis (a; b).
-void gravity_forces(const Model& m, const Projection& pr, const std::vector<Inertia>& composite, Builder& w) {
+// Q_gravity = -g T^T tau with tau = S . (m up; h x up) of each composite (up: K0's z axis in the
+// unit's frame, a lane scalar).
+void gravity_forces(const Model& m, const TwistTree& tree, const Projection& pr, const std::vector<Inertia>& composite, Builder& w) {
   w.charge_to = kQ_gravity;
+  std::vector<Vec3> up(tree.nodes.size());
+  for (std::size_t k = 0; k < tree.nodes.size(); ++k) {
+    const TwistNode& node = tree.nodes[k];
+    const Vec3 above = node.parent < 0 ? Vec3(0, 0, 1) : up[at(node.parent)];
+    for (int a = 0; a < 3; ++a)
+      up[k][a] = node.placement_R(0, a) * above[0] + node.placement_R(1, a) * above[1] + node.placement_R(2, a) * above[2];
+  }
   std::vector<Signed> per_unit(pr.units.units.size());
   for (std::size_t u = 0; u < pr.units.units.size(); ++u) {
-    const S6& S = pr.axis[u];
+    const Unit& unit = pr.units.units[u];
     const Inertia& I = composite[u];
-    per_unit[u] = w.define(value_id(Quantity::gravity_force, pr.units.units[u].nodes[0]),
-                           {{S[5], I.mass}, {S[0], I.h[1]}, {-S[1], I.h[0]}});
+    const int node = unit.nodes[0];
+    S3 z;
+    for (int c = 0; c < 3; ++c)
+      z[at(c)] = per_joint(w, unit, Quantity::up_direction, c, 0, [&](int n) { return up[at(n)][c]; });
+    S6 W;
+    for (int c = 0; c < 3; ++c) W[at(c)] = w.define(value_id(Quantity::gravity_wrench, node, c), {{I.mass, z[at(c)]}});
+    for (int c = 0; c < 3; ++c) W[at(c + 3)] = w.define(value_id(Quantity::gravity_wrench, node, c + 3), cross(I.h, z, c));
+    per_unit[u] = w.define(value_id(Quantity::gravity_force, node), power(pr.axis[u], W));
   }
   const Signed minus_g = w.scalar(value_id(Quantity::minus_gravity), -m.parameter(m.dynamics->gravity).symbol);
   std::vector<Signed> Q;
@@ -259,97 +145,127 @@ void gravity_forces(const Model& m, const Projection& pr, const std::vector<Iner
   w.add(lane_code::CloseOutput{});
 }
 
-// Body slot s of unit u: its wrench at zero u' without gravity (force m a_bias; moment p x force +
-// R N, N = I alpha_b + omega_b x I omega_b in body axes), as Kane's sums weigh it.
-S6 bias_wrench(const Model& m, const Unit& u, std::size_t s, const Vec3& origin, Builder& w) {
-  const int index = u.bodies[s][0];
-  const auto per_lane = [&](Quantity what, int a, int b, const auto& value) {
+// The motion at each unit's origin, in its axes, at zero u' and without gravity: omega, alpha, a.
+struct Motion {
+  S3 omega, alpha, acceleration;
+};
+
+// Out along the chains: omega_k = R^T omega_p + e s'_k, alpha_k = R^T alpha_p + (R^T omega_p) x e s'_k,
+// a_k = R^T (a_p + alpha_p x r + omega_p x (omega_p x r)) for a revolute joint (a prismatic one
+// adds 2 (R^T omega_p) x e s'_k to a_k instead), e s'_k from the joint's axis S.
+std::vector<Motion> bias_motion(const Projection& pr, const std::vector<Placement>& X, Builder& w) {
+  const auto& units = pr.units.units;
+  std::vector<Motion> out(units.size());
+  for (std::size_t u = 0; u < units.size(); ++u) {
+    const Unit& unit = units[u];
+    const int node = unit.nodes[0];
+    const auto id = [&](Quantity what, int c) { return value_id(what, node, c); };
+    const Motion above = unit.parent < 0 ? Motion{} : out[at(unit.parent)];
+    const Placement& P = X[u];
     std::vector<Signed> lanes;
-    for (int i : u.bodies[s]) lanes.push_back(w.scalar(value_id(what, i, a, b), value(m.bodies[at(i)])));
-    return w.pack(value_id(what, index, a, b), lanes);
-  };
-  const auto torque = [&](const Body& body) {
-    const Frame& f = body.com_frame;
-    const auto to_body = [&](const Vec3& v) {
-      Vec3 out;
-      for (int a = 0; a < 3; ++a) out[a] = f.R(0, a) * v[0] + f.R(1, a) * v[1] + f.R(2, a) * v[2];
-      return out;
-    };
-    Vec3 I;
-    for (int a = 0; a < 3; ++a) I[a] = m.parameter(body.inertia[at(a)]).symbol;
-    const auto inertia_times = [&](const Vec3& v) { return Vec3(I[0] * v[0], I[1] * v[1], I[2] * v[2]); };
-    const Vec3 omega = to_body(f.omega);
-    return inertia_times(to_body(f.alpha_bias)) + wlx::codegen::cross(omega, inertia_times(omega));
-  };
-  const Signed mass = per_lane(Quantity::mass, 0, 0, [&](const Body& b) { return m.parameter(b.mass).symbol; });
-  S3 p, F, N;
-  for (int c = 0; c < 3; ++c) {
-    p[at(c)] = per_lane(Quantity::com_offset, c, 0, [&](const Body& b) { return b.com_frame.r[c] - origin[c]; });
-    N[at(c)] = per_lane(Quantity::bias_torque, c, 0, [&](const Body& b) { return torque(b)[c]; });
-    const Signed a = per_lane(Quantity::bias_acceleration, c, 0, [&](const Body& b) { return b.com_frame.a_bias[c]; });
-    F[at(c)] = w.define(value_id(Quantity::force, index, c), {{mass, a}});
-  }
-  S6 out{F[0], F[1], F[2]};
-  for (int c = 0; c < 3; ++c) {
-    std::vector<Product> t = cross(p, F, c);
-    for (int k = 0; k < 3; ++k)
-      t.push_back(
-          {per_lane(Quantity::com_rotation, c, k, [&](const Body& b) { return b.com_frame.R(c, k); }), N[at(k)]});
-    out[at(c + 3)] = w.define(value_id(Quantity::moment, index, c), t);
+    for (int c : unit.coordinates) lanes.push_back({value_id(Quantity::rate, c)});
+    const Signed sd = w.pack(value_id(Quantity::rate, unit.coordinates[0]), lanes);
+    S3 e_rate_angular, e_rate_linear;  // e s'_k
+    for (int c = 0; c < 3; ++c) {
+      e_rate_angular[at(c)] = w.define(id(Quantity::motion_cross, c), {{pr.axis[u][at(c)], sd}});
+      e_rate_linear[at(c)] = w.define(id(Quantity::motion_cross, c + 3), {{pr.axis[u][at(c + 3)], sd}});
+    }
+    S3 wr, ca, w_in, al_in, a_in;
+    for (int c = 0; c < 3; ++c) wr[at(c)] = w.define(id(Quantity::offset_velocity, c), cross(above.omega, P.r, c));
+    for (int c = 0; c < 3; ++c)
+      ca[at(c)] = w.define(id(Quantity::carried_acceleration, c),
+                           joined(joined({{above.acceleration[at(c)]}}, cross(above.alpha, P.r, c)), cross(above.omega, wr, c)));
+    for (int a = 0; a < 3; ++a) {
+      w_in[at(a)] = w.define(id(Quantity::incoming_motion, a), turned_back(P, above.omega, a));
+      al_in[at(a)] = w.define(id(Quantity::incoming_motion, a + 3), turned_back(P, above.alpha, a));
+      a_in[at(a)] = w.define(id(Quantity::incoming_motion, a + 6), turned_back(P, ca, a));
+    }
+    Motion& here = out[u];
+    for (int c = 0; c < 3; ++c) {
+      const std::vector<Product> coriolis = cross(w_in, e_rate_linear, c);
+      here.omega[at(c)] = w.define(value_id(Quantity::spatial_velocity, node, c), {{w_in[at(c)]}, {e_rate_angular[at(c)]}});
+      here.alpha[at(c)] =
+          w.define(value_id(Quantity::spatial_acceleration, node, c), joined({{al_in[at(c)]}}, cross(w_in, e_rate_angular, c)));
+      here.acceleration[at(c)] =
+          w.define(value_id(Quantity::spatial_acceleration, node, c + 3), joined(joined({{a_in[at(c)]}}, coriolis), coriolis));
+    }
   }
   return out;
 }
 
-// b_velocity = T^T tau_bias: the bodies' bias wrenches summed back along the chains, tau = S . W.
-void velocity_forces(const Model& m, const Projection& pr, Builder& w) {
+// Body slot s of unit u (its CoM frame at (Rc, c) in the unit's frame): a_c = a + alpha x c +
+// omega x (omega x c), F = m a_c; in body axes N = I alpha_b + omega_b x I omega_b; its wrench
+// (F; Rc N + c x F) about the unit's origin, in the unit's axes.
+S6 body_bias_wrench(const Model& m, const TwistTree& tree, const Unit& u, std::size_t s, const Motion& motion, Builder& w) {
+  const int index = u.bodies[s][0];
+  const auto id = [&](Quantity what, int c) { return value_id(what, index, c); };
+  const auto per_lane = [&](Quantity what, int a, int b, const std::function<ex(std::size_t)>& value) {
+    std::vector<Signed> lanes;
+    for (int i : u.bodies[s]) lanes.push_back(w.scalar(value_id(what, i, a, b), value(at(i))));
+    return w.pack(value_id(what, index, a, b), lanes);
+  };
+  Placement Rc;  // the body's axes in the unit's, and its CoM
+  for (int a = 0; a < 3; ++a) {
+    Rc.r[at(a)] = per_lane(Quantity::com_offset, a, 0, [&](std::size_t i) { return tree.body_r[i][a]; });
+    for (int b = 0; b < 3; ++b)
+      Rc.R[at(3 * a + b)] = per_lane(Quantity::com_rotation, a, b, [&](std::size_t i) { return tree.body_R[i](a, b); });
+  }
+  const Signed mass = per_lane(Quantity::mass, 0, 0, [&](std::size_t i) { return m.parameter(m.bodies[i].mass).symbol; });
+  S3 I;
+  for (int a = 0; a < 3; ++a)
+    I[at(a)] = per_lane(Quantity::inertia, a, 0, [&](std::size_t i) { return m.parameter(m.bodies[i].inertia[at(a)]).symbol; });
+  S3 wc, ac, F, wb, ab, Iw, N;
+  for (int a = 0; a < 3; ++a) wc[at(a)] = w.define(id(Quantity::com_velocity, a), cross(motion.omega, Rc.r, a));
+  for (int a = 0; a < 3; ++a) {
+    ac[at(a)] = w.define(id(Quantity::com_acceleration, a),
+                         joined(joined({{motion.acceleration[at(a)]}}, cross(motion.alpha, Rc.r, a)), cross(motion.omega, wc, a)));
+    F[at(a)] = w.define(id(Quantity::force, a), {{mass, ac[at(a)]}});
+  }
+  for (int a = 0; a < 3; ++a) {
+    wb[at(a)] = w.define(id(Quantity::body_rate, a), turned_back(Rc, motion.omega, a));
+    ab[at(a)] = w.define(id(Quantity::body_angular_acceleration, a), turned_back(Rc, motion.alpha, a));
+  }
+  for (int a = 0; a < 3; ++a) Iw[at(a)] = w.define(id(Quantity::angular_momentum, a), {{I[at(a)], wb[at(a)]}});
+  for (int a = 0; a < 3; ++a) N[at(a)] = w.define(id(Quantity::body_moment, a), joined({{I[at(a)], ab[at(a)]}}, cross(wb, Iw, a)));
+  S6 out{F[0], F[1], F[2]};
+  for (int a = 0; a < 3; ++a) out[at(a + 3)] = w.define(id(Quantity::moment, a), joined(turned(Rc, N, a), cross(Rc.r, F, a)));
+  return out;
+}
+
+// b_velocity = T^T tau: the bodies' bias wrenches summed back along the chains in each unit's frame
+// (a child's carried by its placement), tau = S . W.
+void velocity_forces(const Model& m, const TwistTree& tree, const Projection& pr, const std::vector<Placement>& X, Builder& w) {
   w.charge_to = kB_velocity;
+  const std::vector<Motion> motion = bias_motion(pr, X, w);
   const Units& units = pr.units;
-  std::vector<S6> beyond(units.units.size());
+  std::vector<S6> beyond(units.units.size()), passed(units.units.size());
   std::vector<Signed> per_unit(units.units.size());
   for (std::size_t u = units.units.size(); u-- > 0;) {
+    const Unit& unit = units.units[u];
+    const int node = unit.nodes[0];
     std::vector<S6> own;
-    for (std::size_t s = 0; s < units.units[u].bodies.size(); ++s)
-      own.push_back(bias_wrench(m, units.units[u], s, pr.origin, w));
+    for (std::size_t s = 0; s < unit.bodies.size(); ++s) own.push_back(body_bias_wrench(m, tree, unit, s, motion[u], w));
     const Summands sum{units, u};
     for (int c = 0; c < 6; ++c)
-      beyond[u][at(c)] = w.define(value_id(Quantity::wrench, units.units[u].nodes[0], c),
-                                  sum(
-                                      [&] {
-                                        std::vector<Product> t;
-                                        for (const S6& x : own) t.push_back({x[at(c)]});
-                                        return t;
-                                      },
-                                      [&](std::size_t child) { return beyond[child][at(c)]; }));
-    per_unit[u] = w.define(value_id(Quantity::joint_force, units.units[u].nodes[0]), power(pr.axis[u], beyond[u]));
+      beyond[u][at(c)] = w.define(value_id(Quantity::wrench, node, c), sum(
+                                                                            [&] {
+                                                                              std::vector<Product> t;
+                                                                              for (const S6& x : own) t.push_back({x[at(c)]});
+                                                                              return t;
+                                                                            },
+                                                                            [&](std::size_t child) { return passed[child][at(c)]; }));
+    per_unit[u] = w.define(value_id(Quantity::joint_force, node), power(pr.axis[u], beyond[u]));
+    if (unit.parent < 0) continue;
+    for (int a = 0; a < 3; ++a) passed[u][at(a)] = w.define(value_id(Quantity::transmitted_force, node, a), turned(X[u], head(beyond[u]), a));
+    for (int a = 0; a < 3; ++a)
+      passed[u][at(a + 3)] = w.define(value_id(Quantity::transmitted_force, node, a + 3),
+                                      joined(turned(X[u], tail(beyond[u]), a), cross(X[u].r, head(passed[u]), a)));
   }
   std::vector<Signed> b;
   for (int l = 0; l < pr.nu; ++l) b.push_back(pr.transposed(value_id(Quantity::commanded_force, l), l, per_unit, w));
   w.add(lane_code::OpenOutput{"b_velocity", ""});
   for (int l = 0; l < pr.nu; ++l) store(w, "b_velocity", l, -1, false, b[at(l)]);
   w.add(lane_code::CloseOutput{});
-}
-
-// The point the spatial quantities are taken about: the first revolute joint's (a floating base's
-// position, a fixed base's first joint), so that the inertias about it stay of the machine's size
-// wherever it stands (about K0's origin, m |p|^2 would cancel in M to the square of its distance
-// over its size), and a rotation at the base has no linear part. K0's origin without one.
-Vec3 reference_point(const TwistTree& tree) {
-  for (const TwistNode& node : tree.nodes)
-    if (node.joint->revolute) return node.joint->origin;
-  return Vec3(0, 0, 0);
-}
-
-// A joint's twist per unit rate about `origin`: (a; (o - origin) x a) for a revolute joint (axis a
-// through o), (0; a) for a prismatic one.
-std::array<ex, 6> axis_about(const JointRecord& joint, const Vec3& origin) {
-  const Vec3 arm(joint.origin[0] - origin[0], joint.origin[1] - origin[1], joint.origin[2] - origin[2]);
-  const Vec3 linear = joint.revolute ? wlx::codegen::cross(arm, joint.axis) : joint.axis;
-  std::array<ex, 6> S;
-  for (int c = 0; c < 3; ++c) {
-    S[at(c)] = joint.revolute ? joint.axis[c] : ex(0);
-    S[at(c + 3)] = linear[c];
-  }
-  return S;
 }
 
 }  // namespace
@@ -359,33 +275,45 @@ lane_code::LaneProgram composite_rigid_body_program(const Model& m) {
   const TwistTree tree = twist_tree(m, roles);
   const Units units = group_units(tree, roles);
   Builder w(units.width);
-  Projection pr{
-      units, roles, rate_speeds(m, roles), static_cast<int>(m.dynamics->commanded.size()), {}, reference_point(tree)};
+  Projection pr{units, roles, rate_speeds(m, roles), static_cast<int>(m.dynamics->commanded.size()), {}};
   w.charge_to = kM;
   if (units.width > 1) w.add(lane_code::LaneTypes{});
+  std::vector<Placement> X;
   for (const Unit& u : units.units) {
-    const int k = u.nodes[0];
+    const auto node_of = [&](int n) -> const TwistNode& { return tree.nodes[at(n)]; };
+    // The joint's axis in its own frame: (sign e_i; 0) revolute, (0; sign e_i) prismatic.
     S6 S;
-    for (int c = 0; c < 6; ++c) {
-      std::vector<Signed> lanes;
-      for (int node : u.nodes)
-        lanes.push_back(w.scalar(value_id(Quantity::joint_axis, node, c),
-                                 axis_about(*tree.nodes[at(node)].joint, pr.origin)[at(c)]));
-      S[at(c)] = w.pack(value_id(Quantity::joint_axis, k, c), lanes);
-    }
+    for (int c = 0; c < 6; ++c)
+      S[at(c)] = per_joint(w, u, Quantity::joint_axis, c, 0, [&](int n) {
+        const JointRecord& joint = *node_of(n).joint;
+        const bool angular = c < 3;
+        return angular == joint.revolute && c % 3 == static_cast<int>(joint.local_axis) ? ex(joint.sign) : ex(0);
+      });
     pr.axis.push_back(S);
+    Placement P;
+    for (int a = 0; a < 3; ++a) {
+      P.r[at(a)] = per_joint(w, u, Quantity::local_offset, a, 0, [&](int n) { return node_of(n).placement_r[a]; });
+      for (int b = 0; b < 3; ++b)
+        P.R[at(3 * a + b)] = per_joint(w, u, Quantity::local_rotation, a, b, [&](int n) { return node_of(n).placement_R(a, b); });
+    }
+    X.push_back(P);
   }
-  w.add(lane_code::Comment{
-      "The bodies' inertias about the first revolute joint's origin, in K0, and their composites beyond each joint."});
-  const std::vector<Inertia> composite = composite_inertias(m, units, pr.origin, w);
-  w.add(lane_code::Comment{"M on the coordinates: S_j . (I_k S_k) for each joint k and each joint j on its chain."});
-  const auto M = unit_mass(pr, composite, w);
+  w.add(lane_code::Comment{"The bodies' inertias in their joints' frames, and the composites beyond each joint carried in."});
+  const std::vector<Inertia> composite = composite_inertias(
+      units,
+      [&](std::size_t u, std::size_t s) {
+        return body_inertia(
+            m, units.units[u], s, [&](std::size_t i) { return tree.body_r[i]; }, [&](std::size_t i) { return tree.body_R[i]; }, w);
+      },
+      [&](std::size_t u, const Inertia& I) { return carried(I, X[u], units.units[u].nodes[0], w); }, w);
+  w.add(lane_code::Comment{"M on the coordinates: I_k S_k carried up the chain, S_j . (I_k S_k) at each joint j on it."});
+  const auto M = unit_mass(pr, X, composite, w);
   w.add(lane_code::Comment{"M on the commanded speeds: T^T M T on T's pattern (T^T M's dense columns are B_bias)."});
   project_mass(pr, M, w);
   w.add(lane_code::Comment{"b_velocity: the bodies' bias wrenches summed back along the chains, projected by T^T."});
-  velocity_forces(m, pr, w);
+  velocity_forces(m, tree, pr, X, w);
   w.add(lane_code::Comment{"Q_gravity from the composites' masses and first moments, projected by T^T."});
-  gravity_forces(m, pr, composite, w);
+  gravity_forces(m, tree, pr, composite, w);
   return std::move(w.program());
 }
 

@@ -6,6 +6,8 @@
 
 #include "derivations_internal.hpp"
 
+#include <algorithm>
+#include <functional>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -63,6 +65,36 @@ class Builder {
   std::map<lane_code::ValueId, Signed> packed_;
 };
 
+using S3 = std::array<Signed, 3>;
+using S6 = std::array<Signed, 6>;  // (angular; linear) of a motion, (force; moment) of a wrench
+
+// (x cross y)_c as two products.
+inline std::vector<Product> cross(const S3& x, const S3& y, int c) {
+  const std::size_t c1 = at((c + 1) % 3), c2 = at((c + 2) % 3);
+  return {{x[c1], y[c2]}, {-x[c2], y[c1]}};
+}
+inline void append(std::vector<Product>& to, const std::vector<Product>& more) {
+  to.insert(to.end(), more.begin(), more.end());
+}
+
+// The rotational inertia's six entries (a <= b), in this order.
+constexpr std::array<std::pair<int, int>, 6> kInertiaEntries{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
+inline std::size_t entry_of(int a, int b) {
+  for (std::size_t e = 0; e < kInertiaEntries.size(); ++e)
+    if (kInertiaEntries[e] == std::pair{std::min(a, b), std::max(a, b)}) return e;
+  throw std::logic_error("inertia entry");
+}
+
+// A spatial inertia in a joint's frame: mass, first moment h = m p (p the CoM from the frame's
+// origin), rotational inertia J about the origin.
+struct Inertia {
+  Signed mass;
+  S3 h;
+  std::array<Signed, 6> J;
+  const Signed& Jab(int a, int b) const { return J[entry_of(a, b)]; }
+};
+
+
 // A joint of the tree, or the joints at one place of G sibling limbs of one shape (a row unit: lane
 // g is limb g). A row unit's joints each have their own coordinate, dense (a row of T), that no
 // other joint has.
@@ -85,8 +117,7 @@ struct Projection {
   RateRoles roles;
   std::vector<std::vector<int>> speeds_of;
   int nu = 0;
-  std::vector<std::array<Signed, 6>> axis;  // per unit, about `origin`
-  Vec3 origin;                              // the point moments and twists are taken about
+  std::vector<std::array<Signed, 6>> axis;  // per unit: its joints' axes in their own frames
   int coordinate(int u, int lane) const { return units.units[at(u)].coordinates[at(lane)]; }
   bool dense_plain(int u) const { return !units.units[at(u)].row() && roles.dense[at(coordinate(u, 0))]; }
   // The plain units of speed b's coordinate.
@@ -105,5 +136,47 @@ struct Projection {
                    Builder& w) const;
   void add_projected(Sum& sum, int l, int u, const std::map<std::pair<int, int>, Signed>& M, Builder& w) const;
 };
+
+
+// A unit's parts summed: its own values and its children's (a row unit's children in the same
+// lanes; a plain unit's row children lane by lane).
+struct Summands {
+  const Units& units;
+  std::size_t u;
+  template <class Own, class OfChild>
+  std::vector<Product> operator()(const Own& own, const OfChild& of_child) const {
+    std::vector<Product> t = own();
+    for (int child : units.units[u].children) {
+      const Signed v = of_child(at(child));
+      if (units.units[at(child)].row() && !units.units[u].row())
+        for (int g = 0; g < units.width; ++g) t.push_back({v, kUnit, g});
+      else
+        t.push_back({v});
+    }
+    return t;
+  }
+};
+
+// Body slot s of unit u as an Inertia about a point: its CoM at p_of(body) from the point, its
+// principal axes R_of(body) in the axes the inertia is written in.
+Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, const std::function<Vec3(std::size_t)>& p_of,
+                     const std::function<Mat3(std::size_t)>& R_of, Builder& w);
+// The composite inertias beyond each unit, from the leaves in: its bodies' (own(u, s)) and its
+// children's as `carried` puts them in its axes (the identity in K0).
+std::vector<Inertia> composite_inertias(const Units& units, const std::function<Inertia(std::size_t, std::size_t)>& own,
+                                        const std::function<Inertia(std::size_t, const Inertia&)>& carried, Builder& w);
+// I S for a composite inertia and a joint's axis S = (a; b), in the inertia's axes and about its
+// point: the momentum of the bodies beyond per unit rate, (force m b + a x h; moment J a + h x b),
+// named joint_momentum (node, c).
+S6 momentum(const Inertia& I, const S6& S, int node, Builder& w);
+// S_j . W as products: the angular part against the moment, the linear against the force.
+std::vector<Product> power(const S6& S, const S6& wrench);
+// The outputs' entries (Store) of M, b_velocity, Q_gravity and B_bias: factor times v (v's lane
+// `lane` of a row).
+void store(Builder& w, const std::string& output, int row, int column, bool mirrored, const Signed& v,
+           const Signed& factor = kUnit, int lane = -1);
+// M* = T^T M T on T's pattern (and B_bias, T^T M's columns of the dense coordinates), from M between
+// units keyed (ancestor, unit).
+void project_mass(const Projection& pr, const std::map<std::pair<int, int>, Signed>& M, Builder& w);
 
 }  // namespace wlx::codegen::derivation::composite

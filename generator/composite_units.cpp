@@ -1,6 +1,9 @@
 // The composite pass' building blocks (composite_internal.hpp): the builder of its statements, the
-// grouping of sibling limbs of one shape into rows of lanes, and the projections by T.
+// grouping of sibling limbs of one shape into rows of lanes, the projections by T, and the
+// inertias and wrenches the pass is made of.
 #include "composite_internal.hpp"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <functional>
@@ -25,8 +28,7 @@ ValueId derived(Quantity what, const ValueId& from) {
 }  // namespace
 
 Builder::Builder(int width) {
-  program_.kind = lane_code::LaneProgram::Kind::scalars;
-  program_.width = program_.speeds = width;
+  program_.width = width;
 }
 
 Signed Builder::scalar(const ValueId& id, const ex& value) {
@@ -53,8 +55,12 @@ Signed Builder::pack(const ValueId& key, const std::vector<Signed>& lanes) {
   if (lanes.size() == 1) return lanes[0];
   if (const auto it = packed_.find(key); it != packed_.end()) return it->second;
   Signed& out = packed_[key];
-  if (std::all_of(lanes.begin(), lanes.end(), [](const Signed& v) { return v.is_zero(); })) return out;
-  lane_code::LoadRow row{derived(Quantity::lanes_of, key), 0, false, {}};
+  // Every lane the same exact zero or +-1: that value, which folds in products as a scalar's would.
+  const Signed& first = lanes[0];
+  if ((first.is_zero() || first.is_one()) &&
+      std::all_of(lanes.begin(), lanes.end(), [&](const Signed& v) { return v.id == first.id && v.negate == first.negate; }))
+    return out = first;
+  lane_code::LoadRow row{derived(Quantity::lanes_of, key), {}};
   for (std::size_t g = 0; g < lanes.size(); ++g)
     if (!lanes[g].is_zero()) row.lanes.emplace_back(static_cast<int>(g), holding(lanes[g]));
   out = {row.target, false};
@@ -79,15 +85,35 @@ Signed Builder::define(const ValueId& target, const std::vector<Product>& produc
   }
   if (terms.empty()) return {};
   const bool row = std::any_of(row_term.begin(), row_term.end(), [](bool r) { return r; });
-  if (row && !std::all_of(row_term.begin(), row_term.end(), [](bool r) { return r; }))
-    throw std::logic_error("composite dynamics: a scalar term in a row's sum");
+  if (row && !std::all_of(row_term.begin(), row_term.end(), [](bool r) { return r; })) {
+    // Scalar terms in a row's sum (a limb's rotation that leaves its parent's omega_x alone, say):
+    // their sum, in every lane, is one more term of the row's.
+    std::vector<Term> rows;
+    std::vector<Product> scalars;
+    for (std::size_t t = 0; t < terms.size(); ++t) {
+      if (row_term[t]) rows.push_back(terms[t]);
+      else scalars.push_back({{terms[t].factor, false}, {terms[t].value, terms[t].negate}, terms[t].lane});
+    }
+    const Signed part = define(derived(Quantity::scalar_part, target), scalars);
+    if (!part.is_zero()) {
+      const ValueId all = derived(Quantity::everywhere, part.id);
+      if (made_.insert(all).second) {
+        lane_code::LoadRow load{all, {}};
+        for (int g = 0; g < program_.width; ++g) load.lanes.emplace_back(g, part.id);
+        rows_.insert(all);
+        add(std::move(load));
+      }
+      rows.push_back({kOne, all, -1, part.negate});
+    }
+    terms = std::move(rows);
+  }
   const bool all_negative = std::all_of(terms.begin(), terms.end(), [](const Term& t) { return t.negate; });
   if (all_negative)
     for (Term& t : terms) t.negate = false;
   std::stable_partition(terms.begin(), terms.end(), [](const Term& t) { return !t.negate; });
   if (terms.size() == 1 && terms[0].factor.what == Quantity::one && terms[0].lane < 0)
     return {terms[0].value, all_negative};
-  add(lane_code::Define{target, row ? Layout::narrow : Layout::scalar, std::move(terms)});
+  add(lane_code::Define{target, row ? Layout::row : Layout::scalar, std::move(terms)});
   if (row) rows_.insert(target);
   return {target, all_negative};
 }
@@ -256,6 +282,155 @@ void Projection::add_projected(Sum& sum, int l, int u, const std::map<std::pair<
     }
   };
   beyond(u);
+}
+
+// Body slot s of unit u: J = R diag(I) R^T + m (|p|^2 1 - p p^T). With R's columns r_k
+// orthonormal, R diag(I) R^T = I_1 1 + (I_2 - I_1) r_2 r_2^T + (I_3 - I_1) r_3 r_3^T, so
+// J = sigma 1 + (I_2 - I_1) r_2 r_2^T + (I_3 - I_1) r_3 r_3^T - h p^T with sigma = I_1 + h . p
+// (h = m p): two products per entry fewer than R diag(I) R^T written out.
+Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, const std::function<Vec3(std::size_t)>& p_of,
+                                const std::function<Mat3(std::size_t)>& R_of, Builder& w) {
+  const int index = u.bodies[s][0];  // the values' names: the first lane's body
+  const auto per_lane = [&](Quantity what, int a, int b, const auto& value) {
+    std::vector<Signed> lanes;
+    for (int i : u.bodies[s]) lanes.push_back(w.scalar(value_id(what, i, a, b), value(at(i))));
+    return w.pack(value_id(what, index, a, b), lanes);
+  };
+  const auto moment = [&](std::size_t i, int k) { return m.parameter(m.bodies[i].inertia[at(k)]).symbol; };
+  Inertia out;
+  out.mass = per_lane(Quantity::mass, 0, 0, [&](std::size_t i) { return m.parameter(m.bodies[i].mass).symbol; });
+  S3 p;
+  for (int c = 0; c < 3; ++c) p[at(c)] = per_lane(Quantity::com_offset, c, 0, [&](std::size_t i) { return p_of(i)[c]; });
+  const auto R = [&](int a, int k) {
+    return per_lane(Quantity::com_rotation, a, k, [&](std::size_t i) { return R_of(i)(a, k); });
+  };
+  std::array<S3, 2> weighted;  // (I_k - I_1) r_k for k = 2, 3
+  for (int k = 1; k < 3; ++k) {
+    const Signed difference =
+        per_lane(Quantity::inertia_difference, k, 0, [&](std::size_t i) { return moment(i, k) - moment(i, 0); });
+    for (int a = 0; a < 3; ++a)
+      weighted[at(k - 1)][at(a)] = w.define(value_id(Quantity::rotated_inertia, index, a, k), {{R(a, k), difference}});
+  }
+  for (int c = 0; c < 3; ++c)
+    out.h[at(c)] = w.define(value_id(Quantity::first_moment, index, c), {{out.mass, p[at(c)]}});
+  std::vector<Product> shift{{per_lane(Quantity::inertia, 0, 0, [&](std::size_t i) { return moment(i, 0); })}};
+  for (int c = 0; c < 3; ++c) shift.push_back({out.h[at(c)], p[at(c)]});
+  const Signed sigma = w.define(value_id(Quantity::inertia_shift, index), shift);
+  for (std::size_t e = 0; e < kInertiaEntries.size(); ++e) {
+    const auto [a, b] = kInertiaEntries[e];
+    std::vector<Product> t;
+    for (int k = 1; k < 3; ++k) t.push_back({weighted[at(k - 1)][at(a)], R(b, k)});
+    t.push_back({-out.h[at(a)], p[at(b)]});
+    if (a == b) t.push_back({sigma});
+    out.J[e] = w.define(value_id(Quantity::origin_inertia, index, a, b), t);
+  }
+  return out;
+}
+
+std::vector<Inertia> composite_inertias(const Units& units,
+                                                   const std::function<Inertia(std::size_t, std::size_t)>& own_inertia,
+                                                   const std::function<Inertia(std::size_t, const Inertia&)>& carried,
+                                                   Builder& w) {
+  std::vector<Inertia> out(units.units.size()), moved(units.units.size());
+  for (std::size_t u = units.units.size(); u-- > 0;) {
+    const Unit& unit = units.units[u];
+    std::vector<Inertia> own;
+    for (std::size_t s = 0; s < unit.bodies.size(); ++s) own.push_back(own_inertia(u, s));
+    const Summands sum{units, u};
+    const int k = unit.nodes[0];
+    const auto total = [&](const ValueId& target, const auto& pick) {
+      return w.define(target, sum(
+                                  [&] {
+                                    std::vector<Product> t;
+                                    for (const Inertia& x : own) t.push_back({pick(x)});
+                                    return t;
+                                  },
+                                  [&](std::size_t child) { return pick(moved[child]); }));
+    };
+    out[u].mass = total(value_id(Quantity::composite_mass, k), [](const Inertia& x) { return x.mass; });
+    for (int c = 0; c < 3; ++c)
+      out[u].h[at(c)] =
+          total(value_id(Quantity::composite_first_moment, k, c), [&](const Inertia& x) { return x.h[at(c)]; });
+    for (std::size_t e = 0; e < kInertiaEntries.size(); ++e)
+      out[u].J[e] = total(value_id(Quantity::composite_inertia, k, kInertiaEntries[e].first, kInertiaEntries[e].second),
+                          [&](const Inertia& x) { return x.J[e]; });
+    if (unit.parent >= 0) moved[u] = carried(u, out[u]);
+  }
+  return out;
+}
+
+S6 momentum(const Inertia& I, const S6& S, int node, Builder& w) {
+  const S3 a{S[0], S[1], S[2]}, b{S[3], S[4], S[5]};
+  S6 out;
+  for (int c = 0; c < 3; ++c) {
+    std::vector<Product> force{{I.mass, b[at(c)]}};
+    append(force, cross(a, I.h, c));
+    out[at(c)] = w.define(value_id(Quantity::joint_momentum, node, c), force);
+    std::vector<Product> moment;
+    for (int d = 0; d < 3; ++d) moment.push_back({I.Jab(c, d), a[at(d)]});
+    append(moment, cross(I.h, b, c));
+    out[at(c + 3)] = w.define(value_id(Quantity::joint_momentum, node, c + 3), moment);
+  }
+  return out;
+}
+
+std::vector<Product> power(const S6& S, const S6& wrench) {
+  std::vector<Product> t;
+  for (int c = 0; c < 3; ++c) {
+    t.push_back({S[at(c)], wrench[at(c + 3)]});
+    t.push_back({S[at(c + 3)], wrench[at(c)]});
+  }
+  return t;
+}
+
+void store(Builder& w, const std::string& output, int row, int column, bool mirrored, const Signed& v,
+                      const Signed& factor, int lane) {
+  std::vector<Term> terms;
+  if (!v.is_zero()) terms.push_back({factor.id, v.id, lane, v.negate != factor.negate});
+  w.add(lane_code::Store{output, row, column, mirrored, std::move(terms)});
+}
+
+// M* = T^T M T on T's pattern: P = T^T M (its columns of the dense coordinates are B_bias's), then
+// M*(l, b) = P(l, b's coordinate) + sum over the dense c of P(l, c) T(c, b), for l <= b.
+void project_mass(const Projection& pr, const std::map<std::pair<int, int>, Signed>& M, Builder& w) {
+  // P(l, c) for each dense coordinate c, as a value per unit (a row for a row unit).
+  std::map<std::pair<int, int>, Signed> bias;  // (l, unit) -> P(l, the unit's coordinates)
+  w.charge_to = kB_bias;
+  for (int l = 0; l < pr.nu; ++l)
+    for (std::size_t u = 0; u < pr.units.units.size(); ++u)
+      if (pr.units.units[u].row() || pr.dense_plain(static_cast<int>(u)))
+        bias[{l, static_cast<int>(u)}] = pr.projected(value_id(Quantity::projected_mass, l, pr.units.units[u].nodes[0]),
+                                                      l, static_cast<int>(u), M, w);
+  // Every value before the outputs' blocks, none inside one: the code a value needs is placed
+  // before its first reader (emit_function.cpp), which must not be in a block a later reader is not.
+  w.charge_to = kM;
+  std::map<std::pair<int, int>, Signed> reduced;
+  for (int l = 0; l < pr.nu; ++l)
+    for (int b = l; b < pr.nu; ++b) {
+      Sum sum;
+      for (int u : pr.units_of_speed(b)) pr.add_projected(sum, l, u, M, w);
+      for (const auto& [key, p] : bias)
+        if (key.first == l) pr.times_T(sum, p, key.second, b, w);
+      reduced[{l, b}] = w.define_sum(value_id(Quantity::reduced_mass, l, b), sum);
+    }
+  w.add(lane_code::OpenOutput{"M", "the upper triangle, mirrored: M is symmetric to the last bit"});
+  for (const auto& [lb, v] : reduced) store(w, "M", lb.first, lb.second, lb.first != lb.second, v);
+  w.add(lane_code::CloseOutput{});
+  w.charge_to = kB_bias;
+  // B_bias(l, c): the sum over c's joints (a lane of a row unit's).
+  std::map<std::pair<int, int>, std::vector<Term>> entries;  // (coordinate, l)
+  for (const auto& [key, p] : bias) {
+    if (p.is_zero()) continue;
+    const Unit& unit = pr.units.units[at(key.second)];
+    for (int g = 0; g < static_cast<int>(unit.nodes.size()); ++g)
+      entries[{pr.coordinate(key.second, g), key.first}].push_back({kOne, p.id, unit.row() ? g : -1, p.negate});
+  }
+  w.add(lane_code::OpenOutput{"B_bias", "", lane_code::OpenOutput::Prologue::zero_if_asked});
+  for (auto& [key, terms] : entries) {
+    std::stable_partition(terms.begin(), terms.end(), [](const Term& t) { return !t.negate; });
+    w.add(lane_code::Store{"B_bias", key.second, key.first, false, std::move(terms)});
+  }
+  w.add(lane_code::CloseOutput{});
 }
 
 }  // namespace wlx::codegen::derivation::composite

@@ -45,8 +45,6 @@ struct FunctionSpec {
   // any of them is requested, after the scalars it reads (lane_scalars: name -> value) are computed.
   std::vector<std::pair<std::string, ex>> lane_scalars = {};
   std::string lane_code = {};
-  // How wide its rows are, for the header's documentation ("10 lanes").
-  std::string lane_layout = {};
 };
 
 // The value Phi_i(s) of one closure condition, in the model's symbols.
@@ -61,7 +59,7 @@ FunctionSpec derive_bodies(const Model& m);
 // subexpressions (the frames' rotations and positions) are computed once per update.
 FunctionSpec derive_kinematic_update(const Model& m);
 // An inverse-dynamics step's two passes, fused the same way: at s, dPhi/ds and C(s); at s, s' and
-// the rate basis T, the convective terms and Kane's equations projected onto the commanded speeds
+// the rate basis T, the convective terms and the equations of motion on the commanded speeds
 // (only for a model with a dynamics section).
 FunctionSpec derive_dynamics_update(const Model& m);
 FunctionSpec derive_reduced_dynamics(const Model& m);

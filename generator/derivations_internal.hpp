@@ -56,13 +56,11 @@ RateRoles rate_roles(const Model& m);
 std::vector<std::vector<int>> rate_speeds(const Model& m, const RateRoles& roles);
 
 // A joint of the bodies' chains as a node of their common tree (chains that share a prefix share
-// its nodes), with the partial twists of the chain up to it on lanes.
+// its nodes).
 struct TwistNode {
   const JointRecord* joint = nullptr;
   int parent = -1;
   std::vector<int> children, bodies;
-  std::array<lane_code::ValueId, 6> twist;   // lanes of (omega; velocity of the point at K0's origin)
-  std::array<lane_code::ValueId, 6> wrench;  // lanes of the sum over the bodies beyond: (force; moment about K0's origin)
   // The frame just after this joint in the frame just after the parent node's joint (K0 for a
   // root), through the held joints between them at their coordinates: orientation and origin.
   Mat3 placement_R = Mat3::identity();
@@ -87,8 +85,10 @@ std::array<ex, 6> spatial_axis(const JointRecord& joint);
 // reduced_dynamics' outputs, in the numbering of its code's statements (lane_code::Statement::output).
 enum ReducedOutput { kM, kB_velocity, kB_bias, kQ_gravity, kReducedOutputs };
 
-// reduced_dynamics by composite rigid bodies (composite_dynamics.cpp): scalar code that writes M,
-// b_velocity, B_bias and Q_gravity from the composite inertias beyond each joint, and T's pattern.
+// reduced_dynamics by composite rigid bodies in the joints' own frames (composite_dynamics.cpp):
+// scalar code, on rows of lanes for sibling limbs of one shape, that writes M, b_velocity, B_bias
+// and Q_gravity from the composite inertias beyond each joint, the Newton-Euler recursion at zero
+// u', and T's pattern.
 lane_code::LaneProgram composite_rigid_body_program(const Model& m);
 
 }  // namespace wlx::codegen::derivation

@@ -112,7 +112,7 @@ TwistTree twist_tree(const Model& m, const RateRoles& roles) {
       if (next < 0) {
         next = static_cast<int>(tree.nodes.size());
         siblings.push_back(next);  // before nodes grows: `siblings` may live in it
-        tree.nodes.push_back({&joint, at, {}, {}, {}, {}, held_R * joint.placement_R, held_r + held_R * joint.placement_r});
+        tree.nodes.push_back({&joint, at, {}, {}, held_R * joint.placement_R, held_r + held_R * joint.placement_r});
       }
       at = next;
       held_R = Mat3::identity();

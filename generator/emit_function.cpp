@@ -271,20 +271,16 @@ std::string operations_documentation(const FunctionSpec& fn, const FunctionGraph
       "// pointer is set (C++20: {}(..., {{.{} = &x}})):\n",
       outputs_type, outputs_type, fn.name, fn.outputs.front().name);
   for (std::size_t o = 0; o < fn.outputs.size(); ++o) {
-    if (fn.outputs[o].from_lanes && fn.lane_layout.empty())  // scalar code
+    if (fn.outputs[o].from_lanes)
       t += fmt::format("//   {:<18} {} (own operations: {})\n", fn.outputs[o].name, fn.outputs[o].doc, w.output_ops[o].total());
-    else if (fn.outputs[o].from_lanes)
-      t += fmt::format("//   {:<18} {} (own operations: {}, on rows of {})\n", fn.outputs[o].name, fn.outputs[o].doc,
-                       w.output_ops[o].total(), fn.lane_layout);
     else
       t += fmt::format("//   {:<18} {} (own operations: {}, nonzero entries: {})\n", fn.outputs[o].name, fn.outputs[o].doc,
                        w.output_ops[o].total(), fg.outs[o].size());
   }
   if (!fn.lane_code.empty())
-    t += fmt::format("// The scalars {} built from ({} of them, the bodies' and joints' geometry among them):\n"
+    t += fmt::format("// The scalars that code is built from ({} of them, the bodies' and joints' geometry among them):\n"
                      "// {} operations, computed only when one of them is requested.\n",
-                     fn.lane_layout.empty() ? "that code is" : "those rows are", fn.lane_scalars.size(),
-                     w.output_ops[fg.lanes].total());
+                     fn.lane_scalars.size(), w.output_ops[fg.lanes].total());
   t += fmt::format("// Intermediate terms: {}; shared by several outputs: {} operations (sin and cos of all angles\n"
                    "// included: they are computed up front, whichever outputs are requested).\n",
                    stats.intermediates, w.shared_ops.total());

@@ -2,7 +2,6 @@
 // as straight-line scalar code (lane_code.hpp, printed by lane_printer.hpp), projected onto the
 // commanded speeds.
 #include "derivations_internal.hpp"
-#include "expr_graph.hpp"
 #include "lane_printer.hpp"
 
 #include <fmt/format.h>
@@ -33,7 +32,6 @@ class ScalarBuilder {
     ValueId a, b;  // a * b; b one: a alone
     bool negate = false;
   };
-  ScalarBuilder() { program_.kind = lane_code::LaneProgram::Kind::scalars; }
   // A lane scalar (zero for an exact zero).
   ValueId scalar(const ValueId& id, const ex& value) { return program_.scalar(id, value); }
   ValueId define(const ValueId& target, const std::vector<Product>& products) {
@@ -415,23 +413,9 @@ std::map<int, ValueId> local_joint_forces(const TwistTree& tree, const LocalMoti
   return tau_of;
 }
 
-// A printed pass' operations: its own, and its lane scalars' (each distinct subexpression once, as
-// the emitted code computes them: the world frame's pass spends a third of its operations there).
-long operations(const lane_code::PrintedCode& printed) {
-  ExprGraph graph;
-  std::vector<int> stack;
-  for (const auto& [name, value] : printed.scalars) stack.push_back(graph.add(value));
-  std::set<int> seen;
-  long ops = printed.ops[0].total();
-  while (!stack.empty()) {
-    const int id = stack.back();
-    stack.pop_back();
-    if (graph.is_leaf(id) || !seen.insert(id).second) continue;
-    ops += graph.own_ops(id).total();
-    for (int a : graph.node(id).args) stack.push_back(a);
-  }
-  return ops;
-}
+// A printed pass' operations: its own, and its lane scalars' (the world frame's pass spends a
+// third of its operations there).
+long operations(const lane_code::PrintedCode& printed) { return printed.ops[0].total() + lane_code::scalar_operations(printed); }
 
 // The outputs: Q*_l = sum_j T(j, l) tau_j: a commanded speed's coordinate adds its tau to its row;
 // a dense coordinate's, times T(j, l), to the rows of the speeds its rate depends on

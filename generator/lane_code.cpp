@@ -22,13 +22,7 @@ void add_term_reads(const std::vector<Term>& terms, std::vector<ValueId>& out) {
 std::vector<ValueId> reads(const Step& step) {
   std::vector<ValueId> out;
   std::visit(Overloaded{[&](const Define& s) { add_term_reads(s.terms, out); },
-                        [&](const Accumulate& s) { add_term_reads(s.terms, out); },
                         [&](const Store& s) { add_term_reads(s.terms, out); },
-                        [&](const PlusLane& s) {
-                          out.push_back(s.base);
-                          out.push_back(s.value);
-                        },
-                        [&](const Widen& s) { out.push_back(s.source); },
                         [&](const LoadRow& s) {
                           for (const auto& lane : s.lanes) out.push_back(lane.second);
                         },
@@ -39,8 +33,8 @@ std::vector<ValueId> reads(const Step& step) {
 }
 
 ValueId defined_unless_unread(const Step& step) {
-  return std::visit(Overloaded{[](const Define& s) { return s.target; }, [](const PlusLane& s) { return s.target; },
-                               [](const Widen& s) { return s.target; }, [](const auto&) { return ValueId{}; }},
+  return std::visit(Overloaded{[](const Define& s) { return s.target; }, [](const LoadRow& s) { return s.target; },
+                               [](const auto&) { return ValueId{}; }},
                     step);
 }
 
@@ -70,48 +64,19 @@ std::vector<bool> kept_statements(const LaneProgram& program) {
 
 OpCount operations(const LaneProgram& program, const Step& step) {
   // A sum of n terms on rows of k lanes: n - 1 additions and a multiplication per factor, each k
-  // times; a leading minus is one more; `+=` adds one more addition.
-  const auto sum = [&](const std::vector<Term>& terms, Layout layout, long extra_adds) {
+  // times; a leading minus is one more.
+  const auto sum = [&](const std::vector<Term>& terms, Layout layout) {
     const long lanes = program.lanes(layout);
     OpCount ops;
     if (terms.empty()) return ops;
-    ops.adds = (static_cast<long>(terms.size()) - 1 + extra_adds + (terms.front().negate ? 1 : 0)) * lanes;
+    ops.adds = (static_cast<long>(terms.size()) - 1 + (terms.front().negate ? 1 : 0)) * lanes;
     for (const Term& t : terms)
       if (t.factor.what != Quantity::one) ops.muls += lanes;
     return ops;
   };
-  return std::visit(Overloaded{[&](const Define& s) { return sum(s.terms, s.layout, 0); },
-                               [&](const Accumulate& s) { return sum(s.terms, s.layout, 1); },
-                               [&](const Store& s) { return sum(s.terms, Layout::scalar, 0); },
-                               [](const PlusLane&) { return OpCount{1, 0, 0, 0}; },  // one lane's addition
-                               [](const auto&) { return OpCount{}; }},
+  return std::visit(Overloaded{[&](const Define& s) { return sum(s.terms, s.layout); },
+                               [&](const Store& s) { return sum(s.terms, Layout::scalar); }, [](const auto&) { return OpCount{}; }},
                     step);
-}
-
-long instructions(const LaneProgram& program) {
-  const std::vector<bool> keep = kept_statements(program);
-  const auto vectors = [&](Layout layout) { return layout == Layout::scalar ? 1L : (program.lanes(layout) + 3L) / 4L; };
-  // A lane read into a scalar sum is one move.
-  const auto lanes_read = [](const std::vector<Term>& terms) {
-    return static_cast<long>(std::count_if(terms.begin(), terms.end(), [](const Term& t) { return t.lane >= 0; }));
-  };
-  const auto row_ops = [&](const Step& step, Layout layout, const std::vector<Term>& terms) {
-    return operations(program, step).total() / program.lanes(layout) * vectors(layout) + (layout == Layout::scalar ? lanes_read(terms) : 0L);
-  };
-  long out = 0;
-  for (std::size_t i = 0; i < program.statements.size(); ++i) {
-    if (!keep[i]) continue;
-    const Step& step = program.statements[i].step;
-    out += std::visit(Overloaded{[&](const Define& s) { return row_ops(step, s.layout, s.terms); },
-                                 [&](const Accumulate& s) { return row_ops(step, s.layout, s.terms); },
-                                 [&](const Store& s) { return operations(program, step).total() + lanes_read(s.terms); },
-                                 [](const PlusLane&) { return 2L; },  // the lane out, added to, and back
-                                 [](const Widen& s) { return static_cast<long>(s.lanes.size()); },
-                                 [&](const LoadRow& s) { return s.whole ? vectors(Layout::narrow) : static_cast<long>(s.lanes.size()); },
-                                 [&](const ZeroRow& s) { return vectors(s.layout); }, [](const auto&) { return 0L; }},
-                      step);
-  }
-  return out;
 }
 
 }  // namespace wlx::codegen::lane_code

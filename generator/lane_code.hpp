@@ -29,18 +29,14 @@ enum class Quantity : unsigned char {
   acceleration,      // s''_j
   // Lane scalars: expressions in s and the parameters, computed with the function's other
   // expressions (common subexpressions shared) before the code reads them.
-  joint_axis,         // (k, c): a joint's twist per unit rate (spatial_axis)
-  com_offset,         // (i, c): the body's CoM in K0
-  minus_com_offset,   // (i, c)
-  com_rotation,       // (i, a, b): the CoM frame's rotation
-  mass,               // (i)
-  inertia,            // (i, a): principal moment
-  bias_acceleration,  // (i, c): the CoM's acceleration at zero u'
-  bias_torque,        // (i, a): I alpha_bias + omega x I omega, body axes
-  gravity,            // g
-  minus_gravity,      // -g
-  // Values the code computes (rows of lanes per unit commanded speed in reduced_dynamics,
-  // scalars in generalized_forces).
+  joint_axis,     // (k, c): a joint's twist per unit rate (spatial_axis), or its axis in its own frame
+  com_offset,     // (i, c): the body's CoM in K0, or in its joint's frame
+  com_rotation,   // (i, a, b): the CoM frame's rotation, in K0 or in its joint's frame
+  mass,           // (i)
+  inertia,        // (i, a): principal moment
+  gravity,        // g
+  minus_gravity,  // -g
+  // Values the code computes (scalars, or rows of lanes for sibling limbs in reduced_dynamics).
   spatial_velocity,           // (k, c): (omega; velocity at K0's origin) out to node k
   motion_cross,               // (k, c): V_parent x S
   spatial_acceleration,       // (k, c)
@@ -56,50 +52,51 @@ enum class Quantity : unsigned char {
   joint_force,                // (k): node k's tau
   coordinate_force,           // (j): the sum of coordinate j's joints' taus
   commanded_force,            // (l): Q*_l
-  // The composite-rigid-body pass of reduced_dynamics: inertias about its reference point (the
-  // first revolute joint's origin), in K0.
+  // The composite-rigid-body pass of reduced_dynamics (composite_dynamics.cpp): inertias about
+  // each joint's origin, in its frame.
   first_moment,               // (i, c): a body's m p
   inertia_difference,         // (i, k): a body's principal moment k less the first (a lane scalar)
   rotated_inertia,            // (i, a, k): R(a, k) times inertia_difference (i, k)
   inertia_shift,              // (i): a body's first principal moment plus m |p|^2
-  origin_inertia,             // (i, a, b): a body's rotational inertia about the reference point
+  origin_inertia,             // (i, a, b): a body's rotational inertia about its joint's origin
   composite_mass,             // (k): the mass of the bodies beyond node k
   composite_first_moment,     // (k, c)
-  composite_inertia,          // (k, a, b): rotational, about the reference point
+  composite_inertia,          // (k, a, b): rotational, about node k's origin
   joint_momentum,             // (k, c): the composite inertia beyond node k times its axis, (force; moment)
   joint_mass,                 // (j, k): M between the joints of nodes j and k, k beyond j
   projected_mass,             // (l, k): (T^T M)(l, the coordinate of node k)
   reduced_mass,               // (l, b): M on the commanded speeds, l <= b
   gravity_force,              // (k): node k's tau from gravity, over -g
   commanded_gravity,          // (l): Q_gravity_l over -g
-  // generalized_forces' recursion in the joints' own frames (local_motion in generalized_forces.cpp).
+  // The recursions in the joints' own frames (generalized_forces' local_motion, reduced_dynamics' b_velocity).
   local_rotation,     // (k, a, b): node k's frame in its parent's (a lane scalar)
   local_offset,       // (k, c): node k's origin in its parent's frame (a lane scalar)
   offset_velocity,       // (k, c): the parent's omega x node k's origin, in the parent's axes
   carried_acceleration,  // (k, c): the parent's acceleration at node k's origin, in the parent's axes
   incoming_motion,       // (k, c): the parent's omega, alpha, a at node k's origin, in node k's axes (3 each)
-  transmitted_force,  // (k, c): the force beyond node k in its parent's axes
+  transmitted_force,  // (k, c): the force (c < 3) and moment (c >= 3) beyond node k in its parent's axes
+  // reduced_dynamics' composite-rigid-body pass in the joints' own frames (composite_local.cpp):
+  // node k's composite inertia carried into its parent's frame by its placement (R, r).
+  turned_first_moment,   // (k, c): R h
+  carried_first_moment,  // (k, c): R h + m r
+  turned_inertia,        // (k, a, b): R J
+  carried_shift,         // (k): r . (R h + m r) + r . R h
+  carried_inertia,       // (k, a, b): R J R^T shifted to the parent's origin
+  carried_momentum,      // (j, k, c): node k's I_k S_k, (force; moment), in node j's frame
+  up_direction,          // (k, c): K0's z axis in node k's frame (a lane scalar)
+  gravity_wrench,        // (k, c): (m up; h x up) of node k's composite
   // Values of the composite pass' own making (composite_units.cpp), named after another value v:
   lanes_of,  // (v): a row of lanes, v's quantity for each limb of a row unit
   row_sum,   // (v): the row whose lanes add up to v
   negated,   // (v): -v, to be put in a lane
+  scalar_part,  // (v): the scalar terms of row v's sum, added up
+  everywhere,   // (v): a row with scalar v in every lane
   constant,  // (0): 1, (1): -1, to be put in a lane
-  // Rows of the lane code's own: T's row of a dense coordinate j, and the accumulators of the
-  // outputs (M's row k, b_velocity, Q_gravity, B_bias's column j).
-  rate_row,
-  mass_matrix_row,
-  velocity_forces,
-  gravity_forces,
-  bias_column,
 };
 
 struct ValueId {
   Quantity what = Quantity::zero;
   std::array<int, 3> index = {0, 0, 0};
-  // A row's other copies: wide, its lanes laid out one per commanded speed (a narrow row widened,
-  // an accumulator's wide part); part n > 0, an accumulator's n-th narrow part.
-  bool wide_copy = false;
-  int part = 0;
   bool is_zero() const { return what == Quantity::zero; }
   auto operator<=>(const ValueId&) const = default;
 };
@@ -115,9 +112,8 @@ struct Term {
   bool negate = false;
 };
 
-// How a value is held: a scalar, or a row of lanes, narrow (lanes shared by speeds that never move
-// a common body: LaneProgram::width of them) or wide (one per commanded speed).
-enum class Layout : unsigned char { scalar, narrow, wide };
+// How a value is held: a scalar, or a row of LaneProgram::width lanes (one per limb of a row unit).
+enum class Layout : unsigned char { scalar, row };
 
 // The statements. A comment's text is quoted by the printer.
 struct Comment {
@@ -129,39 +125,12 @@ struct Define {
   Layout layout;
   std::vector<Term> terms;
 };
-// target += sum of terms.
-struct Accumulate {
-  ValueId target;
-  Layout layout;
-  std::vector<Term> terms;
-};
-// target = base (zero if none), plus `value` in lane `lane`.
-struct PlusLane {
-  ValueId target;
-  Layout layout;
-  ValueId base;
-  int lane;
-  ValueId value;
-};
-// target (wide) = source's lanes moved: (wide lane, source's lane) per speed.
-struct Widen {
-  ValueId target, source;
-  std::vector<std::pair<int, int>> lanes;
-};
-// The rate_row `target` (narrow) from T's row: its `lanes` (lane, T's entry), or, when `whole`,
-// every entry in the lane of its column.
+// A row `target` from scalars: its `lanes` (lane, value), the others zero.
 struct LoadRow {
   ValueId target;
-  int row;
-  bool whole;
   std::vector<std::pair<int, ValueId>> lanes;
 };
-// An accumulator's part, zero before the code adds to it.
-struct ZeroRow {
-  ValueId target;
-  Layout layout;
-};
-// The lane types (LaneProgram's width and speeds).
+// The lane type (LaneProgram's width).
 struct LaneTypes {};
 // The outputs: the block that writes output `output` when it is requested, and its entries.
 struct OpenOutput {
@@ -179,7 +148,7 @@ struct Store {
   std::vector<Term> terms;
 };
 
-using Step = std::variant<Comment, Define, Accumulate, PlusLane, Widen, LoadRow, ZeroRow, LaneTypes, OpenOutput, CloseOutput, Store>;
+using Step = std::variant<Comment, Define, LoadRow, LaneTypes, OpenOutput, CloseOutput, Store>;
 
 // A statement, and the output its operations count for (the derivation's numbering).
 struct Statement {
@@ -190,11 +159,7 @@ struct Statement {
 // The whole code: its lane scalars (in the order they were made: the order of CSE's roots), its
 // statements in order, and the lanes of its rows.
 struct LaneProgram {
-  // Scalar code (generalized_forces) or rows of lanes (reduced_dynamics): the printer's names
-  // differ between the two.
-  enum class Kind : unsigned char { lanes, scalars } kind = Kind::scalars;
-  int width = 1;   // a narrow row's lanes
-  int speeds = 1;  // a wide row's (the commanded speeds)
+  int width = 1;  // a row's lanes
   std::vector<std::pair<ValueId, ex>> scalars;
   std::vector<Statement> statements;
   // A lane scalar of the given value; zero (nothing made) for an exact zero.
@@ -203,8 +168,7 @@ struct LaneProgram {
     scalars.emplace_back(id, value);
     return id;
   }
-  bool shares_lanes() const { return width < speeds; }
-  int lanes(Layout layout) const { return layout == Layout::scalar ? 1 : layout == Layout::wide ? speeds : width; }
+  int lanes(Layout layout) const { return layout == Layout::scalar ? 1 : width; }
 };
 
 // A visitor of a Step from one lambda per kind of statement (std::visit).
@@ -227,10 +191,5 @@ std::vector<ValueId> reads(const Step& step);
 ValueId defined_unless_unread(const Step& step);
 // Its operations, lane by lane.
 OpCount operations(const LaneProgram& program, const Step& step);
-// What the kept statements cost the machine, in instructions: a row's operation is one per vector
-// of 4 lanes (the lanes of detail::Lanes<double, N> in 32-byte vectors), and moving a lane in or
-// out of a row (PlusLane, Widen, LoadRow, a Store's lane) one each. Operation counts weigh each lane
-// as a scalar; this weighs the code as it runs, to choose between two derivations of one function.
-long instructions(const LaneProgram& program);
 
 }  // namespace wlx::codegen::lane_code

@@ -1,6 +1,8 @@
 // The printer of the dynamics passes' code: names, lane types, indentation (lane_printer.hpp).
 #include "lane_printer.hpp"
 
+#include "expr_graph.hpp"
+
 #include <fmt/format.h>
 #include <wlx/support/text.hpp>
 
@@ -17,68 +19,66 @@ namespace {
 // model file cannot name): the model's coordinates and parameters must not start with it.
 constexpr std::string_view kReservedPrefix = "kane_";
 
-// Each quantity's name, from its indices, in the lane code and in the scalar code (the two spell
-// some alike values apart: the names the generated headers have always had).
+// Each quantity's name, from its indices.
 struct Spelling {
   Quantity what;
-  const char* lanes;
-  const char* scalars;
+  const char* pattern;
 };
 constexpr Spelling kSpellings[] = {
-    {Quantity::rate_basis_entry, "T({}, {})", "T({}, {})"},
-    {Quantity::rate, "sdot({})", "sdot({})"},
-    {Quantity::acceleration, "sddot({})", "sddot({})"},
-    {Quantity::joint_axis, "kane_twist_{}_{}", "kane_S_{}_{}"},
-    {Quantity::com_offset, "kane_p_{}_{}", "kane_p_{}_{}"},
-    {Quantity::minus_com_offset, "kane_minus_p_{}_{}", nullptr},
-    {Quantity::com_rotation, "kane_R_{}_{}_{}", "kane_R_{}_{}_{}"},
-    {Quantity::mass, "kane_mass_{}_0", "kane_mass_{}"},
-    {Quantity::inertia, "kane_inertia_{}_{}", "kane_inertia_{}_{}"},
-    {Quantity::bias_acceleration, "kane_acc_{}_{}", "kane_acc_{}_{}"},
-    {Quantity::bias_torque, "kane_torque_{}_{}", "kane_torque_{}_{}"},
-    {Quantity::gravity, nullptr, "kane_g"},
-    {Quantity::minus_gravity, "kane_minus_g", "kane_minus_g"},
-    {Quantity::spatial_velocity, "twist{}_{}", "kane_V{}_{}"},
-    {Quantity::motion_cross, nullptr, "kane_X{}_{}"},
-    {Quantity::spatial_acceleration, nullptr, "kane_A{}_{}"},
-    {Quantity::com_velocity, "pv{}_{}", "kane_v{}_{}"},
-    {Quantity::com_acceleration, nullptr, "kane_a{}_{}"},
-    {Quantity::force, "dv{}_{}", "kane_F{}_{}"},
-    {Quantity::body_rate, "pb{}_{}", "kane_wb{}_{}"},
-    {Quantity::body_angular_acceleration, nullptr, "kane_ab{}_{}"},
-    {Quantity::angular_momentum, "db{}_{}", "kane_Iw{}_{}"},
-    {Quantity::body_moment, nullptr, "kane_N{}_{}"},
-    {Quantity::moment, "moment{}_{}", "kane_M{}_{}"},
-    {Quantity::wrench, "wrench{}_{}", "kane_W{}_{}"},
-    {Quantity::joint_force, "tau{}", "kane_tau{}"},
-    {Quantity::coordinate_force, nullptr, "kane_tau_s{}"},
-    {Quantity::commanded_force, nullptr, "kane_Q{}"},
-    {Quantity::first_moment, nullptr, "kane_h{}_{}"},
-    {Quantity::inertia_difference, nullptr, "kane_dI{}_{}"},
-    {Quantity::rotated_inertia, nullptr, "kane_RI{}_{}_{}"},
-    {Quantity::inertia_shift, nullptr, "kane_sigma{}"},
-    {Quantity::origin_inertia, nullptr, "kane_J{}_{}_{}"},
-    {Quantity::composite_mass, nullptr, "kane_mc{}"},
-    {Quantity::composite_first_moment, nullptr, "kane_hc{}_{}"},
-    {Quantity::composite_inertia, nullptr, "kane_Jc{}_{}_{}"},
-    {Quantity::joint_momentum, nullptr, "kane_IS{}_{}"},
-    {Quantity::joint_mass, nullptr, "kane_Mjk{}_{}"},
-    {Quantity::projected_mass, nullptr, "kane_TM{}_{}"},
-    {Quantity::reduced_mass, nullptr, "kane_Mu{}_{}"},
-    {Quantity::gravity_force, nullptr, "kane_G{}"},
-    {Quantity::commanded_gravity, nullptr, "kane_Gu{}"},
-    {Quantity::local_rotation, nullptr, "kane_Rl{}_{}_{}"},
-    {Quantity::local_offset, nullptr, "kane_rl{}_{}"},
-    {Quantity::offset_velocity, nullptr, "kane_wr{}_{}"},
-    {Quantity::carried_acceleration, nullptr, "kane_C{}_{}"},
-    {Quantity::incoming_motion, nullptr, "kane_In{}_{}"},
-    {Quantity::transmitted_force, nullptr, "kane_Ft{}_{}"},
-    {Quantity::constant, nullptr, "kane_c{}"},
-    {Quantity::rate_row, "kane_T_{}", nullptr},
-    {Quantity::mass_matrix_row, "kane_M_{}", nullptr},
-    {Quantity::velocity_forces, "kane_b", nullptr},
-    {Quantity::gravity_forces, "kane_Q", nullptr},
-    {Quantity::bias_column, "kane_B_{}", nullptr},
+    {Quantity::rate_basis_entry, "T({}, {})"},
+    {Quantity::rate, "sdot({})"},
+    {Quantity::acceleration, "sddot({})"},
+    {Quantity::joint_axis, "kane_S_{}_{}"},
+    {Quantity::com_offset, "kane_p_{}_{}"},
+    {Quantity::com_rotation, "kane_R_{}_{}_{}"},
+    {Quantity::mass, "kane_mass_{}"},
+    {Quantity::inertia, "kane_inertia_{}_{}"},
+    {Quantity::gravity, "kane_g"},
+    {Quantity::minus_gravity, "kane_minus_g"},
+    {Quantity::spatial_velocity, "kane_V{}_{}"},
+    {Quantity::motion_cross, "kane_X{}_{}"},
+    {Quantity::spatial_acceleration, "kane_A{}_{}"},
+    {Quantity::com_velocity, "kane_v{}_{}"},
+    {Quantity::com_acceleration, "kane_a{}_{}"},
+    {Quantity::force, "kane_F{}_{}"},
+    {Quantity::body_rate, "kane_wb{}_{}"},
+    {Quantity::body_angular_acceleration, "kane_ab{}_{}"},
+    {Quantity::angular_momentum, "kane_Iw{}_{}"},
+    {Quantity::body_moment, "kane_N{}_{}"},
+    {Quantity::moment, "kane_M{}_{}"},
+    {Quantity::wrench, "kane_W{}_{}"},
+    {Quantity::joint_force, "kane_tau{}"},
+    {Quantity::coordinate_force, "kane_tau_s{}"},
+    {Quantity::commanded_force, "kane_Q{}"},
+    {Quantity::first_moment, "kane_h{}_{}"},
+    {Quantity::inertia_difference, "kane_dI{}_{}"},
+    {Quantity::rotated_inertia, "kane_RI{}_{}_{}"},
+    {Quantity::inertia_shift, "kane_sigma{}"},
+    {Quantity::origin_inertia, "kane_J{}_{}_{}"},
+    {Quantity::composite_mass, "kane_mc{}"},
+    {Quantity::composite_first_moment, "kane_hc{}_{}"},
+    {Quantity::composite_inertia, "kane_Jc{}_{}_{}"},
+    {Quantity::joint_momentum, "kane_IS{}_{}"},
+    {Quantity::joint_mass, "kane_Mjk{}_{}"},
+    {Quantity::projected_mass, "kane_TM{}_{}"},
+    {Quantity::reduced_mass, "kane_Mu{}_{}"},
+    {Quantity::gravity_force, "kane_G{}"},
+    {Quantity::commanded_gravity, "kane_Gu{}"},
+    {Quantity::local_rotation, "kane_Rl{}_{}_{}"},
+    {Quantity::local_offset, "kane_rl{}_{}"},
+    {Quantity::offset_velocity, "kane_wr{}_{}"},
+    {Quantity::carried_acceleration, "kane_C{}_{}"},
+    {Quantity::incoming_motion, "kane_In{}_{}"},
+    {Quantity::transmitted_force, "kane_Ft{}_{}"},
+    {Quantity::turned_first_moment, "kane_hr{}_{}"},
+    {Quantity::carried_first_moment, "kane_hp{}_{}"},
+    {Quantity::turned_inertia, "kane_RJ{}_{}_{}"},
+    {Quantity::carried_shift, "kane_sp{}"},
+    {Quantity::carried_inertia, "kane_Jp{}_{}_{}"},
+    {Quantity::carried_momentum, "kane_Fc{}_{}_{}"},
+    {Quantity::up_direction, "kane_up{}_{}"},
+    {Quantity::gravity_wrench, "kane_Wg{}_{}"},
+    {Quantity::constant, "kane_c{}"},
 };
 
 class LanePrinter {
@@ -88,7 +88,8 @@ class LanePrinter {
   std::string name(const ValueId& id) const {
     // The composite pass' values named after another one (composite_units.cpp folds that one's
     // quantity into the first index): its name, marked.
-    if (id.what == Quantity::lanes_of || id.what == Quantity::row_sum || id.what == Quantity::negated) {
+    if (id.what == Quantity::lanes_of || id.what == Quantity::row_sum || id.what == Quantity::negated ||
+        id.what == Quantity::scalar_part || id.what == Quantity::everywhere) {
       const ValueId from = value_id(static_cast<Quantity>(id.index[0] / 1000), id.index[0] % 1000, id.index[1], id.index[2]);
       std::string base;
       for (const char c : name(from))  // T(18, 0) as kane_T_18_0
@@ -96,16 +97,18 @@ class LanePrinter {
         else if (!base.empty() && base.back() != '_') base += '_';
       while (!base.empty() && base.back() == '_') base.pop_back();
       if (!base.starts_with(kReservedPrefix)) base = std::string(kReservedPrefix) + base;
-      return base + (id.what == Quantity::lanes_of ? "_lanes" : id.what == Quantity::row_sum ? "_by_lane" : "_negated");
+      switch (id.what) {
+        case Quantity::lanes_of: return base + "_lanes";
+        case Quantity::row_sum: return base + "_by_lane";
+        case Quantity::scalar_part: return base + "_scalars";
+        case Quantity::everywhere: return base + "_everywhere";
+        default: return base + "_negated";
+      }
     }
     const auto* spelling = std::find_if(std::begin(kSpellings), std::end(kSpellings), [&](const Spelling& s) { return s.what == id.what; });
-    const char* pattern = spelling == std::end(kSpellings) ? nullptr
-                          : program_.kind == LaneProgram::Kind::lanes ? spelling->lanes
-                                                                      : spelling->scalars;
+    const char* pattern = spelling == std::end(kSpellings) ? nullptr : spelling->pattern;
     if (pattern == nullptr) throw std::logic_error(fmt::format("lane code: no name for quantity {}", static_cast<int>(id.what)));
     std::string out = fmt::format(fmt::runtime(pattern), id.index[0], id.index[1], id.index[2]);
-    if (id.wide_copy) out += "_all";
-    if (id.part > 0) out += fmt::format("_part{}", id.part);
     return out;
   }
 
@@ -113,17 +116,13 @@ class LanePrinter {
     const auto& statements = program_.statements;
     for (std::size_t i = 0; i < statements.size(); ++i) {
       if (!keep[i]) continue;
-      if (std::holds_alternative<ZeroRow>(statements[i].step)) {
-        i = zero_rows(i, keep) - 1;
-        continue;
-      }
       std::visit([&](const auto& step) { print(step); }, statements[i].step);
     }
     return std::move(out_);
   }
 
  private:
-  static const char* type(Layout layout) { return layout == Layout::scalar ? "Scalar" : layout == Layout::wide ? "LW" : "L"; }
+  static const char* type(Layout layout) { return layout == Layout::scalar ? "Scalar" : "L"; }
   std::string zero(Layout layout) const { return fmt::format("detail::zero_lanes<Scalar, {}>()", program_.lanes(layout)); }
   const char* indent() const { return output_ != nullptr && output_->indent_body ? "      " : "    "; }
 
@@ -144,47 +143,13 @@ class LanePrinter {
   // Quoted (wlx/support/text.hpp): the text may hold a body's meaning from the model file.
   void print(const Comment& s) { out_ += fmt::format("{}// {}\n", indent(), text::cpp_comment(s.text)); }
   void print(const Define& s) { out_ += fmt::format("{}const {} {} = {};\n", indent(), type(s.layout), name(s.target), sum(s.terms)); }
-  void print(const Accumulate& s) { out_ += fmt::format("{}{} += {};\n", indent(), name(s.target), sum(s.terms)); }
-  void print(const PlusLane& s) {
-    const std::string target = name(s.target);
-    out_ += fmt::format("{0}{1} {2} = {3};\n{0}{2}.add_to_lane({4}, {5});\n", indent(), type(s.layout), target,
-                        s.base.is_zero() ? zero(s.layout) : name(s.base), s.lane, name(s.value));
-  }
-  void print(const Widen& s) {
-    const std::string target = name(s.target), source = name(s.source);
-    out_ += fmt::format("{}LW {} = {};\n", indent(), target, zero(Layout::wide));
-    for (const auto& [lane, from] : s.lanes) out_ += fmt::format("{}{}.set_lane({}, {}.lane({}));\n", indent(), target, lane, source, from);
-  }
   void print(const LoadRow& s) {
     const std::string target = name(s.target);
-    if (s.whole) {
-      out_ += fmt::format("{}const L {} = detail::lanes_of_row<Scalar, {}>(T, {});\n", indent(), target, program_.speeds, s.row);
-      return;
-    }
-    out_ += fmt::format("{}L {} = {};\n", indent(), target, zero(Layout::narrow));
+    out_ += fmt::format("{}L {} = {};\n", indent(), target, zero(Layout::row));
     for (const auto& [lane, entry] : s.lanes) out_ += fmt::format("{}{}.set_lane({}, {});\n", indent(), target, lane, name(entry));
-  }
-  void print(const ZeroRow& s) { out_ += fmt::format("{}{} {} = {};\n", indent(), type(s.layout), name(s.target), zero(s.layout)); }
-  // A run of accumulators' declarations, from statement `first` on, in the order of the
-  // accumulators' names (an accumulator's parts in the order they come): the order the generated
-  // headers have always had, whatever order the derivation made them in. Returns the statement
-  // after the run.
-  std::size_t zero_rows(std::size_t first, const std::vector<bool>& keep) {
-    std::vector<std::pair<std::string, const ZeroRow*>> rows;
-    std::size_t end = first;
-    for (; end < program_.statements.size() && std::holds_alternative<ZeroRow>(program_.statements[end].step); ++end) {
-      if (!keep[end]) continue;
-      const ZeroRow& row = std::get<ZeroRow>(program_.statements[end].step);
-      const ValueId accumulator{row.target.what, row.target.index};
-      rows.emplace_back(name(accumulator), &row);
-    }
-    std::stable_sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& row : rows) print(*row.second);
-    return end;
   }
   void print(const LaneTypes&) {
     out_ += fmt::format("{}using L = detail::Lanes<Scalar, {}>;\n", indent(), program_.width);
-    if (program_.shares_lanes()) out_ += fmt::format("{}using LW = detail::Lanes<Scalar, {}>;\n", indent(), program_.speeds);
   }
   void print(const OpenOutput& s) {
     out_ += fmt::format("    if ({} != nullptr) {{{}\n", s.output, s.note.empty() ? "" : "  // " + s.note);
@@ -218,6 +183,22 @@ void reserve_printer_names(const Model& m) {
   for (const auto& par : m.parameters) reserved("parameter", par.name);
 }
 
+long scalar_operations(const PrintedCode& printed) {
+  ExprGraph graph;
+  std::vector<int> stack;
+  for (const auto& [name, value] : printed.scalars) stack.push_back(graph.add(value));
+  std::set<int> seen;
+  long ops = 0;
+  while (!stack.empty()) {
+    const int id = stack.back();
+    stack.pop_back();
+    if (graph.is_leaf(id) || !seen.insert(id).second) continue;
+    ops += graph.own_ops(id).total();
+    for (int a : graph.node(id).args) stack.push_back(a);
+  }
+  return ops;
+}
+
 PrintedCode print(const LaneProgram& program, std::size_t outputs) {
   const std::vector<bool> keep = kept_statements(program);
   LanePrinter printer(program);
@@ -235,9 +216,6 @@ PrintedCode print(const LaneProgram& program, std::size_t outputs) {
   for (const auto& [id, value] : program.scalars)
     if (read.count(id)) out.scalars.emplace_back(printer.name(id), value);
   out.code = printer.code(keep);
-  if (program.kind == LaneProgram::Kind::lanes)
-    out.layout = program.shares_lanes() ? fmt::format("{} lanes, {} where the limbs' sums meet", program.width, program.speeds)
-                                        : fmt::format("{} lanes", program.speeds);
   return out;
 }
 

@@ -1,5 +1,5 @@
 // The one printer of the dynamics passes' code (lane_code.hpp): it names the values (the names
-// starting with kane_ are its own), spells the lane types L and LW and the rows' lanes, and lays
+// starting with kane_ are its own), spells the lane type L and the rows' lanes, and lays
 // the statements out; unread values and the scalars only they read are left out.
 #pragma once
 
@@ -20,8 +20,10 @@ struct PrintedCode {
   std::string code;
   std::vector<std::pair<std::string, ex>> scalars;  // the lane scalars the code reads, named, in the program's order
   std::vector<OpCount> ops;                         // per output (Statement::output)
-  std::string layout;                               // how wide the rows are ("10 lanes"), empty for scalar code
 };
 PrintedCode print(const LaneProgram& program, std::size_t outputs);
+// The operations of the lane scalars the printed code reads, each distinct subexpression once, as
+// the emitted function computes them (before the code: a pass in K0 spends much of its work there).
+long scalar_operations(const PrintedCode& printed);
 
 }  // namespace wlx::codegen::lane_code

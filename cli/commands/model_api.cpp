@@ -182,7 +182,7 @@ NamedArrays api_inverse_dynamics(const Eigen::VectorXd& s_in, const Eigen::Vecto
   const Coordinates s = coordinates_of(s_in, "s");
   const Weighting weighting = parse_weighting(parse_json(weighting_json, "weighting"), "weighting");
   inverse_dynamics(model, data, s, u, u_dot, terms);
-  DynamicsTerms motion;  // M, b and Q_gravity, which the result returns too (Kane's sums)
+  DynamicsTerms motion;  // M, b and Q_gravity, which the result returns too (reduced_dynamics)
   equations_of_motion(model, data, s, u, motion);
   const TorqueVector tau = weighting.kind == Weighting::Kind::contacts
                                ? distribute_torques_on_contacts(model, data, s, terms).tau

@@ -109,7 +109,7 @@ void equations_of_motion(const Model& model, Data& d, const Coordinates& s, cons
   const Params& p = model.params();
   const DependentPair pair = dynamics_pair();
   // Two generated passes: dPhi/ds and C(s), which give T; at (s, s' = T u, T) the convective terms
-  // and Kane's sums over the bodies (M, the velocity and gravity forces and their gain on
+  // and the composite-rigid-body pass (M, the velocity and gravity forces and their gain on
   // s''_bias), sharing their subexpressions.
   velocity_level(p, d, s, u, out, pair, options);
   CommandVector b_velocity;

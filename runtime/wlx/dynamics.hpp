@@ -4,7 +4,7 @@
 // pitch'), the dependent pair the wheels determine (y_C', yaw') and the actuators; every other
 // input is constant. With s' = T u and s'' = T u' + s''_bias from the non-holonomic solve, the
 // bodies' equations projected on u give Q* = M u' + b - Q_gravity: inverse_dynamics by the recursive
-// Newton-Euler equations (no M), equations_of_motion by Kane's sums (M, b, Q_gravity). The
+// Newton-Euler equations (no M), equations_of_motion by composite rigid bodies (M, b, Q_gravity). The
 // actuators share Q* by weighted least norm: J_beta^T tau = Q*, minimising tau^T W tau.
 #pragma once
 
@@ -71,7 +71,7 @@ void inverse_dynamics(const Model& model, Data& data, const Coordinates& s, cons
                       const CommandVector& u_dot, DynamicsTerms& out, const NonholonomicOptions& options = {});
 
 // The equations of motion on the commanded speeds at s for speeds u, M u' + b - Q_gravity = Q*, by
-// Kane's sums (reduced_dynamics, in one generated pass with the convective terms): T, s', s''_bias
+// composite rigid bodies (reduced_dynamics, in one generated pass with the convective terms): T, s', s''_bias
 // (and s'' at u' = 0), M, b, Q_gravity and J_beta; not Q*. For forward dynamics and whoever wants
 // the mass matrix. With them, M u_dot + b - Q_gravity equals inverse_dynamics' Q* (two
 // formulations; the tests compare them). Allocates nothing; throws as inverse_dynamics does.

@@ -1,5 +1,5 @@
-// The generated functions of the dynamics on the commanded speeds (Kane's sums, a model's largest
-// function, and the Newton-Euler forces), in double, compiled once
+// The generated functions of the dynamics on the commanded speeds (the composite-rigid-body pass, a
+// model's largest function, and the Newton-Euler forces), in double, compiled once
 // for the model's runtime library. The library's users see their declarations only
 // (WLX_GEN_COMPILED_<model>, which the library defines for them; generated types.hpp), so a
 // translation unit that calls them does not compile them again: they are most of a model's compile

@@ -14,10 +14,10 @@
 //   bodies                       315         58902          2163
 //   kinematic_update             194         48373          1304
 //   dynamics_update              150         37306          1043
-//   reduced_dynamics             484        145199          6505
+//   reduced_dynamics             372         62714          4890
 //   generalized_forces             6           100          1120
 //   clearance                      0            22            23
-//   total                                   412867         16172
+//   total                                   330382         14557
 #pragma once
 
 #include "ik.hpp"

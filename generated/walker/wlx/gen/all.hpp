@@ -14,10 +14,10 @@
 //   bodies                       388         63427          2538
 //   kinematic_update             234         60493          1338
 //   dynamics_update              183         47698           988
-//   reduced_dynamics             601        151284          6482
+//   reduced_dynamics             429         68978          5063
 //   generalized_forces             5            92          1228
 //   clearance                      0            22            23
-//   total                                   470105         16582
+//   total                                   387799         15163
 #pragma once
 
 #include "ik.hpp"

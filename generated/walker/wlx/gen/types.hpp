@@ -89,9 +89,8 @@ namespace detail {
 // output pointer may be nullptr (std::type_identity_t, which C++17 lacks).
 template <typename T> struct NonDeducedType { using type = T; };
 template <typename T> using NonDeduced = typename NonDeducedType<T>::type;
-// N scalars side by side, for code that does the same to N columns at once (reduced_dynamics:
-// Kane's sums, one lane per commanded speed, or the composite pass, one lane per limb of one
-// shape). Loops over a fixed N, which compilers unroll.
+// N scalars side by side, for code that does the same to N columns at once (reduced_dynamics'
+// composite pass, one lane per limb of one shape). Loops over a fixed N, which compilers unroll.
 template <typename Scalar, int N>
 struct Lanes {
   Scalar v[N];
