@@ -151,8 +151,40 @@ struct BodyWriter {
 
   void write_blocks(const FunctionSpec& fn, const FunctionGraph& fg) {
     output_ops.assign(fg.outs.size(), OpCount{});
+    // Beside lane code, the outputs of their own (reduced_dynamics' convective terms) share
+    // temporaries the lane code never reads: those go into one scope with those outputs' blocks,
+    // run when one of them is requested, so that a call for the lane code's outputs alone (M, say)
+    // skips them.
+    std::vector<std::size_t> own;
+    for (std::size_t o = 0; o < fn.outputs.size(); ++o)
+      if (!fn.outputs[o].from_lanes) own.push_back(o);
+    std::vector<bool> in_scope(plan.temporaries.size(), false);
+    if (!fn.lane_code.empty() && own.size() >= 2)
+      for (std::size_t k = 0; k < plan.temporaries.size(); ++k)
+        in_scope[k] = users[k].size() >= 2 && !batched(k) &&
+                      std::all_of(users[k].begin(), users[k].end(), [&](int o) { return o != static_cast<int>(fg.lanes); });
+    const bool scoped = std::find(in_scope.begin(), in_scope.end(), true) != in_scope.end();
+    if (scoped) {
+      std::vector<std::string> requested;
+      for (std::size_t o : own) {
+        define_shared_before(o, [&](std::size_t k) { return !in_scope[k]; });
+        requested.push_back(fn.outputs[o].name + " != nullptr");
+      }
+      body += fmt::format("  if ({}) {{\n", fmt::join(requested, " || "));
+      const std::size_t start = body.size();
+      for (std::size_t o : own) {
+        define_shared_before(o, [&](std::size_t k) { return in_scope[k]; });
+        write_output_block(fn.outputs[o], fg.outs[o], o);
+      }
+      std::string inner = body.substr(start), indented;
+      body.resize(start);
+      std::istringstream lines(inner);
+      for (std::string line; std::getline(lines, line);) indented += "  " + line + "\n";
+      body += indented + "  }\n";
+    }
     for (std::size_t o = 0; o < fg.outs.size(); ++o) {
-      define_shared_before(o);
+      if (scoped && std::find(own.begin(), own.end(), o) != own.end()) continue;
+      define_shared_before(o, [](std::size_t) { return true; });
       if (o == fg.lanes)
         write_lane_block(fn, fg.outs[o], o);
       else if (!fn.outputs[o].from_lanes)
@@ -165,10 +197,12 @@ struct BodyWriter {
   // whose expression reaches k, through other temporaries too, so a temporary's first reader is
   // never after the first reader of one built on it, and ascending k within a block keeps the
   // order of dependence. (All up front, clang kept every one live across the blocks and spilled
-  // about 6 kB of stack in the wheeled quadruped's kinematic_update: 1.7x GCC's time.)
-  void define_shared_before(std::size_t o) {
+  // about 6 kB of stack in the wheeled quadruped's kinematic_update: 1.7x GCC's time.) Only the
+  // temporaries `which` takes.
+  template <class Which>
+  void define_shared_before(std::size_t o, const Which& which) {
     for (std::size_t k = 0; k < plan.temporaries.size(); ++k)
-      if (users[k].size() >= 2 && !batched(k) && static_cast<std::size_t>(*users[k].begin()) == o)
+      if (users[k].size() >= 2 && !batched(k) && static_cast<std::size_t>(*users[k].begin()) == o && which(k))
         body += fmt::format("  const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], shared_ops));
   }
 
@@ -282,8 +316,9 @@ std::string operations_documentation(const FunctionSpec& fn, const FunctionGraph
                      "// {} operations, computed only when one of them is requested.\n",
                      fn.lane_scalars.size(), w.output_ops[fg.lanes].total());
   t += fmt::format("// Intermediate terms: {}; shared by several outputs: {} operations (sin and cos of all angles\n"
-                   "// included: they are computed up front, whichever outputs are requested).\n",
-                   stats.intermediates, w.shared_ops.total());
+                   "// included: they are computed up front, whichever outputs are requested{}).\n",
+                   stats.intermediates, w.shared_ops.total(),
+                   fn.lane_code.empty() ? "" : ";\n// those only the outputs outside the lane code share, only when one of them is");
   t += fmt::format("// Operations with every output requested: {}.\n", op_summary(stats.after_cse));
   t += fmt::format("// The same outputs as expression trees, before CSE: {}.\n", op_summary(stats.before_cse));
   return t;

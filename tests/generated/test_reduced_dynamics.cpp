@@ -99,11 +99,20 @@ TEST_CASE("reduced_dynamics: each output alone is what it is with all of them re
   gen::CommandMatrix M, M_alone;
   gen::CommandVector b, Q, b_alone, Q_alone;
   gen::CommandRows B, B_alone;
-  gen::reduced_dynamics(s, sdot, T, p, {.M = &M, .b_velocity = &b, .B_bias = &B, .Q_gravity = &Q});
+  gen::ClosureVector conv, conv_alone;
+  gen::WheelVector C_conv, C_conv_alone;
+  gen::reduced_dynamics(s, sdot, T, p,
+                        {.dPhi_ds_dot_sdot = &conv, .C_dot_sdot = &C_conv, .M = &M, .b_velocity = &b, .B_bias = &B, .Q_gravity = &Q});
+  // The convective terms share their own temporaries in a scope of their own (emit_function.cpp):
+  // each alone, and the lane code's outputs without them.
+  gen::reduced_dynamics(s, sdot, T, p, {.dPhi_ds_dot_sdot = &conv_alone});
+  gen::reduced_dynamics(s, sdot, T, p, {.C_dot_sdot = &C_conv_alone});
   gen::reduced_dynamics(s, sdot, T, p, {.M = &M_alone});
   gen::reduced_dynamics(s, sdot, T, p, {.b_velocity = &b_alone});
   gen::reduced_dynamics(s, sdot, T, p, {.B_bias = &B_alone});
   gen::reduced_dynamics(s, sdot, T, p, {.Q_gravity = &Q_alone});
+  CHECK(conv == conv_alone);
+  CHECK(C_conv == C_conv_alone);
   CHECK(M == M_alone);
   CHECK(b == b_alone);
   CHECK(B == B_alone);

@@ -26,7 +26,8 @@ namespace gen {
 // The scalars that code is built from (107 of them, the bodies' and joints' geometry among them):
 // 43 operations, computed only when one of them is requested.
 // Intermediate terms: 6; shared by several outputs: 30 operations (sin and cos of all angles
-// included: they are computed up front, whichever outputs are requested).
+// included: they are computed up front, whichever outputs are requested;
+// those only the outputs outside the lane code share, only when one of them is).
 // Operations with every output requested: 1120 (adds 469, muls 621, divs 0, calls 30).
 // The same outputs as expression trees, before CSE: 100 (adds 0, muls 28, divs 0, calls 72).
 // Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by

@@ -26,7 +26,8 @@ namespace gen {
 // The scalars that code is built from (115 of them, the bodies' and joints' geometry among them):
 // 43 operations, computed only when one of them is requested.
 // Intermediate terms: 5; shared by several outputs: 30 operations (sin and cos of all angles
-// included: they are computed up front, whichever outputs are requested).
+// included: they are computed up front, whichever outputs are requested;
+// those only the outputs outside the lane code share, only when one of them is).
 // Operations with every output requested: 1228 (adds 523, muls 675, divs 0, calls 30).
 // The same outputs as expression trees, before CSE: 92 (adds 0, muls 20, divs 0, calls 72).
 // Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by

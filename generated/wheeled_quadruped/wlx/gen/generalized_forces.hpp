@@ -26,7 +26,8 @@ namespace gen {
 // The scalars that code is built from (199 of them, the bodies' and joints' geometry among them):
 // 15 operations, computed only when one of them is requested.
 // Intermediate terms: 0; shared by several outputs: 30 operations (sin and cos of all angles
-// included: they are computed up front, whichever outputs are requested).
+// included: they are computed up front, whichever outputs are requested;
+// those only the outputs outside the lane code share, only when one of them is).
 // Operations with every output requested: 2262 (adds 1001, muls 1231, divs 0, calls 30).
 // The same outputs as expression trees, before CSE: 60 (adds 0, muls 0, divs 0, calls 60).
 // Scalar: double, float, or a number type with +, -, *, / and sin, cos (, sqrt, ...) found by
