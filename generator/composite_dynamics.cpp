@@ -232,10 +232,11 @@ S6 body_bias_wrench(const Model& m, const TwistTree& tree, const Unit& u, std::s
   return out;
 }
 
-// b_velocity = T^T tau: the bodies' bias wrenches summed back along the chains in each unit's frame
+// b_velocity = T^T tau, in its output's block: the bodies' bias wrenches summed back along the chains in each unit's frame
 // (a child's carried by its placement), tau = S . W.
 void velocity_forces(const Model& m, const TwistTree& tree, const Projection& pr, const std::vector<Placement>& X, Builder& w) {
   w.charge_to = kB_velocity;
+  w.add(lane_code::OpenOutput{"b_velocity", ""});
   const std::vector<Motion> motion = bias_motion(pr, X, w);
   const Units& units = pr.units;
   std::vector<S6> beyond(units.units.size()), passed(units.units.size());
@@ -263,7 +264,6 @@ void velocity_forces(const Model& m, const TwistTree& tree, const Projection& pr
   }
   std::vector<Signed> b;
   for (int l = 0; l < pr.nu; ++l) b.push_back(pr.transposed(value_id(Quantity::commanded_force, l), l, per_unit, w));
-  w.add(lane_code::OpenOutput{"b_velocity", ""});
   for (int l = 0; l < pr.nu; ++l) store(w, "b_velocity", l, -1, false, b[at(l)]);
   w.add(lane_code::CloseOutput{});
 }
@@ -310,10 +310,11 @@ lane_code::LaneProgram composite_rigid_body_program(const Model& m) {
   const auto M = unit_mass(pr, X, composite, w);
   w.add(lane_code::Comment{"M on the commanded speeds: T^T M T on T's pattern (T^T M's dense columns are B_bias)."});
   project_mass(pr, M, w);
-  w.add(lane_code::Comment{"b_velocity: the bodies' bias wrenches summed back along the chains, projected by T^T."});
-  velocity_forces(m, tree, pr, X, w);
   w.add(lane_code::Comment{"Q_gravity from the composites' masses and first moments, projected by T^T."});
   gravity_forces(m, tree, pr, composite, w);
+  // Last, in a block of its own: nothing after it reads its values, and a call for M alone skips it.
+  w.add(lane_code::Comment{"b_velocity: the bodies' bias wrenches summed back along the chains, projected by T^T."});
+  velocity_forces(m, tree, pr, X, w);
   return std::move(w.program());
 }
 

@@ -63,6 +63,8 @@ class Builder {
   lane_code::LaneProgram program_;
   std::set<lane_code::ValueId> made_, rows_;
   std::map<lane_code::ValueId, Signed> packed_;
+  std::map<std::vector<std::pair<lane_code::ValueId, bool>>, Signed> rows_by_contents_;
+  std::map<ex, Signed, GiNaC::ex_is_less> scalar_of_value_;
 };
 
 using S3 = std::array<Signed, 3>;

@@ -35,7 +35,11 @@ Signed Builder::scalar(const ValueId& id, const ex& value) {
   if (value.is_zero()) return {};
   if (value.is_equal(1)) return kUnit;
   if (value.is_equal(-1)) return -kUnit;
+  // One lane scalar per value: a rotation's cosine on its diagonal twice, its sine and minus it.
+  if (const auto it = scalar_of_value_.find(value); it != scalar_of_value_.end()) return it->second;
+  if (const auto it = scalar_of_value_.find(-value); it != scalar_of_value_.end()) return -it->second;
   if (made_.insert(id).second) program_.scalar(id, value);
+  scalar_of_value_[value] = {id, false};
   return {id, false};
 }
 
@@ -60,13 +64,21 @@ Signed Builder::pack(const ValueId& key, const std::vector<Signed>& lanes) {
   if ((first.is_zero() || first.is_one()) &&
       std::all_of(lanes.begin(), lanes.end(), [&](const Signed& v) { return v.id == first.id && v.negate == first.negate; }))
     return out = first;
+  // Every lane negated (-sin of the limbs' angles, say): the row of the values, read negated; a row
+  // of the same lanes as one made before (a rotation's cosine on its diagonal twice): that row.
+  const bool flip = std::all_of(lanes.begin(), lanes.end(), [](const Signed& v) { return v.is_zero() || v.negate; });
+  std::vector<std::pair<ValueId, bool>> contents;
+  for (const Signed& v : lanes) contents.emplace_back(v.id, flip ? false : v.negate);
+  if (const auto it = rows_by_contents_.find(contents); it != rows_by_contents_.end())
+    return out = flip ? -it->second : it->second;
   lane_code::LoadRow row{derived(Quantity::lanes_of, key), {}};
   for (std::size_t g = 0; g < lanes.size(); ++g)
-    if (!lanes[g].is_zero()) row.lanes.emplace_back(static_cast<int>(g), holding(lanes[g]));
-  out = {row.target, false};
+    if (!lanes[g].is_zero()) row.lanes.emplace_back(static_cast<int>(g), holding(flip ? -lanes[g] : lanes[g]));
+  const Signed made{row.target, false};
   rows_.insert(row.target);
+  rows_by_contents_[contents] = made;
   add(std::move(row));
-  return out;
+  return out = flip ? -made : made;
 }
 
 Signed Builder::define(const ValueId& target, const std::vector<Product>& products) {

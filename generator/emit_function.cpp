@@ -142,6 +142,7 @@ struct BodyWriter {
   std::string body;
   OpCount shared_ops;
   std::vector<OpCount> output_ops;
+  std::string indent = "    ";  // of the lane code's line being written
 
   bool batched(std::size_t k) const { return trig.names.count(plan.temporaries[k]) != 0; }
   // Whether temporary k is block o's alone (then defined inside that block).
@@ -230,9 +231,15 @@ struct BodyWriter {
     std::map<std::string, int> pending;  // lane scalar -> node
     for (const auto& el : scalars) pending.emplace(el.lvalue, el.id);
     std::istringstream lines(fn.lane_code);
+    int depth = 0;  // the lane code's own blocks (an output's code run only when it is requested)
     for (std::string line; std::getline(lines, line);) {
+      const std::size_t text = line.find_first_not_of(' ');
+      if (text != std::string::npos && line[text] == '}') --depth;
+      indent = std::string(4 + 2 * static_cast<std::size_t>(std::max(depth, 0)), ' ');
       for (const auto& word : identifiers(line)) define_lane_scalar(word, pending, emitted, o);
       body += line + "\n";
+      const std::string code = line.substr(0, line.find("  //"));  // a block's opening line may end in a comment
+      if (!code.empty() && code.back() == '{') ++depth;
     }
     if (!pending.empty()) throw std::logic_error("lane scalar " + pending.begin()->first + " is never read");
     body += "  }\n";
@@ -250,12 +257,12 @@ struct BodyWriter {
       if (local_to(k, o) && !emitted[k]) {
         emitted[k] = true;
         define_needs(id, emitted, o);
-        body += fmt::format("    const Scalar t{} = {};\n", k, pr.define(id, output_ops[o]));
+        body += fmt::format("{}const Scalar t{} = {};\n", indent, k, pr.define(id, output_ops[o]));
       }
     } else {
       define_needs(id, emitted, o);
     }
-    body += fmt::format("    const Scalar {} = {};\n", name, pr.value(id, output_ops[o]));
+    body += fmt::format("{}const Scalar {} = {};\n", indent, name, pr.value(id, output_ops[o]));
   }
 
   // The temporaries of block o that node `id` reads, not defined yet, each after its own.
@@ -266,7 +273,7 @@ struct BodyWriter {
         if (!local_to(k, o) || emitted[k]) continue;
         emitted[k] = true;
         define_needs(plan.temporaries[k], emitted, o);
-        body += fmt::format("    const Scalar t{} = {};\n", k, pr.define(plan.temporaries[k], output_ops[o]));
+        body += fmt::format("{}const Scalar t{} = {};\n", indent, k, pr.define(plan.temporaries[k], output_ops[o]));
       } else {
         define_needs(a, emitted, o);
       }

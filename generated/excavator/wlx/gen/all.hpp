@@ -14,10 +14,10 @@
 //   bodies                       315         58902          2163
 //   kinematic_update             194         48373          1304
 //   dynamics_update              150         37306          1043
-//   reduced_dynamics             372         62714          4890
+//   reduced_dynamics             365         62682          4883
 //   generalized_forces             6           100          1120
 //   clearance                      0            22            23
-//   total                                   330382         14557
+//   total                                   330350         14550
 #pragma once
 
 #include "ik.hpp"

@@ -14,10 +14,10 @@
 //   bodies                       388         63427          2538
 //   kinematic_update             234         60493          1338
 //   dynamics_update              183         47698           988
-//   reduced_dynamics             429         68978          5063
+//   reduced_dynamics             423         68952          5056
 //   generalized_forces             5            92          1228
 //   clearance                      0            22            23
-//   total                                   387799         15163
+//   total                                   387773         15156
 #pragma once
 
 #include "ik.hpp"

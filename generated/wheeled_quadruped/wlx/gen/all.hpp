@@ -14,10 +14,10 @@
 //   bodies                      1018        165475          5175
 //   kinematic_update             420         98350          2296
 //   dynamics_update              361        102428          1916
-//   reduced_dynamics             426        198754          8465
+//   reduced_dynamics             425        198722          8464
 //   generalized_forces             0            60          2262
 //   clearance                      0            22            22
-//   total                                   921995         26815
+//   total                                   921963         26814
 #pragma once
 
 #include "ik.hpp"
