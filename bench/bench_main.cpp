@@ -318,8 +318,8 @@ void BM_gen_dynamics_passes(benchmark::State& st) {
     benchmark::DoNotOptimize(x.terms.Qstar.data());
   }
 }
-// Kane's sums alone: reduced_dynamics' (twists and wrenches on lanes) against the same sums over
-// bodies()' full Jacobians with dense Eigen products (what a user of the body Jacobians writes;
+// The equations of motion alone: reduced_dynamics' (composite rigid bodies in the joints' frames)
+// against Kane's sums over bodies()' full Jacobians with dense Eigen products (what a user of the body Jacobians writes;
 // the step's before: the runtime summed them over the bodies' columns).
 void BM_gen_kane_sums(benchmark::State& st) {
   SolvedStep x;
@@ -754,7 +754,7 @@ int main(int argc, char** argv) {
       {"  its generated code alone: 4-limb IK + the three passes", "BM_inverse_dynamics_generated_only", nullptr, 0},
       {"  the three passes: dynamics_update, convective, generalized_forces (Newton-Euler)", "BM_gen_dynamics_passes", nullptr,
        ops::dynamics_update + ops::convective + ops::generalized_forces},
-      {"  Kane's sums: reduced_dynamics, M b B_bias Q_gravity (vs over bodies()' Jacobians)", "BM_gen_kane_sums",
+      {"  reduced_dynamics, M b B_bias Q_gravity (vs Kane's sums over bodies()' Jacobians)", "BM_gen_kane_sums",
        "BM_kane_sums_over_body_jacobians", 0},
       {"NH-1 run (2001 samples, RK4)", "BM_run_NH1", nullptr, 0},
       {"ID-1 run (495 samples, RK4, torques)", "BM_run_ID1", nullptr, 0},
