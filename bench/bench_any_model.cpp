@@ -108,8 +108,8 @@ void inverse_dynamics_step(benchmark::State& st) {
   }
 }
 
-// The same step with Q* from Kane's equations of motion (M u' + b - Q_gravity, reduced_dynamics'
-// sums on the commanded speeds) instead of the Newton-Euler pass: what the step cost before, and
+// The same step with Q* from the equations of motion (M u' + b - Q_gravity, reduced_dynamics on
+// the commanded speeds) instead of the Newton-Euler pass: what the step cost before, and
 // what it costs a user who also wants M.
 void inverse_dynamics_step_by_kane(benchmark::State& st) {
   auto x = std::make_unique<Pose>();

@@ -3,14 +3,11 @@
 // placement_R, placement_r), a joint's I S walks up its chain the same way, and b_velocity comes
 // from the Newton-Euler recursion at zero u' in the same frames. An axis-aligned joint's S is then a
 // signed unit vector (I S is a column of I, S . W one component), and a placement's zero and unit
-// entries cost nothing; the pass in K0 (composite_dynamics.cpp) instead needs every joint's axis and
-// every body's pose in K0 from s, which on a legged machine cost more than the pass itself (the
-// wheeled quadruped: 6,779 instructions and lane-scalar operations in K0, 2,984 here; Kane's sums
-// over the bodies, on lanes per commanded speed, 8,915). Sibling limbs of one shape run side by
-// side, one lane each (composite_units.cpp).
+// entries cost nothing; the same pass in K0, and Kane's sums over the bodies, both gone, needed
+// every joint's axis and every body's pose in K0 from s first, which on a legged machine cost more
+// than the pass itself (docs/architecture.md). Sibling limbs of one shape run side by side, one
+// lane each (composite_units.cpp).
 #include "composite_internal.hpp"
-
-#include <fmt/format.h>
 
 namespace wlx::codegen::derivation {
 
@@ -152,7 +149,7 @@ struct Motion {
 
 // Out along the chains: omega_k = R^T omega_p + e s'_k, alpha_k = R^T alpha_p + (R^T omega_p) x e s'_k,
 // a_k = R^T (a_p + alpha_p x r + omega_p x (omega_p x r)) for a revolute joint (a prismatic one
-// adds 2 (R^T omega_p) x e s'_k to a_k instead), e s'_k from the joint's axis S.
+// adds 2 (R^T omega_p) x e s'_k to a_k, its own e s'_k none to omega), e s'_k from the joint's axis S.
 std::vector<Motion> bias_motion(const Projection& pr, const std::vector<Placement>& X, Builder& w) {
   const auto& units = pr.units.units;
   std::vector<Motion> out(units.size());

@@ -40,7 +40,7 @@ struct Sum {
 
 // Builds the code, one definition per value, each statement counted for `charge_to`. A value is a
 // scalar or a row of `width` lanes (a row unit's, lane g for limb g); a sum is a row when any of
-// its products has a row in it, and then every product must. Exact zeros, ones and signs are
+// its products has a row in it, its scalar products then added up and put in every lane. Exact zeros, ones and signs are
 // folded while building: a sum of one plain product is no statement, a sum whose terms are all
 // negative is defined positive and read negated.
 class Builder {
@@ -60,6 +60,10 @@ class Builder {
 
  private:
   lane_code::ValueId holding(const Signed& v);  // a value equal to v: v itself, a one, a negation
+  // A value of the builder's own named after another one (a row of the first lane's value, the
+  // scalar part of a row's sum), one per (what, from).
+  lane_code::ValueId derived(lane_code::Quantity what, const lane_code::ValueId& from);
+  std::map<std::pair<lane_code::Quantity, lane_code::ValueId>, lane_code::ValueId> derived_;
   lane_code::LaneProgram program_;
   std::set<lane_code::ValueId> made_, rows_;
   std::map<lane_code::ValueId, Signed> packed_;
@@ -164,7 +168,7 @@ struct Summands {
 Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, const std::function<Vec3(std::size_t)>& p_of,
                      const std::function<Mat3(std::size_t)>& R_of, Builder& w);
 // The composite inertias beyond each unit, from the leaves in: its bodies' (own(u, s)) and its
-// children's as `carried` puts them in its axes (the identity in K0).
+// children's as `carried` puts them in its axes.
 std::vector<Inertia> composite_inertias(const Units& units, const std::function<Inertia(std::size_t, std::size_t)>& own,
                                         const std::function<Inertia(std::size_t, const Inertia&)>& carried, Builder& w);
 // I S for a composite inertia and a joint's axis S = (a; b), in the inertia's axes and about its

@@ -3,8 +3,6 @@
 // inertias and wrenches the pass is made of.
 #include "composite_internal.hpp"
 
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <functional>
 
@@ -17,15 +15,14 @@ using lane_code::Term;
 using lane_code::value_id;
 using lane_code::ValueId;
 
-namespace {
-
-// A value named after another one (the first lane's value of a row, say): its quantity and
-// indices, folded into three indices.
-ValueId derived(Quantity what, const ValueId& from) {
-  return value_id(what, static_cast<int>(from.what) * 1000 + from.index[0], from.index[1], from.index[2]);
+ValueId Builder::derived(Quantity what, const ValueId& from) {
+  const auto key = std::pair{what, from};
+  if (const auto it = derived_.find(key); it != derived_.end()) return it->second;
+  const ValueId id = value_id(what, static_cast<int>(derived_.size()));
+  derived_.emplace(key, id);
+  program_.named_after.emplace(id, from);
+  return id;
 }
-
-}  // namespace
 
 Builder::Builder(int width) {
   program_.width = width;
@@ -92,6 +89,7 @@ Signed Builder::define(const ValueId& target, const std::vector<Product>& produc
     Signed factor = p.a, value = p.b;
     if (value.is_one() || (p.lane < 0 && is_row(factor) && !is_row(value))) std::swap(factor, value);
     if (p.lane >= 0 && is_row(factor)) throw std::logic_error("composite dynamics: a row factor of a lane");
+    if (p.lane >= 0 && !is_row(value)) throw std::logic_error("composite dynamics: a lane of a scalar");
     terms.push_back({factor.is_one() ? kOne : factor.id, value.id, p.lane, negate});
     row_term.push_back(is_row(factor) || (is_row(value) && p.lane < 0));
   }
@@ -413,8 +411,9 @@ void project_mass(const Projection& pr, const std::map<std::pair<int, int>, Sign
       if (pr.units.units[u].row() || pr.dense_plain(static_cast<int>(u)))
         bias[{l, static_cast<int>(u)}] = pr.projected(value_id(Quantity::projected_mass, l, pr.units.units[u].nodes[0]),
                                                       l, static_cast<int>(u), M, w);
-  // Every value before the outputs' blocks, none inside one: the code a value needs is placed
-  // before its first reader (emit_function.cpp), which must not be in a block a later reader is not.
+  // Every value M and B_bias read before their blocks: the code a value needs is placed before its
+  // first reader (emit_function.cpp), and a reader after the block of the first would compute it
+  // again.
   w.charge_to = kM;
   std::map<std::pair<int, int>, Signed> reduced;
   for (int l = 0; l < pr.nu; ++l)

@@ -227,55 +227,80 @@ struct BodyWriter {
     // Each scalar right before the first line of lane code that reads it, after the block's own
     // temporaries it needs: computed where used, not all up front, so that fewer values wait in
     // registers or on the stack while the lanes run (the code gets shorter).
-    std::vector<bool> emitted(plan.temporaries.size(), false);
-    std::map<std::string, int> pending;  // lane scalar -> node
-    for (const auto& el : scalars) pending.emplace(el.lvalue, el.id);
+    LaneScalars state;
+    state.emitted.assign(plan.temporaries.size(), false);
+    for (const auto& el : scalars) state.pending.emplace(el.lvalue, el.id);
     std::istringstream lines(fn.lane_code);
-    int depth = 0;  // the lane code's own blocks (an output's code run only when it is requested)
     for (std::string line; std::getline(lines, line);) {
       const std::size_t text = line.find_first_not_of(' ');
-      if (text != std::string::npos && line[text] == '}') --depth;
-      indent = std::string(4 + 2 * static_cast<std::size_t>(std::max(depth, 0)), ' ');
-      for (const auto& word : identifiers(line)) define_lane_scalar(word, pending, emitted, o);
+      if (text != std::string::npos && line[text] == '}') close_lane_scope(state);
+      indent = std::string(4 + 2 * state.scopes.size(), ' ');
+      for (const auto& word : identifiers(line)) define_lane_scalar(word, state, o);
       body += line + "\n";
       const std::string code = line.substr(0, line.find("  //"));  // a block's opening line may end in a comment
-      if (!code.empty() && code.back() == '{') ++depth;
+      if (!code.empty() && code.back() == '{') state.scopes.emplace_back();
     }
-    if (!pending.empty()) throw std::logic_error("lane scalar " + pending.begin()->first + " is never read");
+    if (!state.pending.empty()) throw std::logic_error("lane scalar " + state.pending.begin()->first + " is never read");
     body += "  }\n";
   }
 
-  // The lane scalar `name` if it is still pending, after the temporaries of block o it needs.
-  void define_lane_scalar(const std::string& name, std::map<std::string, int>& pending, std::vector<bool>& emitted,
-                          std::size_t o) {
-    const auto it = pending.find(name);
-    if (it == pending.end()) return;
+  // The lane code's scalars and the temporaries they need, as they are placed: those not yet
+  // defined, and those defined inside each of the lane code's blocks open at the line at hand (an
+  // output's code run only when it is requested), which a reader after the block defines again.
+  struct Scope {
+    std::vector<std::pair<std::string, int>> scalars;
+    std::vector<std::size_t> temporaries;
+  };
+  struct LaneScalars {
+    std::map<std::string, int> pending, closed;  // lane scalar -> node: never defined; defined in a closed block
+    std::vector<bool> emitted;
+    std::vector<Scope> scopes;
+  };
+  static void close_lane_scope(LaneScalars& state) {
+    if (state.scopes.empty()) return;
+    for (const auto& [name, id] : state.scopes.back().scalars) state.closed.emplace(name, id);
+    for (std::size_t k : state.scopes.back().temporaries) state.emitted[k] = false;
+    state.scopes.pop_back();
+  }
+
+  // The lane scalar `name` if it is not defined where this line is, after the temporaries of
+  // block o it needs.
+  void define_lane_scalar(const std::string& name, LaneScalars& state, std::size_t o) {
+    auto it = state.pending.find(name);
+    std::map<std::string, int>* from = &state.pending;
+    if (it == state.pending.end()) {
+      it = state.closed.find(name);
+      from = &state.closed;
+      if (it == state.closed.end()) return;
+    }
     const int id = it->second;
-    pending.erase(it);
+    from->erase(it);
     if (auto t = plan.temp_index.find(id); t != plan.temp_index.end()) {
       const auto k = static_cast<std::size_t>(t->second);
-      if (local_to(k, o) && !emitted[k]) {
-        emitted[k] = true;
-        define_needs(id, emitted, o);
-        body += fmt::format("{}const Scalar t{} = {};\n", indent, k, pr.define(id, output_ops[o]));
-      }
+      if (local_to(k, o) && !state.emitted[k]) define_temporary(k, state, o);
     } else {
-      define_needs(id, emitted, o);
+      define_needs(id, state, o);
     }
     body += fmt::format("{}const Scalar {} = {};\n", indent, name, pr.value(id, output_ops[o]));
+    if (!state.scopes.empty()) state.scopes.back().scalars.emplace_back(name, id);
+  }
+
+  // Temporary k of block o, after those of block o it reads.
+  void define_temporary(std::size_t k, LaneScalars& state, std::size_t o) {
+    state.emitted[k] = true;
+    define_needs(plan.temporaries[k], state, o);
+    body += fmt::format("{}const Scalar t{} = {};\n", indent, k, pr.define(plan.temporaries[k], output_ops[o]));
+    if (!state.scopes.empty()) state.scopes.back().temporaries.push_back(k);
   }
 
   // The temporaries of block o that node `id` reads, not defined yet, each after its own.
-  void define_needs(int id, std::vector<bool>& emitted, std::size_t o) {
+  void define_needs(int id, LaneScalars& state, std::size_t o) {
     for (int a : g.node(id).args) {
       if (auto it = plan.temp_index.find(a); it != plan.temp_index.end()) {
         const auto k = static_cast<std::size_t>(it->second);
-        if (!local_to(k, o) || emitted[k]) continue;
-        emitted[k] = true;
-        define_needs(plan.temporaries[k], emitted, o);
-        body += fmt::format("{}const Scalar t{} = {};\n", indent, k, pr.define(plan.temporaries[k], output_ops[o]));
+        if (local_to(k, o) && !state.emitted[k]) define_temporary(k, state, o);
       } else {
-        define_needs(a, emitted, o);
+        define_needs(a, state, o);
       }
     }
   }

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <compare>
+#include <map>
 #include <string>
 #include <utility>
 #include <variant>
@@ -38,7 +39,7 @@ enum class Quantity : unsigned char {
   minus_gravity,  // -g
   // Values the code computes (scalars, or rows of lanes for sibling limbs in reduced_dynamics).
   spatial_velocity,           // (k, c): (omega; velocity at K0's origin) out to node k
-  motion_cross,               // (k, c): V_parent x S
+  motion_cross,               // (k, c): V_parent x S; in a joint's own frame, its e s' (c < 3 angular)
   spatial_acceleration,       // (k, c)
   com_velocity,               // (i, c)
   com_acceleration,           // (i, c)
@@ -47,7 +48,7 @@ enum class Quantity : unsigned char {
   body_angular_acceleration,  // (i, a)
   angular_momentum,           // (i, a): I omega, body axes
   body_moment,                // (i, a): I alpha + omega x I omega, body axes
-  moment,                     // (i, c): about K0's origin, in K0
+  moment,                     // (i, c): about K0's origin in K0, or its joint's origin in its frame
   wrench,                     // (k, c): the sum over the bodies beyond node k
   joint_force,                // (k): node k's tau
   coordinate_force,           // (j): the sum of coordinate j's joints' taus
@@ -75,7 +76,7 @@ enum class Quantity : unsigned char {
   carried_acceleration,  // (k, c): the parent's acceleration at node k's origin, in the parent's axes
   incoming_motion,       // (k, c): the parent's omega, alpha, a at node k's origin, in node k's axes (3 each)
   transmitted_force,  // (k, c): the force (c < 3) and moment (c >= 3) beyond node k in its parent's axes
-  // reduced_dynamics' composite-rigid-body pass in the joints' own frames (composite_local.cpp):
+  // reduced_dynamics' composite-rigid-body pass in the joints' own frames (composite_dynamics.cpp):
   // node k's composite inertia carried into its parent's frame by its placement (R, r).
   turned_first_moment,   // (k, c): R h
   carried_first_moment,  // (k, c): R h + m r
@@ -162,6 +163,9 @@ struct LaneProgram {
   int width = 1;  // a row's lanes
   std::vector<std::pair<ValueId, ex>> scalars;
   std::vector<Statement> statements;
+  // The values of the composite builder's own making (lanes_of, row_sum, negated, scalar_part,
+  // everywhere): the value each is named after.
+  std::map<ValueId, ValueId> named_after;
   // A lane scalar of the given value; zero (nothing made) for an exact zero.
   ValueId scalar(const ValueId& id, const ex& value) {
     if (value.is_zero()) return {};
@@ -186,7 +190,7 @@ Overloaded(F...) -> Overloaded<F...>;  // clang 14 deduces no aggregate's argume
 // over and over until each value left is read.
 std::vector<bool> kept_statements(const LaneProgram& program);
 // The values a statement reads (with repeats), and the value it defines that may go unread (zero
-// for the statements that stay in any case: accumulations, stores, declarations).
+// for the statements that stay in any case: stores, declarations).
 std::vector<ValueId> reads(const Step& step);
 ValueId defined_unless_unread(const Step& step);
 // Its operations, lane by lane.

@@ -86,11 +86,10 @@ class LanePrinter {
   explicit LanePrinter(const LaneProgram& program) : program_(program) {}
 
   std::string name(const ValueId& id) const {
-    // The composite pass' values named after another one (composite_units.cpp folds that one's
-    // quantity into the first index): its name, marked.
+    // The composite pass' values named after another one (LaneProgram::named_after): its name, marked.
     if (id.what == Quantity::lanes_of || id.what == Quantity::row_sum || id.what == Quantity::negated ||
         id.what == Quantity::scalar_part || id.what == Quantity::everywhere) {
-      const ValueId from = value_id(static_cast<Quantity>(id.index[0] / 1000), id.index[0] % 1000, id.index[1], id.index[2]);
+      const ValueId from = program_.named_after.at(id);
       std::string base;
       for (const char c : name(from))  // T(18, 0) as kane_T_18_0
         if (std::isalnum(static_cast<unsigned char>(c)) || c == '_') base += c;

@@ -8,7 +8,7 @@
 // Q_wlx(s, s', s'') = G^T rne(q, G s', G s'' + G' s').
 //
 // Tolerance: 1e-10 relative to the largest entry of the compared quantity. Both sides are exact
-// formulas in double precision (MuJoCo's recursive CRBA and RNE, wlx's Kane's sums) and differ by
+// formulas in double precision (MuJoCo's recursive CRBA and RNE, wlx's generated passes) and differ by
 // rounding, some 1e-15 relative; MuJoCo stores each full inertia as principal moments and a
 // quaternion (an eigen-decomposition, good to about 1e-15 relative), and the export's placeholders
 // (a moving frame without mass gets 1e-13 of the machine's, MuJoCo refusing a massless moving body)

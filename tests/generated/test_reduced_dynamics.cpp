@@ -1,6 +1,5 @@
-// reduced_dynamics (Kane's sums on the commanded speeds, generated on lanes from the joints'
-// twists and the bodies' wrenches, or the composite-rigid-body pass: whichever the generator chose
-// for the model) against Kane's sums written out over the bodies' full Jacobians from bodies()
+// reduced_dynamics (the composite-rigid-body pass in the joints' own frames, projected on the
+// commanded speeds) against Kane's sums written out over the bodies' full Jacobians from bodies()
 // (itself checked against exact derivatives in test_bodies.cpp).
 #include "../helpers/kane_over_bodies.hpp"
 #include "../helpers/random.hpp"

@@ -96,7 +96,6 @@ struct Lanes {
   Scalar v[N];
   Scalar lane(int i) const noexcept { return v[i]; }
   void set_lane(int i, const Scalar& x) noexcept { v[i] = x; }
-  void add_to_lane(int i, const Scalar& x) noexcept { v[i] += x; }
   Lanes& operator+=(const Lanes& o) noexcept {
     for (int i = 0; i < N; ++i) v[i] += o.v[i];
     return *this;
@@ -124,9 +123,9 @@ struct Lanes {
 #define WLX_GEN_LANES_INLINE inline __attribute__((always_inline))
 // double: GCC / clang vectors of WLX_GEN_LANE_VECTOR doubles, as many as N needs, the last one
 // padded with zeros, so that the rows stay in registers and every operation is one vector
-// instruction per WLX_GEN_LANE_VECTOR lanes whatever N is: 4, an AVX register, where the code
+// instruction per WLX_GEN_LANE_VECTOR lanes (rows of 2 lanes: below): 4, an AVX register, where the code
 // may use AVX (compiled for it, or the AVX2 version of the run-time dispatch); else 2, an SSE2
-// register, since GCC makes slow code of a 4-wide vector on SSE2 (the excavator's Kane's sums
+// register, since GCC makes slow code of a 4-wide vector on SSE2 (the excavator's former Kane's sums
 // at -O2 without the dispatch: 2476 ns with 4 lanes a vector, 1526 ns with 2; clang 1477 ns
 // and 1478 ns). Always inlined: a vector is never passed to or returned from a call, whose
 // convention would depend on whether the caller targets AVX.
@@ -153,7 +152,6 @@ struct Lanes<double, N> {
   Vector c[kVectors];
   __attribute__((always_inline)) double lane(int i) const noexcept { return c[i / kWidth][i % kWidth]; }
   __attribute__((always_inline)) void set_lane(int i, double x) noexcept { c[i / kWidth][i % kWidth] = x; }
-  __attribute__((always_inline)) void add_to_lane(int i, double x) noexcept { c[i / kWidth][i % kWidth] += x; }
   __attribute__((always_inline)) Lanes& operator+=(const Lanes& o) noexcept {
     for (int k = 0; k < kVectors; ++k) c[k] += o.c[k];
     return *this;
@@ -188,12 +186,6 @@ template <typename Scalar, int N>
 WLX_GEN_LANES_INLINE Lanes<Scalar, N> zero_lanes() noexcept {
   Lanes<Scalar, N> out{};
   for (int i = 0; i < N; ++i) out.set_lane(i, Scalar(0));
-  return out;
-}
-template <typename Scalar, int N, class Matrix>
-WLX_GEN_LANES_INLINE Lanes<Scalar, N> lanes_of_row(const Matrix& m, int row) noexcept {
-  Lanes<Scalar, N> out{};
-  for (int i = 0; i < N; ++i) out.set_lane(i, m(row, i));
   return out;
 }
 // The square root the generated functions take. For double and float, Eigen's: on x86 one
