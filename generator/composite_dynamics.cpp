@@ -197,9 +197,7 @@ S6 body_bias_wrench(const Model& m, const TwistTree& tree, const Unit& u, std::s
   const int index = u.bodies[s][0];
   const auto id = [&](Quantity what, int c) { return value_id(what, index, c); };
   const auto per_lane = [&](Quantity what, int a, int b, const std::function<ex(std::size_t)>& value) {
-    std::vector<Signed> lanes;
-    for (int i : u.bodies[s]) lanes.push_back(w.scalar(value_id(what, i, a, b), value(at(i))));
-    return w.pack(value_id(what, index, a, b), lanes);
+    return per_body(w, u, s, what, a, b, value);
   };
   Placement Rc;  // the body's axes in the unit's, and its CoM
   for (int a = 0; a < 3; ++a) {

@@ -163,6 +163,9 @@ struct Summands {
   }
 };
 
+// A row of body slot s of unit u's per-body values (value(body)), named after the first lane's body.
+Signed per_body(Builder& w, const Unit& u, std::size_t s, lane_code::Quantity what, int a, int b,
+                const std::function<ex(std::size_t)>& value);
 // Body slot s of unit u as an Inertia about a point: its CoM at p_of(body) from the point, its
 // principal axes R_of(body) in the axes the inertia is written in.
 Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, const std::function<Vec3(std::size_t)>& p_of,

@@ -294,6 +294,12 @@ void Projection::add_projected(Sum& sum, int l, int u, const std::map<std::pair<
   beyond(u);
 }
 
+Signed per_body(Builder& w, const Unit& u, std::size_t s, Quantity what, int a, int b, const std::function<ex(std::size_t)>& value) {
+  std::vector<Signed> lanes;
+  for (int i : u.bodies[s]) lanes.push_back(w.scalar(value_id(what, i, a, b), value(at(i))));
+  return w.pack(value_id(what, u.bodies[s][0], a, b), lanes);
+}
+
 // Body slot s of unit u: J = R diag(I) R^T + m (|p|^2 1 - p p^T). With R's columns r_k
 // orthonormal, R diag(I) R^T = I_1 1 + (I_2 - I_1) r_2 r_2^T + (I_3 - I_1) r_3 r_3^T, so
 // J = sigma 1 + (I_2 - I_1) r_2 r_2^T + (I_3 - I_1) r_3 r_3^T - h p^T with sigma = I_1 + h . p
@@ -301,10 +307,8 @@ void Projection::add_projected(Sum& sum, int l, int u, const std::map<std::pair<
 Inertia body_inertia(const Model& m, const Unit& u, std::size_t s, const std::function<Vec3(std::size_t)>& p_of,
                                 const std::function<Mat3(std::size_t)>& R_of, Builder& w) {
   const int index = u.bodies[s][0];  // the values' names: the first lane's body
-  const auto per_lane = [&](Quantity what, int a, int b, const auto& value) {
-    std::vector<Signed> lanes;
-    for (int i : u.bodies[s]) lanes.push_back(w.scalar(value_id(what, i, a, b), value(at(i))));
-    return w.pack(value_id(what, index, a, b), lanes);
+  const auto per_lane = [&](Quantity what, int a, int b, const std::function<ex(std::size_t)>& value) {
+    return per_body(w, u, s, what, a, b, value);
   };
   const auto moment = [&](std::size_t i, int k) { return m.parameter(m.bodies[i].inertia[at(k)]).symbol; };
   Inertia out;
