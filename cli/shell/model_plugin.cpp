@@ -52,6 +52,10 @@
 #ifndef WLX_INCLUDE_FROM_BINDIR
 #define WLX_INCLUDE_FROM_BINDIR "../include"
 #endif
+// The build tree's precompiled headers of plugin_prelude.hpp (CMakeLists.txt; none with GCC).
+#ifndef WLX_PLUGIN_PRECOMPILED_DIR
+#define WLX_PLUGIN_PRECOMPILED_DIR ""
+#endif
 
 namespace wlx::cli {
 
@@ -124,6 +128,7 @@ struct Sources {
   fs::path runtime_sources;  // the runtime's *.cpp
   fs::path cli;              // holds shell/, commands/, report/
   fs::path viewer_module;    // holds viewer_module.cpp (the viewer's WebAssembly interface)
+  fs::path precompiled;      // holds plugin_prelude-<flags>.pch (plugin_prelude.hpp precompiled), if wlx built them
 };
 
 Sources find_sources() {
@@ -131,10 +136,11 @@ Sources find_sources() {
   const fs::path bin = executable_dir();
   const fs::path share = (bin / WLX_SHARE_FROM_BINDIR).lexically_normal();
   if (!bin.empty() && fs::is_regular_file(share / "cli" / "commands" / "per_model.hpp", ec))
-    return {(bin / WLX_INCLUDE_FROM_BINDIR).lexically_normal(), share / "support", share / "runtime", share / "cli", share / "viewer_module"};
+    return {(bin / WLX_INCLUDE_FROM_BINDIR).lexically_normal(), share / "support", share / "runtime", share / "cli", share / "viewer_module",
+            share / "precompiled"};
   const fs::path tree = WLX_SOURCE_TREE;
   if (!tree.empty() && fs::is_regular_file(tree / "cli" / "commands" / "per_model.hpp", ec))
-    return {tree / "runtime", tree / "support", tree / "runtime" / "wlx", tree / "cli", tree / "viewer" / "wasm"};
+    return {tree / "runtime", tree / "support", tree / "runtime" / "wlx", tree / "cli", tree / "viewer" / "wasm", WLX_PLUGIN_PRECOMPILED_DIR};
   throw Error("--model-file", fmt::format("the sources a model's plugin is compiled from are missing (looked in {} and {}): "
                                           "reinstall wlx",
                                           share.string(), tree.string()));
@@ -374,6 +380,34 @@ std::vector<GeneratedUnit> generated_units(const fs::path& runtime_sources, cons
   return units;  // the largest first: the longest compiles start first
 }
 
+// The arguments that load plugin_prelude.hpp precompiled for a part compiled with `argv` (the
+// compiler, then its flags: `optimization`'s last), or none. wlx's build precompiles it once per
+// optimization of a model's parts, named after those flags (plugin_prelude-O3.pch for "-O3"; CMakeLists.txt);
+// only the compiler wlx was built with, with the same flags, can load one, and not once a header
+// it was made from has changed (Clang refuses it then). A compile of nothing with it (60 ms) asks
+// the compiler first, so that a header it refuses costs the plugin its speed, never its build; its
+// answer is in precompiled-<name>.log. WLX_PLUGIN_PRECOMPILED_DIR names another folder to look in
+// (empty: none).
+std::vector<std::string> precompiled_prelude(const Sources& src, const std::vector<std::string>& optimization,
+                                             std::vector<std::string> argv, const fs::path& dir) {
+  const char* env = std::getenv("WLX_PLUGIN_PRECOMPILED_DIR");
+  const fs::path folder = env != nullptr ? fs::path(env) : src.precompiled;
+  if (folder.empty() || optimization.empty() || compiler() != built_with_compiler()) return {};
+  std::string name;
+  for (const std::string& flag : optimization) {
+    if (flag.size() < 2 || flag[0] != '-') return {};
+    name += (name.empty() ? "" : "_") + flag.substr(1);
+  }
+  if (!std::all_of(name.begin(), name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; })) return {};
+  const fs::path pch = folder / fmt::format("plugin_prelude-{}.pch", name);
+  std::error_code ec;
+  if (!fs::is_regular_file(pch, ec)) return {};
+  const std::vector<std::string> use{"-include-pch", pch.string()};
+  argv.insert(argv.end(), use.begin(), use.end());
+  argv.insert(argv.end(), {"-fsyntax-only", "-x", "c++", "/dev/null"});
+  return run_program(argv, {}, (dir / fmt::format("precompiled-{}.log", name)).string()).ok() ? use : std::vector<std::string>{};
+}
+
 // Generates the model's headers and compiles its plugin into `dir`.
 void build_plugin(const fs::path& model_file, const Description& description, const std::string& key, const fs::path& dir,
                   const fs::path& failed_logs) {
@@ -428,17 +462,26 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   for (const auto& include : split_list(WLX_PLUGIN_INCLUDES)) common.push_back("-isystem" + include);
   std::vector<Job> jobs;
   std::vector<std::string> objects;
-  const auto compile = [&](const std::string& what, const fs::path& source, const std::string& stem) {
+  std::map<bool, std::vector<std::string>> part_flags;  // by "is the commands' part"
+  const auto probing = std::chrono::steady_clock::now();
+  for (const bool commands : {false, true}) {
     std::vector<std::string> argv = common;
-    for (const auto& f : optimization_flags(what == "commands")) argv.push_back(f);
+    const std::vector<std::string> optimization = optimization_flags(commands);
+    argv.insert(argv.end(), optimization.begin(), optimization.end());
+    for (const auto& f : precompiled_prelude(src, optimization, argv, dir)) argv.push_back(f);
+    part_flags[commands] = argv;
+  }
+  timings.emplace_back("precompiled headers checked", std::chrono::duration<double>(std::chrono::steady_clock::now() - probing).count());
+  const auto compile = [&](const std::string& what, const fs::path& source, const std::string& stem) {
+    std::vector<std::string> argv = part_flags.at(what == "commands");
     argv.insert(argv.end(), {"-c", source.string(), "-o", (dir / (stem + ".o")).string()});
     jobs.push_back({what, argv, dir / (stem + ".log")});
     objects.push_back((dir / (stem + ".o")).string());
   };
   // The longest first, so that the cores finish together.
+  compile("commands", dir / "commands_unity.cpp", "commands_unity");
   compile("runtime", dir / "runtime_unity.cpp", "runtime_unity");
   for (const auto& f : apart) compile("runtime " + f, src.runtime_sources / f, "runtime_" + fs::path(f).stem().string());
-  compile("commands", dir / "commands_unity.cpp", "commands_unity");
   for (const GeneratedUnit& unit : generated_units(src.runtime_sources, gen / "wlx" / "gen")) {
     std::string text = "// The generated functions of " + fmt::format("{}", fmt::join(unit.sources, ", ")) + ", in one translation unit.\n";
     for (const auto& f : unit.sources) text += include_line(src.runtime_sources / f);

@@ -91,6 +91,15 @@ TEST_CASE("--model-file: compiled on first use, then loaded from the cache; it c
   const nlohmann::json own = nlohmann::json::parse(first.out);
   REQUIRE(entries().size() == 1);
   CHECK(fs::file_size(entries().front() / "plugin.so") > 100000);
+  // Built by Clang, wlx precompiled the plugin's common headers for these flags (-O0:
+  // plugin_prelude-O0.pch), and the compiler accepted them (its check's log is empty); GCC's build
+  // has none to offer.
+#ifdef __clang__
+  REQUIRE(fs::exists(entries().front() / "precompiled-O0.log"));
+  CHECK(slurp(entries().front() / "precompiled-O0.log").empty());
+#else
+  CHECK(!fs::exists(entries().front() / "precompiled-O0.log"));
+#endif
 
   // The built-in excavator with the same thighs: the same numbers (the same generated code from
   // the same file, with one parameter moved from the file to --params).
@@ -255,9 +264,19 @@ TEST_CASE("--model-file: a corrupt or replaced cache entry is never loaded but r
   // The build folder a killed first use left behind (its pid runs no more): removed when building.
   const fs::path abandoned = s.cache / (entry.filename().string() + ".build-2147483000");
   fs::create_directories(abandoned / "generated");
+  // This rebuild finds a precompiled header the compiler refuses (not one at all): it compiles
+  // without it, as it would with a stale one.
+  const fs::path refused_pch = wlx_test::work_dir() / "refused-pch";
+  fs::create_directories(refused_pch);
+  write(refused_pch / "plugin_prelude-O0.pch", "not a precompiled header\n");
+  ::setenv("WLX_PLUGIN_PRECOMPILED_DIR", refused_pch.c_str(), 1);
   auto a = wlx_test::start({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose});
   auto b = wlx_test::start({"--model-file", s.model.string(), "fk", "--json"}, {.input = kPose});
   const auto ra = wlx_test::finish(a), rb = wlx_test::finish(b);
+  ::unsetenv("WLX_PLUGIN_PRECOMPILED_DIR");
+#ifdef __clang__
+  CHECK(slurp(entry / "precompiled-O0.log").find("error") != std::string::npos);  // the compiler's refusal
+#endif
   INFO(ra.err);
   INFO(rb.err);
   CHECK(ra.code == 0);
