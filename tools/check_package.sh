@@ -68,6 +68,15 @@ echo '{"z_C": 1.8}' | WLX_CACHE_DIR="$work/cache" WLX_PLUGIN_CXXFLAGS=-O0 \
 grep -q '"closure_residual"' "$work/fk.json"
 grep -rq "share/wlx/cli/commands" "$work/cache"/installed_check-*/commands_unity.cpp || {
   echo "the plugin was not compiled from the installed sources" >&2; exit 1; }
+# Built by Clang, wlx installs its plugins' precompiled headers, and the installed one was accepted
+# (its check compile's log is empty: cli/shell/model_plugin.cpp).
+if [ -f build/plugin_prelude/plugin_prelude-O0.pch ]; then
+  [ -f build/install/share/wlx/precompiled/plugin_prelude-O0.pch ] || {
+    echo "the plugins' precompiled headers were not installed" >&2; exit 1; }
+  log=$(echo "$work/cache"/installed_check-*/precompiled-O0.log)
+  [ -f "$log" ] && [ ! -s "$log" ] || {
+    echo "the installed precompiled header was not used: $(cat "$log" 2>/dev/null)" >&2; exit 1; }
+fi
 # The installed Python package loads the same file from the same cache entry (one plugin serves
 # `wlx --model-file` and wlx.load), without compiling again.
 WLX_CACHE_DIR="$work/cache" WLX_PLUGIN_CXXFLAGS=-O0 PYTHONPATH="$PWD/build/install/lib/python3/dist-packages" \

@@ -123,29 +123,36 @@ double condition_number(Eigen::Matrix<double, N, N> A) {
 // x = A^-1 b for a symmetric positive definite A, from A = L L^T (A's lower triangle is read), as
 // Eigen's LLT computes it: false, x untouched, where a pivot is not positive, A not positive
 // definite to working precision. Unlike Eigen's LLT, a NaN pivot is refused too (Eigen's test,
-// x <= 0, lets it through into NaN results); callers check A's finiteness first to say so.
+// x <= 0, lets it through into NaN results); a NaN off the diagonal gives a NaN in x, which
+// callers check. At these sizes the time is the chain of dependent operations, not their count:
+// the diagonal's reciprocals are computed once, off the chain, and the triangular solves multiply
+// by them and sum each row in a register (10x10 with clang: 253 -> 194 ns; Eigen's LLT 418 ns;
+// GCC 289 ns either way; a right-looking, column-by-column form, which vectorizes, took 320 ns).
 template <int N>
 bool cholesky_solve(const Eigen::Matrix<double, N, N>& A, const Eigen::Matrix<double, N, 1>& b, Eigen::Matrix<double, N, 1>& x) {
   Eigen::Matrix<double, N, N> L = A;
+  Eigen::Matrix<double, N, 1> inverse_diagonal;
   for (int k = 0; k < N; ++k) {
     double pivot = L(k, k);
     for (int j = 0; j < k; ++j) pivot -= L(k, j) * L(k, j);
     if (!(pivot > 0)) return false;
-    L(k, k) = std::sqrt(pivot);
+    inverse_diagonal(k) = 1 / std::sqrt(pivot);
     for (int i = k + 1; i < N; ++i) {
       double sum = L(i, k);
       for (int j = 0; j < k; ++j) sum -= L(i, j) * L(k, j);
-      L(i, k) = sum / L(k, k);
+      L(i, k) = sum * inverse_diagonal(k);
     }
   }
   Eigen::Matrix<double, N, 1> y = b;
-  for (int i = 0; i < N; ++i) {
-    for (int j = 0; j < i; ++j) y(i) -= L(i, j) * y(j);
-    y(i) /= L(i, i);
+  for (int i = 0; i < N; ++i) {  // L y = b
+    double sum = y(i);
+    for (int j = 0; j < i; ++j) sum -= L(i, j) * y(j);
+    y(i) = sum * inverse_diagonal(i);
   }
-  for (int i = N - 1; i >= 0; --i) {
-    for (int j = i + 1; j < N; ++j) y(i) -= L(j, i) * y(j);
-    y(i) /= L(i, i);
+  for (int i = N - 1; i >= 0; --i) {  // L^T x = y
+    double sum = y(i);
+    for (int j = i + 1; j < N; ++j) sum -= L(j, i) * y(j);
+    y(i) = sum * inverse_diagonal(i);
   }
   x = y;
   return true;
