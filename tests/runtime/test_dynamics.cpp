@@ -377,6 +377,22 @@ TEST_CASE("forward dynamics: a torque table refuses bad rows and times outside i
   CHECK(nan_source.error.find("stopped at t = 0.0000 s (step 0 of 10): torques: the torque source gave a non-finite torque") != std::string::npos);
 }
 
+TEST_CASE("forward dynamics: forces that are not finite are an error naming u_dot, never NaN accelerations") {
+  // Commanded speeds of 1e200 keep s' = T u finite but square past the largest double in the
+  // velocity forces b: M stays finite and positive definite, so the error names the forces.
+  const Model model;
+  Data d;
+  Coordinates s = nominal_inputs();
+  solve_ik_closed_form(model, s);
+  DynamicsTerms terms;
+  CommandVector u_dot = CommandVector::Zero();
+  forward_dynamics(model, d, s, CommandVector::Zero(), TorqueVector::Zero(), u_dot, terms);
+  REQUIRE(u_dot.allFinite());  // the same state at rest: finite accelerations
+  CHECK_THROWS_WITH_AS(forward_dynamics(model, d, s, CommandVector::Constant(1e200), TorqueVector::Zero(), u_dot, terms),
+                       doctest::Contains("u_dot: the forces on the commanded speeds (b, Q_gravity) are not finite"), Error);
+  CHECK(terms.M.allFinite());
+}
+
 TEST_CASE("dynamics: ID-3 ends 7 mm above the ground: the cabin would touch it at t ~ 0.583 s") {
   Scenario sc;
   sc.rates(c::z_C) = -3.0;
