@@ -203,6 +203,8 @@ void mass_matrix(benchmark::State& st) {
     benchmark::DoNotOptimize(x->M.data());
   }
 }
+#endif
+
 // Every body's Jacobians (linear at its centre of mass, angular), with its pose, at the nominal
 // pose: what Pinocchio's computeJointJacobians gives per joint (with the joints' placements).
 void body_jacobians(benchmark::State& st) {
@@ -218,7 +220,17 @@ void body_jacobians(benchmark::State& st) {
     benchmark::DoNotOptimize(Jv.data());
   }
 }
-#endif
+// Every coordinate's joint as a twist in K0 (gen::joint_jacobian), at the same pose:
+// what Pinocchio's computeJointJacobians returns (6 numbers per joint), from which any body's
+// Jacobian column is v + omega x c.
+void joint_jacobian(benchmark::State& st) {
+  auto x = std::make_unique<Pose>();
+  gen::JointJacobian J = gen::JointJacobian::Zero();
+  for (auto _ : st) {
+    gen::joint_jacobian(x->s, x->model.params(), {.J = &J}, false);
+    benchmark::DoNotOptimize(J.data());
+  }
+}
 
 #ifdef WLX_HAVE_MUJOCO
 // The nominal pose in MuJoCo too: the exported model at the same coordinates, rates 0.1 and
@@ -319,6 +331,8 @@ const bool registered = [] {
   const std::string model(gen::kModelName);
   benchmark::RegisterBenchmark((model + "/ik_all_limbs").c_str(), ik);
   benchmark::RegisterBenchmark((model + "/fk_1000_states").c_str(), fk_1000_states);
+  benchmark::RegisterBenchmark((model + "/body_jacobians").c_str(), body_jacobians);
+  benchmark::RegisterBenchmark((model + "/joint_jacobian").c_str(), joint_jacobian);
   if (gen::kHasDynamics) {
     benchmark::RegisterBenchmark((model + "/dependent_rates").c_str(), dependent_rates);
     benchmark::RegisterBenchmark((model + "/inverse_dynamics_step").c_str(), inverse_dynamics_step);
@@ -332,10 +346,8 @@ const bool registered = [] {
     }
   }
 #ifdef WLX_PINOCCHIO_URDF
-  // Pinocchio on this model's URDF (bench/pinocchio_peer.cpp), and the body Jacobians to set beside
-  // its joint Jacobians.
+  // Pinocchio on this model's URDF (bench/pinocchio_peer.cpp).
   wlx_peer::register_pinocchio_benchmarks(model, WLX_PINOCCHIO_URDF);
-  benchmark::RegisterBenchmark((model + "/body_jacobians").c_str(), body_jacobians);
   if (gen::kHasDynamics) {
     benchmark::RegisterBenchmark((model + "/newton_euler").c_str(), newton_euler);
     benchmark::RegisterBenchmark((model + "/mass_matrix").c_str(), mass_matrix);

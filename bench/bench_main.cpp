@@ -803,6 +803,17 @@ int main(int argc, char** argv) {
                                  : nullptr});
       first_pair = false;
     }
+    // A body's Jacobian columns from its joints' twists (6 numbers per joint, kinematics'
+    // gen::joint_jacobian) against the bodies' own (3 x n per body and Jacobian, bodies()).
+    bool first_jacobian = true;
+    for (const std::string& model : models) {
+      const std::string joints = model + "/joint_jacobian", bodies = model + "/body_jacobians";
+      if (!collector.median_ns.count(joints) || !collector.median_ns.count(bodies)) continue;
+      rows.push_back({texts.emplace_back(fmt::format("{}: joint_jacobian vs body_jacobians", model)).c_str(), texts.emplace_back(joints).c_str(),
+                      texts.emplace_back(bodies).c_str(), 0, nullptr,
+                      first_jacobian ? "the joints' twists in K0 against every body's CoM Jacobians and pose (speedup: bodies / joints)" : nullptr});
+      first_jacobian = false;
+    }
     // A peer library's rows beside wlx's, per model: (wlx's row, the peer's row, what they compute).
     using PeerRows = std::initializer_list<std::tuple<const char*, const char*, const char*>>;
     const auto peer_rows = [&](const char* peer_name, const char* label, const char* group, PeerRows pairs) {
@@ -842,7 +853,8 @@ int main(int argc, char** argv) {
                {"mass_matrix", "pinocchio_crba", "M on the commanded speeds, reduced_dynamics alone (Pinocchio: the open tree's M, crba)"},
                {"equations_of_motion", "pinocchio_crba", "M, b on the commanded speeds, with the dependent rates (Pinocchio: the open tree's M, crba)"},
                {"forward_dynamics_step", "pinocchio_aba", "constrained forward-dynamics step (Pinocchio: the open tree's aba)"},
-               {"body_jacobians", "pinocchio_jacobians", "body Jacobians (Pinocchio: computeJointJacobians)"}});
+               {"joint_jacobian", "pinocchio_jacobians", "joint Jacobians, a twist per joint in K0 (Pinocchio: computeJointJacobians)"},
+               {"body_jacobians", "pinocchio_jacobians", "bodies' CoM Jacobians, 3 x n per body (Pinocchio: computeJointJacobians)"}});
   }
   const auto get = [&](const char* name) {
     const auto it = collector.median_ns.find(name);

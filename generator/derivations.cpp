@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 
 #include <cctype>
+#include <optional>
+#include <stdexcept>
 
 namespace wlx::codegen {
 
@@ -78,6 +80,63 @@ WheelRow wheel_row(const Model& m, const NonholonomicWheel& wheel) {
 }  // namespace derivation
 
 ex closure_value(const Model& m, const ClosureCondition& c) { return closure_row(m, c).value; }
+
+namespace {
+
+// Each coordinate's joint as a twist in K0, Pinocchio's world convention (its
+// computeJointJacobians): column j = [v; omega], the motion a unit rate of coordinate j gives every
+// body it moves: omega the angular velocity, v the velocity of the body's point at K0's origin
+// (a revolute joint: axis and origin x axis; a prismatic one: 0 and the axis). A body point p's
+// velocity is then v + omega x p, summed over the joints between K0 and it: the bodies' Jacobians
+// follow from these 6 numbers per joint instead of 3 per body and joint. The joints come from the
+// chains of the frames and bodies; a coordinate no chain holds (the wheels' ground heights) has a
+// zero column. wlx-gen refuses a coordinate that moves two different joints (no one twist is its
+// motion).
+OutputSpec joint_twists(const Model& m) {
+  OutputSpec J{"J", "JointJacobian", "the twists, one column per coordinate: rows 0-2 v, rows 3-5 omega", kZeroMatrix, {}};
+  std::vector<std::optional<JointRecord>> joint(m.coordinates.size());
+  const auto same = [](const Vec3& a, const Vec3& b) {
+    for (int i = 0; i < 3; ++i)
+      if (!(a[i] - b[i]).expand().is_zero()) return false;
+    return true;
+  };
+  const auto add = [&](const Frame& f) {
+    for (const JointRecord& r : f.joints) {
+      auto& known = joint.at(static_cast<std::size_t>(r.coordinate));
+      if (!known) {
+        known = r;
+      } else if (known->revolute != r.revolute || !same(known->axis, r.axis) ||
+                 (r.revolute && !same(cross(known->origin - r.origin, r.axis), Vec3{}))) {
+        throw std::runtime_error(fmt::format("coordinate {} moves two different joints: wlx models a coordinate as one joint",
+                                             m.coordinates[static_cast<std::size_t>(r.coordinate)].name));
+      }
+    }
+  };
+  for (const NamedFrame& f : m.frames) add(f.frame);
+  for (const Body& b : m.bodies) add(b.com_frame);
+  for (int j = 0; j < coordinate_count(m); ++j) {
+    const auto& r = joint[static_cast<std::size_t>(j)];
+    if (!r) continue;
+    const Vec3 v = r->revolute ? cross(r->origin, r->axis) : r->axis;
+    for (int i = 0; i < 3; ++i) {
+      J.elements.emplace_back(at(i, j), v[i]);
+      if (r->revolute) J.elements.emplace_back(at(3 + i, j), r->axis[i]);
+    }
+  }
+  return J;
+}
+
+}  // namespace
+
+FunctionSpec derive_joint_jacobian(const Model& m) {
+  FunctionSpec fn{"joint_jacobian", "joint_jacobian.hpp",
+                  "Each coordinate's joint as a twist in K0, 6 x n: column j is [v; omega] for a unit rate of "
+                  "coordinate j, v the velocity of the point at K0's origin (Pinocchio's computeJointJacobians); a "
+                  "point p moved by the joints of coordinates J moves at the sum over j in J of (v_j + omega_j x p) s'_j.",
+                  false, {}};
+  fn.outputs = {joint_twists(m)};
+  return fn;
+}
 
 FunctionSpec derive_kinematics(const Model& m) {
   FunctionSpec fn{"kinematics", "kinematics.hpp",
@@ -262,6 +321,7 @@ std::vector<Derivation> derivations(const Model& m) {
                               {"nonholonomic", derive_nonholonomic},
                               {"convective", derive_convective},
                               {"bodies", derive_bodies},
+                              {"joint_jacobian", derive_joint_jacobian},
                               {"kinematic_update", derive_kinematic_update},
                               {"dynamics_update", derive_dynamics_update}};
   if (m.dynamics) {

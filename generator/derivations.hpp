@@ -55,6 +55,8 @@ FunctionSpec derive_closure(const Model& m);
 FunctionSpec derive_nonholonomic(const Model& m);
 FunctionSpec derive_convective(const Model& m);
 FunctionSpec derive_bodies(const Model& m);
+// Each coordinate's joint as a twist in K0 (what Pinocchio's computeJointJacobians returns).
+FunctionSpec derive_joint_jacobian(const Model& m);
 // Kinematics, closure and non-holonomic rows fused into one function, so that their common
 // subexpressions (the frames' rotations and positions) are computed once per update.
 FunctionSpec derive_kinematic_update(const Model& m);

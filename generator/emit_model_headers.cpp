@@ -107,6 +107,7 @@ std::string scalar_types(const Model& m) {
       "template <typename Scalar> using BodyVectorsOf = Eigen::Matrix<Scalar, 3, {4}>;\n"
       "template <typename Scalar> using BodyRotationsOf = std::array<Eigen::Matrix<Scalar, 3, 3>, {4}>;\n"
       "template <typename Scalar> using BodyJacobiansOf = std::array<Eigen::Matrix<Scalar, 3, {0}>, {4}>;\n"
+      "template <typename Scalar> using JointJacobianOf = Eigen::Matrix<Scalar, 6, {0}>;\n"
       "template <typename Scalar> using Vector3Of = Eigen::Matrix<Scalar, 3, 1>;\n\n"
       "// The double ones: what the runtime uses.\n"
       "using Coordinates = CoordinatesOf<double>;\n"
@@ -119,6 +120,7 @@ std::string scalar_types(const Model& m) {
       "using BodyVectors = BodyVectorsOf<double>;\n"
       "using BodyRotations = BodyRotationsOf<double>;\n"
       "using BodyJacobians = BodyJacobiansOf<double>;\n"
+      "using JointJacobian = JointJacobianOf<double>;\n"
       "using Vector3 = Vector3Of<double>;\n\n"
       "{5}",
       m.coordinates.size(), m.frames.size(), m.closure.size(), m.wheels.size(), m.bodies.size(), dynamics_types(m));

@@ -1,4 +1,4 @@
-// The generated functions of the frames, loop closure, wheel rows, clearance box and fused closed-form IK, in double, compiled once
+// The generated functions of the frames, the joints' twists, loop closure, wheel rows, clearance box and fused closed-form IK, in double, compiled once
 // for the model's runtime library. The library's users see their declarations only
 // (WLX_GEN_COMPILED_<model>, which the library defines for them; generated types.hpp), so a
 // translation unit that calls them does not compile them again: they are most of a model's compile
@@ -8,6 +8,9 @@
 
 #if __has_include(<wlx/gen/kinematics.hpp>)
 #include <wlx/gen/kinematics.hpp>
+#endif
+#if __has_include(<wlx/gen/joint_jacobian.hpp>)
+#include <wlx/gen/joint_jacobian.hpp>
 #endif
 #if __has_include(<wlx/gen/closure.hpp>)
 #include <wlx/gen/closure.hpp>

@@ -164,6 +164,40 @@ TEST_CASE(titled("Phi, dPhi/ds, the wheel rows, the bodies and their convective 
   CHECK(worst_body_conv <= 1e-11);
 }
 
+TEST_CASE(titled("each coordinate's joint as a twist in K0 gives every body's Jacobian column (omega, and v + omega x c at its CoM c)")) {
+  // The bodies' Jacobians (checked against exact derivatives above) are the reference: column j of
+  // a body moved by coordinate j's joint is that joint's twist seen at the body's CoM; a body the
+  // joint does not move has a zero column there.
+  std::mt19937_64 rng(202);
+  const Model model;
+  const gen::Params& p = model.params();
+  double worst = 0;
+  int moved = 0, still = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Coordinates s = random_state(rng, model, 0.05);
+    gen::JointJacobian J;
+    gen::joint_jacobian(s, p, {.J = &J});
+    gen::BodyVectors com;
+    gen::BodyJacobians Jv, Jw;
+    gen::bodies(s, Coordinates::Zero(), p, {.com = &com, .Jv = &Jv, .Jw = &Jw});
+    for (int b = 0; b < gen::kBodyCount; ++b)
+      for (int j = 0; j < kCoordinateCount; ++j) {
+        const Eigen::Vector3d jv = Jv[static_cast<std::size_t>(b)].col(j), jw = Jw[static_cast<std::size_t>(b)].col(j);
+        if (jv.isZero(0) && jw.isZero(0)) {
+          ++still;
+          continue;
+        }
+        ++moved;
+        const Eigen::Vector3d v = J.col(j).head<3>(), omega = J.col(j).tail<3>();
+        worst = std::max({worst, (omega - jw).cwiseAbs().maxCoeff(), (v + omega.cross(com.col(b)) - jv).cwiseAbs().maxCoeff()});
+      }
+  }
+  MESSAGE(kName << ": joint twists against the bodies' Jacobian columns: max error " << worst << " over " << moved
+                << " moved columns (" << still << " still)");
+  CHECK(moved > 0);
+  CHECK(worst <= 1e-12);  // rounding of a few products of unit vectors and lengths of metres
+}
+
 TEST_CASE(titled("the IK from the nominal state, and the model's sweeps: closure to 1e-12, closed form = Newton")) {
   const Model model;
   Data data;

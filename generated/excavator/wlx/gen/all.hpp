@@ -12,12 +12,13 @@
 //   nonholonomic                 106         27474           625
 //   convective                   353         62310          1867
 //   bodies                       315         58902          2163
+//   joint_jacobian               132          9345           829
 //   kinematic_update             194         48373          1304
 //   dynamics_update              150         37306          1043
 //   reduced_dynamics             365         62682          4883
 //   generalized_forces             6           100          1120
 //   clearance                      0            22            23
-//   total                                   330350         14550
+//   total                                   339695         15379
 #pragma once
 
 #include "ik.hpp"
@@ -30,6 +31,7 @@
 #include "nonholonomic.hpp"
 #include "convective.hpp"
 #include "bodies.hpp"
+#include "joint_jacobian.hpp"
 #include "kinematic_update.hpp"
 #include "dynamics_update.hpp"
 #include "reduced_dynamics.hpp"

@@ -12,12 +12,13 @@
 //   nonholonomic                 135         39100           618
 //   convective                   409         68496          1721
 //   bodies                       388         63427          2538
+//   joint_jacobian               138         11629           778
 //   kinematic_update             234         60493          1338
 //   dynamics_update              183         47698           988
 //   reduced_dynamics             423         68952          5056
 //   generalized_forces             5            92          1228
 //   clearance                      0            22            23
-//   total                                   387773         15156
+//   total                                   399402         15934
 #pragma once
 
 #include "ik.hpp"
@@ -30,6 +31,7 @@
 #include "nonholonomic.hpp"
 #include "convective.hpp"
 #include "bodies.hpp"
+#include "joint_jacobian.hpp"
 #include "kinematic_update.hpp"
 #include "dynamics_update.hpp"
 #include "reduced_dynamics.hpp"

@@ -12,12 +12,13 @@
 //   nonholonomic                 351         96920          1892
 //   convective                   412        198116          2120
 //   bodies                      1018        165475          5175
+//   joint_jacobian               105          4961           602
 //   kinematic_update             420         98350          2296
 //   dynamics_update              361        102428          1916
 //   reduced_dynamics             425        198722          8464
 //   generalized_forces             0            60          2262
 //   clearance                      0            22            22
-//   total                                   921963         26814
+//   total                                   926924         27416
 #pragma once
 
 #include "ik.hpp"
@@ -30,6 +31,7 @@
 #include "nonholonomic.hpp"
 #include "convective.hpp"
 #include "bodies.hpp"
+#include "joint_jacobian.hpp"
 #include "kinematic_update.hpp"
 #include "dynamics_update.hpp"
 #include "reduced_dynamics.hpp"

@@ -58,6 +58,7 @@ template <typename Scalar> using WheelVectorOf = Eigen::Matrix<Scalar, 4, 1>;
 template <typename Scalar> using BodyVectorsOf = Eigen::Matrix<Scalar, 3, 17>;
 template <typename Scalar> using BodyRotationsOf = std::array<Eigen::Matrix<Scalar, 3, 3>, 17>;
 template <typename Scalar> using BodyJacobiansOf = std::array<Eigen::Matrix<Scalar, 3, 30>, 17>;
+template <typename Scalar> using JointJacobianOf = Eigen::Matrix<Scalar, 6, 30>;
 template <typename Scalar> using Vector3Of = Eigen::Matrix<Scalar, 3, 1>;
 
 // The double ones: what the runtime uses.
@@ -71,6 +72,7 @@ using WheelVector = WheelVectorOf<double>;
 using BodyVectors = BodyVectorsOf<double>;
 using BodyRotations = BodyRotationsOf<double>;
 using BodyJacobians = BodyJacobiansOf<double>;
+using JointJacobian = JointJacobianOf<double>;
 using Vector3 = Vector3Of<double>;
 
 // The inverse dynamics on the 10 commanded speeds u (reduced_dynamics).
