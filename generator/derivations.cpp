@@ -90,8 +90,9 @@ namespace {
 // velocity is then v + omega x p, summed over the joints between K0 and it: the bodies' Jacobians
 // follow from these 6 numbers per joint instead of 3 per body and joint. The joints come from the
 // chains of the frames and bodies; a coordinate no chain holds (the wheels' ground heights) has a
-// zero column. wlx-gen refuses a coordinate that moves two different joints (no one twist is its
-// motion).
+// zero column. A coordinate drives one joint (the model file's parser refuses a second, "already
+// drives a joint"), which every chain through it records alike: two different records are wlx-gen's
+// own error.
 OutputSpec joint_twists(const Model& m) {
   OutputSpec J{"J", "JointJacobian", "the twists, one column per coordinate: rows 0-2 v, rows 3-5 omega", kZeroMatrix, {}};
   std::vector<std::optional<JointRecord>> joint(m.coordinates.size());
@@ -107,8 +108,8 @@ OutputSpec joint_twists(const Model& m) {
         known = r;
       } else if (known->revolute != r.revolute || !same(known->axis, r.axis) ||
                  (r.revolute && !same(cross(known->origin - r.origin, r.axis), Vec3{}))) {
-        throw std::runtime_error(fmt::format("coordinate {} moves two different joints: wlx models a coordinate as one joint",
-                                             m.coordinates[static_cast<std::size_t>(r.coordinate)].name));
+        throw std::logic_error(fmt::format("joint_jacobian: coordinate {} has two different joint records",
+                                           m.coordinates[static_cast<std::size_t>(r.coordinate)].name));
       }
     }
   };
