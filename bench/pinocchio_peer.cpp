@@ -81,6 +81,10 @@ Eigen::VectorXd PinocchioRobot::inverse_dynamics(const Eigen::VectorXd& q, const
   return pinocchio::rnea(impl_->model, *impl_->data, q, v, a);
 }
 
+Eigen::MatrixXd PinocchioRobot::joint_jacobians(const Eigen::VectorXd& q) {
+  return pinocchio::computeJointJacobians(impl_->model, *impl_->data, q);
+}
+
 #ifdef WLX_PINOCCHIO_BENCHMARKS
 namespace {
 

@@ -39,6 +39,8 @@ class PinocchioRobot {
   std::vector<Eigen::Matrix<double, 3, 4>> link_placements(const Eigen::VectorXd& q, const std::vector<std::string>& links);
   // The open tree's generalized forces with gravity (rnea).
   Eigen::VectorXd inverse_dynamics(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a);
+  // Every joint's Jacobian in the world frame, 6 x nv, [v; omega] (computeJointJacobians' data.J).
+  Eigen::MatrixXd joint_jacobians(const Eigen::VectorXd& q);
 
  private:
   struct Impl;

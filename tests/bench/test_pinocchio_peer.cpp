@@ -3,8 +3,9 @@
 // with the robot's base joined to the world by six joints (x, y, z, then rotations about z, y, x:
 // wlx's base coordinates and their rates), compute at random states what wlx computes from its
 // generated functions: every URDF link's pose (framesForwardKinematics against gen::kinematics)
-// and the open tree's inverse dynamics with gravity (rnea against Kane's sums over the bodies'
-// Jacobians, bench/open_tree.hpp). The wheels' spins, which wlx's model does not have as
+// the joints' Jacobians (computeJointJacobians against gen::joint_jacobian) and the open tree's
+// inverse dynamics with gravity (rnea against Kane's sums over the bodies' Jacobians,
+// bench/open_tree.hpp). The wheels' spins, which wlx's model does not have as
 // coordinates, are held at zero angle, rate and acceleration: each wheel is then a rigid part of its
 // leg in both.
 //
@@ -63,7 +64,7 @@ struct Mapping {
 double relative(double difference, double scale) { return difference / std::max(scale, 1e-300); }
 
 struct Worst {
-  double poses = 0, torques = 0;
+  double poses = 0, jacobians = 0, torques = 0;
 };
 
 // The largest relative differences over kStates random states, with wlx's parameters `p`.
@@ -99,6 +100,16 @@ Worst compare(const gen::Params& p) {
                                   (X[k].col(3) - positions.col(f)).cwiseAbs().maxCoeff()});
       pose_scale = std::max(pose_scale, positions.col(f).cwiseAbs().maxCoeff());
     }
+    // The joints' twists: wlx's column of each coordinate against Pinocchio's of its joint.
+    gen::JointJacobian J;
+    gen::joint_jacobian(s, p, {.J = &J});
+    const Eigen::MatrixXd Jp = robot.joint_jacobians(q);
+    double jacobian_difference = 0, jacobian_scale = 0;
+    for (const auto& [k, i] : map.v_of) {
+      jacobian_difference = std::max(jacobian_difference, (J.col(k) - Jp.col(i)).cwiseAbs().maxCoeff());
+      jacobian_scale = std::max(jacobian_scale, J.col(k).cwiseAbs().maxCoeff());
+    }
+    worst.jacobians = std::max(worst.jacobians, relative(jacobian_difference, jacobian_scale));
     gen::Coordinates Q;
     open_tree::open_tree_inverse_dynamics(p, s, sdot, sddot, w, Q);
     const Eigen::VectorXd tau = robot.inverse_dynamics(q, map.v(sdot), map.v(sddot));
@@ -115,12 +126,13 @@ Worst compare(const gen::Params& p) {
 
 }  // namespace
 
-TEST_CASE("Pinocchio, from the URDF by its own parser, computes the links' poses and the open tree's inverse dynamics that wlx computes") {
+TEST_CASE("Pinocchio, from the URDF by its own parser, computes the links' poses, the joints' Jacobians and the open tree's inverse dynamics that wlx computes") {
   const Model model;
   const Worst worst = compare(model.params());
-  MESSAGE("over " << kStates << " random states, the largest relative differences: link poses " << worst.poses << ", torques "
-                  << worst.torques);
+  MESSAGE("over " << kStates << " random states, the largest relative differences: link poses " << worst.poses
+                  << ", joint Jacobians " << worst.jacobians << ", torques " << worst.torques);
   CHECK(worst.poses < kRelativeTolerance);
+  CHECK(worst.jacobians < kRelativeTolerance);
   CHECK(worst.torques < kRelativeTolerance);
 }
 
@@ -134,5 +146,6 @@ TEST_CASE("The Pinocchio check sees the heaviest body 1% heavier in wlx's parame
   const Worst worst = compare(p);
   MESSAGE("with " << gen::kBodyNames[static_cast<std::size_t>(heaviest)] << " 1% heavier: torques " << worst.torques);
   CHECK(worst.poses < kRelativeTolerance);  // the mass moves no frame
+  CHECK(worst.jacobians < kRelativeTolerance);  // nor any joint
   CHECK(worst.torques > 1e3 * kRelativeTolerance);
 }
