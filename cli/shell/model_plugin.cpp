@@ -383,16 +383,16 @@ std::vector<GeneratedUnit> generated_units(const fs::path& runtime_sources, cons
 // The arguments that load plugin_prelude.hpp precompiled for a part compiled with `argv` (the
 // compiler, then its flags: `optimization`'s last), or none. wlx's build precompiles it once per
 // optimization of a model's parts, named after those flags (plugin_prelude-O3.pch for "-O3"; CMakeLists.txt);
-// only the compiler wlx was built with, with the same flags, can load one, and not once a header
-// it was made from has changed (Clang refuses it then). A compile of nothing with it (60 ms) asks
-// the compiler first, so that a header it refuses costs the plugin its speed, never its build; its
-// answer is in precompiled-<name>.log. WLX_PLUGIN_PRECOMPILED_DIR names another folder to look in
-// (empty: none).
+// only the Clang wlx was built with, with the same flags, can load one (CXX may name it another
+// way), and not once a header it was made from has changed. A compile of nothing with it (60 ms)
+// asks the compiler first, so that a header it refuses (another compiler, GCC, a changed header)
+// costs the plugin its speed, never its build; its answer is in precompiled-<name>.log.
+// WLX_PLUGIN_PRECOMPILED_DIR names another folder to look in (empty: none).
 std::vector<std::string> precompiled_prelude(const Sources& src, const std::vector<std::string>& optimization,
                                              std::vector<std::string> argv, const fs::path& dir) {
   const char* env = std::getenv("WLX_PLUGIN_PRECOMPILED_DIR");
   const fs::path folder = env != nullptr ? fs::path(env) : src.precompiled;
-  if (folder.empty() || optimization.empty() || compiler() != built_with_compiler()) return {};
+  if (folder.empty() || optimization.empty()) return {};
   std::string name;
   for (const std::string& flag : optimization) {
     if (flag.size() < 2 || flag[0] != '-') return {};
