@@ -803,8 +803,8 @@ int main(int argc, char** argv) {
                                  : nullptr});
       first_pair = false;
     }
-    // A body's Jacobian columns from its joints' twists (6 numbers per joint, kinematics'
-    // gen::joint_jacobian) against the bodies' own (3 x n per body and Jacobian, bodies()).
+    // A body's Jacobian columns from its joints' twists (6 numbers per joint, gen::joint_jacobian)
+    // against the bodies' own (3 x n per body and Jacobian, bodies()).
     bool first_jacobian = true;
     for (const std::string& model : models) {
       const std::string joints = model + "/joint_jacobian", bodies = model + "/body_jacobians";

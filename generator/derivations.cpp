@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include <cctype>
-#include <optional>
 #include <stdexcept>
 
 namespace wlx::codegen {
@@ -83,45 +82,36 @@ ex closure_value(const Model& m, const ClosureCondition& c) { return closure_row
 
 namespace {
 
-// Each coordinate's joint as a twist in K0, Pinocchio's world convention (its
+// Each coordinate's joint as a twist in K0 (spatial_axis), in Pinocchio's world convention (its
 // computeJointJacobians): column j = [v; omega], the motion a unit rate of coordinate j gives every
-// body it moves: omega the angular velocity, v the velocity of the body's point at K0's origin
-// (a revolute joint: axis and origin x axis; a prismatic one: 0 and the axis). A body point p's
-// velocity is then v + omega x p, summed over the joints between K0 and it: the bodies' Jacobians
-// follow from these 6 numbers per joint instead of 3 per body and joint. The joints come from the
-// chains of the frames and bodies; a coordinate no chain holds (the wheels' ground heights) has a
-// zero column. A coordinate drives one joint (the model file's parser refuses a second, "already
-// drives a joint"), which every chain through it records alike: two different records are wlx-gen's
-// own error.
+// body it moves: omega the angular velocity, v the velocity of the body's point at K0's origin. A
+// body point p's velocity is then v + omega x p, summed over the joints between K0 and it: the
+// bodies' Jacobians follow from these 6 numbers per joint instead of 3 per body and joint. The
+// joints come from the chains of the frames and bodies; a coordinate no chain holds (the wheels'
+// ground heights) has a zero column. A coordinate drives one joint (the model file's parser refuses
+// a second, "already drives a joint"), which every chain through it records alike: two different
+// records are wlx-gen's own error.
 OutputSpec joint_twists(const Model& m) {
   OutputSpec J{"J", "JointJacobian", "the twists, one column per coordinate: rows 0-2 v, rows 3-5 omega", kZeroMatrix, {}};
-  std::vector<std::optional<JointRecord>> joint(m.coordinates.size());
-  const auto same = [](const Vec3& a, const Vec3& b) {
-    for (int i = 0; i < 3; ++i)
-      if (!(a[i] - b[i]).expand().is_zero()) return false;
-    return true;
-  };
+  std::vector<const JointRecord*> joint(m.coordinates.size(), nullptr);
   const auto add = [&](const Frame& f) {
     for (const JointRecord& r : f.joints) {
-      auto& known = joint.at(static_cast<std::size_t>(r.coordinate));
-      if (!known) {
-        known = r;
-      } else if (known->revolute != r.revolute || !same(known->axis, r.axis) ||
-                 (r.revolute && !same(cross(known->origin - r.origin, r.axis), Vec3{}))) {
+      const JointRecord*& known = joint.at(static_cast<std::size_t>(r.coordinate));
+      if (known == nullptr) known = &r;
+      else if (!same_joint(*known, r))
         throw std::logic_error(fmt::format("joint_jacobian: coordinate {} has two different joint records",
                                            m.coordinates[static_cast<std::size_t>(r.coordinate)].name));
-      }
     }
   };
   for (const NamedFrame& f : m.frames) add(f.frame);
   for (const Body& b : m.bodies) add(b.com_frame);
   for (int j = 0; j < coordinate_count(m); ++j) {
-    const auto& r = joint[static_cast<std::size_t>(j)];
-    if (!r) continue;
-    const Vec3 v = r->revolute ? cross(r->origin, r->axis) : r->axis;
+    const JointRecord* r = joint[static_cast<std::size_t>(j)];
+    if (r == nullptr) continue;
+    const std::array<ex, 6> S = spatial_axis(*r);  // (omega; v)
     for (int i = 0; i < 3; ++i) {
-      J.elements.emplace_back(at(i, j), v[i]);
-      if (r->revolute) J.elements.emplace_back(at(3 + i, j), r->axis[i]);
+      J.elements.emplace_back(at(i, j), S[static_cast<std::size_t>(i + 3)]);
+      if (r->revolute) J.elements.emplace_back(at(3 + i, j), S[static_cast<std::size_t>(i)]);
     }
   }
   return J;

@@ -81,6 +81,8 @@ TwistTree twist_tree(const Model& m, const RateRoles& roles);
 // A joint's twist per unit rate in K0, (omega; velocity of the point at K0's origin): (a; o x a)
 // for a revolute joint (axis a through o), (0; a) for a prismatic one.
 std::array<ex, 6> spatial_axis(const JointRecord& joint);
+// The same joint, recorded by two chains through it: its coordinate, kind, axis and origin alike.
+bool same_joint(const JointRecord& a, const JointRecord& b);
 
 // reduced_dynamics' outputs, in the numbering of its code's statements (lane_code::Statement::output).
 enum ReducedOutput { kM, kB_velocity, kB_bias, kQ_gravity, kReducedOutputs };

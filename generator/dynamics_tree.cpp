@@ -11,16 +11,12 @@ namespace wlx::codegen {
 
 namespace derivation {
 
-namespace {
-
 bool same_joint(const JointRecord& a, const JointRecord& b) {
   if (a.coordinate != b.coordinate || a.revolute != b.revolute) return false;
   for (int c = 0; c < 3; ++c)
     if (!a.axis[c].is_equal(b.axis[c]) || !a.origin[c].is_equal(b.origin[c])) return false;
   return true;
 }
-
-}  // namespace
 
 RateRoles rate_roles(const Model& m) {
   const Dynamics& dyn = *m.dynamics;

@@ -465,6 +465,11 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   std::map<bool, std::vector<std::string>> part_flags;  // by "is the commands' part"
   const auto probing = std::chrono::steady_clock::now();
   for (const bool commands : {false, true}) {
+    // Both parts at the same flags (WLX_PLUGIN_CXXFLAGS): the runtime's, checked once.
+    if (commands && optimization_flags(true) == optimization_flags(false)) {
+      part_flags[true] = part_flags[false];
+      continue;
+    }
     std::vector<std::string> argv = common;
     const std::vector<std::string> optimization = optimization_flags(commands);
     argv.insert(argv.end(), optimization.begin(), optimization.end());
