@@ -42,7 +42,7 @@ set(WLX_GENERATED_FUNCTION_FILES
 set(WLX_COMMAND_SOURCES
   commands/input.cpp commands/description.cpp commands/limits.cpp commands/scenario_io.cpp commands/ik_commands.cpp
   commands/simulate_commands.cpp commands/simulate_stream.cpp commands/fk_command.cpp commands/report_command.cpp
-  report/runner.cpp report/figures.cpp commands/viewer_command.cpp commands/model_api.cpp)
+  report/runner.cpp commands/viewer_command.cpp commands/model_api.cpp)
 # A model compiled from a user's file (a plugin, wlx_generate(PYTHON)) embeds no runs: the same
 # commands and the empty definitions of what a built-in model embeds.
 set(WLX_MODEL_FILE_COMMAND_SOURCES ${WLX_COMMAND_SOURCES} commands/no_embedded_runs.cpp)

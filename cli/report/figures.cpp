@@ -1,14 +1,13 @@
 // The report's figures (report/figures.hpp). Curves that may coincide get distinct dash patterns,
 // and a legend entry says "identical to" when two curves are the same to rounding; legends sit
 // outside the plots; top views show the whole machine with equal axis scales and its heading.
+// Compiled once, into wlx itself: every name and number comes from the model's side
+// (report/results.hpp), none from a model's generated tables.
 #include "report/figures.hpp"
 
-#include "limits.hpp"
-
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <wlx/support/atomic_file.hpp>
-#include <wlx/dynamics.hpp>
-#include <wlx/kinematics.hpp>
 #include <wlx/support/text.hpp>
 
 #include <algorithm>
@@ -17,14 +16,10 @@
 #include <optional>
 #include <sstream>
 
-WLX_COMMANDS_BEGIN
+namespace wlx::cli::report {
 
 namespace {
 
-using report::column;
-using report::data_path;
-using report::FigureSpec;
-using report::log_column;
 // Every text in a script, the report file's and the scenarios' names and labels included, goes in
 // as a gnuplot single-quoted string: nothing in it can end the string or the command.
 std::string q(std::string_view text) { return text::gnuplot_string(text); }
@@ -58,7 +53,7 @@ std::string not_drawn(const std::string& what, std::size_t samples, const std::o
   return fmt::format("{} stopped at t = {:.4f} s {} (it never left its start), with nothing to draw: {}", what, stopped->time,
                      samples == 0 ? "before its first sample" : "after its first sample", stopped->reason);
 }
-std::string not_drawn(const ReportRun& r) { return not_drawn(r.id, r.trajectory.samples.size(), r.stopped); }
+std::string not_drawn(const RunResult& r) { return not_drawn(r.id, static_cast<std::size_t>(r.samples), r.stopped); }
 
 // ". Left out: <why>; <why>" to end a caption, or "".
 std::string left_out(const std::vector<std::string>& why) {
@@ -88,9 +83,9 @@ struct Bounds {
 
 class Figures {
  public:
-  Figures(ReportRunner& runner, const report::ReportSpec& spec, std::string data_dir)
-      : runner_(runner), spec_(spec), data_dir_(std::move(data_dir)) {
-    body_frame_ = spec.pose_frame.empty() ? 0 : frame_index(spec.pose_frame);
+  Figures(const Results& results, const ModelTables& tables, const ReportSpec& spec, std::string data_dir)
+      : results_(results), tables_(tables), spec_(spec), data_dir_(std::move(data_dir)) {
+    body_frame_ = spec.pose_frame.empty() ? 0 : tables.frame_index(spec.pose_frame);
   }
 
   ReportFigures all() {
@@ -107,56 +102,31 @@ class Figures {
   }
 
  private:
-  struct Pose {
-    std::vector<Eigen::Vector3d> frames;
-    Eigen::Vector3d heading;  // the body frame's x axis
-    std::vector<Eigen::Vector3d> outline;
-  };
-
-  Pose pose_at(const Coordinates& s) {
-    Data& data = runner_.data();
-    forward_kinematics(runner_.model(), data, s);
-    Pose p;
-    for (int f = 0; f < gen::kFrameCount; ++f) p.frames.emplace_back(data.frame_positions.col(f));
-    const Eigen::Matrix3d& R = data.frame_rotations[static_cast<std::size_t>(body_frame_)];
-    p.heading = R.col(0);
-    if (spec_.pose_outline.size() == 2) {
-      Params params = runner_.model().params();
-      const double length = *find_param(params, spec_.pose_outline[0]), width = *find_param(params, spec_.pose_outline[1]);
-      for (auto [x, y] : {std::pair{1, 1}, std::pair{1, -1}, std::pair{-1, -1}, std::pair{-1, 1}, std::pair{1, 1}})
-        p.outline.push_back(p.frames[static_cast<std::size_t>(body_frame_)] + R * Eigen::Vector3d(x * length / 2, y * width / 2, 0));
-    }
-    return p;
-  }
-
-  // The thesis' number of a run's weighting (its torque figures are referenced by it).
-  static int weighting_number(const Weighting& w) {
-    return w.kind == Weighting::Kind::contribution ? 2 : w.kind == Weighting::Kind::contacts ? 3 : 1;
-  }
   // The runs of one motion under weightings other than the model file's: the same poses.
-  static bool duplicate_motion(const ReportRun& r) { return r.scenario.weighting && weighting_number(*r.scenario.weighting) != 1; }
-  static std::string title_of(const ReportRun& r) { return r.scenario_id; }
+  static bool duplicate_motion(const RunResult& r) { return r.weighting > 1; }
+  static std::string title_of(const RunResult& r) { return r.scenario_id; }
+  const std::string& coordinate_name(int c) const { return tables_.coordinates.at(static_cast<std::size_t>(c)); }
+  const std::string& body_frame_name() const { return tables_.frames.at(static_cast<std::size_t>(body_frame_)); }
 
   // data/<run>-pose.dat: index 0 the start, index 1 the end; in each, the body outline then one
   // segment per frame from its parent (the skeleton), blank lines between segments; index 2 the
   // body frame's path.
   void write_poses() {
-    for (const auto& r : runner_.runs()) {
-      if (duplicate_motion(r) || r.trajectory.samples.empty()) continue;  // no pose: poses() says so
+    for (const auto& r : results_.runs) {
+      if (duplicate_motion(r) || r.poses.empty()) continue;  // no pose: poses() says so
       std::ostringstream out;
-      for (const Sample* smp : {&r.trajectory.samples.front(), &r.trajectory.samples.back()}) {
-        const Pose p = pose_at(smp->s);
+      for (const Pose& p : r.poses) {
         Bounds& b = bounds_[r.id];
         for (const auto& q : p.frames) b.add(q);
         for (const auto& q : p.outline) b.add(q);
         out << "# body outline\n";
         for (const auto& q : p.outline) out << fmt::format("{},{},{}\n", q.x(), q.y(), q.z());
         out << "\n";
-        for (int f = 0; f < gen::kFrameCount; ++f) {
-          const int parent = gen::kFrameParent[static_cast<std::size_t>(f)];
+        for (std::size_t f = 0; f < p.frames.size(); ++f) {
+          const int parent = tables_.frame_parents.at(f);
           if (parent < 0) continue;
-          for (int g : {parent, f}) {
-            const auto& q = p.frames[static_cast<std::size_t>(g)];
+          for (std::size_t g : {static_cast<std::size_t>(parent), f}) {
+            const auto& q = p.frames[g];
             out << fmt::format("{},{},{}\n", q.x(), q.y(), q.z());
           }
           out << "\n";
@@ -166,9 +136,7 @@ class Figures {
       }
       // Index 2: the path of the body frame, every sample.
       out << "# body frame path\n";
-      for (const auto& smp : r.trajectory.samples) {
-        forward_kinematics(runner_.model(), runner_.data(), smp.s);
-        const Eigen::Vector3d q = runner_.data().frame_positions.col(body_frame_);
+      for (const Eigen::Vector3d& q : r.body_path) {
         out << fmt::format("{},{},{}\n", q.x(), q.y(), q.z());
         bounds_[r.id].add(q);
       }
@@ -196,51 +164,43 @@ class Figures {
   }
 
   void ik(std::vector<FigureSpec>& out) {
-    for (const auto& s : runner_.sweeps()) {
-      const LimbBlock block = limb_block(s.sweep.limb);
-      std::vector<std::string> joints;
-      std::vector<std::vector<double>> curves;
-      for (int j = 0; j < block.size; ++j) {
-        const int c = block.joints[static_cast<std::size_t>(j)];
-        joints.push_back(coordinate_name(c));
-        curves.emplace_back();
-        for (const auto& p : s.points) curves.back().push_back(s.solution(p)(c));
-      }
-      const auto titles = legend_titles(joints, curves, 1e-9);
-      const double xs = s.sweep.degrees ? kDegPerRad : 1;
-      const std::string file = data_path(s.sweep.id + ".csv");
+    for (const auto& s : results_.sweeps) {
+      const std::vector<std::string>& joints = s.joints;
+      const auto titles = legend_titles(joints, s.joint_values, 1e-9);
+      const double xs = s.degrees ? kDegPerRad : 1;
+      const std::string file = data_path(s.id + ".csv");
       std::string b = "set multiplot layout 2,1\nset key outside right top\n";
       b += fmt::format("set xlabel {}\nset ylabel 'joint angle (deg)'\nset title {}\nplot ",
-                       q(fmt::format("{} ({})", s.sweep.input, s.sweep.degrees ? "deg" : "m")),
-                       q(s.sweep.id + (s.closed_form ? ": dependent joints (closed form)"
+                       q(fmt::format("{} ({})", s.input, s.degrees ? "deg" : "m")),
+                       q(s.id + (s.closed_form ? ": dependent joints (closed form)"
                                                      : ": dependent joints (Newton; no closed form)")));
       for (std::size_t k = 0; k < joints.size(); ++k)
-        b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(file), column(s.sweep.input, xs),
+        b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(file), column(s.input, xs),
                          column(joints[k], kDegPerRad), dash(k), q(titles[k]));
       b += "\nset logscale y\nset format y '1e%L'\nset yrange [1e-18:1e-3]\nset ylabel 'analytic check error (m)'\n";
-      b += fmt::format("set title {}\n", q(s.sweep.id + ": |target - FK(solution)| (zeros drawn at 1e-18)"));
+      b += fmt::format("set title {}\n", q(s.id + ": |target - FK(solution)| (zeros drawn at 1e-18)"));
       if (s.closed_form)
         b += fmt::format(
             "plot {0} using {1}:{2} with lines lw 2 title 'closed form', {0} using {1}:{3} with points pt 7 ps 0.4 "
             "title 'Newton'{4}\n",
-            q(file), column(s.sweep.input, xs), log_column("check_error_closed_form"), log_column("check_error_newton"),
+            q(file), column(s.input, xs), log_column("check_error_closed_form"), log_column("check_error_newton"),
             reference_line("ik_check_error"));
       else  // no closed form: Newton's alone (the CSV has no closed-form column)
         b += fmt::format("plot {0} using {1}:{2} with points pt 7 ps 0.4 title 'Newton'{3}\n", q(file),
-                         column(s.sweep.input, xs), log_column("check_error_newton"), reference_line("ik_check_error"));
+                         column(s.input, xs), log_column("check_error_newton"), reference_line("ik_check_error"));
       b += "unset multiplot\n";
       out.push_back(
-          {"ik-" + s.sweep.id,
-           fmt::format("{}: {} swept; {}", s.sweep.id, s.sweep.input,
+          {"ik-" + s.id,
+           fmt::format("{}: {} swept; {}", s.id, s.input,
                        s.closed_form ? "closed form and Newton" : "Newton's method (the limb has no closed form)"),
            "1000,800", b});
     }
   }
 
   void nonholonomic(std::vector<FigureSpec>& out) {
-    std::vector<const ReportRun*> runs;
+    std::vector<const RunResult*> runs;
     std::vector<std::string> why;
-    for (const auto& r : runner_.runs()) {
+    for (const auto& r : results_.runs) {
       if (!r.nonholonomic_verification) continue;
       const std::string reason = not_drawn(r);
       if (reason.empty()) runs.push_back(&r);
@@ -253,13 +213,12 @@ class Figures {
     std::string b = fmt::format("set multiplot layout {},1\nset logscale y\nset format y '1e%L'\nset yrange [1e-19:1e-3]\n"
                                 "set key outside right top\n",
                                 runs.size());
-    for (const ReportRun* r : runs) {
+    for (const RunResult* r : runs) {
       const std::string file = data_path(r->csv);
       b += fmt::format("set title {}\nset xlabel 't (s)'\nset ylabel 'm/s'\nplot ", q(r->id + ": |v_W . n_W|"));
-      for (std::size_t w = 0; w < gen::kWheelNames.size(); ++w)
+      for (std::size_t w = 0; w < tables_.wheels.size(); ++w)
         b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", w ? ", " : "", q(file), column("t"),
-                         log_column(fmt::format("nh_residual_{}", gen::kWheelNames[w])), dash(w),
-                         q(fmt::format("wheel {}", gen::kWheelNames[w])));
+                         log_column("nh_residual_" + tables_.wheels[w]), dash(w), q("wheel " + tables_.wheels[w]));
       b += reference_line("wheel_residual") + "\n";
     }
     b += "unset multiplot\n";
@@ -269,10 +228,10 @@ class Figures {
 
   void runs(std::vector<FigureSpec>& out) {
     for (const auto& g : spec_.run_figures) {
-      std::vector<const ReportRun*> runs;
+      std::vector<const RunResult*> runs;
       std::vector<std::string> why;
       for (const auto& id : g.runs) {
-        const ReportRun* r = runner_.find_run(id);
+        const RunResult* r = results_.find_run(id);
         if (!r) continue;  // not in this report (--quick)
         const std::string reason = not_drawn(*r);
         if (reason.empty()) runs.push_back(r);
@@ -282,15 +241,15 @@ class Figures {
         if (!why.empty()) out.push_back(omitted("run-" + g.id, g.id, why));
         continue;
       }
-      const int x = coordinate_index(g.x);
+      const int x = tables_.coordinate_index(g.x);
       std::string b = fmt::format("set multiplot layout 1,{}\nset key outside right top\n", g.y.size());
       for (const auto& name : g.y) {
-        const int y = coordinate_index(name);
+        const int y = tables_.coordinate_index(name);
         b += fmt::format("set title {}\nset xlabel {}\nset ylabel {}\nplot ", q(fmt::format("{}: {} over {}", g.id, name, g.x)),
-                         q(fmt::format("{} ({})", g.x, display_unit(x))), q(fmt::format("{} ({})", name, display_unit(y))));
+                         q(fmt::format("{} ({})", g.x, tables_.unit(x))), q(fmt::format("{} ({})", name, tables_.unit(y))));
         for (std::size_t k = 0; k < runs.size(); ++k)
           b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(data_path(runs[k]->csv)),
-                           column(g.x, display_scale(x)), column(name, display_scale(y)), dash(k), q(runs[k]->id));
+                           column(g.x, tables_.scale(x)), column(name, tables_.scale(y)), dash(k), q(runs[k]->id));
         b += "\n";
       }
       b += "unset multiplot\n";
@@ -303,14 +262,13 @@ class Figures {
 
   // The contact paths and the body frame's path seen from above, with the machine at the start and the
   // end of each run, on equal axis scales.
-  FigureSpec top_view(const std::string& id, const std::vector<const ReportRun*>& runs) {
+  FigureSpec top_view(const std::string& id, const std::vector<const RunResult*>& runs) {
     Bounds b;
     std::string arrows;
-    for (const ReportRun* r : runs) {
+    for (const RunResult* r : runs) {
       const Bounds& rb = bounds_[r->id];
       b.add(rb.x0, rb.y0), b.add(rb.x1, rb.y1);
-      for (const auto& smp : r->trajectory.samples)
-        for (int w = 0; w < gen::kWheelCount; ++w) b.add(smp.contacts(2 * w), smp.contacts(2 * w + 1));
+      if (r->contact_x0 <= r->contact_x1) b.add(r->contact_x0, r->contact_y0), b.add(r->contact_x1, r->contact_y1);
       arrows += heading_arrows(r->id, 0, 1, 1.0);
     }
     std::string t = fmt::format("set title {}\n"
@@ -323,16 +281,16 @@ class Figures {
       t += fmt::format(", {} index 1 using 1:2 with lines lw 1 dt {} lc {} title {}", q(data_path(runs[k]->id + "-pose.dat")), dash(k),
                        k + 1, q(runs[k]->id + " machine at the end"));
       t += fmt::format(", {} index 2 using 1:2 with lines lw 3 dt {} lc {} title {}", q(data_path(runs[k]->id + "-pose.dat")), dash(k),
-                       k + 1, q(fmt::format("{} {} path", runs[k]->id, gen::kFrameNames[static_cast<std::size_t>(body_frame_)])));
-      for (std::size_t w = 0; w < gen::kWheelNames.size(); ++w) {
-        const std::string wheel(gen::kWheelNames[w]);
+                       k + 1, q(fmt::format("{} {} path", runs[k]->id, body_frame_name())));
+      for (std::size_t w = 0; w < tables_.wheels.size(); ++w) {
+        const std::string& wheel = tables_.wheels[w];
         t += fmt::format(", {} using {}:{} with lines lw 2 dt {} lc {} title {}", q(file), column("x_W" + wheel), column("y_W" + wheel),
                          dash(k), k + 3 + 2 * static_cast<int>(w), q(fmt::format("{} wheel {} contact", runs[k]->id, wheel)));
       }
     }
     t += "\n";
     return {"run-" + id + "-top", fmt::format("{}: wheel contact paths and the path of frame {} seen from above, with the machine at the start "
-                                              "and the end", id, gen::kFrameNames[static_cast<std::size_t>(body_frame_)]),
+                                              "and the end", id, body_frame_name()),
             "1100,650", t};
   }
 
@@ -340,33 +298,33 @@ class Figures {
     std::vector<std::vector<std::string>> panels = spec_.torque_panels;
     if (panels.empty()) {  // no report file: the actuators in two halves
       panels.resize(2);
-      for (std::size_t k = 0; k < kActuatorNames.size(); ++k) panels[k * 2 / kActuatorNames.size()].emplace_back(kActuatorNames[k]);
+      const auto& actuators = tables_.actuators;
+      for (std::size_t k = 0; k < actuators.size(); ++k) panels[k * 2 / actuators.size()].emplace_back(actuators[k]);
     }
-    for (const auto& r : runner_.runs()) {
-      if (!r.scenario.weighting) continue;
+    for (const auto& r : results_.runs) {
+      if (r.weighting == 0) continue;
       if (const std::string why = not_drawn(r); !why.empty()) {
         out.push_back(omitted("id-" + r.id, "the torques of " + r.id, {why}));
         continue;
       }
-      const int weighting = weighting_number(*r.scenario.weighting);
+      const int weighting = r.weighting;
       const report::TorqueReference* reference = nullptr;
       for (const auto& ref : spec_.torque_references)
         if (ref.scenario == r.scenario_id && ref.weighting == weighting) reference = &ref;
-      const double scale = r.summary.largest_tau();
+      const double scale = r.largest_tau;
       std::string b = fmt::format("set multiplot layout {},1\nset xlabel 't (s)'\nset ylabel 'torque (N m)'\nset key outside right top\n",
                                   panels.size());
       for (std::size_t p = 0; p < panels.size(); ++p) {
         std::vector<std::string> names;
         std::vector<std::vector<double>> curves;
         for (const auto& joint : panels[p]) {
-          const auto at = std::find(kActuatorNames.begin(), kActuatorNames.end(), joint) - kActuatorNames.begin();
+          const auto at = std::find(tables_.actuators.begin(), tables_.actuators.end(), joint) - tables_.actuators.begin();
           names.push_back("tau_" + joint);
-          curves.emplace_back();
-          for (const auto& smp : r.trajectory.samples) curves.back().push_back(smp.tau(at));
+          curves.push_back(r.tau.at(static_cast<std::size_t>(at)));
         }
         // Equal to rounding: 1e-9 of the largest torque of the run.
         const auto titles = legend_titles(names, curves, 1e-9 * std::max(scale, 1.0));
-        b += fmt::format("set title {}\nplot ", q(fmt::format("{}, {}: torques{}", r.scenario_id, r.scenario.weighting->label(),
+        b += fmt::format("set title {}\nplot ", q(fmt::format("{}, {}: torques{}", r.scenario_id, r.weighting_label,
                                                                 reference ? " (cf. " + reference->figures[p] + ")" : "")));
         for (std::size_t k = 0; k < names.size(); ++k)
           b += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", k ? ", " : "", q(data_path(r.csv)), column("t"),
@@ -374,7 +332,7 @@ class Figures {
         b += "\n";
       }
       b += "unset multiplot\n";
-      std::string caption = fmt::format("{}: actuator torques with {}", r.scenario_id, r.scenario.weighting->label());
+      std::string caption = fmt::format("{}: actuator torques with {}", r.scenario_id, r.weighting_label);
       if (reference) caption += fmt::format("; cf. {}", fmt::join(reference->figures, ", "));
       out.push_back({"id-" + r.id, caption, fmt::format("1100,{}", 380 * panels.size()), b});
     }
@@ -384,7 +342,7 @@ class Figures {
   // magnitude); the closed loops' signed tracking errors per commanded coordinate (mm, deg), one
   // panel per motion (the model file's weights; the table has every weighting).
   void forward(std::vector<FigureSpec>& trips, std::vector<FigureSpec>& loops) {
-    const auto& rows = runner_.forward();
+    const auto& rows = results_.forward;
     if (rows.empty()) return;
     // Why a row's round trip or closed loop has no curve: its inverse-dynamics run stopped, or it
     // stopped itself before its second sample; "" when it has one.
@@ -428,9 +386,9 @@ class Figures {
                                 shown.size());
     for (const ForwardRow* r : shown) {
       l += fmt::format("set title {}\nplot ", q(r->id + ": closed-loop tracking error, computed torque + PD on a plant 10% heavier"));
-      for (std::size_t j = 0; j < kCommandedSpeeds.size(); ++j) {
-        const int c = kCommandedSpeeds[j];
-        const bool angle = is_angle(c);
+      for (std::size_t j = 0; j < tables_.commanded.size(); ++j) {
+        const int c = tables_.commanded[j];
+        const bool angle = tables_.is_angle(c);
         l += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", j ? ", " : "", q(data_path(r->closed_loop_csv)), column("t"),
                          column("error_" + coordinate_name(c), angle ? kDegPerRad : 1e3), dash(j),
                          q(coordinate_name(c) + (angle ? " (deg)" : " (mm)")));
@@ -447,7 +405,7 @@ class Figures {
   // Per run in the physics engine: the tracking error, each contact's slip, and each contact's
   // normal force, MuJoCo's against the model's for the same torques.
   void engine(std::vector<FigureSpec>& out) {
-    for (const EngineRow& r : runner_.engine()) {
+    for (const EngineRow& r : results_.engine) {
       const std::string why = not_drawn(r.id + " in the physics engine", static_cast<std::size_t>(r.samples), r.stopped);
       if (!why.empty()) {
         out.push_back(omitted("engine-" + r.id, r.id + " in the physics engine", {why}));
@@ -460,14 +418,15 @@ class Figures {
                        q(r.id + " in MuJoCo: tracking error of the commanded coordinates"), csv, column("t"),
                        column("tracking_error_m", 1e3), csv, column("t"), column("tracking_error_rad", kDegPerRad));
       g += fmt::format("set title {}\nset ylabel 'slip (mm/s)'\nplot ", q("each contact's slip: the speed of its material point on the ground"));
-      for (int c = 0; c < kContactCount; ++c)
+      const auto& contacts = tables_.contacts;
+      for (std::size_t c = 0; c < contacts.size(); ++c)
         g += fmt::format("{}{} using {}:{} with lines lw 2 dt {} title {}", c ? ", " : "", csv, column("t"),
-                         column("slip_" + contact_name(c), 1e3), dash(static_cast<std::size_t>(c)), q(contact_name(c)));
+                         column("slip_" + contacts[c], 1e3), dash(c), q(contacts[c]));
       g += fmt::format("\nset title {}\nset ylabel 'normal force (N)'\nplot ", q("normal forces: MuJoCo's (solid) and the model's (dashed)"));
-      for (int c = 0; c < kContactCount; ++c)
+      for (std::size_t c = 0; c < contacts.size(); ++c)
         g += fmt::format("{0}{1} using {2}:{3} with lines lw 2 lc {5} title {6}, {1} using {2}:{4} with lines lw 2 dt 2 lc {5} notitle",
-                         c ? ", " : "", csv, column("t"), column("normal_mujoco_" + contact_name(c)), column("normal_wlx_" + contact_name(c)),
-                         c + 1, q(contact_name(c)));
+                         c ? ", " : "", csv, column("t"), column("normal_mujoco_" + contacts[c]), column("normal_wlx_" + contacts[c]),
+                         c + 1, q(contacts[c]));
       g += "\nunset multiplot\n";
       out.push_back({"engine-" + r.id,
                      r.id + " in MuJoCo: the model's computed-torque controller drives the exported machine at 1 kHz along the run; "
@@ -478,16 +437,16 @@ class Figures {
   }
 
   void poses(std::vector<FigureSpec>& out) {
-    for (const auto& r : runner_.runs()) {
+    for (const auto& r : results_.runs) {
       if (duplicate_motion(r)) continue;
-      if (r.trajectory.samples.empty()) {  // one sample still shows where it stood
+      if (r.poses.empty()) {  // one sample still shows where it stood
         out.push_back(omitted("pose-" + title_of(r), "the poses of " + r.id, {not_drawn(r)}));
         continue;
       }
       const std::string dat = data_path(r.id + "-pose.dat");
       const Bounds& bounds = bounds_[r.id];
       const std::string title = title_of(r);
-      const double end = r.trajectory.samples.back().t;
+      const double end = r.end_time;
       std::string b = "set multiplot layout 1,2\nset size ratio -1\nset key outside bottom center horizontal\n";
       b += fmt::format("set title {}\nset xlabel 'x (m)'\nset ylabel 'z (m)'\n{}{}", q(title + ": side view"), bounds.xz(0.3),
                        heading_arrows(r.id, 0, 2, 1.0));
@@ -507,8 +466,9 @@ class Figures {
     }
   }
 
-  ReportRunner& runner_;
-  const report::ReportSpec& spec_;
+  const Results& results_;
+  const ModelTables& tables_;
+  const ReportSpec& spec_;
   std::string data_dir_;
   int body_frame_ = 0;
   std::map<std::string, Bounds> bounds_;
@@ -517,8 +477,8 @@ class Figures {
 
 }  // namespace
 
-ReportFigures make_figures(ReportRunner& runner, const report::ReportSpec& spec, const std::string& data_dir) {
-  return Figures(runner, spec, data_dir).all();
+ReportFigures make_figures(const Results& results, const ModelTables& tables, const ReportSpec& spec, const std::string& data_dir) {
+  return Figures(results, tables, spec, data_dir).all();
 }
 
-WLX_COMMANDS_END
+}  // namespace wlx::cli::report

@@ -1,22 +1,23 @@
-// The report's figures for one model, as gnuplot plot commands over the CSV files in data/
-// (report/gnuplot.hpp renders them). What is plotted together comes from the report file
-// (run_figures, torque_figures, pose); without one every run still gets its figures.
+// The report's figures, as gnuplot plot commands over the CSV files in data/ (report/gnuplot.hpp
+// renders them). What is plotted together comes from the report file (run_figures, torque_figures,
+// pose); without one every run still gets its figures. Compiled once, into wlx itself: it reads
+// what the model's side computed (report/results.hpp).
 #pragma once
 
-#include "per_model.hpp"
 #include "report/gnuplot.hpp"
-#include "report/runner.hpp"
+#include "report/results.hpp"
+#include "report/spec.hpp"
 
 #include <string>
 #include <vector>
 
-WLX_COMMANDS_BEGIN
+namespace wlx::cli::report {
 
 struct ReportFigures {
-  std::vector<report::FigureSpec> ik, nonholonomic, kinematic, dynamics, forward, closed_loop, engine, poses;
+  std::vector<FigureSpec> ik, nonholonomic, kinematic, dynamics, forward, closed_loop, engine, poses;
 };
 
 // Also writes data/<run>-pose.dat (the skeletons at the start and the end of each run).
-ReportFigures make_figures(ReportRunner& runner, const report::ReportSpec& spec, const std::string& data_dir);
+ReportFigures make_figures(const Results& results, const ModelTables& tables, const ReportSpec& spec, const std::string& data_dir);
 
-WLX_COMMANDS_END
+}  // namespace wlx::cli::report

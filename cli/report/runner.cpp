@@ -25,6 +25,16 @@ WLX_COMMANDS_BEGIN
 
 namespace {
 
+using report::kEngineLostAngle;
+using report::kEngineLostLength;
+using report::kEngineSettle;
+using report::kPlantMassFactor;
+using report::kRoundTripTolerance;
+using report::kStartOffsetAngle;
+using report::kStartOffsetLength;
+using report::kTrackingKd;
+using report::kTrackingKp;
+
 bool is_dynamics(const std::string& scenario_id) {
   return model_scenario_json(scenario_id).contains("weighting");
 }
@@ -61,10 +71,8 @@ void commanded_reference(const ReportRun& run, double t, CommandVector& q, Comma
 
 }  // namespace
 
-std::string Stop::describe() const { return fmt::format("stopped at t = {:.4f} s: {}", time, reason); }
-
-std::string display_unit(int c) { return gen::kCoordinateUnits[static_cast<std::size_t>(c)] == "rad" ? "deg" : std::string(gen::kCoordinateUnits[static_cast<std::size_t>(c)]); }
-double display_scale(int c) { return gen::kCoordinateUnits[static_cast<std::size_t>(c)] == "rad" ? kDegPerRad : 1; }
+std::string display_unit(int c) { return report::display_unit(gen::kCoordinateUnits[static_cast<std::size_t>(c)]); }
+double display_scale(int c) { return report::display_scale(gen::kCoordinateUnits[static_cast<std::size_t>(c)]); }
 
 ReportRunner::ReportRunner(const Params& params, const report::ReportSpec& spec, bool quick, Progress progress)
     : spec_(spec), quick_(quick), progress_(std::move(progress)), model_(params) {
@@ -272,7 +280,7 @@ void ReportRunner::compare_integrators(const std::string& data_dir) {
         record_stop(id, fmt::format("{}, {}", integrator_name(run.integrator), setting), tr);
         return;
       }
-      IntegratorRow row{id, run.integrator, setting, static_cast<long>(tr.samples.size()), tr.evaluations, 0,
+      IntegratorRow row{id, std::string(integrator_name(run.integrator)), setting, static_cast<long>(tr.samples.size()), tr.evaluations, 0,
                         std::vector<double>(compared_.size(), 0.0)};
       for (const auto& smp : tr.samples) {
         const auto& r = ref.samples[static_cast<std::size_t>(std::lround(smp.t / step))];
@@ -298,7 +306,7 @@ void ReportRunner::compare_integrators(const std::string& data_dir) {
   for (const auto& r : integrators_) {
     std::vector<double> values{static_cast<double>(r.samples), static_cast<double>(r.evaluations), r.inputs};
     values.insert(values.end(), r.coordinates.begin(), r.coordinates.end());
-    csv.row({r.id, std::string(integrator_name(r.integrator))}, values);
+    csv.row({r.id, r.integrator}, values);
   }
   csv.commit();
 }
@@ -575,7 +583,7 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
   }
   if (q == "integrator_deviation") {
     if (quick_ || spec_.integrator_scenarios.empty()) return std::nullopt;  // not compared (run_all)
-    const Integrator integrator = *integrator_from_name(m.integrator);
+    const std::string& integrator = m.integrator;  // validated: one of integrator_name()'s
     double worst = 0;
     std::string unit = "m or rad";
     // A compared run stopped, at its own step or in a comparison: its deviation is not known.

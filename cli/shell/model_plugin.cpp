@@ -35,10 +35,14 @@
 #include <unistd.h>
 
 // Set by CMake (CMakeLists.txt, wlx_cli_common; the compiler wlx was built with is
-// compile_jobs.cpp's): the include folders of Eigen, fmt and nlohmann-json, fmt's library, the source tree, and where an installed
+// compile_jobs.cpp's): the include folders of Eigen, fmt and nlohmann-json, the definitions of every
+// part (wlx_plugin_defines says why), fmt's library, the source tree, and where an installed
 // wlx keeps the runtime's headers and the sources a plugin compiles (relative to its bin folder).
 #ifndef WLX_PLUGIN_INCLUDES
 #define WLX_PLUGIN_INCLUDES ""
+#endif
+#ifndef WLX_PLUGIN_DEFINES
+#define WLX_PLUGIN_DEFINES ""
 #endif
 #ifndef WLX_PLUGIN_LIBRARIES
 #define WLX_PLUGIN_LIBRARIES ""
@@ -460,6 +464,7 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   std::vector<std::string> common{cxx, "-std=c++20", "-fPIC", "-DNDEBUG", "-DWLX_MODEL=" + name, "-DWLX_GEN_COMPILED_" + name};
   for (const fs::path& include : {gen, src.runtime_include, src.support_include, src.cli / "shell", src.cli, src.cli / "commands"}) common.push_back("-I" + include.string());
   for (const auto& include : split_list(WLX_PLUGIN_INCLUDES)) common.push_back("-isystem" + include);
+  for (const auto& definition : split_list(WLX_PLUGIN_DEFINES)) common.push_back(definition);
   std::vector<Job> jobs;
   std::vector<std::string> objects;
   std::map<bool, std::vector<std::string>> part_flags;  // by "is the commands' part"
@@ -582,6 +587,7 @@ const ModelCommands& load_model_file(const std::string& model_file, const std::s
   for (const bool commands : {false, true})
     for (const auto& f : optimization_flags(commands)) h.add(f);
   h.add(WLX_PLUGIN_INCLUDES);
+  h.add(WLX_PLUGIN_DEFINES);
   h.add(WLX_PLUGIN_LIBRARIES);
   // The sources the plugin is compiled from and the interface it is loaded through (a rebuilt wlx
   // may have other sources under the same version); the generator's part is the code key.
