@@ -80,82 +80,6 @@ struct TorqueRates {
   }
 };
 
-// The Dormand-Prince 5(4) pair (Hairer, Norsett, Wanner, Solving ODEs I, table 5.2): the nodes c_i,
-// the stages, the 5th-order weights (= the last stage row: first same as last) and the difference
-// to the embedded 4th-order weights, which estimates the local error.
-namespace dopri {
-constexpr double c2 = 1.0 / 5, c3 = 3.0 / 10, c4 = 4.0 / 5, c5 = 8.0 / 9;
-constexpr double a21 = 1.0 / 5;
-constexpr double a31 = 3.0 / 40, a32 = 9.0 / 40;
-constexpr double a41 = 44.0 / 45, a42 = -56.0 / 15, a43 = 32.0 / 9;
-constexpr double a51 = 19372.0 / 6561, a52 = -25360.0 / 2187, a53 = 64448.0 / 6561, a54 = -212.0 / 729;
-constexpr double a61 = 9017.0 / 3168, a62 = -355.0 / 33, a63 = 46732.0 / 5247, a64 = 49.0 / 176, a65 = -5103.0 / 18656;
-constexpr double b1 = 35.0 / 384, b3 = 500.0 / 1113, b4 = 125.0 / 192, b5 = -2187.0 / 6784, b6 = 11.0 / 84;
-constexpr double e1 = 71.0 / 57600, e3 = -71.0 / 16695, e4 = 71.0 / 1920, e5 = -17253.0 / 339200, e6 = 22.0 / 525,
-                 e7 = -1.0 / 40;
-}  // namespace dopri
-
-// Advances x from t to t + span with Dormand-Prince steps under error control; f(t, x) is the
-// right-hand side. `h` carries the step size from one call to the next; k1 = f(t, x) on entry.
-template <class State, class F>
-void dopri5_span(F& f, State& x, State k1, double t, double span, double tolerance, double& h, Trajectory& stats) {
-  using namespace dopri;
-  const double end = t + span;
-  double now = t;
-  int rejected_in_a_row = 0;
-  while (now < end) {
-    const bool last = h >= (end - now) * (1 - 1e-12);  // finish the span rather than leave a sliver
-    const double step = last ? end - now : h;
-    State next, k7;
-    double scaled = 0;
-    std::string failure;  // a stage that left the workspace (unreachable pose, singular J_beta)
-    ErrorKind failure_kind = ErrorKind::other;
-    try {
-      const State k2 = f(now + c2 * step, x + step * a21 * k1);
-      const State k3 = f(now + c3 * step, x + step * (a31 * k1 + a32 * k2));
-      const State k4 = f(now + c4 * step, x + step * (a41 * k1 + a42 * k2 + a43 * k3));
-      const State k5 = f(now + c5 * step, x + step * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4));
-      const State k6 = f(now + step, x + step * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5));
-      next = x + step * (b1 * k1 + b3 * k3 + b4 * k4 + b5 * k5 + b6 * k6);
-      k7 = f(now + step, next);
-      const State error = step * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
-      scaled = (error.array().abs() / (tolerance * (1 + x.array().abs().max(next.array().abs())))).maxCoeff();
-      if (!std::isfinite(scaled)) {  // an overflow, not an error estimate: shrink, and say so if it persists
-        failure = "a stage of the step became non-finite (inf or NaN)";
-        scaled = 1e10;
-      }
-    } catch (const Error& e) {
-      // The stages reach ahead of the step (up to 3.7 step lengths with these coefficients), so
-      // a long step can probe poses the motion itself never reaches: reject and shrink. A real
-      // failure shrinks the step to nothing and is reported below.
-      failure = e.what();
-      failure_kind = e.kind();
-      scaled = 1e10;
-    }
-    // The usual controller: the error scales as step^5; a safety factor and bounded changes.
-    const double factor = std::clamp(0.9 * std::pow(std::max(scaled, 1e-10), -0.2), 0.2, 5.0);
-    if (scaled <= 1) {
-      x = next;
-      k1 = k7;  // first same as last
-      now = last ? end : now + step;
-      ++stats.steps;
-      rejected_in_a_row = 0;
-      if (!last || factor < 1) h = step * factor;  // a step clipped to the sample time says little
-    } else {
-      ++stats.rejected_steps;
-      h = step * std::min(factor, 0.5);
-      if (++rejected_in_a_row > 60 || h < 1e-14 * std::max(1.0, std::abs(end))) {
-        if (!failure.empty())
-          throw Error("", fmt::format("at t = {:.6f} s (adaptive step {:.3g} s): {}", now, step, failure), failure_kind);
-        throw Error("tolerance", fmt::format("the adaptive step fell to {:.3g} s at t = {:.6f} s without meeting the "
-                                             "tolerance {:.3g}: the motion is not smooth here (a singular J_beta or a "
-                                             "limb at its reach); use rk4 with a small dt or loosen the tolerance",
-                                             h, now, tolerance));
-      }
-    }
-  }
-}
-
 // What drives a run's numbers, for a message about a value that became non-finite: the largest
 // commanded rate, gravity and the heaviest body.
 std::string drivers(const Scenario& sc) {
@@ -213,21 +137,6 @@ std::string limit_violation(const Sample& smp) {
 
 }  // namespace
 
-std::string_view integrator_name(Integrator integrator) noexcept {
-  switch (integrator) {
-    case Integrator::rk4: return "rk4";
-    case Integrator::euler: return "euler";
-    case Integrator::dopri5: return "dopri5";
-  }
-  return "?";
-}
-
-std::optional<Integrator> integrator_from_name(std::string_view name) noexcept {
-  for (Integrator i : {Integrator::rk4, Integrator::euler, Integrator::dopri5})
-    if (integrator_name(i) == name) return i;
-  return std::nullopt;
-}
-
 CommandVector Scenario::commanded_speeds() const {
   CommandVector u;
   for (int k = 0; k < kCommandedCount; ++k) u(k) = rates(kCommandedSpeeds[static_cast<std::size_t>(k)]);
@@ -235,16 +144,6 @@ CommandVector Scenario::commanded_speeds() const {
 }
 
 long Scenario::samples() const { return std::lround(duration / dt) + 1; }
-
-void validate_time_grid(double duration, double dt) {
-  if (!(std::isfinite(duration) && duration > 0))
-    throw Error("duration", fmt::format("must be a positive number of seconds, got {}", duration));
-  if (!(std::isfinite(dt) && dt > 0)) throw Error("dt", fmt::format("must be a positive number of seconds, got {}", dt));
-  if (duration / dt > 1e8)
-    throw Error("dt", fmt::format("{} s over {} s is {:.3g} steps, more than the limit of 1e8", dt, duration, duration / dt));
-  if (std::abs(duration / dt - std::round(duration / dt)) > 1e-6 * (duration / dt))
-    throw Error("dt", fmt::format("the duration {} s is not a whole number of steps of {} s", duration, dt));
-}
 
 void Scenario::validate() const {
   validate_time_grid(duration, dt);
@@ -371,53 +270,30 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
   Data& data = *data_storage;
   Trajectory out;
   const long n = sc.samples();
-  double h = sc.dt;  // dopri5's step, adapted as it goes
 
-  // The loop of every run: a sample after each step's first evaluation, then the step. `name(i)`
-  // names the state's entry i for a message about a value that became non-finite.
-  const auto integrate = [&](auto& f, auto x, const auto& fill, const auto& name) {
-    using State = decltype(x);
-    for (long k = 0; k < n; ++k) {
-      const double t = static_cast<double>(k) * sc.dt;
-      try {
-        const State k1 = f(t, x);
-        Sample smp;
-        smp.t = t;
-        fill(smp);
-        check_finite(smp, sc);
-        if (const std::string why = limit_violation(smp); !why.empty()) {
-          if (sc.stop_on_limit) throw Error("limits", why + " (\"on_limit\": \"continue\" goes on)", ErrorKind::limit);
-          if (out.limit_warning.empty()) out.limit_warning = fmt::format("at t = {:.4f} s: {}", t, why);
-        }
-        on_sample(smp);
-        if (progress) progress(k + 1, n);
-        if (k + 1 == n) break;
-        if (sc.integrator == Integrator::euler) {
-          x += sc.dt * k1;
-          ++out.steps;
-        } else if (sc.integrator == Integrator::rk4) {
-          const State k2 = f(t + 0.5 * sc.dt, State(x + 0.5 * sc.dt * k1));
-          const State k3 = f(t + 0.5 * sc.dt, State(x + 0.5 * sc.dt * k2));
-          const State k4 = f(t + sc.dt, State(x + sc.dt * k3));
-          x += sc.dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
-          ++out.steps;
-        } else {
-          dopri5_span(f, x, k1, t, sc.dt, sc.tolerance, h, out);
-        }
-        // Checked after every step: an overflow is reported in the step that made it.
-        for (int i = 0; i < x.size(); ++i)
-          if (!std::isfinite(x(i)))
-            throw Error(name(i), fmt::format("became non-finite ({}) in the step to t = {:.6f} s; {}", x(i),
-                                             static_cast<double>(k + 1) * sc.dt, drivers(sc)));
-      } catch (const Error& e) {
-        out.complete = false;
-        out.error = fmt::format("stopped at t = {:.4f} s (step {} of {}): {}", t, k, n - 1, e.what());
-        out.stop_time = t;
-        out.stop_reason = e.what();
-        out.stop_kind = e.kind();
-        break;
+  // The loop of every run (integration.hpp, compiled once): a sample after each step's first
+  // evaluation, then the step. The state goes between the integrator's vectors and the run's
+  // fixed-size ones at each evaluation. `name(i)` names the state's entry i for a message about a
+  // value that became non-finite.
+  const auto integrate = [&](auto& f, const auto& x0, const auto& fill, const auto& name) {
+    using State = std::decay_t<decltype(x0)>;
+    const integration::Rates rates = [&](double t, const Eigen::VectorXd& x, Eigen::VectorXd& rate) { rate = f(t, State(x)); };
+    const auto sample = [&](long k, double t) {
+      Sample smp;
+      smp.t = t;
+      fill(smp);
+      check_finite(smp, sc);
+      if (const std::string why = limit_violation(smp); !why.empty()) {
+        if (sc.stop_on_limit) throw Error("limits", why + " (\"on_limit\": \"continue\" goes on)", ErrorKind::limit);
+        if (out.limit_warning.empty()) out.limit_warning = fmt::format("at t = {:.4f} s: {}", t, why);
       }
-    }
+      on_sample(smp);
+      if (progress) progress(k + 1, n);
+    };
+    const integration::Outcome run =
+        integration::integrate(rates, Eigen::VectorXd(x0), {n, sc.dt, sc.integrator, sc.tolerance}, sample, name, [&] { return drivers(sc); });
+    out.complete = run.complete, out.error = run.error, out.stop_time = run.stop_time, out.stop_reason = run.stop_reason;
+    out.stop_kind = run.stop_kind, out.steps = run.steps, out.rejected_steps = run.rejected_steps;
     out.evaluations = f.evaluations;
   };
   const auto coordinate = [](int i) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(i)]); };

@@ -9,6 +9,7 @@
 #include "wlx/dynamics.hpp"
 #include "wlx/forward_dynamics.hpp"
 #include "wlx/ik.hpp"
+#include "wlx/integration.hpp"
 #include "wlx/model.hpp"
 #include "wlx/nonholonomic.hpp"
 
@@ -20,17 +21,8 @@
 
 WLX_MODEL_NAMESPACE_BEGIN
 
-// rk4 and euler take fixed steps of dt (the thesis used euler with 0.001 s). dopri5 is the
-// Dormand-Prince 5(4) pair with error control: adaptive steps between the output samples, which
-// stay dt apart; each step's local error estimate is kept below tolerance * (1 + |q|).
-enum class Integrator { rk4, euler, dopri5 };
-std::string_view integrator_name(Integrator integrator) noexcept;
-// The integrator of that name ("rk4", "euler", "dopri5"), or nothing.
-std::optional<Integrator> integrator_from_name(std::string_view name) noexcept;
-
-// Every run's time grid: throws wlx::Error naming "duration" or "dt" unless both are positive and
-// finite and the duration is a whole number of at most 1e8 steps of dt.
-void validate_time_grid(double duration, double dt);
+// The integrators (Integrator, integrator_name, validate_time_grid) are model-independent and
+// compiled once: wlx/integration.hpp.
 
 struct Scenario {
   std::string id;
