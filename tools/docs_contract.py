@@ -640,8 +640,10 @@ def bench_repetitions(build):
     return int(m[1])
 
 
-def benchmark_rows(build):
-    r = run([os.path.join(build, "wlx_bench"), "--json"], timeout=1800)
+def benchmark_rows(build, rows_only=False):
+    """wlx_bench's table as JSON; rows_only: each benchmark once and briefly (its rows and
+    operation counts are right, its times are not)."""
+    r = run([os.path.join(build, "wlx_bench"), "--json", *(["--rows"] if rows_only else [])], timeout=1800)
     if r.returncode != 0:
         raise ContractError(f"wlx_bench --json: exit {r.returncode}\n{r.stderr}")
     return json.loads(r.stdout)
@@ -959,7 +961,7 @@ def cmd_figures(options):
         header, body = table[0], [r for r in table[1:] if not r[0].startswith("**")]
         column = header.index("ops")
         quoted = {r[0]: r[column] for r in body}
-        rows = benchmark_rows(options.build)
+        rows = benchmark_rows(options.build, rows_only=True)
         reported = {r["operation"].strip(): str(r.get("ops", "")) for r in rows}
         for name in sorted(set(reported) ^ set(quoted)):
             problems.append(f"benchmark row '{name}' is in only one of wlx_bench --json and README.md "
