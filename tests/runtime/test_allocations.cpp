@@ -1,12 +1,14 @@
 // The hot paths allocate nothing once a Model and a Data exist: a counting global operator new
 // (this file is its own test program, so the count sees every allocation).
 #include <doctest/doctest.h>
+#include <wlx/contacts.hpp>
 #include <wlx/dynamics.hpp>
 #include <wlx/ik.hpp>
 #include <wlx/kinematics.hpp>
 #include <wlx/nonholonomic.hpp>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <new>
@@ -70,6 +72,29 @@ TEST_CASE("allocations: kinematic update, dependent rates and accelerations, inv
     const TorqueVector tau2 = distribute_torques(terms.J_beta, terms.Qstar, Weighting::contribution());
     CHECK(tau1.allFinite());
     CHECK(tau2.allFinite());
+  }
+  CHECK(g_allocations - before == 0);
+}
+
+// contacts.hpp says both allocate nothing; the polygon's geometry is compiled once, on workspace
+// the model's stability() lends it (support_polygon.hpp).
+TEST_CASE("allocations: contact forces and stability (the support polygon and its margins): none") {
+  const Model model;
+  auto data = std::make_unique<Data>();
+  DynamicsTerms terms;
+  ContactForces forces;
+  Stability st;
+  Coordinates s = nominal_inputs();
+  const long before = g_allocations;
+  for (int k = 0; k < 100; ++k) {
+    s(gen::coord::x_C) = 0.002 * k;
+    solve_ik_closed_form(model, s);
+    inverse_dynamics(model, *data, s, CommandVector(0, 3, 0.1, 0), CommandVector::Zero(), terms);
+    const TorqueVector tau = distribute_torques(terms.J_beta, terms.Qstar, Weighting::model_weights());
+    contact_forces(model, *data, s, terms, tau, forces);
+    stability(model, *data, s, forces, st);
+    CHECK(st.polygon_size >= 2);  // the excavator stands on its feet and wheels
+    CHECK(std::isfinite(st.tip_angle));
   }
   CHECK(g_allocations - before == 0);
 }
