@@ -166,18 +166,12 @@ class ModelSide final : public report::ModelReport {
   void run_all(const std::string& data_dir, const Progress& progress) override {
     progress_ = progress;
     runner_.run_all(data_dir);
-    results_.sweeps.clear(), results_.runs.clear();
-    for (const auto& s : runner_.sweeps()) results_.sweeps.push_back(sweep_result(s));
+    report::Results& results = runner_.results();  // the runner's rows; the sweeps and runs added here
+    for (const auto& s : runner_.sweeps()) results.sweeps.push_back(sweep_result(s));
     RunViews view(runner_.model(), spec_);
-    for (const auto& r : runner_.runs()) results_.runs.push_back(view(r));
-    results_.integrators = runner_.integrators();
-    results_.compared = runner_.compared_coordinates();
-    results_.forward = runner_.forward();
-    results_.engine = runner_.engine();
-    results_.engine_missing = runner_.engine_missing();
-    results_.stopped = runner_.stopped();
+    for (const auto& r : runner_.runs()) results.runs.push_back(view(r));
   }
-  const report::Results& results() const override { return results_; }
+  const report::Results& results() const override { return runner_.results(); }
   std::optional<Measured> measure(const report::Measure& m) override { return runner_.measure(m); }
   void write_viewer_runs(const fs::path& dir) const override {
     for (const auto& r : runner_.runs()) {
@@ -192,7 +186,6 @@ class ModelSide final : public report::ModelReport {
   report::ModelTables tables_;
   Progress progress_;
   ReportRunner runner_;
-  report::Results results_;
 };
 
 }  // namespace

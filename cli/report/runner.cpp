@@ -76,7 +76,7 @@ double display_scale(int c) { return report::display_scale(gen::kCoordinateUnits
 
 ReportRunner::ReportRunner(const Params& params, const report::ReportSpec& spec, bool quick, Progress progress)
     : spec_(spec), quick_(quick), progress_(std::move(progress)), model_(params) {
-  for (const auto& name : spec_.integrator_coordinates) compared_.push_back(coordinate_index(name));
+  for (const auto& name : spec_.integrator_coordinates) results_.compared.push_back(coordinate_index(name));
 }
 
 // ---- names --------------------------------------------------------------------------------------
@@ -227,31 +227,31 @@ void ReportRunner::run_all(const std::string& data_dir) {
       ForwardRow row;
       row.id = runs_[k].id;
       row.not_run = runs_[k].stopped;
-      forward_.push_back(row);
+      results_.forward.push_back(row);
       continue;
     }
     progress_(fmt::format("forward dynamics of {}: its torques fed back, and a controller tracking it on a heavier plant", runs_[k].id));
-    forward_.push_back(forward_dynamics_of(runs_[k], data_dir));
+    results_.forward.push_back(forward_dynamics_of(runs_[k], data_dir));
   }
   // The physics engine: each scenario's run under the model file's weights (the controller's own split).
-  engine_missing_ = physics_engine_missing();
-  if (engine_missing_.empty() && description_text().empty()) engine_missing_ = "the model's description is not loaded";
-  if (engine_missing_.empty() && kContactCount == 0) engine_missing_ = "the model has no contacts with the ground";
+  results_.engine_missing = physics_engine_missing();
+  if (results_.engine_missing.empty() && description_text().empty()) results_.engine_missing = "the model's description is not loaded";
+  if (results_.engine_missing.empty() && kContactCount == 0) results_.engine_missing = "the model has no contacts with the ground";
   for (std::size_t k = 0; k < inverse_runs; ++k) {
     const ReportRun& run = runs_[k];
     if (!run.scenario.weighting || run.scenario.weighting->kind != Weighting::Kind::model_weights) continue;
-    if (!engine_missing_.empty() || run.stopped) {
-      progress_(fmt::format("{} in a physics engine: not run ({})", run.id, run.stopped ? run.id + " stopped" : engine_missing_));
+    if (!results_.engine_missing.empty() || run.stopped) {
+      progress_(fmt::format("{} in a physics engine: not run ({})", run.id, run.stopped ? run.id + " stopped" : results_.engine_missing));
       continue;
     }
     progress_(fmt::format("{} in a physics engine: the controller drives MuJoCo's machine", run.id));
     try {
-      engine_.push_back(physics_engine_of(run, data_dir));
+      results_.engine.push_back(physics_engine_of(run, data_dir));
     } catch (const Error& e) {  // MuJoCo's machine could not be made (what the export cannot express): a row that says so
       EngineRow row;
       row.id = run.id;
       row.stopped = Stop{0, std::string("no machine in MuJoCo: ") + e.what()};
-      engine_.push_back(row);
+      results_.engine.push_back(row);
     }
   }
   if (!quick_ && !spec_.integrator_scenarios.empty()) {
@@ -281,14 +281,14 @@ void ReportRunner::compare_integrators(const std::string& data_dir) {
         return;
       }
       IntegratorRow row{id, std::string(integrator_name(run.integrator)), setting, static_cast<long>(tr.samples.size()), tr.evaluations, 0,
-                        std::vector<double>(compared_.size(), 0.0)};
+                        std::vector<double>(results_.compared.size(), 0.0)};
       for (const auto& smp : tr.samples) {
         const auto& r = ref.samples[static_cast<std::size_t>(std::lround(smp.t / step))];
         const Coordinates d = (smp.s - r.s).cwiseAbs();
         row.inputs = std::max(row.inputs, d.head<kInputCount>().maxCoeff());
-        for (std::size_t k = 0; k < compared_.size(); ++k) row.coordinates[k] = std::max(row.coordinates[k], d(compared_[k]));
+        for (std::size_t k = 0; k < results_.compared.size(); ++k) row.coordinates[k] = std::max(row.coordinates[k], d(results_.compared[k]));
       }
-      integrators_.push_back(row);
+      results_.integrators.push_back(row);
     };
     Scenario euler = sc, rk4 = sc, dopri = sc;
     euler.integrator = Integrator::euler;
@@ -301,9 +301,9 @@ void ReportRunner::compare_integrators(const std::string& data_dir) {
     compare(fmt::format("tolerance {:.0e}", dopri.tolerance), dopri);
   }
   std::vector<std::string> header{"run", "integrator", "samples", "evaluations", "max_input_deviation"};
-  for (int c : compared_) header.push_back("max_" + coordinate_name(c) + "_deviation");
+  for (int c : results_.compared) header.push_back("max_" + coordinate_name(c) + "_deviation");
   CsvWriter csv(data_dir + "/integrators.csv", header);
-  for (const auto& r : integrators_) {
+  for (const auto& r : results_.integrators) {
     std::vector<double> values{static_cast<double>(r.samples), static_cast<double>(r.evaluations), r.inputs};
     values.insert(values.end(), r.coordinates.begin(), r.coordinates.end());
     csv.row({r.id, r.integrator}, values);
@@ -512,12 +512,12 @@ EngineRow ReportRunner::physics_engine_of(const ReportRun& run, const std::strin
 
 Stop ReportRunner::record_stop(const std::string& run, const std::string& part, const Trajectory& trajectory) {
   const Stop stop{trajectory.stop_time, trajectory.stop_reason};
-  stopped_.push_back({run, part, stop});
+  results_.stopped.push_back({run, part, stop});
   return stop;
 }
 
 const StoppedRun* ReportRunner::first_stop(const std::vector<std::string>& runs, const std::vector<std::string>& parts) const {
-  for (const auto& s : stopped_)
+  for (const auto& s : results_.stopped)
     if (std::count(runs.begin(), runs.end(), s.run) && (parts.empty() || std::count(parts.begin(), parts.end(), s.part))) return &s;
   return nullptr;
 }
@@ -589,7 +589,7 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
     // A compared run stopped, at its own step or in a comparison: its deviation is not known.
     if (const StoppedRun* s = first_stop(m.runs.empty() ? spec_.integrator_scenarios : m.runs, {}))
       return stopped(*s, m.coordinates.empty() ? unit : display_unit(coordinate_index(m.coordinates.front())));
-    for (const auto& r : integrators_) {
+    for (const auto& r : results_.integrators) {
       if (r.integrator != integrator || (!m.runs.empty() && std::find(m.runs.begin(), m.runs.end(), r.id) == m.runs.end())) continue;
       if (m.coordinates.empty()) {
         worst = std::max(worst, r.inputs);
@@ -597,7 +597,7 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
       }
       for (const auto& name : m.coordinates) {
         const int k = coordinate_index(name);
-        const auto at = std::find(compared_.begin(), compared_.end(), k) - compared_.begin();
+        const auto at = std::find(results_.compared.begin(), results_.compared.end(), k) - results_.compared.begin();
         worst = std::max(worst, r.coordinates[static_cast<std::size_t>(at)] * display_scale(k));
         unit = display_unit(k);
       }
@@ -629,7 +629,7 @@ std::optional<Measured> ReportRunner::measure(const report::Measure& m) {
     double worst = 0;
     bool any = false;
     const std::string unit = q == "energy_balance" ? "" : "m or rad";
-    for (const ForwardRow& r : forward_) {
+    for (const ForwardRow& r : results_.forward) {
       if (!m.runs.empty() && std::find(m.runs.begin(), m.runs.end(), r.id) == m.runs.end()) continue;
       any = true;
       // The inverse-dynamics run, or the simulation this quantity comes from, stopped: not measured.

@@ -64,15 +64,11 @@ class ReportRunner {
 
   const std::vector<IkSweepResult>& sweeps() const { return sweeps_; }
   const std::vector<ReportRun>& runs() const { return runs_; }
-  const std::vector<IntegratorRow>& integrators() const { return integrators_; }
-  const std::vector<ForwardRow>& forward() const { return forward_; }
-  const std::vector<EngineRow>& engine() const { return engine_; }
-  // Why the report has no physics engine's runs (empty: it has them, one per completed
-  // inverse-dynamics run).
-  const std::string& engine_missing() const { return engine_missing_; }
-  const std::vector<int>& compared_coordinates() const { return compared_; }
-  // Every simulation that stopped, in the order they ran.
-  const std::vector<StoppedRun>& stopped() const { return stopped_; }
+  // What it made in the page's terms (report/results.hpp): the integrators compared, the forward
+  // and physics-engine rows, why there is no engine, every simulation that stopped; the sweeps and
+  // runs are left for the view to add (commands/report_command.cpp), which poses the machine.
+  report::Results& results() { return results_; }
+  const report::Results& results() const { return results_; }
   const Model& model() const { return model_; }
   Data& data() { return data_; }
   const ReportRun* find_run(const std::string& id) const;
@@ -94,14 +90,9 @@ class ReportRunner {
   Progress progress_;
   Model model_;
   Data data_;
-  std::vector<int> compared_;
   std::vector<IkSweepResult> sweeps_;
   std::vector<ReportRun> runs_;
-  std::vector<IntegratorRow> integrators_;
-  std::vector<ForwardRow> forward_;
-  std::vector<EngineRow> engine_;
-  std::string engine_missing_;
-  std::vector<StoppedRun> stopped_;
+  report::Results results_;
 };
 
 // The unit a coordinate is shown in ("deg" for angles, "m") and the factor from SI to it.

@@ -18,13 +18,16 @@ void stability(const Model& model, Data& d, const Coordinates& s, const ContactF
 
   // The polygon and the margins: geometry on the contacts alone, compiled once (support_polygon.hpp),
   // on workspace of this model's sizes.
-  std::array<bool, kContactSlots> supports{};
-  for (int c = 0; c < kContactCount; ++c) supports[at(c)] = gen::kContacts[at(c)].supports;
+  static constexpr std::array<bool, kContactSlots> kSupports = [] {
+    std::array<bool, kContactSlots> supports{};
+    for (int c = 0; c < kContactCount; ++c) supports[at(c)] = gen::kContacts[at(c)].supports;
+    return supports;
+  }();
   std::array<int, kContactSlots> loaded{};
   std::array<int, 2 * kContactSlots + 1> hull{};
   std::array<Eigen::Vector2d, kContactSlots> corners{};
   const support::Margins m = support::margins(kContactCount, forces.point.data(), forces.force.data(), forces.moment.data(),
-                                              forces.normal.data(), supports.data(), out.com, out.polygon, loaded, hull, corners);
+                                              forces.normal.data(), kSupports.data(), out.com, out.polygon, loaded, hull, corners);
   out.polygon_size = m.polygon_size;
   out.static_margin = m.static_margin;
   out.zmp = m.zmp;
