@@ -8,6 +8,7 @@
 #include "viewer_export.hpp"
 
 #include <fmt/format.h>
+#include <wlx/support/csv.hpp>
 #include <wlx/support/diagnostics.hpp>
 #include <wlx/error.hpp>
 
@@ -22,9 +23,8 @@ std::string trajectory_csv_text(const Trajectory& trajectory, const Scenario& sc
   for (std::size_t k = 0; k < header.size(); ++k) text += (k ? "," : "") + header[k];
   text += "\n";
   for (const auto& sample : trajectory.samples) {
-    const auto row = trajectory_row(sample, scenario);
-    for (std::size_t k = 0; k < row.size(); ++k) text += fmt::format("{}{:.17g}", k ? "," : "", row[k]);
-    text += "\n";
+    CsvWriter::append_numbers(text, trajectory_row(sample, scenario), false);
+    text += '\n';
   }
   return text;
 }

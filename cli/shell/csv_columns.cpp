@@ -7,7 +7,6 @@
 
 #include <charconv>
 #include <cmath>
-#include <sstream>
 #include <utility>
 
 namespace wlx::cli {
@@ -24,13 +23,40 @@ std::vector<std::string> split_csv_line(std::string_view line) {
   return out;
 }
 
+namespace {
+
+// The next line of `text` from `offset` (without its LF or CR LF), advancing `offset` past it;
+// false at the end. Views into the text: the rows are read without a copy per line or per cell
+// (a long run's trajectory has ~10^5 cells, read back for the viewer).
+bool next_line(std::string_view text, std::size_t& offset, std::string_view& line) {
+  if (offset >= text.size()) return false;
+  const std::size_t newline = text.find('\n', offset);
+  const std::size_t stop = newline == std::string_view::npos ? text.size() : newline;
+  line = text.substr(offset, stop - offset);
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  offset = stop + 1;
+  return true;
+}
+
+void split_into(std::string_view line, std::vector<std::string_view>& cells) {
+  cells.clear();
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    cells.push_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+}
+
+}  // namespace
+
 std::map<std::string, std::vector<double>> read_csv_columns(std::string_view text, const std::string& where,
                                                             const std::string& what, const std::vector<std::string>& wanted,
                                                             std::vector<std::string>* header_out) {
-  std::istringstream in{std::string(text)};
-  std::string line;
-  if (!std::getline(in, line)) throw Error(where, what + " is empty");
-  if (!line.empty() && line.back() == '\r') line.pop_back();
+  std::size_t offset = 0;
+  std::string_view line;
+  if (!next_line(text, offset, line)) throw Error(where, what + " is empty");
   const std::vector<std::string> header = split_csv_line(line);
   if (header_out != nullptr) *header_out = header;
   std::map<std::string, std::size_t> position;
@@ -48,16 +74,17 @@ std::map<std::string, std::vector<double>> read_csv_columns(std::string_view tex
   }
   long row = 1;  // the header is row 1, as an editor counts lines
   long samples = 0;
-  while (std::getline(in, line)) {
+  std::vector<std::string_view> cells;
+  cells.reserve(header.size());
+  while (next_line(text, offset, line)) {
     ++row;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     ++samples;
-    const std::vector<std::string> cells = split_csv_line(line);
+    split_into(line, cells);
     if (cells.size() != header.size())
       throw Error(where, fmt::format("row {} of {} has {} values for {} columns", row, what, cells.size(), header.size()));
     for (const auto& [index, values] : targets) {
-      const std::string& cell = cells[index];
+      const std::string_view cell = cells[index];
       double v = 0;
       const auto [end, error] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
       if (error != std::errc() || end != cell.data() + cell.size() || !std::isfinite(v))

@@ -29,8 +29,20 @@ struct MjDataDeleter {
 using MjModelPtr = std::unique_ptr<mjModel, MjModelDeleter>;
 using MjDataPtr = std::unique_ptr<mjData, MjDataDeleter>;
 
+// MuJoCo's last warning on this thread ("Nan, Inf or huge value in CTRL ..."), kept for its
+// caller to report instead of MuJoCo's default, which appends it to MUJOCO_LOG.TXT in whatever
+// folder the user ran wlx from. Installed by load_mjcf, before anything of MuJoCo's runs.
+inline std::string& mujoco_last_warning() {
+  thread_local std::string warning;
+  return warning;
+}
+inline void keep_mujoco_warnings() {
+  mju_user_warning = [](const char* message) { mujoco_last_warning() = message == nullptr ? "" : message; };
+}
+
 // Throws wlx::Error ("physics engine") for a file that cannot be written, or with MuJoCo's reason.
 inline MjModelPtr load_mjcf(const std::string& xml) {
+  keep_mujoco_warnings();
   char path[] = "/tmp/wlx-mjcf-XXXXXX";
   const int fd = ::mkstemp(path);
   if (fd < 0) throw Error("physics engine", fmt::format("cannot create a temporary file for the MJCF ({})", std::strerror(errno)));

@@ -270,6 +270,13 @@ Eigen::VectorXd PhysicsEngine::set_torques(const Eigen::Ref<const Eigen::VectorX
   for (std::size_t k = 0; k < e.motors.size(); ++k) {
     const int id = e.motors[k];
     double& value = applied(static_cast<Eigen::Index>(k));
+    // MuJoCo would zero such a control with only a warning and step on: the run would go on
+    // under torques nobody asked for.
+    if (!std::isfinite(value) || std::abs(value) > mjMAXVAL) {
+      const char* name = mj_id2name(e.m.get(), mjOBJ_ACTUATOR, id);
+      throw Error("tau", fmt::format("actuator {}'s torque {:g} is not finite or beyond MuJoCo's bound of {:g}",
+                                     name == nullptr ? std::to_string(k) : std::string(name), value, mjMAXVAL));
+    }
     if (e.m->actuator_ctrllimited[id]) value = std::clamp(value, e.m->actuator_ctrlrange[2 * id], e.m->actuator_ctrlrange[2 * id + 1]);
     e.d->ctrl[id] = value;
   }
@@ -281,8 +288,12 @@ void PhysicsEngine::step() { mj_step(impl_->m.get(), impl_->d.get()); }
 std::string PhysicsEngine::trouble() const {
   const mjData* d = impl_->d.get();
   for (const auto& [warning, what] : {std::pair{mjWARN_BADQACC, "accelerations"}, std::pair{mjWARN_BADQVEL, "velocities"},
-                                      std::pair{mjWARN_BADQPOS, "positions"}})
-    if (d->warning[warning].number > 0) return fmt::format("MuJoCo's simulation met {} that were not finite and reset itself", what);
+                                      std::pair{mjWARN_BADQPOS, "positions"}, std::pair{mjWARN_BADCTRL, "controls"}})
+    if (d->warning[warning].number > 0) {
+      const std::string& said = mujoco_last_warning();
+      return fmt::format("MuJoCo's simulation met {} that were not finite or too large and reset itself{}", what,
+                         said.empty() ? "" : " (" + said + ")");
+    }
   return {};
 }
 

@@ -71,11 +71,12 @@ class PhysicsEngine {
   void read_state(Eigen::Ref<Eigen::VectorXd> s, Eigen::Ref<Eigen::VectorXd> sdot) const;
   // Each actuator's torque or force (the description's `actuated`, in order) until the next call.
   // Returns what MuJoCo applies: tau within each motor's range (the export's `ctrlrange`, from the
-  // model's torque limits), which MuJoCo clamps to.
+  // model's torque limits), which MuJoCo clamps to. A torque that is not finite or beyond MuJoCo's
+  // bound (mjMAXVAL, 1e10) is an error naming its actuator ("tau").
   Eigen::VectorXd set_torques(const Eigen::Ref<const Eigen::VectorXd>& tau);
   void step();
-  // Why MuJoCo's simulation can no longer be trusted (it met accelerations or a state that were not
-  // finite and reset itself, as MuJoCo does then), or empty.
+  // Why MuJoCo's simulation can no longer be trusted (it met accelerations, a state or controls that
+  // were not finite or too large and reset itself, as MuJoCo does then, with its warning), or empty.
   std::string trouble() const;
   // The contacts now (the forces of the last step).
   std::vector<EngineContact> contacts() const;

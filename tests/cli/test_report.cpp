@@ -76,13 +76,19 @@ constexpr bool kFullReport = true;
 #endif
 
 TEST_CASE("report: the full report runs, every image exists, every check passes, the HTML is well formed") {
-  const fs::path dir = temp_dir("wlx_report_test");
+  const fs::path dir = temp_dir("wlx_report_test"), cwd = temp_dir("wlx_report_cwd");
   fs::remove_all(dir);
-  const std::string cmd = std::string(WLX_BINARY) + " report " + (kFullReport ? "" : "--quick ") + "--out " + dir.string() + " > " +
-                          (dir.string() + ".log") + " 2>&1";
+  fs::remove_all(cwd);
+  fs::create_directories(cwd);
+  // Run from a folder of its own, which must stay empty: nothing is written outside --out (MuJoCo,
+  // left to itself, appends its warnings to MUJOCO_LOG.TXT in the current folder).
+  const std::string cmd = "cd " + cwd.string() + " && " + std::string(WLX_BINARY) + " report " + (kFullReport ? "" : "--quick ") +
+                          "--out " + dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
   const int status = std::system(cmd.c_str());
   INFO(slurp(dir.string() + ".log"));
   REQUIRE(WEXITSTATUS(status) == 0);
+  for (const auto& stray : fs::directory_iterator(cwd)) FAIL_CHECK("written outside --out: " << stray.path());
+  fs::remove_all(cwd);
   const std::string html = slurp(dir / "index.html");
   REQUIRE(!html.empty());
   CHECK(markup_problem(html).empty());
