@@ -11,19 +11,19 @@
 
 namespace wlx::cli {
 
-std::vector<std::string> split_csv_line(std::string_view line) {
-  std::vector<std::string> out;
+namespace {
+
+// A CSV line's cells, as views into it (no quoting: the numeric files read here never quote).
+void split_into(std::string_view line, std::vector<std::string_view>& cells) {
+  cells.clear();
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = line.find(',', start);
-    out.emplace_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    cells.push_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
-  return out;
 }
-
-namespace {
 
 // The next line of `text` from `offset` (without its LF or CR LF), advancing `offset` past it;
 // false at the end. Views into the text: the rows are read without a copy per line or per cell
@@ -38,18 +38,13 @@ bool next_line(std::string_view text, std::size_t& offset, std::string_view& lin
   return true;
 }
 
-void split_into(std::string_view line, std::vector<std::string_view>& cells) {
-  cells.clear();
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    cells.push_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-}
-
 }  // namespace
+
+std::vector<std::string> split_csv_line(std::string_view line) {
+  std::vector<std::string_view> cells;
+  split_into(line, cells);
+  return {cells.begin(), cells.end()};
+}
 
 std::map<std::string, std::vector<double>> read_csv_columns(std::string_view text, const std::string& where,
                                                             const std::string& what, const std::vector<std::string>& wanted,
