@@ -103,12 +103,8 @@ class RunViews {
     r.nonholonomic_verification = run.nonholonomic_verification;
     if (run.scenario.weighting) r.weighting = weighting_number(*run.scenario.weighting), r.weighting_label = run.scenario.weighting->label();
     r.stopped = run.stopped;
-    r.samples = st.samples, r.end_time = samples.empty() ? 0 : samples.back().t;
-    r.worst_rolling_residual = st.worst_rolling_residual(), r.worst_cond = st.worst_cond, r.min_clearance = st.min_clearance;
-    r.largest_tau = st.largest_tau(), r.worst_momentum = st.worst_momentum;
-    const auto lowest = [](const RunSummary::Lowest& l) { return report::Lowest{l.value, l.t, l.contact, l.other}; };
-    r.normal = lowest(st.normal), r.friction = lowest(st.friction), r.tip = lowest(st.tip);
-    r.first_slip = st.first_slip, r.first_pull = st.first_pull, r.slip_t = st.slip_t, r.pull_t = st.pull_t;
+    static_cast<cli::RunExtremes&>(r) = st;
+    r.worst_rolling_residual = st.worst_rolling_residual(), r.largest_tau = st.largest_tau();
     if (run.scenario.weighting) {
       r.tau.assign(static_cast<std::size_t>(kActuatedCount), {});
       for (const Sample& smp : samples)

@@ -6,6 +6,7 @@
 
 #include "outputs.hpp"
 #include "per_model.hpp"
+#include "run_extremes.hpp"
 
 #include <wlx/simulation.hpp>
 
@@ -14,28 +15,12 @@
 
 WLX_COMMANDS_BEGIN
 
-struct RunSummary {
-  long samples = 0;
-  double last_t = 0;
-  // Maxima and minima over the samples, meaningful once samples > 0 (a run that stopped at its
-  // first step has none: callers print "-", never an initial value such as 1e300).
+// The model-independent extremes (cli/shell/run_extremes.hpp), and per wheel and actuator:
+struct RunSummary : cli::RunExtremes {
   WheelVector worst_residual = WheelVector::Zero();  // max |v_W . n_W| per wheel, m/s
-  double worst_cond = 0;                             // max cond(J_beta)
-  double min_clearance = 0;                          // m (+infinity without a clearance box)
   TorqueVector peak_tau = TorqueVector::Zero();      // max |tau| per actuator
   TorqueVector sum_tau_squared = TorqueVector::Zero();
   EnergyBalance energy;  // runs driven by torques
-  // Dynamics runs of a model with contacts: the lowest normal force, friction margin and tip angle
-  // with their contact (or edge) and time, the first sample where a contact slips or pulls.
-  struct Lowest {
-    double value = 0, t = 0;
-    int contact = -1, other = -1;
-    void add(double v, int c, double time, int d = -1) {
-      if (contact < 0 || v < value) value = v, contact = c, other = d, t = time;
-    }
-  } normal, friction, tip;
-  int first_slip = -1, first_pull = -1;
-  double slip_t = 0, pull_t = 0, worst_momentum = 0;
 
   // `dynamics`: the sample has torques and (for a model with contacts) contact forces.
   void add(const Sample& smp, bool dynamics) {

@@ -446,7 +446,7 @@ class Figures {
       const std::string dat = data_path(r.id + "-pose.dat");
       const Bounds& bounds = bounds_[r.id];
       const std::string title = title_of(r);
-      const double end = r.end_time;
+      const double end = r.last_t;
       std::string b = "set multiplot layout 1,2\nset size ratio -1\nset key outside bottom center horizontal\n";
       b += fmt::format("set title {}\nset xlabel 'x (m)'\nset ylabel 'z (m)'\n{}{}", q(title + ": side view"), bounds.xz(0.3),
                        heading_arrows(r.id, 0, 2, 1.0));

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "report/spec.hpp"
+#include "run_extremes.hpp"
 
 #include <Eigen/Core>
 
@@ -150,12 +151,6 @@ struct SweepResult {
   std::string first_outside;
 };
 
-// The lowest value of a margin over a run, where and when (RunSummary::Lowest).
-struct Lowest {
-  double value = 0, t = 0;
-  int contact = -1, other = -1;  // -1: none (the run has no such value)
-};
-
 // The machine drawn at one sample: its frames' origins (K0), the body frame's x axis, and the body
 // outline's corners (a closed polygon, empty without an outline in the report file).
 struct Pose {
@@ -165,7 +160,7 @@ struct Pose {
 };
 
 // One run of the report, up to where it stopped.
-struct RunResult {
+struct RunResult : RunExtremes {  // its extremes over the samples: run_extremes.hpp
   std::string id;           // the scenario's id, "<id>-w1"/"<id>-w2"/"<id>-w3" for inverse dynamics
   std::string scenario_id;  // the scenario file's id
   std::string description;
@@ -176,13 +171,8 @@ struct RunResult {
   int weighting = 0;
   std::string weighting_label;
   std::optional<Stop> stopped;  // set: the run ended before its duration
-  long samples = 0;
-  double end_time = 0;  // the last sample's t
-  // Its maxima and minima over the samples (run_summary.hpp), meaningful when samples > 0.
-  double worst_rolling_residual = 0, worst_cond = 0, min_clearance = 0, largest_tau = 0, worst_momentum = 0;
-  Lowest normal, friction, tip;
-  int first_slip = -1, first_pull = -1;  // the contact, or -1
-  double slip_t = 0, pull_t = 0;
+  // The largest over the wheels and over the actuators (run_summary.hpp), meaningful when samples > 0.
+  double worst_rolling_residual = 0, largest_tau = 0;
   std::vector<std::vector<double>> tau;  // inverse-dynamics runs: per actuator, per sample (N m or N)
   // The wheels' contact points over the run, seen from above (x0 > x1 without a wheel or a sample).
   double contact_x0 = 1e300, contact_x1 = -1e300, contact_y0 = 1e300, contact_y1 = -1e300;
