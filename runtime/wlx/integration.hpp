@@ -48,9 +48,9 @@ struct Grid {
 struct Outcome {
   bool complete = true;
   std::string error;  // "stopped at t = ... s (step k of n): <reason>", when !complete
-  double stop_time = 0;
-  std::string stop_reason;
-  ErrorKind stop_kind = ErrorKind::other;
+  double stop_time = 0;     // the time of the step that stopped the run, when !complete
+  std::string stop_reason;  // the reason alone, when !complete
+  ErrorKind stop_kind = ErrorKind::other;  // what kind of failure stopped it (error.hpp)
   long steps = 0, rejected_steps = 0;  // accepted steps; rejected ones (dopri5 only)
 };
 

@@ -290,10 +290,8 @@ Trajectory simulate_each(const Scenario& sc, const std::function<void(const Samp
       on_sample(smp);
       if (progress) progress(k + 1, n);
     };
-    const integration::Outcome run =
+    static_cast<integration::Outcome&>(out) =
         integration::integrate(rates, Eigen::VectorXd(x0), {n, sc.dt, sc.integrator, sc.tolerance}, sample, name, [&] { return drivers(sc); });
-    out.complete = run.complete, out.error = run.error, out.stop_time = run.stop_time, out.stop_reason = run.stop_reason;
-    out.stop_kind = run.stop_kind, out.steps = run.steps, out.rejected_steps = run.rejected_steps;
     out.evaluations = f.evaluations;
   };
   const auto coordinate = [](int i) { return std::string(gen::kCoordinateNames[static_cast<std::size_t>(i)]); };

@@ -92,19 +92,13 @@ struct Sample {
   double momentum_residual = 0;
 };
 
-struct Trajectory {
-  std::vector<Sample> samples;
-  bool complete = true;
-  std::string error;  // why the run stopped early (with its time), when !complete
+// The integration's outcome (wlx/integration.hpp: complete, or why and when it stopped, with the
+// reason apart for a caller that lists stopped runs in a table, its kind, and the accepted and
+// rejected steps), and what the run adds to it.
+struct Trajectory : integration::Outcome {
+  std::vector<Sample> samples;  // its samples end before the step that stopped it
   std::string limit_warning;  // with stop_on_limit false: where a joint first left its limits, else empty
-  // The same apart, when !complete: the time of the step that stopped the run (its samples end
-  // before it) and the reason alone, for a caller that lists stopped runs in a table.
-  double stop_time = 0;
-  std::string stop_reason;
-  ErrorKind stop_kind = ErrorKind::other;  // what kind of failure stopped it (error.hpp)
-  // Integration work: accepted steps, rejected steps (dopri5 only), right-hand-side evaluations
-  // (each one an IK of every limb plus a dependent-rate solve).
-  long steps = 0, rejected_steps = 0, evaluations = 0;
+  long evaluations = 0;  // right-hand-side evaluations (each one an IK of every limb plus a dependent-rate solve)
 };
 
 // Called after each sample with (samples done, samples in all).
