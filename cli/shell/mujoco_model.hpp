@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -43,7 +44,11 @@ inline void keep_mujoco_warnings() {
 // Throws wlx::Error ("physics engine") for a file that cannot be written, or with MuJoCo's reason.
 inline MjModelPtr load_mjcf(const std::string& xml) {
   keep_mujoco_warnings();
-  char path[] = "/tmp/wlx-mjcf-XXXXXX";
+  // In the user's temporary folder (TMPDIR, else /tmp), as every other temporary file of wlx's.
+  std::error_code ec;
+  const std::filesystem::path folder = std::filesystem::temp_directory_path(ec);
+  std::string name = ((ec ? std::filesystem::path("/tmp") : folder) / "wlx-mjcf-XXXXXX").string();
+  char* path = name.data();
   const int fd = ::mkstemp(path);
   if (fd < 0) throw Error("physics engine", fmt::format("cannot create a temporary file for the MJCF ({})", std::strerror(errno)));
   const bool written = ::write(fd, xml.data(), xml.size()) == static_cast<ssize_t>(xml.size());
