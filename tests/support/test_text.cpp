@@ -3,6 +3,7 @@
 // literals and comments), otherwise by decoding the output back (HTML, JSON/JS, CSV).
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
+#include <wlx/support/csv.hpp>
 #include <wlx/support/text.hpp>
 
 #include <cstdio>
@@ -246,4 +247,21 @@ TEST_CASE("text: nearest suggests the closest name within a third of the key's l
   // ...and one near a long name is still found.
   const std::vector<std::string> long_names{std::string(300, 'a') + "b"};
   CHECK(wlx::text::nearest(std::string(300, 'a') + "c", long_names, false) == long_names[0]);
+}
+
+TEST_CASE("CsvWriter: every cell in its column, an empty text cell first included; full precision; nothing non-finite") {
+  const fs::path path = fs::temp_directory_path() / ("wlx_csv_writer_" + std::to_string(::getpid()) + ".csv");
+  {
+    wlx::CsvWriter csv(path.string(), {"", "label", "x", "y"});
+    csv.row({"", "b,c"}, {0.1, -2.5e-300});
+    csv.row({"a", ""}, {1.0 / 3.0, 7});
+    CHECK_THROWS_AS(csv.row({"a", "b"}, {1.0, std::nan("")}), wlx::Error);
+    CHECK_THROWS_AS(csv.row({"a"}, {1.0, 2.0}), wlx::Error);  // three cells for four columns
+    csv.commit();
+  }
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  fs::remove(path);
+  CHECK(text.str() == ",label,x,y\n,\"b,c\",0.10000000000000001,-2.5e-300\na,,0.33333333333333331,7\n");
 }

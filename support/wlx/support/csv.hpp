@@ -21,7 +21,7 @@ class CsvWriter {
   CsvWriter(const std::string& path, const std::vector<std::string>& header)
       : path_(path), columns_(header.size()), file_(path) {
     std::string line;
-    for (const auto& h : header) line += (line.empty() ? "" : ",") + text::csv_field(h);
+    for (std::size_t k = 0; k < header.size(); ++k) line += (k != 0 ? "," : "") + text::csv_field(header[k]);
     file_.write(line + "\n");
     header_ = header;
   }
@@ -53,9 +53,9 @@ class CsvWriter {
     // One buffer per row, no temporary string per cell: a long run writes ~10^5 cells, and the
     // per-model commands that call this compile at -O0.
     line_.clear();
-    for (const auto& l : labels) {
-      if (!line_.empty()) line_ += ',';
-      line_ += text::csv_field(l);
+    for (std::size_t k = 0; k < labels.size(); ++k) {
+      if (k != 0) line_ += ',';  // by position: an empty first label still gets its column
+      line_ += text::csv_field(labels[k]);
     }
     append_numbers(line_, values, !labels.empty());
     line_ += '\n';
