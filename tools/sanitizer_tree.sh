@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One clang tree with AddressSanitizer + UndefinedBehaviorSanitizer (and libFuzzer's coverage
-# instrumentation) that serves both the whole test suite and the fuzzers, so the sanitized
-# objects are compiled once (.ci/run; issue "CI within 30 minutes").
+# instrumentation, on all but the tests' own files: tests/CMakeLists.txt) that serves both the
+# whole test suite and the fuzzers, so the sanitized objects are compiled once (.ci/run; issue
+# "CI within 30 minutes").
 #   tools/sanitizer_tree.sh test          configure, build the tests, run them (ctest)
 #   tools/sanitizer_tree.sh fuzz SECONDS  configure, build the libFuzzer targets, fuzz each for SECONDS
 # Not sanitized: the benchmarks, the viewer (emscripten's WebAssembly) and the Python module, which
