@@ -16,6 +16,7 @@
 #pragma once
 
 #include "wlx/dynamics.hpp"
+#include "wlx/support_polygon.hpp"
 
 #include <array>
 #include <cstddef>
@@ -67,24 +68,13 @@ struct ContactForceMap {
 void contact_force_map(const Model& model, Data& data, const Coordinates& s, const DynamicsTerms& terms,
                        ContactForceMap& out);
 
-struct Stability {
+// The margins (wlx/support_polygon.hpp: the polygon's size, the static and ZMP margins with the
+// ZMP, the tip angle and its edge), with the centre of mass and the polygon they are taken on.
+struct Stability : support::Margins {
   Eigen::Vector3d com = Eigen::Vector3d::Zero();  // the machine's centre of mass, K0
   // The support polygon: the supporting contacts in load (normal force > 0), counter-clockwise seen
-  // from above; fewer than 3 when the machine stands on a line or a point.
+  // from above, its first polygon_size entries.
   std::array<int, kContactCount> polygon{};
-  int polygon_size = 0;
-  // The CoM's projection: signed distance to the nearest polygon edge (m, positive inside).
-  double static_margin = 0;
-  // The zero-moment point of the contact forces on the plane of the loaded contacts' mean height,
-  // and its signed distance to the nearest edge (m, positive inside).
-  Eigen::Vector3d zmp = Eigen::Vector3d::Zero();
-  double zmp_margin = 0;
-  // The force-angle stability measure (Papadopoulos and Rey, 1996): for every edge of the polygon
-  // the angle between the net force on the CoM (gravity and inertia, with the moment's equivalent
-  // couple) and the line from the CoM to the edge; the machine tips about the edge whose angle
-  // reaches zero. The smallest angle (rad) and its edge (two contacts).
-  double tip_angle = 0;
-  std::array<int, 2> tip_edge{-1, -1};
 };
 
 // Stability of the step whose contact forces are `forces` (data's frame positions from

@@ -26,14 +26,9 @@ void stability(const Model& model, Data& d, const Coordinates& s, const ContactF
   std::array<int, kContactSlots> loaded{};
   std::array<int, 2 * kContactSlots + 1> hull{};
   std::array<Eigen::Vector2d, kContactSlots> corners{};
-  const support::Margins m = support::margins(kContactCount, forces.point.data(), forces.force.data(), forces.moment.data(),
-                                              forces.normal.data(), kSupports.data(), out.com, out.polygon, loaded, hull, corners);
-  out.polygon_size = m.polygon_size;
-  out.static_margin = m.static_margin;
-  out.zmp = m.zmp;
-  out.zmp_margin = m.zmp_margin;
-  out.tip_angle = m.tip_angle;
-  out.tip_edge = m.tip_edge;
+  static_cast<support::Margins&>(out) = support::margins(kContactCount, forces.point.data(), forces.force.data(), forces.moment.data(),
+                                                         forces.normal.data(), kSupports.data(), out.com, out.polygon, loaded, hull,
+                                                         corners);
 }
 
 double smallest_contact_margin(const Model& model, const ContactForces& forces) {

@@ -13,11 +13,18 @@
 namespace wlx::support {
 
 struct Margins {
-  int polygon_size = 0;       // vertices written to `polygon`
-  double static_margin = 0;   // the CoM's projection to the nearest edge, m, positive inside
+  int polygon_size = 0;  // vertices written to `polygon`; fewer than 3 on a line or a point
+  // The CoM's projection: signed distance to the nearest polygon edge (m, positive inside).
+  double static_margin = 0;
+  // The zero-moment point of the contact forces on the plane of the loaded contacts' mean height,
+  // and its signed distance to the nearest edge (m, positive inside).
   Eigen::Vector3d zmp = Eigen::Vector3d::Zero();
-  double zmp_margin = 0;      // the ZMP's likewise
-  double tip_angle = 0;       // the force-angle measure's smallest angle, rad, and its edge
+  double zmp_margin = 0;
+  // The force-angle stability measure (Papadopoulos and Rey, 1996): for every edge of the polygon
+  // the angle between the net force on the CoM (gravity and inertia, with the moment's equivalent
+  // couple) and the line from the CoM to the edge; the machine tips about the edge whose angle
+  // reaches zero. The smallest angle (rad) and its edge (two contacts).
+  double tip_angle = 0;
   std::array<int, 2> tip_edge{-1, -1};
 };
 
