@@ -68,11 +68,14 @@ echo '{"z_C": 1.8}' | WLX_CACHE_DIR="$work/cache" WLX_PLUGIN_CXXFLAGS=-O0 \
 grep -q '"closure_residual"' "$work/fk.json"
 grep -rq "share/wlx/cli/commands" "$work/cache"/installed_check-*/commands_unity.cpp || {
   echo "the plugin was not compiled from the installed sources" >&2; exit 1; }
-# Built by Clang, wlx installs its plugins' precompiled headers, and the installed one was accepted
-# (its check compile's log is empty: cli/shell/model_plugin.cpp).
+# Built by Clang, wlx installs its plugins' precompiled headers (the -O0 one, the commands', with its
+# code: plugin_prelude-O0.a), the installed one was accepted (its check compile's log is empty:
+# cli/shell/model_plugin.cpp), and the plugin linked its code (the plugin loaded: fk answered).
 if [ -f build/plugin_prelude/plugin_prelude-O0.pch ]; then
-  [ -f build/install/share/wlx/precompiled/plugin_prelude-O0.pch ] || {
-    echo "the plugins' precompiled headers were not installed" >&2; exit 1; }
+  for f in plugin_prelude-O0.pch plugin_prelude-O0.a; do
+    [ -f "build/install/share/wlx/precompiled/$f" ] || {
+      echo "the plugins' precompiled headers were not installed: $f is missing" >&2; exit 1; }
+  done
   log=$(echo "$work/cache"/installed_check-*/precompiled-O0.log)
   [ -f "$log" ] && [ ! -s "$log" ] || {
     echo "the installed precompiled header was not used: $(cat "$log" 2>/dev/null)" >&2; exit 1; }

@@ -384,16 +384,26 @@ std::vector<GeneratedUnit> generated_units(const fs::path& runtime_sources, cons
   return units;  // the largest first: the longest compiles start first
 }
 
-// The arguments that load plugin_prelude.hpp precompiled for a part compiled with `argv` (the
-// compiler, then its flags: `optimization`'s last), or none. wlx's build precompiles it once per
-// optimization of a model's parts, named after those flags (plugin_prelude-O3.pch for "-O3"; CMakeLists.txt);
-// only the Clang wlx was built with, with the same flags, can load one (CXX may name it another
-// way), and not once a header it was made from has changed. A compile of nothing with it (60 ms)
-// asks the compiler first, so that a header it refuses (another compiler, GCC, a changed header)
-// costs the plugin its speed, never its build; its answer is in precompiled-<name>.log.
-// WLX_PLUGIN_PRECOMPILED_DIR names another folder to look in (empty: none).
-std::vector<std::string> precompiled_prelude(const Sources& src, const std::vector<std::string>& optimization,
-                                             std::vector<std::string> argv, const fs::path& dir) {
+// The plugin's common headers precompiled for a part: the arguments that load them, and the archive
+// that holds their code where they were precompiled with it (-fpch-codegen: the commands' header,
+// plugin_prelude_commands.hpp), which the plugin then links; none of either when there is no such
+// header, or the compiler refuses it.
+struct PrecompiledPrelude {
+  std::vector<std::string> flags;
+  std::string archive;
+};
+
+// The precompiled header for a part compiled with `argv` (the compiler, then its flags:
+// `optimization`'s last). wlx's build precompiles one per optimization of a model's parts, named
+// after those flags (plugin_prelude-O3.pch for "-O3"; CMakeLists.txt), with its code beside it in
+// plugin_prelude-<name>.a where it has some; only the Clang wlx was built with, with the same flags,
+// can load one (CXX may name it another way), and not once a header it was made from has changed.
+// A compile of nothing with it (60 ms) asks the compiler first, so that a header it refuses
+// (another compiler, GCC, a changed header) costs the plugin its speed, never its build; its answer
+// is in precompiled-<name>.log. WLX_PLUGIN_PRECOMPILED_DIR names another folder to look in (empty:
+// none).
+PrecompiledPrelude precompiled_prelude(const Sources& src, const std::vector<std::string>& optimization, std::vector<std::string> argv,
+                                       const fs::path& dir) {
   const char* env = std::getenv("WLX_PLUGIN_PRECOMPILED_DIR");
   const fs::path folder = env != nullptr ? fs::path(env) : src.precompiled;
   if (folder.empty() || optimization.empty()) return {};
@@ -409,7 +419,9 @@ std::vector<std::string> precompiled_prelude(const Sources& src, const std::vect
   const std::vector<std::string> use{"-include-pch", pch.string()};
   argv.insert(argv.end(), use.begin(), use.end());
   argv.insert(argv.end(), {"-fsyntax-only", "-x", "c++", "/dev/null"});
-  return run_program(argv, {}, (dir / fmt::format("precompiled-{}.log", name)).string()).ok() ? use : std::vector<std::string>{};
+  if (!run_program(argv, {}, (dir / fmt::format("precompiled-{}.log", name)).string()).ok()) return {};
+  const fs::path archive = fs::path(pch).replace_extension(".a");
+  return {use, fs::is_regular_file(archive, ec) ? archive.string() : std::string()};
 }
 
 // Generates the model's headers and compiles its plugin into `dir`.
@@ -468,6 +480,7 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   std::vector<Job> jobs;
   std::vector<std::string> objects;
   std::map<bool, std::vector<std::string>> part_flags;  // by "is the commands' part"
+  std::vector<std::string> prelude_archives;            // the code of the precompiled headers the parts load
   const auto probing = std::chrono::steady_clock::now();
   for (const bool commands : {false, true}) {
     // Both parts at the same flags (WLX_PLUGIN_CXXFLAGS): the runtime's, checked once.
@@ -478,7 +491,9 @@ void build_plugin(const fs::path& model_file, const Description& description, co
     std::vector<std::string> argv = common;
     const std::vector<std::string> optimization = optimization_flags(commands);
     argv.insert(argv.end(), optimization.begin(), optimization.end());
-    for (const auto& f : precompiled_prelude(src, optimization, argv, dir)) argv.push_back(f);
+    const PrecompiledPrelude prelude = precompiled_prelude(src, optimization, argv, dir);
+    argv.insert(argv.end(), prelude.flags.begin(), prelude.flags.end());
+    if (!prelude.archive.empty()) prelude_archives.push_back(prelude.archive);
     part_flags[commands] = argv;
   }
   timings.emplace_back("precompiled headers checked", std::chrono::duration<double>(std::chrono::steady_clock::now() - probing).count());
@@ -520,6 +535,15 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   // name (a user's copy of a built-in model, with other geometry, must not run wlx's).
   std::vector<std::string> link{cxx, "-shared", "-Wl,-Bsymbolic", "-o", (dir / "plugin.so").string()};
   link.insert(link.end(), objects.begin(), objects.end());
+  // The precompiled headers' code holds every inline function of their headers, some of which call
+  // what the standard library keeps to itself (std::filesystem::path's private parts): those the
+  // plugin does not call must go, or dlopen would refuse it. Its symbols not exported
+  // (--exclude-libs), every function in a section of its own, --gc-sections drops them.
+  if (!prelude_archives.empty()) link.push_back("-Wl,--gc-sections");
+  for (const auto& archive : prelude_archives) {
+    link.push_back("-Wl,--exclude-libs," + fs::path(archive).filename().string());
+    link.push_back(archive);
+  }
   for (const auto& library : split_list(WLX_PLUGIN_LIBRARIES)) link.push_back(library);
   for (const auto& t : run_jobs({{"link", link, dir / "link.log"}}, 1, failed_logs)) timings.push_back(t);
 
