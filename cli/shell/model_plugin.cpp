@@ -446,7 +446,7 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   const Sources src = find_sources();
   const auto write = [&](const fs::path& path, const std::string& text) { write_file_atomically(path.string(), text); };
   // The runtime's sources in one translation unit, but those CMake names apart
-  // (WLX_PLUGIN_RUNTIME_APART: torque_distribution.cpp, the unrolled QRs on J_beta's structure, the
+  // (WLX_PLUGIN_RUNTIME_APART: torque_distribution.cpp, the QRs on J_beta's structure, the
   // runtime's longest compile on its own), so that
   // the two cores share the longest compile instead of one core waiting for it.
   const std::vector<std::string> apart = split_list(WLX_PLUGIN_RUNTIME_APART);

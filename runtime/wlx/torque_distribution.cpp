@@ -1,5 +1,5 @@
 // How the actuators share the generalized forces on the commanded speeds: the weightings, and the
-// weighted minimum-norm torques tau with J_beta^T tau = Q* (fixed-size, unrolled QR on J_beta's
+// weighted minimum-norm torques tau with J_beta^T tau = Q* (a fixed-size QR on J_beta's
 // structure; the pivoted QR where that declines) (dynamics.hpp).
 #include "wlx/dynamics.hpp"
 
@@ -63,9 +63,6 @@ Weighting Weighting::matrix_of(const TorqueMatrix& W) {
 #if __has_include(<wlx/gen/reduced_dynamics.hpp>)
 namespace {
 
-template <int k>
-using Tail = Eigen::Matrix<double, kActuatedCount - k, 1>;
-
 // An upper bound on the infinity-norm condition number of the upper triangular R: ||R||_inf times
 // ||M(R)^-1 e||_inf, M(R) R's comparison matrix (|r_ii| on the diagonal, -|r_ij| above it) and e =
 // (1, ..., 1). |R^-1| <= M(R)^-1 entrywise (Higham, Accuracy and Stability of Numerical
@@ -97,30 +94,6 @@ double condition_bound(const CommandMatrix& R) {
 // against a long-double solution).
 constexpr double kConditionLimit = kCommandedCount <= 9 ? 1e12 : 0.9e13 / kCommandedCount;
 
-template <int k>
-using Tail = Eigen::Matrix<double, kActuatedCount - k, 1>;
-
-// Householder reflector k: zeroes qr's column k below the diagonal and applies itself to the
-// columns right of it. Sizes are compile-time (k is), so Eigen unrolls and vectorizes every product.
-template <int k>
-bool householder_step(ActuatorJacobian& qr, Tail<k>& v, double& tau) {
-  constexpr int n = kActuatedCount - k;
-  const auto column = qr.col(k).template tail<n>();
-  const double alpha = column(0), norm = column.norm();
-  if (!(norm > 0)) return false;  // a zero column (or NaN): the pivoted QR says what is wrong
-  const double beta = alpha >= 0 ? -norm : norm;
-  v = column * (1 / (alpha - beta));  // one division, not one per entry
-  v(0) = 1;
-  tau = (beta - alpha) / beta;
-  qr(k, k) = beta;
-  if constexpr (k + 1 < kCommandedCount) {
-    auto rest = qr.template block<n, kCommandedCount - k - 1>(k, k + 1);
-    const Eigen::Matrix<double, 1, kCommandedCount - k - 1> projection = v.transpose().lazyProduct(rest);
-    rest.noalias() -= (tau * v).lazyProduct(projection);
-  }
-  return true;
-}
-
 // The part of the dense QR's minimum-norm solve after the reflectors (qr's top rows hold R): the
 // condition test, then R^T y = Q* by forward substitution into x's head, the rest zero. False,
 // leaving the answer to the pivoted QR, unless condition_bound(R) <= kConditionLimit.
@@ -134,29 +107,6 @@ bool solve_transposed_R(const ActuatorJacobian& qr, const CommandVector& Qstar, 
     x(i) = sum / R(i, i);
   }
   return true;
-}
-
-// The minimum-norm x with A^T x = Q*, A actuated x commanded with full column rank: from A = Q R
-// (Householder), x = Q [R^-T Q*; 0]. Unpivoted, fixed-size and unrolled: a fraction of Eigen's
-// column-pivoted QR, whose inner loops run on dynamic-size blocks. Returns false, leaving the
-// answer to the pivoted QR, unless condition_bound(R) <= kConditionLimit.
-// (A template: compiled only where min_norm_solve_fast takes it.)
-template <int = 0>
-bool min_norm_solve_dense(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
-  constexpr int kU = kCommandedCount;
-  ActuatorJacobian qr = A;
-  CommandVector tau;
-  return [&]<int... k>(std::integer_sequence<int, k...>) {
-    std::tuple<Tail<k>...> v;
-    if (!(householder_step<k>(qr, std::get<k>(v), tau(k)) && ...)) return false;
-    // R^T y = Q*, then x = H_0 ... H_{n-1} [y; 0].
-    if (!solve_transposed_R(qr, Qstar, x)) return false;
-    ((x.template tail<kActuatedCount - (kU - 1 - k)>() -=
-      (tau(kU - 1 - k) * std::get<kU - 1 - k>(v).dot(x.template tail<kActuatedCount - (kU - 1 - k)>())) *
-      std::get<kU - 1 - k>(v)),
-     ...);
-    return true;
-  }(std::make_integer_sequence<int, kU>{});
 }
 
 // Which entries of J_beta can be nonzero, from the generated structure: a joint's row is its
@@ -316,13 +266,17 @@ bool min_norm_solve_sparse(const ActuatorJacobian& A, const CommandVector& Qstar
   return true;
 }
 
-// min_norm_solve_dense's answer as plain loops (the same reflectors, each stored below R's diagonal),
-// for a model whose hot path is the sparse plan: there the dense QR answers only a matrix a caller
-// built off J_beta's structure (a full weight matrix), and its unrolled form, one template per
-// column, cost 3.5 s of the wheeled quadruped's compile (ten columns of sixteen rows).
+// The minimum-norm x with A^T x = Q*, A actuated x commanded with full column rank: from A = Q R
+// (Householder, each reflector stored below R's diagonal), x = Q [R^-T Q*; 0]. Unpivoted, on the
+// model's fixed sizes: a fraction of Eigen's column-pivoted QR, whose inner loops run on dynamic-size
+// blocks. Plain loops over compile-time bounds, which the compiler unrolls as it sees fit: as fast
+// as an unrolled template per column (the excavator's 8 x 4 torque split 255-265 ns against
+// 255-295 ns, alternating, 2026-12-07), which cost each model 0.6 s of compile, the wheeled
+// quadruped's 3.5 s (ten columns of sixteen rows). Returns false, leaving the answer to the pivoted
+// QR, unless condition_bound(R) <= kConditionLimit.
 // (A template: compiled only where min_norm_solve_fast takes it.)
 template <int = 0>
-bool min_norm_solve_dense_loops(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
+bool min_norm_solve_dense(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
   constexpr int kU = kCommandedCount, kA = kActuatedCount;
   ActuatorJacobian qr = A;
   CommandVector tau;
@@ -355,12 +309,9 @@ bool min_norm_solve_dense_loops(const ActuatorJacobian& A, const CommandVector& 
 }
 
 bool min_norm_solve_fast(const ActuatorJacobian& A, const CommandVector& Qstar, TorqueVector& x) {
-  if constexpr (kUseSparseQr) {
+  if constexpr (kUseSparseQr)
     if (!breaks_pattern(A)) return min_norm_solve_sparse<>(A, Qstar, x);
-    return min_norm_solve_dense_loops<>(A, Qstar, x);
-  } else {
-    return min_norm_solve_dense<>(A, Qstar, x);
-  }
+  return min_norm_solve_dense<>(A, Qstar, x);
 }
 
 // The motion no actuator acts on, for the message of a rank loss: the unit combination n of the

@@ -284,10 +284,23 @@ TEST_CASE("forward dynamics: the torques of ID-1..3, fed back, reproduce their t
   // rows at every time the forward run's RK4 stages ask for (the inverse run at half its step),
   // nothing is interpolated and the two runs differ only by their integrators' truncation. With
   // rows only at its steps the midpoints are interpolated, off by tau'' dt^2 / 8 (reported).
+  //
+  // ID-2 (roll', which steers the dependent pair y_C, yaw) passes through a singular J_beta: at
+  // t = 0.0955 s its condition number peaks (2.7e7 at the forward run's nearest sample at 0.1 ms,
+  // unbounded at the crossing itself, where the pair's rates are the limit of 0 / 0). There the
+  // rounding of that solve, so amplified, moves u by 7.6e-10 in one step; before it u holds to 3e-13.
+  // From then on the forward run replays the inverse run's torques from a state off by that much,
+  // open loop, so the offset grows (u 1.6e-9, s 2.6e-9 at the end). The torque split's QR unrolled
+  // instead of as loops, rounding otherwise, gave 5.1e-10, 1.1e-9 and 1.7e-9. Halving the step does not
+  // shrink it (a sample lands nearer the pole): why this run once looked like a convergence of
+  // order 1.6. So: every run agrees to 1e-12 up to its largest condition number (all of it where
+  // that stays below 1e6: ID-1), and after it to 1e-8 (rounding at a singular point, not a wrong
+  // dynamics: a wrong term would move u from the start).
   struct Run { int coordinate; double rate, duration; };
   for (const Run& r : {Run{c::x_C, 3.0, 0.494}, Run{c::roll, -10 * kDeg, 0.541}, Run{c::z_C, -3.0, 0.581}}) {
     CommandVector u0;
     std::array<double, 2> worst_s{}, worst_u{};
+    double peak_cond = 0, crossing = 0, before_s = 0, before_u = 0, jump = 0;
     for (int exact = 0; exact < 2; ++exact) {
       const double dt = exact ? 1e-4 : 1e-3;
       Scenario sc;
@@ -317,20 +330,36 @@ TEST_CASE("forward dynamics: the torques of ID-1..3, fed back, reproduce their t
       REQUIRE(fd.complete);
       const std::size_t every = exact ? 2 : 1;  // the kinematic run's samples at the forward run's times
       REQUIRE((fd.samples.size() - 1) * every == id.samples.size() - 1);
+      std::size_t peak = 0;
       for (std::size_t k = 0; k < fd.samples.size(); ++k) {
         worst_s[exact] = std::max(worst_s[exact], (fd.samples[k].s - id.samples[k * every].s).cwiseAbs().maxCoeff());
         worst_u[exact] = std::max(worst_u[exact], (fd.samples[k].u - u0).cwiseAbs().maxCoeff());
+        if (fd.samples[k].cond_J_beta > fd.samples[peak].cond_J_beta) peak = k;
       }
+      if (!exact) continue;
+      // Where the condition peaks, and the agreement before and after that step.
+      peak_cond = fd.samples[peak].cond_J_beta;
+      crossing = fd.samples[peak].t;
+      for (std::size_t k = 0; k + 1 < peak; ++k) {
+        before_s = std::max(before_s, (fd.samples[k].s - id.samples[k * every].s).cwiseAbs().maxCoeff());
+        before_u = std::max(before_u, (fd.samples[k].u - u0).cwiseAbs().maxCoeff());
+      }
+      if (peak + 1 < fd.samples.size()) jump = (fd.samples[peak + 1].u - u0).cwiseAbs().maxCoeff();
     }
     MESSAGE(gen::kCoordinateNames[static_cast<std::size_t>(r.coordinate)] << "' = " << r.rate << ": |s_forward - s_inverse| <= "
             << worst_s[1] << ", |u - u0| <= " << worst_u[1] << " (torques at every stage); " << worst_s[0] << ", "
-            << worst_u[0] << " (interpolated at 1 ms)");
-    // RK4 at 0.1 and 0.05 ms: x_C' and z_C' agree to 1e-12. ID-2 (roll', which steers the dependent
-    // pair y_C, yaw) to 9e-10 m only, and its difference shrinks as dt^1.6 rather than dt^4 (3.6e-8
-    // with the forward run at 1 ms): something along it is not smooth to fourth order, an open
-    // question (docs/architecture.md). The bound holds both with a factor of two.
-    CHECK(worst_s[1] <= 2e-9);
-    CHECK(worst_u[1] <= 2e-9);
+            << worst_u[0] << " (interpolated at 1 ms); peak cond(J_beta) " << peak_cond << " at t = " << crossing
+            << " s: before it |s| <= " << before_s << ", |u| <= " << before_u << "; u just after it " << jump);
+    if (peak_cond < 1e6) {
+      CHECK(worst_s[1] <= 1e-12);
+      CHECK(worst_u[1] <= 1e-12);
+    } else {
+      CHECK(before_s <= 1e-12);
+      CHECK(before_u <= 1e-12);
+      CHECK(jump <= 1e-8);
+      CHECK(worst_s[1] <= 1e-8);
+      CHECK(worst_u[1] <= 1e-8);
+    }
   }
 }
 
