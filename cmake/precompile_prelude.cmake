@@ -6,8 +6,9 @@
 # In: WLX_PRELUDE_COMPILER, WLX_PRELUDE_FLAGS (a list), WLX_PRELUDE_HEADER (in cli/shell/),
 # WLX_PRELUDE_NAME (plugin_prelude-<name>.pch); WLX_PRELUDE_WITH_CODE: the header was precompiled
 # with -fpch-codegen, and its code is compiled with WLX_PRELUDE_CODE_FLAGS into the archive
-# plugin_prelude-<name>.a (WLX_PRELUDE_AR; without it, a plugin that loaded the header would not
-# link: so where it fails, the header is removed too).
+# plugin_prelude-<name>.a (WLX_PRELUDE_AR; without it, a plugin that loaded the header would link
+# but not load, so where it fails the header is removed too, and model_plugin.cpp uses no such
+# header without its archive).
 # Absolute: the header's path is recorded as given, and a relative one (`cmake --install --prefix
 # build/install`) would be looked up from wherever a plugin is built.
 get_filename_component(share "$ENV{DESTDIR}${CMAKE_INSTALL_PREFIX}/${WLX_PRELUDE_DATADIR}/wlx" ABSOLUTE)

@@ -25,7 +25,7 @@ set(WLX_RUNTIME_FILES
   contact_distribution.cpp)
 # Of those, the ones a plugin compiles as units of their own, beside the rest, so that two cores
 # share the runtime instead of one waiting for it: its longest compiles (the integrators'
-# instantiations, the unrolled QRs on J_beta's structure, the rolling rows' factorizations). With
+# instantiations, the QRs on J_beta's structure, the rolling rows' factorizations). With
 # the precompiled headers (cli/shell/plugin_prelude.hpp) a unit of its own costs little more than
 # its share of one unit; an excavator-sized runtime: the rest 6.8 s, these 4.0, 3.8 and 2.7 s
 # (clang 14, -O3), against 12.6 s as one unit. (The build tree's unity build splits the runtime

@@ -56,7 +56,8 @@
 #ifndef WLX_INCLUDE_FROM_BINDIR
 #define WLX_INCLUDE_FROM_BINDIR "../include"
 #endif
-// The build tree's precompiled headers of plugin_prelude.hpp (CMakeLists.txt; none with GCC).
+// The build tree's precompiled headers (plugin_prelude.hpp, the commands' plugin_prelude_commands.hpp
+// with its code beside it: CMakeLists.txt; none with GCC).
 #ifndef WLX_PLUGIN_PRECOMPILED_DIR
 #define WLX_PLUGIN_PRECOMPILED_DIR ""
 #endif
@@ -132,7 +133,7 @@ struct Sources {
   fs::path runtime_sources;  // the runtime's *.cpp
   fs::path cli;              // holds shell/, commands/, report/
   fs::path viewer_module;    // holds viewer_module.cpp (the viewer's WebAssembly interface)
-  fs::path precompiled;      // holds plugin_prelude-<flags>.pch (plugin_prelude.hpp precompiled), if wlx built them
+  fs::path precompiled;      // holds plugin_prelude-<flags>.pch (and .a, its code, for the commands' flags), if wlx built them
 };
 
 Sources find_sources() {
@@ -177,13 +178,17 @@ fs::path generator_program() {
 // Each part's optimization, as cmake/wlxModelBuild.cmake defines it for every builder of a model's
 // code (the runtime and the generated functions -O3, the commands -O0: why, there).
 // WLX_PLUGIN_CXXFLAGS replaces both (all part of the key).
-// The flags an environment variable gives (whitespace-separated), else `fallback`'s.
-std::vector<std::string> flags_from_environment(const char* variable, const char* fallback) {
-  const char* env = std::getenv(variable);
+// Whitespace-separated flags.
+std::vector<std::string> split_flags(const char* text) {
   std::vector<std::string> out;
-  std::istringstream in(env != nullptr && *env != '\0' ? env : fallback);
+  std::istringstream in(text);
   for (std::string flag; in >> flag;) out.push_back(flag);
   return out;
+}
+// The flags an environment variable gives, else `fallback`'s.
+std::vector<std::string> flags_from_environment(const char* variable, const char* fallback) {
+  const char* env = std::getenv(variable);
+  return split_flags(env != nullptr && *env != '\0' ? env : fallback);
 }
 std::vector<std::string> optimization_flags(bool commands = false) {
   return flags_from_environment("WLX_PLUGIN_CXXFLAGS", commands ? WLX_PLUGIN_COMMANDS_OPTIMIZATION : WLX_PLUGIN_RUNTIME_OPTIMIZATION);
@@ -402,26 +407,43 @@ struct PrecompiledPrelude {
 // (another compiler, GCC, a changed header) costs the plugin its speed, never its build; its answer
 // is in precompiled-<name>.log. WLX_PLUGIN_PRECOMPILED_DIR names another folder to look in (empty:
 // none).
-PrecompiledPrelude precompiled_prelude(const Sources& src, const std::vector<std::string>& optimization, std::vector<std::string> argv,
-                                       const fs::path& dir) {
-  const char* env = std::getenv("WLX_PLUGIN_PRECOMPILED_DIR");
-  const fs::path folder = env != nullptr ? fs::path(env) : src.precompiled;
-  if (folder.empty() || optimization.empty()) return {};
+// The name of the precompiled header for `flags`: each flag without its '-', joined by '_' ("-O3"
+// -> "O3", as CMakeLists.txt names them); empty for flags that make no such name.
+std::string prelude_name(const std::vector<std::string>& flags) {
   std::string name;
-  for (const std::string& flag : optimization) {
+  for (const std::string& flag : flags) {
     if (flag.size() < 2 || flag[0] != '-') return {};
     name += (name.empty() ? "" : "_") + flag.substr(1);
   }
   if (!std::all_of(name.begin(), name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; })) return {};
+  return name;
+}
+
+PrecompiledPrelude precompiled_prelude(const Sources& src, const std::vector<std::string>& optimization, std::vector<std::string> argv,
+                                       const fs::path& dir) {
+  const char* env = std::getenv("WLX_PLUGIN_PRECOMPILED_DIR");
+  const fs::path folder = env != nullptr ? fs::path(env) : src.precompiled;
+  const std::string name = prelude_name(optimization);
+  if (folder.empty() || name.empty()) return {};
   const fs::path pch = folder / fmt::format("plugin_prelude-{}.pch", name);
   std::error_code ec;
   if (!fs::is_regular_file(pch, ec)) return {};
   const std::vector<std::string> use{"-include-pch", pch.string()};
   argv.insert(argv.end(), use.begin(), use.end());
   argv.insert(argv.end(), {"-fsyntax-only", "-x", "c++", "/dev/null"});
-  if (!run_program(argv, {}, (dir / fmt::format("precompiled-{}.log", name)).string()).ok()) return {};
+  const fs::path log = dir / fmt::format("precompiled-{}.log", name);
+  if (!run_program(argv, {}, log.string()).ok()) return {};
+  // The header precompiled for the commands' flags holds no code of its own (-fpch-codegen): its
+  // units only call that code, which its archive holds. Without the archive the plugin would link
+  // and then fail to load, so the header is not used.
   const fs::path archive = fs::path(pch).replace_extension(".a");
-  return {use, fs::is_regular_file(archive, ec) ? archive.string() : std::string()};
+  const bool has_archive = fs::is_regular_file(archive, ec);
+  if (!has_archive && name == prelude_name(split_flags(WLX_PLUGIN_COMMANDS_OPTIMIZATION))) {
+    write_file_atomically(log.string(), read_bounded_file(log.string(), kMaxFileBytes).text +
+                                             fmt::format("{} holds no code and {} is missing: not used\n", pch.string(), archive.string()));
+    return {};
+  }
+  return {use, has_archive ? archive.string() : std::string()};
 }
 
 // Generates the model's headers and compiles its plugin into `dir`.
@@ -446,8 +468,8 @@ void build_plugin(const fs::path& model_file, const Description& description, co
   const Sources src = find_sources();
   const auto write = [&](const fs::path& path, const std::string& text) { write_file_atomically(path.string(), text); };
   // The runtime's sources in one translation unit, but those CMake names apart
-  // (WLX_PLUGIN_RUNTIME_APART: torque_distribution.cpp, the QRs on J_beta's structure, the
-  // runtime's longest compile on its own), so that
+  // (WLX_PLUGIN_RUNTIME_APART: simulation.cpp, torque_distribution.cpp and nonholonomic.cpp, the
+  // runtime's longest compiles, each on its own), so that
   // the two cores share the longest compile instead of one core waiting for it.
   const std::vector<std::string> apart = split_list(WLX_PLUGIN_RUNTIME_APART);
   std::string runtime_unity = "// The runtime's sources in one translation unit (those compiled apart excepted).\n";

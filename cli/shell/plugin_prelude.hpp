@@ -1,5 +1,6 @@
 // The headers every translation unit of a model file's plugin includes and no model changes: the
-// standard library's, Eigen's, fmt's and nlohmann-json's. wlx's build compiles them once into a
+// standard library's, Eigen's, fmt's and nlohmann-json's (the commands' units load them through
+// plugin_prelude_commands.hpp, which adds the templates they instantiate). wlx's build compiles them once into a
 // precompiled header per optimization level (CMakeLists.txt, when the compiler is Clang), which
 // the plugin's compiles load instead of parsing these again (cli/shell/model_plugin.cpp): about
 // 1.2 s of each unit's front end, 3.4 s of CPU over an excavator-sized plugin's units. Nothing

@@ -2,12 +2,14 @@
 // headers of plugin_prelude.hpp, and the templates of theirs that the commands instantiate whatever
 // the model: nlohmann-json's parsing, lookups, conversions and building of objects, the standard
 // containers of names and numbers, fmt's joins. wlx's build precompiles this header with
-// -fpch-instantiate-templates and -fpch-codegen, and compiles the result once into an object
-// (plugin_prelude-O0.o, CMakeLists.txt): a unit that loads it neither instantiates these templates
-// nor generates their code again, and the plugin links that object (cli/shell/model_plugin.cpp).
-// That took a fifth off the commands' compile (an excavator's 10.6 s of CPU to 8.5 s, 2026-12-07),
-// where the same for the runtime's -O3 parts made them slower (a larger header to load, and code
-// the optimizer inlines anyway): they load plugin_prelude.hpp alone.
+// -fpch-instantiate-templates and -fpch-codegen, and compiles the result once, a section per
+// function, into an archive (plugin_prelude-O0.a, CMakeLists.txt): a unit that loads it neither
+// instantiates these templates nor generates their code again, and the plugin links the archive
+// (cli/shell/model_plugin.cpp). That took about a sixth off the commands' compile (alternating,
+// medians of three: an excavator copy's 12.2 s of CPU to 10.4 s, 2026-12-07), where the same for
+// the runtime's -O3 parts made them slower (a larger header to load, and code the optimizer
+// inlines anyway): they load plugin_prelude.hpp alone (unless WLX_PLUGIN_CXXFLAGS gives both parts
+// the commands' flags: then both load this one).
 // Nothing here may depend on a model; nothing calls these functions.
 #pragma once
 

@@ -190,7 +190,7 @@ constexpr SparseQrPlan sparse_qr_plan() {
 }
 inline constexpr SparseQrPlan kSparseQr = sparse_qr_plan();
 // Worth it where it skips at least a third of the dense QR's work; a dense J_beta (the excavator's)
-// keeps the dense path, whose fixed-size blocks vectorize.
+// keeps the dense path.
 inline constexpr bool kUseSparseQr = kSparseQr.feasible && 3 * kSparseQr.sparse_work <= 2 * kSparseQr.dense_work;
 
 // Whether A has a nonzero where the structure says zero: J_beta from inverse_dynamics never does,
