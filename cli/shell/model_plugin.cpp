@@ -398,15 +398,6 @@ struct PrecompiledPrelude {
   std::string archive;
 };
 
-// The precompiled header for a part compiled with `argv` (the compiler, then its flags:
-// `optimization`'s last). wlx's build precompiles one per optimization of a model's parts, named
-// after those flags (plugin_prelude-O3.pch for "-O3"; CMakeLists.txt), with its code beside it in
-// plugin_prelude-<name>.a where it has some; only the Clang wlx was built with, with the same flags,
-// can load one (CXX may name it another way), and not once a header it was made from has changed.
-// A compile of nothing with it (60 ms) asks the compiler first, so that a header it refuses
-// (another compiler, GCC, a changed header) costs the plugin its speed, never its build; its answer
-// is in precompiled-<name>.log. WLX_PLUGIN_PRECOMPILED_DIR names another folder to look in (empty:
-// none).
 // The name of the precompiled header for `flags`: each flag without its '-', joined by '_' ("-O3"
 // -> "O3", as CMakeLists.txt names them); empty for flags that make no such name.
 std::string prelude_name(const std::vector<std::string>& flags) {
@@ -419,6 +410,15 @@ std::string prelude_name(const std::vector<std::string>& flags) {
   return name;
 }
 
+// The precompiled header for a part compiled with `argv` (the compiler, then its flags:
+// `optimization`'s last). wlx's build precompiles one per optimization of a model's parts, named
+// after those flags (plugin_prelude-O3.pch for "-O3"; CMakeLists.txt), with its code beside it in
+// plugin_prelude-<name>.a where it has some; only the Clang wlx was built with, with the same flags,
+// can load one (CXX may name it another way), and not once a header it was made from has changed.
+// A compile of nothing with it (60 ms) asks the compiler first, so that a header it refuses
+// (another compiler, GCC, a changed header) costs the plugin its speed, never its build; its answer
+// is in precompiled-<name>.log. WLX_PLUGIN_PRECOMPILED_DIR names another folder to look in (empty:
+// none).
 PrecompiledPrelude precompiled_prelude(const Sources& src, const std::vector<std::string>& optimization, std::vector<std::string> argv,
                                        const fs::path& dir) {
   const char* env = std::getenv("WLX_PLUGIN_PRECOMPILED_DIR");
