@@ -195,6 +195,15 @@ std::string lane_kernels(const TrigConstants& k) {
        "  select(Bits{} - (reinterpret_cast<Bits>(x) >> 63), (kPiHead - a) + kPiTail, a, a);  // x < 0 (and x = -0): pi - a\n"
        "  angle = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(a) ^ (reinterpret_cast<Bits>(y < 0.0) & sign));  // y < 0: -a; y = -0 counts as +0\n"
        "}\n"
+       "#endif\n"
+       "// atan2() of doubles is always inlined: clang kept atan2<12> out of line, compiled for baseline\n"
+       "// x86-64, so that the AVX2 version of the IK (types.hpp) called its SSE2 code (clang's ik_all of\n"
+       "// the excavator 1.25 times GCC's, which inlines it; 1.1 inlined). sincos() is not: inlined, clang's\n"
+       "// `bodies` of the excavator took 2 times GCC's.\n"
+       "#if defined(WLX_GEN_SIMD_SINCOS)\n"
+       "#define WLX_GEN_TRIG_INLINE inline __attribute__((always_inline))\n"
+       "#else\n"
+       "#define WLX_GEN_TRIG_INLINE inline\n"
        "#endif\n\n";
   return t;
 }
@@ -266,7 +275,7 @@ std::string atan2_of_arrays() {
          "// polynomial of atan u;\n"
          "// the octant by bit masks, so the pass is branch-free on SIMD registers like sincos().\n"
          "template <std::size_t N>\n"
-         "inline void atan2(const std::array<double, N>& y, const std::array<double, N>& x, std::array<double, N>& angle) noexcept {\n"
+         "WLX_GEN_TRIG_INLINE void atan2(const std::array<double, N>& y, const std::array<double, N>& x, std::array<double, N>& angle) noexcept {\n"
          "#if defined(WLX_GEN_SIMD_SINCOS)\n"
          "  using trig_detail::Doubles;\n"
          "  constexpr std::size_t lanes = trig_detail::kLanes, full = N / lanes * lanes;\n"

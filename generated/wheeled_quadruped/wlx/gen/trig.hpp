@@ -103,6 +103,15 @@ inline void atan2_lanes(const Doubles& y, const Doubles& x, Doubles& angle) noex
   angle = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(a) ^ (reinterpret_cast<Bits>(y < 0.0) & sign));  // y < 0: -a; y = -0 counts as +0
 }
 #endif
+// atan2() of doubles is always inlined: clang kept atan2<12> out of line, compiled for baseline
+// x86-64, so that the AVX2 version of the IK (types.hpp) called its SSE2 code (clang's ik_all of
+// the excavator 1.25 times GCC's, which inlines it; 1.1 inlined). sincos() is not: inlined, clang's
+// `bodies` of the excavator took 2 times GCC's.
+#if defined(WLX_GEN_SIMD_SINCOS)
+#define WLX_GEN_TRIG_INLINE inline __attribute__((always_inline))
+#else
+#define WLX_GEN_TRIG_INLINE inline
+#endif
 
 }  // namespace trig_detail
 
@@ -167,7 +176,7 @@ inline void sincos(const std::array<Scalar, N>& x, std::array<Scalar, N>& sin_x,
 // polynomial of atan u;
 // the octant by bit masks, so the pass is branch-free on SIMD registers like sincos().
 template <std::size_t N>
-inline void atan2(const std::array<double, N>& y, const std::array<double, N>& x, std::array<double, N>& angle) noexcept {
+WLX_GEN_TRIG_INLINE void atan2(const std::array<double, N>& y, const std::array<double, N>& x, std::array<double, N>& angle) noexcept {
 #if defined(WLX_GEN_SIMD_SINCOS)
   using trig_detail::Doubles;
   constexpr std::size_t lanes = trig_detail::kLanes, full = N / lanes * lanes;
