@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Each generated kernel of a built-in model under GCC and under clang, side by side in one process
 # (bench/compilers/): their times and the ratio, for the issue of code that one compiler makes
-# slower than the other; medians over 5 copies of the program (bench/compilers/main.cpp says why).
+# slower than the other; each compiler's fastest of 7 copies of the program (bench/compilers/main.cpp
+# says why; the tests also time 3 other layouts of it).
 # The tests generated_kernels_by_compiler_* run the same program with --check.
 # Usage: tools/kernels_by_compiler.sh [MODEL] [FLAGS...]
 # (default: wheeled_quadruped, -O3 as the build's Release; e.g. -O2 -DWLX_GEN_NO_MULTIVERSION).
@@ -20,4 +21,4 @@ clang++-14 "${common[@]}" -DKERNEL_NAMESPACE=by_clang -c bench/compilers/kernels
 wait
 clang++-14 -O2 bench/compilers/main.cpp "$work/gcc.o" "$work/clang.o" -o "$work/kernels"
 echo "$model, ${flags[*]}:"
-"$work/kernels" --copies 5
+"$work/kernels" --copies 7
