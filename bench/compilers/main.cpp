@@ -15,8 +15,7 @@
 //                      ran clang's reduced_dynamics of the wheeled quadruped at 0.94 to 1.15 times
 //                      GCC's, and at 0.62 or 1.45 from two other files (a copy's placement is good or
 //                      bad for a kernel, bad in about 4 copies of 10, so even a median of 5 flipped
-//                      from run to run). In the binary: the same two objects linked in another order
-//                      gave 0.72 against 0.93. A bad placement only ever slows a kernel down, so the
+//                      from run to run). A bad placement only ever slows a kernel down, so the
 //                      fastest copy is its code's own speed, for each compiler alike. An offset of
 //                      the stack (0 to 4 kB) moved nothing.
 //   --variant PROGRAM  also measure in N copies of PROGRAM: this program linked with padding before
@@ -304,8 +303,9 @@ int main(int argc, char** argv) {
     }
   }
   if (copies > 1 || !variants.empty())
-    std::printf("(each compiler's fastest of %d copies of this program, each its own process, in %zu layouts)\n",
-                copies, variants.size() + 1);
+    std::printf(
+        "(each compiler's fastest of %d copies of this program, each its own process, %s)\n", copies,
+        variants.empty() ? "in its one layout" : ("in " + std::to_string(variants.size() + 1) + " layouts").c_str());
   for (const std::string& f : failures) std::fprintf(stderr, "FAILED %s\n", f.c_str());
   std::fflush(stdout);
   return failures.empty() ? 0 : 1;
