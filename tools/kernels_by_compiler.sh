@@ -3,7 +3,6 @@
 # (bench/compilers/): their times and the ratio, for the issue of code that one compiler makes
 # slower than the other; each compiler's fastest of 7 copies of the program (bench/compilers/main.cpp
 # says why; the tests also time 3 other layouts of it).
-# The tests generated_kernels_by_compiler_* run the same program with --check.
 # Usage: tools/kernels_by_compiler.sh [MODEL] [FLAGS...]
 # (default: wheeled_quadruped, -O3 as the build's Release; e.g. -O2 -DWLX_GEN_NO_MULTIVERSION).
 set -euo pipefail
