@@ -2,7 +2,7 @@
 # Each generated kernel of a built-in model under GCC and under clang, side by side in one process
 # (bench/compilers/): their times and the ratio, for the issue of code that one compiler makes
 # slower than the other; each compiler's fastest of 7 copies of the program (bench/compilers/main.cpp
-# says why; the tests also time 3 other layouts of it).
+# says why; its --variant also times other layouts, linked with bench/compilers/padding.cpp).
 # Usage: tools/kernels_by_compiler.sh [MODEL] [FLAGS...]
 # (default: wheeled_quadruped, -O3 as the build's Release; e.g. -O2 -DWLX_GEN_NO_MULTIVERSION).
 set -euo pipefail
