@@ -14,6 +14,7 @@ set(WLX_RUNTIME_FILES
   settings.cpp
   kinematics.cpp
   ik.cpp
+  model_code.cpp
   ik_verification.cpp
   nonholonomic.cpp
   simulation.cpp
@@ -48,7 +49,7 @@ set(WLX_COMMAND_SOURCES
 set(WLX_MODEL_FILE_COMMAND_SOURCES ${WLX_COMMAND_SOURCES} commands/no_embedded_runs.cpp)
 # The viewer's module: the runtime's sources it calls (relative to runtime/wlx/), the command
 # line's input bounds (relative to cli/), and the functions its page calls.
-set(WLX_VIEWER_RUNTIME_FILES model.cpp settings.cpp kinematics.cpp ik.cpp)
+set(WLX_VIEWER_RUNTIME_FILES model.cpp parameter_checks.cpp settings.cpp kinematics.cpp ik.cpp)
 set(WLX_VIEWER_CLI_FILES commands/limits.cpp)
 set(WLX_VIEWER_EXPORTED_FUNCTIONS
     _malloc,_free,_wlx_model_info_json,_wlx_last_error,_wlx_solve_ik,_wlx_forward_kinematics,_wlx_closure_residual,_wlx_body_centres)

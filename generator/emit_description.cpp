@@ -1,5 +1,6 @@
 // model.json: the model as data, beside the generated code (emit.hpp, emit_description()).
 #include "emit.hpp"
+#include "structure_facts.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -149,11 +150,15 @@ EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::
                       {"ground", w.ground >= 0 ? coordinate(w.ground) : ""}});
   d["wheels"] = wheels;
   Json limbs = Json::array();
-  for (const auto& l : m.limbs) {
-    Json joints = Json::array(), rows = Json::array();
+  const StructureFacts facts = structure_facts(m);
+  for (std::size_t k = 0; k < m.limbs.size(); ++k) {
+    const auto& l = m.limbs[k];
+    Json joints = Json::array(), rows = Json::array(), inputs = Json::array();
     for (int j : l.joints) joints.push_back(coordinate(j));
     for (int r : l.rows) rows.push_back(m.closure[static_cast<std::size_t>(r)].name);
-    limbs.push_back({{"name", l.name}, {"title", l.title}, {"joints", joints}, {"closure", rows}});
+    // The inputs its closure rows read: what must be finite before the limb is solved.
+    for (int i : facts.limb_inputs[k]) inputs.push_back(coordinate(i));
+    limbs.push_back({{"name", l.name}, {"title", l.title}, {"joints", joints}, {"closure", rows}, {"inputs", inputs}});
   }
   d["limbs"] = limbs;
   const std::vector<GroundContact> contacts = ground_contacts(m);

@@ -8,6 +8,7 @@
 // never a result.
 #pragma once
 
+#include "wlx/ik_options.hpp"
 #include "wlx/model.hpp"
 
 #include <array>
@@ -45,12 +46,13 @@ struct LimbBlock {
 };
 LimbBlock limb_block(Limb limb) noexcept;
 
-struct NewtonReport;
-struct NewtonOptions;
+// A generated solver's outcome in the terms both runtimes share (wlx/ik_options.hpp).
+ClosedFormStatus closed_form_status(gen::IkStatus status) noexcept;
 
-// Which branch each limb's closed form takes, indexed by Limb; kModelsChoice leaves it to the
-// model (resolve_branches). Default-constructed: every limb the model's choice.
-inline constexpr int kModelsChoice = -1;
+struct NewtonReport;
+
+// Which branch each limb's closed form takes, indexed by Limb; kModelsChoice (wlx/ik_options.hpp)
+// leaves it to the model (resolve_branches). Default-constructed: every limb the model's choice.
 struct Branches {
   std::array<int, kLimbCount> limb = [] {
     std::array<int, kLimbCount> all{};
@@ -90,29 +92,7 @@ void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& br
 // Which branch of the closed form a solution lies on (the branch whose solution is nearest).
 int classify_branch(const Model& model, Limb limb, const Coordinates& s);
 
-struct NewtonOptions {
-  double tolerance = 1e-13;  // on max |Phi| of the limb, in m or rad
-  // A limb whose residual no damped step can lower any more has reached its rounding floor; it
-  // counts as converged if that floor is below this (ill-conditioned poses amplify rounding). So
-  // does a limb still below it when max_iterations run out: at a singular pose (a leg stretched
-  // or folded flat) the convergence is linear, and the last digits take hundreds of steps.
-  double floor_tolerance = 1e-10;
-  int max_iterations = 100;  // steps tried per limb (accepted or not)
-  // levenberg_marquardt: damped steps that also descend from far or singular starts (the default).
-  // backtracking: full Newton steps, each halved until the limb's max |Phi| decreases: the
-  // thesis' method, whose basins of attraction its cold starts show (docs/excavator.md section 4).
-  enum class Method { levenberg_marquardt, backtracking };
-  Method method = Method::levenberg_marquardt;
-  // Continuation (solve_newton_limbs from the previous solution): the largest move of a dependent
-  // joint (rad or m) that still counts as following the same solution. A larger one is an error
-  // naming the limb, never a silent switch to another root. Infinite: no check (a one-off solve).
-  double max_jump = std::numeric_limits<double>::infinity();
-};
-
-// The bound of a run's continuation (simulate, the report's runs): between two evaluations of the
-// integrator no dependent joint of a limb solved by Newton's method moves more than half a radian
-// (or half a metre). A run's evaluations lie a step apart; a move that large is another root.
-inline constexpr double kContinuationJump = 0.5;
+// NewtonOptions and kContinuationJump, the bound of a run's continuation: wlx/ik_options.hpp.
 
 struct NewtonReport {
   std::array<int, kLimbCount> iterations{};  // per limb

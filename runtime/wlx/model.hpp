@@ -15,6 +15,10 @@
 #include <string_view>
 #include <vector>
 
+namespace wlx {
+struct ModelCode;  // wlx/model_code.hpp
+}
+
 WLX_MODEL_NAMESPACE_BEGIN
 
 using gen::Coordinates;
@@ -94,5 +98,9 @@ double* find_param(Params& params, std::string_view name) noexcept;
 // The model's nominal inputs (its file's `nominal`), and the dependent joints at the start values of
 // Newton's method (the file's `nominal` and limbs' `start`, else 0): solve them with the IK.
 Coordinates nominal_inputs();
+
+// This model's generated functions for the runtime compiled once for every model (wlx/generic/),
+// behind plain function pointers (wlx/model_code.hpp).
+const ModelCode& model_code() noexcept;
 
 WLX_MODEL_NAMESPACE_END
