@@ -101,6 +101,21 @@ Json principal_axes(const Body& b, const Evaluator& number) {
   return rows;
 }
 
+// The wheels' dependent rates: the inputs whose rates may be chosen, one per wheel, the named
+// choices and the default one (a model without wheels has one choice, of no rates).
+template <class Name>
+Json pairs_description(const Model& m, const StructureFacts& facts, const Name& coordinate) {
+  Json candidates = Json::array(), named = Json::array();
+  for (int k : m.pair_candidates) candidates.push_back(coordinate(k));
+  for (const auto& p : facts.pairs) {
+    Json rates = Json::array();
+    for (int k : p.coordinates) rates.push_back(coordinate(k));
+    named.push_back({{"name", p.name}, {"rates", rates}});
+  }
+  return {{"candidates", candidates}, {"named", named},
+          {"default", facts.pairs.empty() ? Json(nullptr) : Json(facts.pairs[static_cast<std::size_t>(facts.default_pair)].name)}};
+}
+
 }  // namespace
 
 EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::vector<EmittedFile>& code) {
@@ -161,6 +176,7 @@ EmittedFile emit_description(const Model& m, const EmitOptions& opt, const std::
     limbs.push_back({{"name", l.name}, {"title", l.title}, {"joints", joints}, {"closure", rows}, {"inputs", inputs}});
   }
   d["limbs"] = limbs;
+  d["pairs"] = pairs_description(m, facts, coordinate);
   const std::vector<GroundContact> contacts = ground_contacts(m);
   Json contact_list = Json::array();
   for (const auto& c : contacts)

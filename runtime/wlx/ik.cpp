@@ -21,8 +21,6 @@ class FixedIk {
   static constexpr int kLimbSize = gen::kMaxLimbSize;
   static constexpr int kLimbCapacity = kLimbCount;
 
-  // Without a model: for the tables and settings alone (the ranges), nothing solved.
-  FixedIk() = default;
   explicit FixedIk(const Model& model, Data* data = nullptr) : model_(&model), data_(data) {}
 
   int limb_count() const { return kLimbCount; }
@@ -73,6 +71,17 @@ class FixedIk {
   std::optional<Data> own_;
 };
 
+// The joints' ranges and Newton's start values alone, as the algorithms' range checks see them.
+struct FixedRanges {
+  using Vector = Coordinates;
+  int coordinate_count() const { return kCoordinateCount; }
+  int input_count() const { return kInputCount; }
+  std::string_view coordinate_name(int k) const { return gen::kCoordinateNames[static_cast<std::size_t>(k)]; }
+  double lower(int k) const { return settings().lower[static_cast<std::size_t>(k)]; }
+  double upper(int k) const { return settings().upper[static_cast<std::size_t>(k)]; }
+  double dependent_start(int k) const { return settings().dependent_start[static_cast<std::size_t>(k - kInputCount)]; }
+};
+
 }  // namespace
 
 ClosedFormStatus closed_form_status(gen::IkStatus status) noexcept {
@@ -108,11 +117,11 @@ void solve_limb_closed_form(const Model& model, Limb limb, int branch, Coordinat
   ik_algorithms::solve_limb_closed_form(p, limb, branch, s);
 }
 
-bool within_range(const Coordinates& s, int k) noexcept { return ik_algorithms::within_range(FixedIk(), s, k); }
+bool within_range(const Coordinates& s, int k) noexcept { return ik_algorithms::within_range(FixedRanges{}, s, k); }
 
-int first_outside_limits(const Coordinates& s) noexcept { return ik_algorithms::first_outside_limits(FixedIk(), s); }
+int first_outside_limits(const Coordinates& s) noexcept { return ik_algorithms::first_outside_limits(FixedRanges{}, s); }
 
-std::string describe_outside_limits(const Coordinates& s, int k) { return ik_algorithms::describe_outside_limits(FixedIk(), s, k); }
+std::string describe_outside_limits(const Coordinates& s, int k) { return ik_algorithms::describe_outside_limits(FixedRanges{}, s, k); }
 
 Branches resolve_branches(const Model& model, const Coordinates& s, const Branches& requested, std::array<bool, kLimbCount>* outside) {
   Branches out = requested;
@@ -123,6 +132,7 @@ Branches resolve_branches(const Model& model, const Coordinates& s, const Branch
 
 void solve_ik_closed_form(const Model& model, Coordinates& s, const Branches& requested, NewtonReport* newton_report,
                           const NewtonOptions* newton_options) {
+  if (newton_report != nullptr) *newton_report = NewtonReport{};  // nothing stale if a limb fails
   FixedIk p(model);
   const auto progress = ik_algorithms::solve_ik_closed_form(p, s, requested.limb, newton_options);
   if (newton_report != nullptr) ik_algorithms::fill_report(p, progress, *newton_report);
@@ -133,7 +143,7 @@ int classify_branch(const Model& model, Limb limb, const Coordinates& s) {
   return ik_algorithms::classify_branch(p, limb, s);
 }
 
-Coordinates dependent_start(Coordinates s) { return ik_algorithms::dependent_start(FixedIk(), s); }
+Coordinates dependent_start(Coordinates s) { return ik_algorithms::dependent_start(FixedRanges{}, s); }
 
 NewtonReport solve_newton_limbs(const Model& model, Data& data, const std::array<bool, kLimbCount>& limbs, Coordinates& s,
                                 const NewtonOptions& options) {

@@ -18,6 +18,13 @@
 
 WLX_MODEL_NAMESPACE_BEGIN
 
+// The options and constants both runtimes share (wlx/ik_options.hpp), by this model's name too
+// (wlx::<model>::NewtonOptions, as before they were shared).
+using ::wlx::kContinuationJump;
+using ::wlx::kModelsChoice;
+using ::wlx::NewtonOptions;
+using ::wlx::NonholonomicOptions;
+
 // A limb: an index into gen::kLimbs (gen::limb::<name>).
 using Limb = int;
 inline constexpr int kLimbCount = gen::kLimbCount;

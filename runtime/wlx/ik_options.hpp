@@ -1,4 +1,4 @@
-// The inverse kinematics' options and the view of a limb that both runtimes share (the model's
+// The inverse kinematics' and the dependent rates' options, and the view of a limb, that both runtimes share (the model's
 // own, wlx/ik.hpp, and the one compiled once for every model, wlx/generic/ik.hpp): nothing here
 // depends on a model's sizes.
 #pragma once
@@ -43,6 +43,13 @@ struct NewtonOptions {
 // integrator no dependent joint of a limb solved by Newton's method moves more than half a radian
 // (or half a metre). A run's evaluations lie a step apart; a move that large is another root.
 inline constexpr double kContinuationJump = 0.5;
+
+struct NonholonomicOptions {
+  // J_beta counts as singular above this condition number. The thesis scenarios reach 2.7e7
+  // (ST-A1- crossing its singular point on the 1 ms grid); 1e10 leaves a wide margin while
+  // stopping rates that would be rounding noise amplified by more than 1e10 * 1e-16 = 1e-6.
+  double max_condition = 1e10;
+};
 
 // One limb as the algorithms see it.
 struct IkLimb {

@@ -22,6 +22,11 @@ struct Workspace {
     // Called with zero_fill = false, as the model's own runtime calls it (model.hpp, Data): the
     // structural zeros are written once, here.
     dPhi_ds.setZero();
+    sdot.setZero();
+    C.setZero();
+    spin.setZero();
+    dPhi_ds_dot_sdot.setZero();
+    C_dot_sdot.setZero();
     for (std::size_t k = 0; k < gen::kParamInfo.size(); ++k) param_storage[k] = &(params.*gen::kParamInfo[k].member);
   }
   Coordinates s;
@@ -29,6 +34,10 @@ struct Workspace {
   gen::FrameRotations frame_rotations;
   gen::ClosureVector Phi;
   gen::ClosureJacobian dPhi_ds;
+  Coordinates sdot;
+  gen::WheelRows C, spin;
+  gen::ClosureVector dPhi_ds_dot_sdot;
+  gen::WheelVector C_dot_sdot;
   std::array<int, gen::kLimbCount> branches{};
   Params params;
   std::array<double*, gen::kParamInfo.size()> param_storage{};
@@ -61,6 +70,35 @@ constexpr std::array<ModelCodeClosedForm, gen::kLimbCount> closed_forms() {
 // The generated texts are string literals: their views' data() end in a NUL, so they serve as C strings.
 constexpr std::array<ModelCodeClosedForm, gen::kLimbCount> kClosedForms = closed_forms();
 
+// The names as C strings: the generated views are of string literals, NUL-terminated.
+template <std::size_t N>
+constexpr std::array<const char*, N> c_strings(const std::array<std::string_view, N>& names) {
+  std::array<const char*, N> out{};
+  for (std::size_t k = 0; k < N; ++k) out[k] = names[k].data();
+  return out;
+}
+constexpr auto kCoordinateNames = c_strings(gen::kCoordinateNames);
+constexpr auto kFrameNames = c_strings(gen::kFrameNames);
+constexpr std::array<const char*, gen::kParamInfo.size()> kParameterNames = [] {
+  std::array<const char*, gen::kParamInfo.size()> out{};
+  for (std::size_t k = 0; k < out.size(); ++k) out[k] = gen::kParamInfo[k].name.data();
+  return out;
+}();
+constexpr std::array<IkLimb, gen::kLimbCount> kLimbViews = [] {
+  std::array<IkLimb, gen::kLimbCount> out{};
+  for (std::size_t l = 0; l < out.size(); ++l) {
+    const gen::LimbInfo& b = gen::kLimbs[l];
+    out[l] = {b.size, b.rows.data(), b.joints.data(), b.input_count, b.inputs.data()};
+  }
+  return out;
+}();
+
+constexpr std::array<const char*, gen::kWheelCount> kWheelNames = [] {
+  std::array<const char*, gen::kWheelCount> out{};
+  for (std::size_t w = 0; w < out.size(); ++w) out[w] = gen::kWheels[w].name.data();
+  return out;
+}();
+
 ModelCode make_model_code() noexcept {
   ModelCode c;
   c.version = kModelCodeVersion;
@@ -71,7 +109,13 @@ ModelCode make_model_code() noexcept {
   c.closure_rows = gen::kClosureCount;
   c.limbs = gen::kLimbCount;
   c.params = static_cast<int>(gen::kParamInfo.size());
+  c.wheels = kWheelCount;
   c.closed_forms = kClosedForms.data();
+  c.coordinate_names = kCoordinateNames.data();
+  c.frame_names = kFrameNames.data();
+  c.parameter_names = kParameterNames.data();
+  c.limb_views = kLimbViews.data();
+  c.wheel_names = kWheelNames.data();
   c.create_workspace = []() -> void* { return new Workspace; };
   c.destroy_workspace = [](void* w) noexcept { delete static_cast<Workspace*>(w); };
   c.arrays = [](void* w) noexcept {
@@ -82,6 +126,11 @@ ModelCode make_model_code() noexcept {
     a.frame_rotations = ws.frame_rotations.empty() ? nullptr : ws.frame_rotations[0].data();
     a.Phi = data_or_null(ws.Phi);
     a.dPhi_ds = data_or_null(ws.dPhi_ds);
+    a.sdot = ws.sdot.data();
+    a.C = data_or_null(ws.C);
+    a.spin = data_or_null(ws.spin);
+    a.dPhi_ds_dot_sdot = data_or_null(ws.dPhi_ds_dot_sdot);
+    a.C_dot_sdot = data_or_null(ws.C_dot_sdot);
     a.branches = ws.branches.empty() ? nullptr : ws.branches.data();
     a.params = ws.param_storage.empty() ? nullptr : ws.param_storage.data();
     return a;
@@ -93,6 +142,20 @@ ModelCode make_model_code() noexcept {
   c.closure = [](void* w, bool with_jacobian) noexcept {
     Workspace& ws = of(w);
     gen::closure(ws.s, ws.params, {.Phi = &ws.Phi, .dPhi_ds = with_jacobian ? &ws.dPhi_ds : nullptr}, false);
+  };
+  // The rolling rows as the model's own runtime evaluates them (nonholonomic.cpp): the structural
+  // zeros stay as the workspace was made.
+  c.rolling_rows = [](void* w) noexcept {
+    Workspace& ws = of(w);
+    gen::kinematic_update(ws.s, ws.params, {.dPhi_ds = &ws.dPhi_ds, .C = &ws.C}, false);
+  };
+  c.wheel_rows = [](void* w) noexcept {
+    Workspace& ws = of(w);
+    gen::nonholonomic(ws.s, ws.params, {.C = &ws.C, .spin = &ws.spin}, false);
+  };
+  c.convective = [](void* w) noexcept {
+    Workspace& ws = of(w);
+    gen::convective(ws.s, ws.sdot, ws.params, {.dPhi_ds_dot_sdot = &ws.dPhi_ds_dot_sdot, .C_dot_sdot = &ws.C_dot_sdot});
   };
   c.ik_all = [](void* w, ClosedFormFailure* failure) noexcept {
     Workspace& ws = of(w);

@@ -12,7 +12,7 @@
 // Nothing here depends on a model: this header is the one both sides include.
 #pragma once
 
-#include "wlx/ik_options.hpp"  // ClosedFormStatus, ClosedFormFailure
+#include "wlx/ik_options.hpp"  // ClosedFormStatus, ClosedFormFailure, IkLimb
 
 namespace wlx {
 
@@ -36,6 +36,11 @@ struct ModelCodeArrays {
   double* frame_rotations = nullptr;  // frames matrices 3 x 3, one after another
   double* Phi = nullptr;              // closure rows
   double* dPhi_ds = nullptr;          // closure rows x coordinates
+  double* sdot = nullptr;             // coordinates: their rates (convective's input)
+  double* C = nullptr;                // wheels x coordinates: the rolling rows, sideways
+  double* spin = nullptr;             // wheels x coordinates: the wheels' spin rates' rows
+  double* dPhi_ds_dot_sdot = nullptr; // closure rows: (d/dt dPhi/ds) s'
+  double* C_dot_sdot = nullptr;       // wheels: (d/dt C) s'
   int* branches = nullptr;            // per limb: the branch ik_all takes
   double* const* params = nullptr;    // per parameter (model.json's order): where its value is kept
 };
@@ -43,8 +48,15 @@ struct ModelCodeArrays {
 struct ModelCode {
   int version = 0;  // kModelCodeVersion of the code that filled this in
   const char* model = "";
-  int coordinates = 0, inputs = 0, frames = 0, closure_rows = 0, limbs = 0, params = 0;
+  int coordinates = 0, inputs = 0, frames = 0, closure_rows = 0, limbs = 0, params = 0, wheels = 0;
   const ModelCodeClosedForm* closed_forms = nullptr;  // per limb
+  // What the code was generated for, to check a description against (generic::Model): the names
+  // in the code's order, and each limb's rows, joints and the inputs its rows read.
+  const char* const* coordinate_names = nullptr;  // per coordinate
+  const char* const* frame_names = nullptr;       // per frame
+  const char* const* parameter_names = nullptr;   // per parameter
+  const IkLimb* limb_views = nullptr;             // per limb
+  const char* const* wheel_names = nullptr;       // per wheel, in the rolling rows' order
 
   // A workspace (zeroed; its structural zeros stay zero: every call leaves them) and its arrays.
   void* (*create_workspace)() = nullptr;
@@ -55,6 +67,12 @@ struct ModelCode {
   void (*kinematics)(void* workspace) noexcept = nullptr;
   // s -> Phi, and dPhi_ds when with_jacobian.
   void (*closure)(void* workspace, bool with_jacobian) noexcept = nullptr;
+  // s -> dPhi_ds and C (the fused kinematic update: they share most of their terms).
+  void (*rolling_rows)(void* workspace) noexcept = nullptr;
+  // s -> C and spin.
+  void (*wheel_rows)(void* workspace) noexcept = nullptr;
+  // s, sdot -> dPhi_ds_dot_sdot and C_dot_sdot.
+  void (*convective)(void* workspace) noexcept = nullptr;
   // Every limb that has a closed form, on its branch in `branches`, from the inputs in s into s's
   // dependent joints (the fused pass; the others' joints are left as they are).
   ClosedFormStatus (*ik_all)(void* workspace, ClosedFormFailure* failure) noexcept = nullptr;

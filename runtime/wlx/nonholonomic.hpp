@@ -10,6 +10,7 @@
 // wheels, n for n wheels; the rest of the inputs' rates are commanded.)
 #pragma once
 
+#include "wlx/ik_options.hpp"
 #include "wlx/model.hpp"
 
 #include <array>
@@ -33,12 +34,7 @@ DependentPair dependent_pair(const std::vector<std::string>& names, const std::s
 DependentPair named_pair(std::string_view name, const std::string& field = "dependent");
 inline DependentPair default_pair() noexcept { return {}; }
 
-struct NonholonomicOptions {
-  // J_beta counts as singular above this condition number. The thesis scenarios reach 2.7e7
-  // (ST-A1- crossing its singular point on the 1 ms grid); 1e10 leaves a wide margin while
-  // stopping rates that would be rounding noise amplified by more than 1e10 * 1e-16 = 1e-6.
-  double max_condition = 1e10;
-};
+// NonholonomicOptions (J_beta's largest condition): wlx/ik_options.hpp.
 
 // The 2-norm condition number sigma_max / sigma_min of J_beta; infinity for a singular matrix. For two
 // wheels in closed form, accurate to a few ulp even where the singular values nearly agree; otherwise

@@ -10,12 +10,15 @@
 #include <wlx/error.hpp>
 #include <wlx/generic/ik.hpp>
 #include <wlx/generic/kinematics.hpp>
+#include <wlx/generic/nonholonomic.hpp>
 #include <wlx/ik.hpp>
 #include <wlx/kinematics.hpp>
+#include <wlx/nonholonomic.hpp>
 #include <wlx/model_code.hpp>
 #include <wlx/settings.hpp>
 
 #include <cstring>
+#include <algorithm>
 #include <deque>
 #include <fstream>
 #include <optional>
@@ -204,6 +207,7 @@ TEST_CASE(titled("the IK on every branch and by the model's choice, Newton's met
       REQUIRE(eg == ea);
       if (!ea.empty()) continue;
       REQUIRE(same_bits(n, dynamic(n_fixed)));
+      CHECK(g.converged == a.converged);
       CHECK(g.residual == a.residual);
       for (int l = 0; l < kLimbCount; ++l) CHECK(g.iterations[static_cast<std::size_t>(l)] == a.iterations[static_cast<std::size_t>(l)]);
     }
@@ -234,12 +238,15 @@ TEST_CASE(titled("Newton's continuation and its bound on a jump, as the model's 
     const std::string ea = error_of([&] { solve_newton_limbs(fixed_model, fixed, all, a, options); });
     const std::string eg = error_of([&] { generic::solve_newton_limbs(model, data, std::vector<bool>(kLimbCount, true), g, options); });
     REQUIRE(eg == ea);
+    if (bound < 1) CHECK(ea.find("another solution") != std::string::npos);  // back by 0.3 is a jump past 0.1
+    else CHECK(ea.empty());
     if (ea.empty()) CHECK(same_bits(g, dynamic(a)));
   }
 }
 
 TEST_CASE(titled("parameters and descriptions that do not fit are refused, naming what")) {
   // A parameter refused by its kind: the same words as the model's own Model.
+  int refused = 0;
   std::vector<double> params;
   for (const auto& p : description()->parameters) params.push_back(p.value);
   for (std::size_t k = 0; k < params.size(); ++k) {
@@ -250,7 +257,9 @@ TEST_CASE(titled("parameters and descriptions that do not fit are refused, namin
     const std::string a = error_of([&] { Model m(fixed_params); });
     const std::string g = error_of([&] { generic::Model m(description(), model_code(), bad); });
     CHECK(g == a);
+    refused += !a.empty();
   }
+  CHECK(refused > 0);  // every model has masses and inertias, which -1 is not
   CHECK(error_of([&] { generic::Model m(description(), model_code(), std::vector<double>(params.size() + 1, 1.0)); }).find("params") !=
         std::string::npos);
   // A description of another model, or of other sizes, is not this code's.
@@ -278,4 +287,235 @@ TEST_CASE(titled("parameters and descriptions that do not fit are refused, namin
     text.replace(at, joint.size(), "\"no_such_joint\"");
     CHECK(error_of([&] { generic::read_description(text); }).find("no coordinate 'no_such_joint'") != std::string::npos);
   }
+}
+
+TEST_CASE(titled("other parameters' values, one Data for two Models, the branches' choice and its limits, one limb's Newton")) {
+  // Every length, mass and inertia 3% larger (a uniform scale keeps the inertias physical), in both.
+  Params scaled = settings().params;
+  std::vector<double> values;
+  for (std::size_t k = 0; k < gen::kParamInfo.size(); ++k) {
+    const auto kind = gen::kParamInfo[k].kind;
+    double& v = scaled.*gen::kParamInfo[k].member;
+    if (kind == gen::ParamKind::length || kind == gen::ParamKind::mass || kind == gen::ParamKind::inertia) v *= 1.03;
+    values.push_back(v);
+  }
+  const Model fixed_default, fixed_scaled(scaled);
+  const generic::Model model_default(description(), model_code()), model_scaled(description(), model_code(), values);
+  CHECK(model_scaled.total_mass() == fixed_scaled.total_mass());
+  generic::Data data(model_default);  // shared: each call must load its own model's parameters
+  Data fixed;
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  for (int trial = 0; trial < 20; ++trial) {
+    Coordinates s;
+    for (int k = 0; k < kCoordinateCount; ++k) s(k) = u(rng);
+    for (const bool use_scaled : {true, false, true}) {
+      const Model& fm = use_scaled ? fixed_scaled : fixed_default;
+      const generic::Model& gm = use_scaled ? model_scaled : model_default;
+      forward_kinematics(fm, fixed, s);
+      generic::forward_kinematics(gm, data, dynamic(s));
+      REQUIRE(same_bits(data.frame_positions, fixed.frame_positions));
+      closure(fm, fixed, s, true);
+      generic::closure(gm, data, dynamic(s), true);
+      REQUIRE(same_bits(data.dPhi_ds, fixed.dPhi_ds));
+    }
+  }
+  // The model's choice of branch and whether it leaves a joint's range, every branch requested
+  // explicitly, and one limb by Newton's method, at states near the nominal one.
+  for (int trial = 0; trial < 20; ++trial) {
+    const Coordinates start = near_nominal(rng, 0.05);
+    std::array<bool, kLimbCount> outside_fixed{};
+    std::vector<bool> outside;
+    std::string ea, eg;
+    Branches chosen_fixed;
+    generic::Branches chosen;
+    ea = error_of([&] { chosen_fixed = resolve_branches(fixed_scaled, start, {}, &outside_fixed); });
+    eg = error_of([&] { chosen = generic::resolve_branches(model_scaled, data, dynamic(start), {}, &outside); });
+    REQUIRE(eg == ea);
+    if (!ea.empty()) continue;
+    for (int l = 0; l < kLimbCount; ++l) {
+      CHECK(chosen[static_cast<std::size_t>(l)] == chosen_fixed.limb[static_cast<std::size_t>(l)]);
+      CHECK(outside[static_cast<std::size_t>(l)] == outside_fixed[static_cast<std::size_t>(l)]);
+    }
+    for (int b = 0; kLimbCount > 0 && b < branch_count(0); ++b) {
+      Branches requested;
+      requested.limb.fill(kModelsChoice);
+      requested.limb[0] = b;
+      generic::Branches asked(static_cast<std::size_t>(kLimbCount), kModelsChoice);
+      asked[0] = b;
+      Coordinates a = start;
+      Eigen::VectorXd g = dynamic(start);
+      ea = error_of([&] { solve_ik_closed_form(fixed_scaled, a, requested); });
+      eg = error_of([&] { generic::solve_ik_closed_form(model_scaled, data, g, asked); });
+      REQUIRE(eg == ea);
+      if (ea.empty()) REQUIRE(same_bits(g, dynamic(a)));
+      if (!ea.empty() || kLimbCount == 0) continue;
+      // The first limb again by Newton's method from its start values; its report as the model's.
+      Coordinates na = dependent_start(a);
+      Eigen::VectorXd ng = generic::dependent_start(model_scaled, dynamic(a));
+      NewtonReport ra;
+      generic::NewtonReport rg;
+      ea = error_of([&] { ra = solve_limb_newton(fixed_scaled, fixed, 0, na); });
+      eg = error_of([&] { rg = generic::solve_limb_newton(model_scaled, data, 0, ng); });
+      REQUIRE(eg == ea);
+      if (!ea.empty()) continue;
+      REQUIRE(same_bits(ng, dynamic(na)));
+      CHECK(rg.iterations == std::vector<int>(ra.iterations.begin(), ra.iterations.end()));
+    }
+    // The ranges: a joint moved past its upper bound is named alike.
+    Coordinates moved = start;
+    for (int k = 0; k < kCoordinateCount; ++k)
+      if (std::isfinite(settings().upper[static_cast<std::size_t>(k)])) {
+        moved(k) = settings().upper[static_cast<std::size_t>(k)] + 0.25;
+        break;
+      }
+    const int k = first_outside_limits(moved);
+    CHECK(generic::first_outside_limits(model_scaled, dynamic(moved)) == k);
+    if (k >= 0) {
+      CHECK(generic::describe_outside_limits(model_scaled, dynamic(moved), k) == describe_outside_limits(moved, k));
+      CHECK_FALSE(generic::within_range(model_scaled, dynamic(moved), k));
+    }
+  }
+}
+
+TEST_CASE(titled("wrong sizes, indices and code are refused, naming what")) {
+  const generic::Model model(description(), model_code());
+  generic::Data data(model);
+  Eigen::VectorXd short_s = Eigen::VectorXd::Zero(kCoordinateCount - 1);
+  CHECK(error_of([&] { generic::forward_kinematics(model, data, short_s); }).find("s: ") != std::string::npos);
+  CHECK(error_of([&] { generic::solve_ik_closed_form(model, data, short_s); }).find("s: ") != std::string::npos);
+  CHECK(error_of([&] { generic::first_outside_limits(model, short_s); }).find("s: ") != std::string::npos);
+  Eigen::VectorXd s = generic::nominal_coordinates(model);
+  CHECK(error_of([&] { generic::within_range(model, s, kCoordinateCount); }).find("no coordinate") != std::string::npos);
+  CHECK(error_of([&] { generic::solve_limb_closed_form(model, data, kLimbCount, 0, s); }).find("no limb") != std::string::npos);
+  CHECK(error_of([&] { generic::solve_ik_closed_form(model, data, s, generic::Branches(static_cast<std::size_t>(kLimbCount) + 1, 0)); })
+            .find("branches for the model's") != std::string::npos);
+  CHECK(error_of([&] { data.frame_rotation(gen::kFrameCount); }).find("no frame") != std::string::npos);
+  // Code of another version of the interface.
+  ModelCode old = model_code();
+  old.version = kModelCodeVersion + 1;
+  CHECK(error_of([&] { generic::Model m(description(), old); }).find("compile the model again") != std::string::npos);
+  // A description whose names are not the code's: a coordinate renamed.
+  generic::Description renamed = *description();
+  renamed.coordinates[0].name = "renamed";
+  CHECK(error_of([&] { generic::Model m(std::make_shared<const generic::Description>(renamed), model_code()); })
+            .find("coordinate 'renamed' where the code has") != std::string::npos);
+  // A description made in code whose indices point nowhere: refused before anything reads them.
+  generic::Description broken = *description();
+  if (!broken.bodies.empty()) {
+    broken.bodies[0].mass = 100000;
+    CHECK(error_of([&] { generic::Model m(std::make_shared<const generic::Description>(broken), model_code()); })
+              .find("mass is no parameter") != std::string::npos);
+  }
+  if (kLimbCount > 0) {
+    broken = *description();
+    std::swap(broken.limbs[0].joints, broken.limbs[0].rows);  // rows are no joints (and the other way)
+    CHECK_FALSE(error_of([&] { generic::Model m(std::make_shared<const generic::Description>(broken), model_code()); }).empty());
+  }
+  broken = *description();
+  broken.settings.lower.pop_back();
+  CHECK(error_of([&] { generic::Model m(std::make_shared<const generic::Description>(broken), model_code()); }).find("settings.limits") !=
+        std::string::npos);
+  CHECK(error_of([] { generic::read_description(std::string(generic::kMaxDescriptionBytes + 1, ' ')); }).find("more than a description's") !=
+        std::string::npos);
+}
+
+namespace {
+
+// Relative agreement of two results of the same algorithm whose sums Eigen orders differently at
+// fixed and at run-time sizes (a product's inner sum, a norm): rounding, amplified at most by the
+// condition of the solves they pass through (J_beta's and the limb blocks', below 1e6 at these
+// states): 1e-12 of the larger entry leaves that room at 1e-16 per operation.
+bool agree(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::Ref<const Eigen::MatrixXd>& b) {
+  if (a.rows() != b.rows() || a.cols() != b.cols() || !a.allFinite() || !b.allFinite()) return false;
+  if (a.size() == 0) return true;  // J_beta of a model without wheels
+  const double scale = std::max({1.0, a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff()});
+  return (a - b).cwiseAbs().maxCoeff() <= 1e-12 * scale;
+}
+
+}  // namespace
+
+TEST_CASE(titled("the dependent rates, accelerations and rate basis, and the pairs, as the model's own runtime")) {
+  const Model fixed_model;
+  Data fixed;
+  const generic::Model model(description(), model_code());
+  generic::Data data(model);
+  // The pairs: by name, by the rates' names, the default, and the refusals, word for word.
+  const DependentPair fixed_default = default_pair();
+  const generic::DependentPair generic_default = generic::default_pair(model);
+  CHECK(generic_default.index == std::vector<int>(fixed_default.index.begin(), fixed_default.index.end()));
+  CHECK(generic::pair_label(model, generic_default) == fixed_default.label());
+  for (const auto& named : gen::kPairs) {
+    CHECK(generic::named_pair(model, named.name).index == std::vector<int>(named.coordinates.begin(), named.coordinates.end()));
+    std::vector<std::string> names;
+    for (int k : named.coordinates) names.emplace_back(gen::kCoordinateNames[static_cast<std::size_t>(k)]);
+    CHECK(generic::dependent_pair(model, names).index == std::vector<int>(named.coordinates.begin(), named.coordinates.end()));
+  }
+  CHECK(error_of([&] { generic::named_pair(model, "no_such_pair"); }) == error_of([] { named_pair("no_such_pair"); }));
+  const std::vector<std::string> wrong{"no_such_rate"};
+  CHECK(error_of([&] { generic::dependent_pair(model, wrong); }) == error_of([&] { dependent_pair(wrong); }));
+  if (kWheelCount >= 2) {
+    const std::string twice(gen::kCoordinateNames[static_cast<std::size_t>(fixed_default.index[0])]);
+    std::vector<std::string> repeated(static_cast<std::size_t>(kWheelCount), twice);
+    CHECK(error_of([&] { generic::dependent_pair(model, repeated); }) == error_of([&] { dependent_pair(repeated); }));
+  }
+  std::mt19937_64 rng(14);
+  std::uniform_real_distribution<double> rate(-0.5, 0.5);
+  int compared = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    Coordinates s = near_nominal(rng, 0.05);
+    try {
+      solve_ik_closed_form(fixed_model, s);
+    } catch (const Error&) {
+      continue;
+    }
+    Coordinates sdot = Coordinates::Zero(), sddot = Coordinates::Zero();
+    for (int k = 0; k < kInputCount; ++k) sdot(k) = rate(rng), sddot(k) = rate(rng);
+    Eigen::VectorXd g_sdot = dynamic(sdot), g_sddot = dynamic(sddot);
+    const std::string ea = error_of([&] { solve_dependent_rates(fixed_model, fixed, s, sdot, fixed_default); });
+    const std::string eg = error_of([&] { generic::solve_dependent_rates(model, data, dynamic(s), g_sdot, generic_default); });
+    REQUIRE(eg == ea);
+    if (!ea.empty()) continue;
+    ++compared;
+    REQUIRE(agree(g_sdot, dynamic(sdot)));
+    CHECK(agree(data.J_beta, fixed.J_beta));
+    CHECK(std::abs(data.cond_J_beta - fixed.cond_J_beta) <= 1e-10 * fixed.cond_J_beta);
+    solve_dependent_accelerations(fixed_model, fixed, s, sdot, sddot, fixed_default);
+    generic::solve_dependent_accelerations(model, data, dynamic(s), g_sdot, g_sddot, generic_default);
+    REQUIRE(agree(g_sddot, dynamic(sddot)));
+    // The bias accelerations: every input acceleration zero (the fixed runtime reads the convective
+    // terms the previous call left in its data, at the same s and sdot).
+    Coordinates bias;
+    Eigen::VectorXd g_bias;
+    solve_bias_accelerations(fixed, bias, fixed_default);
+    generic::solve_bias_accelerations(model, data, dynamic(s), g_sdot, g_bias, generic_default);
+    REQUIRE(agree(g_bias, dynamic(bias)));
+    // The rate basis on the inputs that are not the pair's.
+    std::vector<int> commanded;
+    for (int k = 0; k < kInputCount; ++k)
+      if (std::find(fixed_default.index.begin(), fixed_default.index.end(), k) == fixed_default.index.end()) commanded.push_back(k);
+    const Eigen::MatrixXd T = generic::rate_basis(model, data, commanded, generic_default);
+    // s' = T u: the basis reproduces the velocity level's rates for those inputs' rates.
+    Eigen::VectorXd u(static_cast<Eigen::Index>(commanded.size()));
+    for (std::size_t c = 0; c < commanded.size(); ++c) u(static_cast<Eigen::Index>(c)) = g_sdot(commanded[c]);
+    CHECK(agree(T * u, g_sdot));
+    if constexpr (gen::kHasDynamics) {
+      const std::vector<int> dynamics_speeds(gen::kCommanded.begin(), gen::kCommanded.end());
+      const DependentPair dynamics_pair{gen::kPairs[static_cast<std::size_t>(gen::kDynamicsPair)].coordinates};
+      const generic::DependentPair g_dynamics_pair{std::vector<int>(dynamics_pair.index.begin(), dynamics_pair.index.end())};
+      Coordinates rates_fixed = sdot;
+      Eigen::VectorXd rates = dynamic(sdot);
+      if (error_of([&] { solve_dependent_rates(fixed_model, fixed, s, rates_fixed, dynamics_pair); }).empty()) {
+        generic::solve_dependent_rates(model, data, dynamic(s), rates, g_dynamics_pair);
+        const auto T_fixed = rate_basis(fixed, gen::kCommanded, dynamics_pair);
+        CHECK(agree(generic::rate_basis(model, data, dynamics_speeds, g_dynamics_pair), T_fixed));
+      }
+    }
+  }
+  if (kWheelCount > 0 || kLimbCount > 0) CHECK(compared > 10);
+  // Refusals of what does not fit the model.
+  Eigen::VectorXd s = generic::nominal_coordinates(model), sdot = Eigen::VectorXd::Zero(kCoordinateCount);
+  CHECK(error_of([&] { generic::solve_dependent_rates(model, data, s, sdot, generic::DependentPair{{0, 0, 0, 0, 0, 0, 0, 0, 0}}); })
+            .find("rates for the model's") != std::string::npos);
+  CHECK(error_of([&] { generic::condition_number(Eigen::MatrixXd::Zero(2, 3)); }).find("not square") != std::string::npos);
 }

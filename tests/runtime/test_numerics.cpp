@@ -188,7 +188,7 @@ void check_small_dense(std::mt19937& random) {
     const Eigen::PartialPivLU<Dense> eigen{Dense(A)};
     Eigen::Matrix<double, N, 2> B;
     B << b, 2 * b;
-    lu.template solve_in_place<2>(B);
+    lu.solve_in_place(B);
     const Column x_eigen = eigen.solve(Eigen::VectorXd(b)), xt_eigen = eigen.transpose().solve(Eigen::VectorXd(b));
     Column xt;
     lu.solve_transposed(b, xt);

@@ -16,8 +16,7 @@ namespace {
 
 using Json = nlohmann::json;
 
-// model.json is wlx-gen's: a bigger or deeper text is not one (the largest models' are under 1 MB).
-constexpr std::size_t kMaxTextBytes = 64u << 20;
+// model.json is wlx-gen's: a deeper text is not one.
 constexpr int kMaxDepth = 16;
 
 [[noreturn]] void fail(const std::string& what) { throw Error("model.json", what); }
@@ -86,23 +85,9 @@ int Description::frame_index(std::string_view name) const noexcept { return inde
 int Description::parameter_index(std::string_view name) const noexcept { return index_by_name(parameters, name); }
 int Description::limb_index(std::string_view name) const noexcept { return index_by_name(limbs, name); }
 
-Description read_description(std::string_view json_text) {
-  if (json_text.size() > kMaxTextBytes) fail(fmt::format("{} bytes, more than a description's {}", json_text.size(), kMaxTextBytes));
-  Json d;
-  try {
-    d = Json::parse(json_text, [](int depth, Json::parse_event_t, Json&) {
-      if (depth > kMaxDepth) throw Error("model.json", fmt::format("nested deeper than {} levels", kMaxDepth));
-      return true;
-    });
-  } catch (const Json::exception& e) {
-    fail(fmt::format("not JSON ({})", e.what()));
-  }
-  if (!d.is_object() || !d.contains("format") || d["format"] != "wlx model description 1")
-    fail("it is not a wlx model description of format 1 (regenerate the model with this wlx-gen)");
-  Description out;
-  out.model = text(d, "model", "model.json");
-  out.code_key = text(d, "code_key", "model.json");
+namespace {
 
+void read_parameters(const Json& d, Description& out) {
   for (const Json& p : list(d, "parameters", "model.json", kMaxParameters)) {
     Parameter parameter;
     parameter.name = text(p, "name", "parameters[]");
@@ -113,6 +98,9 @@ Description read_description(std::string_view json_text) {
     out.parameters.push_back(std::move(parameter));
   }
 
+}
+
+void read_coordinates(const Json& d, Description& out) {
   bool inputs_done = false;
   for (const Json& c : list(d, "coordinates", "model.json", kMaxCoordinates)) {
     Coordinate coordinate;
@@ -127,8 +115,10 @@ Description read_description(std::string_view json_text) {
     out.input_count += coordinate.input ? 1 : 0;
     out.coordinates.push_back(std::move(coordinate));
   }
-  const auto coordinate = [&](const std::string& name) { return out.coordinate_index(name); };
 
+}
+
+void read_frames_and_bodies(const Json& d, Description& out) {
   for (const Json& f : list(d, "frames", "model.json", kMaxFrames)) {
     Frame frame;
     frame.name = text(f, "name", "frames[]");
@@ -156,6 +146,10 @@ Description read_description(std::string_view json_text) {
     out.bodies.push_back(std::move(body));
   }
 
+}
+
+void read_limbs(const Json& d, Description& out) {
+  const auto coordinate = [&](const std::string& name) { return out.coordinate_index(name); };
   for (const Json& r : list(d, "closure", "model.json", kMaxCoordinates)) out.closure_rows.push_back(text(r, "name", "closure[]"));
   const auto row = [&](const std::string& name) {
     for (std::size_t k = 0; k < out.closure_rows.size(); ++k)
@@ -182,6 +176,59 @@ Description read_description(std::string_view json_text) {
     out.limbs.push_back(std::move(limb));
   }
 
+}
+
+void read_wheels_and_pairs(const Json& d, Description& out) {
+  const auto coordinate = [&](const std::string& name) { return out.coordinate_index(name); };
+  const auto axis = [](const std::string& name, const std::string& where) {
+    if (name == "x") return 0;
+    if (name == "y") return 1;
+    if (name == "z") return 2;
+    fail(fmt::format("{} is no axis (x, y or z)", where));
+  };
+  for (const Json& w : list(d, "wheels", "model.json", kMaxWheels)) {
+    Wheel wheel;
+    wheel.name = text(w, "name", "wheels[]");
+    const std::string where = "wheels." + wheel.name;
+    wheel.contact_frame = out.frame_index(text(w, "contact", where));
+    if (wheel.contact_frame < 0) fail(fmt::format("{}.contact is no frame", where));
+    const std::string hub = text(w, "hub", where);
+    if (!hub.empty()) {
+      wheel.hub_frame = out.frame_index(hub);
+      if (wheel.hub_frame < 0) fail(fmt::format("{}.hub is no frame", where));
+    }
+    wheel.radius = out.parameter_index(text(w, "radius", where));
+    if (wheel.radius < 0) fail(fmt::format("{}.radius is no parameter", where));
+    wheel.forward_axis = axis(text(w, "forward", where), where + ".forward");
+    wheel.lateral_axis = axis(text(w, "lateral", where), where + ".lateral");
+    wheel.axle_axis = axis(text(w, "axle", where), where + ".axle");
+    const std::string ground = text(w, "ground", where);
+    if (!ground.empty()) {
+      wheel.ground = out.coordinate_index(ground);
+      if (wheel.ground < 0) fail(fmt::format("{}.ground is no coordinate", where));
+    }
+    out.wheels.push_back(std::move(wheel));
+  }
+  const Json& pairs = member(d, "pairs", "model.json");
+  out.pair_candidates = indices(member(pairs, "candidates", "pairs"), "pairs.candidates", "coordinate", coordinate);
+  for (const Json& p : list(pairs, "named", "pairs", kMaxCoordinates)) {
+    Pair pair;
+    pair.name = text(p, "name", "pairs.named[]");
+    pair.coordinates = indices(member(p, "rates", "pairs." + pair.name), "pairs." + pair.name + ".rates", "coordinate", coordinate);
+    out.pairs.push_back(std::move(pair));
+  }
+  const Json& default_pair = member(pairs, "default", "pairs");
+  if (!default_pair.is_null()) {
+    if (!default_pair.is_string()) fail("pairs.default is not a pair's name");
+    out.default_pair = -1;
+    for (std::size_t k = 0; k < out.pairs.size(); ++k)
+      if (out.pairs[k].name == default_pair.get<std::string>()) out.default_pair = static_cast<int>(k);
+    if (out.default_pair < 0) fail(fmt::format("pairs.default: no pair '{}'", default_pair.get<std::string>()));
+  }
+
+}
+
+void read_settings(const Json& d, Description& out) {
   const Json& settings = member(d, "settings", "model.json");
   const auto n = static_cast<std::size_t>(out.coordinate_count());
   Settings& s = out.settings;
@@ -226,7 +273,141 @@ Description read_description(std::string_view json_text) {
       fail(fmt::format("settings.branches.{} is not a branch (a whole number from 0)", name));
     s.default_branch[static_cast<std::size_t>(l)] = static_cast<int>(value.get<std::int64_t>());
   }
+}
+
+}  // namespace
+
+Description read_description(std::string_view json_text) {
+  if (json_text.size() > kMaxDescriptionBytes)
+    fail(fmt::format("{} bytes, more than a description's {}", json_text.size(), kMaxDescriptionBytes));
+  Json d;
+  try {
+    d = Json::parse(json_text, [](int depth, Json::parse_event_t, Json&) {
+      if (depth > kMaxDepth) throw Error("model.json", fmt::format("nested deeper than {} levels", kMaxDepth));
+      return true;
+    });
+  } catch (const Json::exception& e) {
+    fail(fmt::format("not JSON ({})", e.what()));
+  }
+  if (!d.is_object() || !d.contains("format") || d["format"] != "wlx model description 1")
+    fail("it is not a wlx model description of format 1 (regenerate the model with this wlx-gen)");
+  Description out;
+  out.model = text(d, "model", "model.json");
+  out.code_key = text(d, "code_key", "model.json");
+
+  read_parameters(d, out);
+  read_coordinates(d, out);
+  read_frames_and_bodies(d, out);
+  read_limbs(d, out);
+  read_wheels_and_pairs(d, out);
+  read_settings(d, out);
+  validate(out);
   return out;
+}
+
+void validate(const Description& d) {
+  const auto bounded = [](const char* what, std::size_t n, int most) {
+    if (n > static_cast<std::size_t>(most)) fail(fmt::format("{} {}, more than the {} a model may have", n, what, most));
+  };
+  bounded("coordinates", d.coordinates.size(), kMaxCoordinates);
+  bounded("frames", d.frames.size(), kMaxFrames);
+  bounded("bodies", d.bodies.size(), kMaxFrames);
+  bounded("parameters", d.parameters.size(), kMaxParameters);
+  bounded("limbs", d.limbs.size(), kMaxLimbs);
+  bounded("closure rows", d.closure_rows.size(), kMaxCoordinates);
+  const auto unique = [](const char* what, const auto& items, const auto& name_of) {
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      if (name_of(items[i]).empty()) fail(fmt::format("{}[{}] has no name", what, i));
+      for (std::size_t j = 0; j < i; ++j)
+        if (name_of(items[i]) == name_of(items[j])) fail(fmt::format("{}: '{}' twice", what, name_of(items[i])));
+    }
+  };
+  const auto named = [](const auto& item) -> const std::string& { return item.name; };
+  unique("coordinates", d.coordinates, named);
+  unique("frames", d.frames, named);
+  unique("parameters", d.parameters, named);
+  unique("bodies", d.bodies, named);
+  unique("limbs", d.limbs, named);
+  unique("closure", d.closure_rows, [](const std::string& row) -> const std::string& { return row; });
+  const int n = d.coordinate_count();
+  int inputs = 0;
+  for (std::size_t k = 0; k < d.coordinates.size(); ++k) {
+    const Coordinate& c = d.coordinates[k];
+    if (c.unit != "m" && c.unit != "rad") fail(fmt::format("coordinates.{}: unit '{}', not m or rad", c.name, c.unit));
+    if (c.input && static_cast<int>(k) != inputs) fail(fmt::format("coordinates.{}: an input after a dependent coordinate (the inputs come first)", c.name));
+    inputs += c.input ? 1 : 0;
+  }
+  if (inputs != d.input_count) fail(fmt::format("{} inputs flagged, input_count {}", inputs, d.input_count));
+  const auto in_range = [](int k, std::size_t size) { return k >= 0 && static_cast<std::size_t>(k) < size; };
+  for (std::size_t f = 0; f < d.frames.size(); ++f)
+    if (d.frames[f].parent < -1 || d.frames[f].parent >= static_cast<int>(f))
+      fail(fmt::format("frames.{}: its parent is not a frame before it", d.frames[f].name));
+  for (const Body& b : d.bodies) {
+    if (!in_range(b.frame, d.frames.size())) fail(fmt::format("bodies.{}.frame is no frame", b.name));
+    if (!in_range(b.mass, d.parameters.size())) fail(fmt::format("bodies.{}.mass is no parameter", b.name));
+    for (int i : b.inertia)
+      if (!in_range(i, d.parameters.size())) fail(fmt::format("bodies.{}.inertia names no parameter", b.name));
+  }
+  for (const Limb& l : d.limbs) {
+    const std::string where = "limbs." + l.name;
+    if (l.joints.size() != l.rows.size())
+      fail(fmt::format("{}: {} joints against {} closure rows (a limb's block is square)", where, l.joints.size(), l.rows.size()));
+    if (l.joints.empty() || l.joints.size() > static_cast<std::size_t>(kMaxLimbSize))
+      fail(fmt::format("{}: {} joints; a limb has 1 to {}", where, l.joints.size(), kMaxLimbSize));
+    for (int j : l.joints)
+      if (!in_range(j, d.coordinates.size()) || d.coordinates[static_cast<std::size_t>(j)].input)
+        fail(fmt::format("{}.joints: not a dependent coordinate", where));
+    for (int r : l.rows)
+      if (!in_range(r, d.closure_rows.size())) fail(fmt::format("{}.closure: not a closure row", where));
+    if (l.inputs.size() > d.coordinates.size()) fail(fmt::format("{}.inputs: more than the model's coordinates", where));
+    for (int i : l.inputs)
+      if (!in_range(i, d.coordinates.size()) || !d.coordinates[static_cast<std::size_t>(i)].input)
+        fail(fmt::format("{}.inputs: not an input", where));
+  }
+  bounded("wheels", d.wheels.size(), kMaxWheels);
+  unique("wheels", d.wheels, named);
+  for (const Wheel& w : d.wheels) {
+    const std::string where = "wheels." + w.name;
+    if (!in_range(w.contact_frame, d.frames.size())) fail(fmt::format("{}.contact is no frame", where));
+    if (w.hub_frame != -1 && !in_range(w.hub_frame, d.frames.size())) fail(fmt::format("{}.hub is no frame", where));
+    if (!in_range(w.radius, d.parameters.size())) fail(fmt::format("{}.radius is no parameter", where));
+    for (int a : {w.forward_axis, w.lateral_axis, w.axle_axis})
+      if (a < 0 || a > 2) fail(fmt::format("{}: an axis that is not x, y or z", where));
+    if (w.ground != -1 && (!in_range(w.ground, d.coordinates.size()) || !d.coordinates[static_cast<std::size_t>(w.ground)].input))
+      fail(fmt::format("{}.ground is no input", where));
+  }
+  for (int k : d.pair_candidates)
+    if (!in_range(k, d.coordinates.size()) || !d.coordinates[static_cast<std::size_t>(k)].input)
+      fail("pairs.candidates: not an input");
+  if (d.pairs.empty()) fail("pairs.named: no pair (a model without wheels has one, of no rates)");
+  for (const Pair& p : d.pairs) {
+    if (p.coordinates.size() != d.wheels.size())
+      fail(fmt::format("pairs.{}: {} rates for {} wheels", p.name, p.coordinates.size(), d.wheels.size()));
+    for (int k : p.coordinates)
+      if (!in_range(k, d.coordinates.size()) || !d.coordinates[static_cast<std::size_t>(k)].input)
+        fail(fmt::format("pairs.{}: a rate that is not an input's", p.name));
+  }
+  if (!in_range(d.default_pair, d.pairs.size())) fail("pairs.default is no pair");
+  const Settings& s = d.settings;
+  const auto sized = [](const char* what, std::size_t size, std::size_t expected) {
+    if (size != expected) fail(fmt::format("settings.{}: {} values for {}", what, size, expected));
+  };
+  sized("nominal", s.nominal_inputs.size(), static_cast<std::size_t>(d.input_count));
+  sized("dependent_start", s.dependent_start.size(), static_cast<std::size_t>(n));
+  sized("limits (lower)", s.lower.size(), static_cast<std::size_t>(n));
+  sized("limits (upper)", s.upper.size(), static_cast<std::size_t>(n));
+  sized("limits (velocity)", s.velocity_limit.size(), static_cast<std::size_t>(n));
+  sized("branches", s.default_branch.size(), d.limbs.size());
+  for (std::size_t k = 0; k < s.nominal_inputs.size(); ++k)
+    if (!std::isfinite(s.nominal_inputs[k])) fail(fmt::format("settings.nominal.{} is not finite", d.coordinates[k].name));
+  for (std::size_t k = 0; k < s.dependent_start.size(); ++k)
+    if (!std::isfinite(s.dependent_start[k])) fail(fmt::format("settings.dependent_start.{} is not finite", d.coordinates[k].name));
+  for (std::size_t k = 0; k < s.lower.size(); ++k)
+    if (!(s.lower[k] <= s.upper[k]) || std::isnan(s.velocity_limit[k]) || s.velocity_limit[k] < 0)
+      fail(fmt::format("settings.limits.{}: not a range (lower {}, upper {}, velocity {})", d.coordinates[k].name, s.lower[k],
+                       s.upper[k], s.velocity_limit[k]));
+  for (std::size_t l = 0; l < s.default_branch.size(); ++l)
+    if (s.default_branch[l] < -1) fail(fmt::format("settings.branches.{} is not a branch", d.limbs[l].name));
 }
 
 }  // namespace wlx::generic

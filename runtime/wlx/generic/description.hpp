@@ -7,6 +7,7 @@
 #include "wlx/parameter_checks.hpp"
 
 #include <array>
+#include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,6 +22,7 @@ inline constexpr int kMaxFrames = 1024;
 inline constexpr int kMaxParameters = 16384;
 inline constexpr int kMaxLimbs = 64;
 inline constexpr int kMaxLimbSize = 8;  // the limb steps are compiled for sizes 1 to 8
+inline constexpr int kMaxWheels = 64;
 
 struct Coordinate {
   std::string name;
@@ -55,6 +57,21 @@ struct Limb {
   std::vector<int> inputs;   // the input coordinates those rows read
 };
 
+struct Wheel {
+  std::string name;
+  int contact_frame = -1;  // the frame at its contact point
+  int hub_frame = -1;      // -1: none (the contact frame's own turn is the wheel's)
+  int radius = -1;         // parameter index
+  int forward_axis = 0, lateral_axis = 1, axle_axis = 1;  // 0 x, 1 y, 2 z: of the contact frame (axle: of the hub)
+  int ground = -1;         // the input its ground level is, or -1
+};
+
+// A choice of the input rates the wheels' rolling determines, one per wheel.
+struct Pair {
+  std::string name;
+  std::vector<int> coordinates;  // the rates' coordinates, one per wheel
+};
+
 // The model file's numbers that no generated function holds (model.json's settings).
 struct Settings {
   std::vector<double> nominal_inputs;   // per input
@@ -74,6 +91,10 @@ struct Description {
   std::vector<Body> bodies;
   std::vector<Limb> limbs;
   std::vector<std::string> closure_rows;
+  std::vector<Wheel> wheels;
+  std::vector<int> pair_candidates;  // the inputs whose rates may be a pair's
+  std::vector<Pair> pairs;           // the named choices (one, of no rates, without wheels)
+  int default_pair = 0;
   Settings settings;
 
   int coordinate_count() const noexcept { return static_cast<int>(coordinates.size()); }
@@ -84,10 +105,20 @@ struct Description {
   int frame_index(std::string_view name) const noexcept;
   int parameter_index(std::string_view name) const noexcept;
   int limb_index(std::string_view name) const noexcept;
+  int wheel_count() const noexcept { return static_cast<int>(wheels.size()); }
 };
 
-// Reads model.json's text. Throws wlx::Error (field "model.json") naming what is missing or wrong
-// and where: a description of another format, or one whose parts do not fit together.
+// Reads model.json's text (at most kMaxDescriptionBytes). Throws wlx::Error (field "model.json")
+// naming what is missing or wrong and where: a description of another format, or one whose parts
+// do not fit together (validate).
+inline constexpr std::size_t kMaxDescriptionBytes = std::size_t{4} << 20;  // the largest models' are under 1 MB
 Description read_description(std::string_view json_text);
+
+// Throws wlx::Error (field "model.json") unless every part fits: sizes within the bounds above,
+// unique names, units "m" or "rad", the inputs first, every index in range (a frame's parent
+// before it, a body's frame and parameters, a limb's joints dependent, its inputs inputs, its rows
+// closure rows, as many rows as joints), every setting sized to what it is for, ranges ordered. A
+// Model validates its description so (one made in code too).
+void validate(const Description& description);
 
 }  // namespace wlx::generic

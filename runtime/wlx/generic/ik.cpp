@@ -229,15 +229,27 @@ NewtonReport solve_limb_newton(const Model& model, Data& data, int limb, Eigen::
   return with_problem(model, data, [&](auto& p) { return report_of(p, ik_algorithms::newton(p, active, s, options)); });
 }
 
-bool within_range(const Model& model, const Eigen::VectorXd& s, int k) noexcept {
+namespace {
+void check_coordinate(const Model& model, int k) {
+  if (k < 0 || k >= model.description().coordinate_count())
+    throw Error("coordinate", fmt::format("no coordinate {} (the model has {})", k, model.description().coordinate_count()));
+}
+}  // namespace
+
+bool within_range(const Model& model, const Eigen::VectorXd& s, int k) {
+  check_size(model, s);
+  check_coordinate(model, k);
   return ik_algorithms::within_range(Ranges{model.description()}, s, k);
 }
 
-int first_outside_limits(const Model& model, const Eigen::VectorXd& s) noexcept {
+int first_outside_limits(const Model& model, const Eigen::VectorXd& s) {
+  check_size(model, s);
   return ik_algorithms::first_outside_limits(Ranges{model.description()}, s);
 }
 
 std::string describe_outside_limits(const Model& model, const Eigen::VectorXd& s, int k) {
+  check_size(model, s);
+  check_coordinate(model, k);
   return ik_algorithms::describe_outside_limits(Ranges{model.description()}, s, k);
 }
 

@@ -42,8 +42,9 @@ NewtonReport solve_newton_limbs(const Model& model, Data& data, const std::vecto
                                 const NewtonOptions& options = {});
 NewtonReport solve_limb_newton(const Model& model, Data& data, int limb, Eigen::VectorXd& s, const NewtonOptions& options = {});
 
-bool within_range(const Model& model, const Eigen::VectorXd& s, int k) noexcept;
-int first_outside_limits(const Model& model, const Eigen::VectorXd& s) noexcept;
+// The joints' ranges (wlx/ik.hpp). wlx::Error for an s of another size or a k out of range.
+bool within_range(const Model& model, const Eigen::VectorXd& s, int k);
+int first_outside_limits(const Model& model, const Eigen::VectorXd& s);
 std::string describe_outside_limits(const Model& model, const Eigen::VectorXd& s, int k);
 
 }  // namespace wlx::generic

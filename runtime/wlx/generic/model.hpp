@@ -10,6 +10,7 @@
 
 #include "wlx/generic/description.hpp"
 #include "wlx/model_code.hpp"
+#include "wlx/small_dense.hpp"
 
 #include <Eigen/Core>
 
@@ -65,16 +66,29 @@ class Data {
   Eigen::Map<const Eigen::Matrix3Xd> frame_positions;  // 3 x frames
   Eigen::Map<const Eigen::VectorXd> Phi;                // closure rows
   Eigen::Map<const Eigen::MatrixXd> dPhi_ds;            // closure rows x coordinates
-  // Frame k's orientation in K0 (columns: its axes).
-  Eigen::Map<const Eigen::Matrix3d> frame_rotation(int k) const noexcept {
-    return Eigen::Map<const Eigen::Matrix3d>(arrays_.frame_rotations + 9 * k);
-  }
+  // Frame k's orientation in K0 (columns: its axes); wlx::Error for a k that is no frame.
+  Eigen::Map<const Eigen::Matrix3d> frame_rotation(int k) const;
+
+  // The rolling rows and the convective terms after the algorithms that fill them (nonholonomic.hpp).
+  Eigen::Map<const Eigen::MatrixXd> C;                  // wheels x coordinates
+  Eigen::Map<const Eigen::MatrixXd> spin;               // wheels x coordinates
+  Eigen::Map<const Eigen::VectorXd> dPhi_ds_dot_sdot;   // closure rows
+  Eigen::Map<const Eigen::VectorXd> C_dot_sdot;         // wheels
+  // The dependent rates' factorizations (nonholonomic.hpp): the adjoint Lambda = Phi_dep^-T C_dep^T,
+  // J_beta (one row and column per wheel), its LU factorization and condition number, and the
+  // inverses of the limbs' blocks of dPhi/ds (each the largest limb's size, padded with a unit diagonal).
+  Eigen::MatrixXd wheel_adjoint;
+  Eigen::MatrixXd J_beta;
+  small::PartialPivotLu<Eigen::Dynamic> J_beta_lu;
+  double cond_J_beta = 0;
+  std::vector<double> limb_inverses;  // limbs x (size x size), column-major
 
   // For the algorithms: the workspace with `model`'s parameters loaded, and s given to it.
   void* workspace(const Model& model);
   const ModelCodeArrays& arrays() const noexcept { return arrays_; }
   void set_coordinates(const Eigen::Ref<const Eigen::VectorXd>& s) noexcept;
   void get_coordinates(Eigen::Ref<Eigen::VectorXd> s) const noexcept;
+  void set_rates(const Eigen::Ref<const Eigen::VectorXd>& sdot) noexcept;
 
 };
 
