@@ -33,6 +33,7 @@ class FixedRates {
   static constexpr int kInputs = kInputCount;
 
   explicit FixedRates(D& data) : data_(data) {}
+  int limb_size() const { return gen::kMaxLimbSize; }
   int wheel_count() const { return kWheelCount; }
   int closure_rows() const { return gen::kClosureCount; }
   int input_count() const { return kInputCount; }

@@ -2,7 +2,8 @@
 // both runtimes: the model's own at its fixed sizes and the one compiled once for every model, at
 // run-time sizes (wlx/generic/nonholonomic.hpp). They see the model through a problem P:
 //
-//   static constexpr int kLimbSize;          the largest limb's size: the limb blocks' fixed size
+//   static constexpr int kLimbSize;          the limb blocks' size at compile time (or Eigen::Dynamic)
+//   int limb_size() const;                   the largest limb's size: the limb blocks' size
 //   static constexpr int kWheels, kClosureRows, kInputs;   the sizes at compile time (or Eigen::Dynamic)
 //   int wheel_count() const;  int closure_rows() const;  int input_count() const;
 //   void for_each_limb(F f) const;           f(limb, IkLimb) for every limb; the model's own runtime
@@ -74,8 +75,9 @@ void reduce(const P& p) {
   auto& d = p.data();
   const int wheels = p.wheel_count();
   p.for_each_limb([&](auto limb, const IkLimb& b) {
-    LimbMatrix<N> block = LimbMatrix<N>::Identity();
-    Eigen::Matrix<double, N, P::kWheels> rhs = Eigen::Matrix<double, N, P::kWheels>::Zero(N, wheels);
+    const int n = p.limb_size();
+    LimbMatrix<N> block = LimbMatrix<N>::Identity(n, n);
+    Eigen::Matrix<double, N, P::kWheels> rhs = Eigen::Matrix<double, N, P::kWheels>::Zero(n, wheels);
     for (int j = 0; j < b.size; ++j) {
       const int joint = b.joints[j];
       for (int i = 0; i < b.size; ++i) block(i, j) = d.dPhi_ds(b.rows[i], joint);
@@ -109,7 +111,7 @@ template <class P, class Closure, class Vector>
 void solve_closure(const P& p, const Closure& v, Vector& out) {
   constexpr int N = P::kLimbSize;
   p.for_each_limb([&](auto limb, const IkLimb& b) {
-    LimbVector<N> rhs = LimbVector<N>::Zero();
+    LimbVector<N> rhs = LimbVector<N>::Zero(p.limb_size());
     for (int i = 0; i < b.size; ++i) rhs(i) = -v(b.rows[i]);
     const LimbVector<N> x = p.limb_inverse(limb) * rhs;
     for (int j = 0; j < b.size; ++j) out(b.joints[j]) = x(j);
@@ -254,7 +256,7 @@ void rate_basis(const P& p, const Commanded& commanded, const Pair& pair, Basis&
     for (int w = 0; w < wheels; ++w)
       rhs.noalias() += d.dPhi_ds.col(pair.index[static_cast<std::size_t>(w)]).lazyProduct(pair_rates.row(w));
   p.for_each_limb([&](auto limb, const IkLimb& b) {
-    Eigen::Matrix<double, N, kU> block_rhs = Eigen::Matrix<double, N, kU>::Zero(N, u_count);
+    Eigen::Matrix<double, N, kU> block_rhs = Eigen::Matrix<double, N, kU>::Zero(p.limb_size(), u_count);
     for (int i = 0; i < b.size; ++i) block_rhs.row(i) = -rhs.row(b.rows[i]);
     const Eigen::Matrix<double, N, kU> x = p.limb_inverse(limb).lazyProduct(block_rhs);
     for (int j = 0; j < b.size; ++j) T.row(b.joints[j]) = x.row(j);

@@ -3,9 +3,10 @@
 // the model's own runtime (wlx/model.hpp) and in Pinocchio, Model is immutable (validated
 // parameters) and Data is the workspace the algorithms write into, made once per thread.
 //
-// Sizes are the model's, known at run time: the algorithms here are the same as the model's own
-// runtime's where they share a source (wlx/ik_algorithms.hpp), and their results are the same to
-// the last bit (the same generated code runs, on the same numbers).
+// Sizes are the model's, known at run time. The algorithms are the model's own runtime's, written
+// once for both (wlx/ik_algorithms.hpp, wlx/rate_algorithms.hpp), on the same generated code: the
+// kinematics and the IK give the same results to the last bit, the dependent rates the same to
+// rounding (Eigen orders a product's inner sum differently at fixed and at run-time sizes).
 #pragma once
 
 #include "wlx/generic/description.hpp"

@@ -26,17 +26,19 @@ std::string wheel_hint(const Description& d) {
                      nominal.empty() ? "" : "; the model's nominal pose has " + nominal);
 }
 
-// The model as the dependent rates' algorithms see it (wlx/rate_algorithms.hpp), N its largest
-// limb's size.
-template <int N>
+// The model as the dependent rates' algorithms see it (wlx/rate_algorithms.hpp). At run-time sizes
+// throughout, the limb blocks too: one instantiation for every model (the limb blocks' inverses are
+// Eigen's LU then, where the model's own runtime inverts at its fixed size in closed form: the
+// results agree to rounding, as every product's sum in another order does).
 class GenericRates {
  public:
-  static constexpr int kLimbSize = N;
+  static constexpr int kLimbSize = Eigen::Dynamic;
   static constexpr int kWheels = Eigen::Dynamic;
   static constexpr int kClosureRows = Eigen::Dynamic;
   static constexpr int kInputs = Eigen::Dynamic;
 
-  GenericRates(const Model& model, Data& data) : d_(model.description()), data_(data) {}
+  GenericRates(const Model& model, Data& data) : d_(model.description()), data_(data), limb_size_(d_.max_limb_size()) {}
+  int limb_size() const { return limb_size_; }
   int wheel_count() const { return d_.wheel_count(); }
   int closure_rows() const { return static_cast<int>(d_.closure_rows.size()); }
   int input_count() const { return d_.input_count; }
@@ -48,8 +50,9 @@ class GenericRates {
       f(l, IkLimb{static_cast<int>(b.joints.size()), b.rows.data(), b.joints.data(), static_cast<int>(b.inputs.size()), b.inputs.data()});
     }
   }
-  Eigen::Map<Eigen::Matrix<double, N, N>> limb_inverse(int l) const {
-    return Eigen::Map<Eigen::Matrix<double, N, N>>(data_.limb_inverses.data() + static_cast<std::ptrdiff_t>(l) * N * N);
+  Eigen::Map<Eigen::MatrixXd> limb_inverse(int l) const {
+    return Eigen::Map<Eigen::MatrixXd>(data_.limb_inverses.data() + static_cast<std::ptrdiff_t>(l) * limb_size_ * limb_size_, limb_size_,
+                                       limb_size_);
   }
   std::string_view coordinate_name(int k) const { return d_.coordinates[static_cast<std::size_t>(k)].name; }
   std::string_view limb_title(int l) const { return d_.limbs[static_cast<std::size_t>(l)].title; }
@@ -58,6 +61,7 @@ class GenericRates {
  private:
   const Description& d_;
   Data& data_;
+  int limb_size_;
 };
 
 // The model's pairs as the algorithms see them.
@@ -70,26 +74,10 @@ struct Pairs {
   const std::vector<Pair>& pairs() const { return d.pairs; }
 };
 
-// Calls f(GenericRates<N>&) with N the model's largest limb's size (as generic/ik.cpp does).
 template <class F>
 decltype(auto) with_rates(const Model& model, Data& data, F&& f) {
-  static_assert(kMaxLimbSize == 8, "a case per limb size below");
-  const auto at = [&]<int N>(std::integral_constant<int, N>) -> decltype(auto) {
-    GenericRates<N> p(model, data);
-    return f(p);
-  };
-  switch (model.description().max_limb_size()) {
-    case 1: return at(std::integral_constant<int, 1>{});
-    case 2: return at(std::integral_constant<int, 2>{});
-    case 3: return at(std::integral_constant<int, 3>{});
-    case 4: return at(std::integral_constant<int, 4>{});
-    case 5: return at(std::integral_constant<int, 5>{});
-    case 6: return at(std::integral_constant<int, 6>{});
-    case 7: return at(std::integral_constant<int, 7>{});
-    case 8: return at(std::integral_constant<int, 8>{});
-    default: break;
-  }
-  throw Error("limbs", fmt::format("a limb of {} joints; this runtime solves limbs of 1 to {}", model.description().max_limb_size(), kMaxLimbSize));
+  GenericRates p(model, data);
+  return f(p);
 }
 
 void check_sizes(const Model& model, const Eigen::VectorXd& s, const char* name) {
