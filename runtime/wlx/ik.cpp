@@ -13,29 +13,33 @@ namespace {
 const gen::LimbInfo& info(Limb limb) { return gen::kLimbs[static_cast<std::size_t>(limb)]; }
 const gen::ClosedFormInfo& closed_form(Limb limb) { return gen::kClosedForm[static_cast<std::size_t>(limb)]; }
 
+// The joints' ranges and Newton's start values alone, as the algorithms' range checks see them.
+struct FixedRanges {
+  using Vector = Coordinates;
+  int coordinate_count() const { return kCoordinateCount; }
+  int input_count() const { return kInputCount; }
+  std::string_view coordinate_name(int k) const { return gen::kCoordinateNames[static_cast<std::size_t>(k)]; }
+  double lower(int k) const { return settings().lower[static_cast<std::size_t>(k)]; }
+  double upper(int k) const { return settings().upper[static_cast<std::size_t>(k)]; }
+  double dependent_start(int k) const { return settings().dependent_start[static_cast<std::size_t>(k - kInputCount)]; }
+};
+
 // The model as the IK's algorithms see it (wlx/ik_algorithms.hpp): its tables, its settings, the
 // generated closed forms and closure, on a Data given or made when Newton's method first needs one.
-class FixedIk {
+class FixedIk : public FixedRanges {
  public:
-  using Vector = Coordinates;
   static constexpr int kLimbSize = gen::kMaxLimbSize;
   static constexpr int kLimbCapacity = kLimbCount;
 
   explicit FixedIk(const Model& model, Data* data = nullptr) : model_(&model), data_(data) {}
 
   int limb_count() const { return kLimbCount; }
-  int coordinate_count() const { return kCoordinateCount; }
-  int input_count() const { return kInputCount; }
   IkLimb limb(int l) const {
     const gen::LimbInfo& b = info(l);
     return {b.size, b.rows.data(), b.joints.data(), b.input_count, b.inputs.data()};
   }
   std::string_view limb_title(int l) const { return info(l).title; }
-  std::string_view coordinate_name(int k) const { return gen::kCoordinateNames[static_cast<std::size_t>(k)]; }
   std::string_view coordinate_unit(int k) const { return gen::kCoordinateUnits[static_cast<std::size_t>(k)]; }
-  double lower(int k) const { return settings().lower[static_cast<std::size_t>(k)]; }
-  double upper(int k) const { return settings().upper[static_cast<std::size_t>(k)]; }
-  double dependent_start(int k) const { return settings().dependent_start[static_cast<std::size_t>(k - kInputCount)]; }
   int default_branch(int l) const { return settings().default_branch[static_cast<std::size_t>(l)]; }
   bool has_closed_form(int l) const { return closed_form(l).solve != nullptr; }
   int closed_form_branches(int l) const { return closed_form(l).branches; }
@@ -71,16 +75,6 @@ class FixedIk {
   std::optional<Data> own_;
 };
 
-// The joints' ranges and Newton's start values alone, as the algorithms' range checks see them.
-struct FixedRanges {
-  using Vector = Coordinates;
-  int coordinate_count() const { return kCoordinateCount; }
-  int input_count() const { return kInputCount; }
-  std::string_view coordinate_name(int k) const { return gen::kCoordinateNames[static_cast<std::size_t>(k)]; }
-  double lower(int k) const { return settings().lower[static_cast<std::size_t>(k)]; }
-  double upper(int k) const { return settings().upper[static_cast<std::size_t>(k)]; }
-  double dependent_start(int k) const { return settings().dependent_start[static_cast<std::size_t>(k - kInputCount)]; }
-};
 
 }  // namespace
 

@@ -66,6 +66,18 @@ std::vector<int> indices(const Json& names, const std::string& where, const char
   return out;
 }
 
+// The index `lookup` gives the name at object[key], refused as "<where>.<key> is no <what>"; an
+// empty name is -1 where `optional`.
+template <class Lookup>
+int named_index(const Json& object, const char* key, const std::string& where, const char* what, Lookup lookup,
+                bool optional = false) {
+  const std::string name = text(object, key, where);
+  if (optional && name.empty()) return -1;
+  const int k = lookup(name);
+  if (k < 0) fail(fmt::format("{}.{} is no {}", where, key, what));
+  return k;
+}
+
 template <class T>
 int index_by_name(const std::vector<T>& items, std::string_view name) noexcept {
   for (std::size_t k = 0; k < items.size(); ++k)
@@ -119,6 +131,8 @@ void read_coordinates(const Json& d, Description& out) {
 }
 
 void read_frames_and_bodies(const Json& d, Description& out) {
+  const auto frame_named = [&](const std::string& name) { return out.frame_index(name); };
+  const auto parameter_named = [&](const std::string& name) { return out.parameter_index(name); };
   for (const Json& f : list(d, "frames", "model.json", kMaxFrames)) {
     Frame frame;
     frame.name = text(f, "name", "frames[]");
@@ -135,12 +149,10 @@ void read_frames_and_bodies(const Json& d, Description& out) {
     Body body;
     body.name = text(b, "name", "bodies[]");
     const std::string where = "bodies." + body.name;
-    body.frame = out.frame_index(text(b, "frame", where));
-    if (body.frame < 0) fail(fmt::format("{}.frame is no frame", where));
-    body.mass = out.parameter_index(text(b, "mass", where));
-    if (body.mass < 0) fail(fmt::format("{}.mass is no parameter", where));
+    body.frame = named_index(b, "frame", where, "frame", frame_named);
+    body.mass = named_index(b, "mass", where, "parameter", parameter_named);
     const std::vector<int> inertia =
-        indices(member(b, "inertia", where), where + ".inertia", "parameter", [&](const std::string& n) { return out.parameter_index(n); });
+        indices(member(b, "inertia", where), where + ".inertia", "parameter", parameter_named);
     if (inertia.size() != 3) fail(fmt::format("{}.inertia does not name three parameters", where));
     std::copy(inertia.begin(), inertia.end(), body.inertia.begin());
     out.bodies.push_back(std::move(body));
@@ -179,6 +191,8 @@ void read_limbs(const Json& d, Description& out) {
 }
 
 void read_wheels_and_pairs(const Json& d, Description& out) {
+  const auto frame_named = [&](const std::string& name) { return out.frame_index(name); };
+  const auto parameter_named = [&](const std::string& name) { return out.parameter_index(name); };
   const auto coordinate = [&](const std::string& name) { return out.coordinate_index(name); };
   const auto axis = [](const std::string& name, const std::string& where) {
     if (name == "x") return 0;
@@ -190,23 +204,13 @@ void read_wheels_and_pairs(const Json& d, Description& out) {
     Wheel wheel;
     wheel.name = text(w, "name", "wheels[]");
     const std::string where = "wheels." + wheel.name;
-    wheel.contact_frame = out.frame_index(text(w, "contact", where));
-    if (wheel.contact_frame < 0) fail(fmt::format("{}.contact is no frame", where));
-    const std::string hub = text(w, "hub", where);
-    if (!hub.empty()) {
-      wheel.hub_frame = out.frame_index(hub);
-      if (wheel.hub_frame < 0) fail(fmt::format("{}.hub is no frame", where));
-    }
-    wheel.radius = out.parameter_index(text(w, "radius", where));
-    if (wheel.radius < 0) fail(fmt::format("{}.radius is no parameter", where));
+    wheel.contact_frame = named_index(w, "contact", where, "frame", frame_named);
+    wheel.hub_frame = named_index(w, "hub", where, "frame", frame_named, true);
+    wheel.radius = named_index(w, "radius", where, "parameter", parameter_named);
     wheel.forward_axis = axis(text(w, "forward", where), where + ".forward");
     wheel.lateral_axis = axis(text(w, "lateral", where), where + ".lateral");
     wheel.axle_axis = axis(text(w, "axle", where), where + ".axle");
-    const std::string ground = text(w, "ground", where);
-    if (!ground.empty()) {
-      wheel.ground = out.coordinate_index(ground);
-      if (wheel.ground < 0) fail(fmt::format("{}.ground is no coordinate", where));
-    }
+    wheel.ground = named_index(w, "ground", where, "coordinate", coordinate, true);
     out.wheels.push_back(std::move(wheel));
   }
   const Json& pairs = member(d, "pairs", "model.json");

@@ -12,30 +12,35 @@ namespace wlx::generic {
 
 namespace {
 
+// The joints' ranges alone, as the algorithms' range checks see them.
+struct Ranges {
+  using Vector = Eigen::VectorXd;
+  const Description& d;
+  int coordinate_count() const { return d.coordinate_count(); }
+  std::string_view coordinate_name(int k) const { return d.coordinates[static_cast<std::size_t>(k)].name; }
+  double lower(int k) const { return d.settings.lower[static_cast<std::size_t>(k)]; }
+  double upper(int k) const { return d.settings.upper[static_cast<std::size_t>(k)]; }
+};
+
 // The model as the IK's algorithms see it (wlx/ik_algorithms.hpp), N its largest limb's size: its
 // description, and its code on data's workspace.
 template <int N>
-class GenericIk {
+class GenericIk : public Ranges {
  public:
-  using Vector = Eigen::VectorXd;
   static constexpr int kLimbSize = N;
   static constexpr int kLimbCapacity = kMaxLimbs;
 
   GenericIk(const Model& model, Data& data)
-      : d_(model.description()), code_(model.code()), data_(data), workspace_(data.workspace(model)) {}
+      : Ranges{model.description()}, d_(model.description()), code_(model.code()), data_(data), workspace_(data.workspace(model)) {}
 
   int limb_count() const { return static_cast<int>(d_.limbs.size()); }
-  int coordinate_count() const { return d_.coordinate_count(); }
   int input_count() const { return d_.input_count; }
   IkLimb limb(int l) const {
     const Limb& b = d_.limbs[static_cast<std::size_t>(l)];
     return {static_cast<int>(b.joints.size()), b.rows.data(), b.joints.data(), static_cast<int>(b.inputs.size()), b.inputs.data()};
   }
   std::string_view limb_title(int l) const { return d_.limbs[static_cast<std::size_t>(l)].title; }
-  std::string_view coordinate_name(int k) const { return d_.coordinates[static_cast<std::size_t>(k)].name; }
   std::string_view coordinate_unit(int k) const { return d_.coordinates[static_cast<std::size_t>(k)].unit; }
-  double lower(int k) const { return d_.settings.lower[static_cast<std::size_t>(k)]; }
-  double upper(int k) const { return d_.settings.upper[static_cast<std::size_t>(k)]; }
   double dependent_start(int k) const { return d_.settings.dependent_start[static_cast<std::size_t>(k)]; }
   int default_branch(int l) const { return d_.settings.default_branch[static_cast<std::size_t>(l)]; }
   bool has_closed_form(int l) const { return code_.closed_forms[l].exists; }
@@ -128,25 +133,12 @@ NewtonReport report_of(const P& p, const ik_algorithms::NewtonProgress<P>& progr
   return report;
 }
 
-// The joints' ranges alone, as the algorithms' range checks see them.
-struct Ranges {
-  using Vector = Eigen::VectorXd;
-  const Description& d;
-  int coordinate_count() const { return d.coordinate_count(); }
-  std::string_view coordinate_name(int k) const { return d.coordinates[static_cast<std::size_t>(k)].name; }
-  double lower(int k) const { return d.settings.lower[static_cast<std::size_t>(k)]; }
-  double upper(int k) const { return d.settings.upper[static_cast<std::size_t>(k)]; }
-};
 
 void check_limb(const Model& model, int limb) {
   if (limb < 0 || limb >= static_cast<int>(model.description().limbs.size()))
     throw Error("limb", fmt::format("no limb {} (the model has {})", limb, model.description().limbs.size()));
 }
 
-void check_size(const Model& model, const Eigen::VectorXd& s) {
-  if (s.size() != model.description().coordinate_count())
-    throw Error("s", fmt::format("{} values for the model's {} coordinates", s.size(), model.description().coordinate_count()));
-}
 
 }  // namespace
 
@@ -169,14 +161,14 @@ Eigen::VectorXd nominal_coordinates(const Model& model) {
 }
 
 Eigen::VectorXd dependent_start(const Model& model, Eigen::VectorXd s) {
-  check_size(model, s);
+  check_coordinate_count(model, s);
   const Description& d = model.description();
   for (int k = d.input_count; k < d.coordinate_count(); ++k) s(k) = d.settings.dependent_start[static_cast<std::size_t>(k)];
   return s;
 }
 
 Branches resolve_branches(const Model& model, Data& data, const Eigen::VectorXd& s, const Branches& requested, std::vector<bool>* outside) {
-  check_size(model, s);
+  check_coordinate_count(model, s);
   BranchArray chosen = branch_array(model, requested);
   Flags leaves{};
   with_problem(model, data, [&](auto& p) { ik_algorithms::resolve_branches(p, s, chosen, outside != nullptr ? &leaves : nullptr); });
@@ -187,13 +179,13 @@ Branches resolve_branches(const Model& model, Data& data, const Eigen::VectorXd&
 
 void solve_limb_closed_form(const Model& model, Data& data, int limb, int branch, Eigen::VectorXd& s) {
   check_limb(model, limb);
-  check_size(model, s);
+  check_coordinate_count(model, s);
   with_problem(model, data, [&](auto& p) { ik_algorithms::solve_limb_closed_form(p, limb, branch, s); });
 }
 
 void solve_ik_closed_form(const Model& model, Data& data, Eigen::VectorXd& s, const Branches& branches, NewtonReport* newton,
                           const NewtonOptions* newton_options) {
-  check_size(model, s);
+  check_coordinate_count(model, s);
   const BranchArray chosen = branch_array(model, branches);
   with_problem(model, data, [&](auto& p) {
     const auto progress = ik_algorithms::solve_ik_closed_form(p, s, chosen, newton_options);
@@ -203,19 +195,19 @@ void solve_ik_closed_form(const Model& model, Data& data, Eigen::VectorXd& s, co
 
 int classify_branch(const Model& model, Data& data, int limb, const Eigen::VectorXd& s) {
   check_limb(model, limb);
-  check_size(model, s);
+  check_coordinate_count(model, s);
   return with_problem(model, data, [&](auto& p) { return ik_algorithms::classify_branch(p, limb, s); });
 }
 
 NewtonReport solve_newton_limbs(const Model& model, Data& data, const std::vector<bool>& limbs, Eigen::VectorXd& s,
                                 const NewtonOptions& options) {
-  check_size(model, s);
+  check_coordinate_count(model, s);
   const Flags active = flags(model, limbs);
   return with_problem(model, data, [&](auto& p) { return report_of(p, ik_algorithms::solve_newton_limbs(p, active, s, options)); });
 }
 
 NewtonReport solve_ik_newton(const Model& model, Data& data, Eigen::VectorXd& s, const NewtonOptions& options) {
-  check_size(model, s);
+  check_coordinate_count(model, s);
   Flags all{};
   std::fill(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(model.description().limbs.size()), true);
   return with_problem(model, data, [&](auto& p) { return report_of(p, ik_algorithms::newton(p, all, s, options)); });
@@ -223,7 +215,7 @@ NewtonReport solve_ik_newton(const Model& model, Data& data, Eigen::VectorXd& s,
 
 NewtonReport solve_limb_newton(const Model& model, Data& data, int limb, Eigen::VectorXd& s, const NewtonOptions& options) {
   check_limb(model, limb);
-  check_size(model, s);
+  check_coordinate_count(model, s);
   Flags active{};
   active[static_cast<std::size_t>(limb)] = true;
   return with_problem(model, data, [&](auto& p) { return report_of(p, ik_algorithms::newton(p, active, s, options)); });
@@ -237,18 +229,18 @@ void check_coordinate(const Model& model, int k) {
 }  // namespace
 
 bool within_range(const Model& model, const Eigen::VectorXd& s, int k) {
-  check_size(model, s);
+  check_coordinate_count(model, s);
   check_coordinate(model, k);
   return ik_algorithms::within_range(Ranges{model.description()}, s, k);
 }
 
 int first_outside_limits(const Model& model, const Eigen::VectorXd& s) {
-  check_size(model, s);
+  check_coordinate_count(model, s);
   return ik_algorithms::first_outside_limits(Ranges{model.description()}, s);
 }
 
 std::string describe_outside_limits(const Model& model, const Eigen::VectorXd& s, int k) {
-  check_size(model, s);
+  check_coordinate_count(model, s);
   check_coordinate(model, k);
   return ik_algorithms::describe_outside_limits(Ranges{model.description()}, s, k);
 }

@@ -95,6 +95,11 @@ Model::Model(std::shared_ptr<const Description> description, const ModelCode& co
   }
 }
 
+void check_coordinate_count(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& values, const char* name) {
+  if (values.size() != model.description().coordinate_count())
+    throw Error(name, fmt::format("{} values for the model's {} coordinates", values.size(), model.description().coordinate_count()));
+}
+
 Data::Data(const Model& model)
     : code_(&model.code()),
       workspace_(model.code().create_workspace()),

@@ -21,6 +21,10 @@
 
 namespace wlx::generic {
 
+class Model;
+// Throws wlx::Error naming `name` unless `values` has one entry per coordinate of the model.
+void check_coordinate_count(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& values, const char* name = "s");
+
 class Model {
  public:
   // The description with its code. Throws wlx::Error when they do not belong together (another

@@ -80,10 +80,6 @@ decltype(auto) with_rates(const Model& model, Data& data, F&& f) {
   return f(p);
 }
 
-void check_sizes(const Model& model, const Eigen::VectorXd& s, const char* name) {
-  if (s.size() != model.description().coordinate_count())
-    throw Error(name, fmt::format("{} values for the model's {} coordinates", s.size(), model.description().coordinate_count()));
-}
 
 void check_pair(const Model& model, const DependentPair& pair) {
   const Description& d = model.description();
@@ -120,8 +116,8 @@ double condition_number(const Eigen::MatrixXd& J) {
 
 void solve_dependent_rates(const Model& model, Data& data, const Eigen::VectorXd& s, Eigen::VectorXd& sdot,
                            const DependentPair& pair, const NonholonomicOptions& options) {
-  check_sizes(model, s, "s");
-  check_sizes(model, sdot, "sdot");
+  check_coordinate_count(model, s, "s");
+  check_coordinate_count(model, sdot, "sdot");
   check_pair(model, pair);
   void* w = data.workspace(model);
   data.set_coordinates(s);
@@ -134,16 +130,23 @@ void solve_dependent_rates(const Model& model, Data& data, const Eigen::VectorXd
   });
 }
 
-void solve_dependent_accelerations(const Model& model, Data& data, const Eigen::VectorXd& s, const Eigen::VectorXd& sdot,
-                                   Eigen::VectorXd& sddot, const DependentPair& pair) {
-  check_sizes(model, s, "s");
-  check_sizes(model, sdot, "sdot");
-  check_sizes(model, sddot, "sddot");
+namespace {
+// The convective terms at (s, sdot) in data, for an acceleration level.
+void convective_terms(const Model& model, Data& data, const Eigen::VectorXd& s, const Eigen::VectorXd& sdot, const DependentPair& pair) {
+  check_coordinate_count(model, s, "s");
+  check_coordinate_count(model, sdot, "sdot");
   check_pair(model, pair);
   void* w = data.workspace(model);
   data.set_coordinates(s);
   data.set_rates(sdot);
   model.code().convective(w);
+}
+}  // namespace
+
+void solve_dependent_accelerations(const Model& model, Data& data, const Eigen::VectorXd& s, const Eigen::VectorXd& sdot,
+                                   Eigen::VectorXd& sddot, const DependentPair& pair) {
+  check_coordinate_count(model, sddot, "sddot");
+  convective_terms(model, data, s, sdot, pair);
   with_rates(model, data, [&](auto& p) {
     for (int k : pair.index) sddot(k) = 0;
     rate_algorithms::solve_pair_and_closure<false>(p, pair, data.dPhi_ds_dot_sdot, data.C_dot_sdot, sddot);
@@ -152,13 +155,7 @@ void solve_dependent_accelerations(const Model& model, Data& data, const Eigen::
 
 void solve_bias_accelerations(const Model& model, Data& data, const Eigen::VectorXd& s, const Eigen::VectorXd& sdot,
                               Eigen::VectorXd& sddot, const DependentPair& pair) {
-  check_sizes(model, s, "s");
-  check_sizes(model, sdot, "sdot");
-  check_pair(model, pair);
-  void* w = data.workspace(model);
-  data.set_coordinates(s);
-  data.set_rates(sdot);
-  model.code().convective(w);
+  convective_terms(model, data, s, sdot, pair);
   sddot = Eigen::VectorXd::Zero(model.description().coordinate_count());
   with_rates(model, data, [&](auto& p) {
     rate_algorithms::solve_pair_and_closure<true>(p, pair, data.dPhi_ds_dot_sdot, data.C_dot_sdot, sddot);
